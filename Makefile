@@ -1,0 +1,41 @@
+# poppy — the two commands a new machine needs are `make run` and `make test`.
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+
+.PHONY: run test lint completions bench clean
+
+$(BIN)/activate:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+
+$(VENV)/.installed: pyproject.toml | $(BIN)/activate
+	$(BIN)/pip install --quiet -e .
+	touch $@
+
+$(VENV)/.installed-test: pyproject.toml | $(BIN)/activate
+	$(BIN)/pip install --quiet -e '.[test]'
+	touch $(VENV)/.installed $@
+
+run: $(VENV)/.installed
+	$(BIN)/poppy demo
+
+test: $(VENV)/.installed-test
+	$(BIN)/ruff check poppy_core poppy_cli tests bench
+	$(BIN)/mypy
+	$(BIN)/pytest
+
+lint: $(VENV)/.installed-test
+	$(BIN)/ruff check poppy_core poppy_cli tests bench
+	$(BIN)/mypy
+
+completions: $(VENV)/.installed
+	_POPPY_COMPLETE=source_bash $(BIN)/poppy > completions/poppy.bash
+	_POPPY_COMPLETE=source_zsh $(BIN)/poppy > completions/poppy.zsh
+	_POPPY_COMPLETE=source_fish $(BIN)/poppy > completions/poppy.fish
+
+bench: $(VENV)/.installed-test
+	$(BIN)/python -m bench
+
+clean:
+	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache

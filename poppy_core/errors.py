@@ -1,0 +1,113 @@
+"""Typed errors shared by every layer of poppy_core.
+
+The tree (catch the bases, raise the leaves)::
+
+    PoppyError
+    ├── BusError                  anything about a bus; carries ``port``
+    │   ├── PortError             the port cannot be opened (missing, busy, permission)
+    │   └── CommunicationError    a transaction failed on the wire
+    │       ├── BusTimeout        no (complete) status packet in time
+    │       └── CorruptPacketError  a status packet with a bad checksum/CRC or shape
+    ├── ProtocolError             bytes that do not make a valid packet / unsupported instruction
+    ├── MotorError                a motor answered with error bits; carries ``motor_id``, ``errors``
+    ├── UnknownModelError         a model number or name poppy does not know
+    ├── RegisterError             unknown register, read-only register, value out of range
+    ├── SetupError                a setup operation refused or could not be verified (ID taken, ...)
+    └── ConfigError               a bad robot config; carries ``file``, ``field``, ``reason``
+
+This module imports nothing of ours, so every layer (protocol included) may use it.
+"""
+
+from __future__ import annotations
+
+
+class PoppyError(Exception):
+    """Base of every error poppy raises on purpose."""
+
+
+class BusError(PoppyError):
+    """Something went wrong on a bus."""
+
+    def __init__(self, message: str, *, port: str | None = None) -> None:
+        super().__init__(message)
+        self.port = port
+
+
+class PortError(BusError):
+    """The serial port cannot be opened or used."""
+
+
+class CommunicationError(BusError):
+    """A transaction on the bus failed."""
+
+    def __init__(
+        self, message: str, *, port: str | None = None, motor_id: int | None = None
+    ) -> None:
+        super().__init__(message, port=port)
+        self.motor_id = motor_id
+
+
+class BusTimeout(CommunicationError):
+    """No complete status packet arrived before the deadline."""
+
+
+class CorruptPacketError(CommunicationError):
+    """A status packet arrived with a bad checksum/CRC or a wrong shape."""
+
+
+class ProtocolError(PoppyError):
+    """Bytes or arguments that do not make a valid Dynamixel packet."""
+
+
+class MotorError(PoppyError):
+    """A motor answered with error bits set in its status packet."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        motor_id: int,
+        errors: list[str] | None = None,
+        register: str | None = None,
+        port: str | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.motor_id = motor_id
+        self.errors = errors or []
+        self.register = register
+        self.port = port
+
+
+class UnknownModelError(PoppyError):
+    """A model number or model name that poppy does not know."""
+
+
+class RegisterError(PoppyError):
+    """An unknown register, a write to a read-only register, or a value out of range."""
+
+    def __init__(self, message: str, *, register: str | None = None) -> None:
+        super().__init__(message)
+        self.register = register
+
+
+class SetupError(PoppyError):
+    """A setup operation was refused or could not be verified."""
+
+
+class ConfigError(PoppyError):
+    """A robot configuration is invalid."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | None = None,
+        field: str | None = None,
+        value: object = None,
+        reason: str | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.file = file
+        self.field = field
+        self.value = value
+        self.reason = reason
