@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Create bench/.venv-peers with the peer libraries the benchmarks compare poppy against:
+# pypot (+ poppy-ergo-jr for the REST benchmark) and the Robotis dynamixel-sdk.
+# Idempotent and quiet: prints one summary line; pip output goes to .venv-peers/install.log
+# and is shown only when a step fails. Usage: bash bench/setup_peers.sh [--force]
+#
+# pypot declares heavy dependencies it never imports for the bus or REST paths
+# (opencv-contrib-python, matplotlib via hampy, requests, wget). So pypot, poppy-ergo-jr and
+# ikpy are installed with --no-deps and only what their imports need is added
+# (see bench/README.md, "Peers venv").
+set -euo pipefail
+
+HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+VENV="$HERE/.venv-peers"
+PYTHON="${PYTHON:-python3.11}"
+LOG="$VENV/install.log"
+
+# Exact peer versions, so results stay comparable between runs.
+PEERS_NODEPS=(pypot==5.0.2 poppy-ergo-jr==4.0.2 ikpy==3.0.1)
+CORE_DEPS=(dynamixel-sdk==4.1.0 "pyserial>=3.5" "numpy>=1.26")
+# Imported by pypot.creatures / pypot.server / poppy_ergo_jr (REST benchmark only).
+REST_DEPS=(scipy sympy tornado bottle opencv-python-headless)
+
+STAMP_TEXT="$PYTHON ${PEERS_NODEPS[*]} ${CORE_DEPS[*]} ${REST_DEPS[*]}"
+STAMP="$VENV/.installed"
+
+if [[ "${1:-}" != "--force" && -f "$STAMP" && "$(cat "$STAMP")" == "$STAMP_TEXT" ]]; then
+    exit 0
+fi
+
+fail() {
+    echo "setup_peers: $1 failed; log follows ($LOG)" >&2
+    tail -n 40 "$LOG" >&2
+    exit 1
+}
+
+if [[ ! -x "$VENV/bin/python" ]]; then
+    command -v "$PYTHON" >/dev/null || { echo "setup_peers: $PYTHON not found" >&2; exit 1; }
+    "$PYTHON" -m venv "$VENV"
+fi
+: >"$LOG"
+PIP=("$VENV/bin/python" -m pip --disable-pip-version-check)
+
+"${PIP[@]}" install --upgrade pip >>"$LOG" 2>&1 || fail "pip upgrade"
+"${PIP[@]}" install --no-deps "${PEERS_NODEPS[@]}" >>"$LOG" 2>&1 || fail "peer install"
+"${PIP[@]}" install "${CORE_DEPS[@]}" >>"$LOG" 2>&1 || fail "core deps"
+
+rest="yes"
+if ! "${PIP[@]}" install "${REST_DEPS[@]}" >>"$LOG" 2>&1; then
+    rest="no"
+    echo "setup_peers: REST deps failed to install; poppy-ergo-jr unusable (see $LOG)" >&2
+fi
+
+"$VENV/bin/python" - >>"$LOG" 2>&1 <<'PY' || fail "import check (scan)"
+import dynamixel_sdk, pypot.dynamixel, pypot.robot
+PY
+if [[ "$rest" == "yes" ]]; then
+    "$VENV/bin/python" - >>"$LOG" 2>&1 <<'PY' || { rest="no"; echo "setup_peers: poppy_ergo_jr import failed (see $LOG)" >&2; }
+# pypot.creatures must be imported first: importing poppy_ergo_jr first leaves the
+# creature registry empty (circular import inside pypot.creatures).
+import pypot.creatures, pypot.server.httpserver
+assert "poppy-ergo-jr" in pypot.creatures.installed_poppy_creatures
+PY
+fi
+
+if [[ "$rest" == "yes" ]]; then
+    echo "$STAMP_TEXT" >"$STAMP"
+fi
+versions="$("$VENV/bin/python" -c 'from importlib.metadata import version as v
+print(" ".join(f"{p}={v(p)}" for p in ("pypot", "dynamixel-sdk", "poppy-ergo-jr")))')"
+echo "setup_peers: $VENV ready ($versions, rest=$rest)"
