@@ -1,0 +1,1 @@
+"""poppy_cli: the `poppy` command line and terminal UI."""

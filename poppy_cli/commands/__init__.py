@@ -1,0 +1,1 @@
+"""The `poppy` command groups, one module each."""

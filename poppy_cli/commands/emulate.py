@@ -1,0 +1,132 @@
+"""`poppy emulate`: serve virtual Dynamixel motors on a pty or a TCP port until stopped."""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from typing import TYPE_CHECKING
+
+import typer
+
+from poppy_cli.output import EXIT_USAGE, err_console, error_line
+
+if TYPE_CHECKING:
+    from poppy_core.emulator import VirtualBus
+
+
+def profile_buses(name: str, baud: int | None, **options: object) -> list[tuple[str, VirtualBus]]:
+    """One virtual bus per controller of a robot profile, with the profile's motors on it."""
+    from poppy_core.emulator import build_bus_from_spec
+    from poppy_core.robot.profiles import load_profile
+
+    config = load_profile(name)
+    buses = []
+    for controller_name, controller in config.controllers.items():
+        motors = config.motors_of_controller(controller_name)
+        spec = ",".join(f"{config.motors[m].type}:{config.motors[m].id}" for m in motors)
+        buses.append(
+            (
+                controller_name,
+                build_bus_from_spec(
+                    spec,
+                    protocol=controller.protocol,
+                    baudrate=baud or controller.baudrate,
+                    **options,  # type: ignore[arg-type]
+                ),
+            )
+        )
+    return buses
+
+
+def parse_hostport(text: str) -> tuple[str, int]:
+    """Parse HOST:PORT (PORT 0 picks a free port)."""
+    host, sep, port_text = text.rpartition(":")
+    if not sep or not port_text.isdigit():
+        raise typer.BadParameter(f"{text!r} is not HOST:PORT, e.g. 127.0.0.1:4000")
+    return host or "127.0.0.1", int(port_text)
+
+
+def emulate(
+    profile: str | None = typer.Option(
+        None, "--profile", help="Robot profile: ergo-jr (6 XL-320, ids 1-6), torso, humanoid."
+    ),
+    motors: str | None = typer.Option(
+        None, "--motors", help="Models and IDs, e.g. MX-28:11-15,AX-12A:36-37."
+    ),
+    protocol: int | None = typer.Option(
+        None, "--protocol", min=1, max=2, help="Protocol (default: the models')."
+    ),
+    baud: int | None = typer.Option(None, "--baud", "-b", help="Baud rate (default 1000000)."),
+    pty: bool = typer.Option(False, "--pty", help="Serve on a pseudo-terminal (the default)."),
+    tcp: str | None = typer.Option(
+        None, "--tcp", help="Serve on TCP HOST:PORT instead (port 0: any free port)."
+    ),
+    wire_timing: bool = typer.Option(
+        False, "--wire-timing", help="Delay replies as a real wire does (10 bits/byte)."
+    ),
+    latency_ms: float = typer.Option(
+        0.0, "--latency-ms", min=0.0, help="Adapter (USB) latency added to replies, in ms."
+    ),
+    usb2ax: bool = typer.Option(
+        False, "--usb2ax", help="Act as a USB2AX adapter (answers protocol 1 SYNC_READ 0x84)."
+    ),
+) -> None:
+    """Serve virtual motors: print the pty path (or socket:// URL), then serve until Ctrl-C."""
+    from poppy_core.emulator import build_bus_from_spec, serve_pty, serve_tcp
+
+    if (profile is None) == (motors is None):
+        error_line("give either --profile NAME or --motors MODEL:IDS (e.g. --motors XL-320:1-6)")
+        raise typer.Exit(EXIT_USAGE)
+    if pty and tcp:
+        error_line("give either --pty or --tcp, not both")
+        raise typer.Exit(EXIT_USAGE)
+    options: dict[str, object] = {
+        "wire_timing": wire_timing,
+        "latency_s": latency_ms / 1000.0,
+        "adapter": "usb2ax" if usb2ax else "u2d2",
+    }
+    if profile is not None:
+        buses = profile_buses(profile, baud, **options)
+        if protocol is not None and any(b.protocol != protocol for _, b in buses):
+            error_line(f"profile {profile} speaks protocol {buses[0][1].protocol}, not {protocol}")
+            raise typer.Exit(EXIT_USAGE)
+    else:
+        assert motors is not None
+        buses = [
+            (
+                "bus",
+                build_bus_from_spec(
+                    motors, protocol=protocol, baudrate=baud or 1_000_000, **options
+                ),
+            )  # type: ignore[arg-type]
+        ]
+    hostport = parse_hostport(tcp) if tcp else None
+    # Handlers go in before the URL is printed: a client may stop us as soon as it reads it.
+    stop = threading.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: stop.set())
+    servers = []
+    try:
+        for index, (_name, bus) in enumerate(buses):
+            if hostport is None:
+                servers.append(serve_pty(bus))
+            else:
+                host, port = hostport
+                servers.append(serve_tcp(bus, host, port + index if port else 0))
+        for server in servers:
+            sys.stdout.write(server.url + "\n")
+        sys.stdout.flush()
+        for (name, bus), server in zip(buses, servers, strict=True):
+            ids = ", ".join(str(m.id) for m in bus.motors)
+            err_console.print(
+                f"[green]serving[/] {name}: {len(bus.motors)} {bus.motors[0].model.name}"
+                f"{'…' if len({m.model.name for m in bus.motors}) > 1 else ''} "
+                f"(ids {ids}) protocol {bus.protocol} at {bus.baudrate} bps on {server.url}"
+                " — Ctrl-C to stop"
+            )
+        while not stop.wait(0.5):
+            pass
+    finally:
+        for server in servers:
+            server.stop()

@@ -1,0 +1,243 @@
+"""`poppy motor ...`: read, write and set up one motor (or a few) on a bus, in SI units."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import typer
+
+from poppy_cli.connect import open_bus, ping_model
+from poppy_cli.options import BAUD_HELP, PORT_HELP, PROTOCOL_HELP, default_port, parse_ids
+from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json
+
+if TYPE_CHECKING:
+    from poppy_core.bus.results import SetupResult
+    from poppy_core.models import Register
+
+app = typer.Typer(
+    help="Read, write and set up motors: IDs, baud rates, limits, torque, LED, reset.",
+    no_args_is_help=True,
+)
+
+PortOpt = typer.Option(None, "--port", "-p", help=PORT_HELP)
+BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP)
+ProtoOpt = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2)
+JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
+
+
+def require_port(port: str | None) -> str:
+    chosen = default_port(port)
+    if not chosen:
+        error_line("no port given: pass --port (see `poppy ports`) or set POPPY_PORT")
+        raise typer.Exit(EXIT_USAGE)
+    return chosen
+
+
+def parse_value(register: Register, text: str) -> object:
+    """Turn command-line text into the SI value ``register.from_si`` expects."""
+    from poppy_core.models.register import Boolean, Choice
+
+    conversion = register.conversion
+    lowered = text.strip().lower()
+    if isinstance(conversion, Boolean):
+        if lowered in ("on", "true", "1", "yes"):
+            return True
+        if lowered in ("off", "false", "0", "no"):
+            return False
+        raise typer.BadParameter(f"{register.name} takes on or off, not {text!r}")
+    if isinstance(conversion, Choice):
+        try:
+            return int(lowered)
+        except ValueError:
+            return lowered
+    try:
+        number = float(text)
+    except ValueError:
+        raise typer.BadParameter(
+            f"{register.name} takes a number in {register.unit or 'raw units'}, not {text!r}"
+        ) from None
+    return int(number) if number.is_integer() else number
+
+
+def print_setup(result: SetupResult, json_output: bool) -> None:
+    if json_output:
+        print_json(
+            {
+                "operation": result.operation,
+                "port": result.port,
+                "id": result.motor_id,
+                "baud": result.baudrate,
+                "protocol": result.protocol,
+                "changes": {k: list(v) for k, v in result.changes.items()},
+                "verified": result.verified,
+                "notes": result.notes,
+            }
+        )
+        return
+    for name, (old, new) in result.changes.items():
+        console.print(f"{name}: {fmt_value(old)} → [bold]{fmt_value(new)}[/]")
+    for note in result.notes:
+        console.print(f"[dim]{note}[/]")
+    check = "[green]verified[/]" if result.verified else "[yellow]not verified[/]"
+    console.print(
+        f"motor {result.motor_id} on {result.port} at {result.baudrate} bps "
+        f"(protocol {result.protocol}): {check}"
+    )
+
+
+@app.command("info")
+def info(
+    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Show a motor's model and its whole control table in SI units."""
+    from rich.table import Table
+
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        result = ping_model(bus, motor_id)
+        model = result.model
+        assert model is not None
+        raw = bus.read(motor_id, 0, model.table_size)
+    rows = []
+    for reg in sorted(model.registers.values(), key=lambda r: r.address):
+        value = reg.to_si(reg.decode(raw[reg.address : reg.address + reg.size]))
+        rows.append((reg, value))
+    if json_output:
+        print_json(
+            {
+                "id": motor_id,
+                "model": model.name,
+                "model_number": result.model_number,
+                "firmware": result.firmware,
+                "port": bus.port,
+                "baud": bus.baudrate,
+                "protocol": bus.protocol,
+                "registers": {
+                    reg.name: {
+                        "value": value,
+                        "unit": reg.unit,
+                        "address": reg.address,
+                        "access": reg.access,
+                        "memory": reg.memory,
+                    }
+                    for reg, value in rows
+                },
+            }
+        )
+        return
+    table = Table(
+        title=f"motor {motor_id}: {model.name} (firmware {result.firmware}) "
+        f"on {bus.port} at {bus.baudrate} bps, protocol {bus.protocol}"
+    )
+    for column in ("address", "register", "value", "access", "memory"):
+        table.add_column(column, justify="right" if column == "address" else "left")
+    for reg, value in rows:
+        access = "read-only" if not reg.writable else "rw"
+        table.add_row(str(reg.address), reg.name, fmt_value(value, reg.unit), access, reg.memory)
+    console.print(table)
+
+
+@app.command("get")
+def get(
+    ids: str = typer.Argument(..., help="Motor ID(s): 11, or 1-6, or 1,3,5."),
+    registers: list[str] = typer.Argument(..., help="Register name(s), e.g. present_position."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Read registers in SI units: `poppy motor get 11 present_position` prints degrees."""
+    id_list = parse_ids(ids)
+    values: dict[int, dict[str, object]] = {}
+    units: dict[str, str] = {}
+    with open_bus(require_port(port), id_list, baud, protocol) as bus:
+        for motor_id in id_list:
+            model = ping_model(bus, motor_id).model
+            assert model is not None
+            values[motor_id] = {}
+            for name in registers:
+                reg = model.register(name)
+                units[name] = reg.unit
+                values[motor_id][name] = bus.read_register(motor_id, model, name)
+    if json_output:
+        print_json(values if len(id_list) > 1 else values[id_list[0]])
+        return
+    if len(id_list) == 1 and len(registers) == 1:
+        console.print(fmt_value(values[id_list[0]][registers[0]], units[registers[0]]))
+        return
+    from rich.table import Table
+
+    table = Table()
+    table.add_column("id", justify="right")
+    for name in registers:
+        table.add_column(name)
+    for motor_id, row in values.items():
+        table.add_row(str(motor_id), *(fmt_value(row[n], units[n]) for n in registers))
+    console.print(table)
+
+
+@app.command("set")
+def set_register(
+    ids: str = typer.Argument(..., help="Motor ID(s): 11, or 1-6, or 1,3,5."),
+    register: str = typer.Argument(..., help="Register name, e.g. goal_position."),
+    value: str = typer.Argument(..., help="Value in SI units (degrees, deg/s, %, on/off...)."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+) -> None:
+    """Write one register in SI units, e.g. `poppy motor set 11 goal_position 30`."""
+    from poppy_core.errors import RegisterError
+
+    id_list = parse_ids(ids)
+    if register in ("id", "baudrate"):
+        command = "set-id" if register == "id" else "set-baudrate"
+        raise RegisterError(
+            f"{register} is changed with `poppy motor {command}`, which verifies the motor "
+            "still answers afterwards",
+            register=register,
+        )
+    with open_bus(require_port(port), id_list, baud, protocol) as bus:
+        for motor_id in id_list:
+            model = ping_model(bus, motor_id).model
+            assert model is not None
+            reg = model.register(register)
+            if not reg.writable:
+                raise RegisterError(
+                    f"{reg.name} is read-only on the {model.name}", register=reg.name
+                )
+            bus.write_register(motor_id, model, reg.name, parse_value(reg, value))
+            written = bus.read_register(motor_id, model, reg.name)
+            console.print(f"motor {motor_id}: {reg.name} = {fmt_value(written, reg.unit)}")
+
+
+def _toggle(
+    ids: str, register: str, state: str, port: str | None, baud: int | None, protocol: int | None
+) -> None:
+    set_register(ids, register, state, port, baud, protocol)
+
+
+@app.command("torque")
+def torque(
+    ids: str = typer.Argument(..., help="Motor ID(s)."),
+    state: str = typer.Argument(..., help="on or off."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+) -> None:
+    """Turn torque on (stiff) or off (compliant)."""
+    _toggle(ids, "torque_enable", state, port, baud, protocol)
+
+
+@app.command("led")
+def led(
+    ids: str = typer.Argument(..., help="Motor ID(s)."),
+    state: str = typer.Argument(..., help="on/off, or a colour on the XL-320 (red, green, ...)."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+) -> None:
+    """Switch the LED on or off (or pick its colour on an XL-320)."""
+    _toggle(ids, "led", state, port, baud, protocol)

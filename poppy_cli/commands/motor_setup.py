@@ -1,0 +1,202 @@
+"""`poppy motor set-id|set-baudrate|set-return-delay|angle-limits|reset|reboot|factory-reset`."""
+
+from __future__ import annotations
+
+import typer
+
+from poppy_cli.commands.motor import (
+    BaudOpt,
+    JsonOpt,
+    PortOpt,
+    ProtoOpt,
+    app,
+    print_setup,
+    require_port,
+)
+
+__all__ = ["app"]
+from poppy_cli.connect import open_bus
+from poppy_cli.output import EXIT_USAGE, console, error_line
+
+
+def _say(message: str) -> None:
+    console.print(f"[dim]· {message}[/]")
+
+
+@app.command("set-id")
+def set_id(
+    motor_id: int = typer.Argument(..., help="Current ID.", min=0, max=253),
+    new_id: int = typer.Argument(..., help="New ID.", min=0, max=253),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Give a motor a new ID (refused if the ID is taken; verified afterwards)."""
+    from poppy_core.bus.setup import change_id
+
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        result = change_id(bus, motor_id, new_id, progress=None if json_output else _say)
+    print_setup(result, json_output)
+
+
+@app.command("set-baudrate")
+def set_baudrate(
+    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    rate: int = typer.Argument(..., help="New baud rate in bps, e.g. 1000000."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Change a motor's baud rate; it is checked at the new rate (and found again if lost)."""
+    from poppy_core.bus.setup import change_baudrate
+
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        result = change_baudrate(bus, motor_id, rate, progress=None if json_output else _say)
+    print_setup(result, json_output)
+
+
+@app.command("set-return-delay")
+def set_return_delay(
+    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    delay_us: float = typer.Argument(..., help="Return delay in µs (0 for a fast bus)."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Set the return delay time (µs); Poppy robots use 0."""
+    from poppy_core.bus.setup import set_return_delay as run
+
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        result = run(bus, motor_id, delay_us, progress=None if json_output else _say)
+    print_setup(result, json_output)
+
+
+@app.command("angle-limits")
+def angle_limits(
+    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    min_deg: float | None = typer.Argument(None, help="Lower limit in degrees."),
+    max_deg: float | None = typer.Argument(None, help="Upper limit in degrees."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Show the angle limits, or set them: `poppy motor angle-limits 3 -- -90 90`."""
+    from poppy_cli.connect import ping_model
+    from poppy_cli.output import fmt_value, print_json
+    from poppy_core.bus.setup import set_angle_limits
+
+    if (min_deg is None) != (max_deg is None):
+        error_line("give both limits (MIN MAX), or none to read them")
+        raise typer.Exit(EXIT_USAGE)
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        if min_deg is None or max_deg is None:
+            model = ping_model(bus, motor_id).model
+            assert model is not None
+            low = bus.read_register(motor_id, model, "min_position_limit")
+            high = bus.read_register(motor_id, model, "max_position_limit")
+            if json_output:
+                print_json({"id": motor_id, "min": low, "max": high})
+            else:
+                console.print(
+                    f"motor {motor_id}: {fmt_value(low, 'deg')} .. {fmt_value(high, 'deg')}"
+                )
+            return
+        result = set_angle_limits(
+            bus, motor_id, min_deg, max_deg, progress=None if json_output else _say
+        )
+    print_setup(result, json_output)
+
+
+@app.command("reboot")
+def reboot(
+    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Reboot a motor (clears a hardware alarm) and wait until it answers again."""
+    from poppy_core.bus.setup import reboot as run
+
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        result = run(bus, motor_id, progress=None if json_output else _say)
+    print_setup(result, json_output)
+
+
+@app.command("factory-reset")
+def factory_reset(
+    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    reset_id: bool = typer.Option(
+        False, "--reset-id", help="Also reset the ID to the factory one."
+    ),
+    reset_baudrate: bool = typer.Option(
+        False, "--reset-baudrate", help="Also reset the baud rate to the factory one."
+    ),
+    yes: bool = typer.Option(False, "--yes", "-y", help="Do not ask for confirmation."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Restore the factory control table (keeps ID and baud rate unless told otherwise)."""
+    from poppy_core.bus.setup import factory_reset as run
+
+    if not yes and not typer.confirm(
+        f"Reset motor {motor_id} to its factory settings?", default=False
+    ):
+        error_line("factory reset cancelled")
+        raise typer.Exit(EXIT_USAGE)
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        result = run(
+            bus,
+            motor_id,
+            keep_id=not reset_id,
+            keep_baudrate=not reset_baudrate,
+            progress=None if json_output else _say,
+        )
+    print_setup(result, json_output)
+
+
+@app.command("reset")
+def reset(
+    motor_id: int = typer.Argument(..., help="Current motor ID (a new motor is ID 1)."),
+    target_id: int = typer.Argument(..., help="The ID the motor must have.", min=0, max=253),
+    model: str | None = typer.Option(
+        None, "--model", help="Expected model (e.g. MX-28); refused if the motor differs."
+    ),
+    rate: int = typer.Option(1_000_000, "--rate", help="Baud rate to set (Poppy: 1000000)."),
+    limits: str | None = typer.Option(
+        None, "--angle-limits", help="Angle limits MIN,MAX in degrees, e.g. -150,150."
+    ),
+    zero: bool = typer.Option(False, "--zero", help="Move the motor to 0° afterwards."),
+    port: str | None = PortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Prepare a motor for a Poppy robot (the old poppy-reset-motor): ID, 1 Mbps, delay 0."""
+    from poppy_core.bus.setup import reset_motor
+
+    angle_limits = None
+    if limits is not None:
+        try:
+            low, high = (float(v) for v in limits.split(","))
+        except ValueError:
+            raise typer.BadParameter(f"{limits!r} is not MIN,MAX, e.g. -150,150") from None
+        angle_limits = (low, high)
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        result = reset_motor(
+            bus,
+            motor_id,
+            target_id=target_id,
+            model=model,
+            baudrate=rate,
+            angle_limits=angle_limits,
+            go_to_zero=zero,
+            progress=None if json_output else _say,
+        )
+    print_setup(result, json_output)

@@ -1,0 +1,68 @@
+"""Entry point of `poppy`: composes the command groups and turns errors into one line."""
+
+from __future__ import annotations
+
+import logging
+import sys
+
+import typer
+
+from poppy_cli import state
+from poppy_cli.commands import demo, emulate, motor_setup, ports, scan
+from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, error_line
+
+app = typer.Typer(
+    name="poppy",
+    help="Set up, drive, simulate and serve robots built from Dynamixel servos.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    rich_markup_mode="rich",
+)
+
+
+@app.callback()
+def _root(
+    debug: bool = typer.Option(False, "--debug", help="Show tracebacks and debug logs."),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="Show info logs."),
+) -> None:
+    state.debug = debug
+    if debug or verbose:
+        logging.basicConfig(
+            level=logging.DEBUG if debug else logging.INFO,
+            format="%(asctime)s %(name)s %(levelname)s: %(message)s",
+        )
+
+
+app.command("ports")(ports.ports)
+app.command("scan")(scan.scan)
+# motor_setup adds the setup commands to the `poppy motor` group defined in commands/motor.py.
+app.add_typer(motor_setup.app, name="motor")
+app.command("emulate")(emulate.emulate)
+app.command("demo")(demo.demo)
+
+
+def main() -> None:
+    """Run the CLI; a PoppyError becomes one line on stderr and exit code 1."""
+    from poppy_core.errors import PoppyError
+
+    try:
+        app()
+    except PoppyError as exc:
+        if state.debug:
+            raise
+        error_line(str(exc))
+        sys.exit(EXIT_FAILURE)
+    except KeyboardInterrupt:
+        if state.debug:
+            raise
+        error_line("interrupted")
+        sys.exit(EXIT_INTERRUPTED)
+    except Exception as exc:  # a bug: still one line unless --debug
+        if state.debug:
+            raise
+        error_line(f"unexpected {type(exc).__name__}: {exc} (run with --debug for the traceback)")
+        sys.exit(EXIT_FAILURE)
+
+
+if __name__ == "__main__":
+    main()

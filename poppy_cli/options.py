@@ -1,0 +1,59 @@
+"""Option parsers shared by commands: ID ranges, baud rates, protocols, bus selection."""
+
+from __future__ import annotations
+
+import os
+
+import typer
+
+
+def parse_ids(text: str) -> list[int]:
+    """Parse "0-253", "1,2,5-7" into a sorted list of IDs in 0..253."""
+    ids: set[int] = set()
+    for part in text.replace(" ", "").split(","):
+        if not part:
+            continue
+        try:
+            if "-" in part:
+                lo_text, hi_text = part.split("-", 1)
+                lo, hi = int(lo_text), int(hi_text)
+                if lo > hi:
+                    raise typer.BadParameter(
+                        f"range {part!r} goes backwards; write it as {hi}-{lo}"
+                    )
+                ids.update(range(lo, hi + 1))
+            else:
+                ids.add(int(part))
+        except ValueError:
+            raise typer.BadParameter(
+                f"{part!r} is not an ID or a range; use e.g. 1-6 or 1,3,11-15"
+            ) from None
+    bad = sorted(i for i in ids if not 0 <= i <= 253)
+    if bad:
+        raise typer.BadParameter(f"ID {bad[0]} is out of range; Dynamixel IDs are 0-253")
+    if not ids:
+        raise typer.BadParameter("no ID given; use e.g. 0-253 or 1,2,3")
+    return sorted(ids)
+
+
+def parse_protocols(text: str) -> list[int]:
+    """Parse "1", "2" or "both"."""
+    value = text.strip().lower()
+    if value == "both":
+        return [1, 2]
+    if value in ("1", "2", "1.0", "2.0"):
+        return [int(float(value))]
+    raise typer.BadParameter(f"protocol {text!r} is not 1, 2 or both")
+
+
+def default_port(port: str | None) -> str | None:
+    """The port given, or POPPY_PORT from the environment."""
+    return port or os.environ.get("POPPY_PORT") or None
+
+
+PORT_HELP = (
+    "Serial port: a device (/dev/ttyUSB0), a pty, or a URL (socket://127.0.0.1:4000)."
+    " [env: POPPY_PORT]"
+)
+BAUD_HELP = "Baud rate in bps (default: search the standard rates)."
+PROTOCOL_HELP = "Dynamixel protocol: 1 or 2 (default: search both)."

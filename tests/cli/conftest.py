@@ -1,0 +1,95 @@
+"""Fixtures: `poppy` run as a subprocess against `poppy emulate` processes."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import pytest
+
+POPPY = [sys.executable, "-m", "poppy_cli"]
+
+
+@dataclass
+class Result:
+    """What a `poppy` run printed and returned."""
+
+    code: int
+    stdout: str
+    stderr: str
+
+    def json(self) -> Any:
+        return json.loads(self.stdout)
+
+
+def run_poppy(*args: str, timeout: float = 60, input: str | None = None) -> Result:
+    """Run `poppy ARGS...` and capture its output."""
+    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    proc = subprocess.run(
+        [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=env, input=input
+    )
+    return Result(proc.returncode, proc.stdout, proc.stderr)
+
+
+class Emulator:
+    """A `poppy emulate` process; `url` is the first line it printed."""
+
+    def __init__(self, *args: str) -> None:
+        self.proc = subprocess.Popen(
+            [*POPPY, "emulate", *args],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert self.proc.stdout is not None
+        line = self.proc.stdout.readline().strip()
+        if not line:
+            raise RuntimeError(f"poppy emulate printed nothing: {self.proc.stderr.read()}")
+        self.url = line
+
+    def stop(self, signum: int = signal.SIGINT) -> int:
+        if self.proc.poll() is None:
+            self.proc.send_signal(signum)
+        code = self.proc.wait(timeout=10)
+        for stream in (self.proc.stdout, self.proc.stderr):
+            if stream is not None:
+                stream.close()
+        return code
+
+
+@pytest.fixture
+def poppy() -> Any:
+    """Run `poppy ARGS...` as a subprocess: ``poppy("scan", "--json")``."""
+    return run_poppy
+
+
+@pytest.fixture
+def emulator_factory() -> Iterator[Any]:
+    started: list[Emulator] = []
+
+    def start(*args: str) -> Emulator:
+        emulator = Emulator(*args)
+        started.append(emulator)
+        return emulator
+
+    yield start
+    for emulator in started:
+        emulator.stop()
+
+
+@pytest.fixture
+def ergo_jr(emulator_factory: Any) -> Emulator:
+    """A virtual Ergo Jr bus (six XL-320, ids 1-6, protocol 2, 1 Mbps) in its own process."""
+    return emulator_factory("--profile", "ergo-jr")  # type: ignore[no-any-return]
+
+
+@pytest.fixture
+def mx_bus(emulator_factory: Any) -> Emulator:
+    """Three MX-28 (ids 11-13) and one AX-12A (36), protocol 1, 1 Mbps."""
+    return emulator_factory("--motors", "MX-28:11-13,AX-12A:36")  # type: ignore[no-any-return]
