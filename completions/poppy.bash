@@ -1,0 +1,12 @@
+
+_poppy_completion() {
+    local IFS=$'
+'
+    COMPREPLY=( $( env COMP_WORDS="${COMP_WORDS[*]}" \
+                   COMP_CWORD=$COMP_CWORD \
+                   _POPPY_COMPLETE=complete_bash $1 ) )
+    return 0
+}
+
+complete -o default -F _poppy_completion poppy
+

@@ -1,0 +1,1 @@
+complete --command poppy --no-files --arguments "(env _POPPY_COMPLETE=complete_fish _TYPER_COMPLETE_FISH_ACTION=get-args _TYPER_COMPLETE_ARGS=(commandline -cp) poppy)" --condition "env _POPPY_COMPLETE=complete_fish _TYPER_COMPLETE_FISH_ACTION=is-args _TYPER_COMPLETE_ARGS=(commandline -cp) poppy"
