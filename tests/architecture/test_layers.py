@@ -1,0 +1,89 @@
+"""The house plan holds: rooms import only the rooms below them, and start-up stays light."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+# room -> rooms of ours it may import (ARCHITECTURE.md); `errors` is a leaf every room may use.
+ALLOWED: dict[str, set[str]] = {
+    "protocol": set(),
+    "models": {"protocol"},
+    "bus": {"protocol", "models"},
+    "emulator": {"protocol", "models"},
+    "robot": {"bus", "models", "emulator", "protocol", "motion"},
+    "motion": {"robot", "models"},
+    "creatures": {"robot", "motion", "models"},
+    "kinematics": set(),
+    "server": {"robot", "motion", "models"},
+}
+# robot may import motion.trajectory only: a leaf of pure maths shared by Motor.goto_position.
+LEAF_EXCEPTIONS = {("robot", "poppy_core.motion.trajectory"), ("robot", "poppy_core.motion")}
+
+
+def _imports(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module)
+    return names
+
+
+def test_rooms_import_only_downwards() -> None:
+    bad = []
+    for room, allowed in ALLOWED.items():
+        for path in sorted((ROOT / "poppy_core" / room).rglob("*.py")):
+            for name in _imports(path):
+                parts = name.split(".")
+                if parts[0] == "poppy_cli":
+                    bad.append(f"{path.relative_to(ROOT)} imports {name}")
+                if parts[0] != "poppy_core" or len(parts) < 2:
+                    continue
+                target = parts[1]
+                if target in (room, "errors") or target in allowed:
+                    continue
+                if (room, name) in LEAF_EXCEPTIONS:
+                    continue
+                bad.append(f"{path.relative_to(ROOT)} imports {name}")
+    assert bad == []
+
+
+def _loaded_after(code: str) -> set[str]:
+    out = subprocess.run(
+        [sys.executable, "-c", code + "\nimport sys\nprint('\\n'.join(sys.modules))"],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+    ).stdout
+    return {line.split(".")[0] for line in out.splitlines()}
+
+
+def test_core_loads_no_ui_or_server_library() -> None:
+    loaded = _loaded_after(
+        "import poppy_core.protocol, poppy_core.models, poppy_core.bus.scan, "
+        "poppy_core.emulator, poppy_core.robot"
+    )
+    assert not loaded & {"typer", "rich", "textual", "fastapi", "uvicorn", "mujoco", "matplotlib"}
+
+
+def test_cli_start_up_is_lazy() -> None:
+    loaded = _loaded_after("import poppy_cli.main")
+    assert not loaded & {"textual", "fastapi", "uvicorn", "mujoco", "matplotlib", "serial"}
+    assert "poppy_core" not in loaded or not {"numpy"} & loaded
+
+
+def test_help_does_not_import_heavy_libraries() -> None:
+    code = (
+        "import sys\nfrom poppy_cli.main import app\n"
+        "try:\n    app(['--help'])\nexcept SystemExit:\n    pass\n"
+    )
+    loaded = _loaded_after(code)
+    assert not loaded & {"textual", "fastapi", "uvicorn", "mujoco", "matplotlib"}
