@@ -1,0 +1,65 @@
+"""Bus layer: transports, ``DxlBus`` transactions, port listing, scanning and motor setup."""
+
+from poppy_core.bus.core import is_alarm_only
+from poppy_core.bus.dxlbus import DxlBus
+from poppy_core.bus.ports import (
+    KNOWN_ADAPTERS,
+    PortInfo,
+    describe_ports,
+    latency_advice,
+    list_ports,
+    port_info,
+    read_ftdi_latency_ms,
+    recognise_adapter,
+)
+from poppy_core.bus.results import BusStats, FoundMotor, PingResult, ScanProgress, SetupResult
+from poppy_core.bus.scan import find_port, scan
+from poppy_core.bus.setup import (
+    change_baudrate,
+    change_id,
+    identify,
+    locate,
+    reboot,
+    set_angle_limits,
+    set_return_delay,
+    wait_for_answer,
+)
+from poppy_core.bus.setup_reset import factory_reset, reset_motor
+from poppy_core.bus.timing import Deadline, LinkTiming, default_latency_s, is_virtual_port
+from poppy_core.bus.transport import Transport, port_error
+
+__all__ = [
+    "KNOWN_ADAPTERS",
+    "BusStats",
+    "Deadline",
+    "DxlBus",
+    "FoundMotor",
+    "LinkTiming",
+    "PingResult",
+    "PortInfo",
+    "ScanProgress",
+    "SetupResult",
+    "Transport",
+    "change_baudrate",
+    "change_id",
+    "default_latency_s",
+    "describe_ports",
+    "factory_reset",
+    "find_port",
+    "identify",
+    "is_alarm_only",
+    "is_virtual_port",
+    "latency_advice",
+    "list_ports",
+    "locate",
+    "port_error",
+    "port_info",
+    "read_ftdi_latency_ms",
+    "reboot",
+    "recognise_adapter",
+    "reset_motor",
+    "scan",
+    "set_angle_limits",
+    "set_return_delay",
+    "wait_for_answer",
+]

@@ -1,0 +1,340 @@
+"""The transaction engine under ``DxlBus``: lock, physical deadlines, retries, error bits, counters.
+
+Error bits policy (decided here, relied upon above):
+
+* *Alarm* bits report the motor's state, not a refused instruction: protocol 1 input voltage,
+  overheating and overload; protocol 2 the hardware alert bit (bit 7) with no error number. The
+  instruction was executed, so the data is returned (or the write counted as done); the alarm is
+  logged once when it appears, counted in ``stats.alarms`` and kept in ``bus.alarms[id]``.
+* Any other bit (protocol 1 angle limit, range, checksum, instruction; protocol 2 error numbers)
+  means the instruction was refused: ``MotorError`` is raised, naming the motor and the bits.
+* ``ping`` never raises ``MotorError``: any valid reply proves the motor is there.
+
+Retries: a timeout or a corrupt reply is retried ``retries`` times (``MotorError`` never is).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections import deque
+from collections.abc import Sequence
+from types import TracebackType
+
+from poppy_core.bus.results import BusStats
+from poppy_core.bus.timing import (
+    DEFAULT_RETURN_DELAY_S,
+    Deadline,
+    LinkTiming,
+    default_latency_s,
+    status_size,
+)
+from poppy_core.bus.transport import Transport
+from poppy_core.errors import BusTimeout, CorruptPacketError, MotorError, ProtocolError
+from poppy_core.protocol import InstructionPacket, StatusPacket, decode_errors, encode_instruction
+
+logger = logging.getLogger(__name__)
+
+# e-manual (Protocol 1.0 status packet): bit 0 input voltage, bit 2 overheating, bit 5 overload.
+V1_ALARM_MASK = 0x01 | 0x04 | 0x20
+# e-manual (Protocol 2.0 status packet): bit 7 is the hardware alert flag, bits 0-6 the error.
+V2_ALERT_BIT = 0x80
+V2_ERROR_NUMBER_MASK = 0x7F
+
+
+def is_alarm_only(protocol: int, error: int) -> bool:
+    """True when ``error`` carries only alarm bits (the instruction was still executed)."""
+    if error == 0:
+        return False
+    if protocol == 1:
+        return error & ~V1_ALARM_MASK & 0xFF == 0
+    return error & V2_ERROR_NUMBER_MASK == 0
+
+
+class BusCore:
+    """One Dynamixel bus: a port, a baud rate, a protocol, and one lock for every transaction.
+
+    Timeouts come from ``LinkTiming`` (baud rate, packet sizes, return delay, adapter latency);
+    see ``poppy_core.bus.timing``. ``latency_s=None`` picks the adapter latency from the port
+    (FTDI latency timer from sysfs, 2 ms for other devices, 1 ms for ptys and URLs).
+
+    Attributes:
+        retries: extra attempts after a timeout or a corrupt reply.
+        stats: counters (``BusStats``).
+        timeout_s: fixed reply timeout, None to compute it from the link timing.
+        sync_read_enabled: the ``sync_read`` argument (True, False or None for auto).
+        sync_read_mode: how ``sync_read`` reads: ``"sync"``, ``"bulk"``, ``"sequential"``, or
+            None until found out.
+        usb2ax: whether the adapter answers the USB2AX sync read (None until tried).
+        alarms: motor ID -> alarm names from its last status packet (empty list once cleared).
+    """
+
+    def __init__(
+        self,
+        port: str,
+        baudrate: int = 1_000_000,
+        protocol: int = 1,
+        *,
+        latency_s: float | None = None,
+        retries: int = 1,
+        return_delay_s: float = DEFAULT_RETURN_DELAY_S,
+        sync_read: bool | None = None,
+        transport: Transport | None = None,
+        timeout_s: float | None = None,
+    ) -> None:
+        """Open a bus.
+
+        Args:
+            port: device path or pyserial URL (``socket://host:port``, ``loop://``).
+            baudrate: line speed in bit/s.
+            protocol: Dynamixel protocol, 1 or 2.
+            latency_s: adapter latency; None picks it from the port (see above).
+            retries: extra attempts after a timeout or a corrupt reply.
+            return_delay_s: the motors' return delay assumed in timeouts (factory 500 µs).
+            sync_read: use the sync read instruction (protocol 2 SYNC_READ, protocol 1 USB2AX
+                0x84): True forces it, False never uses it, None tries it once and remembers.
+            timeout_s: a fixed reply timeout replacing the physical estimate (for odd bridges;
+                None, the default, computes it per transaction).
+            transport: an open ``Transport`` to use instead of opening ``port``; the bus then
+                sets its baud rate and protocol but does not close it.
+
+        Raises:
+            PortError: the port cannot be opened.
+            ProtocolError: ``protocol`` is not 1 or 2.
+        """
+        if protocol not in (1, 2):
+            raise ProtocolError(f"protocol must be 1 or 2, not {protocol}")
+        self._protocol = protocol
+        self._owns_transport = transport is None
+        if transport is None:
+            transport = Transport(port, baudrate, protocol)
+        else:
+            transport.protocol = protocol
+            if transport.baudrate != baudrate:
+                transport.set_baudrate(baudrate)
+        self._transport = transport
+        self._port = port
+        self._lock = threading.RLock()
+        self._latency_s = default_latency_s(port) if latency_s is None else latency_s
+        self._timing = LinkTiming(baudrate, return_delay_s, self._latency_s)
+        self.retries = retries
+        self.timeout_s = timeout_s
+        self.stats = BusStats()
+        self.alarms: dict[int, list[str]] = {}
+        self._strays: deque[StatusPacket] = deque(maxlen=256)
+        self.sync_read_enabled = sync_read
+        self.sync_read_mode: str | None = None
+        self.usb2ax: bool | None = None
+        logger.debug(
+            "bus %s: %d bps, protocol %d, latency %.1f ms",
+            port,
+            baudrate,
+            protocol,
+            self._latency_s * 1000,
+        )
+
+    # -- properties --------------------------------------------------------------------------
+
+    @property
+    def port(self) -> str:
+        """The device path or URL."""
+        return self._port
+
+    @property
+    def protocol(self) -> int:
+        """Dynamixel protocol (1 or 2)."""
+        return self._protocol
+
+    @property
+    def baudrate(self) -> int:
+        """Line speed in bit/s; setting it reconfigures the port."""
+        return self._timing.baudrate
+
+    @baudrate.setter
+    def baudrate(self, baudrate: int) -> None:
+        with self._lock:
+            self._transport.set_baudrate(baudrate)
+            self._timing = LinkTiming(baudrate, self._timing.return_delay_s, self._latency_s)
+
+    @property
+    def latency_s(self) -> float:
+        """Adapter latency assumed in timeouts."""
+        return self._latency_s
+
+    @property
+    def timing(self) -> LinkTiming:
+        """The timing model in use."""
+        return self._timing
+
+    @property
+    def lock(self) -> threading.RLock:
+        """The bus lock; hold it to chain several transactions without interleaving."""
+        return self._lock
+
+    # -- core ------------------------------------------------------------------------------------
+
+    def exchange(
+        self,
+        packet: InstructionPacket,
+        expected: Sequence[tuple[int, int]],
+        *,
+        timeout_s: float | None = None,
+    ) -> dict[int, StatusPacket]:
+        """Send one instruction and collect the replies of ``expected`` motors (one attempt).
+
+        The caller should hold ``lock``. Replies from other IDs (late answers to an earlier
+        instruction) are kept aside; ``take_strays`` returns them.
+
+        Args:
+            packet: the instruction.
+            expected: ``(id, n_params)`` of each reply, in the order motors send them.
+            timeout_s: wait for the first reply this long instead of the physical estimate.
+
+        Returns:
+            The replies that arrived, by ID.
+        """
+        transport = self._transport
+        self._strays.extend(transport.drain())
+        corrupt_before, skipped_before = transport.corrupt_packets, transport.skipped_bytes
+        data = encode_instruction(self._protocol, packet)
+        transport.write(data)
+        if not expected:
+            return {}
+        sizes = [status_size(self._protocol, n) for _, n in expected]
+        first = timeout_s if timeout_s is not None else self.timeout_s
+        if first is None:
+            first = self._timing.reply_timeout_s(len(data), sizes[0])
+        deadline = Deadline(first)
+        grace = self._timing.grace_s(max(sizes))
+        wanted = {motor_id for motor_id, _ in expected}
+        sizes_by_id = dict(expected)
+        got: dict[int, StatusPacket] = {}
+        while len(got) < len(wanted):
+            status = transport.read_packet(deadline, grace_s=grace)
+            if status is None:
+                break
+            if status.id in wanted and status.id not in got and self._fits(status, sizes_by_id):
+                got[status.id] = status
+                deadline.extend(self._timing.quiet_gap_s(max(sizes)))
+            else:
+                logger.debug("%s: stray status from ID %d kept aside", self._port, status.id)
+                self._strays.append(status)
+        corrupt = transport.corrupt_packets - corrupt_before
+        if len(got) < len(wanted) and not corrupt and transport.skipped_bytes > skipped_before:
+            corrupt = 1  # bytes came back but no packet could be found in them: garbage
+        self.stats.corrupt_packets += corrupt
+        self.stats.timeouts += len(wanted) - len(got)
+        return got
+
+    def _fits(self, status: StatusPacket, n_params: dict[int, int]) -> bool:
+        """A reply of the expected size, or a refusal (which carries no data).
+
+        A status of another size is a late answer to an earlier instruction (for instance a
+        write sent with ``reply=False`` that was answered all the same): it is kept aside.
+        """
+        if len(status.params) == n_params[status.id]:
+            return True
+        return bool(status.error) and not is_alarm_only(self._protocol, status.error)
+
+    def take_strays(self) -> list[StatusPacket]:
+        """Return and forget the status packets that arrived for no pending transaction."""
+        with self._lock:
+            late = list(self._strays) + self._transport.drain()
+            self._strays.clear()
+            return late
+
+    def _transact(
+        self, packet: InstructionPacket, motor_id: int, n_params: int, *, retries: int | None = None
+    ) -> StatusPacket:
+        """One instruction to one motor with retries; returns its checked-in reply."""
+        attempts = 1 + (self.retries if retries is None else retries)
+        corrupt = False
+        with self._lock:
+            self.stats.transactions += 1
+            for attempt in range(attempts):
+                if attempt:
+                    self.stats.retries += 1
+                before = self.stats.corrupt_packets
+                status = self.exchange(packet, [(motor_id, n_params)]).get(motor_id)
+                if status is not None:
+                    if status.error and not is_alarm_only(self._protocol, status.error):
+                        return status
+                    if len(status.params) == n_params:
+                        return status
+                    self.stats.corrupt_packets += 1
+                    corrupt = True
+                    continue
+                corrupt = self.stats.corrupt_packets > before
+        what = f"instruction {packet.instruction:#04x}"
+        if corrupt:
+            raise CorruptPacketError(
+                f"motor {motor_id} on {self._port} sent a corrupt reply to {what} "
+                f"({attempts} attempt(s)); check wiring, baud rate and power",
+                port=self._port,
+                motor_id=motor_id,
+            )
+        raise BusTimeout(
+            f"motor {motor_id} on {self._port} did not answer {what} at {self.baudrate} bps, "
+            f"protocol {self._protocol} ({attempts} attempt(s))",
+            port=self._port,
+            motor_id=motor_id,
+        )
+
+    def check_status(self, status: StatusPacket, *, register: str | None = None) -> None:
+        """Raise ``MotorError`` for refusal bits; log and record alarm bits (see module doc)."""
+        if status.error == 0 or is_alarm_only(self._protocol, status.error):
+            self.record_alarms(status)
+            return
+        self.stats.motor_errors += 1
+        names = decode_errors(self._protocol, status.error)
+        where = f" ({register})" if register else ""
+        raise MotorError(
+            f"motor {status.id} on {self._port}{where} reported: {', '.join(names)}",
+            motor_id=status.id,
+            errors=names,
+            register=register,
+            port=self._port,
+        )
+
+    def record_alarms(self, status: StatusPacket) -> None:
+        """Keep the alarm bits of ``status`` in ``alarms`` and log when they change."""
+        names = decode_errors(self._protocol, status.error) if status.error else []
+        if names != self.alarms.get(status.id, []):
+            if names:
+                logger.warning(
+                    "motor %d on %s reports: %s", status.id, self._port, ", ".join(names)
+                )
+            else:
+                logger.info("motor %d on %s: alarm cleared", status.id, self._port)
+        if names:
+            self.stats.alarms += 1
+        self.alarms[status.id] = names
+
+    def _send(self, packet: InstructionPacket) -> None:
+        with self._lock:
+            self.stats.transactions += 1
+            self.exchange(packet, [])
+
+    # -- lifetime ----------------------------------------------------------------------------------
+
+    @property
+    def transport(self) -> Transport:
+        """The underlying transport."""
+        return self._transport
+
+    def close(self) -> None:
+        """Close the port (unless the transport was given by the caller). Idempotent."""
+        with self._lock:
+            if self._owns_transport:
+                self._transport.close()
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"DxlBus({self._port!r}, baudrate={self.baudrate}, protocol={self._protocol})"

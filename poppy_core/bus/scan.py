@@ -1,0 +1,271 @@
+"""Motor discovery: scan ports, baud rates and protocols; find the port holding given motors.
+
+How a scan stays fast:
+
+* every ping waits only for the physical round trip (first status byte), not a flat timeout;
+* a reply is trusted as soon as its checksum/CRC is valid, so found motors are not re-pinged;
+  a reply that arrives late (after its own deadline) is still caught: it shows up as a stray
+  packet during the next ping, and that ID is pinged again at the end of the pass;
+* protocol 2 first sends one broadcast ping, which finds every motor at that rate in a single
+  transaction. Its result is trusted when the line stayed clean (no corrupt packet and no stray
+  byte during the collection window): then the per-ID pings at that rate are skipped, silence
+  included. Garbage on the line (replies colliding, noise) means the broadcast may have missed
+  someone, so every ID is pinged one by one.
+
+A scan opens each port once and switches rates on it. On an abort (``should_abort()`` true) it
+returns what it has found so far.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+
+from poppy_core.bus.dxlbus import DxlBus
+from poppy_core.bus.ports import list_ports
+from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
+from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S
+from poppy_core.bus.transport import Transport
+from poppy_core.errors import CorruptPacketError, PortError, SetupError
+from poppy_core.models import standard_baudrates
+
+logger = logging.getLogger(__name__)
+
+SCAN_IDS = range(254)
+PROTOCOLS = (1, 2)
+
+
+def _found(port: str, bus: DxlBus, result: PingResult) -> FoundMotor:
+    return FoundMotor(
+        port=port,
+        baudrate=bus.baudrate,
+        protocol=bus.protocol,
+        id=result.id,
+        model_number=result.model_number,
+        model=result.model_name,
+        firmware=result.firmware,
+    )
+
+
+@dataclass
+class _Scan:
+    """State of one scan run."""
+
+    ids: list[int]
+    progress: Callable[[ScanProgress], None] | None
+    should_abort: Callable[[], bool] | None
+    on_found: Callable[[FoundMotor], None] | None
+    total: int
+    done: int = 0
+    found: list[FoundMotor] = field(default_factory=list)
+    aborted: bool = False
+
+    def abort_requested(self) -> bool:
+        if not self.aborted and self.should_abort is not None and self.should_abort():
+            logger.info("scan aborted after %d ping(s)", self.done)
+            self.aborted = True
+        return self.aborted
+
+    def report(self, port: str, bus: DxlBus, step: str, motor_id: int | None, count: int) -> None:
+        self.done += count
+        if self.progress is not None:
+            self.progress(
+                ScanProgress(
+                    port,
+                    bus.baudrate,
+                    bus.protocol,
+                    step,
+                    motor_id,
+                    self.done,
+                    self.total,
+                    len(self.found),
+                )
+            )
+
+    def add(self, motor: FoundMotor) -> None:
+        self.found.append(motor)
+        logger.info(
+            "found motor %d (%s) on %s at %d bps, protocol %d",
+            motor.id,
+            motor.model or f"model {motor.model_number}",
+            motor.port,
+            motor.baudrate,
+            motor.protocol,
+        )
+        if self.on_found is not None:
+            self.on_found(motor)
+
+
+def _ping(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
+    try:
+        return bus.ping(motor_id, retries=retries)
+    except CorruptPacketError:
+        logger.debug("%s: garbage in reply to ping %d", bus.port, motor_id)
+        return None
+
+
+def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> None:
+    """Scan one (port, rate, protocol)."""
+    seen: set[int] = set()
+    wanted = set(state.ids)
+    if bus.protocol == 2 and broadcast:
+        transport = bus.transport
+        corrupt, skipped = transport.corrupt_packets, transport.skipped_bytes
+        results = bus.broadcast_ping()
+        for pinged in results:
+            if pinged.id in wanted and pinged.id not in seen:
+                seen.add(pinged.id)
+                state.add(_found(port, bus, pinged))
+        if transport.corrupt_packets == corrupt and transport.skipped_bytes == skipped:
+            state.report(port, bus, "broadcast ping", None, len(state.ids))
+            return
+        logger.info(
+            "%s: garbage during broadcast ping at %d bps; pinging each ID", port, bus.baudrate
+        )
+    late: set[int] = set()
+    bus.take_strays()
+    for motor_id in state.ids:
+        if state.abort_requested():
+            return
+        if motor_id not in seen:
+            result = _ping(bus, motor_id, retries=0)
+            if result is not None:
+                seen.add(motor_id)
+                state.add(_found(port, bus, result))
+            late.update(s.id for s in bus.take_strays() if s.id in wanted and s.id not in seen)
+        state.report(port, bus, "ping", motor_id, 1)
+    for motor_id in sorted(late - seen):
+        result = _ping(bus, motor_id, retries=1)
+        if result is not None:
+            seen.add(motor_id)
+            state.add(_found(port, bus, result))
+
+
+def scan(
+    ports: str | Sequence[str],
+    baudrates: Iterable[int] | None = None,
+    protocols: Iterable[int] = PROTOCOLS,
+    ids: Iterable[int] = SCAN_IDS,
+    *,
+    progress: Callable[[ScanProgress], None] | None = None,
+    should_abort: Callable[[], bool] | None = None,
+    on_found: Callable[[FoundMotor], None] | None = None,
+    broadcast: bool = True,
+    latency_s: float | None = None,
+    return_delay_s: float = DEFAULT_RETURN_DELAY_S,
+) -> list[FoundMotor]:
+    """Find every motor answering on ``ports`` at ``baudrates`` in ``protocols``.
+
+    Args:
+        ports: one port or several (device paths or URLs).
+        baudrates: rates to try; None tries the standard rates of each protocol.
+        protocols: protocols to try (1, 2 or both).
+        ids: IDs to look for (0-253).
+        progress: called after each ping (and after a trusted broadcast ping).
+        should_abort: polled before each ping; when it returns True the scan stops and returns
+            what it found.
+        on_found: called for each motor as soon as it is found.
+        broadcast: use a protocol 2 broadcast ping first (see the module docstring).
+        latency_s: adapter latency (None: from the port).
+        return_delay_s: return delay assumed in timeouts.
+
+    Returns:
+        The motors found, in the order found. Unknown model numbers give ``model=None``.
+
+    Raises:
+        PortError: the only port given cannot be opened (with several ports, one that cannot
+            be opened is logged and skipped).
+    """
+    port_list = [ports] if isinstance(ports, str) else list(ports)
+    protocol_list = list(protocols)
+    fixed = None if baudrates is None else list(baudrates)
+    rates = {p: fixed if fixed is not None else list(standard_baudrates(p)) for p in protocol_list}
+    id_list = list(ids)
+    total = len(port_list) * sum(len(rates[p]) for p in protocol_list) * len(id_list)
+    state = _Scan(id_list, progress, should_abort, on_found, total)
+    for port in port_list:
+        try:
+            transport = Transport(port)
+        except PortError as exc:
+            if len(port_list) == 1:
+                raise
+            logger.warning("skipping %s: %s", port, exc)
+            continue
+        try:
+            for protocol in protocol_list:
+                for rate in rates[protocol]:
+                    if state.abort_requested():
+                        return state.found
+                    bus = DxlBus(
+                        port,
+                        rate,
+                        protocol,
+                        latency_s=latency_s,
+                        retries=0,
+                        return_delay_s=return_delay_s,
+                        transport=transport,
+                    )
+                    _scan_rate(state, port, bus, broadcast)
+        finally:
+            transport.close()
+    return state.found
+
+
+def find_port(
+    ids: Iterable[int],
+    ports: Sequence[str] | None = None,
+    baudrates: Iterable[int] | None = None,
+    protocols: Iterable[int] = PROTOCOLS,
+    *,
+    latency_s: float | None = None,
+) -> tuple[str, int, int]:
+    """Find the bus holding every motor in ``ids``.
+
+    Args:
+        ids: motor IDs that must all answer.
+        ports: ports to try; None tries every port ``list_ports`` finds.
+        baudrates: rates to try; None tries the standard rates of each protocol.
+        protocols: protocols to try.
+        latency_s: adapter latency (None: from the port).
+
+    Returns:
+        ``(port, baudrate, protocol)``.
+
+    Raises:
+        PortError: no serial port at all.
+        SetupError: no port/rate/protocol answers for every ID (the message says the closest).
+    """
+    wanted = list(ids)
+    fixed = None if baudrates is None else list(baudrates)
+    port_list = list(ports) if ports is not None else [p.device for p in list_ports()]
+    if not port_list:
+        raise PortError("no serial port found: plug the adapter or run `poppy ports`")
+    best: tuple[int, str] = (0, "")
+    for port in port_list:
+        try:
+            transport = Transport(port)
+        except PortError as exc:
+            logger.warning("skipping %s: %s", port, exc)
+            continue
+        try:
+            for protocol in protocols:
+                rates = fixed if fixed is not None else list(standard_baudrates(protocol))
+                for rate in rates:
+                    bus = DxlBus(port, rate, protocol, latency_s=latency_s, transport=transport)
+                    answered = [i for i in wanted if _ping(bus, i, retries=1) is not None]
+                    if len(answered) == len(wanted):
+                        return port, rate, protocol
+                    if len(answered) > best[0]:
+                        best = (
+                            len(answered),
+                            f"{port} at {rate} bps, protocol {protocol} "
+                            f"has {', '.join(map(str, answered))}",
+                        )
+        finally:
+            transport.close()
+    closest = f"; closest: {best[1]}" if best[0] else "; none of them answered anywhere"
+    raise SetupError(
+        f"no port holds motors {', '.join(map(str, wanted))} "
+        f"(searched {', '.join(port_list)}){closest}"
+    )

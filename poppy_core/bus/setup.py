@@ -1,0 +1,269 @@
+"""Motor setup that never strands a motor: every change is verified, and a lost motor is found.
+
+* EEPROM writes first turn torque off on protocol 2 models (X series and XL-320 lock their
+  EEPROM while torque is on; e-manual "Torque Enable").
+* A write that changes the ID or the baud rate may be answered from the new ID or at the new
+  rate (or not at all): its reply is not relied upon; the motor is pinged at the new setting.
+* ``factory_reset`` on protocol 1 resets everything (ID and baud rate included): the motor is
+  then looked for at the model's factory ID and rate and, as asked, its ID and baud rate are put
+  back. Before resetting, the factory ID must be free at the factory rate, else two motors would
+  end up sharing it.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+
+from poppy_core.bus.dxlbus import DxlBus
+from poppy_core.bus.results import PingResult, SetupResult
+from poppy_core.errors import CommunicationError, SetupError
+from poppy_core.models import ServoModel, SIValue, standard_baudrates
+
+logger = logging.getLogger(__name__)
+
+Progress = Callable[[str], None]
+
+# e-manual (Protocol 2.0 Factory Reset): 0xFF all, 0x01 all but ID, 0x02 all but ID and baud.
+RESET_ALL, RESET_KEEP_ID, RESET_KEEP_ID_BAUDRATE = 0xFF, 0x01, 0x02
+# How long a motor may take to answer again after a reboot, reset or rate change.
+ANSWER_TIMEOUT_S = 1.0
+_POLL_S = 0.005
+
+
+def say(progress: Progress | None, message: str) -> None:
+    logger.info(message)
+    if progress is not None:
+        progress(message)
+
+
+def where(bus: DxlBus) -> str:
+    return f"{bus.port} at {bus.baudrate} bps, protocol {bus.protocol}"
+
+
+def identify(bus: DxlBus, motor_id: int) -> tuple[PingResult, ServoModel]:
+    """Ping ``motor_id`` and return its ping result and model.
+
+    Raises:
+        SetupError: no answer, or a model number poppy does not know.
+    """
+    found = bus.ping(motor_id)
+    if found is None:
+        raise SetupError(f"motor {motor_id} does not answer on {where(bus)}")
+    if found.model is None:
+        raise SetupError(
+            f"motor {motor_id} on {bus.port} has unknown model number {found.model_number}: "
+            "poppy cannot set it up"
+        )
+    return found, found.model
+
+
+def wait_for_answer(bus: DxlBus, motor_id: int, timeout_s: float = ANSWER_TIMEOUT_S) -> bool:
+    """Ping ``motor_id`` until it answers or ``timeout_s`` passes."""
+    end = time.monotonic() + timeout_s
+    while True:
+        if bus.ping(motor_id, retries=0) is not None:
+            return True
+        if time.monotonic() >= end:
+            return False
+        time.sleep(_POLL_S)
+
+
+def unlock_eeprom(bus: DxlBus, motor_id: int, model: ServoModel) -> None:
+    if model.protocol == 2:
+        bus.write_register(motor_id, model, "torque_enable", False)
+
+
+def _write_verified(
+    bus: DxlBus, motor_id: int, model: ServoModel, name: str, value: SIValue
+) -> tuple[SIValue, SIValue]:
+    """Write register ``name``, read it back, and return (old, new) SI values."""
+    register = model.register(name)
+    wanted = register.from_si(value)
+    old = bus.read_register(motor_id, model, name)
+    if register.memory == "EEPROM":
+        unlock_eeprom(bus, motor_id, model)
+    bus.write_register(motor_id, model, name, value)
+    raw = register.decode(bus.read(motor_id, register.address, register.size))
+    if raw != wanted:
+        raise SetupError(
+            f"motor {motor_id} on {bus.port}: {name} reads {register.to_si(raw)} after writing "
+            f"{value}"
+        )
+    return old, register.to_si(raw)
+
+
+def new_result(bus: DxlBus, operation: str, motor_id: int) -> SetupResult:
+    return SetupResult(operation, bus.port, motor_id, bus.baudrate, bus.protocol)
+
+
+def change_id(
+    bus: DxlBus, old_id: int, new_id: int, *, progress: Progress | None = None
+) -> SetupResult:
+    """Give motor ``old_id`` the ID ``new_id``, verified.
+
+    Raises:
+        SetupError: the motor does not answer, ``new_id`` is taken, or the change did not hold.
+        RegisterError: ``new_id`` is outside the model's ID range.
+    """
+    _, model = identify(bus, old_id)
+    result = new_result(bus, "change_id", old_id)
+    if new_id == old_id:
+        result.verified = True
+        return result
+    model.register("id").from_si(new_id)
+    if bus.ping(new_id) is not None:
+        raise SetupError(f"ID {new_id} is already taken on {bus.port}")
+    say(progress, f"motor {old_id}: setting ID {new_id}")
+    unlock_eeprom(bus, old_id, model)
+    try:
+        bus.write_register(old_id, model, "id", new_id)
+    except CommunicationError as exc:
+        logger.debug("ID write not acknowledged (expected from some firmwares): %s", exc)
+    if not wait_for_answer(bus, new_id):
+        still_old = bus.ping(old_id) is not None
+        hint = f"it still answers as {old_id}" if still_old else "run `poppy scan` to find it"
+        raise SetupError(f"motor {old_id} does not answer as {new_id} on {bus.port}: {hint}")
+    if bus.ping(old_id, retries=0) is not None:
+        raise SetupError(f"both IDs {old_id} and {new_id} answer on {bus.port}: check the wiring")
+    result.motor_id = new_id
+    result.changes["id"] = (old_id, new_id)
+    result.verified = True
+    say(progress, f"motor {old_id} is now motor {new_id}")
+    return result
+
+
+def locate(bus: DxlBus, motor_id: int, rates: list[int] | None = None) -> int | None:
+    """Search the standard baud rates for ``motor_id``; leave the bus at the rate found.
+
+    Returns:
+        The rate where it answers, None when nowhere (the bus's rate is then restored).
+    """
+    original = bus.baudrate
+    for rate in rates if rates is not None else standard_baudrates(bus.protocol):
+        bus.baudrate = rate
+        if bus.ping(motor_id) is not None:
+            return rate
+    bus.baudrate = original
+    return None
+
+
+def change_baudrate(
+    bus: DxlBus, motor_id: int, baudrate: int, *, progress: Progress | None = None
+) -> SetupResult:
+    """Set the motor's baud rate, switch the bus to it and check the motor answers there.
+
+    On success the bus stays at ``baudrate``. When the motor does not answer at the new rate,
+    the standard rates are searched and ``SetupError`` says where it is (the bus is left there).
+
+    Raises:
+        SetupError: the motor does not answer before, or cannot be found at the new rate.
+        RegisterError: the model has no such baud rate.
+    """
+    _, model = identify(bus, motor_id)
+    old = bus.baudrate
+    result = new_result(bus, "change_baudrate", motor_id)
+    model.baudrate_code(baudrate)
+    if baudrate != old:
+        say(progress, f"motor {motor_id}: setting {baudrate} bps")
+        unlock_eeprom(bus, motor_id, model)
+        try:
+            bus.write_register(motor_id, model, "baudrate", baudrate)
+        except CommunicationError as exc:
+            logger.debug("baud rate write not acknowledged: %s", exc)
+        bus.baudrate = baudrate
+        if not wait_for_answer(bus, motor_id):
+            found = locate(bus, motor_id)
+            where = f"it answers at {found} bps" if found else "it answers at no standard rate"
+            raise SetupError(
+                f"motor {motor_id} does not answer at {baudrate} bps on {bus.port} after the "
+                f"change: {where}"
+            )
+        result.changes["baudrate"] = (old, baudrate)
+    result.baudrate = bus.baudrate
+    result.verified = True
+    return result
+
+
+def set_return_delay(
+    bus: DxlBus, motor_id: int, delay_us: float, *, progress: Progress | None = None
+) -> SetupResult:
+    """Set the return delay time (µs; poppy uses 0), verified by reading it back."""
+    _, model = identify(bus, motor_id)
+    say(progress, f"motor {motor_id}: return delay {delay_us} µs")
+    result = new_result(bus, "set_return_delay", motor_id)
+    result.changes["return_delay_time"] = _write_verified(
+        bus, motor_id, model, "return_delay_time", delay_us
+    )
+    result.verified = True
+    return result
+
+
+def set_angle_limits(
+    bus: DxlBus,
+    motor_id: int,
+    min_deg: float,
+    max_deg: float,
+    *,
+    progress: Progress | None = None,
+) -> SetupResult:
+    """Set the angle (position) limits in degrees, verified by reading them back.
+
+    Raises:
+        SetupError: ``min_deg >= max_deg`` or the limits did not hold.
+        RegisterError: a limit outside the model's range.
+    """
+    if min_deg >= max_deg:
+        raise SetupError(f"angle limits need min < max (got {min_deg}° and {max_deg}°)")
+    _, model = identify(bus, motor_id)
+    say(progress, f"motor {motor_id}: angle limits {min_deg}° .. {max_deg}°")
+    result = new_result(bus, "set_angle_limits", motor_id)
+    for name, value in (("min_position_limit", min_deg), ("max_position_limit", max_deg)):
+        result.changes[name] = _write_verified(bus, motor_id, model, name, value)
+    result.verified = True
+    return result
+
+
+def reboot(
+    bus: DxlBus,
+    motor_id: int,
+    *,
+    timeout_s: float = ANSWER_TIMEOUT_S,
+    progress: Progress | None = None,
+) -> SetupResult:
+    """Reboot the motor (protocol 2) and wait until it answers again.
+
+    Raises:
+        SetupError: protocol 1 (no reboot instruction), or no answer after ``timeout_s``.
+    """
+    if bus.protocol != 2:
+        raise SetupError("reboot exists only in protocol 2: power-cycle the motor instead")
+    identify(bus, motor_id)
+    say(progress, f"motor {motor_id}: rebooting")
+    start = time.monotonic()
+    bus.reboot(motor_id)
+    if not wait_for_answer(bus, motor_id, timeout_s):
+        raise SetupError(f"motor {motor_id} did not answer within {timeout_s} s after a reboot")
+    result = new_result(bus, "reboot", motor_id)
+    result.notes.append(f"answered again after {time.monotonic() - start:.3f} s")
+    result.verified = True
+    return result
+
+
+# The whole-motor operations live next door (size); they are reachable from here too.
+from poppy_core.bus.setup_reset import factory_reset, reset_motor  # noqa: E402
+
+__all__ = [
+    "ANSWER_TIMEOUT_S",
+    "change_baudrate",
+    "change_id",
+    "factory_reset",
+    "identify",
+    "locate",
+    "reboot",
+    "reset_motor",
+    "set_angle_limits",
+    "set_return_delay",
+    "wait_for_answer",
+]
