@@ -24,6 +24,9 @@ def profile_buses(name: str, baud: int | None, **options: object) -> list[tuple[
     buses = []
     for controller_name, controller in config.controllers.items():
         motors = config.motors_of_controller(controller_name)
+        # Poppy's protocol-1 robots read through a USB2AX, whose SYNC_READ their configs enable.
+        adapter = "usb2ax" if controller.protocol == 1 and controller.sync_read else "u2d2"
+        bus_options = {"adapter": adapter, **options}
         spec = ",".join(f"{config.motors[m].type}:{config.motors[m].id}" for m in motors)
         buses.append(
             (
@@ -32,7 +35,7 @@ def profile_buses(name: str, baud: int | None, **options: object) -> list[tuple[
                     spec,
                     protocol=controller.protocol,
                     baudrate=baud or controller.baudrate,
-                    **options,  # type: ignore[arg-type]
+                    **bus_options,  # type: ignore[arg-type]
                 ),
             )
         )
@@ -81,11 +84,9 @@ def emulate(
     if pty and tcp:
         error_line("give either --pty or --tcp, not both")
         raise typer.Exit(EXIT_USAGE)
-    options: dict[str, object] = {
-        "wire_timing": wire_timing,
-        "latency_s": latency_ms / 1000.0,
-        "adapter": "usb2ax" if usb2ax else "u2d2",
-    }
+    options: dict[str, object] = {"wire_timing": wire_timing, "latency_s": latency_ms / 1000.0}
+    if usb2ax:
+        options["adapter"] = "usb2ax"
     if profile is not None:
         buses = profile_buses(profile, baud, **options)
         if protocol is not None and any(b.protocol != protocol for _, b in buses):

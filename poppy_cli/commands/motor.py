@@ -46,6 +46,8 @@ def parse_value(register: Register, text: str) -> object:
             return False
         raise typer.BadParameter(f"{register.name} takes on or off, not {text!r}")
     if isinstance(conversion, Choice):
+        if register.name == "led" and lowered == "on":
+            return "white"  # the XL-320 LED takes a colour; "on" means all three LEDs
         try:
             return int(lowered)
         except ValueError:
@@ -187,6 +189,7 @@ def set_register(
     port: str | None = PortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
 ) -> None:
     """Write one register in SI units, e.g. `poppy motor set 11 goal_position 30`."""
     from poppy_core.errors import RegisterError
@@ -199,6 +202,7 @@ def set_register(
             "still answers afterwards",
             register=register,
         )
+    results: dict[str, dict[str, object]] = {}
     with open_bus(require_port(port), id_list, baud, protocol) as bus:
         for motor_id in id_list:
             model = ping_model(bus, motor_id).model
@@ -210,13 +214,23 @@ def set_register(
                 )
             bus.write_register(motor_id, model, reg.name, parse_value(reg, value))
             written = bus.read_register(motor_id, model, reg.name)
-            console.print(f"motor {motor_id}: {reg.name} = {fmt_value(written, reg.unit)}")
+            results[str(motor_id)] = {reg.name: written}
+            if not json_output:
+                console.print(f"motor {motor_id}: {reg.name} = {fmt_value(written, reg.unit)}")
+    if json_output:
+        print_json(results)
 
 
 def _toggle(
-    ids: str, register: str, state: str, port: str | None, baud: int | None, protocol: int | None
+    ids: str,
+    register: str,
+    state: str,
+    port: str | None,
+    baud: int | None,
+    protocol: int | None,
+    json_output: bool,
 ) -> None:
-    set_register(ids, register, state, port, baud, protocol)
+    set_register(ids, register, state, port, baud, protocol, json_output)
 
 
 @app.command("torque")
@@ -226,9 +240,10 @@ def torque(
     port: str | None = PortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
 ) -> None:
     """Turn torque on (stiff) or off (compliant)."""
-    _toggle(ids, "torque_enable", state, port, baud, protocol)
+    _toggle(ids, "torque_enable", state, port, baud, protocol, json_output)
 
 
 @app.command("led")
@@ -238,6 +253,7 @@ def led(
     port: str | None = PortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
+    json_output: bool = JsonOpt,
 ) -> None:
     """Switch the LED on or off (or pick its colour on an XL-320)."""
-    _toggle(ids, "led", state, port, baud, protocol)
+    _toggle(ids, "led", state, port, baud, protocol, json_output)
