@@ -8,6 +8,9 @@ from poppy_core.robot.config import (
     RobotConfig,
 )
 from poppy_core.robot.config_io import config_to_text, dump_config, load_config
+from poppy_core.robot.factory import autodetect, from_config, from_profile, start_emulators
+from poppy_core.robot.goto import GotoHandle, GotoRunner
+from poppy_core.robot.motor import Motor
 from poppy_core.robot.profiles import (
     PROFILE_FILE,
     ProfileInfo,
@@ -17,21 +20,48 @@ from poppy_core.robot.profiles import (
     profile_dirs,
     user_profile_dir,
 )
+from poppy_core.robot.robot import Robot
+from poppy_core.robot.startup import ReturnDelayIssue
+from poppy_core.robot.sync import (
+    BASE_LOOPS,
+    LIGHT_LOOPS,
+    BusSync,
+    LoopSpec,
+    LoopStats,
+    SyncStats,
+    loops_for,
+)
 
 __all__ = [
+    "BASE_LOOPS",
     "DEFAULT_BAUDRATE",
+    "LIGHT_LOOPS",
     "PROFILE_FILE",
+    "BusSync",
     "ControllerConfig",
+    "GotoHandle",
+    "GotoRunner",
+    "LoopSpec",
+    "LoopStats",
+    "Motor",
     "MotorConfig",
     "ProfileHeader",
     "ProfileInfo",
+    "ReturnDelayIssue",
+    "Robot",
     "RobotConfig",
+    "SyncStats",
+    "autodetect",
     "config_to_text",
     "dump_config",
     "find_profile",
+    "from_config",
+    "from_profile",
     "list_profiles",
     "load_config",
     "load_profile",
+    "loops_for",
     "profile_dirs",
+    "start_emulators",
     "user_profile_dir",
 ]

@@ -1,0 +1,285 @@
+"""Build a ``Robot``: from a config, a profile, or whatever motors a scan finds; real or simulated.
+
+``sim=True`` starts one in-process emulator per controller (a ``VirtualBus`` with the configured
+models, IDs and baud rate, served on a pty), so the robot talks the same bytes as with hardware.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+from poppy_core.bus import DxlBus, find_port, list_ports, scan
+from poppy_core.emulator import Adapter, VirtualBus, VirtualMotor, serve_pty
+from poppy_core.errors import ConfigError, PortError, RegisterError, SetupError
+from poppy_core.models import model_by_name
+from poppy_core.robot import startup
+from poppy_core.robot.config import RobotConfig
+from poppy_core.robot.config_io import load_config
+from poppy_core.robot.motor import Motor
+from poppy_core.robot.profiles import load_profile
+from poppy_core.robot.robot import Robot
+from poppy_core.robot.startup import ReturnDelayConsent
+from poppy_core.robot.sync import BusSync, loops_for
+
+logger = logging.getLogger(__name__)
+
+
+def start_emulators(config: RobotConfig) -> dict[str, Any]:
+    """One emulator per controller, served on a pty: controller name -> ``EmulatorServer``.
+
+    The virtual motors have the configured models, IDs and baud rate, and a return delay of 0
+    (a robot already set up). Protocol 1 controllers with ``sync_read`` get a USB2AX adapter.
+    """
+    servers: dict[str, Any] = {}
+    try:
+        for name, controller in config.controllers.items():
+            motors = []
+            for motor_name in config.motors_of_controller(name):
+                entry = config.motors[motor_name]
+                virtual = VirtualMotor(model_by_name(entry.type), entry.id, controller.baudrate)
+                virtual.table.set("return_delay_time", 0)
+                motors.append(virtual)
+            adapter: Adapter = (
+                "usb2ax" if controller.protocol == 1 and controller.sync_read else "u2d2"
+            )
+            bus = VirtualBus(
+                motors, controller.protocol, baudrate=controller.baudrate, adapter=adapter
+            )
+            servers[name] = serve_pty(bus)
+    except BaseException:
+        for server in servers.values():
+            server.stop()
+        raise
+    return servers
+
+
+def _resolve_port(
+    controller: str, config: RobotConfig, used: set[str], search: Sequence[str] | None
+) -> str:
+    entry = config.controllers[controller]
+    ids = [config.motors[n].id for n in config.motors_of_controller(controller)]
+    candidates = list(search) if search is not None else [p.device for p in list_ports()]
+    candidates = [p for p in candidates if p not in used]
+    if not candidates:
+        raise PortError("no free serial port to search: plug the adapter or give the port")
+    port, _, _ = find_port(ids, candidates, [entry.baudrate], [entry.protocol])
+    return port
+
+
+def _motor_targets(config: RobotConfig, names: Iterable[str]) -> dict[str, float]:
+    return {n: float(config.motors[n].return_delay_time or 0) for n in names}
+
+
+def from_config(
+    config: RobotConfig | str | os.PathLike[str],
+    sim: bool = False,
+    *,
+    strict: bool = True,
+    fix_return_delay: ReturnDelayConsent = False,
+    write_angle_limits: bool = True,
+    ports: Sequence[str] | None = None,
+    start_sync: bool = True,
+) -> Robot:
+    """Build and start a robot from a config (a ``RobotConfig`` or a JSON/YAML file).
+
+    Args:
+        config: the config or its path.
+        sim: serve the config's motors from in-process emulators instead of hardware.
+        strict: missing or mismatched motors raise ``SetupError``; when False they are logged
+            and missing ones start offline (retried by the sync loop).
+        fix_return_delay: set return delays above the wanted one (0 µs unless the config's
+            ``return_delay_time`` says) to it: True, False (warn only) or a function shown
+            the issues that returns True to fix them.
+        write_angle_limits: write the configured limits to the servos' EEPROM (see
+            ``poppy_core.robot.startup``).
+        ports: ports searched for controllers whose port is ``"auto"`` (None: every port).
+        start_sync: start the sync loops.
+
+    Returns:
+        The running robot (close it, or use it in a ``with`` block).
+
+    Raises:
+        ConfigError: invalid config.
+        SetupError: one line listing missing motors (with where they were searched) and
+            motors whose model differs from the config.
+        PortError: a port cannot be opened.
+    """
+    cfg = config if isinstance(config, RobotConfig) else load_config(config)
+    emulators: dict[str, Any] = {}
+    buses: dict[str, DxlBus] = {}
+    try:
+        if sim:
+            emulators = start_emulators(cfg)
+        motors: dict[str, list[Motor]] = {}
+        problems: list[str] = []
+        used: set[str] = set()
+        for name, entry in cfg.controllers.items():
+            names = cfg.motors_of_controller(name)
+            if not names:
+                continue
+            port = emulators[name].url if sim else entry.port
+            if port == "auto":
+                try:
+                    port = _resolve_port(name, cfg, used, ports)
+                except (SetupError, PortError) as exc:
+                    problems.append(
+                        f"controller {name!r} ({entry.baudrate} bps, protocol "
+                        f"{entry.protocol}): {exc}"
+                    )
+                    continue
+            used.add(port)
+            bus = DxlBus(
+                port, entry.baudrate, entry.protocol, sync_read=None if entry.sync_read else False
+            )
+            buses[name] = bus
+            motors[name] = [
+                Motor.from_config(n, cfg.motors[n], model_by_name(cfg.motors[n].type))
+                for n in names
+            ]
+            problems += startup.check_presence(bus, name, motors[name])
+        if problems:
+            message = "; ".join(problems)
+            if strict:
+                raise SetupError(message)
+            logger.warning("%s", message)
+        syncs = []
+        for name, bus in buses.items():
+            _prepare(bus, cfg, motors[name], fix_return_delay, write_angle_limits)
+            loops = loops_for(cfg.controllers[name].syncloop)
+            syncs.append(BusSync(name, bus, motors[name], loops))
+    except BaseException:
+        for bus in buses.values():
+            bus.close()
+        for server in emulators.values():
+            server.stop()
+        raise
+    every = [m for name in cfg.controllers for m in motors.get(name, [])]
+    groups = {g: [n for n in cfg.resolve_group(g) if n in {m.name for m in every}]
+              for g in cfg.motorgroups}
+    robot = Robot(every, groups=groups, syncs=syncs, buses=buses, config=cfg, emulators=emulators)
+    if start_sync:
+        robot.start_sync()
+    return robot
+
+
+def _prepare(
+    bus: DxlBus,
+    cfg: RobotConfig,
+    motors: list[Motor],
+    fix_return_delay: ReturnDelayConsent,
+    write_angle_limits: bool,
+) -> None:
+    """First state, return delays, angle limits and configured torque/gains of one bus."""
+    startup.load_state(bus, motors)
+    issues = startup.return_delay_issues(motors, _motor_targets(cfg, (m.name for m in motors)))
+    startup.fix_return_delays(bus, motors, issues, fix_return_delay)
+    if write_angle_limits:
+        startup.write_angle_limits(bus, motors)
+    for motor in motors:
+        entry = cfg.motors[motor.name]
+        try:
+            if entry.max_torque is not None and motor.model.has_torque_limit:
+                motor.torque_limit = entry.max_torque
+            if entry.pid is not None:
+                motor.pid = entry.pid
+        except RegisterError as exc:
+            logger.warning("%s: config value not applied: %s", motor.name, exc)
+
+
+def _with_ports(config: RobotConfig, port: str | Mapping[str, str]) -> RobotConfig:
+    data = config.to_dict()
+    controllers = data["controllers"]
+    if isinstance(port, str):
+        if len(controllers) != 1:
+            raise ConfigError(
+                f"this robot has {len(controllers)} controllers ({', '.join(controllers)}): "
+                "give the port of each as a mapping",
+                field="controllers",
+            )
+        port = {next(iter(controllers)): port}
+    for name, value in port.items():
+        if name not in controllers:
+            raise ConfigError(f"no controller {name!r}", field=f"controllers.{name}")
+        controllers[name]["port"] = value
+    return RobotConfig.from_dict(data, source="profile")
+
+
+def from_profile(
+    name: str, port: str | Mapping[str, str] | None = None, sim: bool = False, **options: Any
+) -> Robot:
+    """Build a robot from an installed or user profile (``"ergo-jr"``, ``"torso"``...).
+
+    Args:
+        name: the profile name.
+        port: the port (one controller) or controller name -> port; None keeps the profile's
+            (``"auto"`` searches for the bus holding the motors).
+        sim: serve the motors from emulators.
+        **options: passed to :func:`from_config`.
+    """
+    config = load_profile(name)
+    if port is not None:
+        config = _with_ports(config, port)
+    return from_config(config, sim, **options)
+
+
+def autodetect(
+    port: str | None = None,
+    *,
+    baudrates: Iterable[int] | None = None,
+    protocols: Iterable[int] = (1, 2),
+    ids: Iterable[int] = range(254),
+    **options: Any,
+) -> Robot:
+    """Scan for motors and build a robot of them (named ``m<id>``, one controller per port).
+
+    The angle limits are the ones stored in the motors (the whole range when unset).
+
+    Args:
+        port: the port to scan; None scans every port.
+        baudrates: rates to try (None: the standard ones).
+        protocols: protocols to try.
+        ids: IDs to look for.
+        **options: passed to :func:`from_config`.
+
+    Raises:
+        SetupError: no motor found.
+    """
+    ports = [port] if port is not None else [p.device for p in list_ports()]
+    found = scan(ports, baudrates, protocols, ids)
+    found = [f for f in found if f.model is not None]
+    if not found:
+        raise SetupError(f"no known motor found on {', '.join(ports) or 'any port'}")
+    controllers: dict[str, Any] = {}
+    motors: dict[str, Any] = {}
+    for index, device in enumerate(sorted({f.port for f in found}), start=1):
+        on_port = [f for f in found if f.port == device]
+        setting = max({(f.baudrate, f.protocol) for f in on_port},
+                      key=lambda s: sum((f.baudrate, f.protocol) == s for f in on_port))
+        chosen = [f for f in on_port if (f.baudrate, f.protocol) == setting]
+        names = [f"m{f.id}" for f in chosen]
+        controllers[f"controller_{index}"] = {
+            "port": device, "baudrate": setting[0], "protocol": setting[1],
+            "sync_read": setting[1] == 2, "attached_motors": names,
+        }  # fmt: skip
+        with DxlBus(device, setting[0], setting[1]) as bus:
+            for f in chosen:
+                motors[f"m{f.id}"] = _detected_motor(bus, f.id, str(f.model))
+    config = RobotConfig.from_dict(
+        {"controllers": controllers, "motorgroups": {}, "motors": motors}, source="autodetect"
+    )
+    return from_config(config, **options)
+
+
+def _detected_motor(bus: DxlBus, motor_id: int, model_name: str) -> dict[str, Any]:
+    model = model_by_name(model_name)
+    span = model.position_range_deg / 2
+    low = bus.read_register(motor_id, model, "min_position_limit")
+    high = bus.read_register(motor_id, model, "max_position_limit")
+    wheel = low == high == -span  # AX/MX wheel mode: both limits raw 0
+    if not isinstance(low, float) or not isinstance(high, float) or not low < high:
+        low, high = -span, span
+    return {"id": motor_id, "type": model.name, "orientation": "direct", "offset": 0.0,
+            "angle_limit": [low, high], "wheel_mode": wheel}  # fmt: skip

@@ -1,0 +1,180 @@
+"""Goto runner: steps minimum-jerk trajectories into goal positions from one on-demand thread.
+
+The thread starts with the first motion and ends when no motion is left, so an idle robot (or
+a lone ``Motor``) holds no goto thread. A new goto on a motor replaces the one it was doing.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from poppy_core.errors import PortError
+from poppy_core.motion.trajectory import CONTROLS, MinimumJerk, dummy_speed
+from poppy_core.robot.schedule import Periodic
+
+if TYPE_CHECKING:
+    from poppy_core.robot.motor import Motor
+
+logger = logging.getLogger(__name__)
+
+DEFAULT_RATE_HZ = 50.0
+
+
+class GotoHandle:
+    """A running goto of one or several motors; done when every motor arrived or was cancelled."""
+
+    def __init__(self, count: int, duration_s: float) -> None:
+        self._left = count
+        self._done = threading.Event()
+        self.duration_s = duration_s
+        self.cancelled = False
+        if count == 0:
+            self._done.set()
+
+    @property
+    def done(self) -> bool:
+        """True once the motion is over (or cancelled)."""
+        return self._done.is_set()
+
+    def wait(self, timeout_s: float | None = None) -> bool:
+        """Block until the motion is over; False when ``timeout_s`` ran out first."""
+        return self._done.wait(timeout_s)
+
+    def _finish_one(self, cancelled: bool) -> None:
+        self.cancelled = self.cancelled or cancelled
+        self._left -= 1
+        if self._left <= 0:
+            self._done.set()
+
+
+@dataclass
+class _Move:
+    motor: Motor
+    goal: float
+    trajectory: MinimumJerk | None
+    t0: float
+    end: float
+    handle: GotoHandle
+
+
+class GotoRunner:
+    """Runs gotos at ``rate_hz`` (the write rate of the sync loops)."""
+
+    def __init__(
+        self,
+        rate_hz: float = DEFAULT_RATE_HZ,
+        *,
+        name: str = "goto",
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.period_s = 1.0 / rate_hz
+        self.name = name
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._moves: dict[int, _Move] = {}
+        self._thread: threading.Thread | None = None
+        self._wake = threading.Event()
+        self._closed = False
+
+    @property
+    def active(self) -> int:
+        """Number of motors moving under a goto."""
+        with self._lock:
+            return len(self._moves)
+
+    def start(self, targets: Mapping[Motor, float], duration_s: float, control: str) -> GotoHandle:
+        """Start moving each motor to its target (degrees, user frame) in ``duration_s``.
+
+        Raises:
+            ValueError: unknown ``control`` or a negative duration.
+            PortError: the runner (its robot) is closed.
+        """
+        if control not in CONTROLS:
+            raise ValueError(f"control must be one of {', '.join(CONTROLS)}, not {control!r}")
+        if duration_s < 0:
+            raise ValueError(f"duration must not be negative, got {duration_s} s")
+        handle = GotoHandle(len(targets), duration_s)
+        now = self._clock()
+        with self._lock:
+            if self._closed:
+                raise PortError("the robot is closed: no more motions")
+            for motor, target in targets.items():
+                self._cancel_locked(motor)
+                low, high = motor.angle_limit
+                goal = float(target) if motor.wheel_mode else min(max(float(target), low), high)
+                start = motor.present_position
+                trajectory = None
+                if control == "dummy" or duration_s == 0:
+                    speed = dummy_speed(start, goal, duration_s)
+                    register = motor.model.register("moving_speed")
+                    motor.moving_speed = max(speed, abs(float(register.to_si(1)))) if speed else 0
+                    motor.set_goal(goal)
+                else:
+                    motor.moving_speed = 0.0  # full speed: the trajectory sets the pace
+                    trajectory = MinimumJerk(start, goal, duration_s)
+                self._moves[id(motor)] = _Move(
+                    motor, goal, trajectory, now, now + duration_s, handle
+                )
+            if self._moves and self._thread is None:
+                self._wake.clear()
+                self._thread = threading.Thread(target=self._run, name=self.name, daemon=True)
+                self._thread.start()
+        return handle
+
+    def cancel(self, motor: Motor) -> None:
+        """Stop the goto of ``motor`` where it is (its goal stays the last one sent)."""
+        with self._lock:
+            self._cancel_locked(motor)
+
+    def _cancel_locked(self, motor: Motor) -> None:
+        move = self._moves.pop(id(motor), None)
+        if move is not None:
+            move.handle._finish_one(cancelled=True)
+
+    def close(self) -> None:
+        """Cancel every goto and join the thread (idempotent)."""
+        with self._lock:
+            self._closed = True
+            for move in self._moves.values():
+                move.handle._finish_one(cancelled=True)
+            self._moves.clear()
+            thread = self._thread
+            self._wake.set()
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout=2.0)
+
+    def _step(self, now: float) -> bool:
+        """Advance every move; False when none is left (the thread then ends)."""
+        with self._lock:
+            for key, move in list(self._moves.items()):
+                try:
+                    if move.trajectory is not None:
+                        move.motor.set_goal(move.trajectory.position(now - move.t0))
+                except Exception:
+                    logger.exception("goto of %s failed; stopping it", move.motor.name)
+                    del self._moves[key]
+                    move.handle._finish_one(cancelled=True)
+                    continue
+                if now >= move.end:
+                    if move.trajectory is not None:
+                        move.motor.set_goal(move.goal)
+                    del self._moves[key]
+                    move.handle._finish_one(cancelled=False)
+            if not self._moves or self._closed:
+                self._thread = None
+                return False
+            return True
+
+    def _run(self) -> None:
+        schedule = Periodic(self.period_s, self._clock())
+        while True:
+            now = self._clock()
+            if not self._step(now):
+                return
+            schedule.advance(now)
+            self._wake.wait(max(0.0, schedule.next_deadline - self._clock()))

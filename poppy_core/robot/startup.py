@@ -1,0 +1,169 @@
+"""Start-up checks of a robot's motors: presence and model, first state, return delay, limits.
+
+Angle limits: like pypot, the configured limits are written to the servos' EEPROM angle limits
+at start-up (only when they differ by more than one step, to spare the EEPROM), so the servo's
+own firmware enforces them too. Unlike pypot, they are converted from the user frame to the
+motor frame first (orientation and offset applied), which fixes pypot's indirect-motor limits
+(pypot issues #231, #304). ``write_angle_limits=False`` leaves the EEPROM alone; goals are
+clamped in software either way.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from poppy_core.bus import DxlBus
+from poppy_core.errors import BusError, MotorError, RegisterError
+from poppy_core.robot import registers as regs
+from poppy_core.robot.motor import Motor
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ReturnDelayIssue:
+    """A motor whose return delay is above the wanted one (0 µs unless the config says)."""
+
+    motor: str
+    id: int
+    delay_us: float
+    target_us: float
+
+    def __str__(self) -> str:
+        return f"{self.motor} (id {self.id}): {self.delay_us:g} µs"
+
+
+ReturnDelayConsent = bool | Callable[[list[ReturnDelayIssue]], bool]
+"""True/False, or a function shown the issues that returns whether to fix them."""
+
+
+def where(bus: DxlBus) -> str:
+    """``/dev/ttyUSB0 at 1000000 bps, protocol 1`` (for messages)."""
+    return f"{bus.port} at {bus.baudrate} bps, protocol {bus.protocol}"
+
+
+def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> list[str]:
+    """Ping every motor; return one readable problem per missing motor or wrong model.
+
+    Motors that do not answer are marked offline (``motor.online = False``).
+    """
+    missing: list[str] = []
+    wrong: list[str] = []
+    for motor in motors:
+        try:
+            found = bus.ping(motor.id)
+        except BusError:
+            found = None
+        if found is None:
+            motor.online = False
+            missing.append(f"{motor.name} (id {motor.id})")
+            continue
+        if found.model is None or found.model.name != motor.model.name:
+            seen = found.model_name or f"model number {found.model_number}"
+            wrong.append(f"{motor.name} (id {motor.id}) is {seen}, config says {motor.model.name}")
+    problems = []
+    if missing:
+        problems.append(
+            f"controller {controller!r}: missing motors {', '.join(missing)} "
+            f"(searched {where(bus)})"
+        )
+    if wrong:
+        problems.append(f"controller {controller!r}: wrong model: {', '.join(wrong)}")
+    return problems
+
+
+def load_state(bus: DxlBus, motors: Sequence[Motor]) -> None:
+    """Read each online motor's control table once and fill its cache (one read per motor)."""
+    for motor in motors:
+        if not motor.online:
+            continue
+        data = bus.read(motor.id, 0, motor.model.table_size)
+        motor.update(regs.decode_table(motor.model, data))
+
+
+def return_delay_issues(
+    motors: Sequence[Motor], targets_us: dict[str, float]
+) -> list[ReturnDelayIssue]:
+    """Motors whose return delay (read by ``load_state``) is above its target."""
+    issues = []
+    for motor in motors:
+        if not motor.online:
+            continue
+        delay = motor.cached_number("return_delay_time")
+        target = targets_us.get(motor.name, 0.0)
+        if delay > target:
+            issues.append(ReturnDelayIssue(motor.name, motor.id, delay, target))
+    return issues
+
+
+def fix_return_delays(
+    bus: DxlBus,
+    motors: Sequence[Motor],
+    issues: list[ReturnDelayIssue],
+    consent: ReturnDelayConsent,
+) -> list[ReturnDelayIssue]:
+    """Report return delays above target and, with consent, write the targets.
+
+    Returns:
+        The issues left unfixed.
+    """
+    if not issues:
+        return []
+    agreed = consent(issues) if callable(consent) else consent
+    if not agreed:
+        logger.warning(
+            "return delay above 0 slows every transaction on %s: %s "
+            "(pass fix_return_delay=True to set it)",
+            bus.port,
+            ", ".join(map(str, issues)),
+        )
+        return issues
+    by_name = {m.name: m for m in motors}
+    left = []
+    for issue in issues:
+        motor = by_name[issue.motor]
+        try:
+            bus.write_register(motor.id, motor.model, "return_delay_time", issue.target_us)
+        except (BusError, MotorError, RegisterError) as exc:
+            logger.warning("%s: could not set the return delay: %s", issue.motor, exc)
+            left.append(issue)
+            continue
+        motor.update({"return_delay_time": issue.target_us})
+        logger.info("%s: return delay set to %g µs", issue.motor, issue.target_us)
+    return left
+
+
+def write_angle_limits(bus: DxlBus, motors: Sequence[Motor]) -> None:
+    """Write each motor's limits (motor frame) to its EEPROM when they differ (see module doc)."""
+    for motor in motors:
+        if not motor.online or motor.wheel_mode:
+            continue
+        model = motor.model
+        step = model.position_range_deg / model.resolution
+        wanted = motor.motor_limits()
+        names = ("min_position_limit", "max_position_limit")
+        present = (motor.cached_number(names[0]), motor.cached_number(names[1]))
+        if all(abs(w - p) <= step for w, p in zip(wanted, present, strict=True)):
+            continue
+        try:
+            for name, value in zip(names, wanted, strict=True):
+                bus.write_register(motor.id, model, name, value)
+        except (BusError, MotorError) as exc:
+            logger.warning(
+                "%s: could not write its angle limits %s (torque on?): %s",
+                motor.name,
+                wanted,
+                exc,
+            )
+            continue
+        motor.update(dict(zip(names, wanted, strict=True)))
+        logger.info(
+            "%s: EEPROM angle limits %s -> %s (motor frame)",
+            motor.name,
+            tuple(round(p, 1) for p in present),
+            tuple(round(w, 1) for w in wanted),
+        )
+
+

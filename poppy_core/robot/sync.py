@@ -1,0 +1,339 @@
+"""Sync loops: one thread per bus reads and writes register groups, each at its own rate.
+
+Defaults follow pypot's controllers. ``base`` (BaseDxlController): present position, speed and
+load read at 50 Hz; goal position, moving speed, torque limit, torque enable and LED written at
+50 Hz; PID gains or compliance margins/slopes written at 10 Hz; angle limits at 1 Hz; temperature
+and voltage read at 1 Hz. ``light`` (LightDxlController) reads only position and speed at 50 Hz
+and load, temperature and voltage at 1 Hz. Writes only send values that changed.
+
+Reads use ``DxlBus.sync_read`` (sync read, USB2AX sync read, bulk read or single reads, as the
+bus offers), one transaction per group of motors sharing a register layout. A motor that misses
+``offline_after`` reads in a row is marked offline: it leaves the fast loops and is pinged once
+per ``retry_period_s`` until it answers again. Deadlines are drift-free (``Periodic``).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+from poppy_core.bus import DxlBus
+from poppy_core.errors import BusError, MotorError, PoppyError
+from poppy_core.models import ServoModel
+from poppy_core.robot import registers as regs
+from poppy_core.robot.motor import Motor
+from poppy_core.robot.schedule import Periodic, RateMeter
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class LoopSpec:
+    """One register group: its registers, direction and rate."""
+
+    name: str
+    registers: tuple[str, ...]
+    write: bool
+    rate_hz: float
+
+
+BASE_LOOPS: tuple[LoopSpec, ...] = (
+    LoopSpec("present", regs.PRESENT, False, 50.0),
+    LoopSpec("goals", regs.GOALS, True, 50.0),
+    LoopSpec("gains", regs.GAINS, True, 10.0),
+    LoopSpec("limits", regs.LIMITS, True, 1.0),
+    LoopSpec("sensors", regs.SENSORS, False, 1.0),
+)
+LIGHT_LOOPS: tuple[LoopSpec, ...] = (
+    LoopSpec("present", ("present_position", "present_speed"), False, 50.0),
+    LoopSpec("goals", regs.GOALS, True, 50.0),
+    LoopSpec("gains", regs.GAINS, True, 10.0),
+    LoopSpec("limits", regs.LIMITS, True, 1.0),
+    LoopSpec("sensors", ("present_load", *regs.SENSORS), False, 1.0),
+)
+RETRY = "retry"
+
+
+def loops_for(syncloop: str) -> tuple[LoopSpec, ...]:
+    """The loops for a config's ``syncloop`` name (``LightDxlController`` → light, else base)."""
+    return LIGHT_LOOPS if "light" in syncloop.lower() else BASE_LOOPS
+
+
+@dataclass(frozen=True)
+class LoopStats:
+    """What one loop did: target and measured rate, runs, skipped periods, errors."""
+
+    name: str
+    target_hz: float
+    measured_hz: float
+    runs: int
+    missed_periods: int
+    errors: int
+    last_duration_s: float
+
+
+@dataclass(frozen=True)
+class SyncStats:
+    """One bus's loops, its motors' health and its bus counters."""
+
+    controller: str
+    port: str
+    running: bool
+    loops: dict[str, LoopStats]
+    motor_errors: dict[str, int]
+    offline: list[str]
+    bus: dict[str, int] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, object]:
+        """Plain data (for ``--json``)."""
+        return {
+            "controller": self.controller,
+            "port": self.port,
+            "running": self.running,
+            "loops": {name: vars(loop) for name, loop in self.loops.items()},
+            "motor_errors": dict(self.motor_errors),
+            "offline": list(self.offline),
+            "bus": dict(self.bus),
+        }
+
+
+class _Loop:
+    def __init__(self, spec: LoopSpec, start_s: float) -> None:
+        self.spec = spec
+        self.schedule = Periodic(1.0 / spec.rate_hz, start_s)
+        self.meter = RateMeter()
+        self.errors = 0
+        self.last_duration_s = 0.0
+
+
+class BusSync:
+    """The sync loops of one bus (one thread).
+
+    Args:
+        controller: the controller's name (for logs and stats).
+        bus: the open bus.
+        motors: the motors on it.
+        loops: the register groups (``BASE_LOOPS``, ``LIGHT_LOOPS`` or your own).
+        offline_after: consecutive missed reads before a motor is marked offline.
+        retry_period_s: how often offline motors are pinged.
+        clock: monotonic clock in seconds.
+    """
+
+    def __init__(
+        self,
+        controller: str,
+        bus: DxlBus,
+        motors: Sequence[Motor],
+        loops: Sequence[LoopSpec] = BASE_LOOPS,
+        *,
+        offline_after: int = 3,
+        retry_period_s: float = 1.0,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.controller = controller
+        self.bus = bus
+        self.motors = list(motors)
+        self.offline_after = offline_after
+        self._clock = clock
+        self._specs = [*loops, LoopSpec(RETRY, (), False, 1.0 / retry_period_s)]
+        self._loops: list[_Loop] = []
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._blocks: dict[tuple[str, ServoModel], list[regs.Block]] = {}
+
+    @property
+    def running(self) -> bool:
+        """True while the loop thread is alive."""
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self) -> None:
+        """Start the thread (no-op when running)."""
+        if self.running:
+            return
+        now = self._clock()
+        self._loops = [_Loop(spec, now) for spec in self._specs]
+        self._stop.clear()
+        self._thread = threading.Thread(
+            target=self._run, name=f"sync {self.controller}", daemon=True
+        )
+        self._thread.start()
+
+    def stop(self, timeout_s: float = 2.0) -> None:
+        """Stop and join the thread, then send the writes still pending (idempotent)."""
+        self._stop.set()
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout_s)
+            if thread.is_alive():
+                logger.warning("sync loop of %s did not stop in %.1f s", self.controller, timeout_s)
+        self._thread = None
+        self.flush()
+
+    def flush(self) -> None:
+        """Send every pending write now, from the calling thread.
+
+        Sync writes get no reply: when something was sent, one ping follows, so the writes
+        have been handled once this returns (the bus may be closed right after).
+        """
+        if not any(m.online and m.has_pending() for m in self.motors):
+            return
+        for spec in self._specs:
+            if spec.write:
+                try:
+                    self._write(spec)
+                except PoppyError as exc:
+                    logger.warning("%s: final writes failed: %s", self.controller, exc)
+        online = [m for m in self.motors if m.online]
+        if online:
+            try:
+                self.bus.ping(online[0].id, retries=0)
+            except PoppyError as exc:
+                logger.debug("%s: no reply after the final writes: %s", self.controller, exc)
+
+    def run_once(self, name: str) -> None:
+        """Run one loop now (tests and tools); errors propagate."""
+        spec = next(s for s in self._specs if s.name == name)
+        self._execute(spec)
+
+    def stats(self) -> SyncStats:
+        """Measured rates, error counts and offline motors."""
+        loops = {
+            loop.spec.name: LoopStats(
+                loop.spec.name,
+                loop.spec.rate_hz,
+                loop.meter.rate_hz,
+                loop.meter.count,
+                loop.schedule.missed,
+                loop.errors,
+                loop.last_duration_s,
+            )
+            for loop in self._loops
+        }
+        return SyncStats(
+            self.controller,
+            self.bus.port,
+            self.running,
+            loops,
+            {m.name: m.errors for m in self.motors},
+            [m.name for m in self.motors if not m.online],
+            self.bus.stats.as_dict(),
+        )
+
+    # -- the thread ------------------------------------------------------------------------------
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            now = self._clock()
+            for loop in self._loops:
+                if self._stop.is_set():
+                    return
+                if not loop.schedule.due(now):
+                    continue
+                loop.meter.tick(now)
+                started = self._clock()
+                try:
+                    self._execute(loop.spec)
+                except Exception as exc:
+                    loop.errors += 1
+                    if isinstance(exc, PoppyError | OSError):
+                        logger.debug("%s %s loop: %s", self.controller, loop.spec.name, exc)
+                    else:
+                        logger.exception("%s %s loop failed", self.controller, loop.spec.name)
+                loop.last_duration_s = self._clock() - started
+                loop.schedule.advance(now)
+            wake = min(loop.schedule.next_deadline for loop in self._loops)
+            self._stop.wait(max(0.0, wake - self._clock()))
+
+    def _execute(self, spec: LoopSpec) -> None:
+        if spec.name == RETRY:
+            self._retry()
+        elif spec.write:
+            self._write(spec)
+        else:
+            self._read(spec)
+
+    def _blocks_for(self, spec: LoopSpec, model: ServoModel) -> list[regs.Block]:
+        key = (spec.name, model)
+        if key not in self._blocks:
+            self._blocks[key] = regs.read_blocks(model, spec.registers)
+        return self._blocks[key]
+
+    def _read(self, spec: LoopSpec) -> None:
+        # Motors whose blocks share address and length go in one transaction, whatever their
+        # model (AX and MX have the same layout); each decodes with its own registers.
+        batches: dict[tuple[int, int], list[tuple[Motor, regs.Block]]] = {}
+        for motor in self.motors:
+            if motor.online:
+                for block in self._blocks_for(spec, motor.model):
+                    batches.setdefault((block.address, block.length), []).append((motor, block))
+        for (address, length), members in batches.items():
+            by_id = {motor.id: (motor, block) for motor, block in members}
+            try:
+                data = self.bus.sync_read(address, length, list(by_id))
+            except MotorError as exc:
+                member = by_id.get(exc.motor_id)
+                self._missed(None if member is None else member[0], str(exc))
+                raise
+            for motor_id, payload in data.items():
+                if motor_id not in by_id:
+                    continue
+                motor, block = by_id[motor_id]
+                if payload is None or len(payload) != length:
+                    self._missed(motor, f"no reply to the {spec.name} read")
+                    continue
+                motor.update(block.decode(payload))
+                self._answered(motor)
+
+    def _answered(self, motor: Motor) -> None:
+        if motor.mark_answered():
+            logger.info("%s (id %d) answers again", motor.name, motor.id)
+            motor.resend_state()
+
+    def _missed(self, motor: Motor | None, reason: str) -> None:
+        if motor is not None and motor.mark_missed(self.offline_after):
+            logger.warning(
+                "%s (id %d) on %s stopped answering (%s); retrying every %.1f s",
+                motor.name,
+                motor.id,
+                self.bus.port,
+                reason,
+                1.0 / self._specs[-1].rate_hz,
+            )
+
+    def _write(self, spec: LoopSpec) -> None:
+        taken: list[tuple[Motor, dict[str, int]]] = []
+        for motor in self.motors:
+            if motor.online:
+                values = motor.take_pending(spec.registers)
+                if values:
+                    taken.append((motor, values))
+        if not taken:
+            return
+        try:
+            for name in spec.registers:
+                groups: dict[tuple[int, int], dict[int, bytes]] = {}
+                for motor, values in taken:
+                    if name in values:
+                        register = motor.model.register(name)
+                        key = (register.address, register.size)
+                        groups.setdefault(key, {})[motor.id] = register.encode(values[name])
+                for (address, _), data in groups.items():
+                    self.bus.sync_write(address, data)
+        except BusError:
+            for motor, values in taken:
+                motor.restore_pending(values)
+            raise
+
+    def _retry(self) -> None:
+        for motor in self.motors:
+            if motor.online or self._stop.is_set():
+                continue
+            try:
+                answered = self.bus.ping(motor.id, retries=0) is not None
+            except BusError:
+                answered = False
+            if answered:
+                self._answered(motor)

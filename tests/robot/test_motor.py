@@ -1,0 +1,149 @@
+"""Motor arithmetic without a bus: frames, limits, goal speed, compliance, pending writes."""
+
+from __future__ import annotations
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from poppy_core.errors import RegisterError
+from poppy_core.models import model_by_name
+from poppy_core.robot import Motor
+
+AX = model_by_name("AX-12A")
+MX = model_by_name("MX-28")
+XL = model_by_name("XL-320")
+XM = model_by_name("XM430-W350")
+
+
+def stiff(motor: Motor, present_user: float = 0.0) -> Motor:
+    """Give the motor a present position (as a read would) and switch its torque on."""
+    motor.update({"present_position": motor.to_motor(present_user)})
+    motor.compliant = False
+    motor.take_pending(["goal_position", "torque_enable"])
+    return motor
+
+
+@given(
+    st.sampled_from(["direct", "indirect"]),
+    st.floats(-40, 40, allow_nan=False),
+    st.floats(-100, 100, allow_nan=False),
+)
+def test_frames_are_inverse(orientation: str, offset: float, user: float) -> None:
+    motor = Motor("m", MX, 1, orientation=orientation, offset=offset)  # type: ignore[arg-type]
+    assert motor.to_user(motor.to_motor(user)) == pytest.approx(user)
+
+
+def test_indirect_flips_and_offset_adds() -> None:
+    motor = Motor("m", AX, 1, orientation="indirect", offset=20.0, angle_limit=(-40, 8))
+    motor.update({"present_position": 10.0, "present_speed": 5.0, "present_load": -12.0})
+    assert motor.present_position == pytest.approx(-30.0)  # -(10) - 20
+    assert motor.present_speed == -5.0
+    assert motor.present_load == 12.0
+    stiff(motor, -30.0)
+    motor.goal_position = 0.0
+    assert motor.goal_position == pytest.approx(0.0)
+    register = AX.register("goal_position")
+    raw = motor.take_pending(["goal_position"])["goal_position"]
+    assert register.to_si(raw) == pytest.approx(-20.0, abs=0.3)  # motor = -(0 + 20)
+
+
+def test_goal_clamped_to_user_limits_and_model_range() -> None:
+    motor = stiff(Motor("m", XL, 2, orientation="indirect", angle_limit=(-90, 125)))
+    motor.goal_position = 170
+    assert motor.goal_position == 125
+    motor.goal_position = -1000
+    assert motor.goal_position == -90
+    assert motor.motor_limits() == (-125, 90)
+    whole = stiff(Motor("w", AX, 3, angle_limit=(-150, 150)))
+    whole.goal_position = 150  # past the last raw step (149.7°): clamped, no RegisterError
+    assert whole.take_pending(["goal_position"]) == {"goal_position": 1023}
+
+
+def test_goal_waits_while_compliant() -> None:
+    motor = Motor("m", MX, 1)
+    motor.update({"present_position": 12.0})
+    motor.goal_position = 30
+    assert motor.take_pending(["goal_position"]) == {}
+    motor.compliant = False  # goal = present, then torque on
+    pending = motor.take_pending(["goal_position", "torque_enable"])
+    assert pending["torque_enable"] == 1
+    goal = MX.register("goal_position").to_si(pending["goal_position"])
+    assert goal == pytest.approx(12, abs=0.1)
+
+
+def test_goal_speed_uses_limits() -> None:
+    motor = stiff(Motor("m", AX, 1, orientation="indirect", angle_limit=(-40, 30)), 5.0)
+    motor.goal_speed = 20
+    assert motor.goal_position == 30 and motor.moving_speed == 20 and motor.goal_speed == 20
+    motor.goal_speed = -1e6
+    assert motor.goal_position == -40
+    assert motor.moving_speed == pytest.approx(AX.no_load_speed_dps)
+    motor.goal_speed = 0
+    assert motor.goal_position == pytest.approx(5.0) and motor.goal_speed == 0
+    motor.goal_speed = 0.01  # below one step: sent as the smallest speed, never 0 (= full)
+    assert motor.moving_speed > 0
+    motor.goal_position = 0
+    assert motor.goal_speed == 0
+
+
+def test_safe_compliance_stiffens_past_a_limit() -> None:
+    motor = Motor("m", MX, 1, angle_limit=(-30, 30))
+    motor.compliant_behavior = "safe"
+    motor.compliant = True
+    motor.update({"present_position": 10.0})
+    assert not motor.torque_enabled
+    motor.update({"present_position": 42.0})
+    assert motor.torque_enabled and motor.compliant
+    assert motor.goal_position == 30
+    motor.update({"present_position": 29.5})  # still at the wall: keeps holding
+    assert motor.torque_enabled
+    motor.update({"present_position": 20.0})  # pulled back inside: free again
+    assert not motor.torque_enabled
+    motor.compliant_behavior = "dummy"
+    motor.update({"present_position": 50.0})
+    assert not motor.torque_enabled
+    with pytest.raises(RegisterError):
+        motor.compliant_behavior = "soft"
+
+
+def test_model_specific_registers() -> None:
+    ax, mx, xm = Motor("a", AX, 1), Motor("b", MX, 2), Motor("c", XM, 3)
+    assert "compliance_margin" in ax.registers and "pid" not in ax.registers
+    assert "pid" in mx.registers and "torque_limit" not in xm.registers
+    mx.pid = (4.0, 0.0, 1.0)
+    assert mx.pid == (4.0, 0.0, 1.0)
+    assert set(mx.take_pending(["p_gain", "i_gain", "d_gain"])) == {"p_gain", "i_gain", "d_gain"}
+    ax.compliance_margin = 2
+    assert ax.compliance_margin == (2, 2)
+    with pytest.raises(RegisterError):
+        ax.pid = (1.0, 0.0, 0.0)
+    with pytest.raises(RegisterError):
+        mx.compliance_slope = 32
+    assert xm.torque_limit == 100.0
+    with pytest.raises(RegisterError):
+        xm.torque_limit = 50
+    mx.max_torque = 40
+    assert mx.torque_limit == 40
+    with pytest.raises(RegisterError):
+        mx.torque_limit = 150
+    with pytest.raises(RegisterError):
+        mx.moving_speed = -5
+
+
+def test_restore_keeps_newer_values() -> None:
+    motor = stiff(Motor("m", MX, 1))
+    motor.moving_speed = 10
+    taken = motor.take_pending(["moving_speed"])
+    motor.moving_speed = 20
+    motor.restore_pending(taken)
+    newer = motor.take_pending(["moving_speed"])["moving_speed"]
+    assert MX.register("moving_speed").to_si(newer) == pytest.approx(20, abs=0.7)
+
+
+def test_bad_limits_refused() -> None:
+    with pytest.raises(RegisterError):
+        Motor("m", MX, 1, angle_limit=(10, -10))
+    motor = Motor("m", MX, 1)
+    with pytest.raises(RegisterError):
+        motor.angle_limit = (5, 5)

@@ -1,0 +1,171 @@
+"""A simulated Ergo Jr through a real pty: compliance, gotos, speed control, faults, closing."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Iterator
+
+import pytest
+
+from poppy_core.errors import ConfigError, PortError
+from poppy_core.robot import Robot, from_profile
+
+CONTROLLER = "my_dxl_controller"
+
+
+def eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
+    """Poll ``check`` until it holds (True) or the timeout runs out (False)."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if check():
+            return True
+        time.sleep(0.01)
+    return check()
+
+
+@pytest.fixture
+def ergo() -> Iterator[Robot]:
+    robot = from_profile("ergo-jr", sim=True)
+    try:
+        yield robot
+    finally:
+        robot.close()
+
+
+def virtual(robot: Robot, motor_id: int):  # type: ignore[no-untyped-def]
+    return robot.emulators[CONTROLLER].bus.motor(motor_id)
+
+
+def test_motors_and_groups_as_attributes(ergo: Robot) -> None:
+    assert [m.name for m in ergo.motors] == ["m1", "m2", "m3", "m4", "m5", "m6"]
+    assert ergo.base == [ergo.m1, ergo.m2, ergo.m3]
+    assert ergo.motor("m4") is ergo.m4 and ergo.group("tip")[0] is ergo.m4
+    with pytest.raises(AttributeError):
+        _ = ergo.m9
+    with pytest.raises(ConfigError):
+        ergo.motor("m9")
+
+
+def test_stiff_motor_reaches_its_goal(ergo: Robot) -> None:
+    ergo.m2.compliant = False
+    ergo.m2.goal_position = 40  # indirect: the virtual horn goes to -40
+    assert eventually(lambda: abs(ergo.m2.present_position - 40) < 1)
+    assert virtual(ergo, 2).present_position_deg == pytest.approx(-40, abs=1)
+    ergo.m2.goal_position = 500  # clamped to the limit (125)
+    assert eventually(lambda: abs(ergo.m2.present_position - 125) < 1)
+    ergo.compliant = True
+    assert eventually(lambda: not virtual(ergo, 2).torque_enabled)
+    assert ergo.compliant
+
+
+def test_compliant_motor_follows_the_hand(ergo: Robot) -> None:
+    virtual(ergo, 1).move_by_hand(33.0)
+    assert eventually(lambda: abs(ergo.m1.present_position - 33) < 0.5)
+    virtual(ergo, 1).move_by_hand(170.0)  # past its limits, dummy compliance: stays there
+    assert eventually(lambda: ergo.m1.present_position > 140)
+    time.sleep(0.1)
+    assert not virtual(ergo, 1).torque_enabled
+
+
+def test_safe_compliance_stiffens_at_the_limit(ergo: Robot) -> None:
+    motor = ergo.m3  # indirect, limits -90..90
+    motor.compliant_behavior = "safe"
+    motor.compliant = True
+    virtual(ergo, 3).move_by_hand(-20.0)  # user +20: inside, stays free
+    assert eventually(lambda: abs(motor.present_position - 20) < 0.5)
+    assert not virtual(ergo, 3).torque_enabled
+    virtual(ergo, 3).move_by_hand(-120.0)  # user +120: past the 90° limit
+    assert eventually(lambda: virtual(ergo, 3).torque_enabled)
+    assert eventually(lambda: abs(motor.present_position - 90) < 1)
+    assert motor.compliant and motor.torque_enabled
+
+
+def test_minjerk_goto_timing_and_accuracy(ergo: Robot) -> None:
+    ergo.power_up()
+    start = time.monotonic()
+    handle = ergo.goto_position({"m1": 60, "m2": -30, "m6": 200}, 1.0)
+    assert not handle.done
+    time.sleep(0.5)
+    assert 15 < ergo.m1.present_position < 45  # half-way on a symmetric bell
+    assert handle.wait(3.0)
+    elapsed = time.monotonic() - start
+    assert 0.9 <= elapsed < 1.6
+    assert eventually(lambda: abs(ergo.m1.present_position - 60) < 1, 1.0)
+    assert abs(ergo.m2.present_position + 30) < 1
+    assert abs(ergo.m6.present_position - 90) < 1  # clamped target
+
+
+def test_dummy_goto_and_cancel(ergo: Robot) -> None:
+    ergo.power_up()
+    first = ergo.m4.goto_position(50, 2.0)
+    ergo.m4.goto_position(-20, 0.5, control="dummy", wait=True)
+    assert first.done and first.cancelled
+    assert ergo.m4.moving_speed == pytest.approx(40, rel=0.1)  # 20° in 0.5 s
+    assert eventually(lambda: abs(ergo.m4.present_position + 20) < 1, 1.0)
+    with pytest.raises(ValueError):
+        ergo.m4.goto_position(0, 1, control="linear")
+
+
+def test_goal_speed_moves_at_speed_and_stops_at_the_limit(ergo: Robot) -> None:
+    ergo.power_up()
+    motor = ergo.m5  # indirect, limits -90..90
+    motor.goal_speed = 100
+    time.sleep(0.1)
+    p0, t0 = motor.present_position, time.monotonic()
+    time.sleep(0.3)
+    speed = (motor.present_position - p0) / (time.monotonic() - t0)
+    assert 50 < speed < 150
+    assert motor.present_speed > 0
+    assert eventually(lambda: abs(motor.present_position - 90) < 1, 2.0)
+    motor.goal_speed = -400
+    assert eventually(lambda: abs(motor.present_position + 90) < 1, 2.0)
+
+
+def test_unplugged_motor_does_not_slow_the_others(ergo: Robot) -> None:
+    emulator = ergo.emulators[CONTROLLER].bus
+    emulator.unplug(4)
+    assert eventually(lambda: not ergo.m4.online, 2.0)
+    time.sleep(1.2)  # a full rate window without m4
+    stats = ergo.sync_stats()[CONTROLLER]
+    assert "m4" in stats.offline and stats.motor_errors["m4"] >= 3
+    assert stats.loops["present"].measured_hz > 30
+    virtual(ergo, 1).move_by_hand(-25.0)
+    assert eventually(lambda: abs(ergo.m1.present_position + 25) < 0.5, 1.0)
+    emulator.plug(4)
+    assert eventually(lambda: ergo.m4.online, 3.0)
+    assert ergo.sync_stats()[CONTROLLER].offline == []
+
+
+def test_to_config_reflects_the_motors(ergo: Robot) -> None:
+    ergo.m1.angle_limit = (-100, 100)
+    config = ergo.to_config()
+    assert config.motors["m1"].angle_limit == (-100, 100)
+    assert config.controllers[CONTROLLER].port == "auto"
+    assert eventually(lambda: virtual(ergo, 1).table.get_si("max_position_limit") == pytest.approx(
+        100, abs=0.3), 2.0)
+
+
+def test_close_stops_every_thread() -> None:
+    before = set(threading.enumerate())
+    robot = from_profile("ergo-jr", sim=True)
+    robot.power_up()
+    robot.goto_position({"m1": 40}, 5.0)
+    assert len(set(threading.enumerate()) - before) >= 3  # sync, goto, emulator
+    robot.m1.compliant = True
+    robot.close()
+    robot.close()
+    assert set(threading.enumerate()) - before == set()
+    assert robot.closed
+    with pytest.raises(PortError):
+        robot.goto_position({"m1": 0}, 1.0)
+
+
+def test_context_manager_sends_last_orders() -> None:
+    with from_profile("ergo-jr", sim=True) as robot:
+        robot.power_up()
+        time.sleep(0.1)
+        bus = robot.emulators[CONTROLLER].bus
+        robot.compliant = True  # sent by the final flush even if the loop is not due yet
+        assert robot.m1.compliant
+    assert not any(m.torque_enabled for m in bus.motors)
