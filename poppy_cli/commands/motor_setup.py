@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
 import typer
 
 from poppy_cli.commands.motor import (
@@ -14,6 +17,10 @@ from poppy_cli.commands.motor import (
     require_port,
 )
 
+if TYPE_CHECKING:
+    from poppy_core.bus.dxlbus import DxlBus
+    from poppy_core.bus.results import SetupResult
+
 __all__ = ["app"]
 from poppy_cli.connect import open_bus
 from poppy_cli.output import EXIT_USAGE, console, error_line
@@ -21,6 +28,20 @@ from poppy_cli.output import EXIT_USAGE, console, error_line
 
 def _say(message: str) -> None:
     console.print(f"[dim]· {message}[/]")
+
+
+def _run_setup(
+    port: str | None,
+    motor_id: int,
+    baud: int | None,
+    protocol: int | None,
+    json_output: bool,
+    operation: Callable[[DxlBus, Callable[[str], None] | None], SetupResult],
+) -> None:
+    """Open the bus where ``motor_id`` answers, run one setup operation, print its result."""
+    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
+        result = operation(bus, None if json_output else _say)
+    print_setup(result, json_output)
 
 
 @app.command("set-id")
@@ -35,9 +56,14 @@ def set_id(
     """Give a motor a new ID (refused if the ID is taken; verified afterwards)."""
     from poppy_core.bus.setup import change_id
 
-    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
-        result = change_id(bus, motor_id, new_id, progress=None if json_output else _say)
-    print_setup(result, json_output)
+    _run_setup(
+        port,
+        motor_id,
+        baud,
+        protocol,
+        json_output,
+        lambda bus, say: change_id(bus, motor_id, new_id, progress=say),
+    )
 
 
 @app.command("set-baudrate")
@@ -52,9 +78,14 @@ def set_baudrate(
     """Change a motor's baud rate; it is checked at the new rate (and found again if lost)."""
     from poppy_core.bus.setup import change_baudrate
 
-    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
-        result = change_baudrate(bus, motor_id, rate, progress=None if json_output else _say)
-    print_setup(result, json_output)
+    _run_setup(
+        port,
+        motor_id,
+        baud,
+        protocol,
+        json_output,
+        lambda bus, say: change_baudrate(bus, motor_id, rate, progress=say),
+    )
 
 
 @app.command("set-return-delay")
@@ -69,9 +100,14 @@ def set_return_delay(
     """Set the return delay time (µs); Poppy robots use 0."""
     from poppy_core.bus.setup import set_return_delay as run
 
-    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
-        result = run(bus, motor_id, delay_us, progress=None if json_output else _say)
-    print_setup(result, json_output)
+    _run_setup(
+        port,
+        motor_id,
+        baud,
+        protocol,
+        json_output,
+        lambda bus, say: run(bus, motor_id, delay_us, progress=say),
+    )
 
 
 @app.command("angle-limits")
@@ -122,9 +158,14 @@ def reboot(
     """Reboot a motor (clears a hardware alarm) and wait until it answers again."""
     from poppy_core.bus.setup import reboot as run
 
-    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
-        result = run(bus, motor_id, progress=None if json_output else _say)
-    print_setup(result, json_output)
+    _run_setup(
+        port,
+        motor_id,
+        baud,
+        protocol,
+        json_output,
+        lambda bus, say: run(bus, motor_id, progress=say),
+    )
 
 
 @app.command("factory-reset")
@@ -150,15 +191,16 @@ def factory_reset(
     ):
         error_line("factory reset cancelled")
         raise typer.Exit(EXIT_USAGE)
-    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
-        result = run(
-            bus,
-            motor_id,
-            keep_id=not reset_id,
-            keep_baudrate=not reset_baudrate,
-            progress=None if json_output else _say,
-        )
-    print_setup(result, json_output)
+    _run_setup(
+        port,
+        motor_id,
+        baud,
+        protocol,
+        json_output,
+        lambda bus, say: run(
+            bus, motor_id, keep_id=not reset_id, keep_baudrate=not reset_baudrate, progress=say
+        ),
+    )
 
 
 @app.command("reset")
@@ -188,8 +230,13 @@ def reset(
         except ValueError:
             raise typer.BadParameter(f"{limits!r} is not MIN,MAX, e.g. -150,150") from None
         angle_limits = (low, high)
-    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
-        result = reset_motor(
+    _run_setup(
+        port,
+        motor_id,
+        baud,
+        protocol,
+        json_output,
+        lambda bus, say: reset_motor(
             bus,
             motor_id,
             target_id=target_id,
@@ -197,6 +244,6 @@ def reset(
             baudrate=rate,
             angle_limits=angle_limits,
             go_to_zero=zero,
-            progress=None if json_output else _say,
-        )
-    print_setup(result, json_output)
+            progress=say,
+        ),
+    )
