@@ -1,0 +1,1 @@
+"""Benchmarks comparing poppy with pypot and dynamixel-sdk; run with ``python -m bench``."""
