@@ -8,7 +8,7 @@ import sys
 import typer
 
 from poppy_cli import state
-from poppy_cli.commands import demo, emulate, motor_setup, ports, scan
+from poppy_cli.commands import config, demo, emulate, motor_setup, ports, robot, scan
 from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, error_line
 
 app = typer.Typer(
@@ -39,6 +39,8 @@ app.command("scan")(scan.scan)
 app.add_typer(motor_setup.app, name="motor")
 app.command("emulate")(emulate.emulate)
 app.command("demo")(demo.demo)
+app.add_typer(config.app, name="config")
+app.add_typer(robot.app, name="robot")
 
 
 def main() -> None:

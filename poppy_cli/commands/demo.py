@@ -1,18 +1,37 @@
-"""`poppy demo`: a virtual Ergo Jr in-process, found by a scan and read in SI units."""
+"""`poppy demo`: a virtual Ergo Jr in-process, scanned, read in SI units, then moved."""
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import typer
 
 from poppy_cli.output import console, fmt_value
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from poppy_core.robot import Robot
+
+# The choreography: (label, motor name -> degrees, seconds); about 6 s in all.
+CHOREOGRAPHY: list[tuple[str, dict[str, float], float]] = [
+    ("base turn", {"m1": 45.0}, 1.0),
+    ("bow", {"m1": 0.0, "m2": 40.0, "m3": 30.0}, 1.2),
+    ("wave up", {"m2": -20.0, "m3": -30.0, "m5": 40.0}, 1.0),
+    ("wave", {"m4": 40.0, "m6": -30.0}, 0.6),
+    ("wave back", {"m4": -40.0, "m6": 30.0}, 0.6),
+    ("back to zero", {f"m{i}": 0.0 for i in range(1, 7)}, 1.4),
+]
+QUICK_FACTOR = 0.1
 
 
 def demo(
     wire_timing: bool = typer.Option(
         True, "--wire-timing/--no-wire-timing", help="Emulate the wire's timing (1 Mbps)."
     ),
+    quick: bool = typer.Option(False, "--quick", help="Play the choreography ten times faster."),
 ) -> None:
-    """Start a virtual Ergo Jr (six XL-320), scan its bus, and show what was found."""
+    """Start a virtual Ergo Jr (six XL-320), scan it, show it, then play a short dance."""
     from rich.table import Table
 
     from poppy_cli.commands.scan import render_found
@@ -51,7 +70,48 @@ def demo(
                     get("led"),
                 )
         console.print(table)
-        console.print(
-            "Next: [bold]poppy emulate --profile ergo-jr[/] serves this robot to other programs; "
-            "[bold]poppy scan --port PATH[/] finds its motors."
+    dance(QUICK_FACTOR if quick else 1.0)
+    console.print(
+        "Next: [bold]poppy emulate --profile ergo-jr[/] serves this robot to other programs; "
+        "[bold]poppy scan --port PATH[/] finds its motors; "
+        "[bold]poppy robot status --sim --profile ergo-jr[/] shows a virtual robot."
+    )
+
+
+def positions_table(robot: Robot, step: str) -> Table:
+    """The motors' positions and goals during the dance."""
+    from rich.table import Table
+
+    table = Table(title=f"virtual Ergo Jr dancing: {step}")
+    for column in ("motor", "position", "goal"):
+        table.add_column(column, justify="left" if column == "motor" else "right")
+    for motor in robot.motors:
+        table.add_row(
+            motor.name,
+            fmt_value(round(motor.present_position, 1), "°"),
+            fmt_value(round(motor.goal_position, 1), "°"),
         )
+    return table
+
+
+def dance(time_factor: float) -> None:
+    """Build the virtual Ergo Jr robot and play the choreography, showing the positions live."""
+    import time
+
+    from rich.live import Live
+
+    from poppy_core.robot import from_profile
+
+    with from_profile("ergo-jr", sim=True) as robot:
+        robot.compliant = False
+        with Live(positions_table(robot, "ready"), console=console, refresh_per_second=10) as live:
+            for label, goals, duration_s in CHOREOGRAPHY:
+                handle = robot.goto_position(goals, duration_s * time_factor)
+                end = time.monotonic() + duration_s * time_factor
+                while time.monotonic() < end:
+                    live.update(positions_table(robot, label))
+                    time.sleep(0.05)
+                handle.wait()
+            time.sleep(0.1)
+            live.update(positions_table(robot, "done"))
+    console.print()

@@ -1,0 +1,199 @@
+"""`poppy config ...`: check, convert, show, list and generate robot configs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+
+from poppy_cli.options import BAUD_HELP, PORT_HELP, PROTOCOL_HELP, default_port
+from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, console, error_line, fmt_value, print_json
+
+if TYPE_CHECKING:
+    from poppy_core.bus.results import FoundMotor
+    from poppy_core.robot import RobotConfig
+
+app = typer.Typer(
+    help="Robot configs and profiles: validate, convert, show, list, generate from a bus.",
+    no_args_is_help=True,
+)
+
+
+def _counts(config: RobotConfig) -> str:
+    return (
+        f"{len(config.motors)} motors, {len(config.controllers)} controllers, "
+        f"{len(config.motorgroups)} groups"
+    )
+
+
+@app.command("validate")
+def validate(file: Path = typer.Argument(..., help="Config file (JSON or YAML).")) -> None:
+    """Check a config file; a problem is reported as one line naming the field."""
+    from poppy_core.robot import load_config
+
+    config = load_config(file)
+    console.print(f"[green]ok[/] {file}: {_counts(config)}")
+
+
+@app.command("convert")
+def convert(
+    source: Path = typer.Argument(..., help="Config to read (JSON or YAML)."),
+    target: Path = typer.Argument(..., help="File to write; .json or .yaml/.yml picks the format."),
+) -> None:
+    """Convert a config between JSON and YAML (the format follows TARGET's extension)."""
+    from poppy_core.robot import dump_config, load_config
+
+    if target.suffix.lower() not in (".json", ".yaml", ".yml"):
+        error_line(f"{target}: the extension must be .json, .yaml or .yml")
+        raise typer.Exit(EXIT_USAGE)
+    config = load_config(source)
+    dump_config(config, target)
+    console.print(f"wrote {target}: {_counts(config)}")
+
+
+@app.command("show")
+def show(
+    profile: str = typer.Argument(..., help="Profile name (see `poppy config list`) or a file."),
+    json_output: bool = typer.Option(False, "--json", help="Print the config as JSON."),
+    yaml_output: bool = typer.Option(False, "--yaml", help="Print the config as YAML."),
+) -> None:
+    """Show a profile's (or config file's) motors, controllers and groups."""
+    from rich.table import Table
+
+    from poppy_core.robot import config_to_text, load_config, load_profile
+
+    path = Path(profile)
+    config = load_config(path) if path.is_file() else load_profile(profile)
+    if json_output:
+        print_json(config.to_dict())
+        return
+    if yaml_output:
+        console.print(config_to_text(config, "yaml"), markup=False, end="")
+        return
+    table = Table(title=f"{profile}: {_counts(config)}")
+    for column in ("motor", "id", "model", "orientation", "offset", "limits", "controller"):
+        table.add_column(column, justify="right" if column in ("id", "offset") else "left")
+    for name, motor in config.motors.items():
+        low, high = motor.angle_limit
+        table.add_row(
+            name,
+            str(motor.id),
+            motor.type,
+            motor.orientation,
+            fmt_value(motor.offset, "°"),
+            f"{fmt_value(low)}° … {fmt_value(high)}°",
+            config.controller_of(name) or "-",
+        )
+    console.print(table)
+    for name, controller in config.controllers.items():
+        console.print(
+            f"controller [bold]{name}[/]: port {controller.port}, protocol {controller.protocol}, "
+            f"{controller.baudrate} bps"
+        )
+    for name in config.motorgroups:
+        console.print(f"group [bold]{name}[/]: {', '.join(config.resolve_group(name))}")
+
+
+@app.command("list")
+def list_cmd(
+    json_output: bool = typer.Option(False, "--json", help="Print JSON instead of a table."),
+) -> None:
+    """List the installed and user profiles."""
+    from rich.table import Table
+
+    from poppy_core.robot import list_profiles
+
+    profiles = list_profiles()
+    if json_output:
+        print_json(
+            [
+                {
+                    "name": p.name,
+                    "kind": p.kind,
+                    "description": p.description,
+                    "user": p.user,
+                    "file": str(p.file),
+                }
+                for p in profiles
+            ]
+        )
+        return
+    table = Table(title="robot profiles")
+    for column in ("name", "origin", "description"):
+        table.add_column(column)
+    for p in profiles:
+        table.add_row(p.name, "[bold]user[/]" if p.user else "installed", p.description)
+    console.print(table)
+
+
+def build_config(found: list[FoundMotor], prefix: str) -> dict[str, Any]:
+    """A config mapping for the motors found: one controller per port and protocol."""
+    from poppy_core.bus import DxlBus
+    from poppy_core.models import model_by_name
+
+    controllers: dict[str, Any] = {}
+    motors: dict[str, Any] = {}
+    groups = sorted({(f.port, f.protocol, f.baudrate) for f in found})
+    for index, (device, protocol, baudrate) in enumerate(groups, start=1):
+        chosen = sorted((f for f in found if (f.port, f.protocol, f.baudrate) ==
+                         (device, protocol, baudrate)), key=lambda f: f.id)  # fmt: skip
+        names = [f"{prefix}{f.id}" for f in chosen]
+        controllers[f"controller_{index}"] = {
+            "port": device,
+            "protocol": protocol,
+            "baudrate": baudrate,
+            "sync_read": protocol == 2,
+            "attached_motors": names,
+        }
+        with DxlBus(device, baudrate, protocol) as bus:
+            for name, motor in zip(names, chosen, strict=True):
+                model = model_by_name(str(motor.model))
+                low = bus.read_register(motor.id, model, "min_position_limit")
+                high = bus.read_register(motor.id, model, "max_position_limit")
+                if not isinstance(low, float) or not isinstance(high, float) or not low < high:
+                    span = model.position_range_deg / 2
+                    low, high = -span, span
+                motors[name] = {
+                    "id": motor.id,
+                    "type": model.name,
+                    "orientation": "direct",
+                    "offset": 0.0,
+                    "angle_limit": [round(low, 2), round(high, 2)],
+                }
+    return {"controllers": controllers, "motorgroups": {}, "motors": motors}
+
+
+@app.command("generate")
+def generate(
+    output: Path = typer.Option(..., "--output", "-o", help="File to write (.json or .yaml)."),
+    port: str | None = typer.Option(None, "--port", "-p", help=PORT_HELP),
+    baud: int | None = typer.Option(None, "--baud", "-b", help=BAUD_HELP),
+    protocol: int | None = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2),
+    name: str = typer.Option("m", "--name", help="Motor name prefix: <prefix><ID>."),
+    force: bool = typer.Option(False, "--force", "-f", help="Overwrite an existing file."),
+) -> None:
+    """Scan a bus and write a config of the motors found (limits read from the motors)."""
+    from poppy_core.bus import scan as run_scan
+    from poppy_core.robot import RobotConfig, dump_config
+
+    if output.exists() and not force:
+        error_line(f"{output} exists: pass --force to overwrite it")
+        raise typer.Exit(EXIT_FAILURE)
+    if output.suffix.lower() not in (".json", ".yaml", ".yml"):
+        error_line(f"{output}: the extension must be .json, .yaml or .yml")
+        raise typer.Exit(EXIT_USAGE)
+    chosen_port = default_port(port)
+    if not chosen_port:
+        error_line("no port given: pass --port (see `poppy ports`) or set POPPY_PORT")
+        raise typer.Exit(EXIT_USAGE)
+    baudrates = [baud] if baud is not None else None
+    protocols = [protocol] if protocol is not None else [1, 2]
+    with console.status(f"scanning {chosen_port}…"):
+        found = [f for f in run_scan(chosen_port, baudrates, protocols) if f.model is not None]
+    if not found:
+        error_line(f"no known motor found on {chosen_port}")
+        raise typer.Exit(EXIT_FAILURE)
+    config = RobotConfig.from_dict(build_config(found, name), source="generate")
+    dump_config(config, output)
+    console.print(f"wrote {output}: {_counts(config)}")

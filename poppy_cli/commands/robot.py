@@ -1,0 +1,263 @@
+"""`poppy robot ...`: build a robot from a profile or config file, show it, move it."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+
+from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from poppy_core.robot import Motor, Robot, RobotConfig
+
+app = typer.Typer(
+    help="Drive a whole robot: status, goto, compliance (a profile, a config file or --sim).",
+    no_args_is_help=True,
+)
+
+ProfileOpt = typer.Option(
+    None, "--profile", help="Robot profile, e.g. ergo-jr. [env: POPPY_PROFILE, or user settings]"
+)
+ConfigOpt = typer.Option(None, "--config", "-c", help="Robot config file (JSON or YAML).")
+PortOpt = typer.Option(
+    None, "--port", "-p", help="Serial port of the robot's bus. [env: POPPY_PORT]"
+)
+SimOpt = typer.Option(False, "--sim", help="Build a virtual robot (emulated motors).")
+JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
+
+SETTLE_S = 0.1
+"""Time for the sync loop to read the motors again after a command."""
+
+
+def robot_config(profile: str | None, config_file: Path | None, port: str | None) -> RobotConfig:
+    """The config to build: a file, or a profile (option, env var or user settings).
+
+    A port (option, POPPY_PORT or user settings) replaces the port of a one-bus robot.
+    """
+    from poppy_cli.settings import resolve
+    from poppy_core.errors import ConfigError
+    from poppy_core.robot import RobotConfig, load_config, load_profile
+
+    chosen = resolve(profile, port)
+    if config_file is not None:
+        config = load_config(config_file)
+    elif chosen.profile is not None:
+        config = load_profile(chosen.profile)
+    else:
+        error_line(
+            "no robot given: pass --profile NAME or --config FILE, set POPPY_PROFILE, "
+            "or put `profile: NAME` in the user settings (see `poppy config list`)"
+        )
+        raise typer.Exit(EXIT_USAGE)
+    if chosen.port is None:
+        return config
+    data = config.to_dict()
+    controllers = data["controllers"]
+    if len(controllers) != 1:
+        raise ConfigError(
+            f"--port names one bus but this robot has {len(controllers)} controllers "
+            f"({', '.join(controllers)}): set each port in a config file",
+            field="controllers",
+        )
+    next(iter(controllers.values()))["port"] = chosen.port
+    return RobotConfig.from_dict(data, source="command line")
+
+
+def build_robot(
+    profile: str | None, config_file: Path | None, port: str | None, sim: bool
+) -> Robot:
+    """Build and start the robot the shared options describe."""
+    from poppy_core.robot import from_config
+
+    return from_config(robot_config(profile, config_file, port), sim=sim)
+
+
+def motor_state(motor: Motor) -> dict[str, Any]:
+    """One motor's state as plain values (degrees, deg/s, %, °C, V)."""
+    return {
+        "id": motor.id,
+        "model": motor.model.name,
+        "position": motor.present_position,
+        "goal": motor.goal_position,
+        "speed": motor.present_speed,
+        "load": motor.present_load,
+        "temperature": motor.present_temperature,
+        "voltage": motor.present_voltage,
+        "compliant": motor.compliant,
+        "online": motor.online,
+        "errors": motor.errors,
+    }
+
+
+def robot_state(robot: Robot) -> dict[str, dict[str, Any]]:
+    """Motor name -> its state."""
+    return {motor.name: motor_state(motor) for motor in robot.motors}
+
+
+def status_table(robot: Robot, title: str = "robot status") -> Table:
+    """A Rich table of every motor's state."""
+    from rich.table import Table
+
+    table = Table(title=title)
+    columns = ("motor", "id", "position", "goal", "speed", "load", "temp", "voltage")
+    for column in columns:
+        table.add_column(column, justify="left" if column == "motor" else "right")
+    table.add_column("compliant")
+    table.add_column("link")
+    for name, state in robot_state(robot).items():
+        link = "online" if state["online"] else "[red]offline[/]"
+        if state["errors"]:
+            link += f" ({state['errors']} errors)"
+        table.add_row(
+            name,
+            str(state["id"]),
+            fmt_value(round(state["position"], 1), "°"),
+            fmt_value(round(state["goal"], 1), "°"),
+            fmt_value(round(state["speed"], 1), "°/s"),
+            fmt_value(round(state["load"], 1), "%"),
+            fmt_value(state["temperature"], "°C"),
+            fmt_value(state["voltage"], "V"),
+            "yes" if state["compliant"] else "no",
+            link,
+        )
+    return table
+
+
+@app.command("status")
+def status(
+    profile: str | None = ProfileOpt,
+    config_file: Path | None = ConfigOpt,
+    port: str | None = PortOpt,
+    sim: bool = SimOpt,
+    watch: bool = typer.Option(False, "--watch", "-w", help="Refresh at 10 Hz until Ctrl-C."),
+    json_output: bool = JsonOpt,
+) -> None:
+    """Show every motor: position, goal, speed, load, temperature, voltage, compliance, link."""
+    with build_robot(profile, config_file, port, sim) as robot:
+        if json_output:
+            print_json(robot_state(robot))
+            return
+        if not watch:
+            console.print(status_table(robot))
+            return
+        from rich.live import Live
+
+        try:
+            with Live(status_table(robot), console=console, refresh_per_second=10) as live:
+                while True:
+                    time.sleep(0.1)
+                    live.update(status_table(robot, "robot status (Ctrl-C to stop)"))
+        except KeyboardInterrupt:
+            return
+
+
+def parse_targets(pairs: list[str], known: list[str]) -> dict[str, float]:
+    """Parse ``NAME=DEGREES`` words, checking the names against ``known``."""
+    targets: dict[str, float] = {}
+    for pair in pairs:
+        name, sep, text = pair.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise typer.BadParameter(f"{pair!r} is not NAME=DEGREES (e.g. m1=30)")
+        if name not in known:
+            from poppy_core.errors import ConfigError
+
+            raise ConfigError(
+                f"no motor {name!r} (motors: {', '.join(known)})", field=name, value=name
+            )
+        try:
+            value = float(text)
+        except ValueError:
+            raise typer.BadParameter(f"{pair!r}: {text!r} is not a number of degrees") from None
+        if value != value or value in (float("inf"), float("-inf")):
+            raise typer.BadParameter(f"{pair!r}: the angle must be a finite number")
+        targets[name] = value
+    return targets
+
+
+@app.command("goto")
+def goto(
+    targets: list[str] = typer.Argument(..., help="Targets as NAME=DEGREES, e.g. m1=30 m2=-10."),
+    duration: float = typer.Option(1.0, "--duration", "-d", min=0.0, help="Seconds to move."),
+    wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),
+    control: str = typer.Option("minjerk", "--control", help="minjerk or dummy."),
+    profile: str | None = ProfileOpt,
+    config_file: Path | None = ConfigOpt,
+    port: str | None = PortOpt,
+    sim: bool = SimOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Move motors so they arrive together (torque is turned on for the motors moved).
+
+    A minjerk trajectory is streamed by this command, so it runs until the motion ends; a dummy
+    move is one goal and speed per motor, which the motors finish on their own unless --wait.
+    A --sim robot lives only within the command, so --sim always waits.
+    """
+    if control not in ("minjerk", "dummy"):
+        raise typer.BadParameter(f"control {control!r} is not minjerk or dummy")
+    config = robot_config(profile, config_file, port)
+    goals = parse_targets(targets, list(config.motors))
+    from poppy_core.robot import from_config
+
+    with from_config(config, sim=sim) as robot:
+        for name in goals:
+            robot.motor(name).compliant = False
+        wait = wait or sim or control == "minjerk"
+        robot.goto_position(goals, duration, control=control, wait=wait)
+        if wait:
+            time.sleep(SETTLE_S)
+        reached = {name: robot.motor(name).present_position for name in goals}
+    if json_output:
+        print_json({"goals": goals, "positions": reached, "waited": wait})
+        return
+    for name, goal in goals.items():
+        if wait:
+            console.print(f"{name}: {fmt_value(round(reached[name], 1), '°')} (goal {goal:g}°)")
+        else:
+            console.print(f"{name}: moving to {goal:g}° in {duration:g} s")
+
+
+@app.command("compliant")
+def compliant(
+    state: str = typer.Argument(..., help="on (free to move by hand) or off (holds position)."),
+    names: list[str] | None = typer.Argument(None, help="Motors or groups (default: all)."),
+    profile: str | None = ProfileOpt,
+    config_file: Path | None = ConfigOpt,
+    port: str | None = PortOpt,
+    sim: bool = SimOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Make motors compliant (on) or stiff (off); every motor when none is named."""
+    from poppy_core.errors import ConfigError
+
+    lowered = state.strip().lower()
+    if lowered not in ("on", "off"):
+        raise typer.BadParameter(f"state takes on or off, not {state!r}")
+    value = lowered == "on"
+    config = robot_config(profile, config_file, port)
+    chosen: list[str] = []
+    for name in names or list(config.motors):
+        if name not in config.motors and name not in config.motorgroups:
+            groups = ", ".join(config.motorgroups) or "none"
+            raise ConfigError(
+                f"no motor or group {name!r} (motors: {', '.join(config.motors)}; "
+                f"groups: {groups})",
+                field=name,
+            )
+        chosen.extend(n for n in config.resolve_group(name) if n not in chosen)
+    from poppy_core.robot import from_config
+
+    with from_config(config, sim=sim) as robot:
+        for name in chosen:
+            robot.motor(name).compliant = value
+        result = {name: robot.motor(name).compliant for name in chosen}
+    if json_output:
+        print_json(result)
+        return
+    for name, is_compliant in result.items():
+        console.print(f"{name}: compliant {'on' if is_compliant else 'off'}")
