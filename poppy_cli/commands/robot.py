@@ -14,6 +14,7 @@ if TYPE_CHECKING:
     from rich.table import Table
 
     from poppy_core.robot import Motor, Robot, RobotConfig
+    from poppy_core.robot.startup import ReturnDelayIssue
 
 app = typer.Typer(
     help="Drive a whole robot: status, goto, compliance (a profile, a config file or --sim).",
@@ -71,10 +72,31 @@ def robot_config(profile: str | None, config_file: Path | None, port: str | None
 def build_robot(
     profile: str | None, config_file: Path | None, port: str | None, sim: bool
 ) -> Robot:
-    """Build and start the robot the shared options describe."""
+    """Build and start the robot the shared options describe.
+
+    Motors answering after a return delay above 0 µs slow every transaction: on a terminal the
+    user is asked whether to set it to 0; otherwise it is only reported (a warning).
+    """
     from poppy_core.robot import from_config
 
-    return from_config(robot_config(profile, config_file, port), sim=sim)
+    return from_config(
+        robot_config(profile, config_file, port), sim=sim, fix_return_delay=ask_return_delay
+    )
+
+
+def ask_return_delay(issues: list[ReturnDelayIssue]) -> bool:
+    """Ask (only on an interactive terminal) whether slow return delays may be set to 0 µs."""
+    import sys
+
+    listed = ", ".join(str(issue) for issue in issues)
+    if not sys.stdin.isatty():
+        return False
+    return typer.confirm(
+        f"These motors wait before answering, which slows the bus: {listed}. "
+        "Set their return delay to 0 µs (EEPROM)?",
+        default=True,
+        err=True,
+    )
 
 
 def motor_state(motor: Motor) -> dict[str, Any]:

@@ -115,7 +115,7 @@ def fix_return_delays(
     if not agreed:
         logger.warning(
             "return delay above 0 slows every transaction on %s: %s "
-            "(pass fix_return_delay=True to set it)",
+            "(set it to 0 with fix_return_delay=True, or `poppy motor set-return-delay ID 0`)",
             bus.port,
             ", ".join(map(str, issues)),
         )

@@ -121,3 +121,23 @@ def test_malformed_settings_file(poppy: Any, xdg: Path) -> None:
     write_settings(xdg, "colour: blue\n")
     unknown = poppy("robot", "status", "--sim")
     assert unknown.code == 1 and "unknown key 'colour'" in unknown.stderr
+
+
+def test_slow_return_delay_is_reported_without_a_terminal(poppy: Any, ergo_jr: Any) -> None:
+    # `poppy emulate` motors keep the factory return delay (500 µs); no tty: report, don't write.
+    result = poppy("robot", "status", "--profile", "ergo-jr", "--port", ergo_jr.url, "--json")
+    assert result.code == 0, result.stderr
+    assert "return delay" in result.stderr and "set-return-delay" in result.stderr
+    delays = poppy(
+        "motor",
+        "get",
+        "1",
+        "return_delay_time",
+        "--port",
+        ergo_jr.url,
+        "--baud",
+        "1000000",
+        "--protocol",
+        "2",
+    )
+    assert delays.stdout.strip() == "500 µs"
