@@ -24,6 +24,7 @@ from types import TracebackType
 from poppy_core.bus.results import BusStats
 from poppy_core.bus.timing import (
     DEFAULT_RETURN_DELAY_S,
+    MIN_REPLY_TIMEOUT_S,
     Deadline,
     LinkTiming,
     default_latency_s,
@@ -81,6 +82,7 @@ class BusCore:
         sync_read: bool | None = None,
         transport: Transport | None = None,
         timeout_s: float | None = None,
+        min_timeout_s: float = MIN_REPLY_TIMEOUT_S,
     ) -> None:
         """Open a bus.
 
@@ -95,6 +97,10 @@ class BusCore:
                 0x84): True forces it, False never uses it, None tries it once and remembers.
             timeout_s: a fixed reply timeout replacing the physical estimate (for odd bridges;
                 None, the default, computes it per transaction).
+            min_timeout_s: the shortest wait for a first reply. A motor that is there answers
+                long before it, so it only costs time when a reply is lost; it keeps a reply
+                that the OS delivered late (a loaded machine, a busy emulator) from being taken
+                for silence. Scans, which mostly wait for absent motors, pass 0.
             transport: an open ``Transport`` to use instead of opening ``port``; the bus then
                 sets its baud rate and protocol but does not close it.
 
@@ -119,6 +125,7 @@ class BusCore:
         self._timing = LinkTiming(baudrate, return_delay_s, self._latency_s)
         self.retries = retries
         self.timeout_s = timeout_s
+        self.min_timeout_s = min_timeout_s
         self.stats = BusStats()
         self.alarms: dict[int, list[str]] = {}
         self._strays: deque[StatusPacket] = deque(maxlen=256)
@@ -204,7 +211,7 @@ class BusCore:
         first = timeout_s if timeout_s is not None else self.timeout_s
         if first is None:
             first = self._timing.reply_timeout_s(len(data), sizes[0])
-        deadline = Deadline(first)
+        deadline = Deadline(max(first, self.min_timeout_s))
         grace = self._timing.grace_s(max(sizes))
         wanted = {motor_id for motor_id, _ in expected}
         sizes_by_id = dict(expected)

@@ -212,6 +212,7 @@ def scan(
                         retries=0,
                         return_delay_s=return_delay_s,
                         transport=transport,
+                        min_timeout_s=0.0,
                     )
                     _scan_rate(state, port, bus, broadcast)
         finally:

@@ -41,6 +41,8 @@ VIRTUAL_LATENCY_S = 0.001
 
 # Scheduling margin: a fixed part for the OS waking us late plus a part growing with the wait.
 MIN_MARGIN_S = 0.001
+# Shortest wait for the first reply of a transaction with motors known to be there (scans use 0).
+MIN_REPLY_TIMEOUT_S = 0.010
 MARGIN_FRACTION = 0.1
 
 # Factory return delay of AX/MX/X servos: 250 x 2 µs (e-manual: "Return Delay Time", address 5
