@@ -9,6 +9,12 @@ import typer
 
 from poppy_cli import state
 from poppy_cli.commands import config, demo, emulate, motor_setup, ports, robot, scan
+from poppy_cli.commands import moves as moves_cmd
+from poppy_cli.commands import play as play_cmd
+from poppy_cli.commands import primitive as primitive_cmd
+from poppy_cli.commands import record as record_cmd
+from poppy_cli.commands import serve as serve_cmd
+from poppy_cli.commands import tui as tui_cmd
 from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, error_line
 
 app = typer.Typer(
@@ -41,6 +47,12 @@ app.command("emulate")(emulate.emulate)
 app.command("demo")(demo.demo)
 app.add_typer(config.app, name="config")
 app.add_typer(robot.app, name="robot")
+app.command("tui")(tui_cmd.tui)
+app.add_typer(primitive_cmd.app, name="primitive")
+app.command("record")(record_cmd.record)
+app.command("play")(play_cmd.play)
+app.add_typer(moves_cmd.app, name="moves")
+app.command("serve")(serve_cmd.serve)
 
 
 def main() -> None:

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from types import TracebackType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from poppy_core.bus import DxlBus
 from poppy_core.errors import ConfigError
@@ -24,6 +24,14 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 
+class Behaviour(Protocol):
+    """What ``attach_primitive`` needs of a primitive (``poppy_core.motion.Primitive``)."""
+
+    def is_alive(self) -> bool:
+        """True while it runs."""
+        ...
+
+
 class Robot:
     """Motors by name (``robot.m1``), groups by name (``robot.base``, a list of Motor).
 
@@ -35,6 +43,7 @@ class Robot:
         config: the config it was built from (``to_config`` starts from it).
         emulators: controller name -> emulator server this robot started (``sim=True``).
         goto_runner: runs the gotos; one at 50 Hz when None.
+        simulation: the MuJoCo world behind the emulators (``sim="mujoco"``), stopped by close.
     """
 
     def __init__(
@@ -47,6 +56,7 @@ class Robot:
         config: RobotConfig | None = None,
         emulators: Mapping[str, Any] | None = None,
         goto_runner: GotoRunner | None = None,
+        simulation: Any = None,
     ) -> None:
         self._motors = list(motors)
         self._by_name = {m.name: m for m in self._motors}
@@ -69,9 +79,16 @@ class Robot:
         self.config = config
         self.emulators: dict[str, Any] = dict(emulators or {})
         """Controller name -> ``EmulatorServer`` (its ``.bus`` is the ``VirtualBus``)."""
+        self.simulation: Any = simulation
+        """The simulation handle (``poppy_core.sim.world.Simulation``) with MuJoCo, else None:
+        ``reset()``, ``get_object_position``, ``add_object``, ``colliding``, ``render``..."""
         self._runner = goto_runner if goto_runner is not None else GotoRunner(name="goto robot")
         for motor in self._motors:
             motor.attach_runner(self._runner)
+        self.extensions: dict[str, object] = {}
+        """Named objects reachable as ``robot.<name>`` (attached primitives, their manager)."""
+        self._primitive_names: list[str] = []
+        self._closers: list[Callable[[], None]] = []
         self._close_lock = threading.Lock()
         self._closed = False
 
@@ -87,10 +104,13 @@ class Robot:
         groups = self.__dict__.get("_groups", {})
         if name in groups:
             return groups[name]
+        extensions = self.__dict__.get("extensions", {})
+        if name in extensions:
+            return extensions[name]
         raise AttributeError(f"robot has no motor, group or attribute {name!r}")
 
     def __dir__(self) -> list[str]:
-        return sorted({*super().__dir__(), *self._by_name, *self._groups})
+        return sorted({*super().__dir__(), *self._by_name, *self._groups, *self.extensions})
 
     def __repr__(self) -> str:
         return f"<Robot motors={[m.name for m in self._motors]}>"
@@ -120,6 +140,53 @@ class Robot:
         except KeyError:
             known = ", ".join(self._groups) or "none"
             raise ConfigError(f"no group {name!r} (groups: {known})", field=name) from None
+
+    # -- extensions: attached objects ---------------------------------------------------------
+
+    def attach(self, name: str, obj: object) -> None:
+        """Make ``obj`` reachable as ``robot.<name>`` (replacing what was attached there).
+
+        Raises:
+            ConfigError: ``name`` is not an identifier, starts with ``_``, or is a motor, a group
+                or a Robot attribute.
+        """
+        if not name.isidentifier() or name.startswith("_"):
+            raise ConfigError(f"{name!r} cannot be an attribute name", field=name, value=name)
+        taken = (*self._by_name, *self._groups, *self.__dict__)
+        if name in taken or hasattr(type(self), name):
+            raise ConfigError(
+                f"{name!r} is already a motor, group or attribute of the robot", field=name
+            )
+        self.extensions[name] = obj
+
+    def attach_primitive(self, primitive: Behaviour, name: str) -> None:
+        """Attach a primitive as ``robot.<name>`` and list it in ``primitives`` (pypot's order).
+
+        Raises:
+            ConfigError: see ``attach``.
+        """
+        self.attach(name, primitive)
+        if name not in self._primitive_names:
+            self._primitive_names.append(name)
+
+    @property
+    def primitive_names(self) -> list[str]:
+        """Names of the attached primitives, in attach order."""
+        return [n for n in self._primitive_names if n in self.extensions]
+
+    @property
+    def primitives(self) -> list[Any]:
+        """The attached primitives, in attach order."""
+        return [self.extensions[n] for n in self.primitive_names]
+
+    @property
+    def active_primitives(self) -> list[Any]:
+        """The attached primitives that are running (or paused)."""
+        return [p for p in self.primitives if p.is_alive()]
+
+    def on_close(self, callback: Callable[[], None]) -> None:
+        """Run ``callback`` first thing in ``close`` (e.g. to stop the primitives' threads)."""
+        self._closers.append(callback)
 
     # -- whole-robot commands --------------------------------------------------------------------
 
@@ -213,6 +280,11 @@ class Robot:
             if self._closed:
                 return
             self._closed = True
+        for callback in reversed(self._closers):
+            try:
+                callback()
+            except Exception:
+                logger.exception("closing the robot: %r failed", callback)
         self._runner.close()
         for sync in self._syncs:
             sync.stop()
@@ -223,6 +295,8 @@ class Robot:
                 logger.warning("closing bus %s: %s", name, exc)
         for server in self.emulators.values():
             server.stop()
+        if self.simulation is not None:
+            self.simulation.close()
 
     def __enter__(self) -> Robot:
         return self

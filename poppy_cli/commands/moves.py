@@ -1,0 +1,215 @@
+"""`poppy moves ...`: the move library: list, show, plot, remove, export and import moves."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from poppy_cli.output import EXIT_USAGE, console, error_line, print_json
+
+app = typer.Typer(
+    help="The move library (recorded with `poppy record`): list, show, plot, rm, export, import.",
+    no_args_is_help=True,
+)
+
+JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
+NameArg = typer.Argument(..., help="Library name of the move, or a file path.")
+
+
+def _header(path: Path) -> dict[str, Any]:
+    from poppy_core.motion import read_move
+
+    move = read_move(path)
+    return {
+        "name": path.stem,
+        "path": str(path),
+        "format": "pypot" if path.suffix.lower() == ".json" else "poppy",
+        "size_bytes": path.stat().st_size,
+        "framerate": move.framerate,
+        "frames": len(move),
+        "duration_s": round(move.duration_s, 3),
+        "motors": list(move.motors),
+        "speeds": move.speeds is not None,
+        "metadata": move.metadata,
+        "stats": {
+            name: {k: round(v, 2) + 0.0 for k, v in values.items()}  # + 0.0: no "-0.0"
+            for name, values in move.stats().items()
+        },
+    }
+
+
+@app.command("list")
+def list_cmd(json_output: bool = JsonOpt) -> None:
+    """List the moves of the library (folder: POPPY_MOVES_DIR or the user data folder)."""
+    from rich.table import Table
+
+    from poppy_core.errors import ConfigError
+    from poppy_core.motion import list_moves, moves_dir
+
+    rows: list[dict[str, Any]] = []
+    for entry in list_moves():
+        row: dict[str, Any] = {
+            "name": entry.name, "path": str(entry.path), "format": entry.format,
+            "size_bytes": entry.size_bytes,
+        }  # fmt: skip
+        try:
+            header = _header(entry.path)
+            row.update(
+                {k: header[k] for k in ("frames", "framerate", "duration_s", "motors")}, error=None
+            )
+        except ConfigError as exc:
+            row["error"] = str(exc)
+        rows.append(row)
+    if json_output:
+        print_json({"folder": str(moves_dir()), "moves": rows})
+        return
+    if not rows:
+        console.print(f"no move in {moves_dir()} (record one with `poppy record NAME`)")
+        return
+    table = Table(title=f"moves in {moves_dir()}")
+    for column in ("name", "format", "duration", "frames", "rate", "motors", "size"):
+        table.add_column(column, justify="right" if column in ("duration", "frames") else "left")
+    for row in rows:
+        if row.get("error"):
+            table.add_row(row["name"], row["format"], "[red]unreadable[/]", "", "", "", "")
+            continue
+        table.add_row(
+            row["name"], row["format"], f"{row['duration_s']:.2f} s", str(row["frames"]),
+            f"{row['framerate']:g} Hz", ", ".join(row["motors"]), _size(row["size_bytes"]),
+        )  # fmt: skip
+    console.print(table)
+
+
+def _size(count: int) -> str:
+    for unit in ("B", "kB", "MB"):
+        if count < 1000 or unit == "MB":
+            return f"{count:.0f} {unit}" if unit == "B" else f"{count:.1f} {unit}"
+        count = count / 1000  # type: ignore[assignment]
+    return str(count)
+
+
+@app.command("show")
+def show(name: str = NameArg, json_output: bool = JsonOpt) -> None:
+    """Show a move's header and per-motor statistics (min, max, start, end)."""
+    from rich.table import Table
+
+    from poppy_core.motion import move_path
+
+    header = _header(move_path(name))
+    if json_output:
+        print_json(header)
+        return
+    console.print(
+        f"[bold]{header['name']}[/] ({header['format']}, {_size(header['size_bytes'])}): "
+        f"{header['frames']} frames at {header['framerate']:g} Hz = {header['duration_s']:.2f} s"
+    )
+    for key, value in header["metadata"].items():
+        console.print(f"  {key}: {value}")
+    table = Table(title="positions (°)")
+    for column in ("motor", "start", "end", "min", "max", "range"):
+        table.add_column(column, justify="left" if column == "motor" else "right")
+    for motor, stats in header["stats"].items():
+        values = [f"{stats[k]:.1f}" if k in stats else "" for k in
+                  ("start", "end", "min", "max", "range")]  # fmt: skip
+        table.add_row(motor, *values)
+    console.print(table)
+
+
+@app.command("plot")
+def plot(
+    name: str = NameArg,
+    output: Path = typer.Option(..., "--output", "-o", help="Image file (png, svg, pdf)."),
+    json_output: bool = JsonOpt,
+) -> None:
+    """Draw each motor's trajectory against time into an image (matplotlib)."""
+    from poppy_core.motion import load_move, move_path
+
+    path = move_path(name)
+    move = load_move(path)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axes = plt.subplots(figsize=(10, 5))
+    times = move.times()
+    for index, motor in enumerate(move.motors):
+        axes.plot(times, move.positions[:, index], label=motor)
+    axes.set_xlabel("time (s)")
+    axes.set_ylabel("position (°)")
+    axes.set_title(f"{path.stem}: {len(move)} frames at {move.framerate:g} Hz")
+    axes.grid(True, alpha=0.3)
+    if move.motors:
+        axes.legend(loc="best", fontsize="small")
+    output.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(output, dpi=100)
+    plt.close(figure)
+    if json_output:
+        print_json({"move": str(path), "output": str(output)})
+        return
+    console.print(f"plotted {len(move.motors)} motors of {path.stem} into {output}")
+
+
+@app.command("rm")
+def rm(
+    name: str = NameArg,
+    yes: bool = typer.Option(False, "--yes", "-y", help="Do not ask for confirmation."),
+    json_output: bool = JsonOpt,
+) -> None:
+    """Delete a move (asks first unless --yes)."""
+    from poppy_core.motion import delete_move, move_path
+
+    path = move_path(name)
+    if not yes and not typer.confirm(f"delete {path}?", default=False):
+        error_line("not deleted")
+        raise typer.Exit(EXIT_USAGE)
+    delete_move(path)
+    if json_output:
+        print_json({"deleted": str(path)})
+        return
+    console.print(f"deleted {path}")
+
+
+@app.command("export")
+def export(
+    name: str = NameArg,
+    output: Path = typer.Option(..., "--output", "-o", help="File to write."),
+    fmt: str | None = typer.Option(
+        None, "--format", help="pypot (JSON) or poppy (compact); default from the suffix."
+    ),
+    json_output: bool = JsonOpt,
+) -> None:
+    """Write a move to a file in pypot's JSON (old tools can play it) or poppy's format."""
+    from poppy_core.motion import FORMATS, export_move
+
+    if fmt is not None and fmt not in FORMATS:
+        raise typer.BadParameter(f"{fmt!r} is not {' or '.join(FORMATS)}", param_hint="--format")
+    written = export_move(name, output, fmt)
+    chosen = fmt or ("pypot" if written.suffix.lower() == ".json" else "poppy")
+    if json_output:
+        print_json({"output": str(written), "format": chosen, "size_bytes": written.stat().st_size})
+        return
+    console.print(f"exported {name} as {chosen} to {written}")
+
+
+@app.command("import")
+def import_cmd(
+    file: Path = typer.Argument(..., help="A move file: pypot JSON or poppy .move."),
+    name: str | None = typer.Option(None, "--name", "-n", help="Library name (default: stem)."),
+    force: bool = typer.Option(False, "--force", help="Replace a move of that name."),
+    json_output: bool = JsonOpt,
+) -> None:
+    """Copy a move file into the library (stored in poppy's compact format)."""
+    from poppy_core.motion import import_move, read_move
+
+    target = import_move(file, name, overwrite=force)
+    move = read_move(target)
+    if json_output:
+        print_json(
+            {"name": target.stem, "path": str(target), "frames": len(move),
+             "motors": list(move.motors)}
+        )  # fmt: skip
+        return
+    console.print(f"imported {file} as {target.stem} ({len(move)} frames) into {target}")

@@ -1,0 +1,105 @@
+"""`poppy play NAME|PATH`: play a recorded move (ours or pypot's JSON) on a robot."""
+
+from __future__ import annotations
+
+import signal
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import typer
+
+from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, robot_config
+from poppy_cli.output import console, err_console, print_json
+
+if TYPE_CHECKING:
+    from poppy_core.motion import MovePlayer, PlayProgress
+
+
+def play(
+    name: str = typer.Argument(..., help="Library name of the move, or a file path."),
+    speed: float = typer.Option(1.0, "--speed", "-s", min=0.01, help="2 = twice as fast."),
+    reverse: bool = typer.Option(False, "--reverse", "-r", help="Play it backwards."),
+    loop: int = typer.Option(1, "--loop", "-n", min=1, help="Play it this many times."),
+    profile: str | None = ProfileOpt,
+    config_file: Path | None = ConfigOpt,
+    port: str | None = PortOpt,
+    sim: bool = SimOpt,
+    json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+) -> None:
+    """Play a move: a gentle ramp to its first frame, then the frames at the chosen speed.
+
+    The motors of the move turn stiff. Ctrl-C stops where the motors are.
+    """
+    from poppy_core.errors import ConfigError
+    from poppy_core.motion import MovePlayer, load_move, move_path
+    from poppy_core.robot import from_config
+
+    path = move_path(name)
+    move = load_move(path)
+    config = robot_config(profile, config_file, port)
+    missing = [m for m in move.motors if m not in config.motors]
+    if missing:  # refused before the robot is built; MovePlayer says the same
+        raise ConfigError(
+            f"the robot lacks the move's motor{'s' if len(missing) > 1 else ''} "
+            f"{', '.join(missing)} (robot motors: {', '.join(config.motors)})",
+            field="motors",
+            value=missing,
+        )
+    with from_config(config, sim=sim) as robot:
+        player = MovePlayer(robot, move, speed=speed, backwards=reverse, loops=loop)
+        stop = threading.Event()
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(signum, lambda *_: stop.set())
+        _run(player, stop, show=not json_output)
+    summary = {
+        "path": str(path),
+        "motors": list(move.motors),
+        "speed": speed,
+        "reverse": reverse,
+        "loops": loop,
+        "duration_s": round(player.duration_s, 3),
+        "played_s": round(player.played_s, 3),
+        "completed": not player.stopped,
+    }
+    if json_output:
+        print_json(summary)
+        return
+    state = "played" if not player.stopped else "stopped after"
+    console.print(f"{state} {player.played_s:.2f} s of {path.name} ({', '.join(move.motors)})")
+
+
+def _run(player: MovePlayer, stop: threading.Event, *, show: bool) -> None:
+    if not show:
+        player.start()
+        while not player.wait(0.1):
+            if stop.is_set():
+                player.stop()
+        _raise_error(player)
+        return
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    columns = (
+        TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+        TimeRemainingColumn(),
+    )  # fmt: skip
+    with Progress(*columns, console=err_console, transient=True) as progress:
+        task = progress.add_task("going to the first frame", total=1.0)
+
+        def update(event: PlayProgress) -> None:
+            label = "going to the first frame" if event.phase == "ramp" else "playing"
+            if player.loops > 1:
+                label += f" (loop {event.loop}/{event.loops})"
+            progress.update(task, completed=event.fraction, description=label)
+
+        player.on_progress = update
+        player.start()
+        while not player.wait(0.1):
+            if stop.is_set():
+                player.stop()
+    _raise_error(player)
+
+
+def _raise_error(player: MovePlayer) -> None:
+    if player.error is not None:
+        raise player.error

@@ -1,0 +1,58 @@
+"""`poppy tui`: the terminal UI (ports, scan, motor panel, robot), or served to a browser."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+
+import typer
+
+from poppy_cli.output import console
+
+
+def serve_command(port: str | None, baud: int | None, protocol: int | None, sim: bool) -> str:
+    """The command line textual-serve runs for each browser session (the same app)."""
+    words = [sys.executable, "-m", "poppy_cli", "tui"]
+    if port is not None:
+        words += ["--port", port]
+    if baud is not None:
+        words += ["--baud", str(baud)]
+    if protocol is not None:
+        words += ["--protocol", str(protocol)]
+    if sim:
+        words.append("--sim")
+    return shlex.join(words)
+
+
+def tui(
+    port: str | None = typer.Option(
+        None, "--port", "-p", help="Open this bus at start and scan it (device, pty or URL)."
+    ),
+    baud: int | None = typer.Option(
+        None, "--baud", "-b", help="Scan --port at this rate only (default: every standard rate)."
+    ),
+    protocol: int | None = typer.Option(
+        None, "--protocol", min=1, max=2, help="Scan --port in this protocol only (1 or 2)."
+    ),
+    sim: bool = typer.Option(
+        False, "--sim", help="Start a virtual Ergo Jr (emulated bus and robot tab)."
+    ),
+    serve: bool = typer.Option(False, "--serve", help="Serve the app to a web browser."),
+    host: str = typer.Option("127.0.0.1", "--host", help="Address to serve on (with --serve)."),
+    web_port: int = typer.Option(8000, "--web-port", help="TCP port to serve on (with --serve)."),
+) -> None:
+    """Herborist's successor: find motors, edit their control table, watch them, drive a robot.
+
+    Keys: F1/F2/F3 switch tabs, ctrl+s scans, Enter opens a motor or edits a register,
+    space marks motors for a multi-apply, t/l toggle torque/LED, arrows turn the goal dial, q quits.
+    """
+    if serve:
+        from textual_serve.server import Server
+
+        command = serve_command(port, baud, protocol, sim)
+        console.print(f"serving poppy tui on http://{host}:{web_port} (Ctrl-C to stop)")
+        Server(command, host=host, port=web_port, title="poppy").serve()
+        return
+    from poppy_cli.tui.app import make_app
+
+    make_app(port, baud, protocol, sim).run()

@@ -1,0 +1,1 @@
+"""`poppy tui`: the Textual successor of herborist (ports, scan, motor panel, robot tab)."""

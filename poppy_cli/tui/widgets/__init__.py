@@ -1,0 +1,1 @@
+"""Widgets of the poppy TUI, one module per area."""

@@ -1,0 +1,196 @@
+"""Robot tab: open a profile/config (or a virtual robot), live motor table, compliance, goto."""
+# ruff: noqa: TID253  (the TUI package is only imported by `poppy tui`, lazily)
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, ClassVar
+
+from textual import on, work
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical
+from textual.widgets import Button, Checkbox, DataTable, Input, Select
+
+from poppy_cli.tui.messages import BusFailed, RobotOpened
+from poppy_core.errors import ConfigError, PoppyError
+
+if TYPE_CHECKING:
+    from poppy_core.robot import Robot
+
+REFRESH_S = 0.1
+COLUMNS = ("motor", "id", "pos °", "goal °", "speed", "load %", "temp", "compliant")
+
+
+def parse_goto(text: str, known: list[str]) -> dict[str, float]:
+    """Parse ``"m1=30 m2=-10"`` into motor name -> degrees.
+
+    Raises:
+        ConfigError: a word that is not NAME=DEGREES, or an unknown motor.
+    """
+    targets: dict[str, float] = {}
+    for word in text.replace(",", " ").split():
+        name, sep, number = word.partition("=")
+        if not sep or not name:
+            raise ConfigError(f"{word!r} is not NAME=DEGREES (e.g. m1=30)", field="goto")
+        if name not in known:
+            raise ConfigError(f"no motor {name!r} (motors: {', '.join(known)})", field=name)
+        try:
+            value = float(number)
+        except ValueError:
+            raise ConfigError(f"{word!r}: {number!r} is not a number", field=name) from None
+        if value != value or abs(value) == float("inf"):
+            raise ConfigError(f"{word!r}: the angle must be finite", field=name)
+        targets[name] = value
+    if not targets:
+        raise ConfigError("no target: type e.g. m1=30 m2=-10", field="goto")
+    return targets
+
+
+def open_robot(source: str, sim: bool) -> Robot:
+    """Build a robot from a config file path or a profile name (blocking)."""
+    from poppy_core.robot import from_config, from_profile, load_config
+
+    if Path(source).is_file():
+        return from_config(load_config(Path(source)), sim)
+    return from_profile(source, sim=sim)
+
+
+class RobotPanel(Vertical):
+    """A whole robot: its motors from the caches (no bus I/O here), compliance and goto."""
+
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("c", "toggle_compliant", "Compliant")]
+
+    def __init__(self, *, id: str | None = None) -> None:
+        super().__init__(id=id)
+        self.robot: Robot | None = None
+
+    def compose(self) -> ComposeResult:
+        with Horizontal(classes="row"):
+            yield Input(placeholder="profile (ergo-jr) or config file", id="robot-source")
+            yield Checkbox("sim", id="robot-sim")
+            yield Button("Open", id="robot-open")
+        yield DataTable[str](id="robot-table", cursor_type="row", zebra_stripes=True)
+        with Horizontal(classes="row"):
+            yield Input(placeholder="goto: m1=30 m2=-10", id="goto")
+            yield Input("1.0", id="goto-duration", type="number")
+            yield Button("Go", id="goto-go", variant="primary")
+        with Horizontal(classes="row"):
+            yield Select[str]([], prompt="group", id="robot-group")
+            yield Button("Compliant", id="group-compliant")
+            yield Button("Stiff", id="group-stiff")
+
+    def on_mount(self) -> None:
+        table = self.query_one("#robot-table", DataTable)
+        for column in COLUMNS:
+            table.add_column(column, key=column)
+        self.set_interval(REFRESH_S, self.refresh_table)
+
+    @work(thread=True, exclusive=True, group="robot", exit_on_error=False)
+    def open(self, source: str, sim: bool) -> None:
+        """Build the robot in a thread (it opens buses and starts the sync loops)."""
+        try:
+            robot = open_robot(source, sim)
+        except PoppyError as exc:
+            self.post_message(BusFailed(f"cannot open robot {source!r}: {exc}"))
+            return
+        self.post_message(RobotOpened(robot, f"{source}{' (sim)' if sim else ''}"))
+
+    @on(RobotOpened)
+    def _opened(self, message: RobotOpened) -> None:
+        message.stop()
+        self.close_robot()
+        self.robot = message.robot
+        table = self.query_one("#robot-table", DataTable)
+        table.clear()
+        for motor in message.robot.motors:
+            table.add_row(*self._cells(motor.name), key=motor.name)
+        groups = [("all", "*"), *((name, name) for name in message.robot.motorgroups)]
+        self.query_one("#robot-group", Select).set_options(groups)
+        self.notify(f"robot {message.title}: {len(message.robot.motors)} motors")
+
+    def _cells(self, name: str) -> tuple[str, ...]:
+        assert self.robot is not None
+        motor = self.robot.motor(name)
+        link = "" if motor.online else " offline"
+        return (
+            name,
+            str(motor.id),
+            f"{motor.present_position:.1f}",
+            f"{motor.goal_position:.1f}",
+            f"{motor.present_speed:.0f}",
+            f"{motor.present_load:.0f}",
+            f"{motor.present_temperature:.0f}",
+            ("yes" if motor.compliant else "no") + link,
+        )
+
+    def refresh_table(self) -> None:
+        """Show the motors' cached values (the sync loops keep them fresh)."""
+        if self.robot is None or self.robot.closed:
+            return
+        table = self.query_one("#robot-table", DataTable)
+        for motor in self.robot.motors:
+            for column, text in zip(COLUMNS, self._cells(motor.name), strict=True):
+                table.update_cell(motor.name, column, text)
+
+    def on_unmount(self) -> None:
+        self.close_robot()
+
+    def close_robot(self) -> None:
+        """Close the robot (stops its loops and its emulators)."""
+        if self.robot is not None:
+            self.robot.close()
+            self.robot = None
+
+    @on(Button.Pressed, "#robot-open")
+    @on(Input.Submitted, "#robot-source")
+    def _open_pressed(self) -> None:
+        source = self.query_one("#robot-source", Input).value.strip()
+        if not source:
+            self.notify("type a profile name or a config file", severity="warning")
+            return
+        self.open(source, self.query_one("#robot-sim", Checkbox).value)
+
+    @on(Button.Pressed, "#goto-go")
+    @on(Input.Submitted, "#goto")
+    @on(Input.Submitted, "#goto-duration")
+    def _goto(self) -> None:
+        if self.robot is None:
+            self.notify("open a robot first", severity="warning")
+            return
+        try:
+            targets = parse_goto(
+                self.query_one("#goto", Input).value, [m.name for m in self.robot.motors]
+            )
+            duration = float(self.query_one("#goto-duration", Input).value or 1.0)
+            for name in targets:
+                self.robot.motor(name).compliant = False
+            self.robot.goto_position(targets, max(duration, 0.0), wait=False)
+        except (PoppyError, ValueError) as exc:
+            self.notify(str(exc), severity="error")
+            return
+        self.notify(f"goto {', '.join(f'{n}={v:g}°' for n, v in targets.items())}")
+
+    def action_toggle_compliant(self) -> None:
+        """Toggle the compliance of the motor under the cursor."""
+        table = self.query_one("#robot-table", DataTable)
+        if self.robot is None or table.row_count == 0:
+            return
+        name = str(table.coordinate_to_cell_key(table.cursor_coordinate).row_key.value)
+        motor = self.robot.motor(name)
+        motor.compliant = not motor.compliant
+
+    @on(Button.Pressed, "#group-compliant")
+    @on(Button.Pressed, "#group-stiff")
+    def _group(self, event: Button.Pressed) -> None:
+        if self.robot is None:
+            self.notify("open a robot first", severity="warning")
+            return
+        choice = self.query_one("#robot-group", Select).value
+        motors = (
+            self.robot.group(str(choice))
+            if isinstance(choice, str) and choice != "*"
+            else self.robot.motors
+        )
+        for motor in motors:
+            motor.compliant = event.button.id == "group-compliant"

@@ -1,0 +1,317 @@
+"""Built-in primitives: Sinus, Cosinus, Square, PositionWatcher and SimplePosture.
+
+Each one can be built with the robot alone (``Sinus(robot)``): motor lists default to every motor
+and the other arguments to gentle values, so ``poppy primitive run`` can start any of them.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar
+
+from poppy_core.errors import ConfigError
+from poppy_core.motion.manager import attach_primitive
+from poppy_core.motion.primitive import LoopPrimitive, Primitive
+from poppy_core.motion.sandbox import MockupMotor
+
+if TYPE_CHECKING:
+    from poppy_core.robot import Motor, Robot
+
+DEFAULT_UPDATE_HZ = 50.0
+MotorList = Sequence["str | Motor | MockupMotor"] | None
+
+
+def _names(robot: Robot, motors: MotorList) -> list[str]:
+    if motors is None:
+        return [m.name for m in robot.motors]
+    return [m if isinstance(m, str) else m.name for m in motors]
+
+
+def _check_motors(robot: Robot, names: Sequence[str]) -> None:
+    for name in names:
+        robot.motor(name)  # raises ConfigError naming the known motors
+
+
+class Sinus(LoopPrimitive):
+    """A sinusoid on each listed motor: ``offset + amp * sin(2π freq t + phase)``.
+
+    Args:
+        robot: the robot.
+        refresh_freq: update rate in Hz.
+        motor_list: motors (names or motors); every motor when None.
+        amp: amplitude in degrees.
+        freq: frequency of the signal in Hz.
+        offset: centre in degrees.
+        phase: phase in degrees.
+    """
+
+    properties: ClassVar[Sequence[str]] = (
+        "frequency", "amplitude", "offset", "phase", "motor_list", "update_freq",
+    )  # fmt: skip
+
+    def __init__(
+        self,
+        robot: Robot,
+        refresh_freq: float = DEFAULT_UPDATE_HZ,
+        motor_list: MotorList = None,
+        amp: float = 1.0,
+        freq: float = 0.5,
+        offset: float = 0.0,
+        phase: float = 0.0,
+    ) -> None:
+        super().__init__(robot, refresh_freq)
+        self.motor_list = _names(robot, motor_list)
+        self.amplitude = float(amp)
+        self.frequency = freq
+        self.offset = float(offset)
+        self.phase = float(phase)
+
+    @property
+    def frequency(self) -> float:
+        """Frequency of the signal in Hz (>= 0)."""
+        return self._signal_hz
+
+    @frequency.setter
+    def frequency(self, value: float) -> None:
+        if not math.isfinite(value) or value < 0:
+            raise ValueError(f"frequency must be a finite number >= 0 Hz, got {value}")
+        self._signal_hz = float(value)
+
+    def setup(self) -> None:
+        """Check the motor names."""
+        _check_motors(self.real_robot, self.motor_list)
+
+    def signal(self, t_s: float) -> float:
+        """The position (degrees) the motors get at ``t_s`` seconds."""
+        angle = 2 * math.pi * self.frequency * t_s + math.radians(self.phase)
+        return self.offset + self.amplitude * self.wave(angle)
+
+    def wave(self, angle_rad: float) -> float:
+        """The periodic function (period 2π, range -1..1)."""
+        return math.sin(angle_rad)
+
+    def update(self) -> None:
+        """Request the signal's value at the elapsed time on every motor."""
+        position = self.signal(self.elapsed_time)
+        for name in self.motor_list:
+            self.robot.motor(name).goal_position = position
+
+
+class Cosinus(Sinus):
+    """A cosinusoid on each listed motor: ``offset + amp * cos(2π freq t + phase)``."""
+
+    def wave(self, angle_rad: float) -> float:
+        """Cosine instead of sine."""
+        return math.cos(angle_rad)
+
+
+class Square(Sinus):
+    """A square signal: ``offset + amp`` for ``duty`` of each period, then ``offset - amp``.
+
+    Args:
+        robot: the robot.
+        refresh_freq: update rate in Hz.
+        motor_list: motors; every motor when None.
+        amp: amplitude in degrees.
+        freq: frequency of the signal in Hz.
+        offset: centre in degrees.
+        phase: phase in degrees.
+        duty: share of the period spent high (0..1).
+    """
+
+    properties: ClassVar[Sequence[str]] = (*Sinus.properties, "duty")
+
+    def __init__(
+        self,
+        robot: Robot,
+        refresh_freq: float = DEFAULT_UPDATE_HZ,
+        motor_list: MotorList = None,
+        amp: float = 1.0,
+        freq: float = 1.0,
+        offset: float = 0.0,
+        phase: float = 0.0,
+        duty: float = 0.5,
+    ) -> None:
+        super().__init__(robot, refresh_freq, motor_list, amp, freq, offset, phase)
+        self.duty = duty
+
+    @property
+    def duty(self) -> float:
+        """Share of each period spent at ``offset + amp`` (0..1)."""
+        return self._duty
+
+    @duty.setter
+    def duty(self, value: float) -> None:
+        if not 0.0 <= value <= 1.0:
+            raise ValueError(f"duty must be between 0 and 1, got {value}")
+        self._duty = float(value)
+
+    def signal(self, t_s: float) -> float:
+        """High for the first ``duty`` of each period, low for the rest."""
+        cycle = (self.frequency * t_s + self.phase / 360.0) % 1.0
+        high = cycle < self.duty
+        return self.offset + (self.amplitude if high else -self.amplitude)
+
+
+class PositionWatcher(LoopPrimitive):
+    """Records the present position of some motors at a rate; ``plot`` draws them.
+
+    Args:
+        robot: the robot.
+        refresh_freq: samples per second.
+        watched_motors: motors; every motor when None.
+
+    Attributes:
+        times: seconds since the start of each sample.
+        record_positions: motor name -> its positions (degrees), one per sample.
+    """
+
+    properties: ClassVar[Sequence[str]] = ("watched_motors", "update_freq")
+    methods: ClassVar[Sequence[str]] = (*Primitive.methods, "plot")
+
+    def __init__(
+        self,
+        robot: Robot,
+        refresh_freq: float = DEFAULT_UPDATE_HZ,
+        watched_motors: MotorList = None,
+    ) -> None:
+        super().__init__(robot, refresh_freq)
+        self.watched_motors = _names(robot, watched_motors)
+        self.times: list[float] = []
+        self.record_positions: dict[str, list[float]] = {}
+
+    def setup(self) -> None:
+        """Check the motor names and start a new record."""
+        _check_motors(self.real_robot, self.watched_motors)
+        self.times = []
+        self.record_positions = {name: [] for name in self.watched_motors}
+
+    def update(self) -> None:
+        """Record one sample."""
+        self.times.append(self.elapsed_time)
+        for name, positions in self.record_positions.items():
+            positions.append(self.robot.motor(name).present_position)
+
+    def plot(self, path: str | Path) -> Path:
+        """Save the recorded positions over time as a PNG image.
+
+        Args:
+            path: the image file to write.
+
+        Returns:
+            The path written.
+        """
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from matplotlib.figure import Figure
+
+        figure = Figure(figsize=(8, 4.5))
+        axes = figure.add_subplot()
+        times = list(self.times)
+        for name, positions in self.record_positions.items():
+            count = min(len(times), len(positions))
+            axes.plot(times[:count], positions[:count], label=name)
+        axes.set_xlabel("time (s)")
+        axes.set_ylabel("present position (°)")
+        if self.record_positions:
+            axes.legend(loc="upper right")
+        out = Path(path)
+        figure.savefig(out, format="png")
+        return out
+
+
+class SimplePosture(Primitive):
+    """Goes to a posture (motor name -> degrees) in ``duration`` seconds, then ends.
+
+    ``start()`` then ``wait_to_stop()`` (or ``go(wait=True)``) blocks until it is reached.
+
+    Args:
+        robot: the robot.
+        duration: seconds to reach the posture.
+        target_position: the posture; every motor at 0° when None.
+    """
+
+    properties: ClassVar[Sequence[str]] = ("duration", "target_position")
+    methods: ClassVar[Sequence[str]] = (*Primitive.methods, "go")
+
+    def __init__(
+        self,
+        robot: Robot,
+        duration: float = 2.0,
+        target_position: Mapping[str, float] | None = None,
+    ) -> None:
+        super().__init__(robot)
+        self.duration = duration
+        if target_position is None:
+            target_position = {m.name: 0.0 for m in robot.motors}
+        self.target_position = dict(target_position)
+
+    @property
+    def duration(self) -> float:
+        """Seconds to reach the posture (>= 0)."""
+        return self._duration
+
+    @duration.setter
+    def duration(self, value: float) -> None:
+        if not math.isfinite(value) or value < 0:
+            raise ValueError(f"duration must be a finite number >= 0 s, got {value}")
+        self._duration = float(value)
+
+    def setup(self) -> None:
+        """Check the posture and stiffen its motors."""
+        _check_motors(self.real_robot, list(self.target_position))
+        for name in self.target_position:
+            self.robot.motor(name).compliant = False
+
+    def run(self) -> None:
+        """Move, and return once the posture is reached (or when stopped)."""
+        start = time.monotonic()
+        self.robot.goto_position(self.target_position, self.duration)
+        self.sleep(self.duration - (time.monotonic() - start))
+
+    def go(self, wait: bool = True) -> None:
+        """Start (or restart) and, with ``wait``, block until the posture is reached."""
+        self.start()
+        if wait:
+            self.wait_to_stop()
+
+
+BUILTINS: dict[str, type[Primitive]] = {
+    "sinus": Sinus,
+    "cosinus": Cosinus,
+    "square": Square,
+    "position_watcher": PositionWatcher,
+    "simple_posture": SimplePosture,
+}
+"""Name -> built-in primitive class (each can be built from the robot alone)."""
+
+
+def attach_builtins(robot: Robot, **overrides: Any) -> dict[str, Primitive]:
+    """Attach one instance of every built-in not yet attached, under its ``BUILTINS`` name.
+
+    Args:
+        robot: the robot.
+        **overrides: name -> a primitive to attach instead of the default instance.
+
+    Returns:
+        Name -> the attached primitive (also reachable as ``robot.<name>``).
+
+    Raises:
+        ConfigError: an override that is not a primitive of this robot.
+    """
+    out: dict[str, Primitive] = {}
+    for name, cls in BUILTINS.items():
+        existing = robot.extensions.get(name)
+        if isinstance(existing, Primitive):
+            out[name] = existing
+            continue
+        primitive = overrides.get(name) or cls(robot)
+        if not isinstance(primitive, Primitive):
+            raise ConfigError(f"{name}: {primitive!r} is not a primitive", field=name)
+        attach_primitive(robot, name, primitive)
+        out[name] = primitive
+    return out

@@ -1,0 +1,225 @@
+"""``Move``: motor positions sampled at a fixed framerate, with interpolation between frames."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+
+
+class Move:
+    """A recorded motion: frame ``i`` holds every motor's position at ``i / framerate`` seconds.
+
+    Positions are degrees in the robot's user frame (what ``Motor.present_position`` reads).
+
+    Args:
+        framerate: frames per second (> 0).
+        motors: the motor names, one per column.
+        positions: shape ``(frames, len(motors))``, degrees.
+        speeds: the same shape in deg/s, or None (pypot files carry them; playback ignores them).
+        metadata: free header fields (``created``, ``robot``, ``description``...), JSON-ready.
+
+    Raises:
+        ValueError: a bad framerate, duplicate or empty motor names, a wrong shape or a
+            value that is not a finite number.
+    """
+
+    def __init__(
+        self,
+        framerate: float,
+        motors: Sequence[str],
+        positions: npt.ArrayLike,
+        *,
+        speeds: npt.ArrayLike | None = None,
+        metadata: Mapping[str, Any] | None = None,
+    ) -> None:
+        rate = float(framerate)
+        if not math.isfinite(rate) or rate <= 0:
+            raise ValueError(f"framerate must be a positive number, got {framerate!r}")
+        names = tuple(str(m) for m in motors)
+        if any(not n for n in names):
+            raise ValueError("motor names must not be empty")
+        if len(set(names)) != len(names):
+            raise ValueError(f"motor names must be unique, got {', '.join(names)}")
+        self.framerate = rate
+        self.motors = names
+        self.positions = self._checked(positions, "positions")
+        self.speeds = None if speeds is None else self._checked(speeds, "speeds")
+        if self.speeds is not None and self.speeds.shape != self.positions.shape:
+            raise ValueError("speeds must have the same shape as positions")
+        self.metadata: dict[str, Any] = dict(metadata or {})
+
+    def _checked(self, values: npt.ArrayLike, what: str) -> FloatArray:
+        array = np.array(values, dtype=np.float64)
+        if array.size == 0:
+            array = array.reshape(0, len(self.motors))
+        if array.ndim != 2 or array.shape[1] != len(self.motors):
+            raise ValueError(
+                f"{what} must have shape (frames, {len(self.motors)}), got {array.shape}"
+            )
+        if not np.all(np.isfinite(array)):
+            raise ValueError(f"{what} must be finite numbers")
+        return array
+
+    @classmethod
+    def from_frames(
+        cls,
+        framerate: float,
+        frames: Sequence[Mapping[str, float]],
+        *,
+        metadata: Mapping[str, Any] | None = None,
+    ) -> Move:
+        """Build a move from frames given as ``{motor: degrees}`` dicts (same motors in each).
+
+        Raises:
+            ValueError: frames that do not all name the same motors.
+        """
+        motors = list(frames[0]) if frames else []
+        rows = []
+        for index, frame in enumerate(frames):
+            if set(frame) != set(motors):
+                raise ValueError(f"frame {index} names other motors than frame 0")
+            rows.append([float(frame[m]) for m in motors])
+        return cls(framerate, motors, rows, metadata=metadata)
+
+    def __repr__(self) -> str:
+        return (
+            f"<Move {len(self)} frames at {self.framerate:g} Hz, {self.duration_s:.2f} s, "
+            f"motors={list(self.motors)}>"
+        )
+
+    def __len__(self) -> int:
+        return int(self.positions.shape[0])
+
+    @property
+    def period_s(self) -> float:
+        """Time between two frames."""
+        return 1.0 / self.framerate
+
+    @property
+    def duration_s(self) -> float:
+        """Time from the first frame to the last (0 for fewer than two frames)."""
+        return max(len(self) - 1, 0) / self.framerate
+
+    def times(self) -> FloatArray:
+        """The time of each frame in seconds."""
+        return np.arange(len(self), dtype=np.float64) / self.framerate
+
+    def frame(self, index: int) -> dict[str, float]:
+        """Frame ``index`` as ``{motor: degrees}`` (negative indexes count from the end)."""
+        return dict(zip(self.motors, (float(v) for v in self.positions[index]), strict=True))
+
+    def trajectory(self, motor: str) -> FloatArray:
+        """Every position of one motor.
+
+        Raises:
+            KeyError: a motor the move does not hold.
+        """
+        if motor not in self.motors:
+            raise KeyError(f"the move has no motor {motor!r} (motors: {', '.join(self.motors)})")
+        return self.positions[:, self.motors.index(motor)].copy()
+
+    def positions_at(self, t_s: float) -> FloatArray:
+        """Positions at ``t_s`` seconds, linearly interpolated, held at both ends.
+
+        Raises:
+            ValueError: the move has no frame.
+        """
+        count = len(self)
+        if count == 0:
+            raise ValueError("an empty move has no position")
+        x = min(max(float(t_s) * self.framerate, 0.0), float(count - 1))
+        low = math.floor(x)
+        if low >= count - 1:
+            last: FloatArray = self.positions[count - 1].copy()
+            return last
+        frac = x - low
+        result: FloatArray = self.positions[low] * (1.0 - frac) + self.positions[low + 1] * frac
+        return result
+
+    def position_at(self, t_s: float) -> dict[str, float]:
+        """``positions_at`` as ``{motor: degrees}``."""
+        return dict(zip(self.motors, (float(v) for v in self.positions_at(t_s)), strict=True))
+
+    def reversed(self) -> Move:
+        """The same move played from its last frame to its first."""
+        speeds = None if self.speeds is None else -self.speeds[::-1]
+        return Move(
+            self.framerate, self.motors, self.positions[::-1], speeds=speeds,
+            metadata=self.metadata,
+        )  # fmt: skip
+
+    def select(self, motors: Sequence[str]) -> Move:
+        """A move holding only ``motors`` (in that order).
+
+        Raises:
+            KeyError: a motor the move does not hold.
+        """
+        missing = [m for m in motors if m not in self.motors]
+        if missing:
+            raise KeyError(f"the move has no motor {', '.join(missing)}")
+        columns = [self.motors.index(m) for m in motors]
+        speeds = None if self.speeds is None else self.speeds[:, columns]
+        return Move(
+            self.framerate, motors, self.positions[:, columns], speeds=speeds,
+            metadata=self.metadata,
+        )  # fmt: skip
+
+    def stats(self) -> dict[str, dict[str, float]]:
+        """Per motor: ``min``, ``max``, ``mean``, ``start``, ``end`` (degrees), ``range``."""
+        result: dict[str, dict[str, float]] = {}
+        for index, name in enumerate(self.motors):
+            column = self.positions[:, index]
+            if column.size == 0:
+                result[name] = {}
+                continue
+            low, high = float(column.min()), float(column.max())
+            result[name] = {
+                "min": low,
+                "max": high,
+                "range": high - low,
+                "mean": float(column.mean()),
+                "start": float(column[0]),
+                "end": float(column[-1]),
+            }
+        return result
+
+    def same_as(self, other: Move, tolerance_deg: float = 0.0) -> bool:
+        """True when both moves hold the same motors, framerate and positions (± tolerance)."""
+        return (
+            self.motors == other.motors
+            and math.isclose(self.framerate, other.framerate, rel_tol=1e-9)
+            and self.positions.shape == other.positions.shape
+            and bool(np.all(np.abs(self.positions - other.positions) <= tolerance_deg))
+        )
+
+
+def resample(times_s: npt.ArrayLike, positions: npt.ArrayLike, framerate: float) -> FloatArray:
+    """Positions sampled at irregular times, linearly resampled at ``framerate``.
+
+    Args:
+        times_s: increasing sample times (the first one becomes t = 0).
+        positions: shape ``(samples, motors)``.
+        framerate: frames per second of the result.
+
+    Returns:
+        Shape ``(frames, motors)``: frame ``k`` is the position at ``times_s[0] + k / framerate``,
+        up to the last sample time.
+    """
+    t = np.asarray(times_s, dtype=np.float64)
+    values = np.asarray(positions, dtype=np.float64)
+    if t.size == 0:
+        return values.reshape(0, values.shape[1] if values.ndim == 2 else 0)
+    span = float(t[-1] - t[0])
+    # A small slack keeps a last sample that falls a hair before its frame's time.
+    count = math.floor(span * framerate + 1e-6) + 1
+    grid = t[0] + np.arange(count, dtype=np.float64) / framerate
+    out = np.empty((count, values.shape[1]), dtype=np.float64)
+    for column in range(values.shape[1]):
+        out[:, column] = np.interp(grid, t, values[:, column])
+    return out

@@ -1,0 +1,204 @@
+"""The move library: a folder of moves (platformdirs user data, or ``POPPY_MOVES_DIR``) by name.
+
+A *name* is a file stem in the library (``wave`` → ``<library>/wave.move``, or ``wave.json`` for
+a pypot file dropped there); anything with a folder part or a move suffix is a *path*.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import platformdirs
+
+from poppy_core.errors import ConfigError
+from poppy_core.motion.move import Move
+from poppy_core.motion.move_format import (
+    MOVE_SUFFIX,
+    PYPOT_SUFFIX,
+    atomic_write_bytes,
+    decode_any,
+    detect_format,
+    format_for_path,
+    read_bytes,
+    read_move,
+    write_move,
+)
+
+MOVES_DIR_ENV = "POPPY_MOVES_DIR"
+SUFFIXES: tuple[str, ...] = (MOVE_SUFFIX, PYPOT_SUFFIX)
+_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._ -]*$")
+
+
+@dataclass(frozen=True)
+class MoveEntry:
+    """One move of the library."""
+
+    name: str
+    path: Path
+    format: str
+    size_bytes: int
+
+
+def moves_dir() -> Path:
+    """The library folder: ``$POPPY_MOVES_DIR``, else ``<user data dir>/poppy/moves``."""
+    override = os.environ.get(MOVES_DIR_ENV)
+    if override:
+        return Path(override)
+    return Path(platformdirs.user_data_dir("poppy")) / "moves"
+
+
+def is_path(ref: str | os.PathLike[str]) -> bool:
+    """True when ``ref`` names a file (folder part or move suffix), not a library name."""
+    text = os.fspath(ref)
+    return os.sep in text or "/" in text or Path(text).suffix.lower() in SUFFIXES
+
+
+def check_name(name: str) -> str:
+    """A valid library name (letters, digits, ``. _ -`` and spaces; no folder part).
+
+    Raises:
+        ConfigError: a name that cannot be a file stem.
+    """
+    if not _NAME.match(name) or name.endswith((".", " ")):
+        raise ConfigError(
+            f"{name!r} is not a move name: use letters, digits, '.', '_', '-' or spaces",
+            field="name",
+            value=name,
+        )
+    return name
+
+
+def list_moves(folder: Path | None = None) -> list[MoveEntry]:
+    """The moves in the library, sorted by name (``.move`` first when both exist)."""
+    root = folder if folder is not None else moves_dir()
+    if not root.is_dir():
+        return []
+    entries = []
+    for path in root.iterdir():
+        if path.suffix.lower() in SUFFIXES and path.is_file() and not path.name.startswith("."):
+            entries.append(MoveEntry(path.stem, path, format_for_path(path), path.stat().st_size))
+    return sorted(entries, key=lambda e: (e.name, SUFFIXES.index(e.path.suffix.lower())))
+
+
+def move_path(ref: str | os.PathLike[str], *, must_exist: bool = True) -> Path:
+    """The file a name or a path refers to.
+
+    Args:
+        ref: a library name or a path.
+        must_exist: raise when there is no such move (else give the path a new move would take).
+
+    Raises:
+        ConfigError: no such move.
+    """
+    if is_path(ref):
+        path = Path(ref).expanduser()
+        if must_exist and not path.is_file():
+            raise ConfigError(f"no move file {path}", file=str(path), reason="not found")
+        return path
+    name = check_name(os.fspath(ref))
+    root = moves_dir()
+    for suffix in SUFFIXES:
+        candidate = root / f"{name}{suffix}"
+        if candidate.is_file():
+            return candidate
+    if must_exist:
+        known = ", ".join(e.name for e in list_moves()) or "none"
+        raise ConfigError(
+            f"no move {name!r} in {root} (moves: {known})", file=str(root), field=name
+        )
+    return root / f"{name}{MOVE_SUFFIX}"
+
+
+def load_move(ref: str | os.PathLike[str]) -> Move:
+    """Load a move by library name or path (either format).
+
+    Raises:
+        ConfigError: no such move, or not a move file.
+    """
+    return read_move(move_path(ref))
+
+
+def save_move(move: Move, ref: str | os.PathLike[str], fmt: str | None = None) -> Path:
+    """Save a move under a library name (poppy's format) or at a path (format from its suffix).
+
+    Returns:
+        The path written (atomically).
+    """
+    return write_move(move, move_path(ref, must_exist=False), fmt)
+
+
+def delete_move(ref: str | os.PathLike[str]) -> Path:
+    """Delete a move by name or path.
+
+    Returns:
+        The path deleted.
+
+    Raises:
+        ConfigError: no such move.
+    """
+    path = move_path(ref)
+    path.unlink()
+    return path
+
+
+def import_move(
+    source: str | os.PathLike[str], name: str | None = None, *, overwrite: bool = False
+) -> Path:
+    """Copy a move file (pypot JSON or ours) into the library, stored in poppy's format.
+
+    Args:
+        source: the file to import.
+        name: its library name (default: the file's stem).
+        overwrite: replace a move of that name.
+
+    Returns:
+        The new library file.
+
+    Raises:
+        ConfigError: not a move file, or the name is taken and ``overwrite`` is False.
+    """
+    src = Path(source).expanduser()
+    move = read_move(src)
+    target_name = check_name(name if name is not None else src.stem)
+    existing = [moves_dir() / f"{target_name}{s}" for s in SUFFIXES]
+    taken = [p for p in existing if p.is_file()]
+    if taken and not overwrite:
+        raise ConfigError(
+            f"a move named {target_name!r} exists ({taken[0]}): choose another name or overwrite",
+            file=str(taken[0]),
+            field="name",
+        )
+    move.metadata.setdefault("imported_from", str(src))
+    target = write_move(move, moves_dir() / f"{target_name}{MOVE_SUFFIX}", "poppy")
+    for path in taken:
+        if path != target:
+            path.unlink()
+    return target
+
+
+def export_move(
+    ref: str | os.PathLike[str], destination: str | os.PathLike[str], fmt: str | None = None
+) -> Path:
+    """Write a library move (or any move file) to ``destination`` in ``fmt``.
+
+    Args:
+        ref: library name or path of the move.
+        destination: the file to write.
+        fmt: ``"poppy"`` or ``"pypot"``; from the destination's suffix when None.
+
+    Returns:
+        The path written.
+    """
+    source = move_path(ref)
+    target = Path(destination).expanduser()
+    chosen = fmt or format_for_path(target)
+    if source.resolve() == target.resolve():
+        raise ConfigError(f"{target} is the move itself", file=str(target))
+    data = read_bytes(source)
+    if chosen == "poppy" and detect_format(data) == "poppy":
+        atomic_write_bytes(target, data)  # already ours: copied byte for byte
+        return target
+    return write_move(decode_any(data, str(source)), target, chosen)

@@ -1,0 +1,293 @@
+"""``MovePlayer``: plays a ``Move`` on a robot, interpolating frames at the robot's write rate.
+
+Each loop starts with a gentle minimum-jerk ramp from where the motors are to the move's first
+frame, then streams goal positions interpolated between frames, ``speed`` times faster than
+recorded, until the last frame.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import TracebackType
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from poppy_core.errors import ConfigError
+from poppy_core.motion.move import Move
+from poppy_core.robot.schedule import Periodic
+
+if TYPE_CHECKING:
+    from poppy_core.robot import Motor, Robot
+
+logger = logging.getLogger(__name__)
+
+DEFAULT_RATE_HZ = 50.0
+DEFAULT_RAMP_SPEED_DPS = 60.0
+"""Mean speed of the ramp to the first frame (a minimum-jerk peak is 1.875 times that)."""
+MIN_RAMP_S = 0.3
+RAMP_SKIP_DEG = 0.5
+"""No ramp when every motor is already this close to the first frame."""
+
+Phase = Literal["ramp", "play", "done"]
+
+
+@dataclass(frozen=True)
+class PlayProgress:
+    """Where a playback is, given to the progress callback.
+
+    Attributes:
+        phase: ``"ramp"`` (going to the first frame), ``"play"`` or ``"done"``.
+        loop: the loop being played, from 1.
+        loops: how many loops in all.
+        move_t_s: time in the move (0..``Move.duration_s``; counts down when backwards).
+        fraction: share of the whole playback done (ramps excluded), 0..1.
+    """
+
+    phase: Phase
+    loop: int
+    loops: int
+    move_t_s: float
+    fraction: float
+
+
+ProgressCallback = Callable[[PlayProgress], None]
+
+
+def write_rate_hz(robot: Robot) -> float:
+    """The rate the robot writes goals at (its slowest ``goals`` loop; 50 Hz if unknown)."""
+    rates = [
+        loop.target_hz
+        for stats in robot.sync_stats().values()
+        for name, loop in stats.loops.items()
+        if name == "goals" and loop.target_hz > 0
+    ]
+    return min(rates) if rates else DEFAULT_RATE_HZ
+
+
+def missing_motors(robot: Robot, move: Move) -> list[str]:
+    """The motors of ``move`` the robot does not have."""
+    names = {m.name for m in robot.motors}
+    return [m for m in move.motors if m not in names]
+
+
+class MovePlayer:
+    """Plays a move on a robot (stiffening its motors).
+
+    Args:
+        robot: the robot.
+        move: the move; every motor it names must be on the robot.
+        speed: play speed factor (2.0 = twice as fast, half the time).
+        backwards: play from the last frame to the first.
+        loops: how many times to play it.
+        ramp_s: duration of the ramp to the first frame; None picks the largest distance over
+            ``ramp_speed_dps`` (at least ``MIN_RAMP_S``; none when already there).
+        ramp_speed_dps: mean speed of the automatic ramp.
+        rate_hz: goal update rate; None uses the robot's write rate.
+        on_progress: called at each update with a ``PlayProgress``.
+        clock: the time source (seconds).
+
+    Raises:
+        ConfigError: the robot lacks motors of the move (they are named).
+        ValueError: an empty move, a speed or loop count that is not positive.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        move: Move,
+        speed: float = 1.0,
+        backwards: bool = False,
+        loops: int = 1,
+        *,
+        ramp_s: float | None = None,
+        ramp_speed_dps: float = DEFAULT_RAMP_SPEED_DPS,
+        rate_hz: float | None = None,
+        on_progress: ProgressCallback | None = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        if not (math.isfinite(speed) and speed > 0):
+            raise ValueError(f"speed must be a positive number, got {speed}")
+        if loops < 1:
+            raise ValueError(f"loops must be at least 1, got {loops}")
+        if len(move) == 0:
+            raise ValueError("the move has no frame to play")
+        missing = missing_motors(robot, move)
+        if missing:
+            known = ", ".join(m.name for m in robot.motors)
+            raise ConfigError(
+                f"the robot lacks the move's motor{'s' if len(missing) > 1 else ''} "
+                f"{', '.join(missing)} (robot motors: {known})",
+                field="motors",
+                value=missing,
+                reason="missing motors",
+            )
+        self.robot = robot
+        self.move = move
+        self.speed = float(speed)
+        self.backwards = backwards
+        self.loops = int(loops)
+        self.ramp_s = ramp_s
+        self.ramp_speed_dps = ramp_speed_dps
+        self.rate_hz = rate_hz if rate_hz is not None else write_rate_hz(robot)
+        self.on_progress = on_progress
+        self._clock = clock
+        self._played = move.reversed() if backwards else move
+        self._motors: list[Motor] = [robot.motor(name) for name in move.motors]
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self.loop_times: list[tuple[float, float]] = []
+        """``(start, end)`` clock times of each loop's playing phase (ramps excluded)."""
+        self.stopped = False
+        self.error: BaseException | None = None
+
+    @property
+    def duration_s(self) -> float:
+        """Time the playback takes, ramps excluded."""
+        return self.move.duration_s * self.loops / self.speed
+
+    @property
+    def played_s(self) -> float:
+        """Time spent playing so far (ramps excluded)."""
+        return sum(end - start for start, end in self.loop_times)
+
+    # -- control -----------------------------------------------------------------------------
+
+    def start(self) -> MovePlayer:
+        """Start playing in a thread.
+
+        Raises:
+            RuntimeError: already playing.
+        """
+        if self.playing:
+            raise RuntimeError("the move is already playing")
+        self._stop.clear()
+        self.loop_times = []
+        self.stopped = False
+        self.error = None
+        self._thread = threading.Thread(target=self._run, name="move player", daemon=True)
+        self._thread.start()
+        return self
+
+    def play(self) -> MovePlayer:
+        """Play the whole move; returns when it is over (or ``stop()`` from another thread)."""
+        self.start()
+        self.wait()
+        if self.error is not None:
+            raise self.error
+        return self
+
+    def wait(self, timeout_s: float | None = None) -> bool:
+        """Block until the playback ends; False when ``timeout_s`` ran out first."""
+        thread = self._thread
+        if thread is None:
+            return True
+        thread.join(timeout_s)
+        return not thread.is_alive()
+
+    def stop(self) -> None:
+        """Stop where the motors are (they stay stiff)."""
+        self._stop.set()
+        self.wait(5.0)
+
+    @property
+    def playing(self) -> bool:
+        """True while the thread runs."""
+        return self._thread is not None and self._thread.is_alive()
+
+    # -- thread ------------------------------------------------------------------------------
+
+    def _report(self, phase: Phase, loop: int, move_t_s: float, fraction: float) -> None:
+        if self.on_progress is None:
+            return
+        try:
+            self.on_progress(PlayProgress(phase, loop, self.loops, move_t_s, fraction))
+        except Exception:
+            logger.exception("progress callback failed")
+
+    def _set_goals(self, positions: np.ndarray[tuple[int], np.dtype[np.float64]]) -> None:
+        for motor, value in zip(self._motors, positions.tolist(), strict=True):
+            motor.goal_position = value
+
+    def _ramp(self, loop: int) -> None:
+        first = self._played.positions[0]
+        distance = max(
+            abs(m.present_position - float(v)) for m, v in zip(self._motors, first, strict=True)
+        )
+        duration = self.ramp_s
+        if duration is None:
+            duration = (
+                0.0 if distance < RAMP_SKIP_DEG else max(MIN_RAMP_S, distance / self.ramp_speed_dps)
+            )
+        if duration <= 0:
+            self._set_goals(first)
+            return
+        targets = {m.name: float(v) for m, v in zip(self._motors, first, strict=True)}
+        handle = self.robot.goto_position(targets, duration, control="minjerk")
+        while not handle.wait(0.05):
+            self._report("ramp", loop, 0.0, (loop - 1) / self.loops)
+            if self._stop.is_set():
+                for motor in self._motors:
+                    motor.goal_position = motor.present_position
+                return
+
+    def _play_once(self, loop: int) -> None:
+        move = self._played
+        period = 1.0 / self.rate_hz
+        start = self._clock()
+        schedule = Periodic(period, start)
+        duration = move.duration_s
+        try:
+            while not self._stop.is_set():
+                now = self._clock()
+                move_t = (now - start) * self.speed
+                if move_t >= duration:
+                    self._set_goals(move.positions[-1])
+                    break
+                self._set_goals(move.positions_at(move_t))
+                shown_t = duration - move_t if self.backwards else move_t
+                done = (loop - 1 + move_t / duration) / self.loops if duration else 0.0
+                self._report("play", loop, shown_t, done)
+                schedule.advance(self._clock())
+                self._stop.wait(max(0.0, schedule.next_deadline - self._clock()))
+        finally:
+            self.loop_times.append((start, self._clock()))
+
+    def _run(self) -> None:
+        try:
+            for motor in self._motors:
+                motor.compliant = False
+            for loop in range(1, self.loops + 1):
+                if self._stop.is_set():
+                    break
+                self._ramp(loop)
+                if self._stop.is_set():
+                    break
+                self._play_once(loop)
+            self.stopped = self._stop.is_set()
+            fraction = 1.0
+            if self.stopped and self.duration_s > 0:
+                fraction = min(1.0, self.played_s / self.duration_s)
+            end_t = 0.0 if self.backwards else self.move.duration_s
+            self._report("done", self.loops, end_t, fraction)
+        except BaseException as exc:  # handed to play()/the caller through .error
+            self.error = exc
+            logger.exception("move playback failed")
+
+    # -- context manager -----------------------------------------------------------------------
+
+    def __enter__(self) -> MovePlayer:
+        return self.start()
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.stop()

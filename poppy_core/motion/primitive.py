@@ -1,0 +1,381 @@
+"""``Primitive`` and ``LoopPrimitive``: restartable behaviours running in their own thread.
+
+A primitive acts on a sandboxed view of the robot (``self.robot``, see ``sandbox``): its writes
+are requests that the robot's ``PrimitiveManager`` combines with those of the other running
+primitives. A primitive whose code raises is stopped, its traceback logged and kept in
+``error``; ``state`` then reads ``"failed"``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+import time
+import traceback
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
+
+from poppy_core.errors import ConfigError
+from poppy_core.motion.primitive_values import convert_value
+from poppy_core.motion.sandbox import MockupMotor, MockupRobot
+from poppy_core.robot.schedule import Periodic, RateMeter
+
+if TYPE_CHECKING:
+    from poppy_core.motion.manager import PrimitiveManager
+    from poppy_core.robot import Motor, Robot
+
+logger = logging.getLogger(__name__)
+
+State = Literal["idle", "running", "paused", "stopped", "failed"]
+JOIN_TIMEOUT_S = 5.0
+
+
+@dataclass(frozen=True)
+class PrimitiveFailure:
+    """Why a primitive failed: the exception's type, its message and the traceback text."""
+
+    type: str
+    message: str
+    traceback: str
+
+    @property
+    def one_line(self) -> str:
+        """``"Type: message"``, for a status line."""
+        return f"{self.type}: {self.message}" if self.message else self.type
+
+    def to_dict(self) -> dict[str, str]:
+        """Plain values (for JSON)."""
+        return {"type": self.type, "message": self.message, "traceback": self.traceback}
+
+
+class Primitive:
+    """A behaviour in its own thread: ``setup()``, ``run()``, ``teardown()``; restartable.
+
+    Subclass it and write ``run`` (check ``should_stop()``; use ``sleep()`` to wait). Writes to
+    ``self.robot`` are requests combined by the manager; reads reach the real robot.
+
+    Attributes:
+        properties: names ``get_property``/``set_property`` expose (e.g. to the REST server).
+        methods: names ``call_method`` may call.
+        real_robot: the robot itself (writing to it bypasses the manager).
+        robot: the sandboxed view this primitive acts on.
+        error: why the last run failed, None otherwise.
+
+    Args:
+        robot: the robot to act on.
+    """
+
+    properties: ClassVar[Sequence[str]] = ()
+    methods: ClassVar[Sequence[str]] = ("start", "stop", "pause", "resume")
+
+    def __init__(self, robot: Robot) -> None:
+        from poppy_core.motion.manager import primitive_manager
+
+        self.real_robot = robot
+        self._stop_event = threading.Event()
+        self._resume_event = threading.Event()
+        self._resume_event.set()
+        self.robot = MockupRobot(robot, self._stop_event)
+        self._manager: PrimitiveManager = primitive_manager(robot)
+        self._thread: threading.Thread | None = None
+        self._lifecycle = threading.Lock()
+        self._state: State = "idle"
+        self.error: PrimitiveFailure | None = None
+        self._t0: float | None = None
+        self._paused_at: float | None = None
+        self._paused_s = 0.0
+        self._ended_at: float | None = None
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.state}>"
+
+    # -- to override -------------------------------------------------------------------------
+
+    def setup(self) -> None:
+        """Called in the primitive's thread before ``run`` at each (re)start."""
+
+    def run(self) -> None:
+        """The behaviour; return to finish. Long runs must check ``should_stop()``."""
+
+    def teardown(self) -> None:
+        """Called in the primitive's thread after ``run`` (also after a failure)."""
+
+    # -- lifecycle ---------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Start the primitive, or restart it (a running one is stopped first).
+
+        Raises:
+            PortError: the robot is closed.
+            RuntimeError: called from the primitive's own thread.
+        """
+        if self._thread is threading.current_thread():
+            raise RuntimeError("a primitive cannot restart itself from its own thread")
+        with self._lifecycle:
+            if self.is_alive():
+                self._stop_locked(wait=True)
+            self.robot.clear()
+            self._manager.add(self)  # raises when the robot is closed
+            self._stop_event.clear()
+            self._resume_event.set()
+            self.error = None
+            self._t0 = time.monotonic()
+            self._paused_s = 0.0
+            self._paused_at = None
+            self._ended_at = None
+            self._state = "running"
+            self._thread = threading.Thread(
+                target=self._main, name=f"primitive {type(self).__name__}", daemon=True
+            )
+            self._thread.start()
+        logger.info("%s started", type(self).__name__)
+
+    def stop(self, wait: bool = True) -> None:
+        """Ask the primitive to stop; with ``wait``, return once its thread ended."""
+        with self._lifecycle:
+            self._stop_locked(wait)
+
+    def _stop_locked(self, wait: bool) -> None:
+        self._stop_event.set()
+        self._resume_event.set()
+        thread = self._thread
+        if wait and thread is not None and thread is not threading.current_thread():
+            thread.join(JOIN_TIMEOUT_S)
+            if thread.is_alive():
+                logger.warning("%s did not stop within %s s", type(self).__name__, JOIN_TIMEOUT_S)
+
+    def pause(self) -> None:
+        """Ask the primitive to pause (``should_pause()`` turns True); its requests stay."""
+        if self._state == "running":
+            self._resume_event.clear()
+            self._paused_at = time.monotonic()
+            self._state = "paused"
+            logger.info("%s paused", type(self).__name__)
+
+    def resume(self) -> None:
+        """Let a paused primitive go on."""
+        if self._state == "paused":
+            if self._paused_at is not None:
+                self._paused_s += time.monotonic() - self._paused_at
+            self._paused_at = None
+            self._state = "running"
+            self._resume_event.set()
+            logger.info("%s resumed", type(self).__name__)
+
+    def _main(self) -> None:
+        name = type(self).__name__
+        try:
+            self.setup()
+            if not self._stop_event.is_set():
+                self.run()
+        except Exception as exc:
+            self._fail(exc)
+        finally:
+            try:
+                self.teardown()
+            except Exception as exc:
+                if self.error is None:
+                    self._fail(exc)
+                else:
+                    logger.exception("%s: teardown failed too", name)
+            try:
+                self._manager.remove(self)
+            finally:
+                self._ended_at = time.monotonic()
+                if self._paused_at is not None:
+                    self._paused_s += self._ended_at - self._paused_at
+                    self._paused_at = None
+                if self._state != "failed":
+                    self._state = "stopped"
+                    logger.info("%s stopped", name)
+
+    def _fail(self, exc: BaseException) -> None:
+        text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
+        self.error = PrimitiveFailure(type(exc).__name__, str(exc), text)
+        self._state = "failed"
+        self._stop_event.set()
+        logger.error("primitive %s failed:\n%s", type(self).__name__, text.rstrip())
+
+    # -- state -------------------------------------------------------------------------------
+
+    @property
+    def state(self) -> State:
+        """``"idle"`` (never started), ``"running"``, ``"paused"``, ``"stopped"`` or ``"failed"``.
+
+        A failed primitive keeps its ``error`` until it is started again.
+        """
+        return self._state
+
+    def is_alive(self) -> bool:
+        """True while the thread runs (also when paused)."""
+        thread = self._thread
+        return thread is not None and thread.is_alive()
+
+    def should_stop(self) -> bool:
+        """True once ``stop()`` was asked: ``run`` should return."""
+        return self._stop_event.is_set()
+
+    def should_pause(self) -> bool:
+        """True while paused: ``run`` should call ``wait_to_resume()``."""
+        return not self._resume_event.is_set()
+
+    def wait_to_resume(self, timeout_s: float | None = None) -> bool:
+        """Block while paused; False when ``timeout_s`` ran out first."""
+        return self._resume_event.wait(timeout_s)
+
+    def wait_to_stop(self, timeout_s: float | None = None) -> bool:
+        """Block until the thread ended; False when ``timeout_s`` ran out first."""
+        thread = self._thread
+        if thread is None or thread is threading.current_thread():
+            return not self.is_alive()
+        thread.join(timeout_s)
+        return not thread.is_alive()
+
+    def sleep(self, seconds: float) -> bool:
+        """Wait ``seconds`` unless stopped first; True when the primitive should stop."""
+        return self._stop_event.wait(max(0.0, seconds))
+
+    @property
+    def elapsed_time(self) -> float:
+        """Seconds since the (re)start, pauses left out; frozen once stopped; 0 before."""
+        if self._t0 is None:
+            return 0.0
+        end = self._ended_at if self._ended_at is not None else time.monotonic()
+        paused = self._paused_s
+        if self._paused_at is not None:
+            paused += end - self._paused_at
+        return max(0.0, end - self._t0 - paused)
+
+    def get_mockup_motor(self, motor: Motor | MockupMotor | str) -> MockupMotor:
+        """The sandboxed version of a motor (or motor name) for this primitive."""
+        return self.robot.mockup(motor)
+
+    # -- remote access -----------------------------------------------------------------------
+
+    def get_property(self, name: str) -> Any:
+        """The value of declared property ``name``.
+
+        Raises:
+            ConfigError: ``name`` is not in ``properties``.
+        """
+        self._check_name(name, self.properties, "property")
+        return getattr(self, name)
+
+    def set_property(self, name: str, value: Any) -> None:
+        """Set declared property ``name``, converted to the type of its present value.
+
+        Text is parsed (``"0.5"``, ``"true"``, ``"m1,m2"``), so command-line and JSON values work.
+
+        Raises:
+            ConfigError: unknown property, a value of the wrong type, or one the primitive refuses.
+        """
+        self._check_name(name, self.properties, "property")
+        converted = convert_value(name, getattr(self, name), value)
+        try:
+            setattr(self, name, converted)
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(
+                f"property {name}: {exc}", field=name, value=value, reason=str(exc)
+            ) from None
+
+    def property_values(self) -> dict[str, Any]:
+        """Every declared property and its value."""
+        return {name: getattr(self, name) for name in self.properties}
+
+    def call_method(self, name: str, *args: Any) -> Any:
+        """Call declared method ``name`` with ``args`` and return its result.
+
+        Raises:
+            ConfigError: ``name`` is not in ``methods``.
+        """
+        self._check_name(name, self.methods, "method")
+        return getattr(self, name)(*args)
+
+    def _check_name(self, name: str, known: Sequence[str], kind: str) -> None:
+        if name not in known:
+            listed = ", ".join(known) or "none"
+            raise ConfigError(
+                f"{type(self).__name__} has no {kind} {name!r} ({kind}s: {listed})",
+                field=name,
+                value=name,
+            )
+
+    def describe(self) -> dict[str, Any]:
+        """State, elapsed time, properties, methods and error as plain values (for JSON)."""
+        return {
+            "class": type(self).__name__,
+            "state": self.state,
+            "alive": self.is_alive(),
+            "elapsed_s": round(self.elapsed_time, 3),
+            "properties": self.property_values(),
+            "methods": list(self.methods),
+            "error": self.error.to_dict() if self.error is not None else None,
+        }
+
+
+class LoopPrimitive(Primitive):
+    """A primitive calling ``update()`` at ``freq`` Hz, drift-free, until stopped.
+
+    Args:
+        robot: the robot to act on.
+        freq: update rate in Hz.
+    """
+
+    def __init__(self, robot: Robot, freq: float) -> None:
+        super().__init__(robot)
+        self.update_freq = freq
+        self._meter = RateMeter(window=10)
+        self._recent: deque[float] = deque(maxlen=10)
+
+    @property
+    def update_freq(self) -> float:
+        """Updates per second (takes effect at the next (re)start)."""
+        return self._freq
+
+    @update_freq.setter
+    def update_freq(self, value: float) -> None:
+        if not math.isfinite(value) or value <= 0:
+            raise ValueError(f"update frequency must be a positive number of Hz, got {value}")
+        self._freq = float(value)
+
+    @property
+    def period_s(self) -> float:
+        """Seconds between two updates."""
+        return 1.0 / self._freq
+
+    @property
+    def update_rate_hz(self) -> float:
+        """Measured update rate over the last updates (0 until two ran)."""
+        return self._meter.rate_hz
+
+    @property
+    def recent_update_frequencies(self) -> list[float]:
+        """The last (up to 10) instantaneous update rates, most recent first."""
+        return list(reversed(self._recent))
+
+    def update(self) -> None:
+        """One step of the behaviour, called at ``update_freq``."""
+
+    def run(self) -> None:
+        """Call ``update()`` on a drift-free schedule; late updates skip missed periods."""
+        self._meter = RateMeter(window=10)
+        self._recent.clear()
+        last: float | None = None
+        schedule = Periodic(self.period_s, time.monotonic())
+        while not self.should_stop():
+            if self.should_pause():
+                self.wait_to_resume()
+                schedule = Periodic(self.period_s, time.monotonic())
+                last = None
+                continue
+            now = time.monotonic()
+            self.update()
+            self._meter.tick(now)
+            if last is not None and now > last:
+                self._recent.append(1.0 / (now - last))
+            last = now
+            schedule.advance(time.monotonic())
+            self.sleep(schedule.next_deadline - time.monotonic())

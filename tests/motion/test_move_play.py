@@ -1,0 +1,202 @@
+"""Record and play moves on a simulated Ergo Jr, moving its compliant virtual motors by hand."""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from poppy_core.errors import ConfigError
+from poppy_core.motion import Move, MovePlayer, MoveRecorder, PlayProgress, read_move
+from poppy_core.robot import Robot, from_profile
+
+CONTROLLER = "my_dxl_controller"
+TOLERANCE_DEG = 1.0  # the issue's bound between playback and recording
+LAG_S = 0.08  # goal write (50 Hz) + the plant step + our sampling: timing slack only
+
+
+@pytest.fixture
+def ergo() -> Iterator[Robot]:
+    robot = from_profile("ergo-jr", sim=True)
+    try:
+        yield robot
+    finally:
+        robot.close()
+
+
+def eventually(check: Callable[[], bool], timeout_s: float = 2.0) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline and not check():
+        time.sleep(0.01)
+    return check()
+
+
+def virtual_position(robot: Robot, name: str) -> float:
+    """The horn's position in the user frame, read from the emulator (no sync-loop delay)."""
+    motor = robot.motor(name)
+    return motor.to_user(robot.emulators[CONTROLLER].bus.motor(motor.id).present_position_deg)
+
+
+def move_by_hand(robot: Robot, paths: dict[str, list[float]], duration_s: float) -> None:
+    """Walk the compliant motors through ``paths`` (user degrees) in small steps."""
+    bus = robot.emulators[CONTROLLER].bus
+    steps = len(next(iter(paths.values())))
+    for index in range(steps):
+        for name, values in paths.items():
+            motor = robot.motor(name)
+            bus.motor(motor.id).move_by_hand(motor.to_motor(values[index]))
+        time.sleep(duration_s / steps)
+
+
+def sample_playback(
+    robot: Robot, player: MovePlayer, names: list[str]
+) -> list[tuple[float, list[float]]]:
+    """Start ``player`` and sample the horns until it ends: (clock time, positions)."""
+    samples: list[tuple[float, list[float]]] = []
+    player.start()
+    while player.playing:
+        samples.append((time.monotonic(), [virtual_position(robot, n) for n in names]))
+        time.sleep(0.01)
+    assert player.error is None
+    return samples
+
+
+def worst_error(move: Move, player: MovePlayer, samples: list[tuple[float, list[float]]]) -> float:
+    """Largest distance between a sample and the move at that time (allowing ``LAG_S`` late)."""
+    start, end = player.loop_times[0]
+    worst = 0.0
+    checked = 0
+    for t, positions in samples:
+        if not start + LAG_S <= t <= end:
+            continue
+        checked += 1
+        move_t = (t - start) * player.speed
+        candidates = [
+            move.positions_at(move_t - lag * player.speed) for lag in np.linspace(0, LAG_S, 9)
+        ]
+        error = min(float(np.max(np.abs(np.array(positions) - c))) for c in candidates)
+        worst = max(worst, error)
+    assert checked > 10
+    return worst
+
+
+def test_recording_by_hand_replays_within_one_degree(ergo: Robot, tmp_path: Path) -> None:
+    names = ["m1", "m3", "m5"]
+    for name in names:
+        ergo.motor(name).compliant = True
+    steps = 75
+    ramp = np.linspace(0.0, 1.0, steps)
+    paths = {
+        "m1": list(30 * np.sin(np.pi * ramp)),
+        "m3": list(-25 * ramp),
+        "m5": list(20 * ramp - 10 * ramp**2),
+    }
+    move_by_hand(ergo, {n: [v[0]] for n, v in paths.items()}, 0.1)
+    recorder = MoveRecorder(ergo, 50, names, checkpoint_path=tmp_path / "hand.move")
+    recorder.start()
+    move_by_hand(ergo, paths, 1.5)
+    time.sleep(0.1)
+    move = recorder.stop()
+    assert move.motors == tuple(names)
+    assert 1.4 < move.duration_s < 2.5
+    assert abs(float(move.trajectory("m3")[-1]) + 25) < 1.0
+    assert read_move(tmp_path / "hand.move").same_as(move, 1e-3)
+
+    player = MovePlayer(ergo, move)
+    samples = sample_playback(ergo, player, names)
+    assert not any(ergo.motor(n).compliant for n in names)
+    assert worst_error(move, player, samples) <= TOLERANCE_DEG
+    last = move.positions[-1]
+    assert eventually(
+        lambda: (
+            max(abs(virtual_position(ergo, n) - v) for n, v in zip(names, last, strict=True)) <= 1.0
+        )
+    )
+
+
+def ramp_move(seconds: float = 1.0, rate: float = 50.0) -> Move:
+    t = np.arange(int(seconds * rate) + 1) / rate
+    return Move(rate, ["m2", "m4"], np.column_stack([40 * t / seconds, -20 * t / seconds]))
+
+
+def test_speed_two_takes_half_the_time(ergo: Robot) -> None:
+    move = ramp_move(1.0)
+    normal = MovePlayer(ergo, move, ramp_s=0.3).play()
+    fast = MovePlayer(ergo, move, speed=2.0, ramp_s=0.3).play()
+    assert normal.played_s == pytest.approx(1.0, abs=0.15)
+    assert fast.played_s == pytest.approx(0.5, abs=0.1)
+    assert fast.duration_s == pytest.approx(0.5)
+
+
+def test_backwards_plays_the_frames_reversed(ergo: Robot) -> None:
+    move = ramp_move(1.0)
+    events: list[PlayProgress] = []
+    player = MovePlayer(ergo, move, backwards=True, on_progress=events.append)
+    samples = sample_playback(ergo, player, ["m2", "m4"])
+    assert worst_error(move.reversed(), player, samples) <= TOLERANCE_DEG
+    assert eventually(lambda: abs(virtual_position(ergo, "m2")) < TOLERANCE_DEG)  # first frame
+    assert events[-1].phase == "done" and events[-1].fraction == 1.0
+    assert any(e.phase == "ramp" for e in events)  # it first went to 40° by a ramp
+    played = [e.move_t_s for e in events if e.phase == "play"]
+    assert played[0] > played[-1]  # move time counts down
+
+
+def test_loops_repeat_the_move(ergo: Robot) -> None:
+    move = ramp_move(0.4)
+    player = MovePlayer(ergo, move, loops=2, speed=2.0, ramp_s=0.2).play()
+    assert len(player.loop_times) == 2
+    assert player.played_s == pytest.approx(0.4, abs=0.1)
+
+
+def test_pypot_file_written_by_hand_loads_and_plays(ergo: Robot, tmp_path: Path) -> None:
+    # pypot's documented move JSON:
+    # {"framerate": f, "positions": {"<t>": {"<motor>": [pos, speed]}}}
+    positions = {repr(i / 25): {"m1": [i * 0.8, 20.0], "m6": [-i * 0.4, -10.0]} for i in range(26)}
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps({"framerate": 25.0, "positions": positions}, indent=2))
+    move = read_move(path)
+    assert move.framerate == 25.0 and move.motors == ("m1", "m6")
+    assert move.duration_s == pytest.approx(1.0)
+    player = MovePlayer(ergo, move, speed=2.0).play()
+    assert eventually(lambda: abs(virtual_position(ergo, "m1") - 20.0) < TOLERANCE_DEG)
+    assert eventually(lambda: abs(virtual_position(ergo, "m6") + 10.0) < TOLERANCE_DEG)
+    assert player.played_s == pytest.approx(0.5, abs=0.1)
+
+
+def test_play_refuses_missing_motors_naming_them(ergo: Robot) -> None:
+    move = Move(50, ["m1", "elbow", "wrist"], np.zeros((3, 3)))
+    with pytest.raises(ConfigError, match="elbow, wrist") as info:
+        MovePlayer(ergo, move)
+    assert info.value.value == ["elbow", "wrist"]
+
+
+def test_stop_ends_playback_early(ergo: Robot) -> None:
+    player = MovePlayer(ergo, ramp_move(5.0), ramp_s=0.1)
+    player.start()
+    threading.Timer(0.4, player.stop).start()
+    assert player.wait(3.0)
+    assert player.stopped and player.played_s < 1.0
+
+
+def test_recorder_groups_speeds_and_checkpoints(ergo: Robot, tmp_path: Path) -> None:
+    path = tmp_path / "cp.move"
+    recorder = MoveRecorder(
+        ergo, 20, ["base", "m6"], checkpoint_path=path, checkpoint_period_s=0.2, with_speeds=True
+    )
+    with recorder:
+        time.sleep(0.7)
+        assert recorder.recording and recorder.checkpoints >= 2
+        on_disk = read_move(path)  # a checkpoint taken while recording is a valid move
+        assert on_disk.motors == ("m1", "m2", "m3", "m6") and len(on_disk) >= 4
+        assert set(recorder.latest()) == {"m1", "m2", "m3", "m6"}
+    move = read_move(path)
+    assert move.framerate == 20 and move.speeds is not None
+    assert move.metadata["robot"] == "ergo-jr" and "created" in move.metadata
+    assert 0.6 < move.duration_s < 1.2
+    with pytest.raises(ConfigError, match="nothing"):
+        MoveRecorder(ergo, 20, ["nothing"])

@@ -1,0 +1,320 @@
+"""Primitives on a simulated Ergo Jr: lifecycle, timing, failures, properties and attaching."""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Iterator
+
+import pytest
+
+from poppy_core.errors import ConfigError, PortError
+from poppy_core.motion import (
+    LoopPrimitive,
+    Primitive,
+    SimplePosture,
+    Sinus,
+    active_primitives,
+    attach_primitive,
+    attached_primitives,
+    primitive_manager,
+)
+from poppy_core.robot import Robot, from_profile
+
+
+def eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
+    """Poll ``check`` until it holds (True) or the timeout runs out (False)."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if check():
+            return True
+        time.sleep(0.01)
+    return check()
+
+
+def state(primitive: Primitive) -> str:
+    """The state, read afresh (keeps mypy from narrowing it between two reads)."""
+    return primitive.state
+
+
+@pytest.fixture
+def ergo() -> Iterator[Robot]:
+    robot = from_profile("ergo-jr", sim=True)
+    try:
+        yield robot
+    finally:
+        robot.close()
+
+
+class Counter(Primitive):
+    """Counts its loops until stopped; honours pause."""
+
+    def __init__(self, robot: Robot) -> None:
+        super().__init__(robot)
+        self.count = 0
+        self.setups = 0
+        self.teardowns = 0
+
+    def setup(self) -> None:
+        self.setups += 1
+
+    def run(self) -> None:
+        while not self.should_stop():
+            if self.should_pause():
+                self.wait_to_resume()
+                continue
+            self.count += 1
+            self.sleep(0.005)
+
+    def teardown(self) -> None:
+        self.teardowns += 1
+
+
+class Ticker(LoopPrimitive):
+    """Counts its updates."""
+
+    def __init__(self, robot: Robot, freq: float) -> None:
+        super().__init__(robot, freq)
+        self.updates = 0
+
+    def update(self) -> None:
+        self.updates += 1
+
+
+class Crasher(LoopPrimitive):
+    """Raises on its third update."""
+
+    def __init__(self, robot: Robot) -> None:
+        super().__init__(robot, 50)
+        self.updates = 0
+
+    def setup(self) -> None:
+        self.updates = 0
+
+    def update(self) -> None:
+        self.updates += 1
+        self.robot.m1.goal_position = 40.0
+        if self.updates == 3:
+            raise ValueError("boom at update 3")
+
+
+def test_start_stop_restart(ergo: Robot) -> None:
+    counter = Counter(ergo)
+    assert state(counter) == "idle" and not counter.is_alive()
+    counter.start()
+    assert state(counter) == "running" and counter.is_alive()
+    assert eventually(lambda: counter.count > 3)
+    counter.stop()
+    assert state(counter) == "stopped" and not counter.is_alive()
+    assert (counter.setups, counter.teardowns) == (1, 1)
+    counted = counter.count
+    time.sleep(0.05)
+    assert counter.count == counted
+    counter.start()  # restartable, unlike a plain thread
+    assert state(counter) == "running"
+    assert eventually(lambda: counter.count > counted)
+    counter.start()  # start while running restarts it
+    assert (counter.setups, counter.teardowns) == (3, 2)
+    counter.stop()
+    assert counter.wait_to_stop(1.0)
+    assert counter.error is None
+
+
+def test_pause_and_resume(ergo: Robot) -> None:
+    counter = Counter(ergo)
+    counter.start()
+    assert eventually(lambda: counter.count > 0)
+    counter.pause()
+    assert state(counter) == "paused" and counter.should_pause()
+    assert counter.is_alive()  # paused is alive
+    time.sleep(0.05)
+    frozen = counter.count
+    time.sleep(0.1)
+    assert counter.count == frozen
+    counter.resume()
+    assert state(counter) == "running"
+    assert eventually(lambda: counter.count > frozen)
+    counter.stop()
+    assert not counter.is_alive()
+
+
+def test_stop_a_paused_primitive(ergo: Robot) -> None:
+    counter = Counter(ergo)
+    counter.start()
+    counter.pause()
+    counter.stop()
+    assert state(counter) == "stopped" and not counter.is_alive()
+
+
+def test_elapsed_time(ergo: Robot) -> None:
+    counter = Counter(ergo)
+    assert counter.elapsed_time == 0.0
+    counter.start()
+    time.sleep(0.3)
+    assert 0.25 <= counter.elapsed_time < 2.0
+    counter.pause()
+    paused_at = counter.elapsed_time
+    time.sleep(0.2)
+    assert counter.elapsed_time - paused_at < 0.1  # pauses do not count
+    counter.stop()
+    final = counter.elapsed_time
+    time.sleep(0.05)
+    assert counter.elapsed_time == final  # frozen once stopped
+    counter.start()
+    assert counter.elapsed_time < final  # a restart starts from 0
+    counter.stop()
+
+
+def test_loop_primitive_rate(ergo: Robot) -> None:
+    ticker = Ticker(ergo, 50)
+    ticker.start()
+    time.sleep(0.5)
+    ticker.stop()
+    # 50 Hz for 0.5 s is 25 updates; the schedule never runs ahead of its deadlines.
+    assert 12 <= ticker.updates <= 27
+    assert 25 <= ticker.update_rate_hz <= 60
+    assert ticker.recent_update_frequencies
+    with pytest.raises(ValueError):
+        ticker.update_freq = 0
+
+
+def test_crash_is_reported_and_the_manager_survives(
+    ergo: Robot, caplog: pytest.LogCaptureFixture
+) -> None:
+    ergo.compliant = False
+    steady = Sinus(ergo, 50, ["m2"], amp=0.0, offset=15.0)
+    steady.start()
+    crasher = Crasher(ergo)
+    with caplog.at_level(logging.ERROR, logger="poppy_core.motion.primitive"):
+        crasher.start()
+        assert crasher.wait_to_stop(3.0)
+    assert state(crasher) == "failed"
+    assert not crasher.is_alive()
+    assert crasher.error is not None
+    assert crasher.error.type == "ValueError"
+    assert crasher.error.message == "boom at update 3"
+    assert "Traceback" in crasher.error.traceback and "boom at update 3" in crasher.error.traceback
+    assert crasher.error.one_line == "ValueError: boom at update 3"
+    assert crasher.describe()["error"]["type"] == "ValueError"
+    assert any(
+        r.name == "poppy_core.motion.primitive" and "boom at update 3" in r.getMessage()
+        for r in caplog.records
+    )
+    manager = primitive_manager(ergo)
+    assert crasher not in manager.primitives and steady in manager.primitives
+    # The manager still applies the other primitive's requests.
+    steady.set_property("offset", -20)
+    assert eventually(lambda: abs(ergo.m2.goal_position + 20) < 1)
+    assert manager.running
+    steady.stop()
+    first_error = crasher.error
+    crasher.start()  # a failed primitive can be started again (its error is reset)
+    assert crasher.wait_to_stop(3.0)
+    assert state(crasher) == "failed" and crasher.updates == 3
+    assert crasher.error is not None and crasher.error is not first_error
+
+
+def test_failing_setup_never_runs(ergo: Robot) -> None:
+    sinus = Sinus(ergo, 50, ["nope"])
+    sinus.start()
+    assert sinus.wait_to_stop(3.0)
+    assert state(sinus) == "failed"
+    assert sinus.error is not None and sinus.error.type == "ConfigError"
+    assert "nope" in sinus.error.message
+
+
+def test_properties_get_set_and_validation(ergo: Robot) -> None:
+    sinus = Sinus(ergo, 50, ["m1"], amp=10, freq=0.5)
+    assert sinus.get_property("amplitude") == 10.0
+    sinus.set_property("amplitude", "20")
+    assert sinus.amplitude == 20.0
+    sinus.set_property("frequency", 2)
+    assert sinus.get_property("frequency") == 2.0
+    sinus.set_property("motor_list", "m1, m2")
+    assert sinus.motor_list == ["m1", "m2"]
+    with pytest.raises(ConfigError, match="not a number"):
+        sinus.set_property("amplitude", "loud")
+    with pytest.raises(ConfigError, match="not a number"):
+        sinus.set_property("amplitude", True)
+    with pytest.raises(ConfigError, match="finite"):
+        sinus.set_property("offset", "nan")
+    with pytest.raises(ConfigError, match="frequency"):
+        sinus.set_property("frequency", -1)
+    with pytest.raises(ConfigError, match="no property 'colour'"):
+        sinus.set_property("colour", 1)
+    with pytest.raises(ConfigError, match="no property"):
+        sinus.get_property("run")
+    assert set(sinus.property_values()) == set(Sinus.properties)
+    posture = SimplePosture(ergo)
+    posture.set_property("target_position", "m1=10, m2=-5")
+    assert posture.target_position == {"m1": 10.0, "m2": -5.0}
+    with pytest.raises(ConfigError, match="NAME=NUMBER"):
+        posture.set_property("target_position", "m1")
+
+
+def test_call_method(ergo: Robot) -> None:
+    sinus = Sinus(ergo, 50, ["m1"])
+    sinus.call_method("start")
+    assert sinus.is_alive()
+    sinus.call_method("stop")
+    assert not sinus.is_alive()
+    with pytest.raises(ConfigError, match="no method 'run'"):
+        sinus.call_method("run")
+
+
+def test_attach_primitive(ergo: Robot) -> None:
+    dance = Sinus(ergo, 50, ["m1"])
+    ergo.attach_primitive(dance, "dance")
+    assert ergo.dance is dance
+    assert ergo.primitives == [dance]
+    assert "dance" in dir(ergo)
+    watcher = Counter(ergo)
+    attach_primitive(ergo, "watch", watcher)
+    assert attached_primitives(ergo) == {"dance": dance, "watch": watcher}
+    assert ergo.active_primitives == []
+    dance.start()
+    assert ergo.active_primitives == [dance]
+    assert active_primitives(ergo) == [dance]
+    dance.stop()
+    with pytest.raises(ConfigError):
+        attach_primitive(ergo, "m1", Counter(ergo))  # a motor's name
+    with pytest.raises(ConfigError):
+        attach_primitive(ergo, "close", Counter(ergo))  # a Robot attribute
+
+
+def test_attach_a_primitive_of_another_robot(ergo: Robot) -> None:
+    with (
+        from_profile("ergo-jr", sim=True) as other,
+        pytest.raises(ConfigError, match="another robot"),
+    ):
+        attach_primitive(ergo, "foreign", Counter(other))
+
+
+def test_close_stops_primitives(ergo: Robot) -> None:
+    counter = Counter(ergo)
+    counter.start()
+    manager = primitive_manager(ergo)
+    ergo.close()
+    assert not counter.is_alive()
+    assert not manager.running
+    with pytest.raises(PortError, match="closed"):
+        counter.start()
+    assert state(counter) == "stopped"
+
+
+def test_primitive_cannot_restart_itself(ergo: Robot) -> None:
+    errors: list[BaseException] = []
+
+    class Selfish(Primitive):
+        def run(self) -> None:
+            try:
+                self.start()
+            except RuntimeError as exc:
+                errors.append(exc)
+
+    selfish = Selfish(ergo)
+    selfish.start()
+    assert selfish.wait_to_stop(2.0)
+    assert len(errors) == 1 and state(selfish) == "stopped"
+    assert threading.active_count() >= 1
