@@ -2,6 +2,8 @@
 
 ``sim=True`` starts one in-process emulator per controller (a ``VirtualBus`` with the configured
 models, IDs and baud rate, served on a pty), so the robot talks the same bytes as with hardware.
+``sim="mujoco"`` does the same with MuJoCo physics behind the virtual servos (one world for the
+whole robot, ``robot.simulation``); ``sim=True`` / ``"ideal"`` keep the ideal servo plant.
 """
 
 from __future__ import annotations
@@ -12,14 +14,14 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 from poppy_core.bus import DxlBus, find_port, list_ports, scan
-from poppy_core.emulator import Adapter, VirtualBus, VirtualMotor, serve_pty
+from poppy_core.emulator import Adapter, Plant, VirtualBus, VirtualMotor, serve_pty
 from poppy_core.errors import ConfigError, PortError, RegisterError, SetupError
 from poppy_core.models import model_by_name
 from poppy_core.robot import startup
 from poppy_core.robot.config import RobotConfig
 from poppy_core.robot.config_io import load_config
 from poppy_core.robot.motor import Motor
-from poppy_core.robot.profiles import load_profile
+from poppy_core.robot.profiles import load_profile, profile_dirs
 from poppy_core.robot.robot import Robot
 from poppy_core.robot.startup import ReturnDelayConsent
 from poppy_core.robot.sync import BusSync, loops_for
@@ -27,11 +29,56 @@ from poppy_core.robot.sync import BusSync, loops_for
 logger = logging.getLogger(__name__)
 
 
-def start_emulators(config: RobotConfig) -> dict[str, Any]:
+SimMode = bool | str
+SIM_MODES = ("ideal", "mujoco")
+
+
+def _sim_mode(sim: SimMode) -> str | None:
+    """None (hardware), "ideal" or "mujoco" from the ``sim`` argument."""
+    if sim is False or sim is None:
+        return None
+    if sim is True:
+        return "ideal"
+    if sim in SIM_MODES:
+        return str(sim)
+    raise ConfigError(f"unknown simulation {sim!r} (expected one of {', '.join(SIM_MODES)})",
+                      field="sim", value=sim)  # fmt: skip
+
+
+def start_simulation(config: RobotConfig) -> Any:
+    """The MuJoCo world of the config's robot (its profile's ``model.xml``), not yet running.
+
+    Raises:
+        ConfigError: the config names no profile kind with a simulation model.
+    """
+    from poppy_core.sim.world import Simulation  # mujoco loads only here
+
+    kind = (config.profile.kind or config.profile.name) if config.profile is not None else ""
+    for directory in profile_dirs():
+        path = directory / kind / "model.xml"
+        if kind and path.is_file():
+            return Simulation(path.read_text(encoding="utf-8"))
+    raise ConfigError(f"no simulation model for robot kind {kind!r} (profiles/<kind>/model.xml)",
+                      field="profile.kind", value=kind)  # fmt: skip
+
+
+def _mujoco_plant(config: RobotConfig, controller: str, simulation: Any) -> Plant:
+    from poppy_core.sim.plant import JointLink, MujocoPlant
+
+    links = {}
+    for name in config.motors_of_controller(controller):
+        entry = config.motors[name]
+        sign = 1.0 if entry.orientation == "direct" else -1.0
+        links[entry.id] = JointLink(name, sign, float(entry.offset))
+    return MujocoPlant(simulation, links)
+
+
+def start_emulators(config: RobotConfig, simulation: Any = None) -> dict[str, Any]:
     """One emulator per controller, served on a pty: controller name -> ``EmulatorServer``.
 
     The virtual motors have the configured models, IDs and baud rate, and a return delay of 0
     (a robot already set up). Protocol 1 controllers with ``sync_read`` get a USB2AX adapter.
+    With a ``simulation`` (``start_simulation``), each bus gets a MuJoCo plant view on it.
     """
     servers: dict[str, Any] = {}
     try:
@@ -45,8 +92,13 @@ def start_emulators(config: RobotConfig) -> dict[str, Any]:
             adapter: Adapter = (
                 "usb2ax" if controller.protocol == 1 and controller.sync_read else "u2d2"
             )
+            plant = None if simulation is None else _mujoco_plant(config, name, simulation)
             bus = VirtualBus(
-                motors, controller.protocol, baudrate=controller.baudrate, adapter=adapter
+                motors,
+                controller.protocol,
+                baudrate=controller.baudrate,
+                adapter=adapter,
+                plant=plant,
             )
             servers[name] = serve_pty(bus)
     except BaseException:
@@ -75,7 +127,7 @@ def _motor_targets(config: RobotConfig, names: Iterable[str]) -> dict[str, float
 
 def from_config(
     config: RobotConfig | str | os.PathLike[str],
-    sim: bool = False,
+    sim: SimMode = False,
     *,
     strict: bool = True,
     fix_return_delay: ReturnDelayConsent = False,
@@ -87,7 +139,8 @@ def from_config(
 
     Args:
         config: the config or its path.
-        sim: serve the config's motors from in-process emulators instead of hardware.
+        sim: serve the config's motors from in-process emulators instead of hardware: True or
+            ``"ideal"`` (ideal servos), ``"mujoco"`` (physics; ``robot.simulation`` is set).
         strict: missing or mismatched motors raise ``SetupError``; when False they are logged
             and missing ones start offline (retried by the sync loop).
         fix_return_delay: set return delays above the wanted one (0 µs unless the config's
@@ -110,9 +163,13 @@ def from_config(
     cfg = config if isinstance(config, RobotConfig) else load_config(config)
     emulators: dict[str, Any] = {}
     buses: dict[str, DxlBus] = {}
+    mode = _sim_mode(sim)
+    simulation = start_simulation(cfg) if mode == "mujoco" else None
     try:
-        if sim:
-            emulators = start_emulators(cfg)
+        if mode is not None:
+            emulators = start_emulators(cfg, simulation)
+            if simulation is not None:
+                simulation.start()
         motors: dict[str, list[Motor]] = {}
         problems: list[str] = []
         used: set[str] = set()
@@ -120,7 +177,7 @@ def from_config(
             names = cfg.motors_of_controller(name)
             if not names:
                 continue
-            port = emulators[name].url if sim else entry.port
+            port = emulators[name].url if mode is not None else entry.port
             if port == "auto":
                 try:
                     port = _resolve_port(name, cfg, used, ports)
@@ -155,11 +212,14 @@ def from_config(
             bus.close()
         for server in emulators.values():
             server.stop()
+        if simulation is not None:
+            simulation.close()
         raise
     every = [m for name in cfg.controllers for m in motors.get(name, [])]
     groups = {g: [n for n in cfg.resolve_group(g) if n in {m.name for m in every}]
               for g in cfg.motorgroups}
-    robot = Robot(every, groups=groups, syncs=syncs, buses=buses, config=cfg, emulators=emulators)
+    robot = Robot(every, groups=groups, syncs=syncs, buses=buses, config=cfg, emulators=emulators,
+                  simulation=simulation)  # fmt: skip
     if start_sync:
         robot.start_sync()
     return robot
@@ -208,7 +268,7 @@ def _with_ports(config: RobotConfig, port: str | Mapping[str, str]) -> RobotConf
 
 
 def from_profile(
-    name: str, port: str | Mapping[str, str] | None = None, sim: bool = False, **options: Any
+    name: str, port: str | Mapping[str, str] | None = None, sim: SimMode = False, **options: Any
 ) -> Robot:
     """Build a robot from an installed or user profile (``"ergo-jr"``, ``"torso"``...).
 
@@ -216,7 +276,7 @@ def from_profile(
         name: the profile name.
         port: the port (one controller) or controller name -> port; None keeps the profile's
             (``"auto"`` searches for the bus holding the motors).
-        sim: serve the motors from emulators.
+        sim: serve the motors from emulators (True/``"ideal"`` or ``"mujoco"``).
         **options: passed to :func:`from_config`.
     """
     config = load_profile(name)

@@ -1,0 +1,321 @@
+"""Write the MuJoCo models (MJCF) of Ergo Jr, Torso and Humanoid from their public URDFs.
+
+Run ``python -m poppy_core.sim.mjcf [profiles_dir]`` to regenerate ``profiles/<robot>/model.xml``.
+
+Each URDF joint becomes a hinge named like the profile's motor; links get capsules between the
+joint origins (no meshes) and the URDF's mass and inertia. A MuJoCo joint angle is the poppy
+angle of the motor (user frame): ``JOINT_FRAMES`` holds, per joint, the URDF angle at poppy's
+zero and the direction, where the URDF differs (see docs/simulation.md for the checks).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from poppy_core.models import model_by_name
+from poppy_core.sim.servos import servo_params
+from poppy_core.sim.urdf import (
+    Quat,
+    Urdf,
+    UrdfJoint,
+    Vec3,
+    conjugate,
+    parse_urdf,
+    quat_from_axis_angle,
+    quat_from_rpy,
+    quat_mul,
+    rotate,
+)
+
+URDF_DIR = Path(__file__).resolve().parent / "urdf"
+ROBOTS: dict[str, str] = {
+    "ergo-jr": "poppy_ergo_jr.urdf",
+    "torso": "poppy_torso.urdf",
+    "humanoid": "poppy_humanoid.urdf",
+}
+
+# joint -> (URDF angle in degrees at poppy's 0°, direction of poppy's angle about the URDF axis).
+# Ergo Jr: pypot drives the URDF with the motor angle (its IK chain, no reversed motor), so the
+# indirect motors turn the other way. Torso/Humanoid: the URDF limits equal the profile's
+# (user-frame) limits, but its arms are in a T-pose at 0: the shoulders are turned so that
+# poppy's 0 has the arms down, the directions follow the mirrored limits of each side.
+_ARMS: dict[str, tuple[float, float]] = {
+    "l_shoulder_y": (90.0, -1.0),
+    "l_shoulder_x": (90.0, -1.0),
+    "r_shoulder_y": (-90.0, -1.0),
+    "r_shoulder_x": (90.0, 1.0),
+}
+JOINT_FRAMES: dict[str, dict[str, tuple[float, float]]] = {
+    "ergo-jr": {name: (0.0, -1.0) for name in ("m2", "m3", "m5", "m6")},
+    "torso": dict(_ARMS),
+    "humanoid": dict(_ARMS),
+}
+
+
+@dataclass(frozen=True)
+class Style:
+    """How a robot looks and where it stands."""
+
+    radius_m: float
+    rgba: str
+    mount: str  # "table", "support" or "floor"
+    camera: tuple[Vec3, Vec3]  # position, point looked at
+
+
+STYLES: dict[str, Style] = {
+    "ergo-jr": Style(0.012, "0.95 0.95 0.95 1", "table", ((0.3, -0.3, 0.3), (0, 0, 0.15))),
+    "torso": Style(0.022, "0.92 0.92 0.9 1", "support", ((0.7, -0.7, 1.25), (0, 0, 0.95))),
+    "humanoid": Style(0.025, "0.92 0.92 0.9 1", "floor", ((1.0, -1.0, 0.8), (0, 0, 0.45))),
+}
+# link -> (geom type, size) drawn at the link's centre of mass, so the robot looks like itself.
+BLOBS: dict[str, dict[str, tuple[str, Vec3]]] = {
+    "ergo-jr": {"tip": ("sphere", (0.018, 0.0, 0.0))},
+    "torso": {"head": ("sphere", (0.055, 0.0, 0.0)), "chest": ("box", (0.07, 0.05, 0.04))},
+    "humanoid": {
+        "head": ("sphere", (0.055, 0.0, 0.0)),
+        "chest": ("box", (0.07, 0.05, 0.04)),
+        "pelvis": ("box", (0.06, 0.035, 0.03)),
+    },
+}
+TABLE_TOP_M = 0.05
+SUPPORT_TOP_M = 0.75
+
+
+def _f(value: float) -> str:
+    text = f"{value:.6g}"
+    return "0" if text in ("-0", "0") else text
+
+
+def _v(values: tuple[float, ...]) -> str:
+    return " ".join(_f(v) for v in values)
+
+
+def _norm(v: Vec3) -> float:
+    return math.sqrt(sum(c * c for c in v))
+
+
+def load_profile_motors(profiles_dir: Path, robot: str) -> dict[str, dict[str, Any]]:
+    """The ``motors`` section of ``profiles/<robot>/profile.yaml``."""
+    data = yaml.safe_load((profiles_dir / robot / "profile.yaml").read_text(encoding="utf-8"))
+    motors: dict[str, dict[str, Any]] = data["motors"]
+    return motors
+
+
+class _Writer:
+    def __init__(self, robot: str, urdf: Urdf, motors: dict[str, dict[str, Any]]) -> None:
+        self.robot = robot
+        self.urdf = urdf
+        self.motors = motors
+        self.style = STYLES[robot]
+        self.frames = JOINT_FRAMES.get(robot, {})
+        self.lines: list[str] = []
+
+    def joint_quat(self, joint: UrdfJoint) -> Quat:
+        zero_deg, _ = self.frames.get(joint.name, (0.0, 1.0))
+        base = quat_from_rpy(joint.rpy)
+        return quat_mul(base, quat_from_axis_angle(joint.axis, math.radians(zero_deg)))
+
+    def world_frames(self) -> dict[str, tuple[Vec3, Quat]]:
+        """World pose of every link at poppy's zero pose (root at the origin)."""
+        poses: dict[str, tuple[Vec3, Quat]] = {self.urdf.root: ((0.0, 0.0, 0.0), (1, 0, 0, 0))}
+        pending = [self.urdf.root]
+        while pending:
+            link = pending.pop()
+            pos, quat = poses[link]
+            for joint in self.urdf.children(link):
+                offset = rotate(quat, joint.xyz)
+                child_pos = (pos[0] + offset[0], pos[1] + offset[1], pos[2] + offset[2])
+                poses[joint.child] = (child_pos, quat_mul(quat, self.joint_quat(joint)))
+                pending.append(joint.child)
+        return poses
+
+    def geoms(self, link: str, indent: str, world_quat: Quat) -> None:
+        radius = self.style.radius_m
+        rgba = self.style.rgba
+        inertial = self.urdf.links.get(link)
+        ends = [j.xyz for j in self.urdf.children(link) if _norm(j.xyz) > 1e-3]
+        feet = link.endswith("foot")
+        if feet:
+            ends = []
+        elif not ends and inertial is not None and _norm(inertial.com) > 1e-3:
+            com = inertial.com
+            ends = [(2 * com[0], 2 * com[1], 2 * com[2])]
+        for index, end in enumerate(ends):
+            r = radius * (0.8 if index else 1.0)
+            self.lines.append(
+                f'{indent}<geom name="{link}_{index}" type="capsule" size="{_f(r)}" '
+                f'fromto="0 0 0 {_v(end)}" rgba="{rgba}"/>'
+            )
+        blob = BLOBS.get(self.robot, {}).get(link)
+        if blob is not None and inertial is not None:
+            kind, size = blob
+            self.lines.append(
+                f'{indent}<geom name="{link}_body" type="{kind}" size="{_v(size)}" '
+                f'pos="{_v(inertial.com)}" rgba="{rgba}"/>'
+            )
+        elif not ends and not feet:
+            self.lines.append(
+                f'{indent}<geom name="{link}_0" type="sphere" size="{_f(radius)}" rgba="{rgba}"/>'
+            )
+        if feet and inertial is not None:
+            # flat sole, aligned with the world at the zero pose
+            inv = conjugate(world_quat)
+            half = (0.04, 0.09, 0.01)
+            center = (inertial.com[0], inertial.com[1], inertial.com[2])
+            down = rotate(inv, (0.0, 0.0, -0.015))
+            pos = (center[0] + down[0], center[1] + down[1], center[2] + down[2])
+            self.lines.append(
+                f'{indent}<geom name="{link}_sole" type="box" size="{_v(half)}" '
+                f'pos="{_v(pos)}" quat="{_v(inv)}" rgba="0.3 0.3 0.3 1"/>'
+            )
+        if link == self.urdf.root and self.robot == "ergo-jr":
+            self.lines.append(
+                f'{indent}<geom name="{link}_box" type="box" size="0.045 0.045 0.034" '
+                f'pos="0 0 -0.034" rgba="0.3 0.3 0.3 1"/>'
+            )
+
+    def inertial(self, link: str, indent: str) -> None:
+        inertial = self.urdf.links.get(link)
+        if inertial is None:
+            return
+        ixx, iyy, izz, ixy, ixz, iyz = inertial.inertia
+        self.lines.append(
+            f'{indent}<inertial pos="{_v(inertial.com)}" mass="{_f(inertial.mass_kg)}" '
+            f'fullinertia="{_v((ixx, iyy, izz, ixy, ixz, iyz))}"/>'
+        )
+
+    def body(self, joint: UrdfJoint, depth: int, poses: dict[str, tuple[Vec3, Quat]]) -> None:
+        indent = "  " * depth
+        quat = self.joint_quat(joint)
+        self.lines.append(
+            f'{indent}<body name="{joint.child}" pos="{_v(joint.xyz)}" quat="{_v(quat)}">'
+        )
+        self.inertial(joint.child, indent + "  ")
+        if joint.kind in ("revolute", "continuous"):
+            _, direction = self.frames.get(joint.name, (0.0, 1.0))
+            axis = tuple(direction * c for c in joint.axis)
+            motor = self.motors.get(joint.name, {})
+            low, high = motor.get("angle_limit", (-150.0, 150.0))
+            servo = servo_params(model_by_name(motor.get("type", "MX-28")))
+            self.lines.append(
+                f'{indent}  <joint name="{joint.name}" axis="{_v(axis)}" '
+                f'range="{_f(math.radians(low))} {_f(math.radians(high))}" '
+                f'armature="{_f(servo.armature_kgm2)}" frictionloss="{_f(servo.friction_nm)}"/>'
+            )
+        self.geoms(joint.child, indent + "  ", poses[joint.child][1])
+        for child in self.urdf.children(joint.child):
+            self.body(child, depth + 1, poses)
+        self.lines.append(f"{indent}</body>")
+
+    def lowest_point(self, poses: dict[str, tuple[Vec3, Quat]]) -> float:
+        """Height of the lowest sole below the root at the zero pose (Humanoid)."""
+        lows = []
+        for link, (pos, _) in poses.items():
+            inertial = self.urdf.links.get(link)
+            if link.endswith("foot") and inertial is not None:
+                com = rotate(poses[link][1], inertial.com)
+                lows.append(pos[2] + com[2] - 0.025)
+        return min(lows) if lows else 0.0
+
+    def write(self) -> str:
+        style = self.style
+        poses = self.world_frames()
+        root = self.urdf.root
+        cam_pos, _ = style.camera
+        out = self.lines
+        out += [
+            f'<mujoco model="poppy-{self.robot}">',
+            f"  <!-- Generated by poppy_core/sim/mjcf.py from {ROBOTS[self.robot]}: "
+            "do not edit by hand. -->",
+            '  <compiler angle="radian" autolimits="true"/>',
+            '  <option timestep="0.002" integrator="implicitfast"/>',
+            '  <visual><global offwidth="1280" offheight="960"/></visual>',
+            "  <asset>",
+            '    <texture name="grid" type="2d" builtin="checker" rgb1="0.82 0.84 0.86" '
+            'rgb2="0.72 0.74 0.76" width="256" height="256"/>',
+            '    <material name="grid" texture="grid" texrepeat="8 8" reflectance="0.1"/>',
+            "  </asset>",
+            "  <default>",
+            '    <geom contype="2" conaffinity="1" condim="3" friction="0.8 0.02 0.001"/>',
+            '    <default class="world">',
+            '      <geom contype="1" conaffinity="3"/>',
+            "    </default>",
+            "  </default>",
+            "  <worldbody>",
+            '    <light name="sun" pos="0 0 3" dir="0 0 -1" directional="true"/>',
+            '    <light name="key" pos="1 -1 2" dir="-1 1 -1.5"/>',
+            '    <geom name="floor" class="world" type="plane" size="3 3 0.05" material="grid"/>',
+            f'    <camera name="front" mode="targetbody" target="{root}" pos="{_v(cam_pos)}"/>',
+        ]
+        if style.mount == "table":
+            top = TABLE_TOP_M
+            out.append(
+                f'    <geom name="table" class="world" type="box" size="0.3 0.3 {_f(top / 2)}" '
+                f'pos="0 0 {_f(top / 2)}" rgba="0.55 0.4 0.3 1"/>'
+            )
+            root_pos: Vec3 = (0.0, 0.0, top + 0.068)
+        elif style.mount == "support":
+            top = SUPPORT_TOP_M
+            out.append(
+                f'    <geom name="support" class="world" type="box" size="0.06 0.06 {_f(top / 2)}" '
+                f'pos="0 0 {_f(top / 2)}" rgba="0.3 0.3 0.3 1"/>'
+            )
+            root_pos = (0.0, 0.0, top)
+        else:
+            root_pos = (0.0, 0.0, -self.lowest_point(poses) + 0.002)
+        out.append(f'    <body name="{root}" pos="{_v(root_pos)}">')
+        if style.mount == "floor":
+            out.append('      <freejoint name="root"/>')
+        self.inertial(root, "      ")
+        self.geoms(root, "      ", poses[root][1])
+        for joint in self.urdf.children(root):
+            self.body(joint, 3, poses)
+        out.append("    </body>")
+        out.append("  </worldbody>")
+        out.append("  <actuator>")
+        for joint in self.urdf.joints:
+            if joint.kind not in ("revolute", "continuous"):
+                continue
+            motor_type = self.motors.get(joint.name, {}).get("type", "MX-28")
+            servo = servo_params(model_by_name(motor_type))
+            out.append(
+                f'    <position name="{joint.name}" joint="{joint.name}" '
+                f'kp="{_f(servo.kp_nm_per_rad)}" kv="{_f(servo.kv_nms_per_rad)}" '
+                f'forcerange="{_f(-servo.stall_torque_nm)} {_f(servo.stall_torque_nm)}"/>'
+            )
+        out.append("  </actuator>")
+        out.append("</mujoco>")
+        return "\n".join(out) + "\n"
+
+
+def generate(robot: str, profiles_dir: Path) -> str:
+    """The MJCF text of ``robot`` (``"ergo-jr"``, ``"torso"`` or ``"humanoid"``)."""
+    urdf = parse_urdf(URDF_DIR / ROBOTS[robot])
+    return _Writer(robot, urdf, load_profile_motors(profiles_dir, robot)).write()
+
+
+def write_all(profiles_dir: Path) -> list[Path]:
+    """Write ``model.xml`` next to each robot's profile; returns the files written."""
+    written = []
+    for robot in ROBOTS:
+        path = profiles_dir / robot / "model.xml"
+        path.write_text(generate(robot, profiles_dir), encoding="utf-8")
+        written.append(path)
+    return written
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command-line entry: regenerate the models in ``argv[0]`` (default ``./profiles``)."""
+    args = sys.argv[1:] if argv is None else argv
+    write_all(Path(args[0]) if args else Path("profiles"))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,75 @@
+"""MujocoPlant: the emulator's Plant protocol over one shared MuJoCo world (one view per bus)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from poppy_core.emulator.motor import VirtualMotor
+from poppy_core.errors import ConfigError
+
+if TYPE_CHECKING:
+    from poppy_core.sim.world import Simulation
+
+
+@dataclass(frozen=True)
+class JointLink:
+    """How one motor drives one joint: ``joint_deg = sign * motor_deg - offset_deg``.
+
+    ``sign`` is +1 for a direct motor, -1 for an indirect one; ``offset_deg`` is the profile's
+    offset. The joint angle is poppy's (user-frame) angle, so 30° in poppy is 30° at the joint.
+    """
+
+    joint: str
+    sign: float = 1.0
+    offset_deg: float = 0.0
+
+    def joint_deg(self, motor_deg: float) -> float:
+        """The joint angle for a motor (control table) angle."""
+        return self.sign * motor_deg - self.offset_deg
+
+    def motor_deg(self, joint_deg: float) -> float:
+        """The motor (control table) angle for a joint angle."""
+        return self.sign * (joint_deg + self.offset_deg)
+
+
+class MujocoPlant:
+    """The motors of one bus, moved by the joints of a :class:`Simulation`.
+
+    The physics runs in the simulation's own thread, which reads the motors' commands and writes
+    their sensed state through the control tables (under ``motor.lock``). :meth:`step` is
+    therefore a no-op: the bus sees the physics only through the tables. Without the thread
+    (tests), ``Simulation.advance(dt)`` steps the world and the tables together.
+
+    Args:
+        simulation: the world shared by every bus of the robot.
+        links: motor id -> its joint, sign and offset.
+    """
+
+    def __init__(self, simulation: Simulation, links: Mapping[int, JointLink]) -> None:
+        self.simulation = simulation
+        self.links = dict(links)
+
+    def attach(self, motors: Sequence[VirtualMotor]) -> None:
+        """Bind each motor to its joint (by the motor's id) and start it at the joint's pose.
+
+        Raises:
+            ConfigError: a motor has no joint, or the joint is not in the model.
+        """
+        for motor in motors:
+            link = self.links.get(motor.id)
+            if link is None:
+                raise ConfigError(
+                    f"motor {motor.id} has no joint in the simulation", field="motors"
+                )
+            self.simulation.bind(motor, link)
+            motor.hand_mover = self._move_by_hand
+
+    def step(self, dt_s: float) -> None:
+        """Nothing to do: the simulation's thread advances the physics (see the class doc)."""
+
+    def _move_by_hand(self, motor: VirtualMotor, position_deg: float) -> None:
+        link = self.links[motor.id]
+        self.simulation.set_joint_deg(link.joint, link.joint_deg(position_deg))
+        motor.table.set_si("present_position", position_deg)

@@ -1,0 +1,369 @@
+"""Simulation: one MuJoCo world for a robot, its physics thread, and the handle robot.simulation."""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
+    os.environ["MUJOCO_GL"] = "egl"  # headless rendering; osmesa also works when installed
+
+import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
+import numpy as np
+
+from poppy_core.emulator.motor import VirtualMotor
+from poppy_core.errors import ConfigError
+from poppy_core.sim.objects import ObjectSpec, add_objects
+from poppy_core.sim.plant import JointLink
+
+logger = logging.getLogger(__name__)
+
+SYNC_PERIOD_S = 0.005  # physics <-> control tables exchange period (5 physics steps at 2 ms)
+
+
+@dataclass
+class _Binding:
+    motor: VirtualMotor
+    link: JointLink
+    qpos: int = 0
+    dof: int = 0
+    actuator: int = 0
+    stall_nm: float = 1.0
+    kp: float = 0.0
+    kv: float = 0.0
+    target_rad: float = 0.0
+
+
+@dataclass
+class _Command:
+    torque_on: bool
+    goal_rad: float
+    speed_rps: float
+    torque_pct: float
+
+
+@dataclass
+class _State:
+    position_deg: float
+    speed_dps: float
+    load_pct: float
+    moving: bool
+
+
+@dataclass
+class _Objects:
+    specs: list[ObjectSpec] = field(default_factory=list)
+
+
+class Simulation:
+    """A MuJoCo world whose joints are driven by virtual motors (``robot.simulation``).
+
+    Args:
+        xml: the MJCF text of the robot (``profiles/<robot>/model.xml``).
+        speed: how many simulated seconds pass per real second in the physics thread.
+    """
+
+    def __init__(self, xml: str, speed: float = 1.0) -> None:
+        self._xml = xml
+        self.speed = speed
+        self._lock = threading.RLock()
+        self.model = mujoco.MjModel.from_xml_string(xml)
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)
+        self._bindings: list[_Binding] = []
+        self._objects = _Objects()
+        self._renderers: dict[tuple[int, int], Any] = {}
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+
+    # ------------------------------------------------------------------ motors
+
+    def _resolve(self, binding: _Binding) -> None:
+        name = binding.link.joint
+        joint = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, name)
+        actuator = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+        if joint < 0 or actuator < 0:
+            raise ConfigError(f"the simulation model has no joint/actuator {name!r}", field=name)
+        binding.qpos = int(self.model.jnt_qposadr[joint])
+        binding.dof = int(self.model.jnt_dofadr[joint])
+        binding.actuator = actuator
+
+    def bind(self, motor: VirtualMotor, link: JointLink) -> None:
+        """Let ``motor`` drive joint ``link.joint``; its table starts at the joint's pose."""
+        binding = _Binding(motor, link)
+        with self._lock:
+            self._resolve(binding)
+            a = binding.actuator
+            binding.stall_nm = float(self.model.actuator_forcerange[a][1])
+            binding.kp = float(self.model.actuator_gainprm[a][0])
+            binding.kv = float(-self.model.actuator_biasprm[a][2])
+            binding.target_rad = float(self.data.qpos[binding.qpos])
+            self._bindings.append(binding)
+            position = link.motor_deg(math.degrees(binding.target_rad))
+        with motor.lock:
+            motor.set_state(position, 0.0, 0.0, False)
+            motor.table.set_si("goal_position", position)
+
+    def set_joint_deg(self, joint: str, angle_deg: float) -> None:
+        """Put joint ``joint`` at ``angle_deg`` (poppy's frame), at rest."""
+        with self._lock:
+            index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+            if index < 0:
+                raise ConfigError(f"no joint {joint!r} in the simulation", field=joint)
+            self.data.qpos[self.model.jnt_qposadr[index]] = math.radians(angle_deg)
+            self.data.qvel[self.model.jnt_dofadr[index]] = 0.0
+            for binding in self._bindings:
+                if binding.link.joint == joint:
+                    binding.target_rad = math.radians(angle_deg)
+            mujoco.mj_forward(self.model, self.data)
+
+    def joint_deg(self, joint: str) -> float:
+        """Angle of joint ``joint`` in degrees (poppy's frame)."""
+        with self._lock:
+            index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+            if index < 0:
+                raise ConfigError(f"no joint {joint!r} in the simulation", field=joint)
+            return math.degrees(float(self.data.qpos[self.model.jnt_qposadr[index]]))
+
+    # ------------------------------------------------------------------ stepping
+
+    def _command(self, binding: _Binding) -> _Command:
+        motor, link = binding.motor, binding.link
+        with motor.lock:
+            low, high = motor.position_limits_deg()
+            goal = min(max(motor.goal_position_deg, low), high)
+            torque = motor.table.get_si("torque_limit") if motor.model.has_torque_limit else None
+            return _Command(
+                torque_on=motor.torque_enabled,
+                goal_rad=math.radians(link.joint_deg(goal)),
+                speed_rps=math.radians(motor.speed_limit_dps),
+                torque_pct=float(torque) if isinstance(torque, (int, float)) else 100.0,
+            )
+
+    def _apply(self, binding: _Binding, command: _Command) -> None:
+        a, model = binding.actuator, self.model
+        limit = binding.stall_nm * min(max(command.torque_pct, 0.0), 100.0) / 100.0
+        model.actuator_forcerange[a] = (-limit, limit)
+        on = command.torque_on
+        model.actuator_gainprm[a][0] = binding.kp if on else 0.0
+        model.actuator_biasprm[a][1] = -binding.kp if on else 0.0
+        model.actuator_biasprm[a][2] = -binding.kv if on else 0.0
+
+    def _state(self, binding: _Binding, command: _Command) -> _State:
+        link = binding.link
+        position = math.degrees(float(self.data.qpos[binding.qpos]))
+        speed = math.degrees(float(self.data.qvel[binding.dof]))
+        force = float(self.data.actuator_force[binding.actuator])
+        # e-manual: present load is a percentage of the maximum (stall) torque
+        load = max(-100.0, min(100.0, 100.0 * force / binding.stall_nm))
+        moving = command.torque_on and (
+            abs(command.goal_rad - binding.target_rad) > 1e-6 or abs(speed) > 2.0
+        )
+        return _State(link.motor_deg(position), link.sign * speed, link.sign * load, moving)
+
+    def advance(self, dt_s: float) -> None:
+        """Advance the physics by ``dt_s`` seconds, exchanging commands and states with the
+        motors' tables before and after (never holding a motor lock and the world lock at once).
+        """
+        commands = [self._command(b) for b in self._bindings]
+        with self._lock:
+            timestep = float(self.model.opt.timestep)
+            steps = max(1, round(dt_s / timestep))
+            for binding, command in zip(self._bindings, commands, strict=True):
+                self._apply(binding, command)
+            for _ in range(steps):
+                for binding, command in zip(self._bindings, commands, strict=True):
+                    if command.torque_on:
+                        delta = command.goal_rad - binding.target_rad
+                        step = command.speed_rps * timestep
+                        binding.target_rad += max(-step, min(step, delta))
+                    else:
+                        binding.target_rad = float(self.data.qpos[binding.qpos])
+                    self.data.ctrl[binding.actuator] = binding.target_rad
+                mujoco.mj_step(self.model, self.data)
+            states = [self._state(b, c) for b, c in zip(self._bindings, commands, strict=True)]
+        for binding, state in zip(self._bindings, states, strict=True):
+            binding.motor.set_state(
+                state.position_deg, state.speed_dps, state.load_pct, state.moving
+            )
+
+    # ------------------------------------------------------------------ thread
+
+    def start(self) -> None:
+        """Run the physics in real time (times ``speed``) in a background thread."""
+        if self._thread is not None:
+            return
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._run, name="mujoco physics", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        last = time.monotonic()
+        while not self._stop.wait(SYNC_PERIOD_S):
+            now = time.monotonic()
+            elapsed = min(now - last, 0.1)  # never try to catch up more than 100 ms
+            last = now
+            try:
+                self.advance(elapsed * self.speed)
+            except Exception:  # keep the emulator answering; the error is in the log
+                logger.exception("physics step failed")
+
+    def stop(self) -> None:
+        """Stop the physics thread (idempotent)."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=2.0)
+            self._thread = None
+
+    @property
+    def running(self) -> bool:
+        """True while the physics thread runs."""
+        return self._thread is not None
+
+    def close(self) -> None:
+        """Stop the thread and free the renderers."""
+        self.stop()
+        with self._lock:
+            for renderer in self._renderers.values():
+                renderer.close()
+            self._renderers.clear()
+
+    # ------------------------------------------------------------------ handle
+
+    def reset(self) -> None:
+        """Back to the initial pose: world state reset, objects back where added, goals = pose."""
+        with self._lock:
+            mujoco.mj_resetData(self.model, self.data)
+            mujoco.mj_forward(self.model, self.data)
+            for binding in self._bindings:
+                binding.target_rad = float(self.data.qpos[binding.qpos])
+            poses = [(b, b.link.motor_deg(math.degrees(b.target_rad))) for b in self._bindings]
+        for binding, position in poses:
+            with binding.motor.lock:
+                binding.motor.table.set_si("goal_position", position)
+                binding.motor.set_state(position, 0.0, 0.0, False)
+
+    def _body(self, name: str) -> int:
+        index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
+        if index < 0:
+            known = ", ".join(self.body_names())
+            raise ConfigError(f"no object {name!r} in the simulation ({known})", field=name)
+        return int(index)
+
+    def body_names(self) -> list[str]:
+        """Names of the bodies (robot links and added objects)."""
+        names = (mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, i) for i in
+                 range(1, self.model.nbody))  # fmt: skip
+        return [n for n in names if n]
+
+    def get_object_position(self, name: str, relative_to: str | None = None) -> list[float]:
+        """Position (m) of body ``name`` in the world, or in body ``relative_to``'s frame."""
+        with self._lock:
+            pos = np.array(self.data.xpos[self._body(name)])
+            if relative_to is not None:
+                ref = self._body(relative_to)
+                rot = np.array(self.data.xmat[ref]).reshape(3, 3)
+                pos = rot.T @ (pos - self.data.xpos[ref])
+            return [float(v) for v in pos]
+
+    def get_object_orientation(self, name: str, relative_to: str | None = None) -> list[float]:
+        """Orientation quaternion (w, x, y, z) of body ``name`` (world or ``relative_to``)."""
+        with self._lock:
+            quat = np.array(self.data.xquat[self._body(name)])
+            if relative_to is not None:
+                inverse = np.zeros(4)
+                mujoco.mju_negQuat(inverse, self.data.xquat[self._body(relative_to)])
+                out = np.zeros(4)
+                mujoco.mju_mulQuat(out, inverse, quat)
+                quat = out
+            return [float(v) for v in quat]
+
+    def add_object(
+        self,
+        kind: str,
+        name: str,
+        position: tuple[float, float, float],
+        size: float | tuple[float, ...] = 0.02,
+        mass: float = 0.05,
+    ) -> None:
+        """Add a free ``"cube"``, ``"sphere"`` or ``"cylinder"`` (size: half side/radius, m).
+
+        The model is rebuilt; the robot's state and the other objects' poses are kept.
+
+        Raises:
+            ConfigError: unknown kind, or the name is already used.
+        """
+        spec = ObjectSpec.make(kind, name, position, size, mass)
+        with self._lock:
+            if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
+                raise ConfigError(f"an object called {name!r} exists", field=name)
+            old_model, old_data = self.model, self.data
+            specs = [*self._objects.specs, spec]
+            model = add_objects(self._xml, specs)
+            data = mujoco.MjData(model)
+            for j in range(old_model.njnt):
+                joint = mujoco.mj_id2name(old_model, mujoco.mjtObj.mjOBJ_JOINT, j)
+                new = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+                size_q = 7 if old_model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE else 1
+                size_v = 6 if size_q == 7 else 1
+                qa, na = old_model.jnt_qposadr[j], model.jnt_qposadr[new]
+                va, nv = old_model.jnt_dofadr[j], model.jnt_dofadr[new]
+                data.qpos[na : na + size_q] = old_data.qpos[qa : qa + size_q]
+                data.qvel[nv : nv + size_v] = old_data.qvel[va : va + size_v]
+            data.time = old_data.time
+            for a in range(old_model.nu):
+                model.actuator_gainprm[a] = old_model.actuator_gainprm[a]
+                model.actuator_biasprm[a] = old_model.actuator_biasprm[a]
+                model.actuator_forcerange[a] = old_model.actuator_forcerange[a]
+                data.ctrl[a] = old_data.ctrl[a]
+            mujoco.mj_forward(model, data)
+            self.model, self.data = model, data
+            self._objects.specs = specs
+            for binding in self._bindings:
+                self._resolve(binding)
+            for renderer in self._renderers.values():
+                renderer.close()
+            self._renderers.clear()
+
+    def contacts(self) -> list[tuple[str, str]]:
+        """Pairs of bodies touching now (each pair once, names sorted)."""
+        with self._lock:
+            pairs = set()
+            for i in range(self.data.ncon):
+                contact = self.data.contact[i]
+                a = self.model.geom_bodyid[contact.geom[0]]
+                b = self.model.geom_bodyid[contact.geom[1]]
+                names = sorted(
+                    mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, int(x)) or "world"
+                    for x in (a, b)
+                )
+                pairs.add((names[0], names[1]))
+            return sorted(pairs)
+
+    def colliding(self, name: str, other: str | None = None) -> bool:
+        """Whether body ``name`` touches ``other`` (any body when None; "world" is the floor)."""
+        return any(name in pair and (other is None or other in pair) for pair in self.contacts())
+
+    def render(self, camera: str | None = None, width: int = 640, height: int = 480) -> Any:
+        """An RGB image (numpy array height × width × 3) from ``camera`` (default: free view).
+
+        Raises:
+            ConfigError: no OpenGL backend (set MUJOCO_GL to egl or osmesa).
+        """
+        with self._lock:
+            key = (width, height)
+            try:
+                if key not in self._renderers:
+                    self._renderers[key] = mujoco.Renderer(self.model, height, width)
+                renderer = self._renderers[key]
+                renderer.update_scene(self.data, camera=camera if camera is not None else -1)
+                return renderer.render()
+            except (mujoco.FatalError, AttributeError, RuntimeError) as exc:
+                raise ConfigError(
+                    f"cannot render ({exc}): set MUJOCO_GL to egl or osmesa", field="MUJOCO_GL"
+                ) from exc

@@ -1,0 +1,60 @@
+"""Helpers for the MuJoCo simulation tests: a world with virtual motors, stepped by hand."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from poppy_core.emulator import VirtualBus, VirtualMotor
+from poppy_core.models import model_by_name
+from poppy_core.robot.profiles import load_profile
+from poppy_core.sim.plant import JointLink, MujocoPlant
+from poppy_core.sim.world import Simulation
+
+ROOT = Path(__file__).resolve().parents[2]
+PROFILES = ROOT / "profiles"
+ROBOTS = ("ergo-jr", "torso", "humanoid")
+
+
+@dataclass
+class World:
+    """A simulation, its motors by name and the joint links (motor name -> JointLink)."""
+
+    sim: Simulation
+    motors: dict[str, VirtualMotor]
+    links: dict[str, JointLink]
+
+    def command(self, name: str, user_deg: float, torque: bool = True) -> None:
+        """Write a goal in poppy's frame (converted to the motor's) and the torque flag."""
+        motor, link = self.motors[name], self.links[name]
+        with motor.lock:
+            motor.table.set_si("goal_position", link.motor_deg(user_deg))
+            motor.table.set("torque_enable", int(torque))
+
+    def present_user_deg(self, name: str) -> float:
+        """The motor's present position, converted to poppy's frame."""
+        return self.links[name].joint_deg(self.motors[name].present_position_deg)
+
+    def run(self, seconds: float) -> None:
+        """Advance the physics ``seconds`` in 10 ms steps (no thread, deterministic)."""
+        for _ in range(round(seconds / 0.01)):
+            self.sim.advance(0.01)
+
+
+def make_world(robot: str) -> World:
+    """The robot's model with one virtual bus per controller attached (physics not running)."""
+    config = load_profile(robot)
+    sim = Simulation((PROFILES / robot / "model.xml").read_text(encoding="utf-8"))
+    motors: dict[str, VirtualMotor] = {}
+    links: dict[str, JointLink] = {}
+    for controller, entry in config.controllers.items():
+        ids: dict[int, JointLink] = {}
+        bus_motors = []
+        for name in config.motors_of_controller(controller):
+            motor_entry = config.motors[name]
+            sign = 1.0 if motor_entry.orientation == "direct" else -1.0
+            links[name] = ids[motor_entry.id] = JointLink(name, sign, float(motor_entry.offset))
+            motors[name] = VirtualMotor(model_by_name(motor_entry.type), motor_entry.id)
+            bus_motors.append(motors[name])
+        VirtualBus(bus_motors, entry.protocol, plant=MujocoPlant(sim, ids), auto_step=False)
+    return World(sim, motors, links)

@@ -1,0 +1,55 @@
+"""A robot built with sim="mujoco": the same bytes on a pty, physics behind the servos."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from poppy_core.errors import ConfigError
+from poppy_core.robot.factory import from_profile
+
+
+def test_ergo_jr_goto_ends_near_the_goal_in_the_physics() -> None:
+    with from_profile("ergo-jr", sim="mujoco") as robot:
+        simulation = robot.simulation
+        assert simulation is not None and simulation.running
+        robot.compliant = False
+        goal = {"m1": 20.0, "m2": -30.0, "m3": 25.0, "m4": -15.0, "m5": 30.0, "m6": -20.0}
+        robot.goto_position(goal, 1.0, wait=True)
+        time.sleep(0.5)
+        for name, value in goal.items():
+            assert simulation.joint_deg(name) == pytest.approx(value, abs=2.0), name
+            assert robot.motor(name).present_position == pytest.approx(value, abs=2.0), name
+    assert not simulation.running  # close() stopped the physics thread
+
+
+def test_compliant_robot_can_be_moved_by_hand() -> None:
+    with from_profile("ergo-jr", sim="mujoco") as robot:
+        robot.compliant = True
+        time.sleep(0.2)
+        bus = next(iter(robot.emulators.values())).bus
+        link_m1 = bus.plant.links[1]
+        bus.motor(1).move_by_hand(link_m1.motor_deg(50.0))
+        time.sleep(0.3)
+        assert robot.m1.present_position == pytest.approx(50.0, abs=2.0)
+
+
+def test_ideal_simulation_has_no_handle() -> None:
+    with from_profile("ergo-jr", sim=True) as robot:
+        assert robot.simulation is None
+
+
+def test_unknown_simulation_is_refused() -> None:
+    with pytest.raises(ConfigError):
+        from_profile("ergo-jr", sim="bullet")
+
+
+def test_humanoid_runs_with_two_buses_on_one_world() -> None:
+    with from_profile("humanoid", sim="mujoco") as robot:
+        assert len(robot.emulators) == 2
+        robot.compliant = False
+        robot.goto_position({"head_z": 30.0, "l_knee_y": 20.0}, 0.5, wait=True)
+        time.sleep(0.5)
+        assert robot.simulation.joint_deg("head_z") == pytest.approx(30.0, abs=3.0)
+        assert robot.head_z.present_position == pytest.approx(30.0, abs=3.0)
