@@ -1,0 +1,38 @@
+"""Creatures: what is specific to Poppy Ergo Jr, Torso and Humanoid (setup and primitives)."""
+
+from poppy_core.creatures.body import DanceBeatMotion, HeadIdleMotion, UpperBodyIdleMotion
+from poppy_core.creatures.ergo_jr import Dance, Jump, SafePowerUp
+from poppy_core.creatures.factory import from_config, from_profile
+from poppy_core.creatures.interaction import ArmsCopyMotion, ArmsTurnCompliant
+from poppy_core.creatures.postures import CreaturePosture
+from poppy_core.creatures.registry import (
+    CREATURES,
+    Creature,
+    CreatureSpec,
+    attach_creature,
+    detect_kind,
+    normalize_kind,
+)
+from poppy_core.creatures.safety import LimitTorque, TemperatureMonitor
+
+__all__ = [
+    "CREATURES",
+    "ArmsCopyMotion",
+    "ArmsTurnCompliant",
+    "Creature",
+    "CreaturePosture",
+    "CreatureSpec",
+    "Dance",
+    "DanceBeatMotion",
+    "HeadIdleMotion",
+    "Jump",
+    "LimitTorque",
+    "SafePowerUp",
+    "TemperatureMonitor",
+    "UpperBodyIdleMotion",
+    "attach_creature",
+    "detect_kind",
+    "from_config",
+    "from_profile",
+    "normalize_kind",
+]

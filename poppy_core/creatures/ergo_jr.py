@@ -1,0 +1,301 @@
+"""Poppy Ergo Jr behaviours: a sinusoidal dance, a jump and a gentle power-up."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar
+
+from poppy_core.creatures.postures import ERGO_JR_IDLE, clamp_to_limits
+from poppy_core.motion import LoopPrimitive, Primitive
+from poppy_core.motion.trajectory import CONTROLS
+
+if TYPE_CHECKING:
+    from poppy_core.robot import Robot
+
+ERGO_JR_MOTORS: tuple[str, ...] = ("m1", "m2", "m3", "m4", "m5", "m6")
+
+# Poppy documentation (Poppy Ergo Jr specific features): "max_torque set to 0.7, so they can use
+# only 70% of their maximal power"; poppy_ergo_jr.py sets torque_limit = 70 on every motor.
+ERGO_JR_TORQUE_LIMIT_PCT = 70.0
+# poppy_ergo_jr.py setup: m.pid = (4, 2, 0) on every motor (XL-320 P = raw/8, I = raw·1000/2048,
+# D = raw·4/1000, the same units as our XL-320 registers).
+ERGO_JR_PID: tuple[float, float, float] = (4.0, 2.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Wave:
+    """One sinusoid of the dance: ``amplitude_deg * sin(2π freq_hz t + phase_deg)``."""
+
+    motors: tuple[str, ...]
+    amplitude_deg: float
+    freq_hz: float
+    phase_deg: float = 0.0
+
+
+# poppy_ergo_jr/primitives/dance.py: five sinusoids refreshed at 25 Hz, their requests summed by
+# the primitive manager (the Ergo Jr's filter is a sum).
+DANCE_WAVES: tuple[Wave, ...] = (
+    Wave(("m1",), 90.0, 0.25),
+    Wave(("m4",), 90.0, 0.25, 180.0),
+    Wave(("m5",), 30.0, 0.8),
+    Wave(("m6",), 30.0, 0.8, 180.0),
+    Wave(ERGO_JR_MOTORS, 10.0, 0.1),
+)
+DANCE_UPDATE_HZ = 25.0  # dance.py: Sinus(..., 25., ...)
+DANCE_INTRO_S = 3.0  # dance.py: goto every motor to 0° in 3 s before dancing
+DANCE_SPEED_DPS = 150.0  # dance.py: moving_speed = 150 while dancing
+
+# poppy_ergo_jr/primitives/jump.py: the two postures (degrees) and their pace.
+JUMP_UP: dict[str, float] = {"m1": 0, "m2": -10, "m3": -20, "m4": 0, "m5": -35, "m6": -35}
+JUMP_DOWN: dict[str, float] = {"m1": 0, "m2": -75, "m3": 55, "m4": 0, "m5": 35, "m6": 35}
+JUMP_UP_S = 0.2  # jump.py: up at full speed (moving_speed 0), then sleep 0.2 s
+JUMP_DOWN_S = 0.4  # jump.py: down at 250 deg/s, then sleep 0.4 s
+JUMP_DOWN_SPEED_DPS = 250.0
+JUMP_PID: tuple[float, float, float] = (10.0, 0.0, 0.0)  # jump.py: stiff P gain while jumping
+
+SAFE_POWER_UP_S = 3.0  # postures.py SafePowerUp: IdlePosture(robot, 3.0)
+
+
+def _check_control(value: str) -> str:
+    if value not in CONTROLS:
+        raise ValueError(f"control must be one of {', '.join(CONTROLS)}, not {value!r}")
+    return value
+
+
+def _finite(name: str, value: float, low: float = 0.0) -> float:
+    if not math.isfinite(value) or value < low:
+        raise ValueError(f"{name} must be a finite number >= {low:g}, got {value}")
+    return float(value)
+
+
+class Dance(LoopPrimitive):
+    """Ergo Jr's dance: sums of sinusoids on its joints, after going to 0° (looping).
+
+    Args:
+        robot: an Ergo Jr.
+        amplitude_scale: multiplies every sinusoid's amplitude (1 = pypot's dance).
+        tempo_scale: multiplies every sinusoid's frequency (1 = pypot's dance).
+        intro_s: seconds to reach 0° on every motor before dancing.
+        control: goto control of the intro.
+    """
+
+    properties: ClassVar[Sequence[str]] = (
+        "amplitude_scale", "tempo_scale", "intro_s", "speed_dps", "update_freq",
+    )  # fmt: skip
+
+    def __init__(
+        self,
+        robot: Robot,
+        amplitude_scale: float = 1.0,
+        tempo_scale: float = 1.0,
+        intro_s: float = DANCE_INTRO_S,
+        control: str = "dummy",
+    ) -> None:
+        super().__init__(robot, DANCE_UPDATE_HZ)
+        self.amplitude_scale = amplitude_scale
+        self.tempo_scale = tempo_scale
+        self.intro_s = intro_s
+        self.speed_dps = DANCE_SPEED_DPS
+        self.control = _check_control(control)
+        self._dance_t0 = 0.0
+        self._speeds: dict[str, float] = {}
+
+    @property
+    def amplitude_scale(self) -> float:
+        """Multiplier of every amplitude (>= 0)."""
+        return self._amplitude_scale
+
+    @amplitude_scale.setter
+    def amplitude_scale(self, value: float) -> None:
+        self._amplitude_scale = _finite("amplitude_scale", value)
+
+    @property
+    def tempo_scale(self) -> float:
+        """Multiplier of every frequency (>= 0)."""
+        return self._tempo_scale
+
+    @tempo_scale.setter
+    def tempo_scale(self, value: float) -> None:
+        self._tempo_scale = _finite("tempo_scale", value)
+
+    @property
+    def intro_s(self) -> float:
+        """Seconds to reach the 0° posture before dancing (>= 0)."""
+        return self._intro_s
+
+    @intro_s.setter
+    def intro_s(self, value: float) -> None:
+        self._intro_s = _finite("intro_s", value)
+
+    @property
+    def speed_dps(self) -> float:
+        """Moving speed while dancing, deg/s (0 = full speed)."""
+        return self._speed_dps
+
+    @speed_dps.setter
+    def speed_dps(self, value: float) -> None:
+        self._speed_dps = _finite("speed_dps", value)
+
+    def _dancers(self) -> list[str]:
+        known = {m.name for m in self.real_robot.motors}
+        return [name for name in ERGO_JR_MOTORS if name in known]
+
+    def setup(self) -> None:
+        """Stiffen, go to 0°, set the dancing speed and light the LEDs green."""
+        names = self._dancers()
+        self._speeds = {n: self.real_robot.motor(n).moving_speed for n in names}
+        for name in names:
+            self.robot.motor(name).compliant = False
+        self.robot.goto_position({n: 0.0 for n in names}, self.intro_s, self.control, wait=True)
+        for name in names:
+            motor = self.robot.motor(name)
+            motor.moving_speed = self.speed_dps
+            motor.led = "green"
+        self._dance_t0 = self.elapsed_time
+
+    def positions(self, t_s: float) -> dict[str, float]:
+        """Motor name -> the dance's goal (degrees) ``t_s`` seconds into the dance."""
+        out = dict.fromkeys(self._dancers(), 0.0)
+        for wave in DANCE_WAVES:
+            angle = 2 * math.pi * wave.freq_hz * self.tempo_scale * t_s
+            value = (
+                self.amplitude_scale
+                * wave.amplitude_deg
+                * math.sin(angle + math.radians(wave.phase_deg))
+            )
+            for name in wave.motors:
+                if name in out:
+                    out[name] += value
+        return out
+
+    def update(self) -> None:
+        """Request the dance's positions at the present time."""
+        for name, position in self.positions(self.elapsed_time - self._dance_t0).items():
+            self.robot.motor(name).goal_position = position
+
+    def teardown(self) -> None:
+        """Hold the last goals, give back the moving speeds and turn the LEDs off."""
+        for name, speed in self._speeds.items():
+            motor = self.robot.motor(name)
+            motor.moving_speed = speed
+            motor.led = "off"
+
+
+class Jump(Primitive):
+    """Ergo Jr folds, then unfolds at full speed: with a light base, it jumps.
+
+    Args:
+        robot: an Ergo Jr.
+        jumps: how many jumps (0: until stopped).
+    """
+
+    properties: ClassVar[Sequence[str]] = ("jumps",)
+
+    def __init__(self, robot: Robot, jumps: int = 1) -> None:
+        super().__init__(robot)
+        self.jumps = jumps
+        self._pids: dict[str, tuple[float, float, float]] = {}
+
+    @property
+    def jumps(self) -> int:
+        """Number of jumps; 0 jumps until stopped."""
+        return self._jumps
+
+    @jumps.setter
+    def jumps(self, value: int) -> None:
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise ValueError(f"jumps must be a whole number >= 0, got {value!r}")
+        self._jumps = value
+
+    def setup(self) -> None:
+        """Stiffen with a high P gain (the gains are put back at the end)."""
+        names = [n for n in JUMP_UP if n in {m.name for m in self.real_robot.motors}]
+        self._pids = {}
+        for name in names:
+            self.robot.motor(name).compliant = False
+            real = self.real_robot.motor(name)
+            if real.model.has_register("p_gain"):
+                self._pids[name] = real.pid
+                real.pid = JUMP_PID
+
+    def _pose(self, posture: dict[str, float], speed_dps: float) -> None:
+        for name, position in clamp_to_limits(self.real_robot, posture).items():
+            motor = self.robot.motor(name)
+            motor.moving_speed = speed_dps
+            motor.goal_position = position
+
+    def run(self) -> None:
+        """Fold, then (up fast, fold) once per jump."""
+        self._pose(JUMP_DOWN, JUMP_DOWN_SPEED_DPS)
+        if self.sleep(JUMP_DOWN_S):
+            return
+        done = 0
+        while not self.should_stop() and (self.jumps == 0 or done < self.jumps):
+            if self.should_pause():
+                self.wait_to_resume()
+                continue
+            self._pose(JUMP_UP, 0.0)
+            if self.sleep(JUMP_UP_S):
+                return
+            self._pose(JUMP_DOWN, JUMP_DOWN_SPEED_DPS)
+            if self.sleep(JUMP_DOWN_S):
+                return
+            done += 1
+
+    def teardown(self) -> None:
+        """Put the gains back."""
+        for name, pid in self._pids.items():
+            self.real_robot.motor(name).pid = pid
+
+
+class SafePowerUp(Primitive):
+    """Power up gently: limited torque, then a slow move to the idle posture.
+
+    Args:
+        robot: an Ergo Jr.
+        duration: seconds to reach the idle posture.
+        torque_limit: torque limit (%) set on every motor before stiffening.
+        control: goto control.
+    """
+
+    properties: ClassVar[Sequence[str]] = ("duration", "torque_limit", "control")
+
+    def __init__(
+        self,
+        robot: Robot,
+        duration: float = SAFE_POWER_UP_S,
+        torque_limit: float = ERGO_JR_TORQUE_LIMIT_PCT,
+        control: str = "dummy",
+    ) -> None:
+        super().__init__(robot)
+        self.duration = _finite("duration", duration)
+        self.torque_limit = torque_limit
+        self.control = _check_control(control)
+
+    @property
+    def torque_limit(self) -> float:
+        """Torque limit in % (0..100) given to every motor."""
+        return self._torque_limit
+
+    @torque_limit.setter
+    def torque_limit(self, value: float) -> None:
+        if not math.isfinite(value) or not 0.0 <= value <= 100.0:
+            raise ValueError(f"torque_limit must be 0..100 %, got {value}")
+        self._torque_limit = float(value)
+
+    def run(self) -> None:
+        """Limit the torque, stiffen, go to the idle posture and wait until it is reached."""
+        posture = clamp_to_limits(self.real_robot, ERGO_JR_IDLE)
+        for name in posture:
+            motor = self.robot.motor(name)
+            if motor.real_motor.model.has_torque_limit:
+                motor.torque_limit = self.torque_limit
+            motor.compliant = False
+        self.robot.goto_position(posture, self.duration, self.control, wait=True)
+
+    def teardown(self) -> None:
+        """Full speed again (pypot's SafePowerUp ends with moving_speed = 0)."""
+        for name in clamp_to_limits(self.real_robot, ERGO_JR_IDLE):
+            self.robot.motor(name).moving_speed = 0.0

@@ -1,0 +1,129 @@
+"""Posture primitives of the creatures: Ergo Jr base/rest/curious, Humanoid stand/sit.
+
+Each one is a ``SimplePosture`` that moves with its creature's default goto control, keeps the
+targets inside the motors' angle limits and, on Ergo Jr, colours the LEDs as pypot's postures do.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, ClassVar
+
+from poppy_core.motion import SimplePosture
+from poppy_core.motion.trajectory import CONTROLS
+
+if TYPE_CHECKING:
+    from poppy_core.robot import Robot
+
+# Durations: poppy_ergo_jr attaches its postures with a 2 s duration (poppy_ergo_jr.py setup).
+ERGO_JR_POSTURE_S = 2.0
+# Humanoid stand/sit: 2 s, the same pace as the Ergo Jr postures (poppy-humanoid is not
+# installed here to read its own value).
+HUMANOID_POSTURE_S = 2.0
+
+# poppy_ergo_jr/primitives/postures.py (BasePosture): every motor at 0°.
+ERGO_JR_BASE: dict[str, float] = {f"m{i}": 0.0 for i in range(1, 7)}
+# poppy_ergo_jr/primitives/postures.py (RestPosture), degrees.
+ERGO_JR_REST: dict[str, float] = {
+    "m1": 0.0, "m2": -90.0, "m3": 35.0, "m4": 0.0, "m5": 55.0, "m6": -5.0,
+}  # fmt: skip
+# poppy_ergo_jr/primitives/postures.py (CuriousPosture), degrees.
+ERGO_JR_CURIOUS: dict[str, float] = {
+    "m1": 0.0, "m2": -15.0, "m3": 40.0, "m4": 0.0, "m5": -35.0, "m6": -60.0,
+}  # fmt: skip
+# poppy_ergo_jr/primitives/postures.py (IdlePosture), degrees; SafePowerUp goes there.
+# m2's -110° lies outside the profile's [-90, 125] limits: goals are clamped to -90°.
+ERGO_JR_IDLE: dict[str, float] = {
+    "m1": 0.0, "m2": -110.0, "m3": 65.0, "m4": 0.0, "m5": 34.0, "m6": 20.0,
+}  # fmt: skip
+
+# Poppy documentation (poppy_humanoid library): "stand_position: the robot moves to standing
+# position (0 to all motors)".
+# Sit, "legs bent with heels under the buttock" (same documentation). poppy-humanoid's own
+# numbers are not available here; these are chosen: knees bent near their 134° stop, thighs
+# raised 35°, feet flat-ish (ankles at their 45° stop). Left-side signs; the right leg's angle
+# limits in the profile are the left ones negated (e.g. l_knee_y [-3.5, 134], r_knee_y
+# [-134, 3.5]), so the right joints get the negated values.
+HUMANOID_SIT_LEFT: dict[str, float] = {"hip_y": -35.0, "knee_y": 125.0, "ankle_y": -45.0}
+
+
+def humanoid_sit() -> dict[str, float]:
+    """The sit posture of both legs (torso and head upright at 0°)."""
+    out = {f"l_{joint}": value for joint, value in HUMANOID_SIT_LEFT.items()}
+    out |= {f"r_{joint}": -value for joint, value in HUMANOID_SIT_LEFT.items()}
+    for name in ("abs_y", "abs_x", "abs_z", "bust_y", "bust_x", "head_z", "head_y"):
+        out[name] = 0.0
+    return out
+
+
+def clamp_to_limits(robot: Robot, posture: Mapping[str, float]) -> dict[str, float]:
+    """The posture restricted to the robot's motors, each target inside its angle limits."""
+    names = {m.name for m in robot.motors}
+    out: dict[str, float] = {}
+    for name, value in posture.items():
+        if name in names:
+            low, high = robot.motor(name).angle_limit
+            out[name] = min(max(float(value), low), high)
+    return out
+
+
+class CreaturePosture(SimplePosture):
+    """A posture reached with a chosen goto control, optionally lighting the LEDs.
+
+    Args:
+        robot: the robot.
+        target_position: motor name -> degrees (motors the robot lacks are left out, targets
+            are clamped to the angle limits).
+        duration: seconds to reach it.
+        control: ``"minjerk"`` or ``"dummy"`` (the creature's default goto behaviour).
+        led: an LED colour to show while moving (``"blue"``...), None to leave the LEDs alone.
+    """
+
+    properties: ClassVar[Sequence[str]] = ("duration", "target_position", "control")
+
+    def __init__(
+        self,
+        robot: Robot,
+        target_position: Mapping[str, float],
+        duration: float,
+        control: str = "minjerk",
+        led: str | None = None,
+    ) -> None:
+        super().__init__(robot, duration, clamp_to_limits(robot, target_position))
+        self.control = control
+        self.led = led
+        self._speeds: dict[str, float] = {}
+
+    @property
+    def control(self) -> str:
+        """The goto control: ``"minjerk"`` or ``"dummy"``."""
+        return self._control
+
+    @control.setter
+    def control(self, value: str) -> None:
+        if value not in CONTROLS:
+            raise ValueError(f"control must be one of {', '.join(CONTROLS)}, not {value!r}")
+        self._control = value
+
+    def setup(self) -> None:
+        """Note the moving speeds, stiffen the posture's motors and light their LEDs."""
+        super().setup()
+        self._speeds = {n: self.real_robot.motor(n).moving_speed for n in self.target_position}
+        if self.led is not None:
+            for name in self.target_position:
+                self.robot.motor(name).led = self.led
+
+    def run(self) -> None:
+        """Move with the chosen control; return once the posture is reached (or when stopped)."""
+        start = time.monotonic()
+        self.robot.goto_position(self.target_position, self.duration, self.control)
+        self.sleep(self.duration - (time.monotonic() - start))
+
+    def teardown(self) -> None:
+        """Give the motors back their moving speeds and turn the LEDs off (as pypot does)."""
+        for name, speed in self._speeds.items():
+            self.robot.motor(name).moving_speed = speed
+        if self.led is not None:
+            for name in self.target_position:
+                self.robot.motor(name).led = "off"

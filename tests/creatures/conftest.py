@@ -1,0 +1,24 @@
+"""Fixtures of the creature tests: one simulated creature per module."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+
+from poppy_core.creatures import from_profile
+from poppy_core.robot import Robot
+
+
+@pytest.fixture(scope="module")
+def ergo() -> Iterator[Robot]:
+    """One simulated Ergo Jr per module."""
+    with from_profile("ergo-jr", sim=True) as robot:
+        yield robot
+
+
+@pytest.fixture(scope="module")
+def humanoid() -> Iterator[Robot]:
+    """One simulated Humanoid (25 motors, 2 buses) per module."""
+    with from_profile("humanoid", sim=True) as robot:
+        yield robot

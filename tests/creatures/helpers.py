@@ -1,0 +1,49 @@
+"""Helpers of the creature tests: waiting, virtual motors, positions."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+from poppy_core.emulator import VirtualMotor
+from poppy_core.robot import Robot
+
+
+def wait_until(predicate: Callable[[], bool], timeout_s: float = 5.0, step_s: float = 0.02) -> bool:
+    """Poll ``predicate`` until it holds or ``timeout_s`` passed; its last value."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        time.sleep(step_s)
+    return predicate()
+
+
+def virtual(robot: Robot, name: str) -> VirtualMotor:
+    """The emulator's virtual motor behind motor ``name``."""
+    assert robot.config is not None
+    controller = robot.config.controller_of(name)
+    assert controller is not None
+    motor: VirtualMotor = robot.emulators[controller].bus.motor(robot.motor(name).id)
+    return motor
+
+
+def stop_all(robot: Robot) -> None:
+    """Stop every attached primitive but the temperature monitor."""
+    for name, primitive in zip(robot.primitive_names, robot.primitives, strict=True):
+        if name != "temperature_monitoring":
+            primitive.stop()
+
+
+def reached(robot: Robot, targets: dict[str, float], tolerance_deg: float = 3.0) -> bool:
+    """True when every motor of ``targets`` is within ``tolerance_deg`` of its target."""
+    return all(
+        abs(robot.motor(n).present_position - v) <= tolerance_deg for n, v in targets.items()
+    )
+
+
+def positions(robot: Robot, names: Any = None) -> dict[str, float]:
+    """Present positions by motor name."""
+    chosen = names if names is not None else [m.name for m in robot.motors]
+    return {n: robot.motor(n).present_position for n in chosen}
