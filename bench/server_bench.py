@@ -1,0 +1,230 @@
+"""``python -m bench server``: REST throughput and latency, poppy's server vs pypot's.
+
+Both servers run in their own process on 127.0.0.1 over a virtual Ergo Jr (poppy: ``poppy
+serve --http --sim``; pypot: ``PoppyErgoJr(simulator="dummy", use_http=True)``). The load comes
+from ``CLIENTS`` threads of this process, each with one keep-alive ``http.client`` connection.
+"""
+
+from __future__ import annotations
+
+import http.client
+import json
+import socket
+import subprocess
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
+
+CLIENTS = 4
+DURATION_S = 1.5
+REQUEST_TIMEOUT_S = 5.0
+GOTO_S = 1.0
+START_TIMEOUT_S = 60.0
+
+PYPOT_SERVER = """
+import sys, time
+import pypot.creatures
+from poppy_ergo_jr import PoppyErgoJr
+port = int(sys.argv[1])
+robot = PoppyErgoJr(simulator="dummy", use_http=True, http_host="127.0.0.1", http_port=port)
+print("ready", flush=True)
+try:
+    while True:
+        time.sleep(1)
+except KeyboardInterrupt:
+    robot.close()
+"""
+
+REGISTER = "/motors/m1/registers/present_position/value.json"
+SCENARIOS: dict[str, tuple[str, str, bytes | None]] = {
+    "register GET": ("GET", REGISTER, None),
+    "/robot.json": ("GET", "/robot.json", None),
+    "goal POST": ("POST", "/motors/m1/registers/goal_position/value.json", b"10"),
+    "register GET during a wait goto": ("GET", REGISTER, None),
+}
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def _wait_listening(port: int, proc: subprocess.Popen[str]) -> None:
+    deadline = time.monotonic() + START_TIMEOUT_S
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            raise RuntimeError(f"the server exited: {proc.stderr.read() if proc.stderr else ''}")
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=0.5):
+                return
+        except OSError:
+            time.sleep(0.1)
+    raise RuntimeError("the server did not listen in time")
+
+
+@contextmanager
+def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
+    port = _free_port()
+    if kind == "poppy":
+        args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", "--sim"]
+        args += ["--profile", "ergo-jr", "--http-port", str(port)]
+    else:
+        args = [str(ctx.peers_python), "-c", PYPOT_SERVER, str(port)]
+    proc = subprocess.Popen(
+        args, cwd=REPO_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        _wait_listening(port, proc)
+        yield port
+    finally:
+        proc.send_signal(2)
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def _load(port: int, method: str, path: str, body: bytes | None) -> dict[str, Any]:
+    latencies: list[float] = []
+    errors = [0]
+    lock = threading.Lock()
+    end = time.monotonic() + DURATION_S
+
+    def client() -> None:
+        conn = http.client.HTTPConnection("127.0.0.1", port, timeout=REQUEST_TIMEOUT_S)
+        mine: list[float] = []
+        while time.monotonic() < end:
+            t0 = time.perf_counter()
+            try:
+                conn.request(method, path, body, {"Content-Type": "application/json"})
+                response = conn.getresponse()
+                response.read()
+                ok = response.status < 400
+            except (OSError, http.client.HTTPException):
+                conn.close()
+                conn = http.client.HTTPConnection("127.0.0.1", port, timeout=REQUEST_TIMEOUT_S)
+                ok = False
+            if ok:
+                mine.append(time.perf_counter() - t0)
+            else:
+                with lock:
+                    errors[0] += 1
+        conn.close()
+        with lock:
+            latencies.extend(mine)
+
+    t0 = time.monotonic()
+    threads = [threading.Thread(target=client) for _ in range(CLIENTS)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    elapsed = time.monotonic() - t0
+    latencies.sort()
+
+    def pct(q: float) -> float | None:
+        return latencies[min(len(latencies) - 1, int(q * len(latencies)))] if latencies else None
+
+    return {
+        "requests": len(latencies),
+        "errors": errors[0],
+        "rps": len(latencies) / elapsed,
+        "p50_s": pct(0.5),
+        "p99_s": pct(0.99),
+    }
+
+
+def _goto_loop(port: int, stop: threading.Event) -> None:
+    body = json.dumps({"motors": ["m2"], "positions": [20], "duration": GOTO_S, "wait": True})
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=GOTO_S + REQUEST_TIMEOUT_S)
+    while not stop.is_set():
+        try:
+            conn.request("POST", "/motors/goto.json", body, {"Content-Type": "application/json"})
+            conn.getresponse().read()
+        except (OSError, http.client.HTTPException):
+            conn.close()
+            conn = http.client.HTTPConnection("127.0.0.1", port, timeout=GOTO_S + 5)
+    conn.close()
+
+
+def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    with _server(kind, ctx) as port:
+        for name, (method, path, body) in SCENARIOS.items():
+            runs = []
+            for _ in range(ctx.repeat):
+                stop = threading.Event()
+                mover = None
+                if "goto" in name:
+                    mover = threading.Thread(target=_goto_loop, args=(port, stop))
+                    mover.start()
+                    time.sleep(0.1)
+                try:
+                    runs.append(_load(port, method, path, body))
+                finally:
+                    stop.set()
+                    if mover is not None:
+                        mover.join()
+            runs.sort(key=lambda r: float(r["rps"]))
+            out[name] = {"median": runs[len(runs) // 2], "runs": runs}
+    return out
+
+
+def _ms(value: float | None) -> str:
+    return "-" if value is None else f"{value * 1000:.2f} ms"
+
+
+@register("server", "REST requests/s and p50/p99 latency: poppy serve vs pypot's HTTP server")
+def server_bench(ctx: BenchContext) -> BenchResult:
+    """Measure both servers on every scenario."""
+    raw: dict[str, Any] = {"clients": CLIENTS, "duration_s": DURATION_S, "goto_s": GOTO_S}
+    raw["poppy"] = _measure("poppy", ctx)
+    notes = []
+    if ctx.peers_python is not None:
+        try:
+            raw["pypot"] = _measure("pypot", ctx)
+        except RuntimeError as exc:
+            notes.append(f"pypot's server could not be measured: {exc}")
+    else:
+        notes.append(f"pypot not measured: {ctx.peers_note}")
+    rows = []
+    for name in SCENARIOS:
+        row = [name]
+        for kind in ("poppy", "pypot"):
+            median = raw.get(kind, {}).get(name, {}).get("median")
+            if median is None:
+                row += ["-", "-", "-", "-"]
+                continue
+            row += [
+                f"{median['rps']:.0f}",
+                _ms(median["p50_s"]),
+                _ms(median["p99_s"]),
+                str(median["errors"]),
+            ]
+        rows.append(row)
+    headers = ["scenario"]
+    headers += [f"{k} {c}" for k in ("poppy", "pypot") for c in ("req/s", "p50", "p99", "errors")]
+    notes.append(
+        f"{CLIENTS} client threads with keep-alive connections for {DURATION_S} s per run, "
+        f"median of {ctx.repeat} runs (by req/s). The wait-goto scenario keeps a "
+        f'`"wait": true` goto of {GOTO_S} s running on /motors/goto.json while measuring; '
+        "pypot's tornado server answers nothing until each such goto ends."
+    )
+    return BenchResult(
+        name="server",
+        title="REST server",
+        intro=(
+            "Requests per second and latency of pypot's REST routes on a virtual Ergo Jr, "
+            "poppy (`poppy serve --http --sim`) against pypot 5 (`PoppyErgoJr(simulator="
+            "'dummy', use_http=True)`), both on 127.0.0.1 in their own process."
+        ),
+        tables=[Table("REST server", headers, rows)],
+        notes=notes,
+        raw=raw,
+    )

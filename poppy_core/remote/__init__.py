@@ -1,0 +1,26 @@
+"""A robot served by ``poppy serve --http``, driven from another process or machine.
+
+``RemoteRobot("http://127.0.0.1:8080")`` mirrors ``Robot``: motors and groups as attributes,
+registers as attributes of the motors, ``goto_position``, ``compliant``, primitives and moves.
+It speaks the server's ``/api/v1`` with the standard library only (keep-alive connections).
+"""
+
+from poppy_core.remote.client import HttpClient
+from poppy_core.remote.robot import (
+    ModelInfo,
+    RemoteGoto,
+    RemoteMotor,
+    RemoteMoves,
+    RemotePrimitive,
+    RemoteRobot,
+)
+
+__all__ = [
+    "HttpClient",
+    "ModelInfo",
+    "RemoteGoto",
+    "RemoteMotor",
+    "RemoteMoves",
+    "RemotePrimitive",
+    "RemoteRobot",
+]

@@ -1,0 +1,142 @@
+"""``HttpClient``: JSON over HTTP with one keep-alive connection per thread (stdlib only)."""
+
+from __future__ import annotations
+
+import http.client
+import json
+import threading
+from typing import Any
+from urllib.parse import quote, urlsplit
+
+from poppy_core.errors import BusTimeout, CommunicationError, ConfigError, RegisterError
+
+DEFAULT_TIMEOUT_S = 10.0
+
+
+def path_of(*parts: str) -> str:
+    """``/api/v1/a/b`` from URL segments, each quoted."""
+    return "/api/v1/" + "/".join(quote(p, safe="") for p in parts)
+
+
+class HttpClient:
+    """Sends requests to a ``poppy serve`` server and turns its errors into poppy errors.
+
+    Args:
+        base_url: ``http://host:port`` of the server.
+        token: sent as ``Authorization: Bearer <token>`` when set.
+        timeout_s: socket timeout of each request.
+
+    Raises:
+        ConfigError: a URL that is not ``http://host[:port]``.
+    """
+
+    def __init__(
+        self, base_url: str, token: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S
+    ) -> None:
+        parts = urlsplit(base_url)
+        if parts.scheme != "http" or not parts.hostname:
+            raise ConfigError(f"{base_url!r} is not an http://host:port URL", field="url")
+        self.base_url = base_url.rstrip("/")
+        self.host = parts.hostname
+        self.port = parts.port or 80
+        self.prefix = parts.path.rstrip("/")
+        self.timeout_s = timeout_s
+        self._headers = {"Accept": "application/json"}
+        if token:
+            self._headers["Authorization"] = f"Bearer {token}"
+        self._local = threading.local()
+        self._all: list[http.client.HTTPConnection] = []
+        self._lock = threading.Lock()
+
+    def _connection(self) -> http.client.HTTPConnection:
+        connection: http.client.HTTPConnection | None = getattr(self._local, "connection", None)
+        if connection is None:
+            connection = http.client.HTTPConnection(self.host, self.port, timeout=self.timeout_s)
+            self._local.connection = connection
+            with self._lock:
+                self._all.append(connection)
+        return connection
+
+    def _drop(self) -> None:
+        connection = getattr(self._local, "connection", None)
+        if connection is not None:
+            connection.close()
+            self._local.connection = None
+
+    def request(self, method: str, path: str, body: Any = None) -> Any:
+        """Send a request and return the decoded JSON answer (None for 204).
+
+        Raises:
+            CommunicationError: the server cannot be reached (``BusTimeout`` on a timeout).
+            ConfigError: refused: unknown name, wrong token, conflict (the server's message).
+            RegisterError: a register value the server refused (422 on a register).
+        """
+        payload = None if body is None else json.dumps(body).encode()
+        headers = dict(self._headers)
+        if payload is not None:
+            headers["Content-Type"] = "application/json"
+        for attempt in (1, 2):
+            connection = self._connection()
+            try:
+                connection.request(method, self.prefix + path, payload, headers)
+                response = connection.getresponse()
+                data = response.read()
+                break
+            except (http.client.RemoteDisconnected, ConnectionResetError, BrokenPipeError) as exc:
+                # The server closed an idle keep-alive connection: retry once on a new one.
+                self._drop()
+                if attempt == 2:
+                    raise CommunicationError(f"{self.base_url}: {exc}", port=self.base_url) from exc
+            except TimeoutError as exc:
+                self._drop()
+                raise BusTimeout(
+                    f"{self.base_url}: no answer within {self.timeout_s:g} s", port=self.base_url
+                ) from exc
+            except OSError as exc:
+                self._drop()
+                raise CommunicationError(
+                    f"cannot reach {self.base_url}: {exc}", port=self.base_url
+                ) from exc
+        if response.will_close:
+            self._drop()
+        return self._decode(method, path, response.status, data)
+
+    def _decode(self, method: str, path: str, status: int, data: bytes) -> Any:
+        try:
+            decoded = json.loads(data) if data else None
+        except json.JSONDecodeError:
+            decoded = data.decode("utf-8", errors="replace")
+        if status < 400:
+            return decoded
+        message = _message(decoded) or f"HTTP {status}"
+        where = f"{method} {path}: {message}"
+        if status == 401:
+            raise ConfigError(f"{self.base_url} refused the token: {message}", field="token")
+        if status == 422 and "/registers/" in path:
+            raise RegisterError(where, register=path.rsplit("/", 1)[-1])
+        if status >= 500:
+            raise CommunicationError(f"{self.base_url}: {where}", port=self.base_url)
+        raise ConfigError(where, reason=message)
+
+    def get(self, path: str) -> Any:
+        """GET ``path``."""
+        return self.request("GET", path)
+
+    def close(self) -> None:
+        """Close every connection this client opened."""
+        with self._lock:
+            connections, self._all = self._all, []
+        for connection in connections:
+            connection.close()
+        self._local = threading.local()
+
+
+def _message(decoded: Any) -> str:
+    if isinstance(decoded, dict):
+        detail = decoded.get("detail", decoded.get("error"))
+        if isinstance(detail, list):  # a validation error of FastAPI
+            return "; ".join(
+                str(item.get("msg", item)) for item in detail if isinstance(item, dict)
+            )
+        return str(detail) if detail is not None else json.dumps(decoded)
+    return str(decoded) if decoded else ""

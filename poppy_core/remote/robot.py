@@ -1,0 +1,368 @@
+"""``RemoteRobot``, ``RemoteMotor``, ``RemotePrimitive``, ``RemoteMoves``: ``Robot`` over HTTP."""
+
+from __future__ import annotations
+
+import builtins
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from types import TracebackType
+from typing import Any
+
+from poppy_core.errors import ConfigError
+from poppy_core.remote.client import DEFAULT_TIMEOUT_S, HttpClient, path_of
+
+_OWN = ("_client", "name", "id", "model", "registers")
+
+
+@dataclass(frozen=True)
+class ModelInfo:
+    """The servo model of a remote motor (by name, like ``ServoModel.name``)."""
+
+    name: str
+
+
+class RemoteGoto:
+    """A goto started on the server (``GotoHandle``'s interface, timed on this side)."""
+
+    def __init__(self, duration_s: float, done: bool = False) -> None:
+        self.duration_s = duration_s
+        self._end = time.monotonic() + (0.0 if done else duration_s)
+
+    @property
+    def done(self) -> bool:
+        """True once the motion should be over."""
+        return time.monotonic() >= self._end
+
+    def wait(self, timeout_s: float | None = None) -> bool:
+        """Sleep until the motion should be over; False when ``timeout_s`` ran out first."""
+        left = self._end - time.monotonic()
+        if timeout_s is not None and timeout_s < left:
+            time.sleep(max(0.0, timeout_s))
+            return False
+        time.sleep(max(0.0, left))
+        return True
+
+
+class RemoteMotor:
+    """A motor of a remote robot: each register is an attribute read/written over HTTP.
+
+    Attributes:
+        name: the motor's name.
+        id: its bus ID.
+        model: its model (``model.name``).
+        registers: the register names it offers (as ``Motor.registers``).
+    """
+
+    def __init__(self, client: HttpClient, info: Mapping[str, Any]) -> None:
+        object.__setattr__(self, "_client", client)
+        object.__setattr__(self, "name", str(info["name"]))
+        object.__setattr__(self, "id", int(info["id"]))
+        object.__setattr__(self, "model", ModelInfo(str(info["model"])))
+        object.__setattr__(self, "registers", list(info["registers"]))
+
+    def __repr__(self) -> str:
+        return f"<RemoteMotor {self.name} id={self.id} {self.model.name}>"
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_") or name not in self.__dict__.get("registers", ()):
+            raise AttributeError(f"motor {self.__dict__.get('name')!r} has no register {name!r}")
+        return self._client.get(path_of("motors", self.name, "registers", name))["value"]
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in _OWN:
+            raise AttributeError(f"{name} cannot be changed")
+        if name not in self.registers:
+            raise AttributeError(f"motor {self.name!r} has no register {name!r}")
+        path = path_of("motors", self.name, "registers", name)
+        self._client.request("PUT", path, {"value": value})
+
+    def __dir__(self) -> list[str]:
+        return sorted({*super().__dir__(), *self.registers})
+
+    def _info(self) -> dict[str, Any]:
+        info = self._client.get(path_of("motors", self.name))
+        assert isinstance(info, dict)
+        return info
+
+    @property
+    def online(self) -> bool:
+        """False once the server's sync loop found the motor silent."""
+        return bool(self._info()["online"])
+
+    @property
+    def errors(self) -> int:
+        """Failed reads so far (on the server)."""
+        return int(self._info()["errors"])
+
+    def snapshot(self) -> dict[str, Any]:
+        """Every register's value in one request."""
+        values = self._info()["registers"]
+        assert isinstance(values, dict)
+        return values
+
+    def goto_position(
+        self, position: float, duration: float, control: str = "minjerk", wait: bool = False
+    ) -> RemoteGoto:
+        """Go to ``position`` (degrees) in ``duration`` seconds (see ``Motor.goto_position``)."""
+        return _goto(self._client, {self.name: position}, duration, control, wait)
+
+
+class RemotePrimitive:
+    """A primitive attached to the remote robot."""
+
+    def __init__(self, client: HttpClient, name: str) -> None:
+        self._client = client
+        self.name = name
+
+    def __repr__(self) -> str:
+        return f"<RemotePrimitive {self.name}>"
+
+    def _post(self, action: str) -> dict[str, Any]:
+        answer = self._client.request("POST", path_of("primitives", self.name, action))
+        assert isinstance(answer, dict)
+        return answer
+
+    def start(self) -> None:
+        """Start (or restart) it."""
+        self._post("start")
+
+    def stop(self) -> None:
+        """Stop it (the server waits for its thread)."""
+        self._post("stop")
+
+    def pause(self) -> None:
+        """Pause it."""
+        self._post("pause")
+
+    def resume(self) -> None:
+        """Resume it."""
+        self._post("resume")
+
+    def describe(self) -> dict[str, Any]:
+        """State, properties, methods and last error."""
+        answer = self._client.get(path_of("primitives", self.name))
+        assert isinstance(answer, dict)
+        return answer
+
+    @property
+    def state(self) -> str:
+        """``idle``, ``running``, ``paused``, ``stopped`` or ``failed``."""
+        return str(self.describe()["state"])
+
+    def is_alive(self) -> bool:
+        """True while it runs (or is paused)."""
+        return bool(self.describe()["alive"])
+
+    @property
+    def properties(self) -> list[str]:
+        """The property names."""
+        return list(self.describe()["properties"])
+
+    def get_property(self, name: str) -> Any:
+        """A property's value."""
+        properties = self.describe()["properties"]
+        if name not in properties:
+            raise ConfigError(f"{self.name} has no property {name!r}", field=name)
+        return properties[name]
+
+    def set_property(self, name: str, value: Any) -> None:
+        """Set a property (converted and checked by the server)."""
+        path = path_of("primitives", self.name, "properties", name)
+        self._client.request("PUT", path, {"value": value})
+
+    def call_method(self, name: str, *args: Any, **kwargs: Any) -> Any:
+        """Call a declared method; returns its result."""
+        path = path_of("primitives", self.name, "methods", name)
+        return self._client.request("POST", path, {"args": list(args), "kwargs": kwargs})["result"]
+
+
+class RemoteMoves:
+    """The server's move library and its recordings and playbacks."""
+
+    def __init__(self, client: HttpClient) -> None:
+        self._client = client
+
+    def list(self) -> list[str]:
+        """Names of the library's moves."""
+        return [entry["name"] for entry in self._client.get(path_of("moves"))]
+
+    def get(self, name: str, positions: bool = False) -> dict[str, Any]:
+        """A move: motors, frames, duration (and its positions when asked)."""
+        query = "?positions=true" if positions else ""
+        answer = self._client.get(path_of("moves", name) + query)
+        assert isinstance(answer, dict)
+        return answer
+
+    def record(self, name: str, motors: Sequence[str] | None = None) -> None:
+        """Start recording ``name`` (every motor by default)."""
+        body = {"motors": list(motors) if motors is not None else None}
+        self._client.request("POST", path_of("moves", name, "record"), body)
+
+    def save(self, name: str) -> dict[str, Any]:
+        """Stop recording ``name`` and save it to the library."""
+        answer = self._client.request("POST", path_of("moves", name, "save"))
+        assert isinstance(answer, dict)
+        return answer
+
+    def play(self, name: str, speed: float = 1.0, backwards: bool = False) -> None:
+        """Start playing a library move."""
+        body = {"speed": speed, "backwards": backwards}
+        self._client.request("POST", path_of("moves", name, "play"), body)
+
+    def stop(self, name: str) -> None:
+        """Stop playing ``name``."""
+        self._client.request("POST", path_of("moves", name, "stop"))
+
+    def delete(self, name: str) -> None:
+        """Delete a library move."""
+        self._client.request("DELETE", path_of("moves", name))
+
+    def status(self) -> dict[str, builtins.list[str]]:
+        """``{"recording": [...], "playing": [...]}``."""
+        answer = self._client.get(path_of("moves", "status"))
+        assert isinstance(answer, dict)
+        return answer
+
+
+def _goto(
+    client: HttpClient, positions: Mapping[str, float], duration: float, control: str, wait: bool
+) -> RemoteGoto:
+    body = {
+        "positions": {k: float(v) for k, v in positions.items()},
+        "duration_s": float(duration),
+        "control": control,
+        "wait": wait,
+    }
+    answer = client.request("POST", path_of("gotos"), body)
+    return RemoteGoto(float(duration), done=bool(answer.get("done")))
+
+
+class RemoteRobot:
+    """A robot served by ``poppy serve --http``: ``robot.m1.goal_position = 10`` works as on
+    a local ``Robot``.
+
+    Args:
+        url: ``http://host:port`` of the server.
+        token: the server's token, if it has one.
+        timeout_s: socket timeout of each request.
+
+    Raises:
+        CommunicationError: the server cannot be reached.
+        ConfigError: it refused the token.
+    """
+
+    def __init__(
+        self, url: str, token: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S
+    ) -> None:
+        self.url = url
+        self._client = HttpClient(url, token=token, timeout_s=timeout_s)
+        infos = self._client.get(path_of("motors"))
+        self._motors = [RemoteMotor(self._client, info) for info in infos]
+        self._by_name = {m.name: m for m in self._motors}
+        robot = self._client.get(path_of("robot"))
+        self._groups: dict[str, list[str]] = {g: list(ms) for g, ms in robot["groups"].items()}
+        self.moves = RemoteMoves(self._client)
+        """Record, save, play, stop, delete and list the server's moves."""
+
+    def __repr__(self) -> str:
+        return f"<RemoteRobot {self.url} motors={list(self._by_name)}>"
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        if name in self.__dict__.get("_by_name", {}):
+            return self._by_name[name]
+        if name in self.__dict__.get("_groups", {}):
+            return self.group(name)
+        raise AttributeError(f"remote robot has no motor or group {name!r}")
+
+    def __dir__(self) -> list[str]:
+        return sorted({*super().__dir__(), *self._by_name, *self._groups})
+
+    @property
+    def motors(self) -> list[RemoteMotor]:
+        """Every motor, in config order."""
+        return list(self._motors)
+
+    @property
+    def motorgroups(self) -> dict[str, list[RemoteMotor]]:
+        """Group name -> its motors."""
+        return {g: [self._by_name[n] for n in names] for g, names in self._groups.items()}
+
+    def motor(self, name: str) -> RemoteMotor:
+        """The motor called ``name``."""
+        try:
+            return self._by_name[name]
+        except KeyError:
+            known = ", ".join(self._by_name)
+            raise ConfigError(f"no motor {name!r} (motors: {known})", field=name) from None
+
+    def group(self, name: str) -> list[RemoteMotor]:
+        """The motors of group ``name``."""
+        if name not in self._groups:
+            known = ", ".join(self._groups) or "none"
+            raise ConfigError(f"no group {name!r} (groups: {known})", field=name)
+        return [self._by_name[n] for n in self._groups[name]]
+
+    @property
+    def compliant(self) -> bool:
+        """True when every motor is compliant; setting it sets every motor."""
+        return bool(self._client.get(path_of("robot"))["compliant"])
+
+    @compliant.setter
+    def compliant(self, value: bool) -> None:
+        self._client.request("PUT", path_of("robot", "compliant"), {"compliant": bool(value)})
+
+    def goto_position(
+        self,
+        position_for_motors: Mapping[str, float],
+        duration: float,
+        control: str = "minjerk",
+        wait: bool = False,
+    ) -> RemoteGoto:
+        """Move several motors so that they arrive together (see ``Robot.goto_position``)."""
+        return _goto(self._client, position_for_motors, duration, control, wait)
+
+    def state(self) -> dict[str, dict[str, Any]]:
+        """Motor name -> present position, speed, load, temperature and LED."""
+        answer = self._client.get(path_of("robot", "state"))
+        assert isinstance(answer, dict)
+        return answer
+
+    @property
+    def primitive_names(self) -> list[str]:
+        """Names of the primitives attached on the server."""
+        return list(self._client.get(path_of("robot"))["primitives"])
+
+    @property
+    def primitives(self) -> list[RemotePrimitive]:
+        """The primitives attached on the server."""
+        return [RemotePrimitive(self._client, n) for n in self.primitive_names]
+
+    @property
+    def active_primitives(self) -> list[RemotePrimitive]:
+        """The primitives running (or paused)."""
+        described = self._client.get(path_of("primitives"))
+        return [RemotePrimitive(self._client, p["name"]) for p in described if p["alive"]]
+
+    def primitive(self, name: str) -> RemotePrimitive:
+        """The primitive called ``name``."""
+        if name not in self.primitive_names:
+            raise ConfigError(f"no primitive {name!r} on the server", field=name)
+        return RemotePrimitive(self._client, name)
+
+    def close(self) -> None:
+        """Close the connections (the served robot keeps running)."""
+        self._client.close()
+
+    def __enter__(self) -> RemoteRobot:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()

@@ -1,0 +1,11 @@
+"""The REST/WebSocket server over a ``Robot``: pypot's routes, the v1 API and a state stream.
+
+Importing this package loads FastAPI: the CLI imports it only inside ``poppy serve``.
+"""
+
+from poppy_core.server.app import create_app
+from poppy_core.server.runner import ServerThread, uvicorn_server
+from poppy_core.server.service import RobotService
+from poppy_core.server.stream import create_stream_app
+
+__all__ = ["RobotService", "ServerThread", "create_app", "create_stream_app", "uvicorn_server"]

@@ -1,0 +1,109 @@
+"""``create_app(robot)``: the FastAPI app serving a robot (pypot's routes, /api/v1, WebSocket)."""
+
+from __future__ import annotations
+
+from collections.abc import AsyncIterator, Sequence
+from contextlib import asynccontextmanager
+from typing import TYPE_CHECKING
+from urllib.parse import urlencode
+
+from starlette.requests import Request
+from starlette.responses import HTMLResponse
+
+from poppy_core.server.errors import install_error_handlers
+from poppy_core.server.fastpath import RegisterFastPath
+from poppy_core.server.middleware import (
+    MAX_BODY_BYTES,
+    BodyLimitMiddleware,
+    CorsMiddleware,
+    TokenMiddleware,
+)
+from poppy_core.server.service import RobotService
+
+if TYPE_CHECKING:
+    from fastapi import FastAPI
+
+    from poppy_core.robot import Robot
+
+API_VERSION = "1.0"
+DEFAULT_STREAM_HZ = 30.0
+
+
+def create_app(
+    robot: Robot,
+    *,
+    token: str | None = None,
+    cors_origins: Sequence[str] = ("*",),
+    max_body_bytes: int = MAX_BODY_BYTES,
+    stream_rate_hz: float = DEFAULT_STREAM_HZ,
+    builtins: bool = True,
+) -> FastAPI:
+    """Build the app serving ``robot`` (which the caller keeps and closes).
+
+    Args:
+        robot: the robot to serve.
+        token: when set, every route and the WebSocket need it (Bearer header or ``?token=``).
+        cors_origins: origins allowed by CORS; ``("*",)`` is pypot's default.
+        max_body_bytes: largest request body accepted (413 beyond).
+        stream_rate_hz: default rate of the WebSocket state stream.
+        builtins: attach the built-in primitives to the robot.
+
+    Returns:
+        The app; its lifespan stops the recordings and playbacks it started on shutdown.
+    """
+    from fastapi import FastAPI
+
+    from poppy_core.server.routers import (
+        pypot_motion,
+        pypot_motors,
+        v1_motion,
+        v1_motors,
+        v1_robot,
+    )
+    from poppy_core.server.stream import add_stream_routes
+
+    service = RobotService(robot, builtins=builtins)
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        yield
+        service.close()
+
+    app = FastAPI(
+        title="poppy robot API",
+        version=API_VERSION,
+        description=(
+            "pypot-compatible routes (``/robot.json``, ``/motors/...``) and the v1 API under "
+            "``/api/v1``. Angles in degrees, speeds in deg/s, durations in seconds."
+        ),
+        lifespan=lifespan,
+        docs_url=None,
+    )
+    app.state.service = service
+    app.state.stream_rate_hz = stream_rate_hz
+    install_error_handlers(app)
+    # pypot's routes first: the hottest ones (register values) are matched soonest.
+    for router in (pypot_motors.router, pypot_motion.router):
+        app.include_router(router)
+    for router in (v1_robot.router, v1_motors.router, v1_motion.router):
+        app.include_router(router, prefix="/api/v1")
+    add_stream_routes(app)
+    add_docs_route(app)
+    app.add_middleware(RegisterFastPath, service=service)
+    app.add_middleware(BodyLimitMiddleware, max_bytes=max_body_bytes)
+    if token:
+        app.add_middleware(TokenMiddleware, token=token)
+    app.add_middleware(CorsMiddleware, origins=tuple(cors_origins))
+    return app
+
+
+def add_docs_route(app: FastAPI) -> None:
+    """``/docs``: Swagger UI; a ``?token=`` given to it is passed on to ``/openapi.json``."""
+    from fastapi.openapi.docs import get_swagger_ui_html
+
+    async def docs(request: Request) -> HTMLResponse:
+        token = request.query_params.get("token")
+        url = "/openapi.json" + (f"?{urlencode({'token': token})}" if token else "")
+        return get_swagger_ui_html(openapi_url=url, title=f"{app.title} - docs")
+
+    app.add_api_route("/docs", docs, include_in_schema=False, methods=["GET"])

@@ -1,0 +1,102 @@
+"""API errors of the server and their translation to JSON responses, in one place.
+
+Routes raise ``ApiError`` (or let a ``PoppyError`` through); the handlers installed by
+``install_error_handlers`` answer ``{"error", "tip", "details"}`` on pypot's routes (with pypot's
+status codes) and ``{"detail"}`` on the v1 API (404 unknown, 409 conflict, 422 invalid value).
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import TYPE_CHECKING, Literal
+
+from starlette.requests import Request
+from starlette.responses import JSONResponse, Response
+
+from poppy_core.errors import (
+    BusError,
+    BusTimeout,
+    ConfigError,
+    MotorError,
+    PoppyError,
+    RegisterError,
+)
+
+if TYPE_CHECKING:
+    from fastapi import FastAPI
+
+logger = logging.getLogger(__name__)
+
+Kind = Literal["not_found", "invalid", "conflict", "unavailable"]
+
+V1_PREFIX = "/api/v1"
+
+V1_STATUS: dict[Kind, int] = {"not_found": 404, "invalid": 422, "conflict": 409, "unavailable": 503}
+"""HTTP status of each kind of error on the v1 API."""
+
+PYPOT_STATUS: dict[Kind, int] = {
+    "not_found": 404,
+    "invalid": 400,
+    "conflict": 404,
+    "unavailable": 503,
+}
+"""HTTP status of each kind on pypot's routes (pypot answers 404 for most refusals)."""
+
+
+class ApiError(Exception):
+    """A request the server refuses.
+
+    Args:
+        kind: ``"not_found"``, ``"invalid"``, ``"conflict"`` or ``"unavailable"``.
+        message: what went wrong (the ``error``/``detail`` text).
+        tip: how to do it right (pypot's ``tip``).
+        pypot_status: the status pypot's route answers, when it differs from ``PYPOT_STATUS``.
+    """
+
+    def __init__(
+        self, kind: Kind, message: str, *, tip: str = "", pypot_status: int | None = None
+    ) -> None:
+        super().__init__(message)
+        self.kind: Kind = kind
+        self.message = message
+        self.tip = tip
+        self.pypot_status = pypot_status
+
+
+def pypot_body(error: str, tip: str = "", details: str = "") -> dict[str, str]:
+    """pypot's error body."""
+    return {"error": error, "tip": tip, "details": details}
+
+
+def error_response(request: Request, error: ApiError) -> JSONResponse:
+    """The response for ``error`` in the style of the route that raised it."""
+    if request.url.path.startswith(V1_PREFIX):
+        return JSONResponse({"detail": error.message}, status_code=V1_STATUS[error.kind])
+    status = error.pypot_status or PYPOT_STATUS[error.kind]
+    return JSONResponse(pypot_body(error.message, error.tip, error.message), status_code=status)
+
+
+def from_poppy_error(exc: PoppyError) -> ApiError:
+    """Translate a core error: bad values are 4xx, bus trouble is 503/504-like ``unavailable``."""
+    if isinstance(exc, RegisterError | ConfigError):
+        return ApiError("invalid", str(exc))
+    if isinstance(exc, BusTimeout | BusError | MotorError):
+        return ApiError("unavailable", f"the robot did not answer: {exc}")
+    return ApiError("invalid", str(exc))
+
+
+async def _api_error(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, ApiError)
+    return error_response(request, exc)
+
+
+async def _poppy_error(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, PoppyError)
+    logger.info("%s %s refused: %s", request.method, request.url.path, exc)
+    return error_response(request, from_poppy_error(exc))
+
+
+def install_error_handlers(app: FastAPI) -> None:
+    """Map ``ApiError`` and ``PoppyError`` to JSON answers on ``app``."""
+    app.add_exception_handler(ApiError, _api_error)
+    app.add_exception_handler(PoppyError, _poppy_error)

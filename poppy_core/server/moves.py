@@ -1,0 +1,208 @@
+"""``MoveService``: record, save, play, stop and delete moves of poppy's move library by name.
+
+Recordings live in memory until saved; saved moves go to the library (``moves_dir()``), never to
+the working directory. Names are restricted to letters, digits, ``_`` and ``-`` so a URL can never
+reach a path outside the library.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import re
+import threading
+from collections.abc import Sequence
+from typing import Any
+
+from poppy_core.errors import ConfigError
+from poppy_core.motion import (
+    Move,
+    MovePlayer,
+    MoveRecorder,
+    delete_move,
+    encode_pypot,
+    list_moves,
+    load_move,
+    save_move,
+)
+from poppy_core.robot import Robot
+from poppy_core.server.errors import ApiError
+
+logger = logging.getLogger(__name__)
+
+NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,63}$")
+MAX_RECORDINGS = 8
+"""Recordings running at once (each is a thread)."""
+RECORD_TIP = "start by recording a move with /records/<move_name>/record.json"
+PLAY_TIP = "start by playing a move with /records/<move_name>/play.json"
+
+
+def check_move_name(name: str) -> str:
+    """``name`` if it can name a library move, else ``ApiError("invalid")``."""
+    if not NAME.match(name):
+        raise ApiError(
+            "invalid",
+            f"{name!r} is not a move name: 1-64 letters, digits, '_' or '-'",
+            pypot_status=400,
+        )
+    return name
+
+
+class MoveService:
+    """The recorders and players of one robot, by move name.
+
+    Args:
+        robot: the robot.
+    """
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+        self._lock = threading.Lock()
+        self._recorders: dict[str, MoveRecorder] = {}
+        self._players: dict[str, MovePlayer] = {}
+
+    # -- library -------------------------------------------------------------------------------
+
+    def names(self) -> list[str]:
+        """The library's moves by name."""
+        return sorted({entry.name for entry in list_moves()})
+
+    def entries(self) -> list[dict[str, Any]]:
+        """The library's moves: name, format, size."""
+        return [
+            {"name": e.name, "format": e.format, "size_bytes": e.size_bytes} for e in list_moves()
+        ]
+
+    def load(self, name: str) -> Move:
+        """The library move ``name``, or ``ApiError("not_found")``."""
+        check_move_name(name)
+        if name not in self.names():
+            raise ApiError("not_found", f"no move {name!r} in the library", tip=RECORD_TIP)
+        try:
+            return load_move(name)
+        except ConfigError as exc:
+            raise ApiError("not_found", str(exc), tip=RECORD_TIP) from None
+
+    def value(self, name: str) -> Move:
+        """The move being recorded under ``name`` (so far), else the library's."""
+        check_move_name(name)
+        with self._lock:
+            recorder = self._recorders.get(name)
+        return recorder.move if recorder is not None else self.load(name)
+
+    def delete(self, name: str) -> None:
+        """Delete a library move (``ApiError("not_found")`` if there is none)."""
+        check_move_name(name)
+        if name not in self.names():
+            raise ApiError(
+                "not_found", f"no move {name!r} in the library to delete", tip=RECORD_TIP
+            )
+        delete_move(name)
+
+    # -- recording -----------------------------------------------------------------------------
+
+    def record(self, name: str, motors: Sequence[str] | None = None) -> MoveRecorder:
+        """Start recording ``name`` (restarting a recording of that name).
+
+        Raises:
+            ApiError: bad name, unknown motor, or too many recordings running.
+        """
+        check_move_name(name)
+        known = {m.name for m in self.robot.motors} | set(self.robot.motorgroups)
+        unknown = [m for m in motors or () if m not in known]
+        if unknown:
+            raise ApiError(
+                "not_found",
+                f"unknown motors: {', '.join(unknown)}",
+                tip='give motors as a list or a comma-separated string, e.g. {"motors": ["m1"]}',
+            )
+        with self._lock:
+            old = self._recorders.pop(name, None)
+            if old is not None:
+                old.stop()
+            if len(self._recorders) >= MAX_RECORDINGS:
+                raise ApiError(
+                    "conflict", f"{MAX_RECORDINGS} recordings already run: save one first"
+                )
+            recorder = MoveRecorder(self.robot, motors=list(motors) if motors else None)
+            recorder.start()
+            self._recorders[name] = recorder
+        return recorder
+
+    def recording(self) -> list[str]:
+        """Names being recorded."""
+        with self._lock:
+            return sorted(self._recorders)
+
+    def save(self, name: str) -> Move:
+        """Stop recording ``name`` and save it to the library (stopping a playback of it)."""
+        check_move_name(name)
+        with self._lock:
+            recorder = self._recorders.pop(name, None)
+            player = self._players.get(name)
+        if recorder is None:
+            raise ApiError("conflict", f"the move {name!r} is not being recorded", tip=RECORD_TIP)
+        move = recorder.stop()
+        if len(move) == 0:
+            raise ApiError("conflict", f"the recording {name!r} holds no frame yet")
+        save_move(move, name)
+        if player is not None and player.playing:
+            player.stop()
+        logger.info("saved move %s (%d frames)", name, len(move))
+        return move
+
+    # -- playing -------------------------------------------------------------------------------
+
+    def play(self, name: str, speed: float = 1.0, backwards: bool = False) -> MovePlayer:
+        """Play a library move (a playback of it already running is left alone)."""
+        check_move_name(name)
+        with self._lock:
+            running = self._players.get(name)
+        if running is not None and running.playing:
+            return running
+        move = self.load(name)
+        try:
+            player = MovePlayer(self.robot, move, speed=speed, backwards=backwards)
+        except ConfigError as exc:
+            raise ApiError("invalid", str(exc)) from None
+        except ValueError as exc:
+            raise ApiError("invalid", f"cannot play {name!r}: {exc}") from None
+        player.start()
+        with self._lock:
+            self._players[name] = player
+        return player
+
+    def playing(self) -> list[str]:
+        """Names being played."""
+        with self._lock:
+            return sorted(n for n, p in self._players.items() if p.playing)
+
+    def stop(self, name: str) -> None:
+        """Stop playing ``name`` (``ApiError("conflict")`` when it was never played)."""
+        check_move_name(name)
+        with self._lock:
+            player = self._players.get(name)
+        if player is None:
+            raise ApiError(
+                "conflict", f"the move {name!r} has not been played", tip=PLAY_TIP, pypot_status=400
+            )
+        player.stop()
+
+    def close(self) -> None:
+        """Stop every recording (unsaved ones are lost) and playback."""
+        with self._lock:
+            recorders = list(self._recorders.values())
+            players = list(self._players.values())
+            self._recorders.clear()
+            self._players.clear()
+        for recorder in recorders:
+            recorder.stop()
+        for player in players:
+            player.stop()
+
+
+def pypot_positions(move: Move) -> dict[str, Any]:
+    """A move's frames as pypot's ``{time: {motor: [position, speed]}}``."""
+    positions = json.loads(encode_pypot(move))["positions"]
+    assert isinstance(positions, dict)
+    return positions

@@ -1,0 +1,1 @@
+"""The routers of the server: pypot's routes and the v1 API, one module per resource."""

@@ -1,0 +1,47 @@
+"""Helpers shared by the routers: raw JSON bodies (pypot's routes) and awaiting a goto."""
+
+import asyncio
+import json
+import time
+from typing import Any
+
+from starlette.requests import Request
+
+from poppy_core.robot import GotoHandle
+from poppy_core.server.errors import ApiError
+
+POLL_S = 0.01
+WAIT_MARGIN_S = 2.0
+"""A waiting request gives up this long after the motion should have ended."""
+
+MISSING = object()
+
+
+async def json_body(request: Request, *, default: Any = MISSING, tip: str = "") -> Any:
+    """The request body parsed as JSON (``default`` for an empty body, if given).
+
+    Raises:
+        ApiError: not JSON (or empty without a default).
+    """
+    raw = await request.body()
+    if not raw.strip() and default is not MISSING:
+        return default
+    try:
+        return json.loads(raw)
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ApiError("invalid", f"the body is not valid JSON: {exc}", tip=tip) from None
+
+
+async def wait_goto(handle: GotoHandle) -> bool:
+    """Wait (without blocking the event loop) until ``handle`` is done; False on timeout."""
+    deadline = time.monotonic() + handle.duration_s + WAIT_MARGIN_S
+    while not handle.done:
+        if time.monotonic() > deadline:
+            return False
+        await asyncio.sleep(POLL_S)
+    return True
+
+
+def truthy(value: Any) -> bool:
+    """pypot's reading of ``wait``: true for ``true``, ``"true"``, ``"True"`` and ``1``."""
+    return str(value) in {"true", "True", "1"}

@@ -1,0 +1,184 @@
+"""pypot's routes for recorded moves (``/records``) and primitives (``/primitives``)."""
+
+import math
+from typing import Any
+
+from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
+from fastapi.responses import JSONResponse, Response  # noqa: TID253
+from starlette.concurrency import run_in_threadpool
+
+from poppy_core.server.deps import Service
+from poppy_core.server.errors import ApiError
+from poppy_core.server.moves import pypot_positions
+from poppy_core.server.routers.common import json_body
+
+router = APIRouter(tags=["pypot"])
+
+MOTORS_TIP = (
+    'give motors as a list or a comma-separated string: {"motors": ["m1", "m2"]} or '
+    '{"motors": "m1,m2"}'
+)
+SPEED_TIP = 'the speed is a number, negative to play backwards, e.g. {"speed": "-1.0"}'
+
+
+# -- records ---------------------------------------------------------------------------------
+
+
+@router.get("/records/list.json", summary="The moves of the library")
+async def records_list(service: Service) -> JSONResponse:
+    """``{"moves": [names]}``."""
+    names = await run_in_threadpool(service.moves.names)
+    return JSONResponse({"moves": names})
+
+
+@router.post("/records/{move}/record.json", status_code=202, summary="Start recording a move")
+async def record(move: str, request: Request, service: Service) -> JSONResponse:
+    """202 ``{move: "recording"}``; the optional body names the motors."""
+    data = await json_body(request, default={}, tip=MOTORS_TIP)
+    motors: Any = data.get("motors") if isinstance(data, dict) else None
+    if isinstance(motors, str):
+        motors = [m.strip() for m in motors.split(",") if m.strip()]
+    if motors is not None and not (
+        isinstance(motors, list) and all(isinstance(m, str) for m in motors)
+    ):
+        raise ApiError("invalid", "cannot read the motors given", tip=MOTORS_TIP)
+    await run_in_threadpool(service.moves.record, move, motors or None)
+    return JSONResponse({move: "recording"}, status_code=202)
+
+
+@router.post("/records/{move}/save.json", status_code=202, summary="Stop recording and save")
+def save(move: str, service: Service) -> JSONResponse:
+    """202 ``{move: "saved"}``; 404 when it is not being recorded."""
+    service.moves.save(move)
+    return JSONResponse({move: "saved"}, status_code=202)
+
+
+@router.get("/records/{move}/value.json", summary="The frames of a move")
+def move_value(move: str, service: Service) -> JSONResponse:
+    """``{move: {time: {motor: [position, speed]}}, "length": frames}``."""
+    recorded = service.moves.value(move)
+    return JSONResponse({move: pypot_positions(recorded), "length": len(recorded)})
+
+
+@router.post("/records/{move}/play.json", status_code=202, summary="Play a move")
+async def play(move: str, request: Request, service: Service) -> JSONResponse:
+    """202 ``{move: "started replay"}``; a negative speed plays it backwards."""
+    data = await json_body(request, tip=SPEED_TIP)
+    if not isinstance(data, dict) or "speed" not in data:
+        raise ApiError("invalid", "speed field is missing.", tip=SPEED_TIP)
+    try:
+        speed = float(data["speed"])
+    except (TypeError, ValueError):
+        raise ApiError("invalid", "the speed is not a number", tip=SPEED_TIP) from None
+    if not math.isfinite(speed) or speed == 0:
+        raise ApiError("invalid", "the speed must be a finite, non-zero number", tip=SPEED_TIP)
+    await run_in_threadpool(service.moves.play, move, abs(speed), speed < 0)
+    return JSONResponse({move: "started replay"}, status_code=202)
+
+
+@router.post("/records/{move}/stop.json", status_code=202, summary="Stop playing a move")
+def stop(move: str, service: Service) -> JSONResponse:
+    """202 ``{move: "stopped"}``; 400 when it was never played."""
+    service.moves.stop(move)
+    return JSONResponse({move: "stopped"}, status_code=202)
+
+
+@router.post("/records/{move}/delete.json", status_code=202, summary="Delete a move")
+def delete(move: str, service: Service) -> JSONResponse:
+    """202 ``{move: "deleted"}``; 404 when there is no such move."""
+    service.moves.delete(move)
+    return JSONResponse({move: "deleted"}, status_code=202)
+
+
+# -- primitives ------------------------------------------------------------------------------
+
+
+@router.get("/primitives/list.json", summary="The attached primitives")
+async def primitives_list(service: Service) -> JSONResponse:
+    """``{"primitives": [names]}``."""
+    return JSONResponse({"primitives": list(service.primitives())})
+
+
+@router.get("/primitives/running/list.json", summary="The running primitives")
+async def running_list(service: Service) -> JSONResponse:
+    """``{"running_primitives": [names]}``."""
+    return JSONResponse({"running_primitives": service.running_primitives()})
+
+
+PAST = {"start": "started", "stop": "stopped", "pause": "paused", "resume": "resumed"}
+
+
+def _control(primitive: str, action: str, service: Any) -> JSONResponse:
+    service.control_primitive(primitive, action)
+    return JSONResponse({primitive: PAST[action]}, status_code=202)
+
+
+@router.get("/primitives/{primitive}/start.json", status_code=202, summary="Start a primitive")
+def start_primitive(primitive: str, service: Service) -> JSONResponse:
+    """202 ``{primitive: "started"}``."""
+    return _control(primitive, "start", service)
+
+
+@router.get("/primitives/{primitive}/stop.json", status_code=202, summary="Stop a primitive")
+def stop_primitive(primitive: str, service: Service) -> JSONResponse:
+    """202 ``{primitive: "stopped"}``."""
+    return _control(primitive, "stop", service)
+
+
+@router.get("/primitives/{primitive}/pause.json", status_code=202, summary="Pause a primitive")
+def pause_primitive(primitive: str, service: Service) -> JSONResponse:
+    """202 ``{primitive: "paused"}``."""
+    return _control(primitive, "pause", service)
+
+
+@router.get("/primitives/{primitive}/resume.json", status_code=202, summary="Resume a primitive")
+def resume_primitive(primitive: str, service: Service) -> JSONResponse:
+    """202 ``{primitive: "resumed"}``."""
+    return _control(primitive, "resume", service)
+
+
+@router.get("/primitives/{primitive}/properties/list.json", summary="A primitive's properties")
+async def properties_list(primitive: str, service: Service) -> JSONResponse:
+    """``{"property": [names]}`` (pypot's key)."""
+    return JSONResponse({"property": service.property_names(primitive)})
+
+
+@router.get(
+    "/primitives/{primitive}/properties/{prop}/value.json", summary="Read a primitive property"
+)
+async def get_property(primitive: str, prop: str, service: Service) -> JSONResponse:
+    """``{"primitive.prop": value}``."""
+    return JSONResponse({f"{primitive}.{prop}": service.get_property(primitive, prop)})
+
+
+@router.post(
+    "/primitives/{primitive}/properties/{prop}/value.json",
+    status_code=204,
+    summary="Write a primitive property (the body is the raw JSON value)",
+)
+async def set_property(primitive: str, prop: str, request: Request, service: Service) -> Response:
+    """204 with no body."""
+    data = await json_body(request, tip="the body is the new value as JSON")
+    service.set_property(primitive, prop, data)
+    return Response(status_code=204)
+
+
+@router.get("/primitives/{primitive}/methods/list.json", summary="A primitive's methods")
+async def methods_list(primitive: str, service: Service) -> JSONResponse:
+    """``{"methods": [names]}``."""
+    return JSONResponse({"methods": service.method_names(primitive)})
+
+
+@router.post(
+    "/primitives/{primitive}/methods/{method}/args.json", summary="Call a primitive method"
+)
+async def call_method(
+    primitive: str, method: str, request: Request, service: Service
+) -> JSONResponse:
+    """``{"primitive:method": result}``; the body holds the keyword arguments (or a list)."""
+    data = await json_body(request, default={}, tip="the body is an object of keyword arguments")
+    args, kwargs = (data, {}) if isinstance(data, list) else ([], data)
+    if not isinstance(kwargs, dict):
+        args, kwargs = [data], {}
+    result = await run_in_threadpool(service.call_method, primitive, method, args, kwargs)
+    return JSONResponse({f"{primitive}:{method}": result})

@@ -1,0 +1,183 @@
+"""pypot's routes for the robot, motors, registers, gotos and sensors (same paths and shapes)."""
+
+import html
+import math
+from typing import Any
+
+from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
+from fastapi.responses import HTMLResponse, JSONResponse  # noqa: TID253
+
+from poppy_core.server.deps import Service
+from poppy_core.server.errors import ApiError
+from poppy_core.server.routers.common import json_body, truthy, wait_goto
+from poppy_core.server.values import jsonable, motor_registers
+
+router = APIRouter(tags=["pypot"])
+
+SENSOR_TIP = "the sensors are listed by /sensors/list.json (this robot has none)"
+GOTO_TIP = (
+    '"position" (degrees) and "duration" (seconds) are required, "wait" is optional. '
+    'Example: {"position": 90, "duration": 3, "wait": true}'
+)
+GOTOS_TIP = (
+    '"motors" (names), "positions" (degrees, one per motor) and "duration" (seconds) are '
+    'required, "wait" is optional. Example: {"motors": ["m1", "m2"], "positions": [90, 0], '
+    '"duration": 2}'
+)
+
+
+@router.get("/", response_class=HTMLResponse, summary="The routes of the API")
+async def index(request: Request) -> HTMLResponse:
+    """Every route, as pypot's server lists them."""
+    lines = ["<b>All url paths available:</b><br>"]
+    for path, operations in request.app.openapi()["paths"].items():
+        methods = ", ".join(m.upper() for m in operations)
+        lines.append(f"{methods} {html.escape(path)}<br>")
+    lines.append("WEBSOCKET /api/v1/ws<br>")
+    return HTMLResponse("\n".join(lines))
+
+
+@router.get("/robot.json", summary="Every motor's registers and every primitive")
+async def robot_json(service: Service) -> JSONResponse:
+    """pypot's robot description."""
+    primitives = []
+    for name, primitive in service.primitives().items():
+        values = jsonable(primitive.property_values())
+        primitives.append(
+            {
+                "primitive": name,
+                "running": primitive.is_alive(),
+                "properties": [{"property": p, "value": v} for p, v in values.items()],
+                "methods": list(primitive.methods),
+            }
+        )
+    motors = [motor_registers(m) for m in service.robot.motors]
+    return JSONResponse({"motors": motors, "primitives": primitives})
+
+
+@router.get("/motors/list.json", summary="The motor names")
+async def motors_list(service: Service) -> JSONResponse:
+    """``{"motors": [names]}``."""
+    return JSONResponse({"motors": service.motor_names()})
+
+
+@router.get("/motors/aliases/list.json", summary="The group names")
+async def aliases_list(service: Service) -> JSONResponse:
+    """``{"aliases": [group names]}``."""
+    return JSONResponse({"aliases": list(service.groups())})
+
+
+@router.get("/motors/registers/{register}/list.json", summary="One register of every motor")
+async def register_values(register: str, service: Service) -> JSONResponse:
+    """``{register: {motor: value}}``."""
+    return JSONResponse({register: service.register_values(register)})
+
+
+@router.get("/motors/{alias}/list.json", summary="The motors of a group")
+async def alias_list(alias: str, service: Service) -> JSONResponse:
+    """``{alias: [names]}``."""
+    return JSONResponse({alias: service.group(alias)})
+
+
+@router.get("/motors/{motor}/registers/list.json", summary="The registers of a motor")
+async def registers_list(motor: str, service: Service) -> JSONResponse:
+    """``{"registers": [names]}``."""
+    return JSONResponse({"registers": list(service.motor(motor).registers)})
+
+
+@router.get("/motors/{motor}/registers/{register}/value.json", summary="Read a register")
+async def get_register(motor: str, register: str, service: Service) -> JSONResponse:
+    """``{register: value}``."""
+    return JSONResponse({register: service.read(motor, register)})
+
+
+@router.post(
+    "/motors/{motor}/registers/{register}/value.json",
+    status_code=202,
+    summary="Write a register (the body is the raw JSON value)",
+)
+async def set_register(
+    motor: str, register: str, request: Request, service: Service
+) -> JSONResponse:
+    """202 ``{register: value}``; 404 unknown motor/register; 400 bad or read-only value."""
+    data = await json_body(request, tip="the body is the new value as JSON, e.g. 90 or true")
+    value = service.write(motor, register, data)
+    return JSONResponse({register: value}, status_code=202)
+
+
+def _float(value: Any, what: str, tip: str) -> float:
+    try:
+        result = float(value)
+    except (TypeError, ValueError):
+        raise ApiError("invalid", f"{what} must be a number", tip=tip) from None
+    if not math.isfinite(result):
+        raise ApiError("invalid", f"{what} must be a finite number", tip=tip)
+    return result
+
+
+@router.post("/motors/{motor}/goto.json", status_code=202, summary="Move one motor")
+async def motor_goto(motor: str, request: Request, service: Service) -> JSONResponse:
+    """202 ``{"motors": {motor: position}, "duration", "waiting"}`` (after the move if waiting)."""
+    data = await json_body(request, tip=GOTO_TIP)
+    if not isinstance(data, dict) or "position" not in data or "duration" not in data:
+        raise ApiError("invalid", "cannot read the data given", tip=GOTO_TIP)
+    position = _float(data["position"], "position", GOTO_TIP)
+    duration = _float(data["duration"], "duration", GOTO_TIP)
+    wait = truthy(data.get("wait", False))
+    handle = service.goto({motor: position}, duration)
+    if wait:
+        await wait_goto(handle)
+    return JSONResponse(
+        {"motors": {motor: position}, "duration": duration, "waiting": wait}, status_code=202
+    )
+
+
+@router.post("/motors/goto.json", status_code=202, summary="Move several motors together")
+async def motors_goto(request: Request, service: Service) -> JSONResponse:
+    """202 ``{"motors": {motor: position}, "duration", "waiting"}``."""
+    data = await json_body(request, tip=GOTOS_TIP)
+    if not isinstance(data, dict) or not {"motors", "positions", "duration"} <= set(data):
+        raise ApiError("invalid", "cannot read the data given", tip=GOTOS_TIP)
+    motors, positions = data["motors"], data["positions"]
+    if not isinstance(motors, list) or not isinstance(positions, list):
+        raise ApiError("invalid", "motors and positions must be lists", tip=GOTOS_TIP)
+    if len(motors) != len(positions):
+        raise ApiError("invalid", "not as many positions as motors", tip=GOTOS_TIP)
+    targets = {
+        str(m): _float(p, f"position of {m}", GOTOS_TIP)
+        for m, p in zip(motors, positions, strict=True)
+    }
+    duration = _float(data["duration"], "duration", GOTOS_TIP)
+    wait = truthy(data.get("wait", False))
+    handle = service.goto(targets, duration)
+    if wait:
+        await wait_goto(handle)
+    return JSONResponse({"motors": targets, "duration": duration, "waiting": wait}, status_code=202)
+
+
+@router.get("/sensors/list.json", summary="The sensor names (none yet)")
+async def sensors_list() -> JSONResponse:
+    """``{"sensors": []}``: poppy drives no sensors yet."""
+    return JSONResponse({"sensors": []})
+
+
+def _no_sensor(sensor: str) -> ApiError:
+    return ApiError("not_found", f"Sensor '{sensor}' does not exist.", tip=SENSOR_TIP)
+
+
+@router.get("/sensors/{sensor}/registers/list.json", summary="The registers of a sensor")
+async def sensor_registers(sensor: str) -> JSONResponse:
+    """404: there is no sensor."""
+    raise _no_sensor(sensor)
+
+
+@router.get("/sensors/{sensor}/registers/{register}/value.json", summary="Read a sensor")
+async def get_sensor_register(sensor: str, register: str) -> JSONResponse:
+    """404: there is no sensor."""
+    raise _no_sensor(sensor)
+
+
+@router.post("/sensors/{sensor}/registers/{register}/value.json", summary="Write a sensor")
+async def set_sensor_register(sensor: str, register: str) -> JSONResponse:
+    """404: there is no sensor."""
+    raise _no_sensor(sensor)

@@ -1,0 +1,150 @@
+"""Pydantic bodies and answers of the v1 API (they make the OpenAPI schema)."""
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, JsonValue
+
+from poppy_core.server.service import MAX_GOTO_S
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+MotorName = Annotated[str, Field(min_length=1, max_length=64)]
+
+
+class Problem(BaseModel):
+    """An error: what went wrong."""
+
+    detail: str
+
+
+class RobotInfo(BaseModel):
+    """The robot: its motors, groups and primitives."""
+
+    motors: list[str]
+    groups: dict[str, list[str]]
+    primitives: list[str]
+    compliant: bool
+
+
+class CompliantBody(BaseModel):
+    """Compliance of the whole robot."""
+
+    model_config = ConfigDict(extra="forbid")
+    compliant: bool
+
+
+class MotorInfo(BaseModel):
+    """One motor and its registers (SI units, user frame)."""
+
+    name: str
+    id: int
+    model: str
+    online: bool
+    errors: int = Field(description="failed reads so far")
+    registers: dict[str, JsonValue]
+
+
+class RegisterValue(BaseModel):
+    """One register of one motor."""
+
+    model_config = ConfigDict(populate_by_name=True)
+    motor: str
+    register_name: str = Field(alias="register")
+    value: JsonValue
+
+
+class ValueBody(BaseModel):
+    """A value to write."""
+
+    model_config = ConfigDict(extra="forbid")
+    value: JsonValue
+
+
+class GotoRequest(BaseModel):
+    """Move motors so that they arrive together."""
+
+    model_config = ConfigDict(extra="forbid")
+    positions: dict[MotorName, Finite] = Field(
+        min_length=1, max_length=64, description="motor name -> target in degrees"
+    )
+    duration_s: Finite = Field(gt=0, le=MAX_GOTO_S, description="seconds the motion lasts")
+    control: Literal["minjerk", "dummy"] = "minjerk"
+    wait: bool = Field(False, description="answer once the motion is over")
+
+
+class GotoResult(BaseModel):
+    """A goto that started (and, with ``wait``, ended)."""
+
+    positions: dict[str, float]
+    duration_s: float
+    control: str
+    waited: bool
+    done: bool
+
+
+class PrimitiveInfo(BaseModel):
+    """A primitive: state, properties, methods, last error."""
+
+    model_config = ConfigDict(populate_by_name=True)
+    name: str
+    class_name: str = Field(alias="class")
+    state: str
+    alive: bool
+    elapsed_s: float
+    properties: dict[str, JsonValue]
+    methods: list[str]
+    error: dict[str, str] | None
+
+
+class MethodCall(BaseModel):
+    """Arguments of a primitive method."""
+
+    model_config = ConfigDict(extra="forbid")
+    args: list[JsonValue] = Field(default_factory=list, max_length=32)
+    kwargs: dict[str, JsonValue] = Field(default_factory=dict, max_length=32)
+
+
+class MethodResult(BaseModel):
+    """What a primitive method returned."""
+
+    result: JsonValue
+
+
+class MoveEntry(BaseModel):
+    """A move of the library."""
+
+    name: str
+    format: str
+    size_bytes: int
+
+
+class MoveInfo(BaseModel):
+    """A move: its motors, frames and (on request) positions in degrees."""
+
+    name: str
+    framerate: float
+    motors: list[str]
+    frames: int
+    duration_s: float
+    positions: list[list[float]] | None = None
+
+
+class RecordRequest(BaseModel):
+    """What to record (every motor when ``motors`` is null)."""
+
+    model_config = ConfigDict(extra="forbid")
+    motors: list[MotorName] | None = Field(None, max_length=64)
+
+
+class PlayRequest(BaseModel):
+    """How to play a move."""
+
+    model_config = ConfigDict(extra="forbid")
+    speed: Finite = Field(1.0, gt=0, le=100, description="2.0 plays twice as fast")
+    backwards: bool = False
+
+
+class MovesStatus(BaseModel):
+    """Moves being recorded and played."""
+
+    recording: list[str]
+    playing: list[str]

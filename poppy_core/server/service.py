@@ -1,0 +1,239 @@
+"""``RobotService``: what the routes do to a robot, shared by pypot's routes, v1 and the stream.
+
+Every method is cheap and thread-safe except ``stop_primitive`` (it joins a thread): routes call
+those from the thread pool. Gotos never block here: the caller awaits the returned handle.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from poppy_core.motion import Primitive, attach_builtins, attached_primitives
+from poppy_core.robot import GotoHandle, Motor, Robot
+from poppy_core.server import values
+from poppy_core.server.errors import ApiError
+from poppy_core.server.moves import MoveService
+
+logger = logging.getLogger(__name__)
+
+MAX_GOTO_S = 600.0
+"""The longest goto accepted (seconds)."""
+
+MOTOR_TIP = "the motors are listed by /motors/list.json"
+PRIMITIVE_TIP = "the primitives are listed by /primitives/list.json"
+CONTROLS = ("minjerk", "dummy")
+
+
+class RobotService:
+    """The robot as the server sees it.
+
+    Args:
+        robot: the robot served (the caller owns it and closes it).
+        builtins: attach the built-in primitives (sinus, square, ...) not yet attached.
+    """
+
+    def __init__(self, robot: Robot, *, builtins: bool = True) -> None:
+        self.robot = robot
+        if builtins:
+            attach_builtins(robot)
+        self.moves = MoveService(robot)
+
+    # -- motors and groups ---------------------------------------------------------------------
+
+    def motor(self, name: str) -> Motor:
+        """The motor ``name``, or ``ApiError("not_found")``."""
+        for motor in self.robot.motors:
+            if motor.name == name:
+                return motor
+        known = ", ".join(m.name for m in self.robot.motors)
+        raise ApiError("not_found", f"no motor {name!r} (motors: {known})", tip=MOTOR_TIP)
+
+    def motor_names(self) -> list[str]:
+        """Every motor name, in config order."""
+        return [m.name for m in self.robot.motors]
+
+    def groups(self) -> dict[str, list[str]]:
+        """Group name -> motor names."""
+        return {g: [m.name for m in ms] for g, ms in self.robot.motorgroups.items()}
+
+    def group(self, name: str) -> list[str]:
+        """The motor names of group ``name`` (``"motors"`` is every motor, as in pypot)."""
+        if name == "motors":
+            return self.motor_names()
+        groups = self.groups()
+        if name not in groups:
+            known = ", ".join(groups) or "none"
+            raise ApiError(
+                "not_found",
+                f"no group {name!r} (groups: {known})",
+                tip="the groups are listed by /motors/aliases/list.json",
+            )
+        return groups[name]
+
+    def read(self, motor: str, register: str) -> Any:
+        """The JSON value of a register."""
+        return values.read_register(self.motor(motor), register)
+
+    def write(self, motor: str, register: str, value: Any) -> Any:
+        """Check then write a register; returns the value written."""
+        return values.jsonable(values.write_register(self.motor(motor), register, value))
+
+    def write_many(self, commands: Any) -> dict[str, dict[str, Any]]:
+        """Apply ``{motor: {register: value}}`` after checking every value (all or nothing)."""
+        if not isinstance(commands, Mapping):
+            raise ApiError("invalid", "expected an object {motor: {register: value}}")
+        checked: list[tuple[Motor, str, Any]] = []
+        for motor_name, registers in commands.items():
+            motor = self.motor(str(motor_name))
+            if not isinstance(registers, Mapping):
+                raise ApiError("invalid", f"{motor_name}: expected an object {{register: value}}")
+            for register, value in registers.items():
+                checked.append(
+                    (motor, str(register), values.check_write(motor, str(register), value))
+                )
+        out: dict[str, dict[str, Any]] = {}
+        for motor, register, value in checked:
+            values.apply_checked(motor, register, value)
+            out.setdefault(motor.name, {})[register] = values.jsonable(value)
+        return out
+
+    def register_values(self, register: str) -> dict[str, Any]:
+        """Motor name -> the value of ``register`` (every motor must have it)."""
+        return {m.name: values.read_register(m, register) for m in self.robot.motors}
+
+    def state(self) -> dict[str, dict[str, Any]]:
+        """Motor name -> its streamed state."""
+        return {m.name: values.motor_state(m) for m in self.robot.motors}
+
+    def set_compliant(self, compliant: bool) -> None:
+        """Make every motor compliant or stiff."""
+        self.robot.compliant = compliant
+
+    # -- gotos ---------------------------------------------------------------------------------
+
+    def goto(
+        self, positions: Mapping[str, Any], duration_s: Any, control: str = "minjerk"
+    ) -> GotoHandle:
+        """Start a goto of several motors after checking every target and the duration.
+
+        Raises:
+            ApiError: unknown motor, a target outside the limits, a bad duration or control.
+        """
+        duration = check_duration(duration_s)
+        if control not in CONTROLS:
+            raise ApiError("invalid", f"control must be one of {', '.join(CONTROLS)}")
+        if not positions:
+            raise ApiError("invalid", "no motor to move")
+        targets = {
+            name: values.check_position(self.motor(name), "goal_position", value)
+            for name, value in positions.items()
+        }
+        return self.robot.goto_position(targets, duration, control=control, wait=False)
+
+    # -- primitives ------------------------------------------------------------------------------
+
+    def primitives(self) -> dict[str, Primitive]:
+        """Name -> every attached primitive."""
+        return attached_primitives(self.robot)
+
+    def primitive(self, name: str) -> Primitive:
+        """The primitive ``name``, or ``ApiError("not_found")``."""
+        found = self.primitives().get(name)
+        if found is None:
+            known = ", ".join(self.primitives()) or "none"
+            raise ApiError(
+                "not_found", f"no primitive {name!r} (primitives: {known})", tip=PRIMITIVE_TIP
+            )
+        return found
+
+    def running_primitives(self) -> list[str]:
+        """Names of the primitives running (or paused)."""
+        return [name for name, p in self.primitives().items() if p.is_alive()]
+
+    def control_primitive(self, name: str, action: str) -> Primitive:
+        """``start``, ``stop``, ``pause`` or ``resume`` a primitive (``stop`` joins its thread)."""
+        primitive = self.primitive(name)
+        if action == "start":
+            primitive.start()
+        elif action == "stop":
+            primitive.stop(wait=True)
+        elif action == "pause":
+            primitive.pause()
+        elif action == "resume":
+            primitive.resume()
+        else:
+            raise ApiError("not_found", f"no action {action!r} on primitives")
+        return primitive
+
+    def property_names(self, name: str) -> list[str]:
+        """The properties a primitive exposes."""
+        return list(self.primitive(name).properties)
+
+    def get_property(self, name: str, prop: str) -> Any:
+        """A primitive's property as JSON."""
+        primitive = self.primitive(name)
+        self._known(primitive, name, prop, primitive.properties, "property")
+        return values.jsonable(primitive.get_property(prop))
+
+    def set_property(self, name: str, prop: str, value: Any) -> Any:
+        """Set a primitive's property (converted and checked by the primitive)."""
+        primitive = self.primitive(name)
+        self._known(primitive, name, prop, primitive.properties, "property")
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ApiError("invalid", f"{name}.{prop}: expected a finite number")
+        primitive.set_property(prop, value)  # ConfigError -> 4xx "invalid"
+        return values.jsonable(primitive.get_property(prop))
+
+    def method_names(self, name: str) -> list[str]:
+        """The methods a primitive exposes."""
+        return list(self.primitive(name).methods)
+
+    def call_method(
+        self,
+        name: str,
+        method: str,
+        args: Sequence[Any] = (),
+        kwargs: Mapping[str, Any] | None = None,
+    ) -> Any:
+        """Call a declared method of a primitive; returns its result as JSON."""
+        primitive = self.primitive(name)
+        self._known(primitive, name, method, primitive.methods, "method")
+        try:
+            result = getattr(primitive, method)(*args, **(kwargs or {}))
+        except (TypeError, ValueError) as exc:
+            raise ApiError("invalid", f"{name}.{method}: {exc}") from None
+        return values.jsonable(result)
+
+    @staticmethod
+    def _known(primitive: Primitive, name: str, item: str, known: Any, kind: str) -> None:
+        if item not in known:
+            listed = ", ".join(known) or "none"
+            raise ApiError(
+                "not_found", f"{name} has no {kind} {item!r} ({kind}s: {listed})", tip=PRIMITIVE_TIP
+            )
+
+    def describe_primitive(self, name: str) -> dict[str, Any]:
+        """State, properties, methods and error of a primitive (JSON)."""
+        primitive = self.primitive(name)
+        described = values.jsonable(primitive.describe())
+        assert isinstance(described, dict)
+        return {"name": name, **described}
+
+    # -- lifetime ----------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Stop the recordings and playbacks this server started."""
+        self.moves.close()
+
+
+def check_duration(value: Any) -> float:
+    """A goto duration: a finite number of seconds in (0, MAX_GOTO_S]."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ApiError("invalid", "duration must be a number of seconds")
+    duration = float(value)
+    if not (math.isfinite(duration) and 0 < duration <= MAX_GOTO_S):
+        raise ApiError("invalid", f"duration must be in (0, {MAX_GOTO_S:g}] seconds")
+    return duration

@@ -1,0 +1,129 @@
+"""The WebSocket stream: every motor's state pushed at a fixed rate, commands taken in.
+
+Frames sent: ``{motor: {present_position, present_speed, present_load, present_temperature,
+led}}`` (pypot's ws server). Frames received: ``{motor: {register: value}}``, checked in full
+before anything is written; a refused command gets ``{"error": "..."}`` back. The send loop runs
+in its own task, so it keeps its rate whatever the client sends and whatever HTTP requests do.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import logging
+from typing import TYPE_CHECKING, Any
+
+from starlette.applications import Starlette
+from starlette.routing import WebSocketRoute
+from starlette.websockets import WebSocket, WebSocketDisconnect
+
+from poppy_core.errors import PoppyError
+from poppy_core.server.errors import ApiError
+from poppy_core.server.middleware import TokenMiddleware
+from poppy_core.server.service import RobotService
+
+if TYPE_CHECKING:
+    from fastapi import FastAPI
+
+logger = logging.getLogger(__name__)
+
+MIN_RATE_HZ = 0.1
+MAX_RATE_HZ = 200.0
+STREAM_PATH = "/api/v1/ws"
+
+
+def clamp_rate(rate_hz: float) -> float:
+    """A stream rate kept within [MIN_RATE_HZ, MAX_RATE_HZ]."""
+    return min(max(rate_hz, MIN_RATE_HZ), MAX_RATE_HZ)
+
+
+async def stream(websocket: WebSocket, service: RobotService, rate_hz: float) -> None:
+    """Serve one WebSocket client until it leaves."""
+    await websocket.accept()
+    send_lock = asyncio.Lock()
+
+    async def send(data: Any) -> None:
+        async with send_lock:
+            await websocket.send_text(json.dumps(data))
+
+    sender = asyncio.create_task(_send_states(send, service, clamp_rate(rate_hz)))
+    try:
+        await _receive_commands(websocket, send, service)
+    except WebSocketDisconnect:
+        pass
+    finally:
+        sender.cancel()
+        with contextlib.suppress(asyncio.CancelledError, Exception):
+            await sender
+
+
+async def _send_states(send: Any, service: RobotService, rate_hz: float) -> None:
+    loop = asyncio.get_running_loop()
+    period = 1.0 / rate_hz
+    deadline = loop.time()
+    while True:
+        await send(service.state())
+        deadline += period
+        delay = deadline - loop.time()
+        if delay < -period:  # fell behind (slow client): start again from now
+            deadline = loop.time()
+            delay = 0.0
+        await asyncio.sleep(max(0.0, delay))
+
+
+async def _receive_commands(websocket: WebSocket, send: Any, service: RobotService) -> None:
+    while True:
+        message = await websocket.receive()
+        if message["type"] == "websocket.disconnect":
+            return
+        text = message.get("text")
+        if text is None and message.get("bytes") is not None:
+            text = message["bytes"].decode("utf-8", errors="replace")
+        if text is None:
+            continue
+        try:
+            service.write_many(json.loads(text))
+        except json.JSONDecodeError as exc:
+            await send({"error": f"not JSON: {exc}"})
+        except ApiError as exc:
+            await send({"error": exc.message})
+        except PoppyError as exc:
+            await send({"error": str(exc)})
+
+
+def _rate_from(websocket: WebSocket, default_hz: float) -> float:
+    text = websocket.query_params.get("rate_hz")
+    try:
+        return float(text) if text is not None else default_hz
+    except ValueError:
+        return default_hz
+
+
+def add_stream_routes(app: FastAPI) -> None:
+    """Add ``/api/v1/ws`` (``?rate_hz=`` overrides the app's default rate)."""
+
+    @app.websocket(STREAM_PATH)
+    async def robot_stream(websocket: WebSocket) -> None:
+        service = websocket.app.state.service
+        await stream(websocket, service, _rate_from(websocket, websocket.app.state.stream_rate_hz))
+
+
+def create_stream_app(
+    service: RobotService, rate_hz: float = 30.0, token: str | None = None
+) -> Any:
+    """A small app serving the stream at ``/`` (pypot's ``--ws`` port).
+
+    Args:
+        service: the service of the HTTP app (``app.state.service``).
+        rate_hz: the default rate.
+        token: required from clients when set.
+    """
+
+    async def endpoint(websocket: WebSocket) -> None:
+        await stream(websocket, service, _rate_from(websocket, rate_hz))
+
+    app: Any = Starlette(routes=[WebSocketRoute("/", endpoint)])
+    if token:
+        app = TokenMiddleware(app, token)
+    return app

@@ -1,0 +1,61 @@
+"""Fixtures: a virtual Ergo Jr served over real HTTP on 127.0.0.1 (uvicorn in a thread)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import httpx
+import pytest
+
+from poppy_core.robot import Robot, from_profile
+from poppy_core.server import ServerThread, create_app
+
+
+@dataclass
+class Served:
+    """A served robot: its URL, the robot itself and the app."""
+
+    url: str
+    robot: Robot
+    app: Any
+
+
+@pytest.fixture(scope="module")
+def moves_folder(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """An empty move library for the servers of one test module (POPPY_MOVES_DIR)."""
+    folder = str(tmp_path_factory.mktemp("moves"))
+    old = os.environ.get("POPPY_MOVES_DIR")
+    os.environ["POPPY_MOVES_DIR"] = folder
+    yield folder
+    if old is None:
+        os.environ.pop("POPPY_MOVES_DIR", None)
+    else:
+        os.environ["POPPY_MOVES_DIR"] = old
+
+
+def serve(moves_folder: str, **options: Any) -> Iterator[Served]:
+    """Serve a fresh virtual Ergo Jr until the generator is closed."""
+    robot = from_profile("ergo-jr", sim=True)
+    app = create_app(robot, **options)
+    server = ServerThread(app).start()
+    try:
+        yield Served(server.url, robot, app)
+    finally:
+        server.stop()
+        robot.close()
+
+
+@pytest.fixture(scope="module")
+def served(moves_folder: str) -> Iterator[Served]:
+    """An Ergo Jr served without a token (one per test module)."""
+    yield from serve(moves_folder)
+
+
+@pytest.fixture
+def client(served: Served) -> Iterator[httpx.Client]:
+    """An HTTP client of ``served``."""
+    with httpx.Client(base_url=served.url, timeout=10.0) as http:
+        yield http

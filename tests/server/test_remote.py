@@ -1,0 +1,87 @@
+"""``RemoteRobot`` mirrors ``Robot``: names, registers, gotos, compliance, primitives, moves."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from poppy_core.errors import CommunicationError, ConfigError, RegisterError
+from poppy_core.remote import RemoteRobot
+from tests.server.conftest import Served
+
+
+@pytest.fixture
+def remote(served: Served) -> RemoteRobot:
+    return RemoteRobot(served.url)
+
+
+def test_same_names_groups_and_registers(remote: RemoteRobot, served: Served) -> None:
+    assert [m.name for m in remote.motors] == [m.name for m in served.robot.motors]
+    assert {g: [m.name for m in ms] for g, ms in remote.motorgroups.items()} == {
+        g: [m.name for m in ms] for g, ms in served.robot.motorgroups.items()
+    }
+    for local, distant in zip(served.robot.motors, remote.motors, strict=True):
+        assert distant.registers == local.registers
+        assert distant.id == local.id and distant.model.name == local.model.name
+    assert remote.m1.present_temperature == served.robot.m1.present_temperature
+    assert remote.m2.angle_limit == list(served.robot.m2.angle_limit)
+    assert [m.name for m in remote.base] == ["m1", "m2", "m3"]
+
+
+def test_registers_read_and_write(remote: RemoteRobot, served: Served) -> None:
+    remote.m4.led = "yellow"
+    assert served.robot.m4.led == "yellow" and remote.m4.led == "yellow"
+    with pytest.raises(RegisterError):
+        remote.m4.goal_position = 1000.0
+    with pytest.raises(RegisterError, match="read-only"):
+        remote.m4.present_position = 3.0
+    with pytest.raises(AttributeError):
+        remote.m4.nope = 1
+    with pytest.raises(ConfigError):
+        remote.motor("m9")
+    remote.m4.led = "off"
+
+
+def test_goto_and_compliance_match_the_robot(remote: RemoteRobot, served: Served) -> None:
+    remote.compliant = False
+    assert served.robot.compliant is False and remote.compliant is False
+    handle = remote.goto_position({"m1": 25, "m2": -15}, 0.4, wait=True)
+    assert handle.done
+    time.sleep(0.1)
+    local = served.robot.goto_position({"m3": 10}, 0.3, wait=True)
+    assert local.done
+    assert remote.m1.present_position == pytest.approx(25, abs=2)
+    assert remote.m2.present_position == pytest.approx(-15, abs=2)
+    moving = remote.m1.goto_position(0, 0.3)
+    assert not moving.done and moving.wait(2.0) and moving.done
+    remote.compliant = True
+    assert served.robot.compliant is True
+
+
+def test_primitives_and_moves(remote: RemoteRobot, served: Served) -> None:
+    assert remote.primitive_names == served.robot.primitive_names
+    sinus = remote.primitive("sinus")
+    sinus.set_property("amplitude", 3)
+    assert sinus.get_property("amplitude") == 3
+    sinus.start()
+    assert sinus.is_alive() and [p.name for p in remote.active_primitives] == ["sinus"]
+    sinus.stop()
+    assert sinus.state == "stopped"
+    remote.moves.record("remote_move", ["m1"])
+    time.sleep(0.2)
+    assert remote.moves.save("remote_move")["motors"] == ["m1"]
+    assert "remote_move" in remote.moves.list()
+    remote.moves.play("remote_move", speed=4)
+    remote.moves.stop("remote_move")
+    remote.moves.delete("remote_move")
+    assert "remote_move" not in remote.moves.list()
+    served.robot.compliant = True
+
+
+def test_keep_alive_and_unreachable_server(remote: RemoteRobot) -> None:
+    for _ in range(20):
+        assert isinstance(remote.m1.present_position, float)
+    assert len(remote._client._all) == 1
+    with pytest.raises(CommunicationError):
+        RemoteRobot("http://127.0.0.1:9", timeout_s=1.0)

@@ -1,0 +1,112 @@
+"""The v1 API: robot, motors, registers, groups, gotos, primitives, moves, OpenAPI."""
+
+from __future__ import annotations
+
+import time
+
+import httpx
+import pytest
+
+from tests.server.conftest import Served
+
+
+def test_openapi_documents_v1(client: httpx.Client) -> None:
+    schema = client.get("/openapi.json").json()
+    for path in ("/api/v1/robot", "/api/v1/motors/{motor}/registers/{register}", "/api/v1/gotos"):
+        assert path in schema["paths"]
+    assert "GotoRequest" in schema["components"]["schemas"]
+    assert client.get("/docs").status_code == 200
+
+
+def test_robot_and_groups(client: httpx.Client) -> None:
+    robot = client.get("/api/v1/robot").json()
+    assert robot["motors"] == ["m1", "m2", "m3", "m4", "m5", "m6"]
+    assert robot["groups"] == {"base": ["m1", "m2", "m3"], "tip": ["m4", "m5", "m6"]}
+    assert client.get("/api/v1/groups/tip").json() == ["m4", "m5", "m6"]
+    assert client.get("/api/v1/groups/nope").status_code == 404
+    state = client.get("/api/v1/robot/state").json()
+    assert set(state["m1"]) >= {"present_position", "present_speed", "led"}
+    assert (
+        client.put("/api/v1/robot/compliant", json={"compliant": False}).json()["compliant"]
+        is False
+    )
+    assert client.put("/api/v1/robot/compliant", json={"compliant": True}).json()["compliant"]
+
+
+def test_motor_registers(client: httpx.Client, served: Served) -> None:
+    motor = client.get("/api/v1/motors/m1").json()
+    assert motor["id"] == 1 and motor["model"] == "XL-320" and motor["online"] is True
+    assert client.get("/api/v1/motors/m1/registers/led").json() == {
+        "motor": "m1",
+        "register": "led",
+        "value": "off",
+    }
+    answer = client.put("/api/v1/motors/m1/registers/led", json={"value": "green"})
+    assert answer.status_code == 200 and answer.json()["value"] == "green"
+    assert served.robot.m1.led == "green"
+    answer = client.put("/api/v1/motors/m1/registers/goal_position", json={"value": 500})
+    assert answer.status_code == 422 and "angle limits" in answer.json()["detail"]
+    assert client.get("/api/v1/motors/m7/registers/led").status_code == 404
+    assert client.get("/api/v1/registers/id").json() == {f"m{i}": i for i in range(1, 7)}
+    served.robot.m1.led = "off"
+
+
+def test_patch_is_all_or_nothing(client: httpx.Client, served: Served) -> None:
+    answer = client.patch("/api/v1/motors", json={"m5": {"led": "red"}, "m6": {"led": "nope"}})
+    assert answer.status_code == 422
+    assert served.robot.m5.led == "off"
+    answer = client.patch("/api/v1/motors", json={"m5": {"led": "red", "torque_limit": 50}})
+    assert answer.status_code == 200
+    assert answer.json() == {"m5": {"led": "red", "torque_limit": 50}}
+    assert served.robot.m5.led == "red" and served.robot.m5.torque_limit == 50
+    served.robot.m5.led = "off"
+    served.robot.m5.torque_limit = 100
+
+
+def test_goto_matches_the_robot(client: httpx.Client, served: Served) -> None:
+    served.robot.compliant = False
+    body = {"positions": {"m1": 15, "m3": -20}, "duration_s": 0.4, "wait": True}
+    answer = client.post("/api/v1/gotos", json=body)
+    assert answer.status_code == 200
+    assert answer.json() == {
+        "positions": {"m1": 15.0, "m3": -20.0},
+        "duration_s": 0.4,
+        "control": "minjerk",
+        "waited": True,
+        "done": True,
+    }
+    time.sleep(0.1)
+    assert served.robot.m1.present_position == pytest.approx(15, abs=2)
+    assert served.robot.m3.present_position == pytest.approx(-20, abs=2)
+    served.robot.compliant = True
+    assert client.post("/api/v1/gotos", json={"positions": {}, "duration_s": 1}).status_code == 422
+
+
+def test_primitives(client: httpx.Client) -> None:
+    listed = client.get("/api/v1/primitives").json()
+    assert "sinus" in [p["name"] for p in listed]
+    started = client.post("/api/v1/primitives/square/start").json()
+    assert started["state"] == "running" and started["class"] == "Square"
+    stopped = client.post("/api/v1/primitives/square/stop").json()
+    assert stopped["state"] == "stopped" and stopped["alive"] is False
+    answer = client.put("/api/v1/primitives/square/properties/amplitude", json={"value": 5})
+    assert answer.status_code == 200 and answer.json()["properties"]["amplitude"] == 5
+    answer = client.post("/api/v1/primitives/square/methods/nope", json={})
+    assert answer.status_code == 404
+
+
+def test_moves(client: httpx.Client) -> None:
+    assert client.post("/api/v1/moves/v1move/record", json={"motors": ["tip"]}).status_code == 202
+    assert client.get("/api/v1/moves/status").json()["recording"] == ["v1move"]
+    time.sleep(0.3)
+    saved = client.post("/api/v1/moves/v1move/save").json()
+    assert saved["motors"] == ["m4", "m5", "m6"] and saved["frames"] > 5
+    assert "v1move" in [m["name"] for m in client.get("/api/v1/moves").json()]
+    move = client.get("/api/v1/moves/v1move?positions=true").json()
+    assert len(move["positions"]) == move["frames"]
+    assert client.post("/api/v1/moves/v1move/play", json={"speed": 4}).status_code == 202
+    assert client.post("/api/v1/moves/v1move/stop").status_code == 200
+    assert client.post("/api/v1/moves/ghost/save").status_code == 409
+    assert client.post("/api/v1/moves/ghost/stop").status_code == 409
+    assert client.delete("/api/v1/moves/v1move").status_code == 204
+    assert client.delete("/api/v1/moves/v1move").status_code == 404
