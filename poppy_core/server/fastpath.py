@@ -1,4 +1,4 @@
-"""A fast path for pypot's hottest routes, GET and POST ``/motors/<m>/registers/<r>/value.json``.
+"""A fast path for pypot's hottest routes: ``/robot.json`` and register values (GET and POST).
 
 Web pages and Snap! poll and set register values many times a second; answering them here skips
 FastAPI's routing and dependency solving (about twice the throughput). Anything unusual (an
@@ -21,7 +21,7 @@ REGISTER_VALUE = re.compile(r"^/motors/([A-Za-z0-9_]+)/registers/([A-Za-z0-9_]+)
 
 
 class RegisterFastPath:
-    """Answer register reads directly; pass every other request on.
+    """Answer ``/robot.json`` and register reads and writes directly; pass the rest on.
 
     Args:
         app: the wrapped app.
@@ -33,6 +33,9 @@ class RegisterFastPath:
         self.service = service
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] == "http" and scope["path"] == "/robot.json" and scope["method"] == "GET":
+            await _answer(send, 200, self.service.description())
+            return
         match = REGISTER_VALUE.match(scope["path"]) if scope["type"] == "http" else None
         if match is None or scope["method"] not in ("GET", "POST"):
             await self.app(scope, receive, send)

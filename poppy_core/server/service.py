@@ -139,6 +139,22 @@ class RobotService:
         """Name -> every attached primitive."""
         return attached_primitives(self.robot)
 
+    def description(self) -> dict[str, Any]:
+        """pypot's ``/robot.json``: every motor's registers and every primitive."""
+        primitives = []
+        for name, primitive in self.primitives().items():
+            props = values.jsonable(primitive.property_values())
+            primitives.append(
+                {
+                    "primitive": name,
+                    "running": primitive.is_alive(),
+                    "properties": [{"property": p, "value": v} for p, v in props.items()],
+                    "methods": list(primitive.methods),
+                }
+            )
+        motors = [values.motor_registers(m) for m in self.robot.motors]
+        return {"motors": motors, "primitives": primitives}
+
     def primitive(self, name: str) -> Primitive:
         """The primitive ``name``, or ``ApiError("not_found")``."""
         found = self.primitives().get(name)

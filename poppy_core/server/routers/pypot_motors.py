@@ -10,7 +10,6 @@ from fastapi.responses import HTMLResponse, JSONResponse  # noqa: TID253
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
 from poppy_core.server.routers.common import json_body, truthy, wait_goto
-from poppy_core.server.values import jsonable, motor_registers
 
 router = APIRouter(tags=["pypot"])
 
@@ -39,20 +38,8 @@ async def index(request: Request) -> HTMLResponse:
 
 @router.get("/robot.json", summary="Every motor's registers and every primitive")
 async def robot_json(service: Service) -> JSONResponse:
-    """pypot's robot description."""
-    primitives = []
-    for name, primitive in service.primitives().items():
-        values = jsonable(primitive.property_values())
-        primitives.append(
-            {
-                "primitive": name,
-                "running": primitive.is_alive(),
-                "properties": [{"property": p, "value": v} for p, v in values.items()],
-                "methods": list(primitive.methods),
-            }
-        )
-    motors = [motor_registers(m) for m in service.robot.motors]
-    return JSONResponse({"motors": motors, "primitives": primitives})
+    """pypot's robot description (also answered by the fast path)."""
+    return JSONResponse(service.description())
 
 
 @router.get("/motors/list.json", summary="The motor names")
