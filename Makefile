@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 
-.PHONY: run test lint completions bench clean
+.PHONY: run test lint completions bench clean sim-deps
 
 $(BIN)/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -33,6 +33,11 @@ completions: $(VENV)/.installed
 	_POPPY_COMPLETE=source_bash $(BIN)/poppy > completions/poppy.bash
 	_POPPY_COMPLETE=source_zsh $(BIN)/poppy > completions/poppy.zsh
 	_POPPY_COMPLETE=source_fish $(BIN)/poppy > completions/poppy.fish
+
+# Offscreen rendering for `poppy sim render` (EGL, or OSMesa on machines without a GPU).
+SIM_PACKAGES := libegl1 libgl1 libosmesa6
+sim-deps:
+	$(if $(filter 0,$(shell id -u)),,sudo) apt-get install -y $(SIM_PACKAGES)
 
 bench: $(VENV)/.installed-test
 	$(BIN)/python -m bench

@@ -14,6 +14,7 @@ from poppy_cli.commands import play as play_cmd
 from poppy_cli.commands import primitive as primitive_cmd
 from poppy_cli.commands import record as record_cmd
 from poppy_cli.commands import serve as serve_cmd
+from poppy_cli.commands import sim as sim_cmd
 from poppy_cli.commands import tui as tui_cmd
 from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, error_line
 
@@ -23,6 +24,7 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     rich_markup_mode="rich",
+    cls=sim_cmd.SimArgsGroup,  # `--sim [ideal|mujoco]`: see poppy_cli/commands/sim.py
 )
 
 
@@ -53,6 +55,7 @@ app.command("record")(record_cmd.record)
 app.command("play")(play_cmd.play)
 app.add_typer(moves_cmd.app, name="moves")
 app.command("serve")(serve_cmd.serve)
+app.add_typer(sim_cmd.app, name="sim")
 
 
 def main() -> None:

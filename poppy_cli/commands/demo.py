@@ -30,8 +30,16 @@ def demo(
         True, "--wire-timing/--no-wire-timing", help="Emulate the wire's timing (1 Mbps)."
     ),
     quick: bool = typer.Option(False, "--quick", help="Play the choreography ten times faster."),
+    sim: str | None = typer.Option(
+        None,
+        "--sim",
+        metavar="[mujoco]",
+        help="The dancing robot's servos: --sim (ideal, the default) or --sim mujoco (physics).",
+    ),
 ) -> None:
     """Start a virtual Ergo Jr (six XL-320), scan it, show it, then play a short dance."""
+    if sim not in (None, "ideal", "mujoco"):
+        raise typer.BadParameter(f"{sim!r}: use --sim (ideal servos) or --sim mujoco (physics)")
     from rich.table import Table
 
     from poppy_cli.commands.scan import render_found
@@ -70,7 +78,7 @@ def demo(
                     get("led"),
                 )
         console.print(table)
-    dance(QUICK_FACTOR if quick else 1.0)
+    dance(QUICK_FACTOR if quick else 1.0, "mujoco" if sim == "mujoco" else True)
     console.print(
         "Next: [bold]poppy emulate --profile ergo-jr[/] serves this robot to other programs; "
         "[bold]poppy scan --port PATH[/] finds its motors; "
@@ -94,15 +102,20 @@ def positions_table(robot: Robot, step: str) -> Table:
     return table
 
 
-def dance(time_factor: float) -> None:
-    """Build the virtual Ergo Jr robot and play the choreography, showing the positions live."""
+def dance(time_factor: float, sim: bool | str = True) -> None:
+    """Build the virtual Ergo Jr robot and play the choreography, showing the positions live.
+
+    Args:
+        time_factor: durations are multiplied by it (0.1 plays ten times faster).
+        sim: the robot's servos: True (ideal) or ``"mujoco"`` (physics).
+    """
     import time
 
     from rich.live import Live
 
     from poppy_core.robot import from_profile
 
-    with from_profile("ergo-jr", sim=True) as robot:
+    with from_profile("ergo-jr", sim=sim) as robot:
         robot.compliant = False
         with Live(positions_table(robot, "ready"), console=console, refresh_per_second=10) as live:
             for label, goals, duration_s in CHOREOGRAPHY:

@@ -24,7 +24,7 @@ def play(
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
-    sim: bool = SimOpt,
+    sim: str | None = SimOpt,
     json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
 ) -> None:
     """Play a move: a gentle ramp to its first frame, then the frames at the chosen speed.

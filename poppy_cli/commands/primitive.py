@@ -84,7 +84,7 @@ def list_primitives(
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
-    sim: bool = SimOpt,
+    sim: str | None = SimOpt,
     json_output: bool = JsonOpt,
 ) -> None:
     """List the primitives of a robot with their state, properties and last error."""
@@ -140,7 +140,7 @@ def run(
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
-    sim: bool = SimOpt,
+    sim: str | None = SimOpt,
     json_output: bool = JsonOpt,
 ) -> None:
     """Start a primitive, show its state live, stop it after --duration or on Ctrl-C.

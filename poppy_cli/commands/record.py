@@ -89,7 +89,7 @@ def record(
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
-    sim: bool = SimOpt,
+    sim: str | None = SimOpt,
     json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
 ) -> None:
     """Record a move: the motors turn compliant, move them by hand, Enter or Ctrl-C stops.

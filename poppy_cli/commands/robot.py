@@ -13,6 +13,7 @@ from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_j
 if TYPE_CHECKING:
     from rich.table import Table
 
+    from poppy_core.remote import RemoteMotor, RemoteRobot
     from poppy_core.robot import Motor, Robot, RobotConfig
     from poppy_core.robot.startup import ReturnDelayIssue
 
@@ -28,8 +29,28 @@ ConfigOpt = typer.Option(None, "--config", "-c", help="Robot config file (JSON o
 PortOpt = typer.Option(
     None, "--port", "-p", help="Serial port of the robot's bus. [env: POPPY_PORT]"
 )
-SimOpt = typer.Option(False, "--sim", help="Build a virtual robot (emulated motors).")
+
+
+def _sim_engine(value: str | None) -> str | None:
+    """Check the engine of ``--sim`` (the root group turns a bare ``--sim`` into ``ideal``)."""
+    if value is not None and value not in ("ideal", "mujoco"):
+        raise typer.BadParameter(f"{value!r}: use --sim (ideal servos) or --sim mujoco (physics)")
+    return value
+
+
+SimOpt = typer.Option(
+    None,
+    "--sim",
+    metavar="[mujoco]",
+    callback=_sim_engine,
+    help="Build a virtual robot: --sim (ideal servos) or --sim mujoco (MuJoCo physics).",
+)
 JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
+RemoteOpt = typer.Option(
+    None,
+    "--remote",
+    help="Drive a robot served by `poppy serve --http` at this URL (token: env POPPY_TOKEN).",
+)
 
 SETTLE_S = 0.1
 """Time for the sync loop to read the motors again after a command."""
@@ -70,18 +91,31 @@ def robot_config(profile: str | None, config_file: Path | None, port: str | None
 
 
 def build_robot(
-    profile: str | None, config_file: Path | None, port: str | None, sim: bool
+    profile: str | None, config_file: Path | None, port: str | None, sim: bool | str | None
 ) -> Robot:
     """Build and start the robot the shared options describe.
+
+    A Poppy creature (Ergo Jr, Torso, Humanoid: named by its profile, or recognised by its motor
+    names) gets its behaviours attached (``poppy_core.creatures``).
 
     Motors answering after a return delay above 0 µs slow every transaction: on a terminal the
     user is asked whether to set it to 0; otherwise it is only reported (a warning).
     """
-    from poppy_core.robot import from_config
+    from poppy_core.creatures import from_config
 
     return from_config(
-        robot_config(profile, config_file, port), sim=sim, fix_return_delay=ask_return_delay
+        robot_config(profile, config_file, port), sim=sim or False,
+        fix_return_delay=ask_return_delay,
     )
+
+
+def open_remote(url: str) -> RemoteRobot:
+    """Connect to a robot served by `poppy serve --http` (token from POPPY_TOKEN)."""
+    import os
+
+    from poppy_core.remote import RemoteRobot
+
+    return RemoteRobot(url, token=os.environ.get("POPPY_TOKEN") or None)
 
 
 def ask_return_delay(issues: list[ReturnDelayIssue]) -> bool:
@@ -99,7 +133,7 @@ def ask_return_delay(issues: list[ReturnDelayIssue]) -> bool:
     )
 
 
-def motor_state(motor: Motor) -> dict[str, Any]:
+def motor_state(motor: Motor | RemoteMotor) -> dict[str, Any]:
     """One motor's state as plain values (degrees, deg/s, %, °C, V)."""
     return {
         "id": motor.id,
@@ -116,12 +150,12 @@ def motor_state(motor: Motor) -> dict[str, Any]:
     }
 
 
-def robot_state(robot: Robot) -> dict[str, dict[str, Any]]:
+def robot_state(robot: Robot | RemoteRobot) -> dict[str, dict[str, Any]]:
     """Motor name -> its state."""
     return {motor.name: motor_state(motor) for motor in robot.motors}
 
 
-def status_table(robot: Robot, title: str = "robot status") -> Table:
+def status_table(robot: Robot | RemoteRobot, title: str = "robot status") -> Table:
     """A Rich table of every motor's state."""
     from rich.table import Table
 
@@ -155,12 +189,14 @@ def status(
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
-    sim: bool = SimOpt,
+    sim: str | None = SimOpt,
     watch: bool = typer.Option(False, "--watch", "-w", help="Refresh at 10 Hz until Ctrl-C."),
     json_output: bool = JsonOpt,
+    remote: str | None = RemoteOpt,
 ) -> None:
     """Show every motor: position, goal, speed, load, temperature, voltage, compliance, link."""
-    with build_robot(profile, config_file, port, sim) as robot:
+    opened = open_remote(remote) if remote else build_robot(profile, config_file, port, sim)
+    with opened as robot:
         if json_output:
             print_json(robot_state(robot))
             return
@@ -211,25 +247,33 @@ def goto(
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
-    sim: bool = SimOpt,
+    sim: str | None = SimOpt,
     json_output: bool = JsonOpt,
+    remote: str | None = RemoteOpt,
 ) -> None:
     """Move motors so they arrive together (torque is turned on for the motors moved).
 
     A minjerk trajectory is streamed by this command, so it runs until the motion ends; a dummy
     move is one goal and speed per motor, which the motors finish on their own unless --wait.
-    A --sim robot lives only within the command, so --sim always waits.
+    A --sim robot lives only within the command, so --sim always waits; a --remote robot
+    (served by `poppy serve`) moves on its own, so the command waits only with --wait.
     """
     if control not in ("minjerk", "dummy"):
         raise typer.BadParameter(f"control {control!r} is not minjerk or dummy")
-    config = robot_config(profile, config_file, port)
-    goals = parse_targets(targets, list(config.motors))
-    from poppy_core.robot import from_config
+    robot: Robot | RemoteRobot
+    if remote:
+        robot = open_remote(remote)
+        goals = parse_targets(targets, [m.name for m in robot.motors])
+    else:
+        config = robot_config(profile, config_file, port)
+        goals = parse_targets(targets, list(config.motors))
+        from poppy_core.robot import from_config
 
-    with from_config(config, sim=sim) as robot:
+        robot = from_config(config, sim=sim)
+        wait = wait or bool(sim) or control == "minjerk"
+    with robot:
         for name in goals:
             robot.motor(name).compliant = False
-        wait = wait or sim or control == "minjerk"
         robot.goto_position(goals, duration, control=control, wait=wait)
         if wait:
             time.sleep(SETTLE_S)
@@ -251,8 +295,9 @@ def compliant(
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
-    sim: bool = SimOpt,
+    sim: str | None = SimOpt,
     json_output: bool = JsonOpt,
+    remote: str | None = RemoteOpt,
 ) -> None:
     """Make motors compliant (on) or stiff (off); every motor when none is named."""
     from poppy_core.errors import ConfigError
@@ -261,20 +306,29 @@ def compliant(
     if lowered not in ("on", "off"):
         raise typer.BadParameter(f"state takes on or off, not {state!r}")
     value = lowered == "on"
-    config = robot_config(profile, config_file, port)
+    robot: Robot | RemoteRobot
+    if remote:
+        robot = open_remote(remote)
+        motors = [m.name for m in robot.motors]
+        members = {g: [m.name for m in ms] for g, ms in robot.motorgroups.items()}
+    else:
+        config = robot_config(profile, config_file, port)
+        motors = list(config.motors)
+        members = {g: config.resolve_group(g) for g in config.motorgroups}
     chosen: list[str] = []
-    for name in names or list(config.motors):
-        if name not in config.motors and name not in config.motorgroups:
-            groups = ", ".join(config.motorgroups) or "none"
+    for name in names or motors:
+        if name not in motors and name not in members:
+            groups = ", ".join(members) or "none"
             raise ConfigError(
-                f"no motor or group {name!r} (motors: {', '.join(config.motors)}; "
-                f"groups: {groups})",
+                f"no motor or group {name!r} (motors: {', '.join(motors)}; groups: {groups})",
                 field=name,
             )
-        chosen.extend(n for n in config.resolve_group(name) if n not in chosen)
-    from poppy_core.robot import from_config
+        chosen.extend(n for n in members.get(name, [name]) if n not in chosen)
+    if not remote:
+        from poppy_core.robot import from_config
 
-    with from_config(config, sim=sim) as robot:
+        robot = from_config(config, sim=sim)
+    with robot:
         for name in chosen:
             robot.motor(name).compliant = value
         result = {name: robot.motor(name).compliant for name in chosen}

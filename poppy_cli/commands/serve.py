@@ -26,7 +26,7 @@ def serve(
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
-    sim: bool = SimOpt,
+    sim: str | None = SimOpt,
     ws: bool = typer.Option(False, "--ws", help="Also stream the motors' state on a WebSocket."),
     ws_port: int = typer.Option(9009, "--ws-port", min=0, max=65535, help="WebSocket port."),
     ws_rate: float = typer.Option(

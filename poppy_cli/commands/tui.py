@@ -4,13 +4,19 @@ from __future__ import annotations
 
 import shlex
 import sys
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
 
 import typer
 
 from poppy_cli.output import console
 
 
-def serve_command(port: str | None, baud: int | None, protocol: int | None, sim: bool) -> str:
+def serve_command(
+    port: str | None, baud: int | None, protocol: int | None, sim: bool | str | None
+) -> str:
     """The command line textual-serve runs for each browser session (the same app)."""
     words = [sys.executable, "-m", "poppy_cli", "tui"]
     if port is not None:
@@ -20,7 +26,7 @@ def serve_command(port: str | None, baud: int | None, protocol: int | None, sim:
     if protocol is not None:
         words += ["--protocol", str(protocol)]
     if sim:
-        words.append("--sim")
+        words.append("--sim=mujoco" if sim == "mujoco" else "--sim")
     return shlex.join(words)
 
 
@@ -34,8 +40,12 @@ def tui(
     protocol: int | None = typer.Option(
         None, "--protocol", min=1, max=2, help="Scan --port in this protocol only (1 or 2)."
     ),
-    sim: bool = typer.Option(
-        False, "--sim", help="Start a virtual Ergo Jr (emulated bus and robot tab)."
+    sim: str | None = typer.Option(
+        None,
+        "--sim",
+        metavar="[mujoco]",
+        help="Start a virtual Ergo Jr: --sim (emulated bus and robot tab) or --sim mujoco "
+        "(the robot tab drives a MuJoCo-simulated Ergo Jr).",
     ),
     serve: bool = typer.Option(False, "--serve", help="Serve the app to a web browser."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to serve on (with --serve)."),
@@ -55,4 +65,35 @@ def tui(
         return
     from poppy_cli.tui.app import make_app
 
-    make_app(port, baud, protocol, sim).run()
+    if sim not in (None, "ideal", "mujoco"):
+        raise typer.BadParameter(f"{sim!r}: use --sim (ideal servos) or --sim mujoco (physics)")
+    if sim == "mujoco":
+        with mujoco_ergo_jr() as config_path:
+            make_app(port, baud, protocol, False, robot_source=str(config_path)).run()
+        return
+    make_app(port, baud, protocol, sim is not None).run()
+
+
+@contextmanager
+def mujoco_ergo_jr() -> Iterator[Path]:
+    """A MuJoCo Ergo Jr served on a pty for this process; yields a config file that opens it."""
+    from poppy_core.robot import load_profile
+    from poppy_core.robot.config_io import dump_config
+    from poppy_core.robot.factory import start_emulators, start_simulation
+
+    config = load_profile("ergo-jr")
+    simulation = start_simulation(config)
+    servers = start_emulators(config, simulation)
+    try:
+        simulation.start()
+        data = config.to_dict()
+        for name, controller in data["controllers"].items():
+            controller["port"] = servers[name].url
+        with tempfile.TemporaryDirectory(prefix="poppy-tui-") as folder:
+            path = Path(folder) / "ergo-jr-mujoco.json"
+            dump_config(type(config).from_dict(data, source="poppy tui --sim mujoco"), path)
+            yield path
+    finally:
+        for server in servers.values():
+            server.stop()
+        simulation.close()

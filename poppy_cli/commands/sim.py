@@ -1,0 +1,371 @@
+"""`poppy sim`: serve a MuJoCo-simulated robot's buses like `poppy emulate`, or render it."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+from typer.core import TyperGroup
+
+from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, console, err_console, error_line
+
+if TYPE_CHECKING:
+    from typer import _click
+
+    from poppy_core.robot import RobotConfig
+
+SIM_ENGINES = ("ideal", "mujoco")
+RENDER_PACKAGES = "libegl1 libgl1 (EGL) or libosmesa6 (OSMesa)"
+GIF_FPS = 15.0
+SETTLE_S = 0.5  # physics time before the first frame: the robot takes its pose
+
+app = typer.Typer(
+    help="Simulate a robot with MuJoCo: serve its buses (like `poppy emulate`) or render it.",
+    invoke_without_command=True,
+    no_args_is_help=False,
+)
+
+
+# ---------------------------------------------------------------------------------- --sim VALUE
+
+
+def _leaf_command(group: TyperGroup, ctx: _click.Context, args: list[str]) -> Any:
+    """The command ``args`` will run (through nested groups), or None."""
+    command: Any = group
+    for token in args:
+        if token == "--":
+            break
+        if token.startswith("-"):
+            continue
+        if not hasattr(command, "get_command"):
+            break
+        found = command.get_command(ctx, token)
+        if found is None:
+            break
+        command = found
+    return None if command is group else command
+
+
+def _sim_takes_value(command: Any) -> bool:
+    for param in getattr(command, "params", []):
+        if "--sim" in getattr(param, "opts", []):
+            return not getattr(param, "is_flag", True)
+    return False
+
+
+def normalise_sim_args(args: list[str], engines: tuple[str, ...] = SIM_ENGINES) -> list[str]:
+    """``--sim`` alone -> ``--sim=ideal``; ``--sim ENGINE`` -> ``--sim=ENGINE`` (words kept).
+
+    So ``--sim`` stays a bare flag in every command line (``poppy robot goto --sim m1=30``)
+    while ``--sim mujoco`` picks the physics engine.
+    """
+    out: list[str] = []
+    index = 0
+    while index < len(args):
+        token = args[index]
+        if token == "--":
+            return out + args[index:]
+        if token == "--sim":
+            following = args[index + 1] if index + 1 < len(args) else None
+            if following in engines:
+                out.append(f"--sim={following}")
+                index += 2
+                continue
+            token = "--sim=ideal"
+        out.append(token)
+        index += 1
+    return out
+
+
+class SimArgsGroup(TyperGroup):
+    """The root group: lets ``--sim`` take an optional engine (see ``normalise_sim_args``).
+
+    Only commands whose ``--sim`` option takes a value get their arguments rewritten.
+    """
+
+    def parse_args(self, ctx: _click.Context, args: list[str]) -> list[str]:
+        """Rewrite ``--sim [ENGINE]`` for the command about to run, then parse as usual."""
+        if "--sim" in args and _sim_takes_value(_leaf_command(self, ctx, args)):
+            args = normalise_sim_args(args)
+        return super().parse_args(ctx, args)
+
+
+# ---------------------------------------------------------------------------------- serving
+
+
+def _display() -> str | None:
+    return os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or None
+
+
+def _open_viewer(simulation: Any) -> Any:
+    """MuJoCo's passive viewer on the simulation, or None with one line saying why not."""
+    if _display() is None:
+        err_console.print(
+            "--view: no display ($DISPLAY and $WAYLAND_DISPLAY are unset), so no viewer "
+            "window; serving without it (render images with `poppy sim render`)"
+        )
+        return None
+    try:
+        import mujoco.viewer
+
+        return mujoco.viewer.launch_passive(simulation.model, simulation.data)
+    except Exception as exc:  # any GL/GLFW failure: keep serving
+        err_console.print(f"--view: cannot open MuJoCo's viewer ({exc}); serving without it")
+        return None
+
+
+def _serve_tcp_instead(servers: dict[str, Any], tcp: str) -> dict[str, Any]:
+    from poppy_cli.commands.emulate import parse_hostport
+    from poppy_core.emulator import serve_tcp
+
+    host, port = parse_hostport(tcp)
+    moved: dict[str, Any] = {}
+    try:
+        for index, (name, server) in enumerate(servers.items()):
+            server.stop()
+            moved[name] = serve_tcp(server.bus, host, port + index if port else 0)
+    except BaseException:
+        for server in moved.values():
+            server.stop()
+        raise
+    return moved
+
+
+def _serve(profile: str, speed: float, tcp: str | None, view: bool) -> None:
+    from poppy_core.robot import load_profile
+    from poppy_core.robot.factory import start_emulators, start_simulation
+
+    config = load_profile(profile)
+    stop = threading.Event()
+    # Handlers go in before the URLs are printed: a client may stop us as soon as it reads one.
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: stop.set())
+    simulation = start_simulation(config)
+    simulation.speed = speed
+    servers: dict[str, Any] = {}
+    viewer: Any = None
+    try:
+        servers = start_emulators(config, simulation)
+        if tcp:
+            servers = _serve_tcp_instead(servers, tcp)
+        simulation.start()
+        for server in servers.values():
+            sys.stdout.write(server.url + "\n")
+        sys.stdout.flush()
+        for name, server in servers.items():
+            bus = server.bus
+            ids = ", ".join(str(m.id) for m in bus.motors)
+            err_console.print(
+                f"[green]simulating[/] {profile} {name}: {len(bus.motors)} motors (ids {ids}), "
+                f"protocol {bus.protocol} at {bus.baudrate} bps on {server.url}, MuJoCo at "
+                f"{speed:g}× real time — Ctrl-C to stop"
+            )
+        viewer = _open_viewer(simulation) if view else None
+        while not stop.wait(1 / 30 if viewer is not None else 0.5):
+            if viewer is not None:
+                if not viewer.is_running():
+                    viewer = None
+                    continue
+                viewer.sync()
+    finally:
+        if viewer is not None:
+            viewer.close()
+        for server in servers.values():
+            server.stop()
+        simulation.close()
+
+
+@app.callback()
+def sim(
+    ctx: typer.Context,
+    profile: str | None = typer.Option(
+        None, "--profile", help="Robot profile with a simulation model: ergo-jr, torso, humanoid."
+    ),
+    speed: float = typer.Option(
+        1.0, "--speed", min=0.01, help="Simulated seconds per real second (1 = real time)."
+    ),
+    pty: bool = typer.Option(False, "--pty", help="Serve on pseudo-terminals (the default)."),
+    tcp: str | None = typer.Option(
+        None, "--tcp", help="Serve on TCP HOST:PORT instead (one port per bus; 0: any free)."
+    ),
+    view: bool = typer.Option(False, "--view", help="Open MuJoCo's viewer (needs a display)."),
+) -> None:
+    """Serve the simulated robot's buses: print each bus's pty path (or socket:// URL) on its
+    own line, then run the physics until Ctrl-C. `poppy scan`, `poppy motor`, `poppy robot
+    --port` work on it as on hardware.
+    """
+    if ctx.invoked_subcommand is not None:
+        return
+    if profile is None:
+        error_line("give --profile NAME (ergo-jr, torso or humanoid): poppy sim --profile ergo-jr")
+        raise typer.Exit(EXIT_USAGE)
+    if pty and tcp:
+        error_line("give either --pty or --tcp, not both")
+        raise typer.Exit(EXIT_USAGE)
+    _serve(profile, speed, tcp, view)
+
+
+# ---------------------------------------------------------------------------------- rendering
+
+
+def _gl_works(backend: str) -> bool:
+    """Whether MuJoCo can open an offscreen context with ``backend`` (tried in a subprocess)."""
+    code = "import mujoco; mujoco.GLContext(8, 8).make_current()"
+    env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
+    try:
+        done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                              timeout=30, check=False)  # fmt: skip
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+    return done.returncode == 0
+
+
+def choose_gl_backend() -> str | None:
+    """Set ``MUJOCO_GL`` for offscreen rendering: the user's, else glfw with a display, else
+    egl, else osmesa. None when nothing works (before mujoco is imported)."""
+    if "MUJOCO_GL" in os.environ:
+        return os.environ["MUJOCO_GL"]
+    if "mujoco" in sys.modules:  # already chosen at import
+        return os.environ.get("MUJOCO_GL", "glfw")
+    candidates = (["glfw"] if _display() else []) + ["egl", "osmesa"]
+    for backend in candidates:
+        if _gl_works(backend):
+            os.environ["MUJOCO_GL"] = backend
+            if backend != "glfw":
+                os.environ.setdefault("PYOPENGL_PLATFORM", backend)
+            return backend
+    return None
+
+
+def _no_gl(detail: str) -> typer.Exit:
+    error_line(
+        f"cannot render offscreen ({detail}): install the Debian packages {RENDER_PACKAGES} "
+        "(`make sim-deps`), or set MUJOCO_GL"
+    )
+    return typer.Exit(EXIT_FAILURE)
+
+
+def _motor_map(config: RobotConfig, servers: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
+    """Motor name -> (virtual motor, JointLink)."""
+    from poppy_core.sim.plant import JointLink
+
+    out: dict[str, tuple[Any, Any]] = {}
+    for controller, server in servers.items():
+        for name in config.motors_of_controller(controller):
+            entry = config.motors[name]
+            sign = 1.0 if entry.orientation == "direct" else -1.0
+            out[name] = (server.bus.motor(entry.id), JointLink(name, sign, float(entry.offset)))
+    return out
+
+
+def _command(motors: dict[str, tuple[Any, Any]], goals: dict[str, float]) -> None:
+    """Torque on and goal positions (poppy's frame) written into the virtual motors' tables."""
+    for name, (motor, link) in motors.items():
+        with motor.lock:
+            motor.table.set("torque_enable", 1)
+            if name in goals:
+                motor.table.set_si("goal_position", link.motor_deg(goals[name]))
+
+
+def render_frames(
+    profile: str, move_ref: str | None, camera: str | None, width: int, height: int
+) -> list[Any]:
+    """RGB frames of the profile's robot: one still (servos on) or the move at ``GIF_FPS``.
+
+    The physics is advanced by hand (no thread, faster than real time); goals go through the
+    virtual servos' control tables, so their speed and torque limits apply as on a robot.
+    """
+    from poppy_core.errors import ConfigError
+    from poppy_core.motion import load_move
+    from poppy_core.robot import load_profile
+    from poppy_core.robot.factory import start_emulators, start_simulation
+
+    config = load_profile(profile)
+    move = load_move(move_ref) if move_ref is not None else None
+    if move is not None:
+        unknown = [m for m in move.motors if m not in config.motors]
+        if unknown:
+            raise ConfigError(f"move {move_ref!r} drives motors {profile} has not: "
+                              f"{', '.join(unknown)}", field="move")  # fmt: skip
+    simulation = start_simulation(config)
+    servers = start_emulators(config, simulation)
+    try:
+        motors = _motor_map(config, servers)
+        first = move.position_at(0.0) if move is not None else {}
+        _command(motors, first)
+        simulation.advance(SETTLE_S)
+        frames = [simulation.render(camera, width, height)]
+        if move is not None:
+            step = 1.0 / GIF_FPS
+            for index in range(1, int(move.duration_s * GIF_FPS) + 2):
+                _command(motors, move.position_at(min(index * step, move.duration_s)))
+                simulation.advance(step)
+                frames.append(simulation.render(camera, width, height))
+        return frames
+    finally:
+        for server in servers.values():
+            server.stop()
+        simulation.close()
+
+
+def save_frames(frames: list[Any], output: Path) -> None:
+    """One frame to a PNG (or any still format Pillow writes), all frames to a GIF."""
+    from PIL import Image
+
+    images = [Image.fromarray(frame) for frame in frames]
+    output.parent.mkdir(parents=True, exist_ok=True)
+    if output.suffix.lower() == ".gif":
+        images[0].save(output, save_all=True, append_images=images[1:],
+                       duration=round(1000 / GIF_FPS), loop=0)  # fmt: skip
+    else:
+        images[-1].save(output)
+
+
+@app.command("render")
+def render(
+    output: Path = typer.Option(..., "--output", "-o", help="out.png (a still) or out.gif."),
+    profile: str = typer.Option("ergo-jr", "--profile", help="Robot profile to render."),
+    move: str | None = typer.Option(
+        None, "--move", help="Play this move (library name or file) and render it (use a .gif)."
+    ),
+    camera: str | None = typer.Option(
+        "front", "--camera", help="Camera of the model ('front'); 'free' for the default view."
+    ),
+    width: int = typer.Option(640, "--width", min=16, max=4096, help="Image width (pixels)."),
+    height: int = typer.Option(480, "--height", min=16, max=4096, help="Image height (pixels)."),
+) -> None:
+    """Render the simulated robot offscreen (EGL or OSMesa, no GPU needed) to a PNG, or a
+    move played in the simulation to a GIF (15 frames per second)."""
+    from poppy_core.errors import ConfigError
+
+    suffix = output.suffix.lower()
+    if suffix not in (".png", ".gif", ".jpg", ".jpeg"):
+        error_line(f"{output}: write a .png, .jpg or .gif")
+        raise typer.Exit(EXIT_USAGE)
+    backend = choose_gl_backend()
+    if backend is None:
+        raise _no_gl("no working OpenGL backend: EGL and OSMesa failed")
+    chosen = None if camera in (None, "free") else camera
+    try:
+        with console.status(f"rendering {profile} with MuJoCo ({backend})…"):
+            frames = render_frames(profile, move, chosen, width, height)
+    except ConfigError as exc:
+        if exc.field == "MUJOCO_GL":
+            raise _no_gl(str(exc)) from None
+        raise
+    except ValueError as exc:  # mujoco: unknown camera
+        error_line(f"{exc} (the models have a camera 'front'; 'free' is the default view)")
+        raise typer.Exit(EXIT_USAGE) from None
+    if suffix != ".gif" and len(frames) > 1:
+        err_console.print(f"a still image holds one frame: the last of {len(frames)} is saved")
+    save_frames(frames, output)
+    console.print(
+        f"wrote {output} ({width}×{height}, {len(frames) if suffix == '.gif' else 1} "
+        f"frame{'s' if suffix == '.gif' and len(frames) > 1 else ''}, {backend})"
+    )
