@@ -1,4 +1,4 @@
-"""Robot tab: open a profile/config (or a virtual robot), live motor table, compliance, goto."""
+"""Robot tab: open a profile/config (or a virtual robot); motors, primitives and moves views."""
 # ruff: noqa: TID253  (the TUI package is only imported by `poppy tui`, lazily)
 
 from __future__ import annotations
@@ -10,13 +10,16 @@ from textual import on, work
 from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
-from textual.widgets import Button, Checkbox, DataTable, Input, Select
+from textual.widgets import Button, Checkbox, DataTable, Input, Select, TabbedContent, TabPane
 
 from poppy_cli.tui.messages import BusFailed, RobotOpened
+from poppy_cli.tui.widgets.moves import MovesPanel
+from poppy_cli.tui.widgets.primitives import PrimitivesPanel
 from poppy_core.errors import ConfigError, PoppyError
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
+    from poppy_core.robot.factory import SimMode
 
 REFRESH_S = 0.1
 COLUMNS = ("motor", "id", "pos °", "goal °", "speed", "load %", "temp", "compliant")
@@ -47,38 +50,64 @@ def parse_goto(text: str, known: list[str]) -> dict[str, float]:
     return targets
 
 
-def open_robot(source: str, sim: bool) -> Robot:
-    """Build a robot from a config file path or a profile name (blocking)."""
-    from poppy_core.robot import from_config, from_profile, load_config
+def open_robot(source: str, sim: SimMode) -> Robot:
+    """Build a robot from a config file path or a profile name (blocking).
+
+    It goes through ``poppy_core.creatures``: a Poppy creature gets its behaviours attached.
+    """
+    from poppy_core.creatures import from_config, from_profile
 
     if Path(source).is_file():
-        return from_config(load_config(Path(source)), sim)
+        return from_config(Path(source), sim)
     return from_profile(source, sim=sim)
 
 
-class RobotPanel(Vertical):
-    """A whole robot: its motors from the caches (no bus I/O here), compliance and goto."""
+class MotorsView(Vertical):
+    """The Motors view: the live table, goto and group compliance (actions on the panel)."""
 
     BINDINGS: ClassVar[list[BindingType]] = [Binding("c", "toggle_compliant", "Compliant")]
+
+    def action_toggle_compliant(self) -> None:
+        """Toggle the compliance of the motor under the cursor."""
+        self.query_ancestor(RobotPanel).toggle_compliant()
+
+
+class RobotPanel(Vertical):
+    """A whole robot: its motors from the caches (no bus I/O here), primitives and moves."""
+
+    # The view tabs' labels show these keys (the footer has no room for them at 80 columns).
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("1", "view('robot-motors')", "Motors", show=False),
+        Binding("2", "view('robot-primitives')", "Primitives", show=False),
+        Binding("3", "view('robot-moves')", "Moves", show=False),
+    ]
 
     def __init__(self, *, id: str | None = None) -> None:
         super().__init__(id=id)
         self.robot: Robot | None = None
+        self.primitives = PrimitivesPanel(id="primitives")
+        self.moves = MovesPanel(id="moves")
 
     def compose(self) -> ComposeResult:
         with Horizontal(classes="row"):
             yield Input(placeholder="profile (ergo-jr) or config file", id="robot-source")
             yield Checkbox("sim", id="robot-sim")
             yield Button("Open", id="robot-open")
-        yield DataTable[str](id="robot-table", cursor_type="row", zebra_stripes=True)
-        with Horizontal(classes="row"):
-            yield Input(placeholder="goto: m1=30 m2=-10", id="goto")
-            yield Input("1.0", id="goto-duration", type="number")
-            yield Button("Go", id="goto-go", variant="primary")
-        with Horizontal(classes="row"):
-            yield Select[str]([], prompt="group", id="robot-group")
-            yield Button("Compliant", id="group-compliant")
-            yield Button("Stiff", id="group-stiff")
+        with TabbedContent(initial="robot-motors", id="robot-views"):
+            with TabPane("Motors 1", id="robot-motors"), MotorsView():
+                yield DataTable[str](id="robot-table", cursor_type="row", zebra_stripes=True)
+                with Horizontal(classes="row"):
+                    yield Input(placeholder="goto: m1=30 m2=-10", id="goto")
+                    yield Input("1.0", id="goto-duration", type="number")
+                    yield Button("Go", id="goto-go", variant="primary")
+                with Horizontal(classes="row"):
+                    yield Select[str]([], prompt="group", id="robot-group")
+                    yield Button("Compliant", id="group-compliant")
+                    yield Button("Stiff", id="group-stiff")
+            with TabPane("Primitives 2", id="robot-primitives"):
+                yield self.primitives
+            with TabPane("Moves 3", id="robot-moves"):
+                yield self.moves
 
     def on_mount(self) -> None:
         table = self.query_one("#robot-table", DataTable)
@@ -86,8 +115,14 @@ class RobotPanel(Vertical):
             table.add_column(column, key=column)
         self.set_interval(REFRESH_S, self.refresh_table)
 
+    def action_view(self, pane: str) -> None:
+        """Show a view of the robot (Motors, Primitives, Moves) and focus its table."""
+        self.query_one("#robot-views", TabbedContent).active = pane
+        focus = {"robot-motors": "#robot-table", "robot-primitives": "#primitive-table"}
+        self.query_one(focus.get(pane, "#moves-table")).focus()
+
     @work(thread=True, exclusive=True, group="robot", exit_on_error=False)
-    def open(self, source: str, sim: bool) -> None:
+    def open(self, source: str, sim: SimMode) -> None:
         """Build the robot in a thread (it opens buses and starts the sync loops)."""
         try:
             robot = open_robot(source, sim)
@@ -101,6 +136,8 @@ class RobotPanel(Vertical):
         message.stop()
         self.close_robot()
         self.robot = message.robot
+        self.primitives.set_robot(message.robot)
+        self.moves.set_robot(message.robot)
         table = self.query_one("#robot-table", DataTable)
         table.clear()
         for motor in message.robot.motors:
@@ -125,20 +162,25 @@ class RobotPanel(Vertical):
         )
 
     def refresh_table(self) -> None:
-        """Show the motors' cached values (the sync loops keep them fresh)."""
+        """Show the motors' cached values (the sync loops keep them fresh), the primitives'
+        states and the recording or playback progress: polling only, no I/O."""
         if self.robot is None or self.robot.closed:
             return
         table = self.query_one("#robot-table", DataTable)
         for motor in self.robot.motors:
             for column, text in zip(COLUMNS, self._cells(motor.name), strict=True):
                 table.update_cell(motor.name, column, text)
+        self.primitives.refresh_states()
+        self.moves.poll()
 
     def on_unmount(self) -> None:
         self.close_robot()
 
     def close_robot(self) -> None:
-        """Close the robot (stops its loops and its emulators)."""
+        """Close the robot (stops its recorder, player, primitives, loops and emulators)."""
         if self.robot is not None:
+            self.moves.release()
+            self.primitives.release()
             self.robot.close()
             self.robot = None
 
@@ -171,7 +213,7 @@ class RobotPanel(Vertical):
             return
         self.notify(f"goto {', '.join(f'{n}={v:g}°' for n, v in targets.items())}")
 
-    def action_toggle_compliant(self) -> None:
+    def toggle_compliant(self) -> None:
         """Toggle the compliance of the motor under the cursor."""
         table = self.query_one("#robot-table", DataTable)
         if self.robot is None or table.row_count == 0:
