@@ -180,6 +180,9 @@ def _ms(value: float | None) -> str:
     return "-" if value is None else f"{value * 1000:.2f} ms"
 
 
+GOAL_RATIO = 2.0
+
+
 @register("server", "REST requests/s and p50/p99 latency: poppy serve vs pypot's HTTP server")
 def server_bench(ctx: BenchContext) -> BenchResult:
     """Measure both servers on every scenario."""
@@ -210,6 +213,19 @@ def server_bench(ctx: BenchContext) -> BenchResult:
         rows.append(row)
     headers = ["scenario"]
     headers += [f"{k} {c}" for k in ("poppy", "pypot") for c in ("req/s", "p50", "p99", "errors")]
+    # Goal (issue): at least 2x pypot's throughput with a lower p99.
+    verdicts: list[bool] = []
+    for row, name in zip(rows, SCENARIOS, strict=True):
+        mine = raw.get("poppy", {}).get(name, {}).get("median")
+        theirs = raw.get("pypot", {}).get(name, {}).get("median")
+        if mine is None or theirs is None or not theirs["rps"]:
+            row += ["-", "-"]
+            continue
+        ratio = mine["rps"] / theirs["rps"]
+        met = ratio >= GOAL_RATIO and mine["p99_s"] < theirs["p99_s"]
+        verdicts.append(met)
+        row += [f"{ratio:.1f}x", "pass" if met else "**FAIL**"]
+    headers += ["poppy / pypot", f">= {GOAL_RATIO:g}x, lower p99"]
     notes.append(
         f"{CLIENTS} client threads with keep-alive connections for {DURATION_S} s per run, "
         f"median of {ctx.repeat} runs (by req/s). The wait-goto scenario keeps a "
@@ -226,5 +242,6 @@ def server_bench(ctx: BenchContext) -> BenchResult:
         ),
         tables=[Table("REST server", headers, rows)],
         notes=notes,
+        passed=all(verdicts) if verdicts else None,
         raw=raw,
     )
