@@ -40,7 +40,9 @@ class MujocoPlant:
     The physics runs in the simulation's own thread, which reads the motors' commands and writes
     their sensed state through the control tables (under ``motor.lock``). :meth:`step` is
     therefore a no-op: the bus sees the physics only through the tables. Without the thread
-    (tests), ``Simulation.advance(dt)`` steps the world and the tables together.
+    (tests), ``Simulation.advance(dt)`` steps the world and the tables together: commands are
+    read at every call, the sensed state is written every ``STATE_PERIOD_S`` (10 ms) of
+    simulated time.
 
     Args:
         simulation: the world shared by every bus of the robot.

@@ -18,41 +18,26 @@ import numpy as np
 
 from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.errors import ConfigError
+from poppy_core.sim.drive import Drive, Joint
+from poppy_core.sim.exchange import MotorPort
 from poppy_core.sim.objects import ObjectSpec, add_objects
 from poppy_core.sim.plant import JointLink
 
 logger = logging.getLogger(__name__)
 
-SYNC_PERIOD_S = 0.005  # physics <-> control tables exchange period (5 physics steps at 2 ms)
+SYNC_PERIOD_S = 0.005  # how often the physics thread wakes: reads commands, steps the world
+# How often (simulated time) the sensed state is written back into the control tables. The bus
+# samples present values at 50 Hz at most, so 100 Hz keeps them at most 10 ms old and halves
+# the cost of the exchange (encoding four registers per motor) against writing every 5 ms.
+STATE_PERIOD_S = 0.01
 
 
 @dataclass
 class _Binding:
     motor: VirtualMotor
     link: JointLink
-    qpos: int = 0
-    dof: int = 0
-    actuator: int = 0
-    stall_nm: float = 1.0
-    kp: float = 0.0
-    kv: float = 0.0
-    target_rad: float = 0.0
-
-
-@dataclass
-class _Command:
-    torque_on: bool
-    goal_rad: float
-    speed_rps: float
-    torque_pct: float
-
-
-@dataclass
-class _State:
-    position_deg: float
-    speed_dps: float
-    load_pct: float
-    moving: bool
+    port: MotorPort
+    index: int  # in the Drive's arrays
 
 
 @dataclass
@@ -76,6 +61,10 @@ class Simulation:
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self._bindings: list[_Binding] = []
+        self._drive = Drive()
+        self._groups: list[tuple[Any, list[_Binding]]] = []  # bindings by their motors' lock
+        self._carry_s = 0.0  # simulated time asked for but not yet stepped (< one timestep)
+        self._state_age_s = math.inf  # simulated time since the state was last written
         self._objects = _Objects()
         self._renderers: dict[tuple[int, int], Any] = {}
         self._thread: threading.Thread | None = None
@@ -83,28 +72,42 @@ class Simulation:
 
     # ------------------------------------------------------------------ motors
 
-    def _resolve(self, binding: _Binding) -> None:
-        name = binding.link.joint
-        joint = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, name)
-        actuator = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
-        if joint < 0 or actuator < 0:
-            raise ConfigError(f"the simulation model has no joint/actuator {name!r}", field=name)
-        binding.qpos = int(self.model.jnt_qposadr[joint])
-        binding.dof = int(self.model.jnt_dofadr[joint])
-        binding.actuator = actuator
+    def _resolve(self, joint: str) -> tuple[int, int, int]:
+        """(qpos address, dof address, actuator id) of ``joint`` in the current model."""
+        index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+        actuator = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint)
+        if index < 0 or actuator < 0:
+            raise ConfigError(f"the simulation model has no joint/actuator {joint!r}", field=joint)
+        return int(self.model.jnt_qposadr[index]), int(self.model.jnt_dofadr[index]), actuator
 
     def bind(self, motor: VirtualMotor, link: JointLink) -> None:
-        """Let ``motor`` drive joint ``link.joint``; its table starts at the joint's pose."""
-        binding = _Binding(motor, link)
+        """Let ``motor`` drive joint ``link.joint``; its table starts at the joint's pose.
+
+        The motor's lock must be the one it keeps (a ``VirtualBus`` sets it before attaching
+        its plant): the exchange takes each lock once for all the motors sharing it.
+        """
         with self._lock:
-            self._resolve(binding)
-            a = binding.actuator
-            binding.stall_nm = float(self.model.actuator_forcerange[a][1])
-            binding.kp = float(self.model.actuator_gainprm[a][0])
-            binding.kv = float(-self.model.actuator_biasprm[a][2])
-            binding.target_rad = float(self.data.qpos[binding.qpos])
+            qpos, dof, actuator = self._resolve(link.joint)
+            joint = Joint(
+                qpos=qpos,
+                dof=dof,
+                actuator=actuator,
+                sign=link.sign,
+                offset_deg=link.offset_deg,
+                stall_nm=float(self.model.actuator_forcerange[actuator][1]),
+                kp=float(self.model.actuator_gainprm[actuator][0]),
+                kv=float(-self.model.actuator_biasprm[actuator][2]),
+            )
+            target_rad = float(self.data.qpos[qpos])
+            binding = _Binding(motor, link, MotorPort(motor), self._drive.add(joint, target_rad))
             self._bindings.append(binding)
-            position = link.motor_deg(math.degrees(binding.target_rad))
+            for lock, members in self._groups:
+                if lock is motor.lock:
+                    members.append(binding)
+                    break
+            else:
+                self._groups.append((motor.lock, [binding]))
+            position = link.motor_deg(math.degrees(target_rad))
         with motor.lock:
             motor.set_state(position, 0.0, 0.0, False)
             motor.table.set_si("goal_position", position)
@@ -119,7 +122,7 @@ class Simulation:
             self.data.qvel[self.model.jnt_dofadr[index]] = 0.0
             for binding in self._bindings:
                 if binding.link.joint == joint:
-                    binding.target_rad = math.radians(angle_deg)
+                    self._drive.set_target(binding.index, math.radians(angle_deg))
             mujoco.mj_forward(self.model, self.data)
 
     def joint_deg(self, joint: str) -> float:
@@ -132,65 +135,40 @@ class Simulation:
 
     # ------------------------------------------------------------------ stepping
 
-    def _command(self, binding: _Binding) -> _Command:
-        motor, link = binding.motor, binding.link
-        with motor.lock:
-            low, high = motor.position_limits_deg()
-            goal = min(max(motor.goal_position_deg, low), high)
-            torque = motor.table.get_si("torque_limit") if motor.model.has_torque_limit else None
-            return _Command(
-                torque_on=motor.torque_enabled,
-                goal_rad=math.radians(link.joint_deg(goal)),
-                speed_rps=math.radians(motor.speed_limit_dps),
-                torque_pct=float(torque) if isinstance(torque, (int, float)) else 100.0,
-            )
-
-    def _apply(self, binding: _Binding, command: _Command) -> None:
-        a, model = binding.actuator, self.model
-        limit = binding.stall_nm * min(max(command.torque_pct, 0.0), 100.0) / 100.0
-        model.actuator_forcerange[a] = (-limit, limit)
-        on = command.torque_on
-        model.actuator_gainprm[a][0] = binding.kp if on else 0.0
-        model.actuator_biasprm[a][1] = -binding.kp if on else 0.0
-        model.actuator_biasprm[a][2] = -binding.kv if on else 0.0
-
-    def _state(self, binding: _Binding, command: _Command) -> _State:
-        link = binding.link
-        position = math.degrees(float(self.data.qpos[binding.qpos]))
-        speed = math.degrees(float(self.data.qvel[binding.dof]))
-        force = float(self.data.actuator_force[binding.actuator])
-        # e-manual: present load is a percentage of the maximum (stall) torque
-        load = max(-100.0, min(100.0, 100.0 * force / binding.stall_nm))
-        moving = command.torque_on and (
-            abs(command.goal_rad - binding.target_rad) > 1e-6 or abs(speed) > 2.0
-        )
-        return _State(link.motor_deg(position), link.sign * speed, link.sign * load, moving)
-
     def advance(self, dt_s: float) -> None:
-        """Advance the physics by ``dt_s`` seconds, exchanging commands and states with the
-        motors' tables before and after (never holding a motor lock and the world lock at once).
+        """Advance the physics by ``dt_s`` seconds, exchanging with the motors' tables: commands
+        read before, sensed state written after when ``STATE_PERIOD_S`` of simulated time has
+        passed since the last write (never holding a motor lock and the world lock at once).
+
+        Whole timesteps are stepped; the remainder is carried to the next call, so the
+        simulated time tracks the sum of the ``dt_s`` asked for.
         """
-        commands = [self._command(b) for b in self._bindings]
+        indexes, commands = [], []
+        for lock, members in self._groups:
+            with lock:
+                for binding in members:
+                    command = binding.port.read_command()
+                    if command is not None:
+                        indexes.append(binding.index)
+                        commands.append(command)
         with self._lock:
+            drive = self._drive
+            drive.command(indexes, commands, self.data)
+            drive.apply(self.model)
             timestep = float(self.model.opt.timestep)
-            steps = max(1, round(dt_s / timestep))
-            for binding, command in zip(self._bindings, commands, strict=True):
-                self._apply(binding, command)
-            for _ in range(steps):
-                for binding, command in zip(self._bindings, commands, strict=True):
-                    if command.torque_on:
-                        delta = command.goal_rad - binding.target_rad
-                        step = command.speed_rps * timestep
-                        binding.target_rad += max(-step, min(step, delta))
-                    else:
-                        binding.target_rad = float(self.data.qpos[binding.qpos])
-                    self.data.ctrl[binding.actuator] = binding.target_rad
-                mujoco.mj_step(self.model, self.data)
-            states = [self._state(b, c) for b, c in zip(self._bindings, commands, strict=True)]
-        for binding, state in zip(self._bindings, states, strict=True):
-            binding.motor.set_state(
-                state.position_deg, state.speed_dps, state.load_pct, state.moving
-            )
+            self._carry_s += dt_s
+            steps = max(0, math.floor(self._carry_s / timestep + 1e-6))
+            self._carry_s -= steps * timestep
+            drive.step(self.model, self.data, steps)
+            self._state_age_s += dt_s
+            if self._state_age_s < STATE_PERIOD_S - 1e-9:
+                return
+            self._state_age_s = 0.0
+            states = drive.sense(self.data)
+        for lock, members in self._groups:
+            with lock:
+                for binding in members:
+                    binding.port.write_state(states[binding.index])
 
     # ------------------------------------------------------------------ thread
 
@@ -240,9 +218,11 @@ class Simulation:
         with self._lock:
             mujoco.mj_resetData(self.model, self.data)
             mujoco.mj_forward(self.model, self.data)
+            poses = []
             for binding in self._bindings:
-                binding.target_rad = float(self.data.qpos[binding.qpos])
-            poses = [(b, b.link.motor_deg(math.degrees(b.target_rad))) for b in self._bindings]
+                target_rad = float(self.data.qpos[self._drive.qpos[binding.index]])
+                self._drive.set_target(binding.index, target_rad)
+                poses.append((binding, binding.link.motor_deg(math.degrees(target_rad))))
         for binding, position in poses:
             with binding.motor.lock:
                 binding.motor.table.set_si("goal_position", position)
@@ -325,7 +305,8 @@ class Simulation:
             self.model, self.data = model, data
             self._objects.specs = specs
             for binding in self._bindings:
-                self._resolve(binding)
+                self._drive.relocate(binding.index, *self._resolve(binding.link.joint))
+            self._drive.invalidate()
             for renderer in self._renderers.values():
                 renderer.close()
             self._renderers.clear()

@@ -150,10 +150,11 @@ def test_render_move_gif(tmp_path: Path) -> None:
                   "-o", str(out)))  # fmt: skip
     with Image.open(out) as gif:
         assert gif.size == (96, 72)
-        assert gif.n_frames >= 15  # 1 s at 15 fps, plus the first pose
+        count = int(getattr(gif, "n_frames", 1))
+        assert count >= 15  # 1 s at 15 fps, plus the first pose
         gif.seek(0)
         first = gif.convert("L").tobytes()
-        gif.seek(gif.n_frames - 1)
+        gif.seek(count - 1)
         last = gif.convert("L").tobytes()
     assert first != last  # the arm moved
 
