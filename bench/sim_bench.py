@@ -188,12 +188,13 @@ def sim_benchmark(ctx: BenchContext) -> BenchResult:
             ),
         ],
         notes=[
-            "Where the plant's time goes (cProfile, Humanoid): reading each motor's command "
-            "from its control table and writing its state back (`table.get_si`/`set_si`, "
-            "register encode/decode) every 5 ms costs several times the physics itself; the "
-            "`bare mj_step` column is the ceiling a cheaper exchange would approach.",
+            "Where the plant's time goes (cProfile, Humanoid): `mj_step` is the largest cost; "
+            "the rest is writing the sensed state to the control tables (every 10 ms of "
+            "simulated time) and this benchmark's own goal writes. The `bare mj_step` column is "
+            "the ceiling.",
             "The plant's cost is MuJoCo's step (2 ms timestep, implicitfast) plus the exchange "
-            "with the virtual motors' control tables every 5 ms. In the full stack the physics "
+            "with the virtual motors' control tables (commands read every 5 ms, state written "
+            "every 10 ms of simulated time). In the full stack the physics "
             "thread shares the interpreter with the emulator and the sync loops "
             f"({cores} cores here); it never tries to catch up more than 100 ms at once, so a "
             "ratio under 1 means simulated time fell behind wall time.",
