@@ -9,7 +9,14 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, robot_config
+from poppy_cli.commands.robot import (
+    ConfigOpt,
+    PortOpt,
+    ProfileOpt,
+    RemoteOpt,
+    SimOpt,
+    robot_config,
+)
 from poppy_cli.output import console, err_console, print_json
 
 if TYPE_CHECKING:
@@ -26,11 +33,18 @@ def play(
     port: str | None = PortOpt,
     sim: str | None = SimOpt,
     json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+    remote: str | None = RemoteOpt,
 ) -> None:
     """Play a move: a gentle ramp to its first frame, then the frames at the chosen speed.
 
-    The motors of the move turn stiff. Ctrl-C stops where the motors are.
+    The motors of the move turn stiff. Ctrl-C stops where the motors are. With --remote, NAME
+    is a move of the server's library.
     """
+    if remote:
+        from poppy_cli.commands.remote_runs import play_remote
+
+        play_remote(remote, name, speed, reverse, loop, json_output)
+        return
     from poppy_core.errors import ConfigError
     from poppy_core.motion import MovePlayer, load_move, move_path
     from poppy_core.robot import from_config

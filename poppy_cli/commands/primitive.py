@@ -8,7 +8,15 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import ConfigOpt, JsonOpt, PortOpt, ProfileOpt, SimOpt, build_robot
+from poppy_cli.commands.robot import (
+    ConfigOpt,
+    JsonOpt,
+    PortOpt,
+    ProfileOpt,
+    RemoteOpt,
+    SimOpt,
+    build_robot,
+)
 from poppy_cli.output import EXIT_FAILURE, console, error_line, print_json
 
 if TYPE_CHECKING:
@@ -86,8 +94,14 @@ def list_primitives(
     port: str | None = PortOpt,
     sim: str | None = SimOpt,
     json_output: bool = JsonOpt,
+    remote: str | None = RemoteOpt,
 ) -> None:
     """List the primitives of a robot with their state, properties and last error."""
+    if remote:
+        from poppy_cli.commands.remote_runs import list_remote
+
+        list_remote(remote, json_output)
+        return
     with build_robot(profile, config_file, port, sim) as robot:
         primitives = robot_primitives(robot)
         if json_output:
@@ -142,12 +156,18 @@ def run(
     port: str | None = PortOpt,
     sim: str | None = SimOpt,
     json_output: bool = JsonOpt,
+    remote: str | None = RemoteOpt,
 ) -> None:
     """Start a primitive, show its state live, stop it after --duration or on Ctrl-C.
 
     Exits with 1 and the error's line when the primitive fails.
     """
     pairs = _settings(settings or [])
+    if remote:
+        from poppy_cli.commands.remote_runs import run_remote
+
+        run_remote(remote, name, duration, pairs, stiff, json_output)
+        return
     _quiet_tracebacks()
     with build_robot(profile, config_file, port, sim) as robot:
         key, primitive = _find(robot_primitives(robot), name)

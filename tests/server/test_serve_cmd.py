@@ -102,3 +102,43 @@ def test_robot_commands_with_remote(served: Any) -> None:
     assert bad.returncode == 1 and "m9" in bad.stderr
     _poppy("robot", "compliant", "on", "--remote", served.url)
     assert served.robot.compliant is True
+
+
+def test_primitive_and_play_with_remote(served: Any) -> None:
+    from poppy_core.motion import Move, save_move
+
+    listed = _poppy("primitive", "list", "--remote", served.url, "--json")
+    assert listed.returncode == 0, listed.stderr
+    assert "sinus" in json.loads(listed.stdout)
+
+    ran = _poppy(
+        "primitive",
+        "run",
+        "sinus",
+        "--duration",
+        "0.5",
+        "--set",
+        "amplitude=10",
+        "--remote",
+        served.url,
+        "--json",
+    )
+    assert ran.returncode == 0, ran.stderr
+    report = json.loads(ran.stdout)
+    assert report["state"] == "stopped" and report["properties"]["amplitude"] == 10
+    assert served.robot.sinus.is_alive() is False
+
+    missing = _poppy("primitive", "run", "nope", "--remote", served.url)
+    assert missing.returncode == 1 and "nope" in missing.stderr
+
+    # the server's library is POPPY_MOVES_DIR (the module's moves folder, shared by env)
+    frames = [{"m1": 10.0 * i / 24} for i in range(25)]
+    save_move(Move.from_frames(50.0, frames), "remote_wave")
+    played = _poppy("play", "remote_wave", "--speed", "2", "--remote", served.url, "--json")
+    assert played.returncode == 0, played.stderr
+    summary = json.loads(played.stdout)
+    assert summary["interrupted"] is False and summary["name"] == "remote_wave"
+    assert served.robot.m1.goal_position == pytest.approx(10, abs=1)
+
+    unknown = _poppy("play", "no_such_move", "--remote", served.url)
+    assert unknown.returncode == 1 and "no_such_move" in unknown.stderr
