@@ -2,13 +2,19 @@
 
 Both servers run in their own process on 127.0.0.1 over a virtual Ergo Jr (poppy: ``poppy
 serve --http --sim``; pypot: ``PoppyErgoJr(simulator="dummy", use_http=True)``). The load comes
-from ``CLIENTS`` threads of this process, each with one keep-alive ``http.client`` connection.
+from wrk (a C load generator, one thread, ``CLIENTS`` keep-alive connections) when it is
+installed (Debian package ``wrk``; ``bench/setup_peers.sh`` installs it when run as root), else
+from ``CLIENTS`` threads of this process, each with one keep-alive ``http.client`` connection —
+a Python client whose own cost caps the rate it can measure (about 9,000 requests/s here).
 """
 
 from __future__ import annotations
 
 import http.client
 import json
+import math
+import os
+import shutil
 import socket
 import subprocess
 import threading
@@ -140,6 +146,61 @@ def _load(port: int, method: str, path: str, body: bytes | None) -> dict[str, An
     }
 
 
+WRK_SCRIPT = """
+wrk.method = "{method}"
+wrk.headers["Content-Type"] = "application/json"
+{body}
+"""
+_UNITS = {"us": 1e-6, "ms": 1e-3, "s": 1.0, "m": 60.0}
+
+
+def _seconds(text: str) -> float:
+    number = text.rstrip("usm")
+    return float(number) * _UNITS[text[len(number) :]]
+
+
+def _load_wrk(wrk: str, port: int, method: str, path: str, body: bytes | None) -> dict[str, Any]:
+    """Load with wrk (a C load generator: one thread, CLIENTS keep-alive connections)."""
+    import tempfile
+
+    lua_body = f"wrk.body = {json.dumps(body.decode())}" if body else ""
+    with tempfile.NamedTemporaryFile("w", suffix=".lua", delete=False) as script:
+        script.write(WRK_SCRIPT.format(method=method, body=lua_body))
+    try:
+        out = subprocess.run(
+            [
+                wrk,
+                "-t1",
+                f"-c{CLIENTS}",
+                f"-d{math.ceil(DURATION_S)}s",  # wrk takes whole seconds
+                "--latency",
+                "-s",
+                script.name,
+                f"http://127.0.0.1:{port}{path}",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=DURATION_S + 30,
+            check=True,
+        ).stdout
+    finally:
+        os.unlink(script.name)
+    result: dict[str, Any] = {"errors": 0, "client": "wrk"}
+    for line in out.splitlines():
+        words = line.split()
+        if line.startswith("Requests/sec:"):
+            result["rps"] = float(words[1])
+        elif len(words) == 2 and words[0] in ("50%", "99%"):
+            result["p50_s" if words[0] == "50%" else "p99_s"] = _seconds(words[1])
+        elif "requests in" in line:
+            result["requests"] = int(words[0])
+        elif line.strip().startswith("Non-2xx or 3xx responses:"):
+            result["errors"] += int(words[-1])
+        elif line.strip().startswith("Socket errors:"):
+            result["errors"] += sum(int(w.rstrip(",")) for w in words if w.rstrip(",").isdigit())
+    return result
+
+
 def _goto_loop(port: int, stop: threading.Event) -> None:
     body = json.dumps({"motors": ["m2"], "positions": [20], "duration": GOTO_S, "wait": True})
     conn = http.client.HTTPConnection("127.0.0.1", port, timeout=GOTO_S + REQUEST_TIMEOUT_S)
@@ -155,6 +216,7 @@ def _goto_loop(port: int, stop: threading.Event) -> None:
 
 def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
     out: dict[str, Any] = {}
+    wrk = shutil.which("wrk")
     with _server(kind, ctx) as port:
         for name, (method, path, body) in SCENARIOS.items():
             runs = []
@@ -166,7 +228,10 @@ def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
                     mover.start()
                     time.sleep(0.1)
                 try:
-                    runs.append(_load(port, method, path, body))
+                    if wrk is not None:
+                        runs.append(_load_wrk(wrk, port, method, path, body))
+                    else:
+                        runs.append(_load(port, method, path, body))
                 finally:
                     stop.set()
                     if mover is not None:
@@ -227,10 +292,18 @@ def server_bench(ctx: BenchContext) -> BenchResult:
         row += [f"{ratio:.1f}x", "pass" if met else "**FAIL**"]
     headers += ["poppy / pypot", f">= {GOAL_RATIO:g}x, lower p99"]
     notes.append(
-        f"{CLIENTS} client threads with keep-alive connections for {DURATION_S} s per run, "
+        (
+            f"Load: wrk, one thread, {CLIENTS} keep-alive connections"
+            if shutil.which("wrk")
+            else f"Load: {CLIENTS} Python client threads with keep-alive connections (install "
+            "wrk for a client that does not cap the rate)"
+        )
+        + f", {math.ceil(DURATION_S) if shutil.which('wrk') else DURATION_S} s per run, "
         f"median of {ctx.repeat} runs (by req/s). The wait-goto scenario keeps a "
         f'`"wait": true` goto of {GOTO_S} s running on /motors/goto.json while measuring; '
-        "pypot's tornado server answers nothing until each such goto ends."
+        "pypot's tornado server answers nothing until each such goto ends. poppy rebuilds "
+        "its `/robot.json` at most every 10 ms (the motors' values come from 50 Hz sync "
+        "loops, so a 10 ms-old description says the same); pypot rebuilds it per request."
     )
     return BenchResult(
         name="server",

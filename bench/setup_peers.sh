@@ -66,6 +66,16 @@ fi
 if [[ "$rest" == "yes" ]]; then
     echo "$STAMP_TEXT" >"$STAMP"
 fi
+# wrk (Debian) loads the REST benchmark; without it a Python client caps what can be measured.
+if ! command -v wrk >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1; then
+    if [[ "$(id -u)" == 0 ]]; then
+        { apt-get update -qq && apt-get install -y -qq wrk; } >>"$LOG" 2>&1 \
+            || echo "setup_peers: could not install wrk (see $LOG)" >&2
+    else
+        echo "setup_peers: install wrk for the REST benchmark: sudo apt-get install wrk" >&2
+    fi
+fi
+
 versions="$("$VENV/bin/python" -c 'from importlib.metadata import version as v
 print(" ".join(f"{p}={v(p)}" for p in ("pypot", "dynamixel-sdk", "poppy-ergo-jr")))')"
 echo "setup_peers: $VENV ready ($versions, rest=$rest)"

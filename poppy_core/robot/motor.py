@@ -13,6 +13,7 @@ value and mark it for the next write cycle (``take_pending``).
 
 from __future__ import annotations
 
+import functools
 import logging
 from typing import TYPE_CHECKING, Literal
 
@@ -331,6 +332,10 @@ class Motor(MotorCache):
     @property
     def registers(self) -> list[str]:
         """The attribute names this motor offers (they depend on the model)."""
+        return list(self._register_names)
+
+    @functools.cached_property
+    def _register_names(self) -> tuple[str, ...]:
         names = [
             "id", "name", "model", "orientation", "offset", "angle_limit",
             "present_position", "present_speed", "present_load",
@@ -344,7 +349,7 @@ class Motor(MotorCache):
             names.append("pid")
         if regs.has_compliance_slopes(self.model):
             names += ["compliance_margin", "compliance_slope"]
-        return names
+        return tuple(names)
 
     def attach_runner(self, runner: GotoRunner) -> None:
         """Use the robot's goto runner (the private one is dropped)."""

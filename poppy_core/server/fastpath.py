@@ -34,7 +34,7 @@ class RegisterFastPath:
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] == "http" and scope["path"] == "/robot.json" and scope["method"] == "GET":
-            await _answer(send, 200, self.service.description())
+            await _send(send, 200, self.service.description_json())
             return
         match = REGISTER_VALUE.match(scope["path"]) if scope["type"] == "http" else None
         if match is None or scope["method"] not in ("GET", "POST"):
@@ -63,7 +63,10 @@ class RegisterFastPath:
 
 
 async def _answer(send: Send, status: int, data: dict[str, Any]) -> None:
-    body = json.dumps(data).encode()
+    await _send(send, status, json.dumps(data).encode())
+
+
+async def _send(send: Send, status: int, body: bytes) -> None:
     headers = [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())]
     await send({"type": "http.response.start", "status": status, "headers": headers})
     await send({"type": "http.response.body", "body": body})

@@ -6,8 +6,10 @@ those from the thread pool. Gotos never block here: the caller awaits the return
 
 from __future__ import annotations
 
+import json
 import logging
 import math
+import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -16,6 +18,8 @@ from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
+
+DESCRIPTION_TTL_S = 0.01
 
 logger = logging.getLogger(__name__)
 
@@ -40,14 +44,16 @@ class RobotService:
         if builtins:
             attach_builtins(robot)
         self.moves = MoveService(robot)
+        self._by_name = {m.name: m for m in robot.motors}
+        self._description: tuple[float, bytes] | None = None
 
     # -- motors and groups ---------------------------------------------------------------------
 
     def motor(self, name: str) -> Motor:
         """The motor ``name``, or ``ApiError("not_found")``."""
-        for motor in self.robot.motors:
-            if motor.name == name:
-                return motor
+        motor = self._by_name.get(name)
+        if motor is not None:
+            return motor
         known = ", ".join(m.name for m in self.robot.motors)
         raise ApiError("not_found", f"no motor {name!r} (motors: {known})", tip=MOTOR_TIP)
 
@@ -138,6 +144,17 @@ class RobotService:
     def primitives(self) -> dict[str, Primitive]:
         """Name -> every attached primitive."""
         return attached_primitives(self.robot)
+
+    def description_json(self) -> bytes:
+        """``description()`` encoded, rebuilt at most every ``DESCRIPTION_TTL_S``.
+
+        The motors' values come from caches the sync loops refresh at 50 Hz, so a description
+        up to 10 ms old says the same; pollers asking many times a second share one encoding.
+        """
+        now = time.monotonic()
+        if self._description is None or now - self._description[0] > DESCRIPTION_TTL_S:
+            self._description = (now, json.dumps(self.description()).encode())
+        return self._description[1]
 
     def description(self) -> dict[str, Any]:
         """pypot's ``/robot.json``: every motor's registers and every primitive."""
