@@ -80,10 +80,7 @@ class ControlTable:
 
     def find(self, name: str) -> Register | None:
         """Return the register called ``name`` (or an alias of it), None when the model lacks it."""
-        try:
-            return self.model.register(name)
-        except RegisterError:
-            return None
+        return self.model.find_register(name)
 
     def get(self, name: str, default: int = 0) -> int:
         """Raw value of register ``name`` (``default`` when the model does not have it)."""

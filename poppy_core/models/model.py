@@ -127,13 +127,21 @@ class ServoModel:
         """True when ``name`` is a register or an alias of this model."""
         return name in self.registers or name in self.aliases
 
+    def find_register(self, name: str) -> Register | None:
+        """The register called ``name`` (or reached through an alias), None when there is none.
+
+        For hot paths that look up names the model may lack (the emulator's firmware); use
+        ``register`` where an unknown name is the caller's mistake.
+        """
+        return self.registers.get(self.aliases.get(name, name))
+
     def register(self, name: str) -> Register:
         """Return the register called ``name`` (or reached through an alias).
 
         Raises:
             RegisterError: unknown name; the message lists the closest names.
         """
-        found = self.registers.get(self.aliases.get(name, name))
+        found = self.find_register(name)
         if found is not None:
             return found
         candidates = [*self.registers, *self.aliases]

@@ -190,3 +190,13 @@ def test_protocol1_standard_rates_map_to_codes(bps: int) -> None:
     for model in ALL_MODELS:
         if model.protocol == 1:
             assert model.baudrate_bps(model.baudrate_code(bps)) == bps
+
+
+def test_find_register_resolves_aliases_and_returns_none_for_unknown_names() -> None:
+    from poppy_core.models import model_by_name
+
+    mx = model_by_name("MX-28")
+    assert mx.find_register("min_position_limit") is mx.register("cw_angle_limit")
+    assert mx.find_register("goal_velocity") is None  # an X-series name: no error, no search
+    xl = model_by_name("XL430-W250")
+    assert xl.find_register("present_speed") is xl.register("present_velocity")
