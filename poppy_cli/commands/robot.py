@@ -104,7 +104,8 @@ def build_robot(
     from poppy_core.creatures import from_config
 
     return from_config(
-        robot_config(profile, config_file, port), sim=sim or False,
+        robot_config(profile, config_file, port),
+        sim=sim or False,
         fix_return_delay=ask_return_delay,
     )
 
