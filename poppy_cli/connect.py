@@ -12,45 +12,16 @@ if TYPE_CHECKING:
     from poppy_core.bus.results import PingResult
 
 
-def locate(port: str, ids: list[int], baud: int | None, protocol: int | None) -> tuple[int, int]:
-    """Find the (baudrate, protocol) where the first of ``ids`` answers on ``port``.
-
-    1 Mbps is tried first in each protocol, then the other standard rates.
-
-    Raises:
-        SetupError: no motor with those IDs answers at any rate tried.
-    """
-    from poppy_core.bus.scan import scan
-    from poppy_core.errors import SetupError
-    from poppy_core.models import standard_baudrates
-
-    protocols = [protocol] if protocol else [2, 1]
-    for proto in protocols:
-        rates = (
-            [baud]
-            if baud
-            else sorted(standard_baudrates(proto), key=lambda r: (r != 1_000_000, -r))
-        )
-        for rate in rates:
-            found = scan(port, [rate], [proto], ids, broadcast=False)
-            if found:
-                return found[0].baudrate, found[0].protocol
-    tried_proto = "protocol " + " and ".join(map(str, protocols))
-    tried_rate = f"{baud} bps" if baud else "every standard baud rate"
-    id_text = ", ".join(map(str, ids))
-    raise SetupError(
-        f"no motor with ID {id_text} answers on {port} ({tried_proto}, {tried_rate}): "
-        "check power and wiring, or run `poppy scan --all-bauds`"
-    )
-
-
 @contextmanager
 def open_bus(port: str, ids: list[int], baud: int | None, protocol: int | None) -> Iterator[DxlBus]:
     """Open a ``DxlBus`` where ``ids`` answer (searching when baud or protocol is unknown)."""
     from poppy_core.bus.dxlbus import DxlBus
+    from poppy_core.bus.scan import find_port
 
     if baud is None or protocol is None:
-        baud, protocol = locate(port, ids, baud, protocol)
+        _, baud, protocol = find_port(
+            ids, [port], None if baud is None else [baud], [protocol] if protocol else (1, 2)
+        )
     bus = DxlBus(port, baud, protocol)
     try:
         yield bus

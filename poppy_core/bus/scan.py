@@ -34,6 +34,7 @@ from poppy_core.models import standard_baudrates
 logger = logging.getLogger(__name__)
 
 SCAN_IDS = range(254)
+DEFAULT_SEARCH_FIRST_BPS = 1_000_000
 PROTOCOLS = (1, 2)
 
 
@@ -245,6 +246,7 @@ def find_port(
         SetupError: no port/rate/protocol answers for every ID (the message says the closest).
     """
     wanted = list(ids)
+    protocols = list(protocols)
     fixed = None if baudrates is None else list(baudrates)
     port_list = list(ports) if ports is not None else [p.device for p in list_ports()]
     if not port_list:
@@ -258,7 +260,11 @@ def find_port(
             continue
         try:
             for protocol in protocols:
-                rates = fixed if fixed is not None else list(standard_baudrates(protocol))
+                # 1 Mbps first: the rate of Poppy robots and of most set-up buses
+                rates = sorted(
+                    fixed if fixed is not None else standard_baudrates(protocol),
+                    key=lambda rate: rate != DEFAULT_SEARCH_FIRST_BPS,
+                )
                 for rate in rates:
                     bus = DxlBus(port, rate, protocol, latency_s=latency_s, transport=transport)
                     answered = [i for i in wanted if _ping(bus, i, retries=1) is not None]
@@ -272,8 +278,11 @@ def find_port(
                         )
         finally:
             transport.close()
-    closest = f"; closest: {best[1]}" if best[0] else "; none of them answered anywhere"
+    closest = f"; closest: {best[1]}" if best[0] else ""
+    rates_text = "every standard rate" if fixed is None else ", ".join(f"{r} bps" for r in fixed)
+    protocols_text = " and ".join(str(p) for p in protocols)
     raise SetupError(
-        f"no port holds motors {', '.join(map(str, wanted))} "
-        f"(searched {', '.join(port_list)}){closest}"
+        f"no motor {', '.join(map(str, wanted))} answers (searched {', '.join(port_list)} at "
+        f"{rates_text}, protocol {protocols_text}){closest}: check power and wiring, "
+        "or run `poppy scan --all-bauds`"
     )
