@@ -15,33 +15,6 @@ if TYPE_CHECKING:
     from poppy_core.emulator import VirtualBus
 
 
-def profile_buses(name: str, baud: int | None, **options: object) -> list[tuple[str, VirtualBus]]:
-    """One virtual bus per controller of a robot profile, with the profile's motors on it."""
-    from poppy_core.emulator import build_bus_from_spec
-    from poppy_core.robot.profiles import load_profile
-
-    config = load_profile(name)
-    buses = []
-    for controller_name, controller in config.controllers.items():
-        motors = config.motors_of_controller(controller_name)
-        # Poppy's protocol-1 robots read through a USB2AX, whose SYNC_READ their configs enable.
-        adapter = "usb2ax" if controller.protocol == 1 and controller.sync_read else "u2d2"
-        bus_options = {"adapter": adapter, **options}
-        spec = ",".join(f"{config.motors[m].type}:{config.motors[m].id}" for m in motors)
-        buses.append(
-            (
-                controller_name,
-                build_bus_from_spec(
-                    spec,
-                    protocol=controller.protocol,
-                    baudrate=baud or controller.baudrate,
-                    **bus_options,  # type: ignore[arg-type]
-                ),
-            )
-        )
-    return buses
-
-
 def parse_hostport(text: str) -> tuple[str, int]:
     """Parse HOST:PORT (PORT 0 picks a free port)."""
     host, sep, port_text = text.rpartition(":")
@@ -85,23 +58,27 @@ def emulate(
         error_line("give either --pty or --tcp, not both")
         raise typer.Exit(EXIT_USAGE)
     options: dict[str, object] = {"wire_timing": wire_timing, "latency_s": latency_ms / 1000.0}
-    if usb2ax:
-        options["adapter"] = "usb2ax"
+    buses: list[tuple[str, VirtualBus]]
     if profile is not None:
-        buses = profile_buses(profile, baud, **options)
+        from poppy_core.robot.factory import virtual_buses
+        from poppy_core.robot.profiles import load_profile
+
+        config = load_profile(profile)
+        # motors as they come from the factory (return delay 500 µs), as on a new robot
+        found = virtual_buses(
+            config, baudrate=baud, set_up=False, adapter="usb2ax" if usb2ax else None, **options
+        )
+        buses = list(found.items())
         if protocol is not None and any(b.protocol != protocol for _, b in buses):
             error_line(f"profile {profile} speaks protocol {buses[0][1].protocol}, not {protocol}")
             raise typer.Exit(EXIT_USAGE)
     else:
         assert motors is not None
-        buses = [
-            (
-                "bus",
-                build_bus_from_spec(
-                    motors, protocol=protocol, baudrate=baud or 1_000_000, **options
-                ),
-            )  # type: ignore[arg-type]
-        ]
+        adapter = "usb2ax" if usb2ax else "u2d2"
+        bus = build_bus_from_spec(
+            motors, protocol=protocol, baudrate=baud or 1_000_000, adapter=adapter, **options
+        )
+        buses = [("bus", bus)]
     hostport = parse_hostport(tcp) if tcp else None
     # Handlers go in before the URL is printed: a client may stop us as soon as it reads it.
     stop = threading.Event()

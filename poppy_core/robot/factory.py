@@ -73,33 +73,57 @@ def _mujoco_plant(config: RobotConfig, controller: str, simulation: Any) -> Plan
     return MujocoPlant(simulation, links)
 
 
+def virtual_buses(
+    config: RobotConfig,
+    simulation: Any = None,
+    *,
+    baudrate: int | None = None,
+    set_up: bool = True,
+    adapter: Adapter | None = None,
+    **bus_options: Any,
+) -> dict[str, VirtualBus]:
+    """One virtual bus per controller with the configured models and IDs: name -> ``VirtualBus``.
+
+    Args:
+        config: the robot.
+        simulation: a MuJoCo world (``start_simulation``): each bus gets a plant view on it.
+        baudrate: every motor's rate (None: each controller's configured rate).
+        set_up: motors already set up for poppy (return delay 0); False keeps the factory value.
+        adapter: the virtual adapter; None gives protocol 1 controllers with ``sync_read`` a
+            USB2AX (their configs expect its SYNC_READ) and the others a U2D2.
+        **bus_options: passed to ``VirtualBus`` (``wire_timing``, ``latency_s``...).
+    """
+    buses: dict[str, VirtualBus] = {}
+    for name, controller in config.controllers.items():
+        rate = baudrate or controller.baudrate
+        motors = []
+        for motor_name in config.motors_of_controller(name):
+            entry = config.motors[motor_name]
+            virtual = VirtualMotor(model_by_name(entry.type), entry.id, rate)
+            if set_up:
+                virtual.table.set("return_delay_time", 0)
+            motors.append(virtual)
+        usb2ax = controller.protocol == 1 and controller.sync_read
+        plant = None if simulation is None else _mujoco_plant(config, name, simulation)
+        buses[name] = VirtualBus(
+            motors,
+            controller.protocol,
+            baudrate=rate,
+            adapter=adapter or ("usb2ax" if usb2ax else "u2d2"),
+            plant=plant,
+            **bus_options,
+        )
+    return buses
+
+
 def start_emulators(config: RobotConfig, simulation: Any = None) -> dict[str, Any]:
     """One emulator per controller, served on a pty: controller name -> ``EmulatorServer``.
 
-    The virtual motors have the configured models, IDs and baud rate, and a return delay of 0
-    (a robot already set up). Protocol 1 controllers with ``sync_read`` get a USB2AX adapter.
-    With a ``simulation`` (``start_simulation``), each bus gets a MuJoCo plant view on it.
+    The buses are ``virtual_buses(config, simulation)``: motors already set up (return delay 0).
     """
     servers: dict[str, Any] = {}
     try:
-        for name, controller in config.controllers.items():
-            motors = []
-            for motor_name in config.motors_of_controller(name):
-                entry = config.motors[motor_name]
-                virtual = VirtualMotor(model_by_name(entry.type), entry.id, controller.baudrate)
-                virtual.table.set("return_delay_time", 0)
-                motors.append(virtual)
-            adapter: Adapter = (
-                "usb2ax" if controller.protocol == 1 and controller.sync_read else "u2d2"
-            )
-            plant = None if simulation is None else _mujoco_plant(config, name, simulation)
-            bus = VirtualBus(
-                motors,
-                controller.protocol,
-                baudrate=controller.baudrate,
-                adapter=adapter,
-                plant=plant,
-            )
+        for name, bus in virtual_buses(config, simulation).items():
             servers[name] = serve_pty(bus)
     except BaseException:
         for server in servers.values():
