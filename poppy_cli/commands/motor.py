@@ -35,30 +35,11 @@ def require_port(port: str | None) -> str:
 
 def parse_value(register: Register, text: str) -> object:
     """Turn command-line text into the SI value ``register.from_si`` expects."""
-    from poppy_core.models.register import Boolean, Choice
+    from poppy_core.models.register import Choice
 
-    conversion = register.conversion
-    lowered = text.strip().lower()
-    if isinstance(conversion, Boolean):
-        if lowered in ("on", "true", "1", "yes"):
-            return True
-        if lowered in ("off", "false", "0", "no"):
-            return False
-        raise typer.BadParameter(f"{register.name} takes on or off, not {text!r}")
-    if isinstance(conversion, Choice):
-        if register.name == "led" and lowered == "on":
-            return "white"  # the XL-320 LED takes a colour; "on" means all three LEDs
-        try:
-            return int(lowered)
-        except ValueError:
-            return lowered
-    try:
-        number = float(text)
-    except ValueError:
-        raise typer.BadParameter(
-            f"{register.name} takes a number in {register.unit or 'raw units'}, not {text!r}"
-        ) from None
-    return int(number) if number.is_integer() else number
+    if register.name == "led" and isinstance(register.conversion, Choice) and text.strip() == "on":
+        return "white"  # the XL-320 LED takes a colour; "on" means all three LEDs
+    return register.parse(text)
 
 
 def print_setup(result: SetupResult, json_output: bool) -> None:

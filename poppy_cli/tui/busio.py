@@ -196,25 +196,6 @@ def parse_si(register: Register, text: str) -> SIValue:
     Raises:
         RegisterError: the text is not a value this register accepts (the message says why).
     """
-    from poppy_core.models.register import Boolean, Choice
-
-    lowered = text.strip().lower()
-    value: SIValue
-    if isinstance(register.conversion, Boolean):
-        if lowered in ("on", "true", "1", "yes"):
-            value = True
-        elif lowered in ("off", "false", "0", "no"):
-            value = False
-        else:
-            raise RegisterError(f"{register.name} takes on or off, not {text!r}")
-    elif isinstance(register.conversion, Choice):
-        value = int(lowered) if lowered.isdigit() else lowered
-    else:
-        try:
-            number = float(lowered)
-        except ValueError:
-            unit = register.unit or "raw units"
-            raise RegisterError(f"{register.name} takes a number in {unit}, not {text!r}") from None
-        value = int(number) if number.is_integer() else number
+    value = register.parse(text)
     register.from_si(value)
     return value

@@ -318,6 +318,33 @@ class Register:
             )
         return raw
 
+    def parse(self, text: str) -> SIValue:
+        """Turn typed text (a command line, a form field) into the SI value ``from_si`` takes.
+
+        ``on``/``off`` (or true/false, 1/0, yes/no) for on/off registers, a name or a number for
+        choices (XL-320 LED colours), a number otherwise. The range is not checked here.
+
+        Raises:
+            RegisterError: text that is not a value of this kind (the message says what is).
+        """
+        lowered = text.strip().lower()
+        if isinstance(self.conversion, Boolean):
+            if lowered in ("on", "true", "1", "yes"):
+                return True
+            if lowered in ("off", "false", "0", "no"):
+                return False
+            raise RegisterError(f"{self.name} takes on or off, not {text!r}", register=self.name)
+        if isinstance(self.conversion, Choice):
+            return int(lowered) if lowered.isdigit() else lowered
+        try:
+            number = float(lowered)
+        except ValueError:
+            raise RegisterError(
+                f"{self.name} takes a number in {self.unit or 'raw units'}, not {text!r}",
+                register=self.name,
+            ) from None
+        return int(number) if number.is_integer() else number
+
     def decode(self, data: bytes) -> int:
         """Read this register's raw value from its little-endian bytes."""
         if len(data) != self.size:

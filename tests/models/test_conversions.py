@@ -214,3 +214,22 @@ def test_decode_and_encode_bytes() -> None:
         AX_12A.register("goal_position").encode(70000)
     with pytest.raises(RegisterError):
         reg.decode(b"\x00")
+
+
+def test_parse_turns_typed_text_into_si_values() -> None:
+    import pytest
+
+    from poppy_core.errors import RegisterError
+    from poppy_core.models import model_by_name
+
+    mx, xl = model_by_name("MX-28"), model_by_name("XL-320")
+    assert mx.register("torque_enable").parse("on") is True
+    assert mx.register("torque_enable").parse("OFF") is False
+    assert mx.register("goal_position").parse("30") == 30
+    assert mx.register("goal_position").parse("-12.5") == -12.5
+    assert xl.register("led").parse("Green") == "green"
+    assert xl.register("led").parse("2") == 2
+    with pytest.raises(RegisterError, match="takes a number in deg"):
+        mx.register("goal_position").parse("thirty")
+    with pytest.raises(RegisterError, match="on or off"):
+        mx.register("torque_enable").parse("maybe")
