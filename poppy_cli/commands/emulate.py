@@ -18,8 +18,10 @@ if TYPE_CHECKING:
 def parse_hostport(text: str) -> tuple[str, int]:
     """Parse HOST:PORT (PORT 0 picks a free port)."""
     host, sep, port_text = text.rpartition(":")
-    if not sep or not port_text.isdigit():
-        raise typer.BadParameter(f"{text!r} is not HOST:PORT, e.g. 127.0.0.1:4000")
+    if not sep or not port_text.isdigit() or int(port_text) > 65535:
+        raise typer.BadParameter(
+            f"{text!r} is not HOST:PORT with a port in 0-65535, e.g. 127.0.0.1:4000"
+        )
     return host or "127.0.0.1", int(port_text)
 
 

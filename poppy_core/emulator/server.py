@@ -160,7 +160,7 @@ class TcpServer(EmulatorServer):
         listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             listener.bind((host, port))
-        except OSError as exc:
+        except (OSError, OverflowError) as exc:  # OverflowError: a port outside 0-65535
             listener.close()
             address = f"{host}:{port}"
             raise PortError(f"cannot listen on {address}: {exc}", port=address) from exc

@@ -159,3 +159,13 @@ def test_emulator_config_builds_a_bus() -> None:
     assert bus.adapter == "usb2ax" and bus.latency_s == 0.001
     assert [m.baudrate_bps for m in bus.motors] == [57_600, 57_600]
     assert bus.process(b"\xff\xff\xfe\x02\x01\xfe") == b""  # v1 broadcast ping: silence
+
+
+def test_serving_on_a_port_out_of_range_is_a_port_error() -> None:
+    import pytest
+
+    from poppy_core.emulator import build_bus_from_spec, serve_tcp
+    from poppy_core.errors import PortError
+
+    with pytest.raises(PortError, match=r"cannot listen on 127\.0\.0\.1:99999"):
+        serve_tcp(build_bus_from_spec("XL-320:1"), "127.0.0.1", 99999)
