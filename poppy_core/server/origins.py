@@ -295,10 +295,11 @@ class OriginPolicy:
 
     def refused_cross_site(self) -> str:
         """The message for a cross-site request without ``Origin`` that would change the robot."""
+        hint = self.origin_hint.format(origin="ORIGIN")
         message = (
             "refused a request that a page of another site made the browser send (a link or an "
-            "image pointing at a route that changes the robot); send it with fetch() from an "
-            f"origin allowed by {self.origin_hint.format(origin='ORIGIN')}"
+            "image pointing at a route that changes the robot): to let a page do that, make it "
+            f"use fetch() and {hint}"
         )
         self._report("cross-site", message)
         return message
@@ -315,8 +316,8 @@ class OriginPolicy:
         return message
 
     def _report(self, key: str, message: str) -> None:
-        logger.info("%s", message)
         if key in self._reported or len(self._reported) >= MAX_REPORTED:
+            logger.debug("%s", message)
             return
         self._reported.add(key)
         self.report(message)
