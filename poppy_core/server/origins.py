@@ -45,6 +45,7 @@ MAX_REPORTED = 64
 MAX_CACHED = 256
 
 SAFE_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
+PORT = re.compile(r"[0-9]{1,5}")
 PYPOT_CONTROL_GET = re.compile(r"^/primitives/[^/]+/(start|stop|pause|resume)\.json$")
 """pypot's GET routes that change the robot (they start and stop primitives)."""
 
@@ -114,14 +115,14 @@ def split_host(value: str) -> tuple[str, int | None]:
     """``"[::1]:8080"`` -> ``("::1", 8080)``; ``"Localhost"`` -> ``("localhost", None)``."""
     value = value.strip().lower()
     port: int | None = None
-    if value.startswith("["):
-        end = value.find("]")
+    if value.startswith("[") and "]" in value:
+        end = value.index("]")
         name, rest = value[1:end], value[end + 1 :]
-        if rest.startswith(":") and rest[1:].isdigit():
+        if PORT.fullmatch(rest[1:]) and rest.startswith(":"):
             port = int(rest[1:])
     elif value.count(":") == 1:
         name, _, text = value.partition(":")
-        port = int(text) if text.isdigit() else None
+        port = int(text) if PORT.fullmatch(text) else None
     else:
         name = value  # a bare IPv6 address or a name without port
     return name.rstrip("."), port

@@ -9,14 +9,17 @@ from __future__ import annotations
 
 import socket
 from collections.abc import Iterator
+from urllib.parse import urlsplit
 
 import httpx
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
 from poppy_core.server import OriginPolicy
-from poppy_core.server.origins import normalize_origin
+from poppy_core.server.origins import Verdict, is_ip, is_loopback, normalize_origin, split_host
 from tests.server.conftest import Served, serve
 
 EVIL = "https://evil.example"
@@ -299,3 +302,26 @@ def test_origins_are_normalized(text: str, normal: str) -> None:
 def test_what_is_not_an_origin_is_refused(text: str) -> None:
     with pytest.raises(ValueError, match=r"not an origin|out of range"):
         OriginPolicy([text])
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.binary(max_size=80), st.one_of(st.none(), st.integers(0, 65535)))
+def test_any_host_header_gets_an_answer_not_an_exception(host: bytes, port: int | None) -> None:
+    policy = OriginPolicy()
+    allowed = policy.host_allowed(host)
+    name, _ = split_host(host.decode("latin-1"))
+    if allowed:
+        assert name in ("localhost", "127.0.0.1", "::1") or is_loopback(name) or is_ip(name)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(max_size=80), st.sampled_from([b"127.0.0.1:8080", b"localhost", None]))
+def test_any_origin_header_gets_a_verdict_and_foreign_text_is_refused(
+    origin: str, host: bytes | None
+) -> None:
+    policy = OriginPolicy()
+    verdict = policy.verdict(origin.encode("utf-8"), host, 8080)
+    assert verdict is not Verdict.ALLOWED  # nothing is allowed unless listed
+    if verdict is Verdict.OWN:
+        parts = urlsplit(normalize_origin(origin.encode("utf-8").decode("latin-1")))
+        assert is_loopback(parts.hostname or "") and (parts.port or 80) == 8080

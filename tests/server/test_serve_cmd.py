@@ -67,6 +67,13 @@ def test_public_host_without_token_warns() -> None:
     assert "without --token" in err and "anyone" in err
 
 
+def test_open_cors_warns() -> None:
+    proc = _start("--http", "--cors", "*", "--profile", "no-such-robot", "--sim")
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode != 0
+    assert "--cors '*': every web page you open can move the robot" in err
+
+
 def test_nothing_to_serve_is_a_usage_error() -> None:
     proc = _start("--sim", "--profile", "ergo-jr")
     _, err = proc.communicate(timeout=30)
