@@ -100,7 +100,7 @@ def serve(
                 print(f"docs: http://{base}:{servers[0].port}/docs", flush=True)
             _wait_for_signal(servers)
         except RuntimeError as exc:
-            error_line(f"{exc} (run with --debug for the server's log)")
+            error_line(f"{exc} (the server's log above says why)")
             raise typer.Exit(EXIT_FAILURE) from None
         finally:
             for server in reversed(servers):
