@@ -6,12 +6,12 @@ import signal
 import sys
 import threading
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import typer
 
 from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, build_robot
-from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, error_line, warn_line
+from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, warn_line
 
 if TYPE_CHECKING:
     from poppy_core.server import ServerThread
@@ -39,43 +39,85 @@ def serve(
         help="Require this token (Authorization: Bearer … or ?token=) on every route.",
     ),
     cors: list[str] | None = typer.Option(
-        None, "--cors", help="Origin allowed by CORS (repeat it); default: any, as pypot."
+        None,
+        "--cors",
+        help="Let web pages of this origin use the robot, e.g. https://snap.berkeley.edu "
+        "(repeat it; '*' allows any page, as pypot did). Default: the server's own pages only.",
+    ),
+    allow_host: list[str] | None = typer.Option(
+        None,
+        "--allow-host",
+        help="Also answer requests for this host name, e.g. poppy.local (repeat it; '*' any). "
+        "Loopback names, IP addresses and --host are always answered.",
     ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
     if not (http or ws):
-        error_line("nothing to serve: pass --http and/or --ws")
-        raise typer.Exit(EXIT_USAGE)
+        _usage("nothing to serve: pass --http and/or --ws")
+    if http and ws and http_port == ws_port and http_port != 0:
+        _usage(
+            f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
+            "server streams the same state at /api/v1/ws)"
+        )
+    from poppy_core.server import OriginPolicy, ServerThread, create_app, create_stream_app
+
+    try:
+        policy = OriginPolicy.for_server(
+            host, cors=cors or (), allow_hosts=allow_host or (), report=_report
+        )
+    except ValueError as exc:
+        _usage(f"{exc} (--cors takes an origin or '*', --allow-host a host name)")
     if host not in LOOPBACK and not token:
         warn_line(
             f"serving on {host} without --token: anyone who can reach this machine can move "
             "the robot (and write its EEPROM); pass --token or keep --host 127.0.0.1"
         )
-    from poppy_core.server import ServerThread, create_app, create_stream_app
-
-    with build_robot(profile, config_file, port, sim) as robot:
-        app = create_app(
-            robot, token=token or None, cors_origins=tuple(cors or ("*",)), stream_rate_hz=ws_rate
+    if policy.any_origin:
+        warn_line(
+            "--cors '*': every web page you open can move the robot; allow the origins you "
+            "use instead (e.g. --cors https://snap.berkeley.edu)"
         )
+    with build_robot(profile, config_file, port, sim) as robot:
+        app = create_app(robot, token=token or None, policy=policy, stream_rate_hz=ws_rate)
         servers: list[ServerThread] = []
+        if http:
+            servers.append(ServerThread(app, host, http_port))
+        if ws:
+            stream_app = create_stream_app(app.state.service, ws_rate, token or None, policy)
+            servers.append(ServerThread(stream_app, host, ws_port))
         try:
+            for server in servers:  # bind every port before serving any: errors come first
+                server.bind()
+            policy.with_ports(server.port for server in servers)
+            for server in servers:
+                server.start()
+            base = _host(host)
             if http:
-                servers.append(ServerThread(app, host, http_port).start())
-                print(f"http://{_host(host)}:{servers[-1].port}", flush=True)
+                print(f"http://{base}:{servers[0].port}", flush=True)
             if ws:
-                stream_app = create_stream_app(app.state.service, ws_rate, token or None)
-                servers.append(ServerThread(stream_app, host, ws_port).start())
-                print(f"ws://{_host(host)}:{servers[-1].port}/", flush=True)
+                print(f"ws://{base}:{servers[-1].port}/", flush=True)
             if http:
-                print(f"docs: http://{_host(host)}:{servers[0].port}/docs", flush=True)
+                print(f"docs: http://{base}:{servers[0].port}/docs", flush=True)
             _wait_for_signal(servers)
         except RuntimeError as exc:
-            error_line(f"{exc}: is the port already in use?")
+            error_line(f"{exc} (the server's log above says why)")
             raise typer.Exit(EXIT_FAILURE) from None
         finally:
             for server in reversed(servers):
                 server.stop()
     print("stopped", file=sys.stderr, flush=True)
+
+
+def _report(line: str) -> None:
+    """Print a refusal of the server literally (it quotes what a client sent)."""
+    from rich.text import Text
+
+    err_console.print(Text.assemble(("warning:", "yellow"), " ", line), soft_wrap=True)
+
+
+def _usage(message: str) -> NoReturn:
+    error_line(message)
+    raise typer.Exit(EXIT_USAGE)
 
 
 def _host(host: str) -> str:

@@ -4,8 +4,20 @@ Importing this package loads FastAPI: the CLI imports it only inside ``poppy ser
 """
 
 from poppy_core.server.app import create_app
-from poppy_core.server.runner import ServerThread, uvicorn_server
+from poppy_core.server.errors import ListenError
+from poppy_core.server.origins import OriginGuard, OriginPolicy
+from poppy_core.server.runner import ServerThread, bind_sockets, uvicorn_server
 from poppy_core.server.service import RobotService
 from poppy_core.server.stream import create_stream_app
 
-__all__ = ["RobotService", "ServerThread", "create_app", "create_stream_app", "uvicorn_server"]
+__all__ = [
+    "ListenError",
+    "OriginGuard",
+    "OriginPolicy",
+    "RobotService",
+    "ServerThread",
+    "bind_sockets",
+    "create_app",
+    "create_stream_app",
+    "uvicorn_server",
+]

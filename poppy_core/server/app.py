@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import AsyncIterator, Sequence
+from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 from typing import TYPE_CHECKING
 from urllib.parse import urlencode
@@ -12,12 +12,8 @@ from starlette.responses import HTMLResponse
 
 from poppy_core.server.errors import install_error_handlers
 from poppy_core.server.fastpath import RegisterFastPath
-from poppy_core.server.middleware import (
-    MAX_BODY_BYTES,
-    BodyLimitMiddleware,
-    CorsMiddleware,
-    TokenMiddleware,
-)
+from poppy_core.server.middleware import MAX_BODY_BYTES, BodyLimitMiddleware, TokenMiddleware
+from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.service import RobotService
 
 if TYPE_CHECKING:
@@ -33,7 +29,7 @@ def create_app(
     robot: Robot,
     *,
     token: str | None = None,
-    cors_origins: Sequence[str] = ("*",),
+    policy: OriginPolicy | None = None,
     max_body_bytes: int = MAX_BODY_BYTES,
     stream_rate_hz: float = DEFAULT_STREAM_HZ,
     builtins: bool = True,
@@ -43,7 +39,8 @@ def create_app(
     Args:
         robot: the robot to serve.
         token: when set, every route and the WebSocket need it (Bearer header or ``?token=``).
-        cors_origins: origins allowed by CORS; ``("*",)`` is pypot's default.
+        policy: the Host names and browser origins accepted (see ``origins``); by default
+            loopback names, IP addresses and the server's own pages only.
         max_body_bytes: largest request body accepted (413 beyond).
         stream_rate_hz: default rate of the WebSocket state stream.
         builtins: attach the built-in primitives to the robot.
@@ -79,7 +76,9 @@ def create_app(
         lifespan=lifespan,
         docs_url=None,
     )
+    policy = policy or OriginPolicy()
     app.state.service = service
+    app.state.policy = policy
     app.state.stream_rate_hz = stream_rate_hz
     install_error_handlers(app)
     # pypot's routes first: the hottest ones (register values) are matched soonest.
@@ -93,7 +92,7 @@ def create_app(
     app.add_middleware(BodyLimitMiddleware, max_bytes=max_body_bytes)
     if token:
         app.add_middleware(TokenMiddleware, token=token)
-    app.add_middleware(CorsMiddleware, origins=tuple(cors_origins))
+    app.add_middleware(OriginGuard, policy=policy)  # outermost: before the token and the fast path
     return app
 
 

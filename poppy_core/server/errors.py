@@ -21,6 +21,7 @@ from poppy_core.errors import (
     PoppyError,
     RegisterError,
 )
+from poppy_core.server.refusals import one_line
 
 if TYPE_CHECKING:
     from fastapi import FastAPI
@@ -41,6 +42,10 @@ PYPOT_STATUS: dict[Kind, int] = {
     "unavailable": 503,
 }
 """HTTP status of each kind on pypot's routes (pypot answers 404 for most refusals)."""
+
+
+class ListenError(PoppyError):
+    """A server cannot listen: a busy port, a name that does not resolve, a refused permission."""
 
 
 class ApiError(Exception):
@@ -69,11 +74,12 @@ def pypot_body(error: str, tip: str = "", details: str = "") -> dict[str, str]:
 
 
 def error_response(request: Request, error: ApiError) -> JSONResponse:
-    """The response for ``error`` in the style of the route that raised it."""
+    """The response for ``error`` in the style of the route that raised it (one line each)."""
+    message = one_line(error.message)
     if request.url.path.startswith(V1_PREFIX):
-        return JSONResponse({"detail": error.message}, status_code=V1_STATUS[error.kind])
+        return JSONResponse({"detail": message}, status_code=V1_STATUS[error.kind])
     status = error.pypot_status or PYPOT_STATUS[error.kind]
-    return JSONResponse(pypot_body(error.message, error.tip, error.message), status_code=status)
+    return JSONResponse(pypot_body(message, one_line(error.tip), message), status_code=status)
 
 
 def from_poppy_error(exc: PoppyError) -> ApiError:
@@ -96,7 +102,17 @@ async def _poppy_error(request: Request, exc: Exception) -> Response:
     return error_response(request, from_poppy_error(exc))
 
 
+async def _bug(request: Request, exc: Exception) -> Response:
+    # uvicorn logs the traceback server-side; the client gets one line without paths.
+    message = f"internal error ({type(exc).__name__}): the server's log has the details"
+    if request.url.path.startswith(V1_PREFIX):
+        return JSONResponse({"detail": message}, status_code=500)
+    tip = "this is a bug in poppy: please report it with the server's log"
+    return JSONResponse(pypot_body(message, tip), status_code=500)
+
+
 def install_error_handlers(app: FastAPI) -> None:
-    """Map ``ApiError`` and ``PoppyError`` to JSON answers on ``app``."""
+    """Map ``ApiError`` and ``PoppyError`` to JSON answers on ``app``, and bugs to a bare 500."""
     app.add_exception_handler(ApiError, _api_error)
     app.add_exception_handler(PoppyError, _poppy_error)
+    app.add_exception_handler(Exception, _bug)

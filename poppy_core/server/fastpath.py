@@ -3,7 +3,8 @@
 Web pages and Snap! poll and set register values many times a second; answering them here skips
 FastAPI's routing and dependency solving (about twice the throughput). Anything unusual (an
 unknown motor or register, a refused value) falls through to the normal route, which formats
-the error. It sits inside the body-size limit, which hands it the whole body in one message.
+the error. It sits inside the Host/Origin guard and the token check (every request it answers
+passed them) and inside the body-size limit, which hands it the whole body in one message.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from typing import Any
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from poppy_core.server.errors import ApiError
+from poppy_core.server.jsonio import parse_json
 from poppy_core.server.service import RobotService
 
 REGISTER_VALUE = re.compile(r"^/motors/([A-Za-z0-9_]+)/registers/([A-Za-z0-9_]+)/value\.json$")
@@ -55,8 +57,8 @@ class RegisterFastPath:
             await self.app(scope, _replay(message, receive), send)
             return
         try:
-            written = self.service.write(motor, register, json.loads(body))
-        except (ApiError, ValueError, UnicodeDecodeError):
+            written = self.service.write(motor, register, parse_json(body))
+        except ApiError:
             await self.app(scope, _replay(message, receive), send)
             return
         await _answer(send, 202, {register: written})

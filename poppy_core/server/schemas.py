@@ -4,7 +4,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, JsonValue
 
-from poppy_core.server.service import MAX_GOTO_S
+from poppy_core.server.service import MAX_GOTO_S, MIN_GOTO_S
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 MotorName = Annotated[str, Field(min_length=1, max_length=64)]
@@ -66,7 +66,7 @@ class GotoRequest(BaseModel):
     positions: dict[MotorName, Finite] = Field(
         min_length=1, max_length=64, description="motor name -> target in degrees"
     )
-    duration_s: Finite = Field(gt=0, le=MAX_GOTO_S, description="seconds the motion lasts")
+    duration_s: Finite = Field(ge=MIN_GOTO_S, le=MAX_GOTO_S, description="seconds the motion lasts")
     control: Literal["minjerk", "dummy"] = "minjerk"
     wait: bool = Field(False, description="answer once the motion is over")
 

@@ -25,6 +25,9 @@ logger = logging.getLogger(__name__)
 
 MAX_GOTO_S = 600.0
 """The longest goto accepted (seconds)."""
+MIN_GOTO_S = 0.001
+"""The shortest goto accepted (seconds): shorter ones are a jump (and 1e-100 overflows the
+trajectory's arithmetic)."""
 
 MOTOR_TIP = "the motors are listed by /motors/list.json"
 PRIMITIVE_TIP = "the primitives are listed by /primitives/list.json"
@@ -217,7 +220,10 @@ class RobotService:
         self._known(primitive, name, prop, primitive.properties, "property")
         if isinstance(value, float) and not math.isfinite(value):
             raise ApiError("invalid", f"{name}.{prop}: expected a finite number")
-        primitive.set_property(prop, value)  # ConfigError -> 4xx "invalid"
+        try:
+            primitive.set_property(prop, value)  # ConfigError -> 4xx "invalid"
+        except (OverflowError, RecursionError):
+            raise ApiError("invalid", f"{name}.{prop}: the value is out of range") from None
         return values.jsonable(primitive.get_property(prop))
 
     def method_names(self, name: str) -> list[str]:
@@ -236,7 +242,7 @@ class RobotService:
         self._known(primitive, name, method, primitive.methods, "method")
         try:
             result = getattr(primitive, method)(*args, **(kwargs or {}))
-        except (TypeError, ValueError) as exc:
+        except (TypeError, ValueError, ArithmeticError) as exc:
             raise ApiError("invalid", f"{name}.{method}: {exc}") from None
         return values.jsonable(result)
 
@@ -253,6 +259,9 @@ class RobotService:
         primitive = self.primitive(name)
         described = values.jsonable(primitive.describe())
         assert isinstance(described, dict)
+        if described.get("error"):
+            # the traceback (server paths) stays in the server's log, where the primitive put it
+            described["error"] = {k: v for k, v in described["error"].items() if k != "traceback"}
         return {"name": name, **described}
 
     # -- lifetime ----------------------------------------------------------------------------
@@ -263,10 +272,15 @@ class RobotService:
 
 
 def check_duration(value: Any) -> float:
-    """A goto duration: a finite number of seconds in (0, MAX_GOTO_S]."""
+    """A goto duration: a finite number of seconds in [MIN_GOTO_S, MAX_GOTO_S]."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ApiError("invalid", "duration must be a number of seconds")
-    duration = float(value)
-    if not (math.isfinite(duration) and 0 < duration <= MAX_GOTO_S):
-        raise ApiError("invalid", f"duration must be in (0, {MAX_GOTO_S:g}] seconds")
+    try:
+        duration = float(value)
+    except OverflowError:
+        duration = math.inf
+    if not (math.isfinite(duration) and MIN_GOTO_S <= duration <= MAX_GOTO_S):
+        raise ApiError(
+            "invalid", f"duration must be between {MIN_GOTO_S:g} and {MAX_GOTO_S:g} seconds"
+        )
     return duration

@@ -101,7 +101,10 @@ def number(motor: Motor, name: str, value: Any) -> float:
     """``value`` as a finite float (JSON numbers only; no bools, strings, NaN or infinity)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise _bad(motor, name, f"expected a number, got {json_type(value)}")
-    result = float(value)
+    try:
+        result = float(value)
+    except OverflowError:  # an integer beyond 1.8e308
+        result = math.inf
     if not math.isfinite(result):
         raise _bad(motor, name, "expected a finite number")
     return result

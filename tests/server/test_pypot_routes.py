@@ -144,15 +144,13 @@ def test_sensors_are_empty(client: httpx.Client) -> None:
     assert client.post("/sensors/camera/registers/x/value.json", content="1").status_code == 404
 
 
-def test_cors_headers_and_options_like_pypot(client: httpx.Client) -> None:
+def test_no_store_and_options_like_pypot(client: httpx.Client) -> None:
+    # pypot's open CORS needs --cors '*' (test_origins.py); scripts see no difference
     answer = client.get("/motors/list.json")
-    assert answer.headers["access-control-allow-origin"] == "*"
     assert answer.headers["cache-control"] == "no-store"
-    assert "POST" in answer.headers["access-control-allow-methods"]
+    assert "access-control-allow-origin" not in answer.headers
     options = client.options("/motors/m1/registers/goal_position/value.json")
     assert options.status_code == 204
-    assert options.headers["access-control-allow-origin"] == "*"
-    assert "Content-Type" in options.headers["access-control-allow-headers"]
 
 
 def test_index_lists_the_routes(client: httpx.Client) -> None:

@@ -1,4 +1,4 @@
-"""Token enforcement, body size limit, CORS origins."""
+"""Token enforcement, body size limit, CORS origins (the Host/Origin rules: test_origins.py)."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import pytest
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
+from poppy_core.server import OriginPolicy
 from tests.server.conftest import Served, serve
 
 TOKEN = "s3cret-token"
@@ -17,7 +18,7 @@ TOKEN = "s3cret-token"
 @pytest.fixture(scope="module")
 def guarded(moves_folder: str) -> Iterator[Served]:
     """An Ergo Jr served with a token and one allowed origin."""
-    yield from serve(moves_folder, token=TOKEN, cors_origins=("http://app.local",))
+    yield from serve(moves_folder, token=TOKEN, policy=OriginPolicy(["http://app.local"]))
 
 
 @pytest.mark.parametrize(
@@ -67,7 +68,12 @@ def test_cors_only_for_the_allowed_origin(guarded: Served) -> None:
         assert allowed.status_code == 204
         assert allowed.headers["access-control-allow-origin"] == "http://app.local"
         other = http.options("/robot.json", headers={"Origin": "http://evil.example"})
+        assert other.status_code == 403
         assert "access-control-allow-origin" not in other.headers
+        # an allowed page reads the 401 of a request without the token (CORS headers on it)
+        refused = http.get("/robot.json", headers={"Origin": "http://app.local"})
+        assert refused.status_code == 401
+        assert refused.headers["access-control-allow-origin"] == "http://app.local"
 
 
 def test_large_bodies_are_refused(client: httpx.Client) -> None:

@@ -67,6 +67,13 @@ def test_public_host_without_token_warns() -> None:
     assert "without --token" in err and "anyone" in err
 
 
+def test_open_cors_warns() -> None:
+    proc = _start("--http", "--cors", "*", "--profile", "no-such-robot", "--sim")
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode != 0
+    assert "--cors '*': every web page you open can move the robot" in err
+
+
 def test_nothing_to_serve_is_a_usage_error() -> None:
     proc = _start("--sim", "--profile", "ergo-jr")
     _, err = proc.communicate(timeout=30)
@@ -142,3 +149,135 @@ def test_primitive_and_play_with_remote(served: Any) -> None:
 
     unknown = _poppy("play", "no_such_move", "--remote", served.url)
     assert unknown.returncode == 1 and "no_such_move" in unknown.stderr
+
+
+def _serve_fails(*args: str) -> subprocess.CompletedProcess[str]:
+    return _poppy("serve", "--sim", "--profile", "ergo-jr", *args)
+
+
+def test_ws_port_equal_to_http_port_is_a_usage_error_before_any_url() -> None:
+    done = _serve_fails("--http", "--ws", "--http-port", "8765", "--ws-port", "8765")
+    assert done.returncode == 2 and done.stdout == ""
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--ws-port 8765 is also the --http-port" in lines[0]
+
+
+def test_a_name_that_does_not_resolve_is_not_a_busy_port() -> None:
+    done = _serve_fails(
+        "--http", "--host", "no-such-host.invalid", "--http-port", "0", "--token", "t"
+    )
+    assert done.returncode == 1 and done.stdout == ""
+    assert "does not resolve" in done.stderr and "in use" not in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_an_address_of_another_machine_is_named() -> None:
+    done = _serve_fails("--http", "--host", "192.0.2.1", "--http-port", "0", "--token", "t")
+    assert done.returncode == 1
+    assert "192.0.2.1 is not an address of this machine" in done.stderr
+
+
+def test_a_busy_port_is_named_and_the_ws_port_is_checked_before_serving() -> None:
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        busy = str(taken.getsockname()[1])
+        done = _serve_fails("--http", "--http-port", busy)
+        assert done.returncode == 1 and done.stdout == ""
+        assert f"127.0.0.1:{busy}: the port is already in use" in done.stderr
+        both = _serve_fails("--http", "--http-port", "0", "--ws", "--ws-port", busy)
+        assert both.returncode == 1 and both.stdout == ""  # no URL printed for the HTTP server
+        assert "already in use" in both.stderr
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
+def test_a_refused_permission_is_named() -> None:
+    from poppy_core.server import ListenError, bind_sockets
+
+    read, write = os.pipe()
+    child = os.fork()
+    if child == 0:  # pragma: no cover (runs in the child)
+        message = "bound"
+        try:
+            if os.geteuid() == 0:
+                os.setuid(65534)  # nobody: ports below 1024 are refused again
+            bind_sockets("127.0.0.1", 1)
+        except ListenError as exc:
+            message = str(exc)
+        except BaseException as exc:
+            message = repr(exc)
+        os.write(write, message.encode())
+        os._exit(0)
+    os.close(write)
+    os.waitpid(child, 0)
+    message = os.read(read, 4096).decode()
+    os.close(read)
+    if message == "bound":
+        pytest.skip("this machine lets every user listen on port 1")
+    assert message.startswith("cannot listen on 127.0.0.1:1: permission denied")
+    assert "ports below 1024 need root" in message
+
+
+@pytest.mark.parametrize(
+    ("option", "value"), [("--cors", "snap.berkeley.edu"), ("--allow-host", "http://x/")]
+)
+def test_bad_origins_and_host_names_are_usage_errors(option: str, value: str) -> None:
+    done = _serve_fails("--http", option, value)
+    assert done.returncode == 2 and done.stdout == ""
+    assert len(done.stderr.strip().splitlines()) == 1 and value in done.stderr
+
+
+def test_both_websockets_apply_the_origin_rules_and_say_how_to_allow_one() -> None:
+    from websockets.exceptions import InvalidStatus
+    from websockets.sync.client import connect
+
+    proc = _start(
+        "--http",
+        "--sim",
+        "--profile",
+        "ergo-jr",
+        "--http-port",
+        "0",
+        "--ws",
+        "--ws-port",
+        "0",
+        "--cors",
+        "https://my.app",
+    )
+    try:
+        assert proc.stdout is not None
+        url = proc.stdout.readline().strip()
+        ws_url = proc.stdout.readline().strip()
+        port = url.rsplit(":", 1)[1]
+        for endpoint in (ws_url, url.replace("http://", "ws://") + "/api/v1/ws"):
+            for _ in range(2):
+                with (
+                    pytest.raises(InvalidStatus) as refused,
+                    connect(
+                        endpoint,
+                        origin="https://evil.example",
+                    ),
+                ):
+                    pass
+                assert refused.value.response.status_code == 403
+            for origin in ("https://my.app", f"http://127.0.0.1:{port}"):
+                with connect(endpoint, origin=origin) as ws:
+                    assert "present_position" in ws.recv(timeout=5)
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=15) == 0
+        assert proc.stderr is not None
+        err = proc.stderr.read()
+        hints = [line for line in err.splitlines() if "evil.example" in line]
+        assert hints == [
+            "warning: refused a request from the web page origin 'https://evil.example': to "
+            "allow it, restart poppy serve with --cors https://evil.example"
+        ]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        for stream in (proc.stdout, proc.stderr):
+            if stream is not None:
+                stream.close()

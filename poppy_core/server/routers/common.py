@@ -1,14 +1,13 @@
 """Helpers shared by the routers: raw JSON bodies (pypot's routes) and awaiting a goto."""
 
 import asyncio
-import json
 import time
 from typing import Any
 
 from starlette.requests import Request
 
 from poppy_core.robot import GotoHandle
-from poppy_core.server.errors import ApiError
+from poppy_core.server.jsonio import parse_json
 
 POLL_S = 0.01
 WAIT_MARGIN_S = 2.0
@@ -26,10 +25,7 @@ async def json_body(request: Request, *, default: Any = MISSING, tip: str = "") 
     raw = await request.body()
     if not raw.strip() and default is not MISSING:
         return default
-    try:
-        return json.loads(raw)
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ApiError("invalid", f"the body is not valid JSON: {exc}", tip=tip) from None
+    return parse_json(raw, tip=tip)
 
 
 async def wait_goto(handle: GotoHandle) -> bool:

@@ -68,7 +68,7 @@ async def play(move: str, request: Request, service: Service) -> JSONResponse:
         raise ApiError("invalid", "speed field is missing.", tip=SPEED_TIP)
     try:
         speed = float(data["speed"])
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ApiError("invalid", "the speed is not a number", tip=SPEED_TIP) from None
     if not math.isfinite(speed) or speed == 0:
         raise ApiError("invalid", "the speed must be a finite, non-zero number", tip=SPEED_TIP)

@@ -95,7 +95,7 @@ async def set_register(
 def _float(value: Any, what: str, tip: str) -> float:
     try:
         result = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ApiError("invalid", f"{what} must be a number", tip=tip) from None
     if not math.isfinite(result):
         raise ApiError("invalid", f"{what} must be a finite number", tip=tip)

@@ -1,0 +1,129 @@
+"""Connection limits uvicorn lacks: a deadline for request headers and a cap on open connections.
+
+uvicorn keeps a connection that sends nothing, or its headers one byte at a time, for ever, so a
+few thousand such sockets exhaust the process's file descriptors. ``guarded_protocol`` wraps
+uvicorn's HTTP protocol class:
+
+- **header deadline**: a connection must complete a request's headers within ``header_timeout_s``
+  of opening, and of its previous answer (uvicorn's keep-alive timeout closes idle ones sooner);
+  a request being answered (a waiting goto, a WebSocket) is never cut;
+- **cap**: beyond ``max_connections`` open connections (HTTP and WebSocket), a new one is
+  answered ``503`` with a one-line JSON body and closed, before it costs anything more.
+
+It relies on the attributes uvicorn's protocols share (``connections``, ``cycle``, ``transport``,
+``loop``, ``on_response_complete``); ``tests/server/test_limits.py`` pins the behaviour.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from typing import Any
+
+from poppy_core.server.refusals import refusal_body
+
+logger = logging.getLogger(__name__)
+
+HEADER_TIMEOUT_S = 10.0
+"""Longest wait for a request's headers (seconds)."""
+MAX_CONNECTIONS = 1000
+"""Most connections open at once (HTTP keep-alive and WebSocket)."""
+REFUSED_LINGER_S = 1.0
+"""How long a refused connection stays open so that the client reads the 503 (not a reset)."""
+
+
+def _answer(status: int, reason: str, message: str, tip: str) -> bytes:
+    body = refusal_body(message, tip)
+    head = (
+        f"HTTP/1.1 {status} {reason}\r\ncontent-type: application/json\r\n"
+        f"content-length: {len(body)}\r\nconnection: close\r\n\r\n"
+    )
+    return head.encode() + body
+
+
+def guarded_protocol(base: Any, header_timeout_s: float, max_connections: int) -> Any:
+    """A subclass of uvicorn's HTTP protocol class ``base`` with a header deadline and a cap."""
+    busy = _answer(
+        503,
+        "Service Unavailable",
+        f"too many connections: this server accepts {max_connections} at once",
+        "close idle connections (or WebSockets) and try again",
+    )
+    slow = _answer(
+        408,
+        "Request Timeout",
+        f"the request's headers did not arrive within {header_timeout_s:g} s",
+        "send the whole request at once",
+    )
+
+    class GuardedProtocol(base):  # type: ignore[misc]
+        def __init__(self, *args: Any, **kwargs: Any) -> None:
+            super().__init__(*args, **kwargs)
+            self._deadline: asyncio.TimerHandle | None = None
+            self._deadline_cycle: Any = None
+            self._partial = False
+            self._refused = False
+
+        def connection_made(self, transport: Any) -> None:
+            if len(self.connections) >= max_connections:
+                self._refused = True
+                logger.warning("refused a connection: %d already open", len(self.connections))
+                transport.write(busy)
+                if transport.can_write_eof():
+                    transport.write_eof()
+                self.loop.call_later(REFUSED_LINGER_S, transport.close)
+                return
+            super().connection_made(transport)
+            self._arm()
+
+        def data_received(self, data: bytes) -> None:
+            if self._refused:
+                return
+            self._partial = True
+            super().data_received(data)
+            if self._deadline is not None and (
+                self.cycle is not self._deadline_cycle or self.transport.get_protocol() is not self
+            ):
+                self._disarm()  # headers complete (a new cycle), or upgraded to a WebSocket
+
+        def on_response_complete(self) -> None:
+            super().on_response_complete()
+            if self.cycle is None or self.cycle.response_complete:
+                self._arm()  # waiting for the next request's headers (no pipelined one started)
+
+        def connection_lost(self, exc: Exception | None) -> None:
+            self._disarm()
+            if not self._refused:
+                super().connection_lost(exc)
+
+        def eof_received(self) -> Any:
+            if self._refused:
+                return None
+            return super().eof_received()
+
+        def _arm(self) -> None:
+            self._disarm()
+            self._partial = False
+            self._deadline_cycle = self.cycle
+            self._deadline = self.loop.call_later(header_timeout_s, self._expire)
+
+        def _disarm(self) -> None:
+            if self._deadline is not None:
+                self._deadline.cancel()
+                self._deadline = None
+
+        def _expire(self) -> None:
+            self._deadline = None
+            transport = self.transport
+            waiting = self.cycle is self._deadline_cycle and (
+                self.cycle is None or self.cycle.response_complete
+            )
+            if not waiting or transport.is_closing() or transport.get_protocol() is not self:
+                return
+            if self._partial:
+                transport.write(slow)
+            transport.close()
+
+    GuardedProtocol.__name__ = f"Guarded{base.__name__}"
+    GuardedProtocol.__qualname__ = GuardedProtocol.__name__
+    return GuardedProtocol

@@ -1,0 +1,128 @@
+"""Connection limits: a deadline for request headers, a cap on open connections (503), bounded fds.
+
+Raw sockets on 127.0.0.1 play the slow and idle clients; no assertion is about speed: every
+wait has a generous bound and only says that the server ends what it must end.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import time
+from collections.abc import Iterator
+
+import httpx
+import pytest
+from websockets.sync.client import connect
+
+from poppy_core.robot import from_profile
+from poppy_core.server import ServerThread, create_app
+
+WAIT_S = 15.0  # upper bound for what should take well under a second
+
+
+@pytest.fixture(scope="module")
+def strict(moves_folder: str) -> Iterator[ServerThread]:
+    """A served Ergo Jr with a 0.5 s header deadline and at most 20 connections."""
+    robot = from_profile("ergo-jr", sim=True)
+    server = ServerThread(create_app(robot), header_timeout_s=0.5, max_connections=20).start()
+    yield server
+    server.stop()
+    robot.close()
+
+
+def _closed_within(sock: socket.socket, seconds: float) -> bytes:
+    """Everything the server sends until it closes ``sock`` (fails if it does not)."""
+    sock.settimeout(seconds)
+    received = b""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        chunk = sock.recv(4096)
+        if not chunk:
+            return received
+        received += chunk
+    raise AssertionError("the server kept the connection open")
+
+
+def test_slow_headers_are_cut(strict: ServerThread) -> None:
+    with socket.create_connection(("127.0.0.1", strict.port)) as sock:
+        sock.sendall(b"GET /robot.json HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # never ends
+        answer = _closed_within(sock, WAIT_S)
+    assert answer.startswith(b"HTTP/1.1 408")
+    assert b'"error": "the request\'s headers did not arrive within 0.5 s"' in answer
+
+
+def test_idle_connections_are_closed(strict: ServerThread) -> None:
+    with socket.create_connection(("127.0.0.1", strict.port)) as sock:
+        assert _closed_within(sock, WAIT_S) == b""
+
+
+def test_slow_headers_after_a_keep_alive_answer_are_cut(strict: ServerThread) -> None:
+    with socket.create_connection(("127.0.0.1", strict.port)) as sock:
+        sock.sendall(b"GET /motors/list.json HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+        sock.settimeout(WAIT_S)
+        assert sock.recv(4096).startswith(b"HTTP/1.1 200")
+        sock.sendall(b"GET /motors/list.json HTTP/1.1\r\n")
+        for _ in range(3):  # a byte now and then does not keep it open
+            time.sleep(0.2)
+            sock.sendall(b"X")
+        assert b"408" in _closed_within(sock, WAIT_S)
+
+
+def test_long_requests_and_websockets_outlive_the_header_deadline(strict: ServerThread) -> None:
+    with httpx.Client(base_url=strict.url, timeout=WAIT_S) as http:
+        http.put("/api/v1/robot/compliant", json={"compliant": False})
+        body = {"positions": {"m1": 5}, "duration_s": 1.2, "wait": True}
+        answer = http.post("/api/v1/gotos", json=body)  # answers after 1.2 s > 0.5 s
+        assert answer.status_code == 200 and answer.json()["waited"] is True
+        http.put("/api/v1/robot/compliant", json={"compliant": True})
+    with connect(strict.url.replace("http://", "ws://") + "/api/v1/ws?rate_hz=10") as ws:
+        end = time.monotonic() + 1.5
+        while time.monotonic() < end:
+            assert "m1" in ws.recv(timeout=5)
+
+
+def test_a_connection_beyond_the_cap_gets_a_clear_503(strict: ServerThread) -> None:
+    with httpx.Client(base_url=strict.url, timeout=WAIT_S) as http:
+        assert http.get("/motors/list.json").status_code == 200  # the client's own connection
+        idle = [socket.create_connection(("127.0.0.1", strict.port)) for _ in range(19)]
+        try:
+            time.sleep(0.2)  # the server has accepted them
+            with httpx.Client(base_url=strict.url, timeout=WAIT_S) as other:
+                refused = other.get("/motors/list.json")
+            assert refused.status_code == 503
+            assert refused.json()["error"] == "too many connections: this server accepts 20 at once"
+            assert http.get("/motors/list.json").status_code == 200  # open ones go on
+        finally:
+            for sock in idle:
+                sock.close()
+    deadline = time.monotonic() + WAIT_S
+    while True:  # the slots come back once the idle sockets are gone
+        with httpx.Client(base_url=strict.url, timeout=WAIT_S) as other:
+            if other.get("/motors/list.json").status_code == 200:
+                break
+        assert time.monotonic() < deadline
+        time.sleep(0.1)
+
+
+def _open_fds() -> int:
+    return len(os.listdir("/proc/self/fd"))
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self/fd"), reason="needs /proc (Linux)")
+def test_a_flood_of_idle_sockets_does_not_exhaust_file_descriptors(moves_folder: str) -> None:
+    robot = from_profile("ergo-jr", sim=True)
+    server = ServerThread(create_app(robot), max_connections=50).start()
+    try:
+        before = _open_fds()
+        flood = [socket.create_connection(("127.0.0.1", server.port)) for _ in range(400)]
+        time.sleep(2.0)  # accepted, refused ones answered and closed after their linger
+        held_by_server = _open_fds() - before - len(flood)
+        assert held_by_server <= 60, held_by_server
+        with httpx.Client(base_url=server.url, timeout=WAIT_S) as http:
+            assert http.get("/motors/list.json").status_code == 503
+        for sock in flood:
+            sock.close()
+    finally:
+        server.stop()
+        robot.close()
