@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -24,9 +25,11 @@ Run everything with `make bench` (it runs `.venv/bin/python -m bench`), or one b
 only), `--list`. The peers live in their own venv, `bench/.venv-peers`, built by
 `bench/setup_peers.sh` on first use (see `bench/README.md`); without it the benchmarks still
 run and say that the peers were not measured. Each run rewrites this file from the latest
-results and keeps the raw measurements in `bench/results/NAME.json` (git-ignored) and a
-time-stamped copy next to it.
+result of the benchmarks it ran (the sections of the others stay as they were) and keeps the
+raw measurements in `bench/results/NAME.json` (git-ignored) and a time-stamped copy next to it.
 """
+
+_SECTION_NAME = re.compile(r"`python -m bench ([\w-]+)`")
 
 
 def _stamp(date: str) -> str:
@@ -105,8 +108,25 @@ def render_section(result: BenchResult, machine: dict[str, Any]) -> str:
     return "\n\n".join(parts)
 
 
+def existing_sections(path: Path) -> dict[str, str]:
+    """The benchmark sections of an existing report, keyed by benchmark name."""
+    try:
+        text = path.read_text()
+    except OSError:
+        return {}
+    sections: dict[str, str] = {}
+    for chunk in re.split(r"\n(?=## )", text):
+        match = _SECTION_NAME.search(chunk) if chunk.startswith("## ") else None
+        if match and not chunk.startswith("## Machine"):
+            sections[match.group(1)] = chunk.strip()
+    return sections
+
+
 def write_doc(names: Iterable[str], path: Path = DOC_PATH) -> Path:
     """Render docs/performance.md from the latest saved result of each benchmark.
+
+    A benchmark with no saved result here keeps the section the report already had, so a run
+    of one benchmark on a fresh clone does not drop the others' figures.
 
     Args:
         names: the registered benchmarks, in report order (those never run are left out).
@@ -115,11 +135,31 @@ def write_doc(names: Iterable[str], path: Path = DOC_PATH) -> Path:
     Returns:
         The path written.
     """
-    loaded = [r for r in (load_result(n) for n in names) if r is not None]
+    kept = existing_sections(path)
     parts = [DOC_INTRO.rstrip()]
-    if loaded:
-        newest = max((m for _, m in loaded), key=lambda m: str(m["date"]))
-        parts.append(_machine_block(newest))
-    parts += [render_section(result, machine) for result, machine in loaded]
+    sections: list[str] = []
+    machines: list[dict[str, Any]] = []
+    for name in names:
+        loaded = load_result(name)
+        if loaded is not None:
+            result, machine = loaded
+            machines.append(machine)
+            sections.append(render_section(result, machine))
+        elif name in kept:
+            sections.append(kept[name])
+    if machines:
+        parts.append(_machine_block(max(machines, key=lambda m: str(m["date"]))))
+    elif kept and (machine_block := _kept_machine_block(path)):
+        parts.append(machine_block)
+    parts += sections
     path.write_text("\n\n".join(parts) + "\n")
     return path
+
+
+def _kept_machine_block(path: Path) -> str | None:
+    try:
+        text = path.read_text()
+    except OSError:
+        return None
+    match = re.search(r"^## Machine\n.*?(?=\n## |\Z)", text, flags=re.S | re.M)
+    return match.group(0).strip() if match else None
