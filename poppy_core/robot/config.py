@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import difflib
+from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    PrivateAttr,
     Strict,
     ValidationError,
     ValidationInfo,
@@ -174,6 +176,17 @@ class RobotConfig(BaseModel):
     motorgroups: dict[Name, list[Name]] = Field(default_factory=dict)
     motors: dict[Name, MotorConfig]
     sensors: dict[Name, dict[str, Any]] = Field(default_factory=dict)
+    _folder: Path | None = PrivateAttr(default=None)
+
+    @property
+    def folder(self) -> Path | None:
+        """The folder of the file this config was read from (relative file names start there)."""
+        return self._folder
+
+    def with_folder(self, folder: Path | None) -> RobotConfig:
+        """This config, remembering ``folder`` as the one it was read from; returns itself."""
+        self._folder = folder
+        return self
 
     @model_validator(mode="after")
     def _check_whole(self, info: ValidationInfo) -> RobotConfig:
