@@ -24,6 +24,8 @@ from poppy_core.kinematics.transforms import Matrix, Vector, homogeneous
 
 JointValues = Mapping[str, float] | Sequence[float]
 """Joint angles in degrees: name -> angle (any subset), or one angle per joint in order."""
+Orientation = Sequence[float] | Sequence[Sequence[float]] | Matrix | None
+"""None, the tip's x axis ``[x, y, z]`` (pypot's vector orientation) or a 3x3 rotation."""
 
 
 @dataclass(frozen=True)
@@ -194,7 +196,7 @@ class Chain:
     def solve(
         self,
         position: Vector,
-        orientation: Sequence[float] | Sequence[Sequence[float]] | Matrix | None = None,
+        orientation: Orientation = None,
         seed: JointValues | None = None,
         *,
         options: SolverOptions | None = None,
@@ -217,18 +219,29 @@ class Chain:
             KinematicsError: the target is out of reach within the limits (the message names
                 the nearest point reached), or a malformed target.
         """
-        solution = self.solve_detailed(position, orientation, seed, options=options)
-        degrees = self.from_model(self._full_theta(solution.theta, seed))
-        return {
-            j.name: min(max(float(d), j.limits_deg[0]), j.limits_deg[1])  # rounding at a limit
-            for j, d in zip(self.joints, degrees, strict=True)
-            if j.active
-        }
+        found = self.solve_detailed(position, orientation, seed, options=options)
+        return self._angles(found, seed)
+
+    def closest(
+        self,
+        position: Vector,
+        orientation: Orientation = None,
+        seed: JointValues | None = None,
+        *,
+        options: SolverOptions | None = None,
+    ) -> tuple[dict[str, float], Solution]:
+        """Like ``solve`` for any target: the angles of the nearest pose found, and its errors.
+
+        Raises:
+            KinematicsError: a malformed target only.
+        """
+        found = self._search(position, orientation, seed, options)[1]
+        return self._angles(found, seed), found
 
     def solve_detailed(
         self,
         position: Vector,
-        orientation: Sequence[float] | Sequence[Sequence[float]] | Matrix | None = None,
+        orientation: Orientation = None,
         seed: JointValues | None = None,
         *,
         options: SolverOptions | None = None,
@@ -238,17 +251,33 @@ class Chain:
         Raises:
             KinematicsError: see ``solve``.
         """
-        opts = options or self.options
+        target, found = self._search(position, orientation, seed, options)
+        if not accepted(found, options or self.options):
+            raise self._out_of_reach(target, found)
+        return found
+
+    def _search(
+        self,
+        position: Vector,
+        orientation: Orientation,
+        seed: JointValues | None,
+        options: SolverOptions | None,
+    ) -> tuple[Target, Solution]:
         target = make_target(position, orientation, self.name)
         start = self.to_model(self._degrees(seed, None))
         kinematics = self._reduced_for(start)
         active = self._active
-        found = solve(
-            kinematics, target, self._lower[active], self._upper[active], start[active], opts
-        )
-        if not accepted(found, opts):
-            raise self._out_of_reach(target, found)
-        return found
+        lower, upper = self._lower[active], self._upper[active]
+        found = solve(kinematics, target, lower, upper, start[active], options or self.options)
+        return target, found
+
+    def _angles(self, solution: Solution, seed: JointValues | None) -> dict[str, float]:
+        degrees = self.from_model(self._full_theta(solution.theta, seed))
+        return {
+            j.name: min(max(float(d), j.limits_deg[0]), j.limits_deg[1])  # rounding at a limit
+            for j, d in zip(self.joints, degrees, strict=True)
+            if j.active
+        }
 
     def _reduced_for(self, theta: Matrix) -> Kinematics:
         if self._active.all():
@@ -303,7 +332,7 @@ def _vector(values: Sequence[float] | Matrix, field: str) -> Matrix:
 
 def make_target(
     position: Vector,
-    orientation: Sequence[float] | Sequence[Sequence[float]] | Matrix | None,
+    orientation: Orientation,
     chain: str = "",
 ) -> Target:
     """A solver ``Target`` from user input, checked.

@@ -28,6 +28,7 @@ from poppy_core.kinematics import (
     matrix_rpy,
     rpy_matrix,
 )
+from poppy_core.kinematics.chain import Orientation
 from poppy_core.kinematics.transforms import Matrix, Vector, axis_angle_matrix, rotation_log
 
 if TYPE_CHECKING:
@@ -35,7 +36,6 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-Orientation = Sequence[float] | Sequence[Sequence[float]] | Matrix | None
 LINEAR_RATE_HZ = 50.0
 MAX_LINEAR_JUMP_DEG = 15.0
 """Largest joint change between two waypoints of a straight line (a jump means a flip)."""
@@ -109,6 +109,17 @@ class RobotChain:
     def motors(self) -> list[Motor]:
         """The chain's motors, base to tip (passive ones included)."""
         return [self.robot.motor(n) for n in self._chain.names]
+
+    @property
+    def base(self) -> str:
+        """The link (or body) of the model whose frame positions are expressed in."""
+        return self._chain.base
+
+    @property
+    def links(self) -> frozenset[str]:
+        """Names of every link (or body) of the robot's model."""
+        joints = self._description.joints
+        return frozenset(j.parent for j in joints) | frozenset(j.child for j in joints)
 
     @property
     def active_motors(self) -> list[Motor]:
