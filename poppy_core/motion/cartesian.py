@@ -84,13 +84,17 @@ class RobotChain:
             for m in self.robot.motors
         }
 
+    def _expand(self, name: str) -> list[str]:
+        groups = self.robot.motorgroups
+        return [m.name for m in groups[name]] if name in groups else [name]
+
     def _build(self) -> Chain:
         frames = self._frames()
         chain = build_chains(
             self._spec,
             self._description,
             frames,
-            self.robot.config.resolve_group if self.robot.config else None,
+            self._expand,
         )[self.name]
         self._signature = tuple(frames[n] for n in chain.names)
         return chain

@@ -8,6 +8,7 @@ A Poppy creature's config without the section (a pypot JSON) gets its profile's 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -82,7 +83,16 @@ def chains_from_config(config: RobotConfig, kind: str | None = None) -> dict[str
         )
         for name, m in config.motors.items()
     }
-    return build_chains(spec, description, motors, config.resolve_group)
+    return build_chains(spec, description, motors, group_expander(config))
+
+
+def group_expander(config: RobotConfig) -> Callable[[str], list[str]]:
+    """Group name -> its motors (nested groups flattened); other names come back alone."""
+
+    def expand(name: str) -> list[str]:
+        return config.resolve_group(name) if name in config.motorgroups else [name]
+
+    return expand
 
 
 def attach_chains(
