@@ -352,6 +352,12 @@ def make_target(
         )
     if orientation is None:
         return Target(point)
+    if isinstance(orientation, int | float):
+        raise KinematicsError(
+            f"an orientation is the tip's x axis [x, y, z] or a 3x3 rotation matrix, not the "
+            f"number {orientation}: give the duration by name (goto(position, duration=...))",
+            chain=chain,
+        )
     try:
         rotation = np.asarray(orientation, dtype=float)
     except (TypeError, ValueError):

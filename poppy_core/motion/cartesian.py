@@ -13,6 +13,7 @@ import math
 import threading
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -249,6 +250,8 @@ def plan_line(
     model = chain.model
     start = chain.pose
     target = make_target(position, orientation, chain.name)
+    chain.solve(position, orientation)  # an unreachable end is said first, as goto says it
+    seeded_only = replace(model.options, restarts=0)
     begin = start[:3, 3]
     seed: dict[str, float] = chain._present()
     waypoints: list[dict[str, float]] = []
@@ -271,15 +274,25 @@ def plan_line(
             rotation = axis_angle_matrix(turn, s * angle) if angle > 0 else np.eye(3)
             goal = rotation @ start[:3, :3] if target.mode == "all" else rotation @ start[:3, 0]
         try:
-            angles = model.solve(point, goal, seed)
+            angles = model.solve(point, goal, seed, options=seeded_only)
         except KinematicsError as exc:
+            where = ", ".join(f"{v:.3f}" for v in point)
+            try:
+                model.solve(point, goal, seed)
+            except KinematicsError:
+                raise KinematicsError(
+                    f"the straight line leaves the reach of chain {chain.name!r} at ({where}) m: "
+                    f"the nearest point there is {exc.distance_m or 0.0:.3f} m off; "
+                    "use goto, or a waypoint in between",
+                    chain=chain.name,
+                    target=exc.target,
+                    nearest=exc.nearest,
+                    distance_m=exc.distance_m,
+                ) from None
             raise KinematicsError(
-                f"the straight line leaves the reach of chain {chain.name!r} at "
-                f"({', '.join(f'{v:.3f}' for v in point)}) m: {exc}",
+                f"chain {chain.name!r} cannot follow the straight line near ({where}) m without "
+                "turning its joints around; use goto, or a waypoint in between",
                 chain=chain.name,
-                target=exc.target,
-                nearest=exc.nearest,
-                distance_m=exc.distance_m,
             ) from None
         jump = max(abs(angles[n] - seed[n]) for n in angles)
         if jump > MAX_LINEAR_JUMP_DEG:
