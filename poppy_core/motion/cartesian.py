@@ -316,6 +316,7 @@ class LinearMove:
         self._robot = robot
         self._waypoints = waypoints
         self._period_s = period_s
+        self.duration_s = period_s * len(waypoints)
         self._cancel = threading.Event()
         self._done = threading.Event()
         self.error: BaseException | None = None
