@@ -233,7 +233,8 @@ def parse_mjcf(path: Path) -> KinematicDescription:
     try:
         model = mujoco.MjModel.from_xml_path(str(path))
     except (ValueError, mujoco.FatalError) as exc:
-        raise ConfigError(f"cannot load MJCF {path}: {exc}", file=str(path)) from exc
+        reason = " ".join(str(exc).split())  # MuJoCo's messages span lines
+        raise ConfigError(f"cannot load MJCF {path}: {reason}", file=str(path)) from exc
     kinds = {
         int(mujoco.mjtJoint.mjJNT_HINGE): "hinge",
         int(mujoco.mjtJoint.mjJNT_SLIDE): "slide",

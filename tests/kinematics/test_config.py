@@ -13,7 +13,7 @@ import yaml
 
 from poppy_core.creatures import from_config
 from poppy_core.errors import ConfigError
-from poppy_core.kinematics import parse_kinematics
+from poppy_core.kinematics import load_description, parse_kinematics
 from poppy_core.motion.cartesian import RobotChain
 from poppy_core.motion.chains import chains_from_config
 from poppy_core.robot import load_config, load_profile
@@ -113,6 +113,23 @@ def test_bad_sections_say_what_is_wrong(
     with pytest.raises(ConfigError, match=message) as caught, from_config(path, sim=True):
         pass
     assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    ("name", "text"),
+    [
+        ("bad.xml", "<mujoco><worldbody><body><joint axis='0 0 0'/></body></worldbody></mujoco>"),
+        ("bad.xml", "not xml"),
+        ("bad.urdf", "<robot><joint name='j'/></robot>"),
+        ("bad.urdf", "<robot"),
+    ],
+)
+def test_unreadable_models_are_one_line(tmp_path: Path, name: str, text: str) -> None:
+    pytest.importorskip("mujoco")
+    (tmp_path / name).write_text(text, encoding="utf-8")
+    with pytest.raises(ConfigError) as caught:
+        load_description(tmp_path / name)
+    assert name in str(caught.value) and "\n" not in str(caught.value)
 
 
 def test_section_must_be_a_mapping() -> None:
