@@ -79,24 +79,18 @@ class RobotChain:
 
     # -- the model, rebuilt when a motor's orientation, offset or limits change ------------------
 
-    def _frames(self) -> dict[str, MotorFrame]:
-        return {
-            m.name: MotorFrame(1.0 if m.direct else -1.0, m.offset, tuple(m.angle_limit))  # type: ignore[arg-type]
-            for m in self.robot.motors
-        }
+    def _frame(self, name: str) -> MotorFrame:
+        motor = self.robot.motor(name)
+        low, high = motor.angle_limit
+        return MotorFrame(1.0 if motor.direct else -1.0, motor.offset, (low, high))
 
     def _expand(self, name: str) -> list[str]:
         groups = self.robot.motorgroups
         return [m.name for m in groups[name]] if name in groups else [name]
 
     def _build(self) -> Chain:
-        frames = self._frames()
-        chain = build_chains(
-            self._spec,
-            self._description,
-            frames,
-            self._expand,
-        )[self.name]
+        frames = {m.name: self._frame(m.name) for m in self.robot.motors}
+        chain = build_chains(self._spec, self._description, frames, self._expand)[self.name]
         self._signature = tuple(frames[n] for n in chain.names)
         return chain
 
@@ -104,7 +98,7 @@ class RobotChain:
     def model(self) -> Chain:
         """The pure kinematic chain, up to date with the motors' frames and limits."""
         with self._lock:
-            if tuple(self._frames()[n] for n in self._chain.names) != self._signature:
+            if tuple(self._frame(n) for n in self._chain.names) != self._signature:
                 self._chain = self._build()
             return self._chain
 
@@ -185,12 +179,9 @@ class RobotChain:
         Raises:
             KinematicsError: out of reach within the angle limits (names the nearest point).
         """
-        start = self._present()
-        if isinstance(seed, Mapping):
-            start.update({k: float(v) for k, v in seed.items()})
-        elif seed is not None:
-            start = dict(zip(self._chain.names, (float(v) for v in seed), strict=True))
-        return self.model.solve(position, orientation, start)
+        if seed is not None and not isinstance(seed, Mapping):
+            return self.model.solve(position, orientation, seed)  # one angle per motor, checked
+        return self.model.solve(position, orientation, {**self._present(), **(seed or {})})
 
     def goto(
         self,
