@@ -104,3 +104,16 @@ def test_unknown_chain_names_the_chains(poppy: Any) -> None:
     )
     assert result.code == 1
     assert "no chain 'arm' (chains: chain)" in result.stderr
+
+
+def test_robot_without_chains_says_how_to_add_them(poppy: Any, tmp_path: Path) -> None:
+    from poppy_core.robot import RobotConfig, dump_config, load_profile
+
+    config = load_profile("ergo-jr").to_dict()
+    config["profile"] = {"name": "my-arm", "kind": "my-arm"}
+    config.pop("kinematics")
+    path = tmp_path / "my-arm.yaml"
+    dump_config(RobotConfig.from_dict(config), path)
+    result = poppy("robot", "where", "--sim", "--config", str(path))
+    assert result.code == 1
+    assert "no kinematic chain" in result.stderr and "kinematics" in result.stderr
