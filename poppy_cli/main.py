@@ -8,10 +8,11 @@ import sys
 import typer
 
 from poppy_cli import state
-from poppy_cli.commands import config, demo, emulate, motor_setup, ports, robot, scan
+from poppy_cli.commands import config, demo, emulate, motor_setup, ports, scan
 from poppy_cli.commands import moves as moves_cmd
 from poppy_cli.commands import play as play_cmd
 from poppy_cli.commands import primitive as primitive_cmd
+from poppy_cli.commands import reach as reach_cmd
 from poppy_cli.commands import record as record_cmd
 from poppy_cli.commands import serve as serve_cmd
 from poppy_cli.commands import sim as sim_cmd
@@ -48,7 +49,8 @@ app.add_typer(motor_setup.app, name="motor")
 app.command("emulate")(emulate.emulate)
 app.command("demo")(demo.demo)
 app.add_typer(config.app, name="config")
-app.add_typer(robot.app, name="robot")
+# reach_cmd adds `reach` and `where` to the `poppy robot` group defined in commands/robot.py.
+app.add_typer(reach_cmd.app, name="robot")
 app.command("tui")(tui_cmd.tui)
 app.add_typer(primitive_cmd.app, name="primitive")
 app.command("record")(record_cmd.record)

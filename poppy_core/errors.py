@@ -13,7 +13,8 @@ The tree (catch the bases, raise the leaves)::
     ├── UnknownModelError         a model number or name poppy does not know
     ├── RegisterError             unknown register, read-only register, value out of range
     ├── SetupError                a setup operation refused or could not be verified (ID taken, ...)
-    └── ConfigError               a bad robot config; carries ``file``, ``field``, ``reason``
+    ├── ConfigError               a bad robot config; carries ``file``, ``field``, ``reason``
+    └── KinematicsError           a target out of a chain's reach; carries ``nearest``
 
 This module imports nothing of ours, so every layer (protocol included) may use it.
 """
@@ -111,3 +112,29 @@ class ConfigError(PoppyError):
         self.field = field
         self.value = value
         self.reason = reason
+
+
+class KinematicsError(PoppyError):
+    """A kinematic chain cannot reach a target within its joint limits.
+
+    Attributes:
+        chain: the chain's name.
+        target: the position asked for (m).
+        nearest: the closest position the chain reached (m), or None.
+        distance_m: how far ``nearest`` is from ``target``.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        chain: str | None = None,
+        target: tuple[float, float, float] | None = None,
+        nearest: tuple[float, float, float] | None = None,
+        distance_m: float | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.chain = chain
+        self.target = target
+        self.nearest = nearest
+        self.distance_m = distance_m

@@ -3,6 +3,7 @@
 from poppy_core.creatures.body import DanceBeatMotion, HeadIdleMotion, UpperBodyIdleMotion
 from poppy_core.creatures.ergo_jr import Dance, Jump, SafePowerUp
 from poppy_core.creatures.factory import from_config, from_profile
+from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.creatures.interaction import ArmsCopyMotion, ArmsTurnCompliant
 from poppy_core.creatures.postures import CreaturePosture
 from poppy_core.creatures.registry import (
@@ -24,6 +25,7 @@ __all__ = [
     "CreatureSpec",
     "Dance",
     "DanceBeatMotion",
+    "HeadFollow",
     "HeadIdleMotion",
     "Jump",
     "LimitTorque",

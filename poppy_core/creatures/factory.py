@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from poppy_core.creatures.registry import attach_creature, detect_kind
+from poppy_core.motion.chains import attach_chains
 from poppy_core.robot import Robot, RobotConfig, load_config
 from poppy_core.robot import from_config as build_from_config
 from poppy_core.robot import from_profile as build_from_profile
@@ -15,10 +16,11 @@ from poppy_core.robot.factory import SimMode
 
 def _attached(robot: Robot, start_defaults: bool) -> Robot:
     kind = detect_kind(robot.config) if robot.config is not None else None
-    if kind is None:
-        return robot
     try:
-        attach_creature(robot, kind, start_defaults=start_defaults)
+        if kind is None:
+            attach_chains(robot)  # a robot of its own: the chains its config describes
+        else:
+            attach_creature(robot, kind, start_defaults=start_defaults)
     except BaseException:
         robot.close()
         raise
@@ -35,7 +37,7 @@ def from_config(
     """``poppy_core.robot.from_config`` plus the creature's behaviours when it names one.
 
     The creature is the config's profile kind, or (pypot JSON without header) the one whose
-    motor names it has; other robots are returned as they are.
+    motor names it has; other robots get the kinematic chains their config describes.
 
     Args:
         config: the config or its path.

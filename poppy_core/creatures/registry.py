@@ -12,8 +12,10 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from poppy_core.creatures import body, ergo_jr, interaction, postures, safety
+from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.errors import ConfigError, RegisterError
 from poppy_core.motion import Primitive, primitive_manager
+from poppy_core.motion.chains import attach_chains
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot, RobotConfig
@@ -193,7 +195,9 @@ def attach_creature(robot: Robot, kind: str, *, start_defaults: bool = True) -> 
     Sets the primitive manager's filter, the safe compliance of the creature's groups and, on
     Ergo Jr, the documented torque limit and gains; then attaches each primitive and starts
     those started by default (``temperature_monitoring``). Attaching again returns the
-    primitives already there.
+    primitives already there. The creature's kinematic chains (``robot.chain``,
+    ``robot.l_arm_chain``...) come from the config's ``kinematics`` section, or the creature's
+    profile; a simulated Ergo Jr (MuJoCo) also gets ``head_follow``.
 
     Args:
         robot: the robot.
@@ -223,6 +227,10 @@ def attach_creature(robot: Robot, kind: str, *, start_defaults: bool = True) -> 
         primitive = factory(robot, spec)
         robot.attach_primitive(primitive, name)
         attached[name] = primitive
+    chains = attach_chains(robot, known, control=spec.goto_control)
+    if known == "ergo-jr" and "chain" in chains and robot.simulation is not None:
+        attached["head_follow"] = HeadFollow(robot, "chain")
+        robot.attach_primitive(attached["head_follow"], "head_follow")
     creature = Creature(known, spec.goto_control, attached)
     robot.attach("creature", creature)
     if start_defaults and not robot.closed:

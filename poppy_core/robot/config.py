@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import difflib
+from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import (
@@ -174,6 +175,21 @@ class RobotConfig(BaseModel):
     motorgroups: dict[Name, list[Name]] = Field(default_factory=dict)
     motors: dict[Name, MotorConfig]
     sensors: dict[Name, dict[str, Any]] = Field(default_factory=dict)
+
+    @property
+    def folder(self) -> Path | None:
+        """The folder of the file this config was read from (relative file names start there)."""
+        folder = self.__dict__.get("_source_folder")
+        return folder if isinstance(folder, Path) else None
+
+    def with_folder(self, folder: Path | None) -> RobotConfig:
+        """This config, remembering ``folder`` as the one it was read from; returns itself.
+
+        Kept outside the model's fields and private attributes, so that two configs with the
+        same content compare equal wherever they were read from.
+        """
+        object.__setattr__(self, "_source_folder", folder)
+        return self
 
     @model_validator(mode="after")
     def _check_whole(self, info: ValidationInfo) -> RobotConfig:

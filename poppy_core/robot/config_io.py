@@ -89,7 +89,7 @@ def load_config(path: str | os.PathLike[str]) -> RobotConfig:
         raise config_error(source, "", None, f"cannot read: {reason}",
                            show_value=False) from None
     data = parse_config_text(text, source, fmt=_format_of(file, text))
-    return RobotConfig.from_dict(data, source=source)
+    return RobotConfig.from_dict(data, source=source).with_folder(file.resolve().parent)
 
 
 class _ConfigDumper(yaml.SafeDumper):

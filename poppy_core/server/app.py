@@ -51,8 +51,10 @@ def create_app(
     from fastapi import FastAPI
 
     from poppy_core.server.routers import (
+        pypot_ik,
         pypot_motion,
         pypot_motors,
+        v1_chains,
         v1_motion,
         v1_motors,
         v1_robot,
@@ -82,9 +84,9 @@ def create_app(
     app.state.stream_rate_hz = stream_rate_hz
     install_error_handlers(app)
     # pypot's routes first: the hottest ones (register values) are matched soonest.
-    for router in (pypot_motors.router, pypot_motion.router):
+    for router in (pypot_motors.router, pypot_motion.router, pypot_ik.router):
         app.include_router(router)
-    for router in (v1_robot.router, v1_motors.router, v1_motion.router):
+    for router in (v1_robot.router, v1_motors.router, v1_motion.router, v1_chains.router):
         app.include_router(router, prefix="/api/v1")
     add_stream_routes(app)
     add_docs_route(app)

@@ -33,7 +33,7 @@ from poppy_core.sim.urdf import (
     rotate,
 )
 
-URDF_DIR = Path(__file__).resolve().parent / "urdf"
+# profiles/<robot>/<file>: the public Poppy URDFs, kept with each profile (the chains use them too)
 ROBOTS: dict[str, str] = {
     "ergo-jr": "poppy_ergo_jr.urdf",
     "torso": "poppy_torso.urdf",
@@ -296,7 +296,7 @@ class _Writer:
 
 def generate(robot: str, profiles_dir: Path) -> str:
     """The MJCF text of ``robot`` (``"ergo-jr"``, ``"torso"`` or ``"humanoid"``)."""
-    urdf = parse_urdf(URDF_DIR / ROBOTS[robot])
+    urdf = parse_urdf(profiles_dir / robot / ROBOTS[robot])
     return _Writer(robot, urdf, load_profile_motors(profiles_dir, robot)).write()
 
 

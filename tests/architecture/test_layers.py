@@ -19,10 +19,12 @@ ALLOWED: dict[str, set[str]] = {
     # needs a room"); the robot factory builds it, as it builds emulators
     "sim": {"emulator", "models", "protocol"},
     "robot": {"bus", "models", "emulator", "sim", "protocol"},
-    "motion": {"robot", "models"},
-    "creatures": {"robot", "motion", "models"},
+    # kinematics is a leaf (numpy only, nothing of ours but errors): rooms that need chains
+    # import it, whatever their place in the plan's table
+    "motion": {"robot", "models", "kinematics"},
+    "creatures": {"robot", "motion", "models", "kinematics"},
     "kinematics": set(),
-    "server": {"robot", "motion", "creatures", "models"},
+    "server": {"robot", "motion", "creatures", "models", "kinematics"},
     "remote": set(),
 }
 # robot may import motion.trajectory only: a leaf of pure maths shared by Motor.goto_position.
@@ -57,6 +59,29 @@ def test_rooms_import_only_downwards() -> None:
                     continue
                 bad.append(f"{path.relative_to(ROOT)} imports {name}")
     assert bad == []
+
+
+def _module_level_imports(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    names: set[str] = set()
+    for node in tree.body:
+        if isinstance(node, ast.Import):
+            names.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def test_kinematics_is_numpy_only() -> None:
+    """The kinematics room loads numpy and the standard library; mujoco only to read an MJCF."""
+    found: set[str] = set()
+    for path in (ROOT / "poppy_core" / "kinematics").rglob("*.py"):
+        found |= _module_level_imports(path)
+    ours = {"poppy_core", "__future__"}
+    third_party = {n for n in found - ours if n not in sys.stdlib_module_names}
+    assert third_party == {"numpy"}
+    loaded = _loaded_after("import poppy_core.kinematics")
+    assert not loaded & {"mujoco", "scipy", "typer", "rich", "pydantic", "serial"}
 
 
 def _loaded_after(code: str) -> set[str]:

@@ -11,7 +11,7 @@ from sim_helpers import PROFILES, ROBOTS
 
 from poppy_core.robot.profiles import load_profile
 from poppy_core.sim.mjcf import ROBOTS as URDF_FILES
-from poppy_core.sim.mjcf import URDF_DIR, generate
+from poppy_core.sim.mjcf import generate
 from poppy_core.sim.urdf import (
     Quat,
     Vec3,
@@ -83,7 +83,7 @@ def test_standing_robot_stays_up_holding_its_zero_pose(robot: str) -> None:
 
 def _urdf_positions(robot: str, urdf_deg: dict[str, float]) -> dict[str, Vec3]:
     """Link origins relative to the root link, for URDF joint angles in degrees."""
-    urdf = parse_urdf(URDF_DIR / URDF_FILES[robot])
+    urdf = parse_urdf(PROFILES / robot / URDF_FILES[robot])
     poses: dict[str, tuple[Vec3, Quat]] = {urdf.root: ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))}
     pending = [urdf.root]
     while pending:

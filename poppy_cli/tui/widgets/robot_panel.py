@@ -1,4 +1,4 @@
-"""Robot tab: open a profile/config (or a virtual robot); motors, primitives and moves views."""
+"""Robot tab: open a profile or config (or a virtual robot); motors, primitives, moves, chains."""
 # ruff: noqa: TID253  (the TUI package is only imported by `poppy tui`, lazily)
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Checkbox, DataTable, Input, Select, TabbedContent, TabPane
 
 from poppy_cli.tui.messages import BusFailed, RobotOpened
+from poppy_cli.tui.widgets.chains import ChainsPanel
 from poppy_cli.tui.widgets.moves import MovesPanel
 from poppy_cli.tui.widgets.primitives import PrimitivesPanel
 from poppy_core.errors import ConfigError, PoppyError
@@ -80,6 +81,7 @@ class RobotPanel(Vertical):
         Binding("1", "view('robot-motors')", "Motors", show=False),
         Binding("2", "view('robot-primitives')", "Primitives", show=False),
         Binding("3", "view('robot-moves')", "Moves", show=False),
+        Binding("4", "view('robot-chains')", "Chains", show=False),
     ]
 
     def __init__(self, *, id: str | None = None) -> None:
@@ -87,6 +89,7 @@ class RobotPanel(Vertical):
         self.robot: Robot | None = None
         self.primitives = PrimitivesPanel(id="primitives")
         self.moves = MovesPanel(id="moves")
+        self.chains = ChainsPanel(id="chains")
 
     def compose(self) -> ComposeResult:
         with Horizontal(classes="row"):
@@ -108,6 +111,8 @@ class RobotPanel(Vertical):
                 yield self.primitives
             with TabPane("Moves 3", id="robot-moves"):
                 yield self.moves
+            with TabPane("Chains 4", id="robot-chains"):
+                yield self.chains
 
     def on_mount(self) -> None:
         table = self.query_one("#robot-table", DataTable)
@@ -118,7 +123,11 @@ class RobotPanel(Vertical):
     def action_view(self, pane: str) -> None:
         """Show a view of the robot (Motors, Primitives, Moves) and focus its table."""
         self.query_one("#robot-views", TabbedContent).active = pane
-        focus = {"robot-motors": "#robot-table", "robot-primitives": "#primitive-table"}
+        focus = {
+            "robot-motors": "#robot-table",
+            "robot-primitives": "#primitive-table",
+            "robot-chains": "#chain-table",
+        }
         self.query_one(focus.get(pane, "#moves-table")).focus()
 
     @work(thread=True, exclusive=True, group="robot", exit_on_error=False)
@@ -138,6 +147,7 @@ class RobotPanel(Vertical):
         self.robot = message.robot
         self.primitives.set_robot(message.robot)
         self.moves.set_robot(message.robot)
+        self.chains.set_robot(message.robot)
         table = self.query_one("#robot-table", DataTable)
         table.clear()
         for motor in message.robot.motors:
@@ -172,6 +182,7 @@ class RobotPanel(Vertical):
                 table.update_cell(motor.name, column, text)
         self.primitives.refresh_states()
         self.moves.poll()
+        self.chains.poll()
 
     def on_unmount(self) -> None:
         self.close_robot()
@@ -181,6 +192,7 @@ class RobotPanel(Vertical):
         if self.robot is not None:
             self.moves.release()
             self.primitives.release()
+            self.chains.release()
             self.robot.close()
             self.robot = None
 

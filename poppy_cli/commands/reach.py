@@ -1,0 +1,188 @@
+"""`poppy robot reach X Y Z` and `poppy robot where`: the tips of the robot's kinematic chains.
+
+Added to the `poppy robot` group defined in commands/robot.py.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+
+from poppy_cli.commands.robot import (
+    SETTLE_S,
+    ConfigOpt,
+    JsonOpt,
+    PortOpt,
+    ProfileOpt,
+    SimOpt,
+    app,
+    build_robot,
+)
+from poppy_cli.output import console, print_json
+
+if TYPE_CHECKING:
+    from poppy_core.motion.cartesian import RobotChain
+    from poppy_core.robot import Robot
+
+__all__ = ["app"]
+
+ChainOpt = typer.Option(None, "--chain", help="The chain to move (default: the robot's first).")
+
+
+def _numbers(text: str, what: str, count: int = 3) -> list[float]:
+    """``count`` finite numbers from words or ``a,b,c``."""
+    parts = [p for p in text.replace(",", " ").split() if p]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        raise typer.BadParameter(
+            f"{what} takes {count} numbers, e.g. 0.1,0,0.2; got {text!r}"
+        ) from None
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise typer.BadParameter(f"{what} takes {count} finite numbers, got {text!r}")
+    return values
+
+
+def _chains(robot: Robot) -> dict[str, RobotChain]:
+    from poppy_core.errors import ConfigError
+    from poppy_core.motion.chains import robot_chains
+
+    chains = robot_chains(robot)
+    if not chains:
+        raise ConfigError(
+            "this robot has no kinematic chain: add a `kinematics` section (model and chains) "
+            "to its config (see docs/kinematics.md)",
+            field="kinematics",
+        )
+    return chains
+
+
+def _pick(robot: Robot, name: str | None) -> RobotChain:
+    from poppy_core.errors import ConfigError
+
+    chains = _chains(robot)
+    if name is None:
+        return next(iter(chains.values()))
+    if name not in chains:
+        raise ConfigError(f"no chain {name!r} (chains: {', '.join(chains)})", field=name)
+    return chains[name]
+
+
+def tip_state(chain: RobotChain) -> dict[str, Any]:
+    """Where a chain's tip is: position (m), x axis, roll/pitch/yaw (degrees), its motors."""
+    pose = chain.pose
+    return {
+        "position": [round(float(v), 5) for v in pose[:3, 3]],
+        "orientation": [round(float(v), 5) for v in pose[:3, 0]],
+        "rpy_deg": [round(math.degrees(v), 2) for v in chain.rpy],
+        "motors": {m.name: round(m.present_position, 2) for m in chain.motors},
+    }
+
+
+def _xyz(values: list[float]) -> str:
+    return "(" + ", ".join(f"{v:.3f}" for v in values) + ") m"
+
+
+@app.command("where")
+def where(
+    profile: str | None = ProfileOpt,
+    config_file: Path | None = ConfigOpt,
+    port: str | None = PortOpt,
+    sim: str | None = SimOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Show where the tip of each kinematic chain is (metres, in the chain's base frame)."""
+    with build_robot(profile, config_file, port, sim) as robot:
+        time.sleep(SETTLE_S)
+        states = {name: tip_state(chain) for name, chain in _chains(robot).items()}
+    if json_output:
+        print_json(states)
+        return
+    from rich.table import Table
+
+    table = Table(title="chain tips")
+    for column in ("chain", "x (m)", "y (m)", "z (m)", "x axis", "roll/pitch/yaw"):
+        table.add_column(column, justify="left" if column == "chain" else "right")
+    for name, state in states.items():
+        x, y, z = state["position"]
+        axis = ", ".join(f"{v:.2f}" for v in state["orientation"])
+        rpy = " / ".join(f"{v:.0f}°" for v in state["rpy_deg"])
+        table.add_row(name, f"{x:.3f}", f"{y:.3f}", f"{z:.3f}", axis, rpy)
+    console.print(table)
+
+
+@app.command("reach", context_settings={"ignore_unknown_options": True})
+def reach(
+    coordinates: list[str] = typer.Argument(
+        ..., help="Target X Y Z in metres (chain's base frame)."
+    ),
+    chain_name: str | None = ChainOpt,
+    orientation: str | None = typer.Option(
+        None, "--orientation", help="The tip's x axis as X,Y,Z (pypot's orientation vector)."
+    ),
+    rpy: str | None = typer.Option(
+        None, "--rpy", help="The tip's whole orientation as roll,pitch,yaw in degrees."
+    ),
+    duration: float = typer.Option(2.0, "--duration", "-d", min=0.0, help="Seconds to move."),
+    linear: bool = typer.Option(False, "--linear", help="Move the tip along a straight line."),
+    wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),
+    profile: str | None = ProfileOpt,
+    config_file: Path | None = ConfigOpt,
+    port: str | None = PortOpt,
+    sim: str | None = SimOpt,
+    json_output: bool = JsonOpt,
+) -> None:
+    """Move a chain's tip to X Y Z (metres): the motors move together, within their limits.
+
+    An unreachable target is refused (nothing moves) with the nearest point the tip can reach.
+    The command waits for the move when it streams it (--linear, minimum-jerk robots such as
+    the Torso) and with --sim (the virtual robot ends with the command).
+    """
+    from poppy_core.kinematics import rotation_degrees
+
+    target = _numbers(" ".join(coordinates), "X Y Z")
+    if orientation is not None and rpy is not None:
+        raise typer.BadParameter("give --orientation or --rpy, not both")
+    goal: Any = None
+    if orientation is not None:
+        goal = _numbers(orientation, "--orientation")
+    elif rpy is not None:
+        goal = rotation_degrees(_numbers(rpy, "--rpy"))
+    with build_robot(profile, config_file, port, sim) as robot:
+        chain = _pick(robot, chain_name)
+        angles = chain.solve(target, goal)
+        # this process streams straight and minjerk moves, and a --sim robot ends with it
+        wait = wait or bool(sim) or linear or chain.control == "minjerk"
+        for motor in chain.active_motors:
+            motor.compliant = False
+        if linear:
+            chain.goto_linear(target, goal, duration=max(duration, 0.05), wait=wait)
+        else:
+            chain.goto(target, goal, duration=duration, wait=wait)
+        if wait:
+            time.sleep(SETTLE_S)
+        reached = [float(v) for v in chain.position] if wait else None
+    result = {
+        "chain": chain.name,
+        "target": target,
+        "angles": angles,
+        "waited": wait,
+        "position": reached,
+    }
+    if reached is not None:
+        result["error_m"] = math.dist(reached, target)
+    if json_output:
+        print_json(result)
+        return
+    motors = ", ".join(f"{n}={a:.1f}°" for n, a in angles.items())
+    if reached is None:
+        console.print(f"{chain.name}: moving to {_xyz(target)} in {duration:g} s ({motors})")
+    else:
+        console.print(
+            f"{chain.name}: at {_xyz(reached)}, {result['error_m'] * 1000:.1f} mm from "
+            f"{_xyz(target)} ({motors})"
+        )

@@ -1,0 +1,221 @@
+"""The ``kinematics`` section of a robot config (model file, chains) and the chains built from it.
+
+```yaml
+kinematics:
+  model: poppy_torso.urdf          # URDF or MJCF; relative to the config file's folder
+  joint_frame: motor               # optional: motor (URDF default, pypot's) or user (MJCF default)
+  chains:
+    l_arm_chain:
+      motors: [torso, l_arm]       # motors or groups, base to tip
+      passive: [torso]             # joints the solver leaves where they are
+      reversed: []                 # motors turning against the model (pypot's reversed_motors)
+      tip: [0, 0.18, 0]            # metres, in the last joint's child frame
+```
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from poppy_core.errors import ConfigError
+from poppy_core.kinematics.chain import Chain, ChainJoint
+from poppy_core.kinematics.description import JointFrame, KinematicDescription
+
+SECTION = "kinematics"
+
+
+@dataclass(frozen=True)
+class ChainSpec:
+    """One chain of the config: its motors (base to tip), passive and reversed ones, its tip."""
+
+    name: str
+    motors: tuple[str, ...]
+    passive: tuple[str, ...] = ()
+    reversed: tuple[str, ...] = ()
+    tip: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class KinematicsSpec:
+    """The whole section: the model file (as written), its joint frame and the chains."""
+
+    model: str
+    chains: tuple[ChainSpec, ...]
+    joint_frame: JointFrame | None = None
+
+
+@dataclass(frozen=True)
+class MotorFrame:
+    """What a chain needs to know of a motor: orientation sign, offset and angle limits."""
+
+    sign: float
+    offset_deg: float
+    limits_deg: tuple[float, float]
+
+
+def _names(value: Any, field: str) -> tuple[str, ...]:
+    if value is None:
+        return ()
+    if isinstance(value, str):
+        return (value,)
+    if isinstance(value, list) and all(isinstance(v, str) for v in value):
+        return tuple(value)
+    raise ConfigError(f"{field} must be a list of motor or group names", field=field, value=value)
+
+
+def parse_kinematics(data: Any, source: str = "config") -> KinematicsSpec:
+    """Check the ``kinematics`` section of a config.
+
+    Raises:
+        ConfigError: naming the field and what it must be.
+    """
+    if not isinstance(data, Mapping):
+        raise ConfigError(
+            f"{source}: {SECTION} must be a mapping with model and chains",
+            file=source,
+            field=SECTION,
+        )
+    model = data.get("model")
+    if not isinstance(model, str) or not model:
+        raise ConfigError(
+            f"{source}: {SECTION}.model must name a URDF or MJCF file",
+            file=source,
+            field=f"{SECTION}.model",
+            value=model,
+        )
+    frame = data.get("joint_frame")
+    if frame not in (None, "motor", "user"):
+        raise ConfigError(
+            f"{source}: {SECTION}.joint_frame is motor or user, not {frame!r}",
+            file=source,
+            field=f"{SECTION}.joint_frame",
+            value=frame,
+        )
+    chains_data = data.get("chains") or {}
+    if not isinstance(chains_data, Mapping):
+        raise ConfigError(
+            f"{source}: {SECTION}.chains must map chain names to chains",
+            file=source,
+            field=f"{SECTION}.chains",
+        )
+    chains = []
+    for name, entry in chains_data.items():
+        field = f"{SECTION}.chains.{name}"
+        if not isinstance(name, str) or not name.isidentifier() or name.startswith("_"):
+            raise ConfigError(
+                f"{source}: chain name {name!r} must be an identifier", file=source, field=field
+            )
+        if not isinstance(entry, Mapping):
+            raise ConfigError(
+                f"{source}: {field} must be a mapping with motors and tip", file=source, field=field
+            )
+        tip = entry.get("tip", [0.0, 0.0, 0.0])
+        if not (
+            isinstance(tip, list)
+            and len(tip) == 3
+            and all(isinstance(v, int | float) and math.isfinite(v) for v in tip)
+        ):
+            raise ConfigError(
+                f"{source}: {field}.tip must be [x, y, z] in metres",
+                file=source,
+                field=f"{field}.tip",
+                value=tip,
+            )
+        motors = _names(entry.get("motors"), f"{field}.motors")
+        if not motors:
+            raise ConfigError(
+                f"{source}: {field}.motors must list the chain's motors",
+                file=source,
+                field=f"{field}.motors",
+            )
+        chains.append(
+            ChainSpec(
+                name=name,
+                motors=motors,
+                passive=_names(entry.get("passive"), f"{field}.passive"),
+                reversed=_names(entry.get("reversed"), f"{field}.reversed"),
+                tip=(float(tip[0]), float(tip[1]), float(tip[2])),
+            )
+        )
+    return KinematicsSpec(model, tuple(chains), frame)
+
+
+def find_model(model: str, folders: Iterable[Path]) -> Path:
+    """The model file: an absolute path, or the first folder holding it.
+
+    Raises:
+        ConfigError: the file is in none of the folders.
+    """
+    path = Path(model).expanduser()
+    if path.is_absolute():
+        if path.is_file():
+            return path
+        raise ConfigError(f"kinematic model {path} not found", field=f"{SECTION}.model")
+    tried = []
+    for folder in folders:
+        candidate = folder / path
+        if candidate.is_file():
+            return candidate
+        tried.append(str(folder))
+    raise ConfigError(
+        f"kinematic model {model!r} not found (looked in {', '.join(tried) or 'no folder'}): "
+        "give a path relative to the config file or an absolute one",
+        field=f"{SECTION}.model",
+        value=model,
+    )
+
+
+def build_chains(
+    spec: KinematicsSpec,
+    description: KinematicDescription,
+    motors: Mapping[str, MotorFrame],
+    expand: Callable[[str], Sequence[str]] | None = None,
+) -> dict[str, Chain]:
+    """The chains of ``spec`` on ``description``, with the motors' frames and limits.
+
+    Args:
+        spec: the config's section.
+        description: the model it names (``load_description``).
+        motors: motor name -> its orientation sign, offset and limits.
+        expand: group name -> motor names (names that are not groups come back alone).
+
+    Raises:
+        ConfigError: an unknown motor or a chain that is not one branch of the model.
+    """
+    frame = spec.joint_frame or description.joint_frame
+
+    def flat(names: Iterable[str]) -> list[str]:
+        out: list[str] = []
+        for name in names:
+            out.extend(n for n in (expand(name) if expand else [name]) if n not in out)
+        return out
+
+    chains: dict[str, Chain] = {}
+    for chain in spec.chains:
+        names = flat(chain.motors)
+        passive, reversed_ = set(flat(chain.passive)), set(flat(chain.reversed))
+        joints = []
+        for name in names:
+            motor = motors.get(name)
+            if motor is None:
+                raise ConfigError(
+                    f"chain {chain.name!r} names {name!r}, which is no motor of the robot",
+                    field=f"{SECTION}.chains.{chain.name}.motors",
+                    value=name,
+                )
+            scale = motor.sign if frame == "motor" else 1.0
+            joints.append(
+                ChainJoint(
+                    name=name,
+                    limits_deg=motor.limits_deg,
+                    scale=-scale if name in reversed_ else scale,
+                    offset_deg=motor.offset_deg if frame == "motor" else 0.0,
+                    active=name not in passive,
+                )
+            )
+        chains[chain.name] = Chain(chain.name, description, joints, chain.tip)
+    return chains

@@ -1,0 +1,119 @@
+"""`poppy robot reach` and `poppy robot where` on virtual robots."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+
+@pytest.fixture(autouse=True)
+def xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """An empty user config folder and no POPPY_* variables."""
+    folder = tmp_path / "xdg"
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(folder))
+    monkeypatch.delenv("POPPY_PROFILE", raising=False)
+    monkeypatch.delenv("POPPY_PORT", raising=False)
+    return folder
+
+
+def test_where_json_lists_every_chain(poppy: Any) -> None:
+    result = poppy("robot", "where", "--sim", "--profile", "torso", "--json")
+    assert result.code == 0, result.stderr
+    data = result.json()
+    assert sorted(data) == ["l_arm_chain", "r_arm_chain"]
+    left = data["l_arm_chain"]
+    assert len(left["position"]) == 3 and len(left["orientation"]) == 3
+    assert "l_elbow_y" in left["motors"] and "abs_z" in left["motors"]
+
+
+def test_where_table(poppy: Any) -> None:
+    result = poppy("robot", "where", "--sim", "--profile", "ergo-jr")
+    assert result.code == 0, result.stderr
+    assert "chain" in result.stdout and "0.156" in result.stdout  # the tip's z at rest
+
+
+def test_reach_with_negative_coordinates(poppy: Any) -> None:
+    result = poppy(
+        "robot",
+        "reach",
+        "--sim",
+        "--profile",
+        "ergo-jr",
+        "0.1",
+        "-0.1",
+        "0.12",
+        "--duration",
+        "0.5",
+        "--json",
+    )
+    assert result.code == 0, result.stderr
+    data = result.json()
+    assert data["chain"] == "chain" and data["waited"] is True
+    assert data["error_m"] < 0.003
+    assert math.dist(data["position"], [0.1, -0.1, 0.12]) < 0.003
+    assert set(data["angles"]) == {f"m{i}" for i in range(1, 7)}
+
+
+def test_reach_linear_with_orientation(poppy: Any) -> None:
+    result = poppy(
+        "robot",
+        "reach",
+        "--sim",
+        "--profile",
+        "ergo-jr",
+        "0.05,-0.15,0.1",
+        "--orientation",
+        "0,0,1",
+        "--linear",
+        "--duration",
+        "0.5",
+    )
+    assert result.code == 0, result.stderr
+    assert "chain: at (" in result.stdout and "mm from" in result.stdout
+
+
+def test_reach_out_of_reach_is_one_line(poppy: Any) -> None:
+    result = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", "0", "0", "0.6")
+    assert result.code == 1
+    assert "nearest point it reaches" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["0.1", "0.1"], "X Y Z takes 3"),
+        (["0.1", "x", "0.1"], "X Y Z takes 3 numbers"),
+        (["0.1", "0", "0.1", "--orientation", "1,2"], "--orientation takes 3"),
+        (["0.1", "0", "0.1", "--orientation", "0,0,1", "--rpy", "0,0,0"], "not both"),
+    ],
+)
+def test_reach_usage_errors(poppy: Any, args: list[str], message: str) -> None:
+    result = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", *args)
+    assert result.code == 2
+    assert message in result.stderr
+
+
+def test_unknown_chain_names_the_chains(poppy: Any) -> None:
+    result = poppy(
+        "robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", "arm", "0.1", "0", "0.1"
+    )
+    assert result.code == 1
+    assert "no chain 'arm' (chains: chain)" in result.stderr
+
+
+def test_robot_without_chains_says_how_to_add_them(poppy: Any, tmp_path: Path) -> None:
+    from poppy_core.robot import RobotConfig, dump_config, load_profile
+
+    config = load_profile("ergo-jr").to_dict()
+    config["profile"] = {"name": "my-arm", "kind": "my-arm"}
+    config.pop("kinematics")
+    path = tmp_path / "my-arm.yaml"
+    dump_config(RobotConfig.from_dict(config), path)
+    result = poppy("robot", "where", "--sim", "--config", str(path))
+    assert result.code == 1
+    assert "no kinematic chain" in result.stderr and "kinematics" in result.stderr
