@@ -13,7 +13,8 @@ The tree (catch the bases, raise the leaves)::
     ├── UnknownModelError         a model number or name poppy does not know
     ├── RegisterError             unknown register, read-only register, value out of range
     ├── SetupError                a setup operation refused or could not be verified (ID taken, ...)
-    └── ConfigError               a bad robot config; carries ``file``, ``field``, ``reason``
+    ├── ConfigError               a bad robot config; carries ``file``, ``field``, ``reason``
+    └── SensorError               a camera or other sensor cannot be opened or read; ``sensor``
 
 This module imports nothing of ours, so every layer (protocol included) may use it.
 """
@@ -111,3 +112,14 @@ class ConfigError(PoppyError):
         self.field = field
         self.value = value
         self.reason = reason
+
+
+class SensorError(PoppyError):
+    """A sensor (camera...) cannot be opened, or gave no value in time."""
+
+    def __init__(
+        self, message: str, *, sensor: str | None = None, device: str | None = None
+    ) -> None:
+        super().__init__(message)
+        self.sensor = sensor
+        self.device = device
