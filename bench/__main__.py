@@ -6,7 +6,15 @@ import argparse
 import logging
 import sys
 
-from bench import ik_bench, move_bench, robot_bench, scan_bench, server_bench, sim_bench
+from bench import (
+    camera_bench,
+    ik_bench,
+    move_bench,
+    robot_bench,
+    scan_bench,
+    server_bench,
+    sim_bench,
+)
 from bench.clients import ensure_peers
 from bench.machine import machine_info
 from bench.registry import BENCHMARKS, BenchContext
@@ -15,7 +23,7 @@ from bench.report import save_result, write_doc
 logger = logging.getLogger("bench")
 
 # Importing a benchmark module registers it; list them here so `--list` sees them all.
-_MODULES = (scan_bench, robot_bench, move_bench, server_bench, sim_bench, ik_bench)
+_MODULES = (scan_bench, robot_bench, move_bench, server_bench, sim_bench, ik_bench, camera_bench)
 
 
 def main(argv: list[str] | None = None) -> int:

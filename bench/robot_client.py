@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     config = RobotConfig.from_dict(data, source=args.config)
     start = time.perf_counter()
     try:
-        robot = from_config(config, fix_return_delay=True, start_sync=False)
+        robot = from_config(config, fix_return_delay=True, start_sync=False, sensors=False)
     except PoppyError as exc:
         record["error"] = f"from_config failed: {type(exc).__name__}: {exc}"
         return record

@@ -8,7 +8,7 @@ import sys
 import typer
 
 from poppy_cli import state
-from poppy_cli.commands import config, demo, emulate, motor_setup, ports, scan
+from poppy_cli.commands import camera, config, demo, emulate, motor_setup, ports, scan
 from poppy_cli.commands import moves as moves_cmd
 from poppy_cli.commands import play as play_cmd
 from poppy_cli.commands import primitive as primitive_cmd
@@ -58,6 +58,7 @@ app.command("play")(play_cmd.play)
 app.add_typer(moves_cmd.app, name="moves")
 app.command("serve")(serve_cmd.serve)
 app.add_typer(sim_cmd.app, name="sim")
+app.add_typer(camera.app, name="camera")
 
 
 def main() -> None:

@@ -14,7 +14,8 @@ The tree (catch the bases, raise the leaves)::
     ├── RegisterError             unknown register, read-only register, value out of range
     ├── SetupError                a setup operation refused or could not be verified (ID taken, ...)
     ├── ConfigError               a bad robot config; carries ``file``, ``field``, ``reason``
-    └── KinematicsError           a target out of a chain's reach; carries ``nearest``
+    ├── KinematicsError           a target out of a chain's reach; carries ``nearest``
+    └── SensorError               a camera or other sensor cannot be opened or read; ``sensor``
 
 This module imports nothing of ours, so every layer (protocol included) may use it.
 """
@@ -138,3 +139,14 @@ class KinematicsError(PoppyError):
         self.target = target
         self.nearest = nearest
         self.distance_m = distance_m
+
+
+class SensorError(PoppyError):
+    """A sensor (camera...) cannot be opened, or gave no value in time."""
+
+    def __init__(
+        self, message: str, *, sensor: str | None = None, device: str | None = None
+    ) -> None:
+        super().__init__(message)
+        self.sensor = sensor
+        self.device = device

@@ -60,7 +60,7 @@ def play(
             field="motors",
             value=missing,
         )
-    with from_config(config, sim=sim) as robot:
+    with from_config(config, sim=sim, sensors=False) as robot:
         player = MovePlayer(robot, move, speed=speed, backwards=reverse, loops=loop)
         stop = threading.Event()
         for signum in (signal.SIGINT, signal.SIGTERM):

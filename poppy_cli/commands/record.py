@@ -109,7 +109,7 @@ def record(
     names = _motor_names(motors, list(config.motors), groups)
     stop = threading.Event()
     _install_stop(stop)
-    with from_config(config, sim=sim) as robot:
+    with from_config(config, sim=sim, sensors=False) as robot:
         for motor_name in names:
             robot.motor(motor_name).compliant = True
         recorder = MoveRecorder(robot, freq, names, checkpoint_path=path)

@@ -91,7 +91,12 @@ def robot_config(profile: str | None, config_file: Path | None, port: str | None
 
 
 def build_robot(
-    profile: str | None, config_file: Path | None, port: str | None, sim: bool | str | None
+    profile: str | None,
+    config_file: Path | None,
+    port: str | None,
+    sim: bool | str | None,
+    *,
+    sensors: bool = False,
 ) -> Robot:
     """Build and start the robot the shared options describe.
 
@@ -100,6 +105,7 @@ def build_robot(
 
     Motors answering after a return delay above 0 µs slow every transaction: on a terminal the
     user is asked whether to set it to 0; otherwise it is only reported (a warning).
+    The config's sensors (cameras) are built only when ``sensors`` (commands that show them).
     """
     from poppy_core.creatures import from_config
 
@@ -107,6 +113,7 @@ def build_robot(
         robot_config(profile, config_file, port),
         sim=sim or False,
         fix_return_delay=ask_return_delay,
+        sensors=sensors,
     )
 
 
@@ -270,7 +277,7 @@ def goto(
         goals = parse_targets(targets, list(config.motors))
         from poppy_core.robot import from_config
 
-        robot = from_config(config, sim=sim)
+        robot = from_config(config, sim=sim, sensors=False)
         wait = wait or bool(sim) or control == "minjerk"
     with robot:
         for name in goals:
@@ -328,7 +335,7 @@ def compliant(
     if not remote:
         from poppy_core.robot import from_config
 
-        robot = from_config(config, sim=sim)
+        robot = from_config(config, sim=sim, sensors=False)
     with robot:
         for name in chosen:
             robot.motor(name).compliant = value

@@ -50,6 +50,9 @@ def serve(
         help="Also answer requests for this host name, e.g. poppy.local (repeat it; '*' any). "
         "Loopback names, IP addresses and --host are always answered.",
     ),
+    no_sensors: bool = typer.Option(
+        False, "--no-sensors", help="Leave the config's cameras closed (e.g. no camera plugged)."
+    ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
     if not (http or ws):
@@ -77,7 +80,7 @@ def serve(
             "--cors '*': every web page you open can move the robot; allow the origins you "
             "use instead (e.g. --cors https://snap.berkeley.edu)"
         )
-    with build_robot(profile, config_file, port, sim) as robot:
+    with build_robot(profile, config_file, port, sim, sensors=not no_sensors) as robot:
         app = create_app(robot, token=token or None, policy=policy, stream_rate_hz=ws_rate)
         servers: list[ServerThread] = []
         if http:

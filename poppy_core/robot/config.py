@@ -22,6 +22,7 @@ from poppy_core.errors import UnknownModelError
 from poppy_core.models import ALL_MODELS, model_by_name
 from poppy_core.robot.config_checks import check_config, expand
 from poppy_core.robot.config_format import DEFAULT_SOURCE, config_error, from_validation_error
+from poppy_core.sensors.config import SensorProblem, check_section
 
 Degrees = Annotated[float, Strict(), Field(allow_inf_nan=False)]
 """A finite angle in degrees (ints accepted, strings and booleans refused)."""
@@ -194,7 +195,17 @@ class RobotConfig(BaseModel):
     @model_validator(mode="after")
     def _check_whole(self, info: ValidationInfo) -> RobotConfig:
         context = info.context if isinstance(info.context, dict) else {}
-        check_config(self, str(context.get("source", DEFAULT_SOURCE)))
+        source = str(context.get("source", DEFAULT_SOURCE))
+        check_config(self, source)
+        try:
+            check_section(self.sensors)
+        except SensorProblem as exc:
+            raise config_error(source, f"sensors.{exc.field}", exc.value, exc.reason) from None
+        for name in self.sensors:
+            if name in self.motors or name in self.motorgroups:
+                raise config_error(source, f"sensors.{name}", name,
+                                   f"sensor {name!r} has the name of a motor or group",
+                                   show_value=False)  # fmt: skip
         return self
 
     @classmethod

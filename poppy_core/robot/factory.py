@@ -25,6 +25,7 @@ from poppy_core.robot.profiles import load_profile, profile_dirs
 from poppy_core.robot.robot import Robot
 from poppy_core.robot.startup import ReturnDelayConsent
 from poppy_core.robot.sync import BusSync, loops_for
+from poppy_core.sensors.config import CameraMaker, build_sensors, dummy_camera, opencv_camera
 
 logger = logging.getLogger(__name__)
 
@@ -158,6 +159,7 @@ def from_config(
     write_angle_limits: bool = True,
     ports: Sequence[str] | None = None,
     start_sync: bool = True,
+    sensors: bool = True,
 ) -> Robot:
     """Build and start a robot from a config (a ``RobotConfig`` or a JSON/YAML file).
 
@@ -174,12 +176,17 @@ def from_config(
             ``poppy_core.robot.startup``).
         ports: ports searched for controllers whose port is ``"auto"`` (None: every port).
         start_sync: start the sync loops.
+        sensors: build the config's sensors (cameras open their device now; each starts on
+            first use): OpenCV devices on hardware, the MuJoCo scene seen from the robot with
+            ``sim="mujoco"``, blank frames with the ideal simulation. False: none.
 
     Returns:
         The running robot (close it, or use it in a ``with`` block).
 
     Raises:
         ConfigError: invalid config.
+        SensorError: a camera cannot be opened (missing, busy): pass ``sensors=False`` to
+            drive the motors without it.
         SetupError: one line listing missing motors (with where they were searched) and
             motors whose model differs from the config.
         PortError: a port cannot be opened.
@@ -231,6 +238,7 @@ def from_config(
             _prepare(bus, cfg, motors[name], fix_return_delay, write_angle_limits)
             loops = loops_for(cfg.controllers[name].syncloop)
             syncs.append(BusSync(name, bus, motors[name], loops))
+        built = build_sensors(cfg.sensors, _camera_maker(mode, simulation)) if sensors else {}
     except BaseException:
         for bus in buses.values():
             bus.close()
@@ -243,10 +251,21 @@ def from_config(
     groups = {g: [n for n in cfg.resolve_group(g) if n in {m.name for m in every}]
               for g in cfg.motorgroups}
     robot = Robot(every, groups=groups, syncs=syncs, buses=buses, config=cfg, emulators=emulators,
-                  simulation=simulation)  # fmt: skip
+                  simulation=simulation, sensors=built)  # fmt: skip
     if start_sync:
         robot.start_sync()
     return robot
+
+
+def _camera_maker(mode: str | None, simulation: Any) -> CameraMaker:
+    """Real devices on hardware; the scene seen from the robot in MuJoCo; blank frames else."""
+    if mode == "mujoco":
+        from poppy_core.sim.camera import sim_camera_maker
+
+        return sim_camera_maker(simulation)
+    if mode is not None:
+        return dummy_camera
+    return opencv_camera
 
 
 def _prepare(

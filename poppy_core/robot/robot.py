@@ -20,6 +20,7 @@ from poppy_core.robot.sync import BusSync, SyncStats
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import RobotConfig
+    from poppy_core.sensors import Sensor, SensorHealth
 
 logger = logging.getLogger(__name__)
 
@@ -44,6 +45,7 @@ class Robot:
         emulators: controller name -> emulator server this robot started (``sim=True``).
         goto_runner: runs the gotos; one at 50 Hz when None.
         simulation: the MuJoCo world behind the emulators (``sim="mujoco"``), stopped by close.
+        sensors: name -> sensor (cameras, marker detectors), reachable as ``robot.<name>``.
     """
 
     def __init__(
@@ -57,6 +59,7 @@ class Robot:
         emulators: Mapping[str, Any] | None = None,
         goto_runner: GotoRunner | None = None,
         simulation: Any = None,
+        sensors: Mapping[str, Sensor] | None = None,
     ) -> None:
         self._motors = list(motors)
         self._by_name = {m.name: m for m in self._motors}
@@ -71,7 +74,13 @@ class Robot:
                     field=f"motorgroups.{name}",
                 )
             self._groups[name] = [self._by_name[n] for n in members]
-        for name in [*self._by_name, *self._groups]:
+        self._sensors: dict[str, Sensor] = dict(sensors or {})
+        clash = sorted(set(self._sensors) & {*self._by_name, *self._groups})
+        if clash:
+            raise ConfigError(
+                f"sensor {clash[0]!r} has the name of a motor or group", field=f"sensors.{clash[0]}"
+            )
+        for name in [*self._by_name, *self._groups, *self._sensors]:
             if hasattr(type(self), name):
                 logger.warning("%r hides a Robot attribute: use robot.motor()/group()", name)
         self._syncs = list(syncs)
@@ -104,13 +113,17 @@ class Robot:
         groups = self.__dict__.get("_groups", {})
         if name in groups:
             return groups[name]
+        sensors = self.__dict__.get("_sensors", {})
+        if name in sensors:
+            return sensors[name]
         extensions = self.__dict__.get("extensions", {})
         if name in extensions:
             return extensions[name]
-        raise AttributeError(f"robot has no motor, group or attribute {name!r}")
+        raise AttributeError(f"robot has no motor, group, sensor or attribute {name!r}")
 
     def __dir__(self) -> list[str]:
-        return sorted({*super().__dir__(), *self._by_name, *self._groups, *self.extensions})
+        names = {*self._by_name, *self._groups, *self._sensors, *self.extensions}
+        return sorted({*super().__dir__(), *names})
 
     def __repr__(self) -> str:
         return f"<Robot motors={[m.name for m in self._motors]}>"
@@ -133,6 +146,27 @@ class Robot:
             known = ", ".join(self._by_name)
             raise ConfigError(f"no motor {name!r} (motors: {known})", field=name) from None
 
+    @property
+    def sensors(self) -> list[Sensor]:
+        """Every sensor (cameras, marker detectors), in config order (pypot's ``sensors``)."""
+        return list(self._sensors.values())
+
+    def sensor(self, name: str) -> Sensor:
+        """The sensor called ``name`` (typed access).
+
+        Raises:
+            ConfigError: no such sensor.
+        """
+        try:
+            return self._sensors[name]
+        except KeyError:
+            known = ", ".join(self._sensors) or "none"
+            raise ConfigError(f"no sensor {name!r} (sensors: {known})", field=name) from None
+
+    def sensor_health(self) -> dict[str, SensorHealth]:
+        """Sensor name -> its health (connected, rate, errors), as the buses report theirs."""
+        return {name: sensor.health() for name, sensor in self._sensors.items()}
+
     def group(self, name: str) -> list[Motor]:
         """The motors of group ``name`` (typed access)."""
         try:
@@ -152,7 +186,7 @@ class Robot:
         """
         if not name.isidentifier() or name.startswith("_"):
             raise ConfigError(f"{name!r} cannot be an attribute name", field=name, value=name)
-        taken = (*self._by_name, *self._groups, *self.__dict__)
+        taken = (*self._by_name, *self._groups, *self._sensors, *self.__dict__)
         if name in taken or hasattr(type(self), name):
             raise ConfigError(
                 f"{name!r} is already a motor, group or attribute of the robot", field=name
@@ -275,7 +309,8 @@ class Robot:
         return self._closed
 
     def close(self) -> None:
-        """Stop gotos and loops (sending pending writes), close buses, stop owned emulators."""
+        """Close sensors, stop gotos and loops (sending pending writes), close buses, stop owned
+        emulators and the simulation."""
         with self._close_lock:
             if self._closed:
                 return
@@ -285,6 +320,8 @@ class Robot:
                 callback()
             except Exception:
                 logger.exception("closing the robot: %r failed", callback)
+        for sensor in reversed(self._sensors.values()):  # detectors before their cameras
+            sensor.close()
         self._runner.close()
         for sync in self._syncs:
             sync.stop()

@@ -54,11 +54,14 @@ def create_app(
         pypot_ik,
         pypot_motion,
         pypot_motors,
+        pypot_sensors,
         v1_chains,
         v1_motion,
         v1_motors,
         v1_robot,
+        v1_sensors,
     )
+    from poppy_core.server.sensors import SensorService
     from poppy_core.server.stream import add_stream_routes
 
     service = RobotService(robot, builtins=builtins)
@@ -80,13 +83,25 @@ def create_app(
     )
     policy = policy or OriginPolicy()
     app.state.service = service
+    app.state.sensors = SensorService(robot)
     app.state.policy = policy
     app.state.stream_rate_hz = stream_rate_hz
     install_error_handlers(app)
     # pypot's routes first: the hottest ones (register values) are matched soonest.
-    for router in (pypot_motors.router, pypot_motion.router, pypot_ik.router):
+    for router in (
+        pypot_motors.router,
+        pypot_motion.router,
+        pypot_ik.router,
+        pypot_sensors.router,
+    ):
         app.include_router(router)
-    for router in (v1_robot.router, v1_motors.router, v1_motion.router, v1_chains.router):
+    for router in (
+        v1_robot.router,
+        v1_motors.router,
+        v1_motion.router,
+        v1_chains.router,
+        v1_sensors.router,
+    ):
         app.include_router(router, prefix="/api/v1")
     add_stream_routes(app)
     add_docs_route(app)

@@ -20,6 +20,7 @@ from poppy_core.errors import (
     MotorError,
     PoppyError,
     RegisterError,
+    SensorError,
 )
 from poppy_core.server.refusals import one_line
 
@@ -88,6 +89,8 @@ def from_poppy_error(exc: PoppyError) -> ApiError:
         return ApiError("invalid", str(exc))
     if isinstance(exc, BusTimeout | BusError | MotorError):
         return ApiError("unavailable", f"the robot did not answer: {exc}")
+    if isinstance(exc, SensorError):
+        return ApiError("unavailable", str(exc))
     return ApiError("invalid", str(exc))
 
 

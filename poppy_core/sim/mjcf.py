@@ -83,6 +83,33 @@ BLOBS: dict[str, dict[str, tuple[str, Vec3]]] = {
         "pelvis": ("box", (0.06, 0.035, 0.03)),
     },
 }
+
+
+@dataclass(frozen=True)
+class CameraMount:
+    """Where the robot's own camera sits: in ``body``, ``ahead_m`` in front of its centre of mass
+    (out of the head's shape), looking along ``look`` with ``up`` up (world axes at the zero
+    pose), with a vertical field of view of ``fovy_deg``."""
+
+    body: str
+    ahead_m: float
+    look: Vec3
+    up: Vec3
+    fovy_deg: float
+
+
+# The MuJoCo camera `camera` (the name of the camera sensor in pypot's configs) sits where the
+# real one does. Ergo Jr: the Raspberry Pi camera in its head (the tip), looking out along the
+# end effector (-z of the tip frame, as pypot's IK tip [0, 0, -0.07]); field of view 41.4°
+# vertical (Raspberry Pi camera module v1, OV5647: 53.5° × 41.4°). Torso/Humanoid: the camera
+# in the head's face, looking forward (-y); the Poppy BOM names a 120° camera: 105° vertical at
+# 4:3 for a pinhole of 120° horizontal.
+CAMERAS: dict[str, CameraMount] = {
+    "ergo-jr": CameraMount("tip", 0.02, (0.0, -1.0, 0.0), (0.0, 0.0, 1.0), 41.4),
+    "torso": CameraMount("head", 0.06, (0.0, -1.0, 0.0), (0.0, 0.0, 1.0), 105.0),
+    "humanoid": CameraMount("head", 0.06, (0.0, -1.0, 0.0), (0.0, 0.0, 1.0), 105.0),
+}
+CAMERA_NAME = "camera"
 TABLE_TOP_M = 0.05
 SUPPORT_TOP_M = 0.75
 
@@ -98,6 +125,16 @@ def _v(values: tuple[float, ...]) -> str:
 
 def _norm(v: Vec3) -> float:
     return math.sqrt(sum(c * c for c in v))
+
+
+def _clean(v: Vec3) -> Vec3:
+    """``v`` without rounding noise (1e-15 written as 0)."""
+    x, y, z = (round(c, 6) + 0.0 for c in v)
+    return (x, y, z)
+
+
+def _cross(a: Vec3, b: Vec3) -> Vec3:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def load_profile_motors(profiles_dir: Path, robot: str) -> dict[str, dict[str, Any]]:
@@ -180,6 +217,23 @@ class _Writer:
                 f'pos="0 0 -0.034" rgba="0.3 0.3 0.3 1"/>'
             )
 
+    def camera(self, link: str, indent: str, world_quat: Quat) -> None:
+        """The robot's camera in ``link`` when it is the one holding it (a MuJoCo camera looks
+        along its -z with +y up: its axes are the mount's, turned into the link's frame)."""
+        mount = CAMERAS.get(self.robot)
+        inertial = self.urdf.links.get(link)
+        if mount is None or mount.body != link or inertial is None:
+            return
+        inv = conjugate(world_quat)
+        look = _clean(rotate(inv, mount.look))
+        up = _clean(rotate(inv, mount.up))
+        right = _clean(_cross(look, up))
+        pos = tuple(c + mount.ahead_m * d for c, d in zip(inertial.com, look, strict=True))
+        self.lines.append(
+            f'{indent}<camera name="{CAMERA_NAME}" pos="{_v(pos)}" '
+            f'xyaxes="{_v(right)} {_v(up)}" fovy="{_f(mount.fovy_deg)}"/>'
+        )
+
     def inertial(self, link: str, indent: str) -> None:
         inertial = self.urdf.links.get(link)
         if inertial is None:
@@ -209,6 +263,7 @@ class _Writer:
                 f'armature="{_f(servo.armature_kgm2)}" frictionloss="{_f(servo.friction_nm)}"/>'
             )
         self.geoms(joint.child, indent + "  ", poses[joint.child][1])
+        self.camera(joint.child, indent + "  ", poses[joint.child][1])
         for child in self.urdf.children(joint.child):
             self.body(child, depth + 1, poses)
         self.lines.append(f"{indent}</body>")

@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
+import numpy as np
 
 from poppy_core.errors import ConfigError
 
 KINDS = ("cube", "sphere", "cylinder")
-_COLORS = {"cube": [0.85, 0.2, 0.2, 1.0], "sphere": [0.2, 0.5, 0.85, 1.0],
+CARD_HALF_THICKNESS_M = 0.001
+_COLORS = {"cube": [0.85, 0.2, 0.2, 1.0], "sphere": [0.2, 0.5, 0.85, 1.0], "card": [1.0] * 4,
            "cylinder": [0.2, 0.7, 0.3, 1.0]}  # fmt: skip
 
 
@@ -23,6 +25,11 @@ class ObjectSpec:
     position: tuple[float, float, float]
     size: tuple[float, ...]
     mass_kg: float
+    quat: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    fixed: bool = False
+    """Held where it was put (no free joint): a card in mid-air stays there."""
+    texture: np.ndarray | None = field(default=None, compare=False, repr=False)
+    """RGB image on the card's front face (local -y), as seen from the front."""
 
     @classmethod
     def make(
@@ -50,6 +57,8 @@ class ObjectSpec:
     def geom_size(self) -> list[float]:
         """MuJoCo geom size: box half sides, sphere radius, cylinder radius and half height."""
         s = self.size
+        if self.kind == "card":
+            return [s[0], CARD_HALF_THICKNESS_M, s[0]]
         if self.kind == "cube":
             return [s[0], s[0], s[0]] if len(s) == 1 else [s[0], s[1], s[2]]
         if self.kind == "sphere":
@@ -58,6 +67,7 @@ class ObjectSpec:
 
 
 _TYPES = {
+    "card": mujoco.mjtGeom.mjGEOM_BOX,
     "cube": mujoco.mjtGeom.mjGEOM_BOX,
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
     "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
@@ -68,9 +78,10 @@ def add_objects(xml: str, specs: list[ObjectSpec]) -> Any:
     """Compile ``xml`` with ``specs`` added as free bodies (MjSpec); returns the MjModel."""
     spec = mujoco.MjSpec.from_string(xml)
     for obj in specs:
-        body = spec.worldbody.add_body(name=obj.name, pos=list(obj.position))
-        body.add_freejoint(name=f"{obj.name}_free")
-        body.add_geom(
+        body = spec.worldbody.add_body(name=obj.name, pos=list(obj.position), quat=list(obj.quat))
+        if not obj.fixed:
+            body.add_freejoint(name=f"{obj.name}_free")
+        geom = body.add_geom(
             name=obj.name,
             type=_TYPES[obj.kind],
             size=obj.geom_size(),
@@ -79,4 +90,40 @@ def add_objects(xml: str, specs: list[ObjectSpec]) -> Any:
             contype=1,
             conaffinity=3,
         )
+        if obj.texture is not None:
+            geom.material = _textured(spec, obj.name, obj.texture)
+            geom.rgba = [1.0, 1.0, 1.0, 1.0]
     return spec.compile()
+
+
+def _textured(spec: Any, name: str, image: np.ndarray) -> str:
+    """A material showing ``image`` (RGB) on a box's -y face, as seen from the front."""
+    pixels = np.ascontiguousarray(image[:, :, :3], dtype=np.uint8)
+    height, width = pixels.shape[:2]
+    texture = spec.add_texture(
+        name=f"{name}_texture", type=mujoco.mjtTexture.mjTEXTURE_2D, width=width,
+        height=height, nchannel=3,
+    )  # fmt: skip
+    texture.data = pixels.tobytes()
+    material = spec.add_material(name=f"{name}_material")
+    roles = list(material.textures)
+    roles[int(mujoco.mjtTextureRole.mjTEXROLE_RGB)] = f"{name}_texture"
+    material.textures = roles
+    return f"{name}_material"
+
+
+def facing_quat(facing: tuple[float, float, float]) -> tuple[float, float, float, float]:
+    """Orientation of a card whose front (local -y) looks along ``facing``, its top up."""
+    front = np.asarray(facing, dtype=float)
+    norm = float(np.linalg.norm(front))
+    if norm == 0:
+        raise ConfigError("a card must face some direction", field="facing", value=facing)
+    y = -front / norm
+    up = np.array([0.0, 0.0, 1.0]) if abs(y[2]) < 0.95 else np.array([1.0, 0.0, 0.0])
+    z = up - y * float(up @ y)
+    z /= float(np.linalg.norm(z))
+    x = np.cross(y, z)
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, np.column_stack([x, y, z]).ravel())
+    w, qx, qy, qz = (float(v) for v in quat)
+    return (w, qx, qy, qz)

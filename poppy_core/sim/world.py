@@ -20,7 +20,7 @@ from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.errors import ConfigError
 from poppy_core.sim.drive import Drive, Joint
 from poppy_core.sim.exchange import MotorPort
-from poppy_core.sim.objects import ObjectSpec, add_objects
+from poppy_core.sim.objects import ObjectSpec, add_objects, facing_quat
 from poppy_core.sim.plant import JointLink
 
 logger = logging.getLogger(__name__)
@@ -278,7 +278,62 @@ class Simulation:
         Raises:
             ConfigError: unknown kind, or the name is already used.
         """
-        spec = ObjectSpec.make(kind, name, position, size, mass)
+        self._add(ObjectSpec.make(kind, name, position, size, mass))
+
+    def add_marker(
+        self,
+        name: str,
+        marker_id: int,
+        position: tuple[float, float, float],
+        size: float = 0.05,
+        *,
+        family: str = "aruco",
+        dictionary: str = "DICT_4X4_50",
+        facing: tuple[float, float, float] | None = None,
+    ) -> None:
+        """Add a card showing a marker, held in place (it does not fall).
+
+        Args:
+            name: the card's body name.
+            marker_id: the marker's id.
+            position: the card's centre (m, world).
+            size: side of the marker's black square (m), as the detector's ``marker_size``;
+                the card adds a white margin of one cell around it.
+            family: ``"aruco"`` or ``"hamming"`` (pypot's cards).
+            dictionary: the ArUco dictionary.
+            facing: direction the marker faces; None: toward the robot's camera (``camera``).
+
+        Raises:
+            ConfigError: the name is used, or no direction to face.
+            SensorError: unknown family, dictionary or id.
+        """
+        from poppy_core.sensors.markers import marker_image
+
+        grey = np.asarray(marker_image(marker_id, family, dictionary, size_px=240))
+        image = np.repeat(grey[:, :, None], 3, axis=2)
+        dark = np.nonzero(grey.min(axis=0) < 128)[0]  # columns of the black square
+        card_half = size / 2 * grey.shape[1] / float(dark[-1] - dark[0] + 1)
+        if facing is None:
+            facing = self._toward_camera(position)
+        spec = ObjectSpec("card", name, tuple(float(v) for v in position),  # type: ignore[arg-type]
+                          (card_half,), 0.01, facing_quat(facing), True, image)  # fmt: skip
+        self._add(spec)
+
+    def _toward_camera(self, position: tuple[float, float, float]) -> tuple[float, float, float]:
+        with self._lock:
+            camera = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, "camera")
+            if camera < 0:
+                raise ConfigError("no camera to face: give facing=(x, y, z)", field="facing")
+            x, y, z = (float(v) for v in self.data.cam_xpos[camera] - np.asarray(position))
+        return (x, y, z)
+
+    @property
+    def lock(self) -> threading.RLock:
+        """The world's lock: hold it to read ``model``/``data`` consistently."""
+        return self._lock
+
+    def _add(self, spec: ObjectSpec) -> None:
+        name = spec.name
         with self._lock:
             if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
                 raise ConfigError(f"an object called {name!r} exists", field=name)

@@ -16,6 +16,8 @@ NAMES = st.from_regex(r"[a-z][a-z0-9_]{0,7}", fullmatch=True)
 FINITE = st.floats(min_value=-360, max_value=360, allow_nan=False) | st.integers(-360, 360)
 JSON_SCALARS = (st.none() | st.booleans() | st.integers(-(2**40), 2**40)
                 | st.floats(allow_nan=False, allow_infinity=False) | st.text(max_size=12))
+SENSOR_KEYS = {"type", "fps", "freq", "resolution", "calibration", "cameras", "cards",
+               "marker_size", "families", "index", "device", "sim_camera"}
 JSON_VALUES = st.recursive(
     JSON_SCALARS,
     lambda inner: st.lists(inner, max_size=3) | st.dictionaries(NAMES, inner, max_size=3),
@@ -85,8 +87,13 @@ def robot_configs(draw: st.DrawFn) -> dict[str, Any]:
         controllers[cname] = controller
     data: dict[str, Any] = {"controllers": controllers, "motorgroups": groups, "motors": motors}
     if draw(st.booleans()):
-        data["sensors"] = draw(st.dictionaries(NAMES, st.dictionaries(NAMES, JSON_VALUES,
-                                                                      max_size=4), max_size=3))
+        # sensors of the types poppy builds, with any extra keys (kept as they are)
+        extras = st.dictionaries(NAMES.filter(lambda n: n not in SENSOR_KEYS), JSON_VALUES,
+                                 max_size=3)  # fmt: skip
+        free = NAMES.filter(lambda n: n not in data["motors"] and n not in groups)
+        cameras = draw(st.dictionaries(free, extras, max_size=2))
+        data["sensors"] = {name: {"type": draw(st.sampled_from(["OpenCVCamera", "DummyCamera"])),
+                                  **extra} for name, extra in cameras.items()}  # fmt: skip
     if draw(st.booleans()):
         data["x_extra"] = draw(JSON_VALUES)
     return data

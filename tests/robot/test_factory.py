@@ -84,7 +84,7 @@ def test_missing_motors_are_listed(served: list[EmulatorServer]) -> None:
     url = serve(served, ergo_line([1, 2, 3, 4]))
     before = set(threading.enumerate())
     with pytest.raises(SetupError) as info:
-        from_profile("ergo-jr", port=url)
+        from_profile("ergo-jr", port=url, sensors=False)
     message = str(info.value)
     assert "m5 (id 5)" in message and "m6 (id 6)" in message and "m4" not in message
     assert url in message and "1000000 bps" in message
@@ -96,12 +96,12 @@ def test_wrong_model_is_reported(served: list[EmulatorServer]) -> None:
     other = VirtualMotor(model_by_name("XL430-W250"), 6, 1_000_000)
     url = serve(served, ergo_line([1, 2, 3, 4, 5], extra=(other,)))
     with pytest.raises(SetupError, match=r"m6 \(id 6\) is XL430-W250, config says XL-320"):
-        from_profile("ergo-jr", port=url)
+        from_profile("ergo-jr", port=url, sensors=False)
 
 
 def test_not_strict_starts_missing_motors_offline(served: list[EmulatorServer]) -> None:
     url = serve(served, ergo_line([1, 2, 3, 4, 5]))
-    with from_profile("ergo-jr", port=url, strict=False) as robot:
+    with from_profile("ergo-jr", port=url, sensors=False, strict=False) as robot:
         assert not robot.m6.online and robot.m5.online
         assert robot.sync_stats()["my_dxl_controller"].offline == ["m6"]
 
@@ -109,7 +109,7 @@ def test_not_strict_starts_missing_motors_offline(served: list[EmulatorServer]) 
 def test_return_delay_reported_then_fixed_with_consent(served: list[EmulatorServer]) -> None:
     bus = ergo_line([1, 2, 3, 4, 5, 6], delay_zero=False)
     url = serve(served, bus)
-    with from_profile("ergo-jr", port=url):
+    with from_profile("ergo-jr", port=url, sensors=False):
         pass
     assert all(m.table.get("return_delay_time") == 250 for m in bus.motors)
     shown: list[list[ReturnDelayIssue]] = []
@@ -118,7 +118,7 @@ def test_return_delay_reported_then_fixed_with_consent(served: list[EmulatorServ
         shown.append(issues)
         return True
 
-    with from_profile("ergo-jr", port=url, fix_return_delay=consent):
+    with from_profile("ergo-jr", port=url, sensors=False, fix_return_delay=consent):
         pass
     assert [i.motor for i in shown[0]] == ["m1", "m2", "m3", "m4", "m5", "m6"]
     assert shown[0][0].delay_us == 500
@@ -128,10 +128,10 @@ def test_return_delay_reported_then_fixed_with_consent(served: list[EmulatorServ
 def test_auto_port_finds_the_bus(served: list[EmulatorServer]) -> None:
     empty = serve(served, VirtualBus([], 2))
     url = serve(served, ergo_line([1, 2, 3, 4, 5, 6]))
-    with from_profile("ergo-jr", ports=[empty, url]) as robot:
+    with from_profile("ergo-jr", ports=[empty, url], sensors=False) as robot:
         assert robot.buses["my_dxl_controller"].port == url
     with pytest.raises(SetupError, match="searched"):
-        from_profile("ergo-jr", ports=[empty])
+        from_profile("ergo-jr", ports=[empty], sensors=False)
 
 
 def test_autodetect_builds_what_it_finds(served: list[EmulatorServer]) -> None:

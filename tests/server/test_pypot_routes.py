@@ -137,13 +137,6 @@ def test_bad_gotos(client: httpx.Client, path: str, body: object, status: int) -
     assert set(answer.json()) == {"error", "tip", "details"}
 
 
-def test_sensors_are_empty(client: httpx.Client) -> None:
-    assert client.get("/sensors/list.json").json() == {"sensors": []}
-    assert client.get("/sensors/camera/registers/list.json").status_code == 404
-    assert client.get("/sensors/camera/registers/frame/value.json").status_code == 404
-    assert client.post("/sensors/camera/registers/x/value.json", content="1").status_code == 404
-
-
 def test_no_store_and_options_like_pypot(client: httpx.Client) -> None:
     # pypot's open CORS needs --cors '*' (test_origins.py); scripts see no difference
     answer = client.get("/motors/list.json")

@@ -59,8 +59,8 @@ def open_robot(source: str, sim: SimMode) -> Robot:
     from poppy_core.creatures import from_config, from_profile
 
     if Path(source).is_file():
-        return from_config(Path(source), sim)
-    return from_profile(source, sim=sim)
+        return from_config(Path(source), sim, sensors=False)
+    return from_profile(source, sim=sim, sensors=False)
 
 
 class MotorsView(Vertical):

@@ -1,4 +1,4 @@
-"""pypot's routes for the robot, motors, registers, gotos and sensors (same paths and shapes)."""
+"""pypot's routes for the robot, motors, registers and gotos (same paths and shapes)."""
 
 import html
 import math
@@ -13,7 +13,6 @@ from poppy_core.server.routers.common import json_body, truthy, wait_goto
 
 router = APIRouter(tags=["pypot"])
 
-SENSOR_TIP = "the sensors are listed by /sensors/list.json (this robot has none)"
 GOTO_TIP = (
     '"position" (degrees) and "duration" (seconds) are required, "wait" is optional. '
     'Example: {"position": 90, "duration": 3, "wait": true}'
@@ -140,31 +139,3 @@ async def motors_goto(request: Request, service: Service) -> JSONResponse:
     if wait:
         await wait_goto(handle)
     return JSONResponse({"motors": targets, "duration": duration, "waiting": wait}, status_code=202)
-
-
-@router.get("/sensors/list.json", summary="The sensor names (none yet)")
-async def sensors_list() -> JSONResponse:
-    """``{"sensors": []}``: poppy drives no sensors yet."""
-    return JSONResponse({"sensors": []})
-
-
-def _no_sensor(sensor: str) -> ApiError:
-    return ApiError("not_found", f"Sensor '{sensor}' does not exist.", tip=SENSOR_TIP)
-
-
-@router.get("/sensors/{sensor}/registers/list.json", summary="The registers of a sensor")
-async def sensor_registers(sensor: str) -> JSONResponse:
-    """404: there is no sensor."""
-    raise _no_sensor(sensor)
-
-
-@router.get("/sensors/{sensor}/registers/{register}/value.json", summary="Read a sensor")
-async def get_sensor_register(sensor: str, register: str) -> JSONResponse:
-    """404: there is no sensor."""
-    raise _no_sensor(sensor)
-
-
-@router.post("/sensors/{sensor}/registers/{register}/value.json", summary="Write a sensor")
-async def set_sensor_register(sensor: str, register: str) -> JSONResponse:
-    """404: there is no sensor."""
-    raise _no_sensor(sensor)

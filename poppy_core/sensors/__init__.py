@@ -1,0 +1,41 @@
+"""Sensors: cameras (OpenCV devices, blank, simulated in ``poppy_core.sim``), marker detection.
+
+Imports nothing of ours but ``errors``; OpenCV is imported on first use. The robot factory
+builds them from a config's ``sensors`` section (``build_sensors``).
+"""
+
+from poppy_core.sensors.base import Sensor, SensorHealth, SensorLost
+from poppy_core.sensors.camera import Camera, CameraCalibration, DummyCamera, Frame
+from poppy_core.sensors.config import (
+    NOT_YET,
+    SUPPORTED_TYPES,
+    SensorProblem,
+    build_sensors,
+    check_section,
+    dummy_camera,
+    opencv_camera,
+)
+from poppy_core.sensors.detector import MarkerDetector
+from poppy_core.sensors.markers import Marker, MarkerFinder, MarkerPose, marker_image
+
+__all__ = [
+    "NOT_YET",
+    "SUPPORTED_TYPES",
+    "Camera",
+    "CameraCalibration",
+    "DummyCamera",
+    "Frame",
+    "Marker",
+    "MarkerDetector",
+    "MarkerFinder",
+    "MarkerPose",
+    "Sensor",
+    "SensorHealth",
+    "SensorLost",
+    "SensorProblem",
+    "build_sensors",
+    "check_section",
+    "dummy_camera",
+    "marker_image",
+    "opencv_camera",
+]

@@ -1,0 +1,355 @@
+"""The sensor contract: a name, registers, a background update at its own rate, health.
+
+A sensor starts on first use (a register read or ``start()``): the first read waits for the
+first value, later reads return the latest one at once. ``update()`` runs in the sensor's own
+thread at ``rate_hz``. A device that goes away (``SensorLost``) is logged at WARNING once,
+shown in ``health()``, reopened with backoff (``reconnect()``) and resumes; one WARNING says
+it is back. Other failures of ``update()`` are counted like a motor's failed reads.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from poppy_core.errors import SensorError
+
+logger = logging.getLogger(__name__)
+
+FIRST_VALUE_TIMEOUT_S = 5.0
+"""How long the first read of a sensor waits for its first value."""
+BACKOFF_START_S = 0.25
+BACKOFF_MAX_S = 5.0
+
+
+class SensorLost(SensorError):
+    """The device behind a sensor stopped answering (unplugged, closed by another program)."""
+
+
+@dataclass(frozen=True)
+class SensorHealth:
+    """Is one sensor well? ``Robot.sensor_health()`` gives one per sensor.
+
+    Same shape as the buses' health: ``ok``, ``connected``, ``running``, ``down_s``, ``losses``,
+    measured and target rates, error counters, and ``as_dict()`` for ``--json`` and REST.
+
+    Attributes:
+        name: the sensor's name (``camera``, ``marker_detector``...).
+        kind: its type (``OpenCVCamera``, ``SimCamera``, ``MarkerDetector``...).
+        connected: False while its device is lost (it is reopened with backoff).
+        running: its background thread is alive (False before first use and after close).
+        down_s: seconds since the device was lost (0 while connected).
+        losses: times the device was lost.
+        rate_hz: updates per second measured now.
+        target_hz: updates per second asked for.
+        errors: failed updates since the start.
+        last_error: the last failure's message ("" when none).
+        age_s: seconds since the last good update (None before the first one).
+    """
+
+    name: str
+    kind: str
+    connected: bool
+    running: bool
+    down_s: float
+    losses: int
+    rate_hz: float
+    target_hz: float
+    errors: int
+    last_error: str
+    age_s: float | None
+
+    @property
+    def ok(self) -> bool:
+        """Connected (a sensor not started yet is well)."""
+        return self.connected
+
+    def as_dict(self) -> dict[str, object]:
+        """Plain data (for ``--json`` and the REST API)."""
+        data = dict(vars(self))
+        data["ok"] = self.ok
+        data["rate_hz"] = round(self.rate_hz, 2)
+        data["down_s"] = round(self.down_s, 3)
+        data["age_s"] = None if self.age_s is None else round(self.age_s, 3)
+        return data
+
+
+class _Rate:
+    """Updates per second over the last few updates (0 once they are stale)."""
+
+    def __init__(self, window: int = 30) -> None:
+        self._times: deque[float] = deque(maxlen=window)
+
+    def tick(self, now_s: float) -> None:
+        self._times.append(now_s)
+
+    def at(self, now_s: float, stale_s: float) -> float:
+        if len(self._times) < 2 or now_s - self._times[-1] > stale_s:
+            return 0.0
+        span = self._times[-1] - self._times[0]
+        return (len(self._times) - 1) / span if span > 0 else 0.0
+
+
+class Sensor:
+    """Base of every sensor: subclasses give ``registers`` and implement ``update``.
+
+    Args:
+        name: the sensor's name (``robot.<name>``).
+        rate_hz: how often ``update`` runs once started.
+        clock: monotonic clock in seconds.
+    """
+
+    registers: ClassVar[tuple[str, ...]] = ()
+    """Names readable as attributes and through REST (pypot's ``registers``)."""
+    writable: ClassVar[tuple[str, ...]] = ()
+    """Registers that may be set through REST."""
+
+    def __init__(
+        self, name: str, rate_hz: float, *, clock: Callable[[], float] = time.monotonic
+    ) -> None:
+        if not rate_hz > 0 or not math.isfinite(rate_hz):
+            raise SensorError(
+                f"sensor {name!r}: its rate must be a positive number of Hz, got {rate_hz}",
+                sensor=name,
+            )
+        self._name = name
+        self._rate_hz = float(rate_hz)
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._first = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._closed = False
+        self._rate = _Rate()
+        self._connected = True
+        self._down_since = 0.0
+        self._losses = 0
+        self._errors = 0
+        self._last_error = ""
+        self._warned = False
+        self._last_good: float | None = None
+        self._fatal = ""
+
+    # -- what subclasses implement -----------------------------------------------------------
+
+    def update(self) -> None:
+        """One background step (grab a frame, detect markers...).
+
+        Raises:
+            SensorLost: the device went away (``reconnect`` is then retried with backoff).
+            Exception: any other failure is counted and logged once; the loop goes on.
+        """
+        raise NotImplementedError
+
+    def reconnect(self) -> None:
+        """Reopen the device after ``SensorLost`` (raise ``SensorError`` while it is away)."""
+
+    def release(self) -> None:
+        """Free the device (called once, by ``close``, after the thread stopped)."""
+
+    def thread_ended(self) -> None:
+        """Free what belongs to the sensor's thread (an OpenGL context), in that thread."""
+
+    def fail(self, reason: str) -> None:
+        """Give up for good (no OpenGL, no such camera in the model): reads raise at once."""
+        self._fatal = reason
+        self._last_error = reason
+        self._first.set()
+        self._stop.set()
+        self.wake()
+
+    def wake(self) -> None:
+        """Wake the threads waiting for a value (``Camera`` overrides it)."""
+
+    # -- the contract -----------------------------------------------------------------------
+
+    @property
+    def name(self) -> str:
+        """The sensor's name."""
+        return self._name
+
+    @property
+    def kind(self) -> str:
+        """Its type name, as a config's ``type`` names it."""
+        return type(self).__name__
+
+    @property
+    def rate_hz(self) -> float:
+        """How often the background update runs."""
+        return self._rate_hz
+
+    def clock_s(self) -> float:
+        """The sensor's clock now (frame times are on it)."""
+        return self._clock()
+
+    @property
+    def running(self) -> bool:
+        """True while the background thread is alive."""
+        thread = self._thread
+        return thread is not None and thread.is_alive()
+
+    @property
+    def closed(self) -> bool:
+        """True once ``close`` ran."""
+        return self._closed
+
+    def start(self) -> None:
+        """Start the background update (idempotent; reading a register does it too).
+
+        Raises:
+            SensorError: the sensor was closed.
+        """
+        with self._lock:
+            if self._closed:
+                raise SensorError(f"sensor {self._name!r} is closed", sensor=self._name)
+            if self._thread is not None:
+                return
+            self._stop.clear()
+            self._thread = threading.Thread(
+                target=self._run, name=f"sensor {self._name}", daemon=True
+            )
+            self._thread.start()
+
+    def close(self) -> None:
+        """Stop the thread and free the device (idempotent)."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            thread, self._thread = self._thread, None
+        self._stop.set()
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout=2.0)
+        try:
+            self.release()
+        except Exception:
+            logger.exception("closing sensor %s", self._name)
+
+    def __enter__(self) -> Sensor:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def wait_first(self, timeout_s: float = FIRST_VALUE_TIMEOUT_S) -> None:
+        """Start if needed and wait until the first update succeeded.
+
+        Raises:
+            SensorError: no value within ``timeout_s`` (with the last failure, if any).
+        """
+        self.start()
+        if self._first.wait(timeout_s) and not self._fatal:
+            return
+        if self._fatal:
+            raise SensorError(f"{self.kind} {self._name!r}: {self._fatal}", sensor=self._name)
+        why = f": {self._last_error}" if self._last_error else ""
+        raise SensorError(
+            f"{self.kind} {self._name!r} gave no value in {timeout_s:g} s{why}", sensor=self._name
+        )
+
+    def read(self, register: str) -> Any:
+        """The value of ``register`` (what REST's ``value.json`` answers).
+
+        Raises:
+            SensorError: not one of this sensor's registers.
+        """
+        if register not in self.registers:
+            known = ", ".join(self.registers)
+            raise SensorError(
+                f"sensor {self._name!r} has no register {register!r} (registers: {known})",
+                sensor=self._name,
+            )
+        return getattr(self, register)
+
+    def health(self) -> SensorHealth:
+        """Connected or not, rate now, errors, age of the latest value."""
+        now = self._clock()
+        return SensorHealth(
+            name=self._name,
+            kind=self.kind,
+            connected=self._connected and not self._fatal,
+            running=self.running,
+            down_s=0.0 if self._connected else now - self._down_since,
+            losses=self._losses,
+            rate_hz=self._rate.at(now, max(1.0, 3.0 / self._rate_hz)),
+            target_hz=self._rate_hz,
+            errors=self._errors,
+            last_error=self._last_error,
+            age_s=None if self._last_good is None else now - self._last_good,
+        )
+
+    def __repr__(self) -> str:
+        return f"<{self.kind} {self._name!r}>"
+
+    # -- the loop ----------------------------------------------------------------------------
+
+    def _run(self) -> None:
+        try:
+            self._loop()
+        finally:
+            try:
+                self.thread_ended()
+            except Exception:
+                logger.exception("sensor %s: cleaning up its thread", self._name)
+
+    def _loop(self) -> None:
+        period = 1.0 / self._rate_hz
+        deadline = self._clock()
+        while not self._stop.is_set():
+            if self._connected:
+                self._step()
+            else:
+                self._retry()
+                continue
+            deadline += period
+            now = self._clock()
+            if now > deadline:  # late: skip the missed periods, no burst to catch up
+                deadline = now
+            self._stop.wait(max(0.0, deadline - now))
+
+    def _step(self) -> None:
+        try:
+            self.update()
+        except SensorLost as exc:
+            self._lost(str(exc))
+            return
+        except Exception as exc:
+            self._errors += 1
+            self._last_error = str(exc) or type(exc).__name__
+            if not self._warned:
+                self._warned = True
+                logger.warning("%s %s: update failed: %s", self.kind, self._name, exc)
+            return
+        now = self._clock()
+        self._rate.tick(now)
+        self._last_good = now
+        self._warned = False
+        self._first.set()
+
+    def _lost(self, reason: str) -> None:
+        self._connected = False
+        self._down_since = self._clock()
+        self._losses += 1
+        self._errors += 1
+        self._last_error = reason
+        logger.warning("%s %s lost: %s; retrying", self.kind, self._name, reason)
+
+    def _retry(self) -> None:
+        backoff = BACKOFF_START_S
+        while not self._stop.wait(backoff):
+            try:
+                self.reconnect()
+            except Exception as exc:
+                self._last_error = str(exc)
+                backoff = min(backoff * 2, BACKOFF_MAX_S)
+                continue
+            self._connected = True
+            down_s = self._clock() - self._down_since
+            logger.warning("%s %s is back after %.1f s", self.kind, self._name, down_s)
+            return

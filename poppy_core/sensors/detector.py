@@ -1,0 +1,120 @@
+"""``MarkerDetector``: markers in the frames of one or more cameras, in the background.
+
+pypot's ``MarkerDetector`` (``cameras``, ``freq``; register ``markers``) with ArUco and Hamming
+markers, poses when a camera's calibration is known, and named cards: ``sees("caribou")`` is
+the library call behind Snap!'s ``/detect/<card>`` block.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import ClassVar
+
+from poppy_core.errors import SensorError
+from poppy_core.sensors.base import FIRST_VALUE_TIMEOUT_S, Sensor
+from poppy_core.sensors.camera import Camera
+from poppy_core.sensors.markers import (
+    DEFAULT_DICTIONARY,
+    DEFAULT_MARKER_SIZE_M,
+    FAMILIES,
+    Marker,
+    MarkerFinder,
+)
+
+DEFAULT_FREQ_HZ = 5.0
+STALE_FRAME_S = 2.0
+"""Frames older than this (a lost camera) show no markers."""
+
+
+class MarkerDetector(Sensor):
+    """Detects markers in the latest frames of ``cameras`` at ``freq`` Hz.
+
+    Args:
+        name: the sensor's name (``marker_detector``).
+        cameras: the cameras to look through.
+        freq: detections per second.
+        cards: card name -> the marker ids printed on it (``{"caribou": [221052793]}``).
+        dictionary: the ArUco dictionary.
+        marker_size: side of the printed markers in metres (for poses).
+        families: ``"aruco"``, ``"hamming"`` or both.
+    """
+
+    registers: ClassVar[tuple[str, ...]] = ("markers", "cards")
+
+    def __init__(
+        self,
+        name: str,
+        cameras: Sequence[Camera],
+        freq: float = DEFAULT_FREQ_HZ,
+        *,
+        cards: Mapping[str, Sequence[int]] | None = None,
+        dictionary: str = DEFAULT_DICTIONARY,
+        marker_size: float = DEFAULT_MARKER_SIZE_M,
+        families: Sequence[str] = FAMILIES,
+    ) -> None:
+        super().__init__(name, freq)
+        if not cameras:
+            raise SensorError(f"sensor {name!r}: a marker detector needs a camera", sensor=name)
+        self.cameras = list(cameras)
+        self.finder = MarkerFinder(dictionary, marker_size, tuple(families))
+        self.card_ids: dict[str, list[int]] = {k: list(v) for k, v in (cards or {}).items()}
+        self._markers: list[Marker] = []
+        self._seen: dict[str, tuple[int, list[Marker]]] = {}
+
+    def update(self) -> None:
+        markers: list[Marker] = []
+        for camera in self.cameras:
+            frame = camera.latest()
+            if camera.clock_s() - frame.time_s > STALE_FRAME_S:
+                continue
+            number, found = self._seen.get(camera.name, (0, []))
+            if number != frame.number:  # a new frame: look again
+                found = self.finder.find(frame.image, camera.calibration, camera.name)
+                self._seen[camera.name] = (frame.number, found)
+            markers.extend(found)
+        self._markers = markers
+
+    # -- registers -------------------------------------------------------------------------------
+
+    @property
+    def markers(self) -> list[Marker]:
+        """The markers seen in the latest frames (the first read starts the detector and waits).
+
+        Raises:
+            SensorError: no detection ran in time (a camera gives no frame).
+        """
+        self.wait_first(FIRST_VALUE_TIMEOUT_S * 2)
+        return list(self._markers)
+
+    @property
+    def cards(self) -> list[str]:
+        """Names of the cards seen now."""
+        ids = {m.id for m in self.markers}
+        return [card for card, card_ids in self.card_ids.items() if ids & set(card_ids)]
+
+    # -- library calls -----------------------------------------------------------------------------
+
+    def sees(self, card_or_id: str | int) -> bool:
+        """Whether a card (by name) or a marker id is in view now (Snap!'s ``/detect/<card>``).
+
+        Raises:
+            SensorError: an unknown card name (the known ones are listed).
+        """
+        if isinstance(card_or_id, int):
+            wanted = {card_or_id}
+        elif card_or_id.strip().lstrip("-").isdigit():
+            wanted = {int(card_or_id)}
+        elif card_or_id in self.card_ids:
+            wanted = set(self.card_ids[card_or_id])
+        else:
+            known = ", ".join(self.card_ids) or "none"
+            raise SensorError(
+                f"no card {card_or_id!r} (cards: {known}; or give a marker id)", sensor=self.name
+            )
+        return any(m.id in wanted for m in self.markers)
+
+    def detect(self, camera: Camera | None = None) -> list[Marker]:
+        """Detect now in ``camera``'s latest frame (the first camera by default), in this thread."""
+        chosen = camera or self.cameras[0]
+        frame = chosen.latest()
+        return self.finder.find(frame.image, chosen.calibration, chosen.name)

@@ -1,0 +1,103 @@
+"""The config's ``sensors`` section: pypot's form accepted, bad or unsupported sensors refused in
+one line, and robots built with their sensors (``robot.sensors``, ``robot.camera``)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+
+from poppy_core.errors import ConfigError, SensorError
+from poppy_core.robot import RobotConfig, from_profile, load_profile
+from poppy_core.sensors import DummyCamera, MarkerDetector
+
+pytest.importorskip("cv2")
+
+
+def with_sensors(sensors: dict[str, Any]) -> dict[str, Any]:
+    data = load_profile("ergo-jr").to_pypot_dict()
+    data["sensors"] = sensors
+    return data
+
+
+@pytest.mark.parametrize(
+    ("kind", "name"),
+    [("KinectSensor", "Kinect"), ("OptiTrackClient", "OptiTrack"), ("IMU", "IMU"),
+     ("ForceSensor", "force")],
+)
+def test_sensors_not_built_yet_are_one_line_errors(kind: str, name: str) -> None:
+    with pytest.raises(ConfigError) as caught:
+        RobotConfig.from_dict(with_sensors({"thing": {"type": kind}}), source="robot.json")
+    message = str(caught.value)
+    assert message.startswith(f'robot.json: sensors.thing.type = "{kind}": ')
+    assert f"{name} sensors are not supported yet" in message and "\n" not in message
+    assert caught.value.field == "sensors.thing.type"
+
+
+@pytest.mark.parametrize(
+    ("sensors", "words"),
+    [
+        ({"cam": {"type": "WebCam"}}, 'sensors.cam.type = "WebCam": unknown sensor type'),
+        ({"cam": {"type": "OpenCVCamera", "fps": 0}}, "sensors.cam.fps = 0: must be a positive"),
+        ({"cam": {"type": "OpenCVCamera", "resolution": [640]}}, "resolution must be"),
+        ({"cam": {"type": "OpenCVCamera", "calibration": {"camera_matrix": [1]}}}, "calibration"),
+        ({"md": {"type": "MarkerDetector", "cameras": ["cam"]}}, "'cam' is not a camera here"),
+        ({"cam": {"type": "DummyCamera"}, "md": {"type": "MarkerDetector", "cameras": ["cam"],
+          "cards": {"caribou": "x"}}}, "sensors.md.cards.caribou"),
+        ({"m1": {"type": "DummyCamera"}}, "sensor 'm1' has the name of a motor or group"),
+        ({"cam": "OpenCVCamera"}, 'sensors.cam = "OpenCVCamera": must be a valid dictionary'),
+    ],
+)
+def test_bad_sensor_entries_are_one_line_errors(sensors: dict[str, Any], words: str) -> None:
+    with pytest.raises(ConfigError) as caught:
+        RobotConfig.from_dict(with_sensors(sensors), source="robot.json")
+    assert words in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_pypot_sections_load_and_round_trip() -> None:
+    sensors = {
+        "camera": {"type": "OpenCVCamera", "index": -1, "fps": 20.0, "resolution": [640, 480]},
+        "marker_detector": {"type": "MarkerDetector", "cameras": ["camera"], "freq": 1.0,
+                            "need_robot": True},
+    }
+    config = RobotConfig.from_dict(with_sensors(sensors))
+    assert config.to_pypot_dict()["sensors"] == sensors
+
+
+def test_a_simulated_robot_has_the_profiles_sensors() -> None:
+    with from_profile("ergo-jr", sim=True) as robot:
+        assert [s.name for s in robot.sensors] == ["camera", "marker_detector"]
+        camera = robot.camera
+        assert isinstance(camera, DummyCamera) and robot.sensor("camera") is camera
+        assert camera.registers == ("frame", "resolution", "fps")
+        assert camera.resolution == [640, 480] and camera.fps == 20.0
+        detector = robot.marker_detector
+        assert isinstance(detector, MarkerDetector) and detector.cameras == [camera]
+        assert detector.card_ids == {"caribou": [221052793], "tetris": [112259237],
+                                     "lapin": [44616414]}  # fmt: skip
+        assert detector.sees("tetris") is False
+        assert set(robot.sensor_health()) == {"camera", "marker_detector"}
+        assert "camera" in dir(robot)
+        with pytest.raises(ConfigError, match=r"no sensor 'lidar' \(sensors: camera, marker_"):
+            robot.sensor("lidar")
+    assert camera.closed and detector.closed and not camera.running
+
+
+def test_sensors_can_be_left_out() -> None:
+    with from_profile("ergo-jr", sim=True, sensors=False) as robot:
+        assert robot.sensors == []
+        with pytest.raises(AttributeError, match="no motor, group, sensor or attribute"):
+            _ = robot.camera
+
+
+def test_a_missing_camera_stops_a_real_robot_in_one_line(tmp_path: Any) -> None:
+    data = with_sensors({"camera": {"type": "OpenCVCamera", "index": "/dev/video99"}})
+    data["controllers"]["my_dxl_controller"]["port"] = "loop://"
+    from poppy_core.robot import from_config
+
+    with pytest.raises(SensorError) as caught:
+        from_config(RobotConfig.from_dict(data), strict=False)
+    assert str(caught.value) == (
+        "camera 'camera': /dev/video99 does not exist: plug the camera in "
+        "(`poppy camera list` shows them)"
+    )
