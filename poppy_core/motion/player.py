@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.move import Move
 from poppy_core.robot.schedule import Periodic
 
@@ -31,6 +31,9 @@ DEFAULT_RATE_HZ = 50.0
 DEFAULT_RAMP_SPEED_DPS = 60.0
 """Mean speed of the ramp to the first frame (a minimum-jerk peak is 1.875 times that)."""
 MIN_RAMP_S = 0.3
+MIN_SPEED = 0.01
+MAX_SPEED = 100.0
+MAX_LOOPS = 10_000
 RAMP_SKIP_DEG = 0.5
 """No ramp when every motor is already this close to the first frame."""
 
@@ -94,7 +97,7 @@ class MovePlayer:
 
     Raises:
         ConfigError: the robot lacks motors of the move (they are named).
-        ValueError: an empty move, a speed or loop count that is not positive.
+        ArgumentError: an empty move, a speed or loop count out of range.
     """
 
     def __init__(
@@ -111,12 +114,17 @@ class MovePlayer:
         on_progress: ProgressCallback | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        if not (math.isfinite(speed) and speed > 0):
-            raise ValueError(f"speed must be a positive number, got {speed}")
-        if loops < 1:
-            raise ValueError(f"loops must be at least 1, got {loops}")
+        if not (math.isfinite(speed) and MIN_SPEED <= speed <= MAX_SPEED):
+            raise ArgumentError(
+                f"speed must be {MIN_SPEED:g}-{MAX_SPEED:g} (1 = as recorded), got {speed}",
+                field="speed", value=speed,
+            )  # fmt: skip
+        if not 1 <= loops <= MAX_LOOPS:
+            raise ArgumentError(
+                f"loops must be 1-{MAX_LOOPS}, got {loops}", field="loops", value=loops
+            )
         if len(move) == 0:
-            raise ValueError("the move has no frame to play")
+            raise ArgumentError("the move has no frame to play", field="move", value=move)
         missing = missing_motors(robot, move)
         if missing:
             known = ", ".join(m.name for m in robot.motors)

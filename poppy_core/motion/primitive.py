@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.primitive_values import convert_value
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
 from poppy_core.robot.schedule import Periodic, RateMeter
@@ -109,7 +109,7 @@ class Primitive:
         """Start the primitive, or restart it (a running one is stopped first).
 
         Raises:
-            PortError: the robot is closed.
+            RobotClosedError: the robot is closed.
             RuntimeError: called from the primitive's own thread.
         """
         if self._thread is threading.current_thread():
@@ -338,7 +338,10 @@ class LoopPrimitive(Primitive):
     @update_freq.setter
     def update_freq(self, value: float) -> None:
         if not math.isfinite(value) or value <= 0:
-            raise ValueError(f"update frequency must be a positive number of Hz, got {value}")
+            raise ArgumentError(
+                f"update frequency must be a positive number of Hz, got {value}",
+                field="update_freq", value=value,
+            )  # fmt: skip
         self._freq = float(value)
 
     @property

@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from poppy_core.motion.move import Move, resample
+from poppy_core.errors import ArgumentError
+from poppy_core.motion.move import MAX_FRAMERATE_HZ, MIN_FRAMERATE_HZ, Move, resample
 from poppy_core.motion.move_format import write_move
 from poppy_core.robot.schedule import Periodic
 
@@ -31,6 +32,8 @@ logger = logging.getLogger(__name__)
 
 DEFAULT_FREQ_HZ = 50.0
 DEFAULT_CHECKPOINT_S = 1.0
+MIN_FREQ_HZ = MIN_FRAMERATE_HZ
+MAX_FREQ_HZ = MAX_FRAMERATE_HZ
 _INITIAL_CAPACITY = 1024
 
 
@@ -71,7 +74,7 @@ class MoveRecorder:
 
     Raises:
         ConfigError: an unknown motor or group name.
-        ValueError: a frequency that is not positive.
+        ArgumentError: a frequency out of range.
     """
 
     def __init__(
@@ -86,8 +89,11 @@ class MoveRecorder:
         metadata: Mapping[str, Any] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        if not freq > 0:
-            raise ValueError(f"the recording frequency must be positive, got {freq}")
+        if not MIN_FREQ_HZ <= freq <= MAX_FREQ_HZ:  # also refuses NaN
+            raise ArgumentError(
+                f"the recording frequency must be {MIN_FREQ_HZ:g}-{MAX_FREQ_HZ:g} Hz, got {freq}",
+                field="freq", value=freq,
+            )  # fmt: skip
         self.robot = robot
         self.freq = float(freq)
         self.motors = resolve_motors(robot, motors)

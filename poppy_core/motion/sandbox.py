@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from poppy_core.errors import ConfigError, RegisterError
-from poppy_core.motion.trajectory import CONTROLS, MinimumJerk, dummy_speed
+from poppy_core.motion.trajectory import MinimumJerk, check_goto, dummy_speed
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -185,12 +185,9 @@ class MockupMotor:
             wait: block until the duration elapsed (or the primitive is stopped).
 
         Raises:
-            ValueError: unknown control or negative duration.
+            ArgumentError: unknown control, a negative or not finite duration.
         """
-        if control not in CONTROLS:
-            raise ValueError(f"control must be one of {', '.join(CONTROLS)}, not {control!r}")
-        if duration < 0:
-            raise ValueError(f"duration must not be negative, got {duration} s")
+        check_goto(duration, control)
         low, high = self._motor.angle_limit
         goal = min(max(_number(self._motor.name, "goal_position", position), low), high)
         start = self._requested_goal() if self._has_goal() else self._motor.present_position

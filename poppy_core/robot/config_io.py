@@ -7,6 +7,7 @@ import json
 import os
 import stat
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -90,6 +91,29 @@ def load_config(path: str | os.PathLike[str]) -> RobotConfig:
                            show_value=False) from None
     data = parse_config_text(text, source, fmt=_format_of(file, text))
     return RobotConfig.from_dict(data, source=source)
+
+
+ConfigSource = RobotConfig | Mapping[str, Any] | str | os.PathLike[str]
+"""What the factories take as a config: a RobotConfig, a pypot-style dict, or a file path."""
+
+DICT_SOURCE = "<config dict>"
+
+
+def as_config(config: ConfigSource) -> RobotConfig:
+    """A validated ``RobotConfig`` from a config, a dict (pypot's ``from_config(my_config)``) or a
+    JSON/YAML file path.
+
+    Raises:
+        ConfigError: an invalid config, an unreadable file, or another kind of object.
+    """
+    if isinstance(config, RobotConfig):
+        return config
+    if isinstance(config, Mapping):
+        return RobotConfig.from_dict(dict(config), source=DICT_SOURCE)
+    if isinstance(config, str | os.PathLike):
+        return load_config(config)
+    raise config_error(DICT_SOURCE, "", None, f"the config must be a RobotConfig, a mapping or a "
+                       f"file path, not {type(config).__name__}", show_value=False)
 
 
 class _ConfigDumper(yaml.SafeDumper):

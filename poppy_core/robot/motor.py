@@ -17,11 +17,11 @@ import functools
 import logging
 from typing import TYPE_CHECKING, Literal
 
-from poppy_core.errors import RegisterError
+from poppy_core.errors import RegisterError, RobotClosedError
 from poppy_core.models import ServoModel
 from poppy_core.robot import registers as regs
 from poppy_core.robot.goto import GotoHandle, GotoRunner
-from poppy_core.robot.motor_cache import MotorCache
+from poppy_core.robot.motor_cache import MotorCache, SIValue
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import MotorConfig
@@ -74,6 +74,7 @@ class Motor(MotorCache):
         self._behavior: CompliantBehavior = "dummy"
         self._goal_speed: float | None = None
         self._runner = runner if runner is not None else GotoRunner(name=f"goto {name}")
+        self._closed = False
         # The motor-frame range a position limit register can hold (AX -150..149.7°).
         register = model.register("min_position_limit")
         ends = sorted(float(register.to_si(r)) for r in (register.min_raw, register.max_raw))
@@ -350,6 +351,16 @@ class Motor(MotorCache):
         if regs.has_compliance_slopes(self.model):
             names += ["compliance_margin", "compliance_slope"]
         return tuple(names)
+
+    def mark_closed(self) -> None:
+        """The robot is closed: later writes raise ``RobotClosedError`` (reads keep the last
+        values)."""
+        self._closed = True
+
+    def _store(self, name: str, value: SIValue) -> None:
+        if self._closed:
+            raise RobotClosedError(f"{self.name}: the robot is closed, {name} cannot be written")
+        super()._store(name, value)
 
     def attach_runner(self, runner: GotoRunner) -> None:
         """Use the robot's goto runner (the private one is dropped)."""
