@@ -59,15 +59,17 @@ app.add_typer(sim_cmd.app, name="sim")
 
 
 def main() -> None:
-    """Run the CLI; a PoppyError becomes one line on stderr and exit code 1."""
-    from poppy_core.errors import PoppyError
+    """Run the CLI; a PoppyError becomes one line on stderr (one per problem) and exit code 1."""
+    from poppy_core.errors import ConfigError, PoppyError
 
     try:
         app()
     except PoppyError as exc:
         if state.debug:
             raise
-        error_line(str(exc))
+        problems = exc.problems if isinstance(exc, ConfigError) else [exc]
+        for problem in problems:
+            error_line(str(problem))
         sys.exit(EXIT_FAILURE)
     except KeyboardInterrupt:
         if state.debug:
