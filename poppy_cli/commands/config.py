@@ -8,7 +8,16 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.options import BAUD_HELP, PORT_HELP, PROTOCOL_HELP, default_port
-from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, console, error_line, fmt_value, print_json
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_USAGE,
+    console,
+    error_line,
+    fmt_value,
+    plain,
+    print_json,
+    styled,
+)
 
 if TYPE_CHECKING:
     from poppy_core.bus.results import FoundMotor
@@ -33,7 +42,7 @@ def validate(file: Path = typer.Argument(..., help="Config file (JSON or YAML)."
     from poppy_core.robot import load_config
 
     config = load_config(file)
-    console.print(f"[green]ok[/] {file}: {_counts(config)}")
+    console.print(styled("[green]ok[/] {}: {}", file, _counts(config)))
 
 
 @app.command("convert")
@@ -88,11 +97,11 @@ def show(
     console.print(table)
     for name, controller in config.controllers.items():
         console.print(
-            f"controller [bold]{name}[/]: port {controller.port}, protocol {controller.protocol}, "
-            f"{controller.baudrate} bps"
+            styled("controller [bold]{}[/]: port {}, protocol {}, {} bps", name, controller.port,
+                   controller.protocol, controller.baudrate)
         )
     for name in config.motorgroups:
-        console.print(f"group [bold]{name}[/]: {', '.join(config.resolve_group(name))}")
+        console.print(styled("group [bold]{}[/]: {}", name, ", ".join(config.resolve_group(name))))
 
 
 @app.command("list")
@@ -123,7 +132,7 @@ def list_cmd(
     for column in ("name", "origin", "description"):
         table.add_column(column)
     for p in profiles:
-        table.add_row(p.name, "[bold]user[/]" if p.user else "installed", p.description)
+        table.add_row(p.name, styled("[bold]user[/]") if p.user else "installed", p.description)
     console.print(table)
 
 
@@ -189,7 +198,7 @@ def generate(
         raise typer.Exit(EXIT_USAGE)
     baudrates = [baud] if baud is not None else None
     protocols = [protocol] if protocol is not None else [1, 2]
-    with console.status(f"scanning {chosen_port}…"):
+    with console.status(plain(f"scanning {chosen_port}…")):
         found = [f for f in run_scan(chosen_port, baudrates, protocols) if f.model is not None]
     if not found:
         error_line(f"no known motor found on {chosen_port}")

@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from poppy_cli.output import EXIT_USAGE, console, error_line, print_json
+from poppy_cli.output import EXIT_USAGE, console, error_line, print_json, styled
 
 app = typer.Typer(
     help="The move library (recorded with `poppy record`): list, show, plot, rm, export, import.",
@@ -73,7 +73,7 @@ def list_cmd(json_output: bool = JsonOpt) -> None:
         table.add_column(column, justify="right" if column in ("duration", "frames") else "left")
     for row in rows:
         if row.get("error"):
-            table.add_row(row["name"], row["format"], "[red]unreadable[/]", "", "", "", "")
+            table.add_row(row["name"], row["format"], styled("[red]unreadable[/]"), "", "", "", "")
             continue
         table.add_row(
             row["name"], row["format"], f"{row['duration_s']:.2f} s", str(row["frames"]),
@@ -102,8 +102,9 @@ def show(name: str = NameArg, json_output: bool = JsonOpt) -> None:
         print_json(header)
         return
     console.print(
-        f"[bold]{header['name']}[/] ({header['format']}, {_size(header['size_bytes'])}): "
-        f"{header['frames']} frames at {header['framerate']:g} Hz = {header['duration_s']:.2f} s"
+        styled("[bold]{}[/] ({}, {}): {} frames at {} Hz = {} s", header["name"], header["format"],
+               _size(header["size_bytes"]), header["frames"], f"{header['framerate']:g}",
+               f"{header['duration_s']:.2f}")
     )
     for key, value in header["metadata"].items():
         console.print(f"  {key}: {value}")

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json
+from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -167,9 +167,8 @@ def status_table(robot: Robot | RemoteRobot, title: str = "robot status") -> Tab
     table.add_column("compliant")
     table.add_column("link")
     for name, state in robot_state(robot).items():
-        link = "online" if state["online"] else "[red]offline[/]"
-        if state["errors"]:
-            link += f" ({state['errors']} errors)"
+        errors = f" ({state['errors']} errors)" if state["errors"] else ""
+        link = styled("online{}" if state["online"] else "[red]offline[/]{}", errors)
         table.add_row(
             name,
             str(state["id"]),

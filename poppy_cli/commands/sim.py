@@ -13,7 +13,15 @@ from typing import TYPE_CHECKING, Any
 import typer
 from typer.core import TyperGroup
 
-from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, console, err_console, error_line
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_USAGE,
+    console,
+    err_console,
+    error_line,
+    plain,
+    styled,
+)
 
 if TYPE_CHECKING:
     from typer import _click
@@ -162,9 +170,9 @@ def _serve(profile: str, speed: float, tcp: str | None, view: bool) -> None:
             bus = server.bus
             ids = ", ".join(str(m.id) for m in bus.motors)
             err_console.print(
-                f"[green]simulating[/] {profile} {name}: {len(bus.motors)} motors (ids {ids}), "
-                f"protocol {bus.protocol} at {bus.baudrate} bps on {server.url}, MuJoCo at "
-                f"{speed:g}× real time — Ctrl-C to stop"
+                styled("[green]simulating[/] {}", f"{profile} {name}: {len(bus.motors)} motors "
+                       f"(ids {ids}), protocol {bus.protocol} at {bus.baudrate} bps on "
+                       f"{server.url}, MuJoCo at {speed:g}× real time — Ctrl-C to stop")
             )
         viewer = _open_viewer(simulation) if view else None
         while not stop.wait(1 / 30 if viewer is not None else 0.5):
@@ -353,7 +361,7 @@ def render(
         raise _no_gl("no working OpenGL backend: EGL and OSMesa failed")
     chosen = None if camera in (None, "free") else camera
     try:
-        with console.status(f"rendering {profile} with MuJoCo ({backend})…"):
+        with console.status(plain(f"rendering {profile} with MuJoCo ({backend})…")):
             frames = render_frames(profile, move, chosen, width, height)
     except ConfigError as exc:
         if exc.field == "MUJOCO_GL":
