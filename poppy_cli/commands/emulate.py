@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from poppy_cli.options import BAUD_LIMITS
 from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
 
 if TYPE_CHECKING:
@@ -35,7 +36,9 @@ def emulate(
     protocol: int | None = typer.Option(
         None, "--protocol", min=1, max=2, help="Protocol (default: the models')."
     ),
-    baud: int | None = typer.Option(None, "--baud", "-b", help="Baud rate (default 1000000)."),
+    baud: int | None = typer.Option(
+        None, "--baud", "-b", help="Baud rate (default 1000000).", **BAUD_LIMITS
+    ),
     pty: bool = typer.Option(False, "--pty", help="Serve on a pseudo-terminal (the default)."),
     tcp: str | None = typer.Option(
         None, "--tcp", help="Serve on TCP HOST:PORT instead (port 0: any free port)."

@@ -7,7 +7,14 @@ from typing import TYPE_CHECKING
 import typer
 
 from poppy_cli.connect import open_bus, ping_model
-from poppy_cli.options import BAUD_HELP, PORT_HELP, PROTOCOL_HELP, default_port, parse_ids
+from poppy_cli.options import (
+    BAUD_HELP,
+    BAUD_LIMITS,
+    PORT_HELP,
+    PROTOCOL_HELP,
+    default_port,
+    parse_ids,
+)
 from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
@@ -20,7 +27,7 @@ app = typer.Typer(
 )
 
 PortOpt = typer.Option(None, "--port", "-p", help=PORT_HELP)
-BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP)
+BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP, **BAUD_LIMITS)
 ProtoOpt = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2)
 JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
 

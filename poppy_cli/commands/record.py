@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, robot_config
+from poppy_cli.options import MAX_DURATION_S, finite
 from poppy_cli.output import EXIT_USAGE, err_console, error_line, print_json
 
 if TYPE_CHECKING:
@@ -81,9 +82,12 @@ def record(
     motors: str | None = typer.Option(
         None, "--motors", "-m", help="Motors or groups to record, e.g. m1,m2 or base (all)."
     ),
-    freq: float = typer.Option(50.0, "--freq", "-f", min=1.0, max=1000.0, help="Frames per s."),
+    freq: float = typer.Option(
+        50.0, "--freq", "-f", min=1.0, max=1000.0, callback=finite, help="Frames per s."
+    ),
     duration: float | None = typer.Option(
-        None, "--duration", "-d", min=0.1, help="Stop after this many seconds."
+        None, "--duration", "-d", min=0.1, max=MAX_DURATION_S, callback=finite,
+        help="Stop after this many seconds.",
     ),
     force: bool = typer.Option(False, "--force", help="Replace an existing move of that name."),
     profile: str | None = ProfileOpt,

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from poppy_cli.options import MAX_DURATION_S, finite
 from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
@@ -214,8 +215,13 @@ def status(
             return
 
 
-def parse_targets(pairs: list[str], known: list[str]) -> dict[str, float]:
-    """Parse ``NAME=DEGREES`` words, checking the names against ``known``."""
+def parse_targets(
+    pairs: list[str],
+    known: list[str],
+    limits: dict[str, tuple[float, float] | None] | None = None,
+) -> dict[str, float]:
+    """Parse ``NAME=DEGREES`` words, checking the names against ``known`` and the angles
+    against ``limits`` (motor -> its angle limits, None for a wheel), as the REST API does."""
     targets: dict[str, float] = {}
     for pair in pairs:
         name, sep, text = pair.partition("=")
@@ -234,6 +240,14 @@ def parse_targets(pairs: list[str], known: list[str]) -> dict[str, float]:
             raise typer.BadParameter(f"{pair!r}: {text!r} is not a number of degrees") from None
         if value != value or value in (float("inf"), float("-inf")):
             raise typer.BadParameter(f"{pair!r}: the angle must be a finite number")
+        bounds = (limits or {}).get(name)
+        if bounds is not None and not bounds[0] <= value <= bounds[1]:
+            from poppy_core.errors import ArgumentError
+
+            raise ArgumentError(
+                f"{name}: {value:g}° is outside the angle limits [{bounds[0]:g}, {bounds[1]:g}]",
+                field=name, value=value, motor=name,
+            )  # fmt: skip
         targets[name] = value
     return targets
 
@@ -241,7 +255,10 @@ def parse_targets(pairs: list[str], known: list[str]) -> dict[str, float]:
 @app.command("goto")
 def goto(
     targets: list[str] = typer.Argument(..., help="Targets as NAME=DEGREES, e.g. m1=30 m2=-10."),
-    duration: float = typer.Option(1.0, "--duration", "-d", min=0.0, help="Seconds to move."),
+    duration: float = typer.Option(
+        1.0, "--duration", "-d", min=0.0, max=MAX_DURATION_S, callback=finite,
+        help="Seconds to move.",
+    ),
     wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),
     control: str = typer.Option("minjerk", "--control", help="minjerk or dummy."),
     profile: str | None = ProfileOpt,
@@ -266,7 +283,11 @@ def goto(
         goals = parse_targets(targets, [m.name for m in robot.motors])
     else:
         config = robot_config(profile, config_file, port)
-        goals = parse_targets(targets, list(config.motors))
+        limits = {
+            name: None if motor.wheel_mode else motor.angle_limit
+            for name, motor in config.motors.items()
+        }
+        goals = parse_targets(targets, list(config.motors), limits)
         from poppy_core.robot import from_config
 
         robot = from_config(config, sim=sim)

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.options import PORT_HELP, default_port, parse_ids, parse_protocols
+from poppy_cli.options import BAUD_LIMITS, PORT_HELP, default_port, parse_ids, parse_protocols
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
@@ -54,7 +54,8 @@ def render_found(motors: list[FoundMotor]) -> None:
 def scan(
     port: str | None = typer.Option(None, "--port", "-p", help=PORT_HELP),
     baud: list[int] | None = typer.Option(
-        None, "--baud", "-b", help="Baud rate to try (repeat for several). Default: 1000000."
+        None, "--baud", "-b", help="Baud rate to try (repeat for several). Default: 1000000.",
+        **BAUD_LIMITS,
     ),
     all_bauds: bool = typer.Option(
         False, "--all-bauds", help="Try every standard baud rate of each protocol."

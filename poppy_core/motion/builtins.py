@@ -6,6 +6,7 @@ and the other arguments to gentle values, so ``poppy primitive run`` can start a
 
 from __future__ import annotations
 
+import io
 import math
 import time
 from collections.abc import Mapping, Sequence
@@ -13,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias
 
 from poppy_core.errors import ArgumentError, ConfigError
+from poppy_core.files import write_file
 from poppy_core.motion.manager import attach_primitive
 from poppy_core.motion.primitive import LoopPrimitive, Primitive
 from poppy_core.motion.sandbox import MockupMotor
@@ -228,7 +230,10 @@ class PositionWatcher(LoopPrimitive):
             path: the image file to write.
 
         Returns:
-            The path written.
+            The path written (atomically; an existing regular file is replaced).
+
+        Raises:
+            FileError: the file cannot be written, or is not a regular file.
         """
         import matplotlib
 
@@ -245,9 +250,9 @@ class PositionWatcher(LoopPrimitive):
         axes.set_ylabel("present position (°)")
         if self.record_positions:
             axes.legend(loc="upper right")
-        out = Path(path)
-        figure.savefig(out, format="png")
-        return out
+        image = io.BytesIO()
+        figure.savefig(image, format="png")
+        return write_file(Path(path), image.getvalue(), replace=True)
 
 
 class SimplePosture(Primitive):

@@ -34,6 +34,8 @@ MIN_RAMP_S = 0.3
 MIN_SPEED = 0.01
 MAX_SPEED = 100.0
 MAX_LOOPS = 10_000
+LIMIT_TOLERANCE_DEG = 0.5
+"""Past a limit by less than this is noise of a recording at the limit: clamped silently."""
 RAMP_SKIP_DEG = 0.5
 """No ramp when every motor is already this close to the first frame."""
 
@@ -73,6 +75,34 @@ def write_rate_hz(robot: Robot) -> float:
     return min(rates) if rates else DEFAULT_RATE_HZ
 
 
+def clamp_to_limits(move: Move, motors: list[Motor]) -> dict[str, float]:
+    """How far past its angle limits each motor of ``move`` goes (motors within are left out).
+
+    Args:
+        move: the move.
+        motors: the robot's motors, one per column of the move (wheels have no limits).
+    """
+    beyond: dict[str, float] = {}
+    for index, motor in enumerate(motors):
+        if motor.wheel_mode or not len(move):
+            continue
+        low, high = motor.angle_limit
+        column = move.positions[:, index]
+        worst = max(low - float(column.min()), float(column.max()) - high, 0.0)
+        if worst > LIMIT_TOLERANCE_DEG:
+            beyond[motor.name] = worst
+    return beyond
+
+
+def _within_limits(move: Move, motors: list[Motor]) -> Move:
+    positions = move.positions.copy()
+    for index, motor in enumerate(motors):
+        if not motor.wheel_mode:
+            low, high = motor.angle_limit
+            np.clip(positions[:, index], low, high, out=positions[:, index])
+    return Move(move.framerate, move.motors, positions, speeds=move.speeds, metadata=move.metadata)
+
+
 def missing_motors(robot: Robot, move: Move) -> list[str]:
     """The motors of ``move`` the robot does not have."""
     names = {m.name for m in robot.motors}
@@ -94,6 +124,10 @@ class MovePlayer:
         rate_hz: goal update rate; None uses the robot's write rate.
         on_progress: called at each update with a ``PlayProgress``.
         clock: the time source (seconds).
+
+    Positions past a motor's angle limits are played at the limit (``clamped`` says by how
+    much, and a warning is logged), so the ramp to the first frame is planned on reachable
+    positions.
 
     Raises:
         ConfigError: the robot lacks motors of the move (they are named).
@@ -145,14 +179,26 @@ class MovePlayer:
         self.rate_hz = rate_hz if rate_hz is not None else write_rate_hz(robot)
         self.on_progress = on_progress
         self._clock = clock
-        self._played = move.reversed() if backwards else move
         self._motors: list[Motor] = [robot.motor(name) for name in move.motors]
+        self.clamped = clamp_to_limits(move, self._motors)
+        """Motor -> how far (degrees) the move went past its angle limits, for each motor it did
+        (those frames are played at the limit)."""
+        if self.clamped:
+            logger.warning("the move goes past the angle limits of %s: played at the limits",
+                           ", ".join(f"{n} (by {d:.1f}°)" for n, d in self.clamped.items()))
+        played = _within_limits(move, self._motors) if self.clamped else move
+        self._played = played.reversed() if backwards else played
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self.loop_times: list[tuple[float, float]] = []
         """``(start, end)`` clock times of each loop's playing phase (ramps excluded)."""
         self.stopped = False
         self.error: BaseException | None = None
+
+    @property
+    def played(self) -> Move:
+        """The move as it is played: reversed when backwards, positions within the limits."""
+        return self._played
 
     @property
     def duration_s(self) -> float:

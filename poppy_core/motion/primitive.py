@@ -30,6 +30,7 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 State = Literal["idle", "running", "paused", "stopped", "failed"]
+_PLURALS = {"property": "properties", "method": "methods"}
 JOIN_TIMEOUT_S = 5.0
 
 
@@ -298,7 +299,7 @@ class Primitive:
         if name not in known:
             listed = ", ".join(known) or "none"
             raise ConfigError(
-                f"{type(self).__name__} has no {kind} {name!r} ({kind}s: {listed})",
+                f"{type(self).__name__} has no {kind} {name!r} ({_PLURALS[kind]}: {listed})",
                 field=name,
                 value=name,
             )

@@ -17,7 +17,9 @@ CASES = [
 
 
 @pytest.mark.parametrize(("args", "message", "hint"), CASES, ids=[" ".join(c[0]) for c in CASES])
-def test_usage_error_is_one_line(poppy: Any, args: tuple[str, ...], message: str, hint: str) -> None:
+def test_usage_error_is_one_line(
+    poppy: Any, args: tuple[str, ...], message: str, hint: str
+) -> None:
     result = poppy(*args)
     assert result.code == 2
     lines = result.stderr.strip().splitlines()

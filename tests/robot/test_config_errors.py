@@ -215,7 +215,7 @@ def test_json_syntax_error_has_line(tmp_path: Path) -> None:
 
 def test_missing_file(tmp_path: Path) -> None:
     path = tmp_path / "nope.yaml"
-    with pytest.raises(ConfigError, match=r"nope.yaml: cannot read: No such file"):
+    with pytest.raises(ConfigError, match=r"nope.yaml: cannot read the config: No such file"):
         load_config(path)
 
 
