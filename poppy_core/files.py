@@ -254,3 +254,62 @@ def _sync_folder(folder: Path) -> None:
             os.fsync(fd)
         finally:
             os.close(fd)
+
+
+class FileLock:
+    """An exclusive lock on a file about to be written, held in ``.<name>.lock`` beside it.
+
+    Two processes recording into one file would each replace the other's work: the second one
+    is refused instead. The lock is advisory (``flock``) and dies with its process, so a crash
+    leaves nothing stuck.
+
+    Args:
+        path: the file the lock protects.
+    """
+
+    def __init__(self, path: str | os.PathLike[str]) -> None:
+        target = Path(path)
+        self.target = target
+        self.path = target.with_name(f".{target.name[:200]}.lock")
+        self._fd: int | None = None
+
+    def acquire(self) -> FileLock:
+        """Take the lock (without waiting).
+
+        Raises:
+            FileError: another process holds it (its pid is named), or it cannot be created.
+        """
+        import fcntl
+
+        try:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, NEW_FILE_MODE)
+        except OSError as exc:
+            raise file_error(exc, self.path, "create the lock") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(fd, 32).decode(errors="replace").strip() or "?"
+            os.close(fd)
+            raise FileError(
+                f"another poppy process (pid {holder}) is writing {self.target}: wait for it, "
+                "or pick another name",
+                path=str(self.target), errno=errno.EBUSY,
+            ) from None  # fmt: skip
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        self._fd = fd
+        return self
+
+    def release(self) -> None:
+        """Drop the lock and its file (again: nothing)."""
+        fd, self._fd = self._fd, None
+        if fd is None:
+            return
+        with contextlib.suppress(OSError):
+            os.unlink(self.path)
+        os.close(fd)
+
+    @property
+    def held(self) -> bool:
+        """True between ``acquire`` and ``release``."""
+        return self._fd is not None
