@@ -163,6 +163,23 @@ def parse_json(text: str | bytes, source: str, limits: Limits, *, check: bool = 
     return data
 
 
+_OPENS = (yaml.BlockMappingStartToken, yaml.BlockSequenceStartToken,
+          yaml.FlowMappingStartToken, yaml.FlowSequenceStartToken)  # fmt: skip
+_CLOSES = (yaml.BlockEndToken, yaml.FlowMappingEndToken, yaml.FlowSequenceEndToken)
+
+
+def _check_yaml_depth(text: str | bytes, source: str, limits: Limits) -> None:
+    """Refuse deep YAML from its tokens (the scanner is a loop; the parser would recurse)."""
+    depth = 0
+    for token in yaml.scan(text, Loader=yaml.SafeLoader):
+        if isinstance(token, _OPENS):
+            depth += 1
+            if depth > limits.max_depth + 1:  # +1: a block mapping wraps the whole document
+                raise _bad(source, f"nested more than {limits.max_depth} levels deep")
+        elif isinstance(token, _CLOSES):
+            depth -= 1
+
+
 def parse_yaml(text: str | bytes, source: str, limits: Limits) -> Any:
     """Parse a YAML document (safe tags only) and check its shape.
 
@@ -171,6 +188,7 @@ def parse_yaml(text: str | bytes, source: str, limits: Limits) -> Any:
             nested too deeply, too large once aliases are expanded, or cyclic.
     """
     try:
+        _check_yaml_depth(text, source, limits)
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
