@@ -64,7 +64,7 @@ class Motor(MotorCache):
         if orientation not in ("direct", "indirect"):
             raise RegisterError(
                 f"{name}: orientation must be 'direct' or 'indirect', not {orientation!r}",
-                register="orientation",
+                register="orientation", motor=name,
             )
         super().__init__(name, model)
         self.id = id
@@ -136,7 +136,7 @@ class Motor(MotorCache):
         if not low < high:
             raise RegisterError(
                 f"{self.name}: angle limits must be (min, max) with min < max, got {low}, {high}",
-                register="angle_limit",
+                register="angle_limit", motor=self.name,
             )
         return float(low), float(high)
 
@@ -202,7 +202,7 @@ class Motor(MotorCache):
         if value < 0:
             raise RegisterError(
                 f"{self.name}: moving_speed is a magnitude (>= 0), got {value}",
-                register="moving_speed",
+                register="moving_speed", motor=self.name,
             )
         self._store("moving_speed", float(value))
 
@@ -244,7 +244,7 @@ class Motor(MotorCache):
         if not self.model.has_torque_limit:
             raise RegisterError(
                 f"{self.name}: {self.model.name} has no torque limit register",
-                register="torque_limit",
+                register="torque_limit", motor=self.name,
             )
         self._store("torque_limit", float(value))
 
@@ -288,7 +288,7 @@ class Motor(MotorCache):
         if value not in BEHAVIORS:
             raise RegisterError(
                 f"{self.name}: compliant behavior must be 'dummy' or 'safe', not {value!r}",
-                register="compliant_behavior",
+                register="compliant_behavior", motor=self.name,
             )
         with self._lock:
             self._behavior = "safe" if value == "safe" else "dummy"

@@ -181,3 +181,19 @@ def test_a_closed_robot_raises_robot_closed_error(tmp_path: Path) -> None:
     with pytest.raises(RobotClosedError):
         robot.m1.compliant = True
     assert isinstance(robot.m1.present_position, float)  # reads still give the last values
+
+
+def test_register_errors_name_the_motor(ergo: Robot) -> None:
+    from poppy_core.errors import RegisterError
+
+    with pytest.raises(RegisterError) as caught:
+        ergo.m2.moving_speed = -1
+    assert (caught.value.motor, caught.value.register) == ("m2", "moving_speed")
+    with pytest.raises(RegisterError) as caught:
+        ergo.m3.torque_limit = 150  # out of the register's range: found by the model
+    assert (caught.value.motor, caught.value.register) == ("m3", "torque_limit")
+    assert str(caught.value).startswith("m3: ")
+    sinus = Sinus(ergo, 50, ["m1"])
+    with pytest.raises(RegisterError) as caught:
+        sinus.robot.motor("m1").goal_position = "far"
+    assert (caught.value.motor, caught.value.register) == ("m1", "goal_position")
