@@ -33,6 +33,7 @@ from poppy_core.robot.schedule import Periodic
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
+    from poppy_core.robot.robot import MotorSpec
 
 logger = logging.getLogger(__name__)
 
@@ -93,7 +94,7 @@ class MoveRecorder:
         self,
         robot: Robot,
         freq: float = DEFAULT_FREQ_HZ,
-        motors: Sequence[Motor | str] | None = None,
+        motors: MotorSpec | None = None,
         *,
         checkpoint_path: str | Path | None = None,
         checkpoint_period_s: float = DEFAULT_CHECKPOINT_S,
@@ -313,20 +314,11 @@ class MoveRecorder:
         self.stop()
 
 
-def resolve_motors(robot: Robot, motors: Sequence[Motor | str] | None) -> list[Motor]:
-    """Motors from motor objects, motor names or group names (each once, in order).
+def resolve_motors(robot: Robot, motors: MotorSpec | None) -> list[Motor]:
+    """Motors from motor objects, motor names or group names (each once, in order); a name
+    alone is one motor or group.
 
     Raises:
-        ConfigError: an unknown motor or group name.
+        UnknownMotorError: an unknown motor or group name.
     """
-    if motors is None:
-        return robot.motors
-    chosen: list[Motor] = []
-    groups = robot.motorgroups
-    for item in motors:
-        if isinstance(item, str):
-            found = groups[item] if item in groups else [robot.motor(item)]
-        else:
-            found = [item]
-        chosen.extend(m for m in found if m not in chosen)
-    return chosen
+    return robot.motors_of(motors)

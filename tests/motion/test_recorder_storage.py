@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core.errors import FileError
+from poppy_core.errors import ConfigError, FileError
 from poppy_core.motion import MoveRecorder, read_move
 from poppy_core.motion import recorder as recorder_module
 from poppy_core.robot import Robot, from_profile
@@ -116,3 +116,9 @@ def test_an_existing_file_is_not_replaced_unless_asked(ergo: Robot, tmp_path: Pa
         recorder.stop()
     assert target.read_bytes() == b"not a take"
     assert len(recorder.move) > 0
+
+
+def test_a_motor_name_alone_is_one_motor(ergo: Robot) -> None:
+    assert [m.name for m in MoveRecorder(ergo, 50, "m2").motors] == ["m2"]
+    with pytest.raises(ConfigError, match="no motor or group 'head_z'"):
+        MoveRecorder(ergo, 50, "head_z")
