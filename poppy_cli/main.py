@@ -6,6 +6,7 @@ import logging
 import sys
 
 import typer
+from typer import _click as click  # typer vendors Click: its exceptions live here
 
 from poppy_cli import state
 from poppy_cli.commands import camera, config, demo, emulate, motor_setup, ports, scan
@@ -17,7 +18,7 @@ from poppy_cli.commands import record as record_cmd
 from poppy_cli.commands import serve as serve_cmd
 from poppy_cli.commands import sim as sim_cmd
 from poppy_cli.commands import tui as tui_cmd
-from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, error_line
+from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
 
 app = typer.Typer(
     name="poppy",
@@ -61,16 +62,38 @@ app.add_typer(sim_cmd.app, name="sim")
 app.add_typer(camera.app, name="camera")
 
 
+def usage_line(exc: click.exceptions.UsageError) -> str:
+    """A usage error as one line: Click's message and where the help is."""
+    message = " ".join(exc.format_message().split())
+    where = exc.ctx.command_path if exc.ctx is not None else "poppy"
+    return f"{message} (see `{where} --help`)"
+
+
 def main() -> None:
-    """Run the CLI; a PoppyError becomes one line on stderr and exit code 1."""
-    from poppy_core.errors import PoppyError
+    """Run the CLI; a PoppyError becomes one line on stderr (one per problem) and exit code 1,
+    a usage error one line and exit code 2."""
+    from poppy_core.errors import ConfigError, PoppyError
 
     try:
-        app()
+        code = app(prog_name="poppy", standalone_mode=False)
+    except click.exceptions.NoArgsIsHelpError as exc:  # `poppy moves`: the help, as before
+        exc.show()
+        sys.exit(exc.exit_code)
+    except click.exceptions.UsageError as exc:
+        error_line(usage_line(exc))
+        sys.exit(EXIT_USAGE)
+    except click.exceptions.ClickException as exc:  # e.g. a file Click could not open
+        error_line(" ".join(exc.format_message().split()))
+        sys.exit(exc.exit_code)
+    except typer.Abort:  # Ctrl-C or end of input at a prompt
+        error_line("aborted")
+        sys.exit(EXIT_FAILURE)
     except PoppyError as exc:
         if state.debug:
             raise
-        error_line(str(exc))
+        problems = exc.problems if isinstance(exc, ConfigError) else [exc]
+        for problem in problems:
+            error_line(str(problem))
         sys.exit(EXIT_FAILURE)
     except KeyboardInterrupt:
         if state.debug:
@@ -82,6 +105,7 @@ def main() -> None:
             raise
         error_line(f"unexpected {type(exc).__name__}: {exc} (run with --debug for the traceback)")
         sys.exit(EXIT_FAILURE)
+    sys.exit(code if isinstance(code, int) else 0)
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 
 import typer
@@ -49,6 +50,26 @@ def parse_protocols(text: str) -> list[int]:
 def default_port(port: str | None) -> str | None:
     """The port given, or POPPY_PORT from the environment."""
     return port or os.environ.get("POPPY_PORT") or None
+
+
+# Dynamixel rates run from 9,600 bps (the slowest code of AX/MX/X) to 10.5 Mbps (X-series); the
+# range is left a little wider for adapters, and refuses 0 or a rate no UART takes.
+MIN_BAUD = 1_200
+MAX_BAUD = 12_000_000
+BAUD_LIMITS = {"min": MIN_BAUD, "max": MAX_BAUD}
+"""``typer.Option(..., **BAUD_LIMITS)``: a rate out of range is a usage error (exit 2)."""
+
+
+MAX_DURATION_S = 86_400.0
+"""A day: the longest goto or move core accepts (``poppy_core.motion.trajectory`` and
+``poppy_core.motion.move``); longer is a typing mistake that would never end."""
+
+
+def finite(value: float | None) -> float | None:
+    """An option callback: NaN and infinities are usage errors (a range check lets NaN by)."""
+    if value is not None and not math.isfinite(value):
+        raise typer.BadParameter(f"{value} is not a finite number")
+    return value
 
 
 PORT_HELP = (

@@ -1,20 +1,76 @@
-"""Shared console helpers: Rich on stdout, errors on stderr, JSON for scripts."""
+"""Shared console helpers: Rich on stdout, errors on stderr, JSON for scripts.
+
+Text is printed literally: the consoles read no Rich markup and no ``:emoji:`` codes, so a file,
+port, motor or move name is shown as it is (``/etc/passwd``'s ``root:x:0:0`` stays text, a motor
+named ``[red]x`` restyles nothing), and control characters (terminal escapes, bidi overrides)
+are shown as ``\x1b``-style escapes instead of acting on the terminal. Our own styling goes
+through ``styled``, which escapes the values it is given.
+"""
 
 from __future__ import annotations
 
 import json
 import sys
+import unicodedata
 from typing import Any
 
 from rich.console import Console
+from rich.markup import escape
+from rich.text import Text
 
 EXIT_OK = 0
 EXIT_FAILURE = 1
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
 
-console = Console(highlight=False)
-err_console = Console(stderr=True, highlight=False)
+_KEPT = frozenset("\n\t")
+_BIDI = frozenset("\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+
+
+def printable(text: str) -> str:
+    """``text`` with control characters (but newlines and tabs) and bidi overrides escaped."""
+    if text.isprintable():
+        return text
+    return "".join(
+        char.encode("unicode_escape").decode("ascii")
+        if (unicodedata.category(char) == "Cc" and char not in _KEPT) or char in _BIDI
+        else char
+        for char in text
+    )
+
+
+class LiteralConsole(Console):
+    """A Rich console that prints every string as it is: no markup, no emoji, no highlighting,
+    no terminal control (see ``printable``); styled output is built with ``styled``."""
+
+    def __init__(self, **options: Any) -> None:
+        super().__init__(markup=False, emoji=False, highlight=False, **options)
+
+    def render_str(self, text: str, **options: Any) -> Text:
+        """Every string printed, in a table cell, a title or a status, passes here."""
+        options.update(markup=False, emoji=False)
+        return super().render_str(printable(text), **options)
+
+
+console = LiteralConsole()
+err_console = LiteralConsole(stderr=True)
+
+
+def styled(template: str, *values: object) -> Text:
+    """Our Rich markup ``template`` with ``values`` put in its ``{}`` literally.
+
+    ``styled("[green]ok[/] {}: {} motors", path, count)``: the template is ours and may carry
+    markup; each value is shown as text, whatever brackets, colons or control characters it
+    holds.
+    """
+    shown = (escape(printable(str(value))) for value in values)
+    return Text.from_markup(template.format(*shown), emoji=False)
+
+
+def plain(text: object) -> Text:
+    """``text`` as a Rich ``Text`` shown literally (for widgets that would read markup in a
+    string: a status spinner, a progress column)."""
+    return Text(printable(str(text)))
 
 
 def print_json(data: Any) -> None:
@@ -24,13 +80,14 @@ def print_json(data: Any) -> None:
 
 
 def error_line(message: str) -> None:
-    """Print one clear error line on stderr."""
-    err_console.print(f"[bold red]error:[/] {message}", soft_wrap=True)
+    """Print one clear error line on stderr (``message`` literally, on one line)."""
+    one_line = message.replace("\r", "\\r").replace("\n", "\\n")
+    err_console.print(styled("[bold red]error:[/] {}", one_line), soft_wrap=True)
 
 
 def warn_line(message: str) -> None:
-    """Print one warning line on stderr."""
-    err_console.print(f"[yellow]warning:[/] {message}", soft_wrap=True)
+    """Print one warning line on stderr (``message`` literally)."""
+    err_console.print(styled("[yellow]warning:[/] {}", message), soft_wrap=True)
 
 
 def fmt_value(value: Any, unit: str = "") -> str:

@@ -35,22 +35,14 @@ def load_settings(path: Path | None = None) -> Settings:
     Raises:
         ConfigError: the file is not a YAML mapping of known keys with text values.
     """
-    import yaml
-
+    from poppy_core.documents import SETTINGS_LIMITS, parse_yaml, read_limited
     from poppy_core.errors import ConfigError
 
     file = path if path is not None else settings_file()
-    try:
-        text = file.read_text(encoding="utf-8")
-    except FileNotFoundError:
+    if not file.exists() and not file.is_symlink():
         return Settings()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{file}: cannot read: {exc}", file=str(file)) from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise ConfigError(f"{file}: not valid YAML: {first}", file=str(file)) from None
+    data = parse_yaml(read_limited(file, SETTINGS_LIMITS.max_bytes, "settings file"), str(file),
+                      SETTINGS_LIMITS)  # fmt: skip
     if data is None:
         return Settings()
     if not isinstance(data, dict):

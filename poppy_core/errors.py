@@ -11,9 +11,19 @@ The tree (catch the bases, raise the leaves)::
     ├── ProtocolError             bytes that do not make a valid packet / unsupported instruction
     ├── MotorError                a motor answered with error bits; carries ``motor_id``, ``errors``
     ├── UnknownModelError         a model number or name poppy does not know
-    ├── RegisterError             unknown register, read-only register, value out of range
+    ├── RegisterError             unknown register, read-only register, value out of range;
+    │                             carries ``register`` and ``motor``
+    ├── ArgumentError             a call argument outside what the call takes (negative duration,
+    │                             unknown control, a frequency of 0); also a ``ValueError``;
+    │                             carries ``field``, ``value``, ``motor``
+    ├── RobotClosedError          the robot was closed: no more motions, primitives or writes
+    ├── FileError                 a file that cannot be read or written, or that poppy refuses to
+    │                             replace (exists, not a regular file); carries ``path``, ``errno``
     ├── SetupError                a setup operation refused or could not be verified (ID taken, ...)
-    ├── ConfigError               a bad robot config; carries ``file``, ``field``, ``reason``
+    ├── ConfigError               a bad robot config, move or name; carries ``file``, ``field``,
+    │   │                         ``value``, ``reason`` and ``problems`` (every problem found)
+    │   └── UnknownMotorError     a motor (or group) name the robot does not have; carries
+    │                             ``motor`` and ``known``
     ├── KinematicsError           a target out of a chain's reach; carries ``nearest``
     └── SensorError               a camera or other sensor cannot be opened or read; ``sensor``
 
@@ -87,9 +97,42 @@ class UnknownModelError(PoppyError):
 class RegisterError(PoppyError):
     """An unknown register, a write to a read-only register, or a value out of range."""
 
-    def __init__(self, message: str, *, register: str | None = None) -> None:
+    def __init__(
+        self, message: str, *, register: str | None = None, motor: str | None = None
+    ) -> None:
         super().__init__(message)
         self.register = register
+        self.motor = motor
+
+
+class ArgumentError(PoppyError, ValueError):
+    """A call argument outside what the call takes (also a ``ValueError`` for old callers)."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        field: str | None = None,
+        value: object = None,
+        motor: str | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.field = field
+        self.value = value
+        self.motor = motor
+
+
+class RobotClosedError(PoppyError):
+    """The robot was closed: motions, primitives and writes are refused."""
+
+
+class FileError(PoppyError):
+    """A file cannot be read or written, or poppy refuses to replace what is there."""
+
+    def __init__(self, message: str, *, path: str | None = None, errno: int | None = None) -> None:
+        super().__init__(message)
+        self.path = path
+        self.errno = errno
 
 
 class SetupError(PoppyError):
@@ -113,6 +156,38 @@ class ConfigError(PoppyError):
         self.field = field
         self.value = value
         self.reason = reason
+        self.problems: list[ConfigError] = [self]
+        """Every problem found (this one alone unless a whole document was checked)."""
+
+    @classmethod
+    def of_problems(cls, problems: list[ConfigError]) -> ConfigError:
+        """One error standing for several: its message is the first problem's plus a count.
+
+        Args:
+            problems: the problems, at least one, in the order they were found.
+        """
+        first = problems[0]
+        if len(problems) == 1:
+            return first
+        more = len(problems) - 1
+        error = cls(
+            f"{first} (and {more} more problem{'s' if more > 1 else ''})",
+            file=first.file,
+            field=first.field,
+            value=first.value,
+            reason=first.reason,
+        )
+        error.problems = list(problems)
+        return error
+
+
+class UnknownMotorError(ConfigError):
+    """A motor or group name the robot does not have."""
+
+    def __init__(self, message: str, *, motor: str, known: list[str] | None = None) -> None:
+        super().__init__(message, field=motor, value=motor, reason="unknown motor")
+        self.motor = motor
+        self.known = list(known or [])
 
 
 class KinematicsError(PoppyError):

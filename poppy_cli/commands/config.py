@@ -7,8 +7,17 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.options import BAUD_HELP, PORT_HELP, PROTOCOL_HELP, default_port
-from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, console, error_line, fmt_value, print_json
+from poppy_cli.options import BAUD_HELP, BAUD_LIMITS, PORT_HELP, PROTOCOL_HELP, default_port
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_USAGE,
+    console,
+    error_line,
+    fmt_value,
+    plain,
+    print_json,
+    styled,
+)
 
 if TYPE_CHECKING:
     from poppy_core.bus.results import FoundMotor
@@ -33,23 +42,36 @@ def validate(file: Path = typer.Argument(..., help="Config file (JSON or YAML)."
     from poppy_core.robot import load_config
 
     config = load_config(file)
-    console.print(f"[green]ok[/] {file}: {_counts(config)}")
+    console.print(styled("[green]ok[/] {}: {}", file, _counts(config)))
+
+
+ForceOpt = typer.Option(False, "--force", "-f", help="Replace an existing file.")
 
 
 @app.command("convert")
 def convert(
     source: Path = typer.Argument(..., help="Config to read (JSON or YAML)."),
-    target: Path = typer.Argument(..., help="File to write; .json or .yaml/.yml picks the format."),
+    target: Path = typer.Argument(
+        ..., help="File to write (.json or .yaml/.yml picks the format), or a folder."
+    ),
+    force: bool = ForceOpt,
 ) -> None:
-    """Convert a config between JSON and YAML (the format follows TARGET's extension)."""
+    """Convert a config between JSON and YAML (the format follows TARGET's extension).
+
+    Into a folder, the file keeps SOURCE's name with the other format's extension. An existing
+    file is replaced only with --force; a folder, a link or a device never.
+    """
+    from poppy_core.files import output_path
     from poppy_core.robot import dump_config, load_config
 
-    if target.suffix.lower() not in (".json", ".yaml", ".yml"):
-        error_line(f"{target}: the extension must be .json, .yaml or .yml")
+    other = ".yaml" if source.suffix.lower() == ".json" else ".json"
+    chosen = output_path(target, default_name=f"{source.stem}{other}", replace=force)
+    if chosen.suffix.lower() not in (".json", ".yaml", ".yml"):
+        error_line(f"{chosen}: the extension must be .json, .yaml or .yml")
         raise typer.Exit(EXIT_USAGE)
     config = load_config(source)
-    dump_config(config, target)
-    console.print(f"wrote {target}: {_counts(config)}")
+    written = dump_config(config, chosen, replace=force)
+    console.print(f"wrote {written}: {_counts(config)}")
 
 
 @app.command("show")
@@ -88,11 +110,11 @@ def show(
     console.print(table)
     for name, controller in config.controllers.items():
         console.print(
-            f"controller [bold]{name}[/]: port {controller.port}, protocol {controller.protocol}, "
-            f"{controller.baudrate} bps"
+            styled("controller [bold]{}[/]: port {}, protocol {}, {} bps", name, controller.port,
+                   controller.protocol, controller.baudrate)
         )
     for name in config.motorgroups:
-        console.print(f"group [bold]{name}[/]: {', '.join(config.resolve_group(name))}")
+        console.print(styled("group [bold]{}[/]: {}", name, ", ".join(config.resolve_group(name))))
 
 
 @app.command("list")
@@ -123,7 +145,7 @@ def list_cmd(
     for column in ("name", "origin", "description"):
         table.add_column(column)
     for p in profiles:
-        table.add_row(p.name, "[bold]user[/]" if p.user else "installed", p.description)
+        table.add_row(p.name, styled("[bold]user[/]") if p.user else "installed", p.description)
     console.print(table)
 
 
@@ -166,34 +188,35 @@ def build_config(found: list[FoundMotor], prefix: str) -> dict[str, Any]:
 
 @app.command("generate")
 def generate(
-    output: Path = typer.Option(..., "--output", "-o", help="File to write (.json or .yaml)."),
+    output: Path = typer.Option(
+        ..., "--output", "-o", help="File to write (.json or .yaml), or a folder (robot.yaml)."
+    ),
     port: str | None = typer.Option(None, "--port", "-p", help=PORT_HELP),
-    baud: int | None = typer.Option(None, "--baud", "-b", help=BAUD_HELP),
+    baud: int | None = typer.Option(None, "--baud", "-b", help=BAUD_HELP, **BAUD_LIMITS),
     protocol: int | None = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2),
     name: str = typer.Option("m", "--name", help="Motor name prefix: <prefix><ID>."),
-    force: bool = typer.Option(False, "--force", "-f", help="Overwrite an existing file."),
+    force: bool = ForceOpt,
 ) -> None:
     """Scan a bus and write a config of the motors found (limits read from the motors)."""
     from poppy_core.bus import scan as run_scan
+    from poppy_core.files import output_path
     from poppy_core.robot import RobotConfig, dump_config
 
-    if output.exists() and not force:
-        error_line(f"{output} exists: pass --force to overwrite it")
-        raise typer.Exit(EXIT_FAILURE)
-    if output.suffix.lower() not in (".json", ".yaml", ".yml"):
+    if output.suffix.lower() not in (".json", ".yaml", ".yml") and not output.is_dir():
         error_line(f"{output}: the extension must be .json, .yaml or .yml")
         raise typer.Exit(EXIT_USAGE)
+    output = output_path(output, default_name="robot.yaml", replace=force)  # before the scan
     chosen_port = default_port(port)
     if not chosen_port:
         error_line("no port given: pass --port (see `poppy ports`) or set POPPY_PORT")
         raise typer.Exit(EXIT_USAGE)
     baudrates = [baud] if baud is not None else None
     protocols = [protocol] if protocol is not None else [1, 2]
-    with console.status(f"scanning {chosen_port}…"):
+    with console.status(plain(f"scanning {chosen_port}…")):
         found = [f for f in run_scan(chosen_port, baudrates, protocols) if f.model is not None]
     if not found:
         error_line(f"no known motor found on {chosen_port}")
         raise typer.Exit(EXIT_FAILURE)
     config = RobotConfig.from_dict(build_config(found, name), source="generate")
-    dump_config(config, output)
-    console.print(f"wrote {output}: {_counts(config)}")
+    written = dump_config(config, output, replace=force)
+    console.print(f"wrote {written}: {_counts(config)}")

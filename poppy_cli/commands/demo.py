@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.output import console, fmt_value
+from poppy_cli.output import console, fmt_value, plain, styled
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -51,9 +51,10 @@ def demo(
     virtual = ergo_jr_bus(wire_timing=wire_timing, latency_s=0.001 if wire_timing else 0.0)
     with serve_pty(virtual) as server:
         console.print(
-            f"[bold]Virtual Poppy Ergo Jr[/]: 6 XL-320 on {server.url} (protocol 2, 1 Mbps)"
+            styled("[bold]Virtual Poppy Ergo Jr[/]: 6 XL-320 on {} (protocol 2, 1 Mbps)",
+                   server.url)
         )
-        with console.status("scanning IDs 0-253 at 1 Mbps, protocol 2…"):
+        with console.status(plain("scanning IDs 0-253 at 1 Mbps, protocol 2…")):
             found = run_scan(server.url, [1_000_000], [2])
         render_found(found)
         table = Table(title="state of the motors found")
@@ -80,9 +81,11 @@ def demo(
         console.print(table)
     dance(QUICK_FACTOR if quick else 1.0, "mujoco" if sim == "mujoco" else True)
     console.print(
-        "Next: [bold]poppy emulate --profile ergo-jr[/] serves this robot to other programs; "
-        "[bold]poppy scan --port PATH[/] finds its motors; "
-        "[bold]poppy robot status --sim --profile ergo-jr[/] shows a virtual robot."
+        styled(
+            "Next: [bold]poppy emulate --profile ergo-jr[/] serves this robot to other programs; "
+            "[bold]poppy scan --port PATH[/] finds its motors; "
+            "[bold]poppy robot status --sim --profile ergo-jr[/] shows a virtual robot."
+        )
     )
 
 
@@ -146,7 +149,8 @@ def record_and_replay(robot: Robot, time_factor: float) -> None:
     for name in arm:
         robot.motor(name).compliant = True
     time.sleep(0.1)
-    console.print(f"[bold]Recording[/] {', '.join(arm)} for {duration_s:.1f} s, moved by hand…")
+    console.print(styled("[bold]Recording[/] {} for {} s, moved by hand…", ", ".join(arm),
+                         f"{duration_s:.1f}"))
     with MoveRecorder(robot, 50, arm) as recorder:
         start = time.monotonic()
         while (elapsed := time.monotonic() - start) < duration_s:

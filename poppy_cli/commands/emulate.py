@@ -9,7 +9,8 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.output import EXIT_USAGE, err_console, error_line
+from poppy_cli.options import BAUD_LIMITS
+from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
 
 if TYPE_CHECKING:
     from poppy_core.emulator import VirtualBus
@@ -35,7 +36,9 @@ def emulate(
     protocol: int | None = typer.Option(
         None, "--protocol", min=1, max=2, help="Protocol (default: the models')."
     ),
-    baud: int | None = typer.Option(None, "--baud", "-b", help="Baud rate (default 1000000)."),
+    baud: int | None = typer.Option(
+        None, "--baud", "-b", help="Baud rate (default 1000000).", **BAUD_LIMITS
+    ),
     pty: bool = typer.Option(False, "--pty", help="Serve on a pseudo-terminal (the default)."),
     tcp: str | None = typer.Option(
         None, "--tcp", help="Serve on TCP HOST:PORT instead (port 0: any free port)."
@@ -99,12 +102,12 @@ def emulate(
         sys.stdout.flush()
         for (name, bus), server in zip(buses, servers, strict=True):
             ids = ", ".join(str(m.id) for m in bus.motors)
-            err_console.print(
-                f"[green]serving[/] {name}: {len(bus.motors)} {bus.motors[0].model.name}"
+            err_console.print(styled(
+                "[green]serving[/] {}", f"{name}: {len(bus.motors)} {bus.motors[0].model.name}"
                 f"{'…' if len({m.model.name for m in bus.motors}) > 1 else ''} "
                 f"(ids {ids}) protocol {bus.protocol} at {bus.baudrate} bps on {server.url}"
                 " — Ctrl-C to stop"
-            )
+            ))
         while not stop.wait(0.5):
             pass
     finally:

@@ -7,8 +7,15 @@ from typing import TYPE_CHECKING
 import typer
 
 from poppy_cli.connect import open_bus, ping_model
-from poppy_cli.options import BAUD_HELP, PORT_HELP, PROTOCOL_HELP, default_port, parse_ids
-from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json
+from poppy_cli.options import (
+    BAUD_HELP,
+    BAUD_LIMITS,
+    PORT_HELP,
+    PROTOCOL_HELP,
+    default_port,
+    parse_ids,
+)
+from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
     from poppy_core.bus.results import SetupResult
@@ -20,7 +27,7 @@ app = typer.Typer(
 )
 
 PortOpt = typer.Option(None, "--port", "-p", help=PORT_HELP)
-BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP)
+BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP, **BAUD_LIMITS)
 ProtoOpt = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2)
 JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
 
@@ -58,13 +65,13 @@ def print_setup(result: SetupResult, json_output: bool) -> None:
         )
         return
     for name, (old, new) in result.changes.items():
-        console.print(f"{name}: {fmt_value(old)} → [bold]{fmt_value(new)}[/]")
+        console.print(styled("{}: {} → [bold]{}[/]", name, fmt_value(old), fmt_value(new)))
     for note in result.notes:
-        console.print(f"[dim]{note}[/]")
+        console.print(styled("[dim]{}[/]", note))
     check = "[green]verified[/]" if result.verified else "[yellow]not verified[/]"
     console.print(
-        f"motor {result.motor_id} on {result.port} at {result.baudrate} bps "
-        f"(protocol {result.protocol}): {check}"
+        styled("motor {} on {} at {} bps (protocol {}): " + check, result.motor_id, result.port,
+               result.baudrate, result.protocol)
     )
 
 

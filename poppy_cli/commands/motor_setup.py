@@ -23,11 +23,11 @@ if TYPE_CHECKING:
 
 __all__ = ["app"]
 from poppy_cli.connect import open_bus
-from poppy_cli.output import EXIT_USAGE, console, error_line
+from poppy_cli.output import EXIT_USAGE, console, error_line, styled
 
 
 def _say(message: str) -> None:
-    console.print(f"[dim]· {message}[/]")
+    console.print(styled("[dim]· {}[/]", message))
 
 
 def _run_setup(

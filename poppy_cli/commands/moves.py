@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from poppy_cli.output import EXIT_USAGE, console, error_line, print_json
+from poppy_cli.output import EXIT_USAGE, console, error_line, print_json, styled
 
 app = typer.Typer(
     help="The move library (recorded with `poppy record`): list, show, plot, rm, export, import.",
@@ -15,6 +15,7 @@ app = typer.Typer(
 )
 
 JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
+ForceOpt = typer.Option(False, "--force", "-f", help="Replace an existing file.")
 NameArg = typer.Argument(..., help="Library name of the move, or a file path.")
 
 
@@ -73,7 +74,7 @@ def list_cmd(json_output: bool = JsonOpt) -> None:
         table.add_column(column, justify="right" if column in ("duration", "frames") else "left")
     for row in rows:
         if row.get("error"):
-            table.add_row(row["name"], row["format"], "[red]unreadable[/]", "", "", "", "")
+            table.add_row(row["name"], row["format"], styled("[red]unreadable[/]"), "", "", "", "")
             continue
         table.add_row(
             row["name"], row["format"], f"{row['duration_s']:.2f} s", str(row["frames"]),
@@ -102,8 +103,9 @@ def show(name: str = NameArg, json_output: bool = JsonOpt) -> None:
         print_json(header)
         return
     console.print(
-        f"[bold]{header['name']}[/] ({header['format']}, {_size(header['size_bytes'])}): "
-        f"{header['frames']} frames at {header['framerate']:g} Hz = {header['duration_s']:.2f} s"
+        styled("[bold]{}[/] ({}, {}): {} frames at {} Hz = {} s", header["name"], header["format"],
+               _size(header["size_bytes"]), header["frames"], f"{header['framerate']:g}",
+               f"{header['duration_s']:.2f}")
     )
     for key, value in header["metadata"].items():
         console.print(f"  {key}: {value}")
@@ -120,13 +122,24 @@ def show(name: str = NameArg, json_output: bool = JsonOpt) -> None:
 @app.command("plot")
 def plot(
     name: str = NameArg,
-    output: Path = typer.Option(..., "--output", "-o", help="Image file (png, svg, pdf)."),
+    output: Path = typer.Option(
+        ..., "--output", "-o", help="Image file (png, svg, pdf), or a folder (NAME.png)."
+    ),
+    force: bool = ForceOpt,
     json_output: bool = JsonOpt,
 ) -> None:
     """Draw each motor's trajectory against time into an image (matplotlib)."""
+    import io
+
+    from poppy_core.files import output_path, write_file
     from poppy_core.motion import load_move, move_path
 
     path = move_path(name)
+    target = output_path(output, default_name=f"{path.stem}.png", replace=force)
+    image_format = target.suffix.lower().lstrip(".") or "png"
+    if image_format not in ("png", "svg", "pdf", "jpg", "jpeg"):
+        error_line(f"{target}: write a .png, .svg, .pdf or .jpg")
+        raise typer.Exit(EXIT_USAGE)
     move = load_move(path)
     import matplotlib
 
@@ -143,13 +156,14 @@ def plot(
     axes.grid(True, alpha=0.3)
     if move.motors:
         axes.legend(loc="best", fontsize="small")
-    output.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(output, dpi=100)
+    image = io.BytesIO()
+    figure.savefig(image, dpi=100, format=image_format)
     plt.close(figure)
+    write_file(target, image.getvalue(), replace=force)
     if json_output:
-        print_json({"move": str(path), "output": str(output)})
+        print_json({"move": str(path), "output": str(target)})
         return
-    console.print(f"plotted {len(move.motors)} motors of {path.stem} into {output}")
+    console.print(f"plotted {len(move.motors)} motors of {path.stem} into {target}")
 
 
 @app.command("rm")
@@ -175,18 +189,23 @@ def rm(
 @app.command("export")
 def export(
     name: str = NameArg,
-    output: Path = typer.Option(..., "--output", "-o", help="File to write."),
+    output: Path = typer.Option(..., "--output", "-o", help="File to write, or a folder."),
     fmt: str | None = typer.Option(
         None, "--format", help="pypot (JSON) or poppy (compact); default from the suffix."
     ),
+    force: bool = ForceOpt,
     json_output: bool = JsonOpt,
 ) -> None:
-    """Write a move to a file in pypot's JSON (old tools can play it) or poppy's format."""
+    """Write a move to a file in pypot's JSON (old tools can play it) or poppy's format.
+
+    Into a folder, the file is named after the move. An existing file is replaced only with
+    --force; a folder, a link, a FIFO or a device never.
+    """
     from poppy_core.motion import FORMATS, export_move
 
     if fmt is not None and fmt not in FORMATS:
         raise typer.BadParameter(f"{fmt!r} is not {' or '.join(FORMATS)}", param_hint="--format")
-    written = export_move(name, output, fmt)
+    written = export_move(name, output, fmt, replace=force)
     chosen = fmt or ("pypot" if written.suffix.lower() == ".json" else "poppy")
     if json_output:
         print_json({"output": str(written), "format": chosen, "size_bytes": written.stat().st_size})
@@ -198,7 +217,7 @@ def export(
 def import_cmd(
     file: Path = typer.Argument(..., help="A move file: pypot JSON or poppy .move."),
     name: str | None = typer.Option(None, "--name", "-n", help="Library name (default: stem)."),
-    force: bool = typer.Option(False, "--force", help="Replace a move of that name."),
+    force: bool = typer.Option(False, "--force", "-f", help="Replace a move of that name."),
     json_output: bool = JsonOpt,
 ) -> None:
     """Copy a move file into the library (stored in poppy's compact format)."""

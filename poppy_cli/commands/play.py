@@ -17,7 +17,8 @@ from poppy_cli.commands.robot import (
     SimOpt,
     robot_config,
 )
-from poppy_cli.output import console, err_console, print_json
+from poppy_cli.options import finite
+from poppy_cli.output import console, err_console, print_json, warn_line
 
 if TYPE_CHECKING:
     from poppy_core.motion import MovePlayer, PlayProgress
@@ -25,9 +26,11 @@ if TYPE_CHECKING:
 
 def play(
     name: str = typer.Argument(..., help="Library name of the move, or a file path."),
-    speed: float = typer.Option(1.0, "--speed", "-s", min=0.01, help="2 = twice as fast."),
+    speed: float = typer.Option(
+        1.0, "--speed", "-s", min=0.01, max=100.0, callback=finite, help="2 = twice as fast."
+    ),
     reverse: bool = typer.Option(False, "--reverse", "-r", help="Play it backwards."),
-    loop: int = typer.Option(1, "--loop", "-n", min=1, help="Play it this many times."),
+    loop: int = typer.Option(1, "--loop", "-n", min=1, max=10_000, help="Play it this many times."),
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
@@ -62,6 +65,9 @@ def play(
         )
     with from_config(config, sim=sim, sensors=False) as robot:
         player = MovePlayer(robot, move, speed=speed, backwards=reverse, loops=loop)
+        for motor, beyond in player.clamped.items():
+            warn_line(f"{motor}: the move goes {beyond:.1f}° past its angle limits "
+                      f"{fmt_limits(robot.motor(motor).angle_limit)}: played at the limit")
         stop = threading.Event()
         for signum in (signal.SIGINT, signal.SIGTERM):
             signal.signal(signum, lambda *_: stop.set())
@@ -83,6 +89,11 @@ def play(
     console.print(f"{state} {player.played_s:.2f} s of {path.name} ({', '.join(move.motors)})")
 
 
+def fmt_limits(limits: tuple[float, float]) -> str:
+    """``[-90, 90]``."""
+    return f"[{limits[0]:g}, {limits[1]:g}]"
+
+
 def _run(player: MovePlayer, stop: threading.Event, *, show: bool) -> None:
     if not show:
         player.start()
@@ -94,7 +105,8 @@ def _run(player: MovePlayer, stop: threading.Event, *, show: bool) -> None:
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     columns = (
-        TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+        TextColumn("{task.description}", markup=False), BarColumn(),
+        TextColumn("{task.percentage:>3.0f}%"),
         TimeRemainingColumn(),
     )  # fmt: skip
     with Progress(*columns, console=err_console, transient=True) as progress:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import typer
 
-from poppy_cli.output import console, print_json
+from poppy_cli.output import console, print_json, styled
 
 
 def ports(
@@ -36,7 +36,7 @@ def ports(
     if not found:
         console.print(
             "No serial port found. Plug the USB2AX/U2D2 adapter in, "
-            "or start a virtual bus with [bold]poppy emulate[/]."
+            "or start a virtual bus with poppy emulate."
         )
         return
     table = Table(title="Serial ports")
@@ -45,10 +45,10 @@ def ports(
     for p in found:
         latency = "-" if p.latency_timer_ms is None else f"{p.latency_timer_ms} ms"
         if p.latency_timer_ms is not None and p.latency_timer_ms > 1:
-            latency = f"[yellow]{latency}[/]"
-        access = "[green]ok[/]" if p.accessible else "[red]denied[/]"
+            latency = styled("[yellow]{}[/]", latency)
+        access = styled("[green]ok[/]") if p.accessible else styled("[red]denied[/]")
         table.add_row(p.device, p.adapter or "-", p.usb_id or "-", latency, access, p.description)
     console.print(table)
     for p in found:
         for hint in p.advice:
-            console.print(f"[yellow]{p.device}[/]: {hint}")
+            console.print(styled("[yellow]{}[/]: {}", p.device, hint))

@@ -17,6 +17,7 @@ from poppy_cli.commands.robot import (
     SimOpt,
     build_robot,
 )
+from poppy_cli.options import MAX_DURATION_S, finite
 from poppy_cli.output import EXIT_FAILURE, console, error_line, print_json
 
 if TYPE_CHECKING:
@@ -143,7 +144,8 @@ def _wait(primitive: Primitive, duration: float | None, on_tick: Any) -> None:
 def run(
     name: str = typer.Argument(..., help="Primitive name (see `poppy primitive list`)."),
     duration: float | None = typer.Option(
-        None, "--duration", "-d", min=0.0, help="Stop after this many seconds (default: Ctrl-C)."
+        None, "--duration", "-d", min=0.0, max=MAX_DURATION_S, callback=finite,
+        help="Stop after this many seconds (default: Ctrl-C).",
     ),
     settings: list[str] | None = typer.Option(
         None, "--set", help="PROPERTY=VALUE before starting, e.g. --set amplitude=20 (repeat)."

@@ -12,30 +12,45 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, robot_config
-from poppy_cli.output import EXIT_USAGE, err_console, error_line, print_json
+from poppy_cli.options import MAX_DURATION_S, finite
+from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, print_json
 
 if TYPE_CHECKING:
     from rich.table import Table
 
+    from poppy_core.errors import FileError
     from poppy_core.motion import MoveRecorder
 
 REFRESH_S = 0.1
 
 
-def _install_stop(stop: threading.Event) -> None:
-    """SIGINT and SIGTERM set ``stop``; Enter does too when stdin is a terminal."""
+def _install_stop(stop: threading.Event) -> threading.Thread | None:
+    """SIGINT and SIGTERM set ``stop``; Enter does too when stdin is a terminal.
+
+    Returns:
+        The Enter watcher: it polls and ends once ``stop`` is set; join it before a prompt
+        reads stdin (else it could take the answer).
+    """
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
     if sys.stdin is not None and sys.stdin.isatty():
 
         def wait_enter() -> None:
+            import select
+
             try:
-                sys.stdin.readline()
+                while not stop.is_set():
+                    ready, _, _ = select.select([sys.stdin], [], [], REFRESH_S)
+                    if ready:
+                        sys.stdin.readline()
+                        stop.set()
             except (OSError, ValueError):
                 return
-            stop.set()
 
-        threading.Thread(target=wait_enter, name="record enter", daemon=True).start()
+        watcher = threading.Thread(target=wait_enter, name="record enter", daemon=True)
+        watcher.start()
+        return watcher
+    return None
 
 
 def _live_table(recorder: MoveRecorder, duration: float | None) -> Table:
@@ -81,11 +96,20 @@ def record(
     motors: str | None = typer.Option(
         None, "--motors", "-m", help="Motors or groups to record, e.g. m1,m2 or base (all)."
     ),
-    freq: float = typer.Option(50.0, "--freq", "-f", min=1.0, max=1000.0, help="Frames per s."),
-    duration: float | None = typer.Option(
-        None, "--duration", "-d", min=0.1, help="Stop after this many seconds."
+    freq: float = typer.Option(
+        50.0, "--freq", "-f", min=1.0, max=1000.0, callback=finite, help="Frames per s."
     ),
-    force: bool = typer.Option(False, "--force", help="Replace an existing move of that name."),
+    duration: float | None = typer.Option(
+        None, "--duration", "-d", min=0.1, max=MAX_DURATION_S, callback=finite,
+        help="Stop after this many seconds.",
+    ),
+    output: Path | None = typer.Option(
+        None, "--output", "-o",
+        help="Save the take here (a file, or a folder for NAME.move) instead of the library.",
+    ),
+    force: bool = typer.Option(
+        False, "--force", "-f", help="Replace an existing move of that name."
+    ),
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
@@ -94,34 +118,56 @@ def record(
 ) -> None:
     """Record a move: the motors turn compliant, move them by hand, Enter or Ctrl-C stops.
 
-    The move is saved as it goes (every second), so even a killed recording keeps what was
-    recorded; the file's path is printed alone on the last line of stdout.
+    The destination is checked before the motors go compliant, and the move is saved as it goes
+    (every second), so even a killed recording keeps what was recorded. If the last save fails
+    (full disk, folder gone), the take is not lost: on a terminal you are asked for another
+    place; otherwise it goes to a temporary file (named on stderr, exit code 1). The file's
+    path is printed alone on the last line of stdout.
     """
+    from poppy_core.errors import FileError
+    from poppy_core.files import output_path, probe_folder
     from poppy_core.motion import MoveRecorder, move_path
+    from poppy_core.motion.move_library import is_path
     from poppy_core.robot import from_config
 
-    path = move_path(name, must_exist=False)
-    if path.exists() and not force:
-        error_line(f"{path} exists: pick another name or pass --force")
-        raise typer.Exit(EXIT_USAGE)
+    in_library = output is None and not is_path(name)
+    if output is not None:
+        check_name(name)
+        path = output_path(output, default_name=f"{name}.move", replace=force)
+    else:
+        path = move_path(name, must_exist=False)
+        if path.exists() and not force:
+            error_line(f"{path} exists: pick another name or pass --force")
+            raise typer.Exit(EXIT_USAGE)
+    probe_folder(path.parent, make_folder=in_library)  # before any motor goes compliant
     config = robot_config(profile, config_file, port)
     groups = {g: config.resolve_group(g) for g in config.motorgroups}
     names = _motor_names(motors, list(config.motors), groups)
     stop = threading.Event()
-    _install_stop(stop)
+    watcher = _install_stop(stop)
+    save_failure: FileError | None = None  # the take is still held by the recorder
     with from_config(config, sim=sim, sensors=False) as robot:
+        recorder = MoveRecorder(robot, freq, names, checkpoint_path=path, replace=force,
+                                make_folder=in_library)  # fmt: skip
+        recorder.start()  # refused here when another `poppy record` writes the same file
         for motor_name in names:
             robot.motor(motor_name).compliant = True
-        recorder = MoveRecorder(robot, freq, names, checkpoint_path=path)
         err_console.print(
             f"recording {', '.join(names)} at {freq:g} Hz into {path}"
             " — move them by hand; Enter or Ctrl-C stops",
             soft_wrap=True,
         )
         sys.stderr.flush()
-        recorder.start()
         _wait(recorder, stop, duration)
-        move = recorder.stop()
+        stop.set()
+        if watcher is not None:
+            watcher.join(1.0)  # a prompt may read stdin next: the watcher must be gone
+        try:
+            move = recorder.stop()
+        except FileError as exc:
+            move, save_failure = recorder.move, exc
+    if save_failure is not None:
+        path = _save_elsewhere(recorder, save_failure, name)
     summary: dict[str, Any] = {
         "path": str(path),
         "frames": len(move),
@@ -131,12 +177,62 @@ def record(
     }
     if json_output:
         print_json(summary)
-        return
-    err_console.print(
-        f"recorded {len(move)} frames ({move.duration_s:.2f} s) of {len(move.motors)} motors"
-    )
-    sys.stdout.write(f"{path}\n")
-    sys.stdout.flush()
+    else:
+        err_console.print(
+            f"recorded {len(move)} frames ({move.duration_s:.2f} s) of {len(move.motors)} motors"
+        )
+        sys.stdout.write(f"{path}\n")
+        sys.stdout.flush()
+    if save_failure is not None and not _interactive():
+        raise typer.Exit(EXIT_FAILURE)
+
+
+def check_name(name: str) -> None:
+    """A library name for the move's metadata and default file name (not a path)."""
+    from poppy_core.motion.move_library import check_name as core_check
+
+    if "/" in name:
+        raise typer.BadParameter("with --output, NAME is a name, not a path", param_hint="NAME")
+    core_check(name)
+
+
+def _interactive() -> bool:
+    return sys.stdin is not None and sys.stdin.isatty() and err_console.is_terminal
+
+
+def _save_elsewhere(recorder: MoveRecorder, failure: FileError, name: str) -> Path:
+    """Save a take whose destination failed: ask for a place on a terminal, else a temp file.
+
+    Raises:
+        FileError: nothing could be written anywhere.
+    """
+    import tempfile
+    from datetime import datetime
+
+    from poppy_core.errors import FileError
+
+    error_line(f"the take could not be saved: {failure}")
+    while _interactive():
+        answer = typer.prompt(
+            "Save it where? (a file or a folder; empty: a temporary file)",
+            default="", show_default=False, err=True,
+        ).strip()  # fmt: skip
+        if not answer:
+            break
+        try:
+            return recorder.save(Path(answer).expanduser())
+        except FileError as exc:
+            error_line(str(exc))
+    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+    fallback = Path(tempfile.gettempdir()) / f"poppy-take-{name.replace('/', '_')}-{stamp}.move"
+    try:
+        written = recorder.save(fallback)
+    except FileError as exc:
+        raise FileError(f"the take could not be saved to {fallback} either ({exc.args[0]}): "
+                        "it is lost", path=str(fallback), errno=exc.errno) from None  # fmt: skip
+    error_line(f"the take was saved to {written} instead: `poppy moves import {written}` puts "
+               "it in the library")  # fmt: skip
+    return written
 
 
 def _wait(recorder: MoveRecorder, stop: threading.Event, duration: float | None) -> None:

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json
+from poppy_cli.options import MAX_DURATION_S, finite
+from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -174,9 +175,8 @@ def status_table(robot: Robot | RemoteRobot, title: str = "robot status") -> Tab
     table.add_column("compliant")
     table.add_column("link")
     for name, state in robot_state(robot).items():
-        link = "online" if state["online"] else "[red]offline[/]"
-        if state["errors"]:
-            link += f" ({state['errors']} errors)"
+        errors = f" ({state['errors']} errors)" if state["errors"] else ""
+        link = styled("online{}" if state["online"] else "[red]offline[/]{}", errors)
         table.add_row(
             name,
             str(state["id"]),
@@ -222,8 +222,13 @@ def status(
             return
 
 
-def parse_targets(pairs: list[str], known: list[str]) -> dict[str, float]:
-    """Parse ``NAME=DEGREES`` words, checking the names against ``known``."""
+def parse_targets(
+    pairs: list[str],
+    known: list[str],
+    limits: dict[str, tuple[float, float] | None] | None = None,
+) -> dict[str, float]:
+    """Parse ``NAME=DEGREES`` words, checking the names against ``known`` and the angles
+    against ``limits`` (motor -> its angle limits, None for a wheel), as the REST API does."""
     targets: dict[str, float] = {}
     for pair in pairs:
         name, sep, text = pair.partition("=")
@@ -242,6 +247,14 @@ def parse_targets(pairs: list[str], known: list[str]) -> dict[str, float]:
             raise typer.BadParameter(f"{pair!r}: {text!r} is not a number of degrees") from None
         if value != value or value in (float("inf"), float("-inf")):
             raise typer.BadParameter(f"{pair!r}: the angle must be a finite number")
+        bounds = (limits or {}).get(name)
+        if bounds is not None and not bounds[0] <= value <= bounds[1]:
+            from poppy_core.errors import ArgumentError
+
+            raise ArgumentError(
+                f"{name}: {value:g}° is outside the angle limits [{bounds[0]:g}, {bounds[1]:g}]",
+                field=name, value=value, motor=name,
+            )  # fmt: skip
         targets[name] = value
     return targets
 
@@ -249,7 +262,10 @@ def parse_targets(pairs: list[str], known: list[str]) -> dict[str, float]:
 @app.command("goto")
 def goto(
     targets: list[str] = typer.Argument(..., help="Targets as NAME=DEGREES, e.g. m1=30 m2=-10."),
-    duration: float = typer.Option(1.0, "--duration", "-d", min=0.0, help="Seconds to move."),
+    duration: float = typer.Option(
+        1.0, "--duration", "-d", min=0.0, max=MAX_DURATION_S, callback=finite,
+        help="Seconds to move.",
+    ),
     wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),
     control: str = typer.Option("minjerk", "--control", help="minjerk or dummy."),
     profile: str | None = ProfileOpt,
@@ -274,7 +290,11 @@ def goto(
         goals = parse_targets(targets, [m.name for m in robot.motors])
     else:
         config = robot_config(profile, config_file, port)
-        goals = parse_targets(targets, list(config.motors))
+        limits = {
+            name: None if motor.wheel_mode else motor.angle_limit
+            for name, motor in config.motors.items()
+        }
+        goals = parse_targets(targets, list(config.motors), limits)
         from poppy_core.robot import from_config
 
         robot = from_config(config, sim=sim, sensors=False)

@@ -6,8 +6,16 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.options import PORT_HELP, default_port, parse_ids, parse_protocols
-from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, console, error_line, print_json
+from poppy_cli.options import BAUD_LIMITS, PORT_HELP, default_port, parse_ids, parse_protocols
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_INTERRUPTED,
+    console,
+    error_line,
+    print_json,
+    printable,
+    styled,
+)
 
 if TYPE_CHECKING:
     from poppy_core.bus.results import FoundMotor
@@ -37,7 +45,7 @@ def render_found(motors: list[FoundMotor]) -> None:
     for column in ("port", "baud", "protocol", "id", "model", "firmware"):
         table.add_column(column, justify="right" if column in ("baud", "id") else "left")
     for m in sorted(motors, key=lambda m: (m.port, m.protocol, -m.baudrate, m.id)):
-        model = m.model or f"[yellow]unknown model {m.model_number}[/]"
+        model = m.model or styled("[yellow]unknown model {}[/]", m.model_number)
         firmware = "-" if m.firmware is None else str(m.firmware)
         table.add_row(m.port, str(m.baudrate), str(m.protocol), str(m.id), model, firmware)
     console.print(table)
@@ -46,7 +54,8 @@ def render_found(motors: list[FoundMotor]) -> None:
 def scan(
     port: str | None = typer.Option(None, "--port", "-p", help=PORT_HELP),
     baud: list[int] | None = typer.Option(
-        None, "--baud", "-b", help="Baud rate to try (repeat for several). Default: 1000000."
+        None, "--baud", "-b", help="Baud rate to try (repeat for several). Default: 1000000.",
+        **BAUD_LIMITS,
     ),
     all_bauds: bool = typer.Option(
         False, "--all-bauds", help="Try every standard baud rate of each protocol."
@@ -74,7 +83,7 @@ def scan(
 
     found: list[FoundMotor] = []
     with Progress(
-        TextColumn("{task.description}"),
+        TextColumn("{task.description}", markup=False),
         BarColumn(),
         TextColumn("{task.completed}/{task.total}"),
         TextColumn("[green]{task.fields[found]} found"),
@@ -94,7 +103,7 @@ def scan(
                 total=p.total,
                 completed=p.done,
                 found=p.found,
-                description=f"{p.port} · {p.baudrate} bps · protocol {p.protocol}",
+                description=printable(f"{p.port} · {p.baudrate} bps · protocol {p.protocol}"),
             )
 
         try:

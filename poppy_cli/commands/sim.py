@@ -13,7 +13,16 @@ from typing import TYPE_CHECKING, Any
 import typer
 from typer.core import TyperGroup
 
-from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, console, err_console, error_line
+from poppy_cli.options import finite
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_USAGE,
+    console,
+    err_console,
+    error_line,
+    plain,
+    styled,
+)
 
 if TYPE_CHECKING:
     from typer import _click
@@ -162,9 +171,9 @@ def _serve(profile: str, speed: float, tcp: str | None, view: bool) -> None:
             bus = server.bus
             ids = ", ".join(str(m.id) for m in bus.motors)
             err_console.print(
-                f"[green]simulating[/] {profile} {name}: {len(bus.motors)} motors (ids {ids}), "
-                f"protocol {bus.protocol} at {bus.baudrate} bps on {server.url}, MuJoCo at "
-                f"{speed:g}× real time — Ctrl-C to stop"
+                styled("[green]simulating[/] {}", f"{profile} {name}: {len(bus.motors)} motors "
+                       f"(ids {ids}), protocol {bus.protocol} at {bus.baudrate} bps on "
+                       f"{server.url}, MuJoCo at {speed:g}× real time — Ctrl-C to stop")
             )
         viewer = _open_viewer(simulation) if view else None
         while not stop.wait(1 / 30 if viewer is not None else 0.5):
@@ -188,7 +197,8 @@ def sim(
         None, "--profile", help="Robot profile with a simulation model: ergo-jr, torso, humanoid."
     ),
     speed: float = typer.Option(
-        1.0, "--speed", min=0.01, help="Simulated seconds per real second (1 = real time)."
+        1.0, "--speed", min=0.01, max=1000.0, callback=finite,
+        help="Simulated seconds per real second (1 = real time).",
     ),
     pty: bool = typer.Option(False, "--pty", help="Serve on pseudo-terminals (the default)."),
     tcp: str | None = typer.Option(
@@ -314,22 +324,34 @@ def render_frames(
         simulation.close()
 
 
-def save_frames(frames: list[Any], output: Path) -> None:
-    """One frame to a PNG (or any still format Pillow writes), all frames to a GIF."""
+def save_frames(frames: list[Any], output: Path, *, replace: bool = False) -> Path:
+    """One frame to a PNG (or any still format Pillow writes), all frames to a GIF.
+
+    The image is encoded in memory and written by ``poppy_core.files.write_file`` (atomic,
+    never over something that is not a regular file).
+    """
+    import io
+
     from PIL import Image
 
+    from poppy_core.files import write_file
+
     images = [Image.fromarray(frame) for frame in frames]
-    output.parent.mkdir(parents=True, exist_ok=True)
-    if output.suffix.lower() == ".gif":
-        images[0].save(output, save_all=True, append_images=images[1:],
+    suffix = output.suffix.lower()
+    image = io.BytesIO()
+    if suffix == ".gif":
+        images[0].save(image, format="GIF", save_all=True, append_images=images[1:],
                        duration=round(1000 / GIF_FPS), loop=0)  # fmt: skip
     else:
-        images[-1].save(output)
+        images[-1].save(image, format="JPEG" if suffix in (".jpg", ".jpeg") else "PNG")
+    return write_file(output, image.getvalue(), replace=replace)
 
 
 @app.command("render")
 def render(
-    output: Path = typer.Option(..., "--output", "-o", help="out.png (a still) or out.gif."),
+    output: Path = typer.Option(
+        ..., "--output", "-o", help="out.png (a still) or out.gif, or a folder (PROFILE.png/gif)."
+    ),
     profile: str = typer.Option("ergo-jr", "--profile", help="Robot profile to render."),
     move: str | None = typer.Option(
         None, "--move", help="Play this move (library name or file) and render it (use a .gif)."
@@ -339,11 +361,15 @@ def render(
     ),
     width: int = typer.Option(640, "--width", min=16, max=4096, help="Image width (pixels)."),
     height: int = typer.Option(480, "--height", min=16, max=4096, help="Image height (pixels)."),
+    force: bool = typer.Option(False, "--force", "-f", help="Replace an existing file."),
 ) -> None:
     """Render the simulated robot offscreen (EGL or OSMesa, no GPU needed) to a PNG, or a
     move played in the simulation to a GIF (15 frames per second)."""
     from poppy_core.errors import ConfigError
+    from poppy_core.files import output_path
 
+    default = f"{profile}.gif" if move is not None else f"{profile}.png"
+    output = output_path(output, default_name=default, replace=force)  # refused before rendering
     suffix = output.suffix.lower()
     if suffix not in (".png", ".gif", ".jpg", ".jpeg"):
         error_line(f"{output}: write a .png, .jpg or .gif")
@@ -353,7 +379,7 @@ def render(
         raise _no_gl("no working OpenGL backend: EGL and OSMesa failed")
     chosen = None if camera in (None, "free") else camera
     try:
-        with console.status(f"rendering {profile} with MuJoCo ({backend})…"):
+        with console.status(plain(f"rendering {profile} with MuJoCo ({backend})…")):
             frames = render_frames(profile, move, chosen, width, height)
     except ConfigError as exc:
         if exc.field == "MUJOCO_GL":
@@ -364,7 +390,7 @@ def render(
         raise typer.Exit(EXIT_USAGE) from None
     if suffix != ".gif" and len(frames) > 1:
         err_console.print(f"a still image holds one frame: the last of {len(frames)} is saved")
-    save_frames(frames, output)
+    save_frames(frames, output, replace=force)
     console.print(
         f"wrote {output} ({width}×{height}, {len(frames) if suffix == '.gif' else 1} "
         f"frame{'s' if suffix == '.gif' and len(frames) > 1 else ''}, {backend})"

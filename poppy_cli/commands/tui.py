@@ -11,6 +11,7 @@ from pathlib import Path
 
 import typer
 
+from poppy_cli.options import BAUD_LIMITS
 from poppy_cli.output import console
 
 
@@ -35,7 +36,8 @@ def tui(
         None, "--port", "-p", help="Open this bus at start and scan it (device, pty or URL)."
     ),
     baud: int | None = typer.Option(
-        None, "--baud", "-b", help="Scan --port at this rate only (default: every standard rate)."
+        None, "--baud", "-b", help="Scan --port at this rate only (default: every standard rate).",
+        **BAUD_LIMITS,
     ),
     protocol: int | None = typer.Option(
         None, "--protocol", min=1, max=2, help="Scan --port in this protocol only (1 or 2)."

@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 from textual import on
 from textual.app import App
 from textual.binding import Binding, BindingType
+from textual.notifications import SeverityLevel
 
 from poppy_cli.tui.busio import BusPool
 from poppy_cli.tui.messages import BusFailed
@@ -87,6 +88,19 @@ class PoppyApp(App[None]):
         if not isinstance(request, str):
             self.main.start_scan([port], request)
         self.main.query_one(MotorTree).focus()
+
+    def notify(
+        self,
+        message: str,
+        *,
+        title: str = "",
+        severity: SeverityLevel = "information",
+        timeout: float | None = None,
+        markup: bool = True,
+    ) -> None:
+        """Notifications carry file, port, motor and move names and error text: shown literally,
+        never read as markup (``markup`` is ignored)."""
+        super().notify(message, title=title, severity=severity, timeout=timeout, markup=False)
 
     @on(BusFailed)
     def _failed(self, message: BusFailed) -> None:

@@ -191,6 +191,7 @@ def set_return_delay(
 ) -> SetupResult:
     """Set the return delay time (µs; poppy uses 0), verified by reading it back."""
     _, model = identify(bus, motor_id)
+    model.register("return_delay_time").from_si(delay_us)  # out of range: refused before a word
     say(progress, f"motor {motor_id}: return delay {delay_us} µs")
     result = new_result(bus, "set_return_delay", motor_id)
     result.changes["return_delay_time"] = _write_verified(
@@ -217,6 +218,8 @@ def set_angle_limits(
     if min_deg >= max_deg:
         raise SetupError(f"angle limits need min < max (got {min_deg}° and {max_deg}°)")
     _, model = identify(bus, motor_id)
+    for name, value in (("min_position_limit", min_deg), ("max_position_limit", max_deg)):
+        model.register(name).from_si(value)  # out of range: refused before a word
     say(progress, f"motor {motor_id}: angle limits {min_deg}° .. {max_deg}°")
     result = new_result(bus, "set_angle_limits", motor_id)
     for name, value in (("min_position_limit", min_deg), ("max_position_limit", max_deg)):

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
+from poppy_core.errors import ArgumentError
 from poppy_core.motion import LoopPrimitive
 
 if TYPE_CHECKING:
@@ -53,7 +54,9 @@ DANCE_AMPLITUDE_DEG = 10.0
 
 def _positive(name: str, value: float) -> float:
     if not math.isfinite(value) or value < 0:
-        raise ValueError(f"{name} must be a finite number >= 0, got {value}")
+        raise ArgumentError(
+            f"{name} must be a finite number >= 0, got {value}", field=name, value=value
+        )
     return float(value)
 
 

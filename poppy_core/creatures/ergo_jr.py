@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
 from poppy_core.creatures.postures import ERGO_JR_IDLE, clamp_to_limits
+from poppy_core.errors import ArgumentError
 from poppy_core.motion import LoopPrimitive, Primitive
 from poppy_core.motion.trajectory import CONTROLS
 
@@ -60,13 +61,18 @@ SAFE_POWER_UP_S = 3.0  # postures.py SafePowerUp: IdlePosture(robot, 3.0)
 
 def _check_control(value: str) -> str:
     if value not in CONTROLS:
-        raise ValueError(f"control must be one of {', '.join(CONTROLS)}, not {value!r}")
+        raise ArgumentError(
+            f"control must be one of {', '.join(CONTROLS)}, not {value!r}",
+            field="control", value=value,
+        )  # fmt: skip
     return value
 
 
 def _finite(name: str, value: float, low: float = 0.0) -> float:
     if not math.isfinite(value) or value < low:
-        raise ValueError(f"{name} must be a finite number >= {low:g}, got {value}")
+        raise ArgumentError(
+            f"{name} must be a finite number >= {low:g}, got {value}", field=name, value=value
+        )
     return float(value)
 
 
@@ -98,9 +104,18 @@ class Dance(LoopPrimitive):
         self.tempo_scale = tempo_scale
         self.intro_s = intro_s
         self.speed_dps = DANCE_SPEED_DPS
-        self.control = _check_control(control)
+        self.control = control
         self._dance_t0 = 0.0
         self._speeds: dict[str, float] = {}
+
+    @property
+    def control(self) -> str:
+        """The goto control of the intro: ``"minjerk"`` or ``"dummy"``."""
+        return self._control
+
+    @control.setter
+    def control(self, value: str) -> None:
+        self._control = _check_control(value)
 
     @property
     def amplitude_scale(self) -> float:
@@ -206,7 +221,9 @@ class Jump(Primitive):
     @jumps.setter
     def jumps(self, value: int) -> None:
         if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-            raise ValueError(f"jumps must be a whole number >= 0, got {value!r}")
+            raise ArgumentError(
+                f"jumps must be a whole number >= 0, got {value!r}", field="jumps", value=value
+            )
         self._jumps = value
 
     def setup(self) -> None:
@@ -270,9 +287,27 @@ class SafePowerUp(Primitive):
         control: str = "dummy",
     ) -> None:
         super().__init__(robot)
-        self.duration = _finite("duration", duration)
+        self.duration = duration
         self.torque_limit = torque_limit
-        self.control = _check_control(control)
+        self.control = control
+
+    @property
+    def duration(self) -> float:
+        """Seconds to reach the idle posture (>= 0)."""
+        return self._duration
+
+    @duration.setter
+    def duration(self, value: float) -> None:
+        self._duration = _finite("duration", value)
+
+    @property
+    def control(self) -> str:
+        """The goto control: ``"minjerk"`` or ``"dummy"``."""
+        return self._control
+
+    @control.setter
+    def control(self, value: str) -> None:
+        self._control = _check_control(value)
 
     @property
     def torque_limit(self) -> float:
@@ -282,7 +317,9 @@ class SafePowerUp(Primitive):
     @torque_limit.setter
     def torque_limit(self, value: float) -> None:
         if not math.isfinite(value) or not 0.0 <= value <= 100.0:
-            raise ValueError(f"torque_limit must be 0..100 %, got {value}")
+            raise ArgumentError(
+                f"torque_limit must be 0..100 %, got {value}", field="torque_limit", value=value
+            )
         self._torque_limit = float(value)
 
     def run(self) -> None:

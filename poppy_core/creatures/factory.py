@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
 from typing import Any
 
 from poppy_core.creatures.registry import attach_creature, detect_kind
 from poppy_core.motion.chains import attach_chains
-from poppy_core.robot import Robot, RobotConfig, load_config
+from poppy_core.robot import Robot
 from poppy_core.robot import from_config as build_from_config
 from poppy_core.robot import from_profile as build_from_profile
+from poppy_core.robot.config_io import ConfigSource, as_config
 from poppy_core.robot.factory import SimMode
 
 
@@ -28,7 +28,7 @@ def _attached(robot: Robot, start_defaults: bool) -> Robot:
 
 
 def from_config(
-    config: RobotConfig | str | os.PathLike[str],
+    config: ConfigSource,
     sim: SimMode = False,
     *,
     start_defaults: bool = True,
@@ -40,7 +40,7 @@ def from_config(
     motor names it has; other robots get the kinematic chains their config describes.
 
     Args:
-        config: the config or its path.
+        config: the config, a dict or a file path.
         sim: see ``poppy_core.robot.from_config``.
         start_defaults: start the primitives the creature starts by default.
         **options: passed to ``poppy_core.robot.from_config``.
@@ -48,7 +48,7 @@ def from_config(
     Returns:
         The running robot, with ``robot.creature`` and its primitives for a known creature.
     """
-    cfg = config if isinstance(config, RobotConfig) else load_config(config)
+    cfg = as_config(config)
     return _attached(build_from_config(cfg, sim, **options), start_defaults)
 
 

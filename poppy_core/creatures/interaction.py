@@ -10,6 +10,7 @@ import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, ClassVar
 
+from poppy_core.errors import ArgumentError
 from poppy_core.motion import LoopPrimitive
 
 if TYPE_CHECKING:
@@ -44,7 +45,9 @@ def arm_motors(robot: Robot, side: str) -> list[str]:
 
 def _positive(name: str, value: float) -> float:
     if not math.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a positive number, got {value}")
+        raise ArgumentError(
+            f"{name} must be a positive number, got {value}", field=name, value=value
+        )
     return float(value)
 
 

@@ -10,6 +10,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, ClassVar
 
+from poppy_core.errors import ArgumentError
 from poppy_core.motion import SimplePosture
 from poppy_core.motion.trajectory import CONTROLS
 
@@ -103,7 +104,10 @@ class CreaturePosture(SimplePosture):
     @control.setter
     def control(self, value: str) -> None:
         if value not in CONTROLS:
-            raise ValueError(f"control must be one of {', '.join(CONTROLS)}, not {value!r}")
+            raise ArgumentError(
+                f"control must be one of {', '.join(CONTROLS)}, not {value!r}",
+                field="control", value=value,
+            )  # fmt: skip
         self._control = value
 
     def setup(self) -> None:

@@ -6,13 +6,15 @@ and the other arguments to gentle values, so ``poppy primitive run`` can start a
 
 from __future__ import annotations
 
+import io
 import math
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError, ConfigError
+from poppy_core.files import write_file
 from poppy_core.motion.manager import attach_primitive
 from poppy_core.motion.primitive import LoopPrimitive, Primitive
 from poppy_core.motion.sandbox import MockupMotor
@@ -21,18 +23,21 @@ if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
 
 DEFAULT_UPDATE_HZ = 50.0
-MotorList = Sequence["str | Motor | MockupMotor"] | None
+MotorList: TypeAlias = "str | Motor | MockupMotor | Sequence[str | Motor | MockupMotor] | None"
 
 
 def _names(robot: Robot, motors: MotorList) -> list[str]:
-    if motors is None:
-        return [m.name for m in robot.motors]
-    return [m if isinstance(m, str) else m.name for m in motors]
+    """Motor names from a motor or group name, a motor, or a list of them (every motor: None).
+
+    Raises:
+        UnknownMotorError: a name the robot does not have (the known ones are listed).
+    """
+    return [m.name for m in robot.motors_of(motors)]
 
 
 def _check_motors(robot: Robot, names: Sequence[str]) -> None:
     for name in names:
-        robot.motor(name)  # raises ConfigError naming the known motors
+        robot.motor(name)  # raises UnknownMotorError naming the known motors
 
 
 class Sinus(LoopPrimitive):
@@ -63,11 +68,20 @@ class Sinus(LoopPrimitive):
         phase: float = 0.0,
     ) -> None:
         super().__init__(robot, refresh_freq)
-        self.motor_list = _names(robot, motor_list)
+        self.motor_list = motor_list
         self.amplitude = float(amp)
         self.frequency = freq
         self.offset = float(offset)
         self.phase = float(phase)
+
+    @property
+    def motor_list(self) -> list[str]:
+        """The motors driven, by name; set a name, a group, a motor or a list of them."""
+        return list(self._motor_list)
+
+    @motor_list.setter
+    def motor_list(self, value: MotorList) -> None:
+        self._motor_list = _names(self.real_robot, value)
 
     @property
     def frequency(self) -> float:
@@ -77,7 +91,10 @@ class Sinus(LoopPrimitive):
     @frequency.setter
     def frequency(self, value: float) -> None:
         if not math.isfinite(value) or value < 0:
-            raise ValueError(f"frequency must be a finite number >= 0 Hz, got {value}")
+            raise ArgumentError(
+                f"frequency must be a finite number >= 0 Hz, got {value}",
+                field="frequency", value=value,
+            )  # fmt: skip
         self._signal_hz = float(value)
 
     def setup(self) -> None:
@@ -146,7 +163,9 @@ class Square(Sinus):
     @duty.setter
     def duty(self, value: float) -> None:
         if not 0.0 <= value <= 1.0:
-            raise ValueError(f"duty must be between 0 and 1, got {value}")
+            raise ArgumentError(
+                f"duty must be between 0 and 1, got {value}", field="duty", value=value
+            )
         self._duty = float(value)
 
     def signal(self, t_s: float) -> float:
@@ -179,9 +198,18 @@ class PositionWatcher(LoopPrimitive):
         watched_motors: MotorList = None,
     ) -> None:
         super().__init__(robot, refresh_freq)
-        self.watched_motors = _names(robot, watched_motors)
+        self.watched_motors = watched_motors
         self.times: list[float] = []
         self.record_positions: dict[str, list[float]] = {}
+
+    @property
+    def watched_motors(self) -> list[str]:
+        """The motors watched, by name; set a name, a group, a motor or a list of them."""
+        return list(self._watched)
+
+    @watched_motors.setter
+    def watched_motors(self, value: MotorList) -> None:
+        self._watched = _names(self.real_robot, value)
 
     def setup(self) -> None:
         """Check the motor names and start a new record."""
@@ -202,7 +230,10 @@ class PositionWatcher(LoopPrimitive):
             path: the image file to write.
 
         Returns:
-            The path written.
+            The path written (atomically; an existing regular file is replaced).
+
+        Raises:
+            FileError: the file cannot be written, or is not a regular file.
         """
         import matplotlib
 
@@ -219,9 +250,9 @@ class PositionWatcher(LoopPrimitive):
         axes.set_ylabel("present position (°)")
         if self.record_positions:
             axes.legend(loc="upper right")
-        out = Path(path)
-        figure.savefig(out, format="png")
-        return out
+        image = io.BytesIO()
+        figure.savefig(image, format="png")
+        return write_file(Path(path), image.getvalue(), replace=True)
 
 
 class SimplePosture(Primitive):
@@ -251,6 +282,16 @@ class SimplePosture(Primitive):
         self.target_position = dict(target_position)
 
     @property
+    def target_position(self) -> dict[str, float]:
+        """The posture: motor name -> degrees (unknown motors are refused when set)."""
+        return self._target
+
+    @target_position.setter
+    def target_position(self, value: Mapping[str, float]) -> None:
+        _check_motors(self.real_robot, list(value))
+        self._target = dict(value)
+
+    @property
     def duration(self) -> float:
         """Seconds to reach the posture (>= 0)."""
         return self._duration
@@ -258,7 +299,10 @@ class SimplePosture(Primitive):
     @duration.setter
     def duration(self, value: float) -> None:
         if not math.isfinite(value) or value < 0:
-            raise ValueError(f"duration must be a finite number >= 0 s, got {value}")
+            raise ArgumentError(
+                f"duration must be a finite number >= 0 s, got {value}",
+                field="duration", value=value,
+            )  # fmt: skip
         self._duration = float(value)
 
     def setup(self) -> None:

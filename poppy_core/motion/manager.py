@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
-from poppy_core.errors import ConfigError, PortError
+from poppy_core.errors import ConfigError, RobotClosedError
 from poppy_core.motion.sandbox import NUMERIC_REGISTERS
 from poppy_core.robot.schedule import Periodic, RateMeter
 
@@ -111,11 +111,11 @@ class PrimitiveManager:
         """Combine ``primitive``'s requests from now on (``start()`` calls it).
 
         Raises:
-            PortError: the manager (its robot) is closed.
+            RobotClosedError: the manager (its robot) is closed.
         """
         with self._lock:
             if self._closed:
-                raise PortError("the robot is closed: primitives cannot start any more")
+                raise RobotClosedError("the robot is closed: primitives cannot start any more")
             if primitive not in self._primitives:
                 self._primitives.append(primitive)
             if self._thread is None:

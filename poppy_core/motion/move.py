@@ -9,7 +9,51 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from poppy_core.errors import ArgumentError, UnknownMotorError
+
 FloatArray = npt.NDArray[np.float64]
+
+# Bounds of a move, checked before any array is allocated so that a tiny file cannot claim a huge
+# move (a pypot JSON with framerate 1e6 resampled to 1.6 GB, a 1e-300 Hz move that never ends).
+MIN_FRAMERATE_HZ = 0.1
+MAX_FRAMERATE_HZ = 1000.0
+MAX_DURATION_S = 24 * 3600.0
+"""A day: longer moves are mistakes that would never end playing."""
+MAX_MOTORS = 1024
+MAX_VALUES = 5_000_000
+"""Frames x motors (40 MB of float64 per array): 66 min of a 25-motor Humanoid at 50 Hz."""
+MAX_POSITION_DEG = 1000.0
+"""No servo turns further from its zero, offsets included; larger values are corrupt data."""
+MAX_SPEED_DPS = 100_000.0
+
+
+def check_size(framerate: float, frames: int, motors: int) -> None:
+    """Refuse a move too large or too long to hold, before its arrays are allocated.
+
+    Raises:
+        ArgumentError: a framerate out of ``MIN_FRAMERATE_HZ``-``MAX_FRAMERATE_HZ``, more than
+            ``MAX_MOTORS`` motors, more than ``MAX_VALUES`` values or longer than a day.
+    """
+    if not MIN_FRAMERATE_HZ <= framerate <= MAX_FRAMERATE_HZ:  # also refuses NaN
+        raise ArgumentError(
+            f"framerate must be {MIN_FRAMERATE_HZ:g}-{MAX_FRAMERATE_HZ:g} Hz, got {framerate:g}",
+            field="framerate", value=framerate,
+        )  # fmt: skip
+    if motors > MAX_MOTORS:
+        raise ArgumentError(
+            f"{motors} motors: a move holds at most {MAX_MOTORS}", field="motors", value=motors
+        )
+    if frames < 0 or frames * max(motors, 1) > MAX_VALUES:
+        raise ArgumentError(
+            f"{frames} frames of {motors} motors: a move holds at most {MAX_VALUES:,} values",
+            field="frames", value=frames,
+        )  # fmt: skip
+    if (frames - 1) / framerate > MAX_DURATION_S:
+        raise ArgumentError(
+            f"{frames} frames at {framerate:g} Hz last {(frames - 1) / framerate:.3g} s: a move "
+            f"lasts at most {MAX_DURATION_S:g} s",
+            field="frames", value=frames,
+        )  # fmt: skip
 
 
 class Move:
@@ -25,8 +69,9 @@ class Move:
         metadata: free header fields (``created``, ``robot``, ``description``...), JSON-ready.
 
     Raises:
-        ValueError: a bad framerate, duplicate or empty motor names, a wrong shape or a
-            value that is not a finite number.
+        ArgumentError: a framerate out of range, duplicate or empty motor names, a wrong shape,
+            a value that is not a finite number or out of range, a move too large (see
+            ``check_size``). It is also a ``ValueError``.
     """
 
     def __init__(
@@ -40,30 +85,47 @@ class Move:
     ) -> None:
         rate = float(framerate)
         if not math.isfinite(rate) or rate <= 0:
-            raise ValueError(f"framerate must be a positive number, got {framerate!r}")
+            raise ArgumentError(
+                f"framerate must be a positive number, got {framerate!r}",
+                field="framerate", value=framerate,
+            )  # fmt: skip
         names = tuple(str(m) for m in motors)
         if any(not n for n in names):
-            raise ValueError("motor names must not be empty")
+            raise ArgumentError("motor names must not be empty", field="motors", value=names)
         if len(set(names)) != len(names):
-            raise ValueError(f"motor names must be unique, got {', '.join(names)}")
+            raise ArgumentError(
+                f"motor names must be unique, got {', '.join(names)}", field="motors", value=names
+            )
         self.framerate = rate
         self.motors = names
-        self.positions = self._checked(positions, "positions")
-        self.speeds = None if speeds is None else self._checked(speeds, "speeds")
+        self.positions = self._checked(positions, "positions", MAX_POSITION_DEG)
+        check_size(rate, len(self.positions), len(names))
+        self.speeds = None if speeds is None else self._checked(speeds, "speeds", MAX_SPEED_DPS)
         if self.speeds is not None and self.speeds.shape != self.positions.shape:
-            raise ValueError("speeds must have the same shape as positions")
+            raise ArgumentError(
+                "speeds must have the same shape as positions", field="speeds", value=None
+            )
         self.metadata: dict[str, Any] = dict(metadata or {})
 
-    def _checked(self, values: npt.ArrayLike, what: str) -> FloatArray:
-        array = np.array(values, dtype=np.float64)
+    def _checked(self, values: npt.ArrayLike, what: str, bound: float) -> FloatArray:
+        try:
+            array = np.array(values, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise ArgumentError(f"{what} must be numbers ({exc})", field=what) from None
         if array.size == 0:
             array = array.reshape(0, len(self.motors))
         if array.ndim != 2 or array.shape[1] != len(self.motors):
-            raise ValueError(
-                f"{what} must have shape (frames, {len(self.motors)}), got {array.shape}"
+            raise ArgumentError(
+                f"{what} must have shape (frames, {len(self.motors)}), got {array.shape}",
+                field=what,
             )
         if not np.all(np.isfinite(array)):
-            raise ValueError(f"{what} must be finite numbers")
+            raise ArgumentError(f"{what} must be finite numbers", field=what)
+        if array.size and float(np.max(np.abs(array))) > bound:
+            worst = float(np.max(np.abs(array)))
+            raise ArgumentError(
+                f"{what} must be within ±{bound:g}, got {worst:g}", field=what, value=worst
+            )
         return array
 
     @classmethod
@@ -77,13 +139,15 @@ class Move:
         """Build a move from frames given as ``{motor: degrees}`` dicts (same motors in each).
 
         Raises:
-            ValueError: frames that do not all name the same motors.
+            ArgumentError: frames that do not all name the same motors.
         """
         motors = list(frames[0]) if frames else []
         rows = []
         for index, frame in enumerate(frames):
             if set(frame) != set(motors):
-                raise ValueError(f"frame {index} names other motors than frame 0")
+                raise ArgumentError(
+                    f"frame {index} names other motors than frame 0", field="frames", value=index
+                )
             rows.append([float(frame[m]) for m in motors])
         return cls(framerate, motors, rows, metadata=metadata)
 
@@ -118,21 +182,24 @@ class Move:
         """Every position of one motor.
 
         Raises:
-            KeyError: a motor the move does not hold.
+            UnknownMotorError: a motor the move does not hold.
         """
         if motor not in self.motors:
-            raise KeyError(f"the move has no motor {motor!r} (motors: {', '.join(self.motors)})")
+            raise UnknownMotorError(
+                f"the move has no motor {motor!r} (motors: {', '.join(self.motors)})",
+                motor=motor, known=list(self.motors),
+            )  # fmt: skip
         return self.positions[:, self.motors.index(motor)].copy()
 
     def positions_at(self, t_s: float) -> FloatArray:
         """Positions at ``t_s`` seconds, linearly interpolated, held at both ends.
 
         Raises:
-            ValueError: the move has no frame.
+            ArgumentError: the move has no frame.
         """
         count = len(self)
         if count == 0:
-            raise ValueError("an empty move has no position")
+            raise ArgumentError("an empty move has no position", field="frames", value=0)
         x = min(max(float(t_s) * self.framerate, 0.0), float(count - 1))
         low = math.floor(x)
         if low >= count - 1:
@@ -158,11 +225,14 @@ class Move:
         """A move holding only ``motors`` (in that order).
 
         Raises:
-            KeyError: a motor the move does not hold.
+            UnknownMotorError: a motor the move does not hold.
         """
         missing = [m for m in motors if m not in self.motors]
         if missing:
-            raise KeyError(f"the move has no motor {', '.join(missing)}")
+            raise UnknownMotorError(
+                f"the move has no motor {', '.join(missing)} (motors: {', '.join(self.motors)})",
+                motor=missing[0], known=list(self.motors),
+            )  # fmt: skip
         columns = [self.motors.index(m) for m in motors]
         speeds = None if self.speeds is None else self.speeds[:, columns]
         return Move(
@@ -210,6 +280,10 @@ def resample(times_s: npt.ArrayLike, positions: npt.ArrayLike, framerate: float)
     Returns:
         Shape ``(frames, motors)``: frame ``k`` is the position at ``times_s[0] + k / framerate``,
         up to the last sample time.
+
+    Raises:
+        ArgumentError: the result would be too large (see ``check_size``), checked before it is
+            allocated.
     """
     t = np.asarray(times_s, dtype=np.float64)
     values = np.asarray(positions, dtype=np.float64)
@@ -218,6 +292,7 @@ def resample(times_s: npt.ArrayLike, positions: npt.ArrayLike, framerate: float)
     span = float(t[-1] - t[0])
     # A small slack keeps a last sample that falls a hair before its frame's time.
     count = math.floor(span * framerate + 1e-6) + 1
+    check_size(framerate, count, values.shape[1] if values.ndim == 2 else 0)
     grid = t[0] + np.arange(count, dtype=np.float64) / framerate
     out = np.empty((count, values.shape[1]), dtype=np.float64)
     for column in range(values.shape[1]):

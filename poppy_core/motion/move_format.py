@@ -1,4 +1,4 @@
-"""Move files: poppy's compact binary format, pypot's JSON, and atomic writes.
+"""Move files: poppy's compact binary format and pypot's JSON (written by ``poppy_core.files``).
 
 poppy's format (``.move``), little-endian::
 
@@ -23,20 +23,20 @@ a period from the regular grid, resample linearly at the framerate.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
 import math
 import os
 import struct
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from poppy_core.errors import ConfigError
-from poppy_core.motion.move import Move, resample
+from poppy_core.documents import Limits, parse_json, read_limited
+from poppy_core.errors import ArgumentError, ConfigError
+from poppy_core.files import write_file
+from poppy_core.motion.move import MAX_VALUES, Move, check_size, resample
 
 logger = logging.getLogger(__name__)
 
@@ -51,6 +51,14 @@ HEADER_KEYS: tuple[str, ...] = (
 )  # fmt: skip
 _DTYPES: dict[str, np.dtype[Any]] = {"<f4": np.dtype("<f4"), "<f8": np.dtype("<f8")}
 _LENGTH = struct.Struct("<I")
+MAX_HEADER_BYTES = 1 << 20
+MAX_MOVE_BYTES = 2 * MAX_VALUES * 8 + MAX_HEADER_BYTES
+"""The largest .move file: the largest move in float64 with speeds."""
+PYPOT_LIMITS = Limits(max_bytes=64 << 20, max_nodes=4 * MAX_VALUES, max_depth=8)
+"""A pypot move JSON: 64 MiB holds 30 min of a 25-motor Humanoid at 50 Hz."""
+
+
+_HEADER_LIMITS = Limits(max_bytes=MAX_HEADER_BYTES, max_nodes=100_000, max_depth=16)
 
 
 def _bad(source: str, reason: str) -> ConfigError:
@@ -101,12 +109,14 @@ def decode_move(data: bytes, source: str = "<bytes>") -> Move:
     if len(data) < start:
         raise _bad(source, "truncated header")
     (length,) = _LENGTH.unpack_from(data, len(MAGIC))
+    if length > MAX_HEADER_BYTES:
+        raise _bad(source, f"a {length:,}-byte header (at most {MAX_HEADER_BYTES:,})")
     if len(data) < start + length:
         raise _bad(source, "truncated header")
     try:
-        header = json.loads(data[start : start + length].decode())
-    except (UnicodeDecodeError, ValueError) as exc:
-        raise _bad(source, f"unreadable header ({exc})") from None
+        header = parse_json(data[start : start + length], source, _HEADER_LIMITS)
+    except ConfigError as exc:
+        raise _bad(source, f"unreadable header ({exc.reason})") from None
     if not isinstance(header, dict) or header.get("format") != FORMAT_NAME:
         raise _bad(source, "the header is not a poppy-move header")
     version = header.get("version")
@@ -117,8 +127,12 @@ def decode_move(data: bytes, source: str = "<bytes>") -> Move:
         frames = int(header["frames"])
         kind = _DTYPES[str(header.get("dtype", "<f4"))]
         framerate = float(header["framerate"])
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise _bad(source, f"bad header field {exc}") from None
+    try:
+        check_size(framerate, frames, len(motors))
+    except ArgumentError as exc:
+        raise _bad(source, str(exc)) from None
     count = frames * len(motors)
     blocks = 2 if header.get("speeds") else 1
     body = start + length
@@ -168,31 +182,45 @@ def decode_pypot(data: bytes | str, source: str = "<json>") -> Move:
     Raises:
         ConfigError: not pypot move JSON.
     """
+    if len(data) > PYPOT_LIMITS.max_bytes:
+        raise _bad(source, f"{len(data):,} bytes of JSON (at most {PYPOT_LIMITS.max_bytes:,})")
     try:
-        document = json.loads(data)
+        document = parse_json(data, source, PYPOT_LIMITS, check=False)
+    except ConfigError as exc:
+        raise _bad(source, str(exc.reason)) from None
+    try:
         framerate = float(document["framerate"])
         timed = document["positions"]
         if not isinstance(timed, dict):
             raise TypeError("positions is not an object")
         items = sorted(((float(k), v) for k, v in timed.items()), key=lambda kv: kv[0])
-    except (ValueError, KeyError, TypeError) as exc:
+    except (ValueError, KeyError, TypeError, OverflowError) as exc:
         raise _bad(source, f"not pypot move JSON ({type(exc).__name__}: {exc})") from None
     if not math.isfinite(framerate) or framerate <= 0:
         raise _bad(source, f"framerate {framerate!r} is not a positive number")
-    motors: list[str] = []
-    for _, frame in items:
+    motors: dict[str, None] = {}
+    for time_s, frame in items:
         if not isinstance(frame, dict):
             raise _bad(source, "a frame is not an object of motor positions")
-        motors.extend(m for m in frame if m not in motors)
+        if not math.isfinite(time_s):
+            raise _bad(source, f"frame time {time_s!r} is not a finite number")
+        motors.update(dict.fromkeys(frame))
+    try:  # the grid the frames are resampled on, checked before any array is made
+        span = items[-1][0] - items[0][0] if items else 0.0
+        grid = int(min(span * framerate, 1e12)) + 1  # inf-safe: a huge grid is refused below
+        check_size(framerate, max(len(items), grid), len(motors))
+    except ArgumentError as exc:
+        raise _bad(source, str(exc)) from None
     times = np.array([t for t, _ in items], dtype=np.float64)
     positions = np.full((len(items), len(motors)), np.nan)
     speeds = np.full((len(items), len(motors)), np.nan)
     column = {m: i for i, m in enumerate(motors)}
+    names = list(motors)
     try:
         for row, (_, frame) in enumerate(items):
             for name, value in frame.items():
                 positions[row, column[name]], speeds[row, column[name]] = _value_pair(value)
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, OverflowError) as exc:
         raise _bad(source, str(exc)) from None
     for array in (positions, speeds):
         _fill_gaps(array)
@@ -203,7 +231,7 @@ def decode_pypot(data: bytes | str, source: str = "<json>") -> Move:
             positions = resample(times, positions, framerate)
             speeds = resample(times, speeds, framerate)
     try:
-        return Move(framerate, motors, positions, speeds=speeds, metadata={})
+        return Move(framerate, names, positions, speeds=speeds, metadata={})
     except ValueError as exc:
         raise _bad(source, str(exc)) from None
 
@@ -276,54 +304,34 @@ def read_bytes(path: str | os.PathLike[str]) -> bytes:
     """A move file's bytes.
 
     Raises:
-        ConfigError: the file is missing or unreadable.
+        ConfigError: the file is missing, unreadable, not a regular file or too large.
     """
-    source = str(path)
-    try:
-        return Path(path).read_bytes()
-    except OSError as exc:
-        raise ConfigError(
-            f"{source}: cannot read the move ({exc.strerror or exc})", file=source,
-            reason=str(exc),
-        ) from None  # fmt: skip
+    return read_limited(path, MAX_MOVE_BYTES, "move")
 
 
-def write_move(move: Move, path: str | os.PathLike[str], fmt: str | None = None) -> Path:
+def write_move(
+    move: Move,
+    path: str | os.PathLike[str],
+    fmt: str | None = None,
+    *,
+    replace: bool = True,
+    make_folder: bool = False,
+) -> Path:
     """Write a move atomically (a reader sees the old file or the new one, never a mix).
 
     Args:
         move: the move.
         path: where to write.
         fmt: ``"poppy"`` or ``"pypot"``; from the suffix when None (``.json`` is pypot's).
+        replace: replace an existing regular file.
+        make_folder: create a missing folder (the library's).
 
     Returns:
         The path written.
+
+    Raises:
+        FileError: refused or failed (see ``poppy_core.files.write_file``).
     """
     target = Path(path)
-    atomic_write_bytes(target, encode(move, fmt or format_for_path(target)))
-    return target
-
-
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file beside ``path``, fsync it, then rename it over ``path``.
-
-    On any failure the temporary file is removed and ``path`` keeps its old content.
-    """
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, temp_name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(temp_name, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temp_name)
-        raise
-    with contextlib.suppress(OSError):  # make the rename itself durable (POSIX)
-        dir_fd = os.open(path.parent, os.O_RDONLY)
-        try:
-            os.fsync(dir_fd)
-        finally:
-            os.close(dir_fd)
+    data = encode(move, fmt or format_for_path(target))
+    return write_file(target, data, replace=replace, make_folder=make_folder)

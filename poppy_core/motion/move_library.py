@@ -13,12 +13,12 @@ from pathlib import Path
 
 import platformdirs
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ConfigError, FileError
+from poppy_core.files import output_path, write_file
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import (
     MOVE_SUFFIX,
     PYPOT_SUFFIX,
-    atomic_write_bytes,
     decode_any,
     detect_format,
     format_for_path,
@@ -30,6 +30,8 @@ from poppy_core.motion.move_format import (
 MOVES_DIR_ENV = "POPPY_MOVES_DIR"
 SUFFIXES: tuple[str, ...] = (MOVE_SUFFIX, PYPOT_SUFFIX)
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._ -]*$")
+MAX_NAME_CHARS = 100
+"""Longest move name: file systems stop at 255 bytes, and a name is read by people."""
 
 
 @dataclass(frozen=True)
@@ -46,8 +48,24 @@ def moves_dir() -> Path:
     """The library folder: ``$POPPY_MOVES_DIR``, else ``<user data dir>/poppy/moves``."""
     override = os.environ.get(MOVES_DIR_ENV)
     if override:
-        return Path(override)
+        return Path(override).expanduser()
     return Path(platformdirs.user_data_dir("poppy")) / "moves"
+
+
+def library() -> Path:
+    """The library folder, checked: it may be missing (no move yet) but not be something else.
+
+    Raises:
+        FileError: the path exists and is not a folder.
+    """
+    root = moves_dir()
+    if root.exists() and not root.is_dir():
+        raise FileError(
+            f"the move library {root} is not a folder: remove it or set {MOVES_DIR_ENV} to a "
+            "folder",
+            path=str(root),
+        )
+    return root
 
 
 def is_path(ref: str | os.PathLike[str]) -> bool:
@@ -62,6 +80,11 @@ def check_name(name: str) -> str:
     Raises:
         ConfigError: a name that cannot be a file stem.
     """
+    if len(name) > MAX_NAME_CHARS:
+        raise ConfigError(
+            f"a move name has at most {MAX_NAME_CHARS} characters ({len(name)} given)",
+            field="name", value=name,
+        )  # fmt: skip
     if not _NAME.match(name) or name.endswith((".", " ")):
         raise ConfigError(
             f"{name!r} is not a move name: use letters, digits, '.', '_', '-' or spaces",
@@ -73,7 +96,7 @@ def check_name(name: str) -> str:
 
 def list_moves(folder: Path | None = None) -> list[MoveEntry]:
     """The moves in the library, sorted by name (``.move`` first when both exist)."""
-    root = folder if folder is not None else moves_dir()
+    root = folder if folder is not None else library()
     if not root.is_dir():
         return []
     entries = []
@@ -99,7 +122,7 @@ def move_path(ref: str | os.PathLike[str], *, must_exist: bool = True) -> Path:
             raise ConfigError(f"no move file {path}", file=str(path), reason="not found")
         return path
     name = check_name(os.fspath(ref))
-    root = moves_dir()
+    root = library()
     for suffix in SUFFIXES:
         candidate = root / f"{name}{suffix}"
         if candidate.is_file():
@@ -121,13 +144,28 @@ def load_move(ref: str | os.PathLike[str]) -> Move:
     return read_move(move_path(ref))
 
 
-def save_move(move: Move, ref: str | os.PathLike[str], fmt: str | None = None) -> Path:
+def save_move(
+    move: Move, ref: str | os.PathLike[str], fmt: str | None = None, *, replace: bool = True
+) -> Path:
     """Save a move under a library name (poppy's format) or at a path (format from its suffix).
+
+    The library folder is created when missing; a path's folder must exist.
+
+    Args:
+        move: the move.
+        ref: a library name or a path.
+        fmt: ``"poppy"`` or ``"pypot"`` (from the suffix when None).
+        replace: replace an existing move file.
 
     Returns:
         The path written (atomically).
+
+    Raises:
+        ConfigError: a bad name.
+        FileError: refused or failed (full disk, read-only folder...): nothing is replaced.
     """
-    return write_move(move, move_path(ref, must_exist=False), fmt)
+    target = move_path(ref, must_exist=False)
+    return write_move(move, target, fmt, replace=replace, make_folder=not is_path(ref))
 
 
 def delete_move(ref: str | os.PathLike[str]) -> Path:
@@ -163,16 +201,20 @@ def import_move(
     src = Path(source).expanduser()
     move = read_move(src)
     target_name = check_name(name if name is not None else src.stem)
-    existing = [moves_dir() / f"{target_name}{s}" for s in SUFFIXES]
+    existing = [library() / f"{target_name}{s}" for s in SUFFIXES]
     taken = [p for p in existing if p.is_file()]
     if taken and not overwrite:
         raise ConfigError(
-            f"a move named {target_name!r} exists ({taken[0]}): choose another name or overwrite",
+            f"a move named {target_name!r} exists ({taken[0]}): choose another name or pass "
+            "--force to replace it",
             file=str(taken[0]),
             field="name",
         )
     move.metadata.setdefault("imported_from", str(src))
-    target = write_move(move, moves_dir() / f"{target_name}{MOVE_SUFFIX}", "poppy")
+    target = write_move(
+        move, library() / f"{target_name}{MOVE_SUFFIX}", "poppy", replace=overwrite,
+        make_folder=True,
+    )  # fmt: skip
     for path in taken:
         if path != target:
             path.unlink()
@@ -180,25 +222,39 @@ def import_move(
 
 
 def export_move(
-    ref: str | os.PathLike[str], destination: str | os.PathLike[str], fmt: str | None = None
+    ref: str | os.PathLike[str],
+    destination: str | os.PathLike[str],
+    fmt: str | None = None,
+    *,
+    replace: bool = False,
 ) -> Path:
     """Write a library move (or any move file) to ``destination`` in ``fmt``.
 
     Args:
         ref: library name or path of the move.
-        destination: the file to write.
-        fmt: ``"poppy"`` or ``"pypot"``; from the destination's suffix when None.
+        destination: the file to write, or a folder to write ``<name>.move``/``.json`` into.
+        fmt: ``"poppy"`` or ``"pypot"``; from the destination's suffix when None (a folder:
+            the move's own format).
+        replace: replace an existing regular file.
 
     Returns:
         The path written.
+
+    Raises:
+        ConfigError: no such move, or not a move file.
+        FileError: the destination is refused (it exists without ``replace``, is not a regular
+            file, or its folder is missing) or the write failed.
     """
     source = move_path(ref)
-    target = Path(destination).expanduser()
-    chosen = fmt or format_for_path(target)
-    if source.resolve() == target.resolve():
-        raise ConfigError(f"{target} is the move itself", file=str(target))
+    given = Path(destination).expanduser()
+    into_folder = given.is_dir() and not given.is_symlink()
+    chosen = fmt or (format_for_path(source) if into_folder else format_for_path(given))
+    suffix = PYPOT_SUFFIX if chosen == "pypot" else MOVE_SUFFIX
+    target = output_path(given, default_name=f"{source.stem}{suffix}", replace=True)
+    if target.exists() and source.resolve() == target.resolve():
+        raise FileError(f"{target} is the move itself: give another file", path=str(target))
+    output_path(target, replace=replace)  # refused now, before the move is read and converted
     data = read_bytes(source)
     if chosen == "poppy" and detect_format(data) == "poppy":
-        atomic_write_bytes(target, data)  # already ours: copied byte for byte
-        return target
-    return write_move(decode_any(data, str(source)), target, chosen)
+        return write_file(target, data, replace=replace)  # already ours: copied byte for byte
+    return write_move(decode_any(data, str(source)), target, chosen, replace=replace)

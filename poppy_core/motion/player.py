@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.move import Move
 from poppy_core.robot.schedule import Periodic
 
@@ -31,6 +31,11 @@ DEFAULT_RATE_HZ = 50.0
 DEFAULT_RAMP_SPEED_DPS = 60.0
 """Mean speed of the ramp to the first frame (a minimum-jerk peak is 1.875 times that)."""
 MIN_RAMP_S = 0.3
+MIN_SPEED = 0.01
+MAX_SPEED = 100.0
+MAX_LOOPS = 10_000
+LIMIT_TOLERANCE_DEG = 0.5
+"""Past a limit by less than this is noise of a recording at the limit: clamped silently."""
 RAMP_SKIP_DEG = 0.5
 """No ramp when every motor is already this close to the first frame."""
 
@@ -70,6 +75,34 @@ def write_rate_hz(robot: Robot) -> float:
     return min(rates) if rates else DEFAULT_RATE_HZ
 
 
+def clamp_to_limits(move: Move, motors: list[Motor]) -> dict[str, float]:
+    """How far past its angle limits each motor of ``move`` goes (motors within are left out).
+
+    Args:
+        move: the move.
+        motors: the robot's motors, one per column of the move (wheels have no limits).
+    """
+    beyond: dict[str, float] = {}
+    for index, motor in enumerate(motors):
+        if motor.wheel_mode or not len(move):
+            continue
+        low, high = motor.angle_limit
+        column = move.positions[:, index]
+        worst = max(low - float(column.min()), float(column.max()) - high, 0.0)
+        if worst > LIMIT_TOLERANCE_DEG:
+            beyond[motor.name] = worst
+    return beyond
+
+
+def _within_limits(move: Move, motors: list[Motor]) -> Move:
+    positions = move.positions.copy()
+    for index, motor in enumerate(motors):
+        if not motor.wheel_mode:
+            low, high = motor.angle_limit
+            np.clip(positions[:, index], low, high, out=positions[:, index])
+    return Move(move.framerate, move.motors, positions, speeds=move.speeds, metadata=move.metadata)
+
+
 def missing_motors(robot: Robot, move: Move) -> list[str]:
     """The motors of ``move`` the robot does not have."""
     names = {m.name for m in robot.motors}
@@ -92,9 +125,13 @@ class MovePlayer:
         on_progress: called at each update with a ``PlayProgress``.
         clock: the time source (seconds).
 
+    Positions past a motor's angle limits are played at the limit (``clamped`` says by how
+    much, and a warning is logged), so the ramp to the first frame is planned on reachable
+    positions.
+
     Raises:
         ConfigError: the robot lacks motors of the move (they are named).
-        ValueError: an empty move, a speed or loop count that is not positive.
+        ArgumentError: an empty move, a speed or loop count out of range.
     """
 
     def __init__(
@@ -111,12 +148,17 @@ class MovePlayer:
         on_progress: ProgressCallback | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        if not (math.isfinite(speed) and speed > 0):
-            raise ValueError(f"speed must be a positive number, got {speed}")
-        if loops < 1:
-            raise ValueError(f"loops must be at least 1, got {loops}")
+        if not (math.isfinite(speed) and MIN_SPEED <= speed <= MAX_SPEED):
+            raise ArgumentError(
+                f"speed must be {MIN_SPEED:g}-{MAX_SPEED:g} (1 = as recorded), got {speed}",
+                field="speed", value=speed,
+            )  # fmt: skip
+        if not 1 <= loops <= MAX_LOOPS:
+            raise ArgumentError(
+                f"loops must be 1-{MAX_LOOPS}, got {loops}", field="loops", value=loops
+            )
         if len(move) == 0:
-            raise ValueError("the move has no frame to play")
+            raise ArgumentError("the move has no frame to play", field="move", value=move)
         missing = missing_motors(robot, move)
         if missing:
             known = ", ".join(m.name for m in robot.motors)
@@ -137,14 +179,26 @@ class MovePlayer:
         self.rate_hz = rate_hz if rate_hz is not None else write_rate_hz(robot)
         self.on_progress = on_progress
         self._clock = clock
-        self._played = move.reversed() if backwards else move
         self._motors: list[Motor] = [robot.motor(name) for name in move.motors]
+        self.clamped = clamp_to_limits(move, self._motors)
+        """Motor -> how far (degrees) the move went past its angle limits, for each motor it did
+        (those frames are played at the limit)."""
+        if self.clamped:
+            logger.warning("the move goes past the angle limits of %s: played at the limits",
+                           ", ".join(f"{n} (by {d:.1f}°)" for n, d in self.clamped.items()))
+        played = _within_limits(move, self._motors) if self.clamped else move
+        self._played = played.reversed() if backwards else played
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self.loop_times: list[tuple[float, float]] = []
         """``(start, end)`` clock times of each loop's playing phase (ramps excluded)."""
         self.stopped = False
         self.error: BaseException | None = None
+
+    @property
+    def played(self) -> Move:
+        """The move as it is played: reversed when backwards, positions within the limits."""
+        return self._played
 
     @property
     def duration_s(self) -> float:

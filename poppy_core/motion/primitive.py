@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.primitive_values import convert_value
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
 from poppy_core.robot.schedule import Periodic, RateMeter
@@ -30,6 +30,7 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 State = Literal["idle", "running", "paused", "stopped", "failed"]
+_PLURALS = {"property": "properties", "method": "methods"}
 JOIN_TIMEOUT_S = 5.0
 
 
@@ -109,7 +110,7 @@ class Primitive:
         """Start the primitive, or restart it (a running one is stopped first).
 
         Raises:
-            PortError: the robot is closed.
+            RobotClosedError: the robot is closed.
             RuntimeError: called from the primitive's own thread.
         """
         if self._thread is threading.current_thread():
@@ -298,7 +299,7 @@ class Primitive:
         if name not in known:
             listed = ", ".join(known) or "none"
             raise ConfigError(
-                f"{type(self).__name__} has no {kind} {name!r} ({kind}s: {listed})",
+                f"{type(self).__name__} has no {kind} {name!r} ({_PLURALS[kind]}: {listed})",
                 field=name,
                 value=name,
             )
@@ -338,7 +339,10 @@ class LoopPrimitive(Primitive):
     @update_freq.setter
     def update_freq(self, value: float) -> None:
         if not math.isfinite(value) or value <= 0:
-            raise ValueError(f"update frequency must be a positive number of Hz, got {value}")
+            raise ArgumentError(
+                f"update frequency must be a positive number of Hz, got {value}",
+                field="update_freq", value=value,
+            )  # fmt: skip
         self._freq = float(value)
 
     @property

@@ -5,6 +5,11 @@ resampled onto the regular frame grid when the move is built, so a late tick doe
 the frames. With a ``checkpoint_path`` the move so far is written atomically every
 ``checkpoint_period_s``: a recording cut short by a signal or a crash keeps everything up to
 the last checkpoint, and ``stop()`` writes the final move.
+
+Nothing recorded is lost to a bad destination: ``start()`` checks that the folder takes files
+and locks the file against a second recorder; a checkpoint that fails (full disk, folder gone)
+is reported once and the take stays in memory; when the final write fails ``stop()`` raises,
+and the move is still there to ``save()`` elsewhere.
 """
 
 from __future__ import annotations
@@ -20,17 +25,22 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from poppy_core.motion.move import Move, resample
-from poppy_core.motion.move_format import write_move
+from poppy_core.errors import ArgumentError, FileError
+from poppy_core.files import FileLock, output_path, probe_folder
+from poppy_core.motion.move import MAX_FRAMERATE_HZ, MIN_FRAMERATE_HZ, Move, resample
+from poppy_core.motion.move_format import MOVE_SUFFIX, write_move
 from poppy_core.robot.schedule import Periodic
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
+    from poppy_core.robot.robot import MotorSpec
 
 logger = logging.getLogger(__name__)
 
 DEFAULT_FREQ_HZ = 50.0
 DEFAULT_CHECKPOINT_S = 1.0
+MIN_FREQ_HZ = MIN_FRAMERATE_HZ
+MAX_FREQ_HZ = MAX_FRAMERATE_HZ
 _INITIAL_CAPACITY = 1024
 
 
@@ -65,29 +75,40 @@ class MoveRecorder:
         motors: motors or motor/group names to record (default: every motor).
         checkpoint_path: write the move there (format from the suffix) while recording.
         checkpoint_period_s: time between two checkpoints.
+        replace: the checkpoint may replace a file already at ``checkpoint_path``.
+        make_folder: create the checkpoint's missing folder (the library's).
         with_speeds: also record present speeds (pypot files carry them).
         metadata: header fields stored with the move (``created`` and ``robot`` are added).
         clock: the time source (seconds).
 
     Raises:
         ConfigError: an unknown motor or group name.
-        ValueError: a frequency that is not positive.
+        ArgumentError: a frequency out of range.
+
+    Attributes:
+        saved_path: where ``stop()`` or ``save()`` last wrote the move.
+        checkpoint_error: the last checkpoint's failure (None once one works again).
     """
 
     def __init__(
         self,
         robot: Robot,
         freq: float = DEFAULT_FREQ_HZ,
-        motors: Sequence[Motor | str] | None = None,
+        motors: MotorSpec | None = None,
         *,
         checkpoint_path: str | Path | None = None,
         checkpoint_period_s: float = DEFAULT_CHECKPOINT_S,
+        replace: bool = True,
+        make_folder: bool = False,
         with_speeds: bool = False,
         metadata: Mapping[str, Any] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        if not freq > 0:
-            raise ValueError(f"the recording frequency must be positive, got {freq}")
+        if not MIN_FREQ_HZ <= freq <= MAX_FREQ_HZ:  # also refuses NaN
+            raise ArgumentError(
+                f"the recording frequency must be {MIN_FREQ_HZ:g}-{MAX_FREQ_HZ:g} Hz, got {freq}",
+                field="freq", value=freq,
+            )  # fmt: skip
         self.robot = robot
         self.freq = float(freq)
         self.motors = resolve_motors(robot, motors)
@@ -104,6 +125,10 @@ class MoveRecorder:
         self._t0 = 0.0
         self.checkpoints = 0
         self.checkpoint_error: Exception | None = None
+        self.saved_path: Path | None = None
+        self._replace = replace
+        self._make_folder = make_folder
+        self._file_lock: FileLock | None = None
 
     # -- control -----------------------------------------------------------------------------
 
@@ -112,9 +137,16 @@ class MoveRecorder:
 
         Raises:
             RuntimeError: already recording.
+            FileError: the checkpoint's folder does not take files (missing, read-only, full),
+                or another process records into the same file; nothing was recorded.
         """
         if self.recording:
             raise RuntimeError("the recorder is already recording")
+        if self.checkpoint_path is not None:
+            probe_folder(self.checkpoint_path.parent, make_folder=self._make_folder)
+            if self._file_lock is None:
+                self._file_lock = FileLock(self.checkpoint_path).acquire()
+        self.checkpoint_error = None
         self._samples = _Samples(self._samples.data.shape[1])
         self._metadata.setdefault("created", datetime.now(UTC).isoformat(timespec="seconds"))
         self._stop.clear()
@@ -124,17 +156,69 @@ class MoveRecorder:
         return self
 
     def stop(self) -> Move:
-        """Stop recording, write the last checkpoint and return the move."""
+        """Stop recording, write the last checkpoint and return the move.
+
+        Raises:
+            FileError: the move could not be written to ``checkpoint_path``; it is still held
+                (``move``) for ``save()`` to write elsewhere.
+        """
         thread = self._thread
         self._stop.set()
         if thread is not None and thread is not threading.current_thread():
             thread.join(timeout=5.0)
         self._thread = None
         move = self.move
-        if self.checkpoint_path is not None and len(move):
-            write_move(move, self.checkpoint_path)
-            self.checkpoints += 1
+        try:
+            if self.checkpoint_path is not None and len(move):
+                self._write(move, self.checkpoint_path)
+        finally:
+            if self._file_lock is not None:
+                self._file_lock.release()
+                self._file_lock = None
         return move
+
+    def save(
+        self, path: str | Path | None = None, *, replace: bool = False, make_folder: bool = False
+    ) -> Path:
+        """Write the move recorded so far (again, or somewhere else).
+
+        Args:
+            path: a file, or a folder to write ``<name>.move`` into; the checkpoint path when
+                None (it is then replaced).
+            replace: replace an existing file.
+            make_folder: create a missing folder.
+
+        Returns:
+            The path written.
+
+        Raises:
+            FileError: refused or failed; the move is still held.
+            ArgumentError: there is no path and no checkpoint path.
+        """
+        if path is None:
+            if self.checkpoint_path is None:
+                raise ArgumentError("give a path: this recorder has no checkpoint path",
+                                    field="path")  # fmt: skip
+            target, replace = self.checkpoint_path, True
+        else:
+            name = self.checkpoint_path.name if self.checkpoint_path else f"take{MOVE_SUFFIX}"
+            target = output_path(path, default_name=name, replace=replace,
+                                 make_folder=make_folder)  # fmt: skip
+        return self._write(self.move, target, replace=replace, make_folder=make_folder)
+
+    def _write(
+        self, move: Move, target: Path, *, replace: bool | None = None, make_folder: bool = False
+    ) -> Path:
+        """Write ``move``; the checkpoint file may be replaced once it is ours."""
+        ours = target == self.checkpoint_path and (self._replace or self.checkpoints > 0)
+        written = write_move(
+            move, target, replace=ours if replace is None else replace,
+            make_folder=make_folder or (target == self.checkpoint_path and self._make_folder),
+        )  # fmt: skip
+        if target == self.checkpoint_path:
+            self.checkpoints += 1
+        self.saved_path = written
+        return written
 
     @property
     def recording(self) -> bool:
@@ -193,11 +277,16 @@ class MoveRecorder:
         if self.checkpoint_path is None:
             return
         try:
-            write_move(self.move, self.checkpoint_path)
-            self.checkpoints += 1
-        except Exception as exc:  # keep recording in memory; stop() tries again
+            self._write(self.move, self.checkpoint_path)
+        except (FileError, OSError) as exc:  # the take stays in memory; stop() tries again
+            if self.checkpoint_error is None:  # once per failing streak, not every second
+                logger.warning("checkpoint to %s failed (the take is kept in memory): %s",
+                               self.checkpoint_path, exc)  # fmt: skip
             self.checkpoint_error = exc
-            logger.warning("checkpoint to %s failed: %s", self.checkpoint_path, exc)
+            return
+        if self.checkpoint_error is not None:
+            logger.warning("checkpoint to %s works again", self.checkpoint_path)
+            self.checkpoint_error = None
 
     def _run(self) -> None:
         schedule = Periodic(1.0 / self.freq, self._t0)
@@ -225,20 +314,11 @@ class MoveRecorder:
         self.stop()
 
 
-def resolve_motors(robot: Robot, motors: Sequence[Motor | str] | None) -> list[Motor]:
-    """Motors from motor objects, motor names or group names (each once, in order).
+def resolve_motors(robot: Robot, motors: MotorSpec | None) -> list[Motor]:
+    """Motors from motor objects, motor names or group names (each once, in order); a name
+    alone is one motor or group.
 
     Raises:
-        ConfigError: an unknown motor or group name.
+        UnknownMotorError: an unknown motor or group name.
     """
-    if motors is None:
-        return robot.motors
-    chosen: list[Motor] = []
-    groups = robot.motorgroups
-    for item in motors:
-        if isinstance(item, str):
-            found = groups[item] if item in groups else [robot.motor(item)]
-        else:
-            found = [item]
-        chosen.extend(m for m in found if m not in chosen)
-    return chosen
+    return robot.motors_of(motors)

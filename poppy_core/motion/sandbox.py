@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from poppy_core.errors import ConfigError, RegisterError
-from poppy_core.motion.trajectory import CONTROLS, MinimumJerk, dummy_speed
+from poppy_core.motion.trajectory import MinimumJerk, check_goto, dummy_speed
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -34,10 +34,12 @@ Requests = dict[str, dict[str, Any]]
 
 def _number(motor: str, register: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise RegisterError(f"{motor}: {register} takes a number, not {value!r}", register=register)
+        raise RegisterError(f"{motor}: {register} takes a number, not {value!r}",
+                            register=register, motor=motor)  # fmt: skip
     number = float(value)
     if not math.isfinite(number):
-        raise RegisterError(f"{motor}: {register} must be finite, got {value}", register=register)
+        raise RegisterError(f"{motor}: {register} must be finite, got {value}",
+                            register=register, motor=motor)  # fmt: skip
     return number
 
 
@@ -113,8 +115,8 @@ class MockupMotor:
             raise RegisterError(
                 f"{self._motor.name}: a primitive may request only "
                 f"{', '.join(REQUESTABLE)} or goal_speed, not {name!r}",
-                register=name,
-            )
+                register=name, motor=self._motor.name,
+            )  # fmt: skip
         checked = self._checked(register, value)
         with self._lock:
             if register == "goal_position":
@@ -126,8 +128,9 @@ class MockupMotor:
         if register == "compliant":
             if not isinstance(value, bool | int):
                 raise RegisterError(
-                    f"{motor.name}: compliant takes True or False", register=register
-                )
+                    f"{motor.name}: compliant takes True or False",
+                    register=register, motor=motor.name,
+                )  # fmt: skip
             return bool(value)
         if register == "led":
             motor.model.register("led").from_si(value)  # raises RegisterError when invalid
@@ -135,18 +138,20 @@ class MockupMotor:
         number = _number(motor.name, register, value)
         if register == "moving_speed" and number < 0:
             raise RegisterError(
-                f"{motor.name}: moving_speed is a magnitude (>= 0), got {value}", register=register
-            )
+                f"{motor.name}: moving_speed is a magnitude (>= 0), got {value}",
+                register=register, motor=motor.name,
+            )  # fmt: skip
         if register == "torque_limit":
             if not motor.model.has_torque_limit:
                 raise RegisterError(
                     f"{motor.name}: {motor.model.name} has no torque limit register",
-                    register=register,
+                    register=register, motor=motor.name,
                 )
             if not 0.0 <= number <= 100.0:
                 raise RegisterError(
-                    f"{motor.name}: torque_limit is 0..100 %, got {value}", register=register
-                )
+                    f"{motor.name}: torque_limit is 0..100 %, got {value}",
+                    register=register, motor=motor.name,
+                )  # fmt: skip
         return number
 
     def _requested_goal(self) -> float:
@@ -185,12 +190,9 @@ class MockupMotor:
             wait: block until the duration elapsed (or the primitive is stopped).
 
         Raises:
-            ValueError: unknown control or negative duration.
+            ArgumentError: unknown control, a negative or not finite duration.
         """
-        if control not in CONTROLS:
-            raise ValueError(f"control must be one of {', '.join(CONTROLS)}, not {control!r}")
-        if duration < 0:
-            raise ValueError(f"duration must not be negative, got {duration} s")
+        check_goto(duration, control)
         low, high = self._motor.angle_limit
         goal = min(max(_number(self._motor.name, "goal_position", position), low), high)
         start = self._requested_goal() if self._has_goal() else self._motor.present_position

@@ -8,8 +8,32 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from poppy_core.errors import ArgumentError
+
 CONTROLS: tuple[str, ...] = ("minjerk", "dummy")
 """The ``control`` names ``goto_position`` accepts."""
+
+MAX_DURATION_S = 24 * 3600.0
+"""The longest goto (a day): longer ones are typing mistakes that would never end."""
+
+
+def check_goto(duration_s: float, control: str) -> None:
+    """Refuse a goto's duration or control before anything moves.
+
+    Raises:
+        ArgumentError: unknown ``control``, or a duration that is negative, not finite or longer
+            than ``MAX_DURATION_S``.
+    """
+    if control not in CONTROLS:
+        raise ArgumentError(
+            f"control must be one of {', '.join(CONTROLS)}, not {control!r}",
+            field="control", value=control,
+        )  # fmt: skip
+    if not 0 <= duration_s <= MAX_DURATION_S:  # also refuses NaN
+        raise ArgumentError(
+            f"duration must be 0-{MAX_DURATION_S:g} s, got {duration_s} s",
+            field="duration", value=duration_s,
+        )  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -33,12 +33,17 @@ class HttpClient:
     def __init__(
         self, base_url: str, token: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S
     ) -> None:
-        parts = urlsplit(base_url)
+        try:
+            parts = urlsplit(base_url)
+            port = parts.port  # parsed here: raises on a port out of 0-65535
+        except ValueError as exc:
+            raise ConfigError(f"{base_url!r} is not an http://host:port URL ({exc})",
+                              field="url") from None  # fmt: skip
         if parts.scheme != "http" or not parts.hostname:
             raise ConfigError(f"{base_url!r} is not an http://host:port URL", field="url")
         self.base_url = base_url.rstrip("/")
         self.host = parts.hostname
-        self.port = parts.port or 80
+        self.port = port or 80
         self.prefix = parts.path.rstrip("/")
         self.timeout_s = timeout_s
         self._headers = {"Accept": "application/json"}
@@ -104,8 +109,14 @@ class HttpClient:
     def _decode(self, method: str, path: str, status: int, data: bytes) -> Any:
         try:
             decoded = json.loads(data) if data else None
-        except json.JSONDecodeError:
-            decoded = data.decode("utf-8", errors="replace")
+        except (ValueError, RecursionError):  # not JSON (or JSON no one should send)
+            decoded = data[:200].decode("utf-8", errors="replace")
+            if status < 400:
+                raise CommunicationError(
+                    f"{self.base_url} is not a poppy server: its answer to {method} {path} is "
+                    "not JSON (is `poppy serve --http` running there?)",
+                    port=self.base_url,
+                ) from None
         if status < 400:
             return decoded
         message = _message(decoded) or f"HTTP {status}"

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import CommunicationError, ConfigError
 from poppy_core.remote.client import DEFAULT_TIMEOUT_S, HttpClient, path_of
 
 _OWN = ("_client", "name", "id", "model", "registers")
@@ -257,11 +257,23 @@ class RemoteRobot:
     ) -> None:
         self.url = url
         self._client = HttpClient(url, token=token, timeout_s=timeout_s)
-        infos = self._client.get(path_of("motors"))
-        self._motors = [RemoteMotor(self._client, info) for info in infos]
+        try:
+            infos = self._client.get(path_of("motors"))
+            self._motors = [RemoteMotor(self._client, info) for info in infos]
+            robot = self._client.get(path_of("robot"))
+            groups = {str(g): [str(m) for m in ms] for g, ms in robot["groups"].items()}
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            self._client.close()
+            raise CommunicationError(
+                f"{url} is not a poppy server: its robot description is not poppy's "
+                f"({type(exc).__name__}: {exc}); is `poppy serve --http` running there?",
+                port=url,
+            ) from None
+        except BaseException:
+            self._client.close()
+            raise
         self._by_name = {m.name: m for m in self._motors}
-        robot = self._client.get(path_of("robot"))
-        self._groups: dict[str, list[str]] = {g: list(ms) for g, ms in robot["groups"].items()}
+        self._groups: dict[str, list[str]] = groups
         self.moves = RemoteMoves(self._client)
         """Record, save, play, stop, delete and list the server's moves."""
 

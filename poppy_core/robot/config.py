@@ -18,10 +18,15 @@ from pydantic import (
 )
 from pydantic_core import PydanticCustomError
 
-from poppy_core.errors import UnknownModelError
+from poppy_core.errors import ConfigError, UnknownModelError
 from poppy_core.models import ALL_MODELS, model_by_name
-from poppy_core.robot.config_checks import check_config, expand
-from poppy_core.robot.config_format import DEFAULT_SOURCE, config_error, from_validation_error
+from poppy_core.robot.config_checks import (
+    CheckView,
+    check_config,
+    expand,
+    whole_config_problems,
+)
+from poppy_core.robot.config_format import DEFAULT_SOURCE, config_error, validation_problems
 from poppy_core.sensors.config import SensorProblem, check_section
 
 Degrees = Annotated[float, Strict(), Field(allow_inf_nan=False)]
@@ -221,7 +226,8 @@ class RobotConfig(BaseModel):
 
         Raises:
             ConfigError: With a one-line message naming the source, the field path, the value
-                and the reason.
+                and the reason of the first problem; ``problems`` lists every problem found,
+                each with its own one-line message.
         """
         if not isinstance(data, dict):
             raise config_error(
@@ -230,7 +236,14 @@ class RobotConfig(BaseModel):
         try:
             return cls.model_validate(data, context={"source": source})
         except ValidationError as exc:
-            raise from_validation_error(exc, source) from None
+            problems = validation_problems(exc, source)
+        # Fields failed: the checks across fields still run on what is readable, so that one
+        # pass reports every problem (a duplicate ID and a reversed limit alike).
+        view = CheckView.of_document(data)
+        if view is not None:
+            fields = {p.field for p in problems}
+            problems += [p for p in whole_config_problems(view, source) if p.field not in fields]
+        raise ConfigError.of_problems(problems) from None
 
     def to_dict(self) -> dict[str, Any]:
         """Our format as plain data (what the YAML writer dumps), profile header included."""

@@ -101,25 +101,50 @@ def _reword(message: str) -> str:
     return message
 
 
+def validation_problems(exc: ValidationError, source: str) -> list[ConfigError]:
+    """Every error of a pydantic ValidationError as one-line ConfigErrors, in document order.
+
+    Args:
+        exc: The pydantic error.
+        source: The file name (or label) to put first in each message.
+
+    Returns:
+        One ConfigError per problem (the same field and reason only once), each naming the field
+        path, the bad value and why.
+    """
+    problems: list[ConfigError] = []
+    seen: set[tuple[str, str]] = set()
+    for error in exc.errors(include_url=False):
+        problem = _translate(error, source)
+        key = (problem.field or "", problem.reason or "")
+        if key not in seen:
+            seen.add(key)
+            problems.append(problem)
+    return problems
+
+
 def from_validation_error(exc: ValidationError, source: str) -> ConfigError:
-    """Translate the first error of a pydantic ValidationError into a one-line ConfigError.
+    """Translate a pydantic ValidationError into a ConfigError listing every problem.
 
     Args:
         exc: The pydantic error.
         source: The file name (or label) to put first in the message.
 
     Returns:
-        The ConfigError naming the field path, the bad value and why.
+        The first problem, with ``problems`` holding all of them.
     """
-    first = exc.errors(include_url=False)[0]
-    raw_loc = list(first["loc"])
-    reason = _reword(str(first["msg"]))
+    return ConfigError.of_problems(validation_problems(exc, source))
+
+
+def _translate(error: Any, source: str) -> ConfigError:
+    raw_loc = list(error["loc"])
+    reason = _reword(str(error["msg"]))
     # Dict-key errors end with a "[key]" marker after the key itself, which is the bad value.
     if "[key]" in raw_loc:
         at = raw_loc.index("[key]")
         raw_loc = [*raw_loc[: at - 1], str(raw_loc[at - 1])]
         reason = f"name {reason}"
     loc: list[str | int] = raw_loc
-    if first["type"] == "missing":
+    if error["type"] == "missing":
         return config_error(source, join_path(loc), None, reason, show_value=False)
-    return config_error(source, join_path(loc), first["input"], reason)
+    return config_error(source, join_path(loc), error["input"], reason)

@@ -1,23 +1,22 @@
-"""Read and write robot configs: pypot JSON or our YAML, with atomic writes."""
+"""Read and write robot configs: pypot JSON or our YAML (written by ``poppy_core.files``)."""
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
-import stat
-import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from poppy_core.documents import CONFIG_LIMITS, parse_json, parse_yaml, read_limited
+from poppy_core.files import write_file
 from poppy_core.robot.config import RobotConfig
 from poppy_core.robot.config_format import config_error
 
 JSON_SUFFIXES = (".json",)
 YAML_SUFFIXES = (".yaml", ".yml")
-NEW_FILE_MODE = 0o644  # rw-r--r--; not derived from the umask (reading it is not thread-safe)
 
 
 def _looks_like_json(text: str) -> bool:
@@ -25,7 +24,7 @@ def _looks_like_json(text: str) -> bool:
 
 
 def parse_config_text(text: str, source: str, *, fmt: str | None = None) -> Any:
-    """Parse a config document (JSON or YAML) into plain data.
+    """Parse a config document (JSON or YAML) into plain data, within ``CONFIG_LIMITS``.
 
     Args:
         text: The document.
@@ -36,23 +35,13 @@ def parse_config_text(text: str, source: str, *, fmt: str | None = None) -> Any:
         The parsed data (not validated).
 
     Raises:
-        ConfigError: On a syntax error, naming the line and column.
+        ConfigError: On a syntax error (naming the line and column), or a document too large,
+            too deep or cyclic (a YAML alias bomb is refused before it expands).
     """
     kind = fmt or ("json" if _looks_like_json(text) else "yaml")
     if kind == "json":
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise config_error(source, "", None, f"JSON syntax error at line {exc.lineno}, "
-                               f"column {exc.colno}: {exc.msg}", show_value=False) from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise config_error(source, "", None, f"YAML syntax error{where}: {problem}",
-                           show_value=False) from None
+        return parse_json(text, source, CONFIG_LIMITS)
+    return parse_yaml(text, source, CONFIG_LIMITS)
 
 
 def _format_of(path: Path, text: str | None = None) -> str | None:
@@ -78,18 +67,42 @@ def load_config(path: str | os.PathLike[str]) -> RobotConfig:
         The validated config.
 
     Raises:
-        ConfigError: The file cannot be read, has a syntax error, or an invalid field.
+        ConfigError: The file cannot be read (missing, not a regular file, over 1 MiB, not
+            UTF-8), has a syntax error, is too deep or large, or has invalid fields.
     """
     file = Path(path)
     source = str(path)
+    raw = read_limited(file, CONFIG_LIMITS.max_bytes, "config")
     try:
-        text = file.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise config_error(source, "", None, f"cannot read: {reason}",
-                           show_value=False) from None
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise config_error(source, "", None, f"cannot read: not UTF-8 text ({exc.reason} at "
+                           f"byte {exc.start})", show_value=False) from None  # fmt: skip
     data = parse_config_text(text, source, fmt=_format_of(file, text))
     return RobotConfig.from_dict(data, source=source).with_folder(file.resolve().parent)
+
+
+ConfigSource = RobotConfig | Mapping[str, Any] | str | os.PathLike[str]
+"""What the factories take as a config: a RobotConfig, a pypot-style dict, or a file path."""
+
+DICT_SOURCE = "<config dict>"
+
+
+def as_config(config: ConfigSource) -> RobotConfig:
+    """A validated ``RobotConfig`` from a config, a dict (pypot's ``from_config(my_config)``) or a
+    JSON/YAML file path.
+
+    Raises:
+        ConfigError: an invalid config, an unreadable file, or another kind of object.
+    """
+    if isinstance(config, RobotConfig):
+        return config
+    if isinstance(config, Mapping):
+        return RobotConfig.from_dict(dict(config), source=DICT_SOURCE)
+    if isinstance(config, str | os.PathLike):
+        return load_config(config)
+    raise config_error(DICT_SOURCE, "", None, f"the config must be a RobotConfig, a mapping or a "
+                       f"file path, not {type(config).__name__}", show_value=False)
 
 
 class _ConfigDumper(yaml.SafeDumper):
@@ -133,50 +146,23 @@ def config_to_text(config: RobotConfig, fmt: str) -> str:
     return dumped
 
 
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write a file so that readers see either the old or the new content, never half of it.
-
-    The text goes to a temporary file in the same folder, is flushed to disk, then renamed
-    over the target with ``os.replace``. An existing file keeps its permission bits; a new
-    one gets 0o644.
-
-    Args:
-        path: The target file.
-        text: The full new content.
-    """
-    directory = path.parent if str(path.parent) else Path(".")
-    try:
-        mode = stat.S_IMODE(path.stat().st_mode)
-    except FileNotFoundError:
-        mode = NEW_FILE_MODE
-    fd, tmp_name = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.chmod(tmp_name, mode)
-        os.replace(tmp_name, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp_name)
-        raise
-
-
-def dump_config(config: RobotConfig, path: str | os.PathLike[str]) -> None:
+def dump_config(
+    config: RobotConfig, path: str | os.PathLike[str], *, replace: bool = True
+) -> Path:
     """Write a config atomically; ``.json`` gives pypot JSON, ``.yaml``/``.yml`` our YAML.
 
     Args:
         config: The config to write.
         path: The target file; its extension picks the format (YAML for others).
+        replace: replace an existing regular file (the CLI passes its ``--force``).
+
+    Returns:
+        The path written.
 
     Raises:
-        ConfigError: The file cannot be written.
+        FileError: The file cannot be written (missing folder, full disk...) or is refused (it
+            exists without ``replace``, or is not a regular file); see ``poppy_core.files``.
     """
     file = Path(path)
     text = config_to_text(config, _format_of(file) or "yaml")
-    try:
-        atomic_write_text(file, text)
-    except OSError as exc:
-        raise config_error(str(file), "", None, f"cannot write: {exc.strerror or exc}",
-                           show_value=False) from None
+    return write_file(file, text, replace=replace)

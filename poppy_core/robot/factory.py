@@ -9,7 +9,6 @@ whole robot, ``robot.simulation``); ``sim=True`` / ``"ideal"`` keep the ideal se
 from __future__ import annotations
 
 import logging
-import os
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
@@ -19,7 +18,7 @@ from poppy_core.errors import ConfigError, PortError, RegisterError, SetupError
 from poppy_core.models import model_by_name
 from poppy_core.robot import startup
 from poppy_core.robot.config import RobotConfig
-from poppy_core.robot.config_io import load_config
+from poppy_core.robot.config_io import ConfigSource, as_config
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.profiles import load_profile, profile_dirs
 from poppy_core.robot.robot import Robot
@@ -151,7 +150,7 @@ def _motor_targets(config: RobotConfig, names: Iterable[str]) -> dict[str, float
 
 
 def from_config(
-    config: RobotConfig | str | os.PathLike[str],
+    config: ConfigSource,
     sim: SimMode = False,
     *,
     strict: bool = True,
@@ -161,10 +160,10 @@ def from_config(
     start_sync: bool = True,
     sensors: bool = True,
 ) -> Robot:
-    """Build and start a robot from a config (a ``RobotConfig`` or a JSON/YAML file).
+    """Build and start a robot from a config (a ``RobotConfig``, a dict or a JSON/YAML file).
 
     Args:
-        config: the config or its path.
+        config: the config, a dict as pypot's ``from_config(my_config)`` takes, or a file path.
         sim: serve the config's motors from in-process emulators instead of hardware: True or
             ``"ideal"`` (ideal servos), ``"mujoco"`` (physics; ``robot.simulation`` is set).
         strict: missing or mismatched motors raise ``SetupError``; when False they are logged
@@ -191,7 +190,7 @@ def from_config(
             motors whose model differs from the config.
         PortError: a port cannot be opened.
     """
-    cfg = config if isinstance(config, RobotConfig) else load_config(config)
+    cfg = as_config(config)
     emulators: dict[str, Any] = {}
     buses: dict[str, DxlBus] = {}
     mode = _sim_mode(sim)

@@ -13,8 +13,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from poppy_core.errors import PortError
-from poppy_core.motion.trajectory import CONTROLS, MinimumJerk, dummy_speed
+from poppy_core.errors import RobotClosedError
+from poppy_core.motion.trajectory import MinimumJerk, check_goto, dummy_speed
 from poppy_core.robot.schedule import Periodic
 
 if TYPE_CHECKING:
@@ -91,18 +91,15 @@ class GotoRunner:
         """Start moving each motor to its target (degrees, user frame) in ``duration_s``.
 
         Raises:
-            ValueError: unknown ``control`` or a negative duration.
-            PortError: the runner (its robot) is closed.
+            ArgumentError: unknown ``control``, a negative or not finite duration.
+            RobotClosedError: the runner (its robot) is closed.
         """
-        if control not in CONTROLS:
-            raise ValueError(f"control must be one of {', '.join(CONTROLS)}, not {control!r}")
-        if duration_s < 0:
-            raise ValueError(f"duration must not be negative, got {duration_s} s")
+        check_goto(duration_s, control)
         handle = GotoHandle(len(targets), duration_s)
         now = self._clock()
         with self._lock:
             if self._closed:
-                raise PortError("the robot is closed: no more motions")
+                raise RobotClosedError("the robot is closed: no more motions")
             for motor, target in targets.items():
                 self._cancel_locked(motor)
                 low, high = motor.angle_limit

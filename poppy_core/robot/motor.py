@@ -17,11 +17,11 @@ import functools
 import logging
 from typing import TYPE_CHECKING, Literal
 
-from poppy_core.errors import RegisterError
+from poppy_core.errors import RegisterError, RobotClosedError
 from poppy_core.models import ServoModel
 from poppy_core.robot import registers as regs
 from poppy_core.robot.goto import GotoHandle, GotoRunner
-from poppy_core.robot.motor_cache import MotorCache
+from poppy_core.robot.motor_cache import MotorCache, SIValue
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import MotorConfig
@@ -64,7 +64,7 @@ class Motor(MotorCache):
         if orientation not in ("direct", "indirect"):
             raise RegisterError(
                 f"{name}: orientation must be 'direct' or 'indirect', not {orientation!r}",
-                register="orientation",
+                register="orientation", motor=name,
             )
         super().__init__(name, model)
         self.id = id
@@ -74,6 +74,7 @@ class Motor(MotorCache):
         self._behavior: CompliantBehavior = "dummy"
         self._goal_speed: float | None = None
         self._runner = runner if runner is not None else GotoRunner(name=f"goto {name}")
+        self._closed = False
         # The motor-frame range a position limit register can hold (AX -150..149.7°).
         register = model.register("min_position_limit")
         ends = sorted(float(register.to_si(r)) for r in (register.min_raw, register.max_raw))
@@ -135,7 +136,7 @@ class Motor(MotorCache):
         if not low < high:
             raise RegisterError(
                 f"{self.name}: angle limits must be (min, max) with min < max, got {low}, {high}",
-                register="angle_limit",
+                register="angle_limit", motor=self.name,
             )
         return float(low), float(high)
 
@@ -201,7 +202,7 @@ class Motor(MotorCache):
         if value < 0:
             raise RegisterError(
                 f"{self.name}: moving_speed is a magnitude (>= 0), got {value}",
-                register="moving_speed",
+                register="moving_speed", motor=self.name,
             )
         self._store("moving_speed", float(value))
 
@@ -243,7 +244,7 @@ class Motor(MotorCache):
         if not self.model.has_torque_limit:
             raise RegisterError(
                 f"{self.name}: {self.model.name} has no torque limit register",
-                register="torque_limit",
+                register="torque_limit", motor=self.name,
             )
         self._store("torque_limit", float(value))
 
@@ -287,7 +288,7 @@ class Motor(MotorCache):
         if value not in BEHAVIORS:
             raise RegisterError(
                 f"{self.name}: compliant behavior must be 'dummy' or 'safe', not {value!r}",
-                register="compliant_behavior",
+                register="compliant_behavior", motor=self.name,
             )
         with self._lock:
             self._behavior = "safe" if value == "safe" else "dummy"
@@ -350,6 +351,16 @@ class Motor(MotorCache):
         if regs.has_compliance_slopes(self.model):
             names += ["compliance_margin", "compliance_slope"]
         return tuple(names)
+
+    def mark_closed(self) -> None:
+        """The robot is closed: later writes raise ``RobotClosedError`` (reads keep the last
+        values)."""
+        self._closed = True
+
+    def _store(self, name: str, value: SIValue) -> None:
+        if self._closed:
+            raise RobotClosedError(f"{self.name}: the robot is closed, {name} cannot be written")
+        super()._store(name, value)
 
     def attach_runner(self, runner: GotoRunner) -> None:
         """Use the robot's goto runner (the private one is dropped)."""

@@ -62,8 +62,11 @@ class MotorCache:
         """Check ``value`` against register ``name`` and mark it for the next write cycle."""
         register = self.model.register(name)
         if not register.writable:
-            raise RegisterError(f"{self.name}: {name} is read-only", register=name)
-        raw = register.from_si(value)
+            raise RegisterError(f"{self.name}: {name} is read-only", register=name, motor=self.name)
+        try:
+            raw = register.from_si(value)
+        except RegisterError as exc:  # the model knows the register; name the motor too
+            raise RegisterError(f"{self.name}: {exc}", register=name, motor=self.name) from None
         with self._lock:
             self._values[name] = value
             self._pending[name] = raw
@@ -150,7 +153,7 @@ class MotorCache:
         if names is None:
             raise RegisterError(
                 f"{self.name}: {self.model.name} has no PID gains (use compliance_margin/slope)",
-                register="pid",
+                register="pid", motor=self.name,
             )
         return names
 
@@ -186,7 +189,7 @@ class MotorCache:
         if not regs.has_compliance_slopes(self.model):
             raise RegisterError(
                 f"{self.name}: {self.model.name} has no compliance margin/slope (use pid)",
-                register="compliance_margin",
+                register="compliance_margin", motor=self.name,
             )
 
     @property

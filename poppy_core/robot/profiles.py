@@ -8,9 +8,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import platformdirs
-import yaml
 
 import poppy_core
+from poppy_core.documents import CONFIG_LIMITS, parse_yaml, read_limited
+from poppy_core.errors import ConfigError
 from poppy_core.robot.config import RobotConfig
 from poppy_core.robot.config_format import config_error
 from poppy_core.robot.config_io import load_config
@@ -90,9 +91,10 @@ def profile_key(name: str) -> str:
 
 def _read_info(file: Path, user: bool) -> ProfileInfo | None:
     try:
-        data = yaml.safe_load(file.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-        logger.warning("skipping profile %s: %s", file, str(exc).splitlines()[0])
+        data = parse_yaml(read_limited(file, CONFIG_LIMITS.max_bytes, "profile"), str(file),
+                          CONFIG_LIMITS)  # fmt: skip
+    except ConfigError as exc:
+        logger.warning("skipping profile %s: %s", file, exc)
         return None
     header = data.get("profile") if isinstance(data, dict) else None
     header = header if isinstance(header, dict) else {}

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from types import TracebackType
 from typing import TYPE_CHECKING, Any, Protocol
 
 from poppy_core.bus import DxlBus
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError, UnknownMotorError
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.sync import BusSync, SyncStats
@@ -23,6 +23,25 @@ if TYPE_CHECKING:
     from poppy_core.sensors import Sensor, SensorHealth
 
 logger = logging.getLogger(__name__)
+
+
+class NamedMotor(Protocol):
+    """Anything standing for a motor by its name (a ``Motor``, a primitive's ``MockupMotor``)."""
+
+    @property
+    def name(self) -> str:
+        """The motor's name in the robot."""
+        ...
+
+
+MotorSpec = str | NamedMotor | Iterable[str | NamedMotor]
+"""A motor or group name, a motor, or a list of them (see ``Robot.motors_of``)."""
+
+
+def _is_motor(item: object) -> bool:
+    return not isinstance(item, str) and isinstance(getattr(item, "name", None), str) and hasattr(
+        item, "present_position"
+    )
 
 
 class Behaviour(Protocol):
@@ -139,12 +158,68 @@ class Robot:
         return {name: list(members) for name, members in self._groups.items()}
 
     def motor(self, name: str) -> Motor:
-        """The motor called ``name`` (typed access)."""
+        """The motor called ``name`` (typed access).
+
+        Raises:
+            UnknownMotorError: no motor of that name (the known ones are listed).
+        """
         try:
             return self._by_name[name]
-        except KeyError:
-            known = ", ".join(self._by_name)
-            raise ConfigError(f"no motor {name!r} (motors: {known})", field=name) from None
+        except (KeyError, TypeError):
+            known = list(self._by_name)
+            raise UnknownMotorError(
+                f"no motor {name!r} (motors: {', '.join(known)})", motor=str(name), known=known
+            ) from None
+
+    def motors_of(self, spec: MotorSpec | None) -> list[Motor]:
+        """The motors a spec names, each once, in order: every motor for None, a motor or group
+        name, a motor, or a list of those (``"head_z"`` is one name, not five letters).
+
+        Raises:
+            UnknownMotorError: a name that is neither a motor nor a group (known ones listed).
+            ArgumentError: an item that is neither a name nor a motor.
+        """
+        if spec is None:
+            return list(self._motors)
+        items: object = [spec] if isinstance(spec, str) or _is_motor(spec) else spec
+        if not isinstance(items, Iterable):
+            raise ArgumentError(
+                f"motors must be a name, a motor or a list of them, not {spec!r}",
+                field="motors", value=spec,
+            )  # fmt: skip
+        chosen: list[Motor] = []
+        for item in items:
+            for motor in self._named(item):
+                if motor not in chosen:
+                    chosen.append(motor)
+        return chosen
+
+    def _named(self, item: object) -> list[Motor]:
+        if isinstance(item, str):
+            if item in self._groups:
+                return list(self._groups[item])
+            if item in self._by_name:
+                return [self._by_name[item]]
+            known = list(self._by_name)
+            groups = ", ".join(self._groups) or "none"
+            raise UnknownMotorError(
+                f"no motor or group {item!r} (motors: {', '.join(known)}; groups: {groups})",
+                motor=item, known=known,
+            )  # fmt: skip
+        if _is_motor(item):
+            name = getattr(item, "name", None)
+            if isinstance(name, str) and name in self._by_name:
+                return [self._by_name[name]]
+            known = list(self._by_name)
+            raise UnknownMotorError(
+                f"{name!r} is not a motor of this robot (motors: {', '.join(known)})",
+                motor=str(name), known=known,
+            )  # fmt: skip
+        known = list(self._by_name)
+        raise UnknownMotorError(
+            f"{item!r} is not a motor name (motors: {', '.join(known)})",
+            motor=str(item), known=known,
+        )  # fmt: skip
 
     @property
     def sensors(self) -> list[Sensor]:
@@ -260,9 +335,14 @@ class Robot:
             The handle of the motion.
 
         Raises:
-            ConfigError: an unknown motor name.
+            UnknownMotorError: an unknown motor name.
+            ArgumentError: a target that is not a finite number, a negative duration, an unknown
+                control.
+            RobotClosedError: the robot is closed.
         """
-        targets = {self.motor(name): float(pos) for name, pos in position_for_motors.items()}
+        if self._closed:
+            raise RobotClosedError("the robot is closed: no more motions")
+        targets = {self.motor(n): _degrees(n, pos) for n, pos in position_for_motors.items()}
         handle = self._runner.start(targets, duration, control)
         if wait:
             handle.wait()
@@ -286,8 +366,17 @@ class Robot:
 
     # -- config and lifetime -----------------------------------------------------------------
 
-    def to_config(self) -> RobotConfig:
-        """The robot's config with the motors' present orientation, offset and angle limits.
+    def to_config(self) -> dict[str, Any]:
+        """The robot's config as pypot's JSON-ready dict, with the motors' present orientation,
+        offset and angle limits (``json.dump(robot.to_config(), f)`` saves it).
+
+        Raises:
+            ConfigError: the robot was not built from a config.
+        """
+        return self.to_robot_config().to_pypot_dict()
+
+    def to_robot_config(self) -> RobotConfig:
+        """``to_config`` as a validated ``RobotConfig`` (profile header kept).
 
         Raises:
             ConfigError: the robot was not built from a config.
@@ -325,6 +414,8 @@ class Robot:
         self._runner.close()
         for sync in self._syncs:
             sync.stop()
+        for motor in self._motors:  # after the loops: only callers' writes are refused now
+            motor.mark_closed()
         for name, bus in self.buses.items():
             try:
                 bus.close()
@@ -345,3 +436,18 @@ class Robot:
         tb: TracebackType | None,
     ) -> None:
         self.close()
+
+
+def _degrees(name: str, value: object) -> float:
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ArgumentError(
+            f"{name}: {value!r} is not a number of degrees", field=name, value=value, motor=name
+        ) from None
+    if number != number or number in (float("inf"), float("-inf")):
+        raise ArgumentError(
+            f"{name}: the target must be a finite number of degrees, got {value!r}",
+            field=name, value=value, motor=name,
+        )  # fmt: skip
+    return number

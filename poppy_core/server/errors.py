@@ -17,9 +17,11 @@ from poppy_core.errors import (
     BusError,
     BusTimeout,
     ConfigError,
+    FileError,
     MotorError,
     PoppyError,
     RegisterError,
+    RobotClosedError,
     SensorError,
 )
 from poppy_core.server.refusals import one_line
@@ -29,11 +31,13 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-Kind = Literal["not_found", "invalid", "conflict", "unavailable"]
+Kind = Literal["not_found", "invalid", "conflict", "unavailable", "storage"]
 
 V1_PREFIX = "/api/v1"
 
-V1_STATUS: dict[Kind, int] = {"not_found": 404, "invalid": 422, "conflict": 409, "unavailable": 503}
+V1_STATUS: dict[Kind, int] = {
+    "not_found": 404, "invalid": 422, "conflict": 409, "unavailable": 503, "storage": 507,
+}  # fmt: skip
 """HTTP status of each kind of error on the v1 API."""
 
 PYPOT_STATUS: dict[Kind, int] = {
@@ -41,6 +45,7 @@ PYPOT_STATUS: dict[Kind, int] = {
     "invalid": 400,
     "conflict": 404,
     "unavailable": 503,
+    "storage": 507,
 }
 """HTTP status of each kind on pypot's routes (pypot answers 404 for most refusals)."""
 
@@ -53,7 +58,8 @@ class ApiError(Exception):
     """A request the server refuses.
 
     Args:
-        kind: ``"not_found"``, ``"invalid"``, ``"conflict"`` or ``"unavailable"``.
+        kind: ``"not_found"``, ``"invalid"``, ``"conflict"``, ``"unavailable"`` or ``"storage"``
+            (507: the server could not save a file; what was to be saved is kept).
         message: what went wrong (the ``error``/``detail`` text).
         tip: how to do it right (pypot's ``tip``).
         pypot_status: the status pypot's route answers, when it differs from ``PYPOT_STATUS``.
@@ -91,6 +97,10 @@ def from_poppy_error(exc: PoppyError) -> ApiError:
         return ApiError("unavailable", f"the robot did not answer: {exc}")
     if isinstance(exc, SensorError):
         return ApiError("unavailable", str(exc))
+    if isinstance(exc, RobotClosedError):
+        return ApiError("unavailable", str(exc))
+    if isinstance(exc, FileError):
+        return ApiError("storage", str(exc))
     return ApiError("invalid", str(exc))
 
 

@@ -14,7 +14,7 @@ import threading
 from collections.abc import Sequence
 from typing import Any
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ConfigError, FileError
 from poppy_core.motion import (
     Move,
     MovePlayer,
@@ -135,17 +135,33 @@ class MoveService:
             return sorted(self._recorders)
 
     def save(self, name: str) -> Move:
-        """Stop recording ``name`` and save it to the library (stopping a playback of it)."""
+        """Stop recording ``name`` and save it to the library (stopping a playback of it).
+
+        A failed save (full disk, read-only library) answers 507 and keeps the recording, stopped,
+        so that a later save of the same name writes it once there is room.
+        """
         check_move_name(name)
         with self._lock:
-            recorder = self._recorders.pop(name, None)
+            recorder = self._recorders.get(name)
             player = self._players.get(name)
         if recorder is None:
             raise ApiError("conflict", f"the move {name!r} is not being recorded", tip=RECORD_TIP)
         move = recorder.stop()
         if len(move) == 0:
+            with self._lock:
+                self._recorders.pop(name, None)
             raise ApiError("conflict", f"the recording {name!r} holds no frame yet")
-        save_move(move, name)
+        try:
+            save_move(move, name)
+        except FileError as exc:
+            logger.warning("saving move %s failed, the recording is kept: %s", name, exc)
+            raise ApiError(
+                "storage", f"the recording {name!r} could not be saved ({exc}); it is kept: "
+                "save it again once there is room", tip="free some space, then save again",
+            ) from None  # fmt: skip
+        with self._lock:
+            if self._recorders.get(name) is recorder:
+                del self._recorders[name]
         if player is not None and player.playing:
             player.stop()
         logger.info("saved move %s (%d frames)", name, len(move))

@@ -250,9 +250,9 @@ class RobotService:
     def _known(primitive: Primitive, name: str, item: str, known: Any, kind: str) -> None:
         if item not in known:
             listed = ", ".join(known) or "none"
-            raise ApiError(
-                "not_found", f"{name} has no {kind} {item!r} ({kind}s: {listed})", tip=PRIMITIVE_TIP
-            )
+            plural = "properties" if kind == "property" else f"{kind}s"
+            message = f"{name} has no {kind} {item!r} ({plural}: {listed})"
+            raise ApiError("not_found", message, tip=PRIMITIVE_TIP)
 
     def describe_primitive(self, name: str) -> dict[str, Any]:
         """State, properties, methods and error of a primitive (JSON)."""

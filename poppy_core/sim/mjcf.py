@@ -18,6 +18,7 @@ from typing import Any
 
 import yaml
 
+from poppy_core.files import write_file
 from poppy_core.models import model_by_name
 from poppy_core.sim.servos import servo_params
 from poppy_core.sim.urdf import (
@@ -360,7 +361,7 @@ def write_all(profiles_dir: Path) -> list[Path]:
     written = []
     for robot in ROBOTS:
         path = profiles_dir / robot / "model.xml"
-        path.write_text(generate(robot, profiles_dir), encoding="utf-8")
+        write_file(path, generate(robot, profiles_dir), replace=True)
         written.append(path)
     return written
 

@@ -9,7 +9,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 
-# room -> rooms of ours it may import (ARCHITECTURE.md); `errors` is a leaf every room may use.
+# room -> rooms of ours it may import (ARCHITECTURE.md); `errors`, `files` (safe writes) and
+# `documents` (bounded JSON/YAML reads) are leaves every room may use.
+LEAVES = {"errors", "files", "documents"}
 ALLOWED: dict[str, set[str]] = {
     "protocol": set(),
     "models": {"protocol"},
@@ -56,7 +58,7 @@ def test_rooms_import_only_downwards() -> None:
                 if parts[0] != "poppy_core" or len(parts) < 2:
                     continue
                 target = parts[1]
-                if target in (room, "errors") or target in allowed:
+                if target == room or target in LEAVES or target in allowed:
                     continue
                 if (room, name) in LEAF_EXCEPTIONS:
                     continue
@@ -85,6 +87,13 @@ def test_kinematics_is_numpy_only() -> None:
     assert third_party == {"numpy"}
     loaded = _loaded_after("import poppy_core.kinematics")
     assert not loaded & {"mujoco", "scipy", "typer", "rich", "pydantic", "serial"}
+
+
+def test_leaves_import_only_errors() -> None:
+    for leaf in sorted(LEAVES):
+        names = _imports(ROOT / "poppy_core" / f"{leaf}.py")
+        ours = {n for n in names if n.split(".")[0] in ("poppy_core", "poppy_cli")}
+        assert ours <= {"poppy_core.errors"}, (leaf, ours)
 
 
 def _loaded_after(code: str) -> set[str]:

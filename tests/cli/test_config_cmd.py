@@ -113,3 +113,21 @@ def test_generate_from_emulator_then_validate(poppy: Any, ergo_jr: Any, tmp_path
     again = poppy(*args, "--protocol", "2", "-o", str(out))
     assert again.code == 1
     assert "--force" in again.stderr
+
+
+def test_validate_lists_every_problem_one_line_each(poppy: Any, tmp_path: Path) -> None:
+    data = json.loads(ERGO_JSON.read_text())
+    data["motors"]["m2"]["id"] = data["motors"]["m1"]["id"]
+    data["motors"]["m3"]["angle_limit"] = [90, -90]
+    data["motors"]["m4"]["type"] = "XL-3200"
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    result = poppy("config", "validate", str(bad))
+    assert result.code == 1
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 3, result.stderr
+    assert all(line.startswith(f"error: {bad}: motors.m") for line in lines)
+    assert any("motors.m2.id = 1: duplicate ID" in line for line in lines)
+    assert any("motors.m3.angle_limit = [90, -90]: min must be below max" in line for line in lines)
+    assert any("motors.m4.type" in line for line in lines)
+    assert "Traceback" not in result.stderr

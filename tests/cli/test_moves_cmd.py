@@ -112,6 +112,9 @@ def test_rm_asks_first(poppy: Any, library: Path) -> None:
 def test_plot_writes_a_png(poppy: Any, tmp_path: Path) -> None:
     save_move(wave(), "wave")
     image = tmp_path / "plots" / "wave.png"
+    refused = poppy("moves", "plot", "wave", "-o", str(image))
+    assert refused.code == 1 and "does not exist" in str(refused.error)  # no folder made for you
+    image.parent.mkdir()
     result = poppy("moves", "plot", "wave", "-o", str(image))
     assert result.code == 0, result.error
     assert image.read_bytes().startswith(b"\x89PNG") and image.stat().st_size > 5000

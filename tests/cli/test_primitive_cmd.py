@@ -55,23 +55,21 @@ def test_run_human_output(poppy: Any) -> None:
     assert "cosinus: stopped" in result.stdout
 
 
-def test_run_a_failing_primitive_exits_1(poppy: Any) -> None:
+def test_an_unknown_motor_is_refused_before_the_primitive_starts(poppy: Any) -> None:
     result = poppy("primitive", "run", "sinus", *SIM, "--set", "motor_list=m9", "--duration", "2")
     assert result.code == 1
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr  # one line, no traceback
-    assert "sinus failed" in lines[0] and "no motor 'm9'" in lines[0]
+    assert "no motor or group 'm9'" in lines[0] and "motors: m1, m2" in lines[0]
 
 
-def test_run_a_failing_primitive_json(poppy: Any) -> None:
+def test_an_unknown_motor_is_refused_before_the_primitive_starts_json(poppy: Any) -> None:
     result = poppy(
         "primitive", "run", "square", *SIM, "--set", "motor_list=nope", "--duration", "2", "--json"
     )
     assert result.code == 1
-    report = result.json()
-    assert report["state"] == "failed"
-    assert report["error"]["type"] == "ConfigError"
-    assert "Traceback" in report["error"]["traceback"]
+    assert result.stdout == ""
+    assert "no motor or group 'nope'" in result.stderr
 
 
 def test_bad_property_value_is_one_line(poppy: Any) -> None:

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ConfigError, FileError
 from poppy_core.motion import (
     Move,
     decode_any,
@@ -157,7 +157,9 @@ def test_newer_format_version_is_refused() -> None:
 
 def test_files_by_suffix(tmp_path: Path) -> None:
     move = Move(25, ["a", "b"], [[1.0, 2.0], [3.0, 4.0]])
-    ours = write_move(move, tmp_path / "sub" / "x.move")
+    with pytest.raises(FileError, match="does not exist: create it first"):
+        write_move(move, tmp_path / "sub" / "x.move")
+    ours = write_move(move, tmp_path / "sub" / "x.move", make_folder=True)
     theirs = write_move(move, tmp_path / "x.json")
     assert ours.read_bytes().startswith(b"POPPYMOV")
     assert json.loads(theirs.read_text())["framerate"] == 25
@@ -176,7 +178,7 @@ def test_failed_write_leaves_the_old_file(tmp_path: Path, monkeypatch: pytest.Mo
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(os, "fsync", broken_fsync)
-    with pytest.raises(OSError, match="No space"):
+    with pytest.raises(FileError, match="no space left on the device"):
         write_move(Move(50, ["m1"], np.zeros((500, 1))), path)
     monkeypatch.undo()
     assert path.read_bytes() == before

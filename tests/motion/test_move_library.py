@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ConfigError, UnknownMotorError
 from poppy_core.motion import (
     Move,
     delete_move,
@@ -55,7 +55,7 @@ def test_reversed_select_stats_and_from_frames() -> None:
     }  # fmt: skip
     rebuilt = Move.from_frames(10, [move.frame(i) for i in range(3)])
     assert rebuilt.same_as(move)
-    with pytest.raises(KeyError, match="c"):
+    with pytest.raises(UnknownMotorError, match="c"):
         move.select(["c"])
 
 

@@ -9,7 +9,7 @@ from collections.abc import Callable, Iterator
 
 import pytest
 
-from poppy_core.errors import ConfigError, PortError
+from poppy_core.errors import ConfigError, RobotClosedError
 from poppy_core.motion import (
     LoopPrimitive,
     Primitive,
@@ -215,13 +215,24 @@ def test_crash_is_reported_and_the_manager_survives(
     assert crasher.error is not None and crasher.error is not first_error
 
 
+class _BadSetup(Primitive):
+    ran = False
+
+    def setup(self) -> None:
+        self.real_robot.motor("nope")
+
+    def run(self) -> None:
+        self.ran = True
+
+
 def test_failing_setup_never_runs(ergo: Robot) -> None:
-    sinus = Sinus(ergo, 50, ["nope"])
-    sinus.start()
-    assert sinus.wait_to_stop(3.0)
-    assert state(sinus) == "failed"
-    assert sinus.error is not None and sinus.error.type == "ConfigError"
-    assert "nope" in sinus.error.message
+    primitive = _BadSetup(ergo)
+    primitive.start()
+    assert primitive.wait_to_stop(3.0)
+    assert state(primitive) == "failed"
+    assert not primitive.ran
+    assert primitive.error is not None and primitive.error.type == "UnknownMotorError"
+    assert "nope" in primitive.error.message
 
 
 def test_properties_get_set_and_validation(ergo: Robot) -> None:
@@ -298,7 +309,7 @@ def test_close_stops_primitives(ergo: Robot) -> None:
     ergo.close()
     assert not counter.is_alive()
     assert not manager.running
-    with pytest.raises(PortError, match="closed"):
+    with pytest.raises(RobotClosedError, match="closed"):
         counter.start()
     assert state(counter) == "stopped"
 

@@ -101,7 +101,8 @@ def test_error_message(base_config: Callable[[], Data], mutate: Callable[[Data],
     mutate(data)
     with pytest.raises(ConfigError) as info:
         RobotConfig.from_dict(data, source="robot.yaml")
-    assert str(info.value) == expected
+    assert str(info.value.problems[0]) == expected
+    assert str(info.value).startswith(expected)
     assert "\n" not in str(info.value)
     assert info.value.file == "robot.yaml"
 
@@ -214,7 +215,7 @@ def test_json_syntax_error_has_line(tmp_path: Path) -> None:
 
 def test_missing_file(tmp_path: Path) -> None:
     path = tmp_path / "nope.yaml"
-    with pytest.raises(ConfigError, match=r"nope.yaml: cannot read: No such file"):
+    with pytest.raises(ConfigError, match=r"nope.yaml: cannot read the config: No such file"):
         load_config(path)
 
 
@@ -223,3 +224,49 @@ def test_bad_key_type() -> None:
     with pytest.raises(ConfigError) as info:
         RobotConfig.from_dict(data, source="robot.yaml")
     assert str(info.value) == "robot.yaml: controllers.1 = 1: name must be a valid string"
+
+
+def test_every_problem_is_listed_in_one_pass(base_config: Callable[[], Data]) -> None:
+    data = base_config()
+    data["motors"]["m2"]["id"] = 1  # duplicate ID on 'upper' (a check across fields)
+    data["motors"]["m3"]["angle_limit"] = [90, -90]  # a field error
+    data["controllers"]["upper"]["protocol"] = 3  # another field error
+    data["motorgroups"]["arm"] = ["m1", "m2", "m22"]  # an unknown group member
+    with pytest.raises(ConfigError) as info:
+        RobotConfig.from_dict(data, source="robot.yaml")
+    lines = [str(p) for p in info.value.problems]
+    assert "robot.yaml: motors.m3.angle_limit = [90, -90]: min must be below max" in lines
+    assert "robot.yaml: controllers.upper.protocol = 3: must be 1 or 2" in lines
+    assert any(line.startswith("robot.yaml: motors.m2.id = 1: duplicate ID") for line in lines)
+    assert any(line.startswith('robot.yaml: motorgroups.arm[2] = "m22"') for line in lines)
+    assert len(lines) == 4
+    assert all("\n" not in line for line in lines)
+    assert str(info.value).endswith("(and 3 more problems)")
+    assert {p.field for p in info.value.problems} == {
+        "motors.m3.angle_limit", "controllers.upper.protocol", "motors.m2.id", "motorgroups.arm[2]"
+    }
+
+
+def test_checks_across_fields_all_report(base_config: Callable[[], Data]) -> None:
+    data = base_config()
+    data["motors"]["m2"]["id"] = 1
+    data["motorgroups"]["loop"] = ["loop"]
+    data["controllers"]["lower"]["attached_motors"] = ["m3", "m1"]
+    with pytest.raises(ConfigError) as info:
+        RobotConfig.from_dict(data, source="robot.yaml")
+    fields = [p.field for p in info.value.problems]
+    assert fields == ["motorgroups.loop", "motors.m2.id", "controllers.lower.attached_motors[1]"]
+
+
+def test_a_long_chain_of_groups_is_checked_without_recursion(
+    base_config: Callable[[], Data],
+) -> None:
+    data = base_config()
+    count = 5000
+    data["motorgroups"].update({f"g{i}": [f"g{i + 1}"] for i in range(count)})
+    data["motorgroups"][f"g{count}"] = ["m1", "g0"]
+    with pytest.raises(ConfigError, match="cyclic groups"):
+        RobotConfig.from_dict(data, source="robot.yaml")
+    data["motorgroups"][f"g{count}"] = ["m1"]
+    config = RobotConfig.from_dict(data, source="robot.yaml")
+    assert config.resolve_group("g0") == ["m1"]

@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import FileError
 from poppy_core.robot import RobotConfig, dump_config, load_config
 
 Data = dict[str, Any]
@@ -37,7 +37,7 @@ def test_failed_dump_leaves_old_file_intact(
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(os, boom_at, boom)
-    with pytest.raises(ConfigError, match="cannot write: No space left on device"):
+    with pytest.raises(FileError, match=r"robot.yaml: no space left on the device"):
         dump_config(_config(base_config), target)
     assert target.read_text(encoding="utf-8") == "old content\n"
     assert _leftovers(tmp_path) == []
@@ -76,8 +76,9 @@ def test_new_file_mode(tmp_path: Path, base_config: Callable[[], Data]) -> None:
 
 
 def test_dump_into_missing_folder(tmp_path: Path, base_config: Callable[[], Data]) -> None:
-    with pytest.raises(ConfigError, match="cannot write"):
+    with pytest.raises(FileError, match="the folder does not exist: create it first"):
         dump_config(_config(base_config), tmp_path / "no" / "robot.yaml")
+    assert not (tmp_path / "no").exists()
 
 
 def test_format_by_extension(tmp_path: Path, base_config: Callable[[], Data]) -> None:

@@ -140,6 +140,6 @@ def test_autodetect_builds_what_it_finds(served: list[EmulatorServer]) -> None:
         assert [m.name for m in robot.motors] == ["m2", "m5"]
         assert robot.m5.model.name == "XL-320"
         assert robot.m5.angle_limit == pytest.approx((-150, 149.7), abs=0.1)
-        assert robot.to_config().motors["m2"].id == 2
+        assert robot.to_config()["motors"]["m2"]["id"] == 2
     with pytest.raises(SetupError):
         autodetect(serve(served, VirtualBus([], 2)), baudrates=[1_000_000], protocols=[2])

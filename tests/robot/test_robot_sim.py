@@ -8,7 +8,7 @@ from collections.abc import Callable, Iterator
 
 import pytest
 
-from poppy_core.errors import ConfigError, PortError
+from poppy_core.errors import ConfigError, RobotClosedError
 from poppy_core.robot import Robot, from_profile
 
 CONTROLLER = "my_dxl_controller"
@@ -139,9 +139,10 @@ def test_unplugged_motor_does_not_slow_the_others(ergo: Robot) -> None:
 
 def test_to_config_reflects_the_motors(ergo: Robot) -> None:
     ergo.m1.angle_limit = (-100, 100)
-    config = ergo.to_config()
+    config = ergo.to_robot_config()
     assert config.motors["m1"].angle_limit == (-100, 100)
     assert config.controllers[CONTROLLER].port == "auto"
+    assert ergo.to_config()["motors"]["m1"]["angle_limit"] == [-100, 100]
     assert eventually(lambda: virtual(ergo, 1).table.get_si("max_position_limit") == pytest.approx(
         100, abs=0.3), 2.0)
 
@@ -157,7 +158,7 @@ def test_close_stops_every_thread() -> None:
     robot.close()
     assert set(threading.enumerate()) - before == set()
     assert robot.closed
-    with pytest.raises(PortError):
+    with pytest.raises(RobotClosedError):
         robot.goto_position({"m1": 0}, 1.0)
 
 
