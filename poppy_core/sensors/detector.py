@@ -102,7 +102,7 @@ class MarkerDetector(Sensor):
         """
         if isinstance(card_or_id, int):
             wanted = {card_or_id}
-        elif card_or_id.strip().lstrip("-").isdigit():
+        elif card_or_id.strip().lstrip("-").isascii() and card_or_id.strip().lstrip("-").isdigit():
             wanted = {int(card_or_id)}
         elif card_or_id in self.card_ids:
             wanted = set(self.card_ids[card_or_id])

@@ -106,4 +106,6 @@ def test_the_detector_names_cards() -> None:
             assert detector.sees(7) is False and detector.sees("7") is False
             with pytest.raises(SensorError, match=r"no card 'rabbit' \(cards: caribou"):
                 detector.sees("rabbit")
+            with pytest.raises(SensorError, match="no card '³'"):
+                detector.sees("³")  # a digit to str.isdigit, not to int()
             assert detector.health().ok and detector.health().target_hz == 20.0
