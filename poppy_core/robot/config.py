@@ -22,6 +22,7 @@ from poppy_core.errors import UnknownModelError
 from poppy_core.models import ALL_MODELS, model_by_name
 from poppy_core.robot.config_checks import check_config, expand
 from poppy_core.robot.config_format import DEFAULT_SOURCE, config_error, from_validation_error
+from poppy_core.robot.frames import user_limits
 
 Degrees = Annotated[float, Strict(), Field(allow_inf_nan=False)]
 """A finite angle in degrees (ints accepted, strings and booleans refused)."""
@@ -89,7 +90,11 @@ def _check_pair_shape(value: Any, size: int, shape: str) -> Any:
 
 
 class MotorConfig(BaseModel):
-    """One motor: its ID, servo model, mounting (orientation, offset) and angle limits."""
+    """One motor: its ID, servo model, mounting (orientation, offset) and angle limits.
+
+    ``angle_limit`` is in the motor frame, as in pypot: the servo's own angles, the values its
+    EEPROM limits hold (``user_angle_limit`` gives them in the user frame).
+    """
 
     model_config = ConfigDict(extra="allow")
 
@@ -138,6 +143,11 @@ class MotorConfig(BaseModel):
         if value[0] >= value[1]:
             raise PydanticCustomError("angle_limit", "min must be below max")
         return value
+
+    @property
+    def user_angle_limit(self) -> tuple[float, float]:
+        """``angle_limit`` in the user frame (orientation and offset applied), (min, max)."""
+        return user_limits(self.angle_limit, self.orientation, self.offset)
 
     @field_validator("pid", mode="before")
     @classmethod

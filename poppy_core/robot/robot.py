@@ -255,6 +255,8 @@ class Robot:
     def to_config(self) -> RobotConfig:
         """The robot's config with the motors' present orientation, offset and angle limits.
 
+        The limits are written in the motor frame, as configs hold them.
+
         Raises:
             ConfigError: the robot was not built from a config.
         """
@@ -266,7 +268,7 @@ class Robot:
             if entry is not None:
                 entry["orientation"] = motor.orientation
                 entry["offset"] = motor.offset
-                entry["angle_limit"] = list(motor.angle_limit)
+                entry["angle_limit"] = list(motor.config_limits())
         return type(self.config).from_dict(data, source="robot")
 
     @property
