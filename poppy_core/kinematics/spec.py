@@ -201,6 +201,13 @@ def build_chains(
             out.extend(n for n in (expand(name) if expand else [name]) if n not in out)
         return out
 
+    for name in flat(spec.reversed):
+        if name not in motors:
+            raise ConfigError(
+                f"{SECTION}.reversed names {name!r}, which is no motor of the robot",
+                field=f"{SECTION}.reversed",
+                value=name,
+            )
     chains: dict[str, Chain] = {}
     for chain in spec.chains:
         names = flat(chain.motors)
