@@ -20,6 +20,7 @@ from bench.registry import REPO_ROOT, BenchContext, BenchResult, Table, register
 from bench.stats import summary
 from poppy_core.emulator import VirtualBus, VirtualMotor
 from poppy_core.models import model_by_name
+from poppy_core.robot.frames import to_motor
 from poppy_core.robot.profiles import load_profile
 
 logger = logging.getLogger(__name__)
@@ -47,8 +48,8 @@ def _world(robot: str) -> tuple[Any, dict[str, VirtualMotor], dict[str, Any]]:
         bus_motors = []
         for name in config.motors_of_controller(controller):
             m = config.motors[name]
-            sign = 1.0 if m.orientation == "direct" else -1.0
-            links[name] = ids[m.id] = JointLink(name, sign, float(m.offset))
+            ids[m.id] = JointLink(name)
+            links[name] = m
             motors[name] = VirtualMotor(model_by_name(m.type), m.id)
             bus_motors.append(motors[name])
         VirtualBus(bus_motors, entry.protocol, plant=MujocoPlant(sim, ids), auto_step=False)
@@ -67,7 +68,9 @@ def plant_rtf(robot: str) -> float:
                 for name, motor in motors.items():
                     with motor.lock:
                         motor.table.set("torque_enable", 1)
-                        motor.table.set_si("goal_position", links[name].motor_deg(goal))
+                        entry = links[name]
+                        target = to_motor(goal, entry.orientation, entry.offset)
+                        motor.table.set_si("goal_position", target)
             sim.advance(STEP_S)
         return PLANT_SIM_S / (time.perf_counter() - start)
     finally:

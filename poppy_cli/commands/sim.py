@@ -262,25 +262,25 @@ def _no_gl(detail: str) -> typer.Exit:
 
 
 def _motor_map(config: RobotConfig, servers: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
-    """Motor name -> (virtual motor, JointLink)."""
-    from poppy_core.sim.plant import JointLink
-
+    """Motor name -> (virtual motor, its config entry)."""
     out: dict[str, tuple[Any, Any]] = {}
     for controller, server in servers.items():
         for name in config.motors_of_controller(controller):
             entry = config.motors[name]
-            sign = 1.0 if entry.orientation == "direct" else -1.0
-            out[name] = (server.bus.motor(entry.id), JointLink(name, sign, float(entry.offset)))
+            out[name] = (server.bus.motor(entry.id), entry)
     return out
 
 
 def _command(motors: dict[str, tuple[Any, Any]], goals: dict[str, float]) -> None:
     """Torque on and goal positions (poppy's frame) written into the virtual motors' tables."""
-    for name, (motor, link) in motors.items():
+    from poppy_core.robot.frames import to_motor
+
+    for name, (motor, entry) in motors.items():
         with motor.lock:
             motor.table.set("torque_enable", 1)
             if name in goals:
-                motor.table.set_si("goal_position", link.motor_deg(goals[name]))
+                goal = to_motor(goals[name], entry.orientation, entry.offset)
+                motor.table.set_si("goal_position", goal)
 
 
 def render_frames(

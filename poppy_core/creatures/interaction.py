@@ -19,11 +19,16 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 ARM_JOINTS: tuple[str, ...] = ("shoulder_y", "shoulder_x", "arm_z", "elbow_y")
-# Mirror: the profiles' right-arm angle limits are the left ones negated (poppy_torso.json and
-# poppy_humanoid.json, e.g. l_shoulder_x [-105, 110], r_shoulder_x [-110, 105]; l_elbow_y
-# [-148, 1], r_elbow_y [-1, 148]): the user frames of the two arms are mirror images, so the
-# right arm mirrors the left with the same angles negated.
-MIRROR_SIGN = -1.0
+# Mirror: the right arm's angle for the left arm's angle. The two arms' user frames are mirror
+# images: a pitch (shoulder_y, elbow_y) has the same sign on both sides, a roll or a yaw
+# (shoulder_x, arm_z) the opposite sign. The profiles' limits (motor frame, as pypot's) say so
+# once turned into the user frame: l_elbow_y and r_elbow_y both [-148, 1] (Humanoid),
+# l_shoulder_x [-20, 195] against r_shoulder_x [-195, 20]; and pypot's PuppetMaster
+# (poppy-humanoid, poppy-torso primitives/interaction.py) copies the left position with the
+# sign +1 for the left arm's direct motors (shoulder_y, elbow_y) and -1 for its indirect ones.
+MIRROR_SIGNS: dict[str, float] = {
+    "shoulder_y": 1.0, "shoulder_x": -1.0, "arm_z": -1.0, "elbow_y": 1.0,
+}  # fmt: skip
 INTERACTION_HZ = 50.0  # the primitive manager's rate (poppy_core.motion.manager)
 
 # arms_turn_compliant (Poppy documentation: "turns the arms compliant when a force is applied").
@@ -82,7 +87,7 @@ class ArmsCopyMotion(LoopPrimitive):
         """Right goal = the left position, mirrored (clamped to the right arm's limits)."""
         for left, right in self._pairs:
             position = self.real_robot.motor(left).present_position
-            self.robot.motor(right).goal_position = MIRROR_SIGN * position
+            self.robot.motor(right).goal_position = MIRROR_SIGNS[left[2:]] * position
 
     def teardown(self) -> None:
         """Stiffen the left arm where it is."""

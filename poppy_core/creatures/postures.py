@@ -33,29 +33,28 @@ ERGO_JR_REST: dict[str, float] = {
 ERGO_JR_CURIOUS: dict[str, float] = {
     "m1": 0.0, "m2": -15.0, "m3": 40.0, "m4": 0.0, "m5": -35.0, "m6": -60.0,
 }  # fmt: skip
-# poppy_ergo_jr/primitives/postures.py (IdlePosture), degrees; SafePowerUp goes there.
-# m2's -110° lies outside the profile's [-90, 125] limits: goals are clamped to -90°.
+# poppy_ergo_jr/primitives/postures.py (IdlePosture), degrees; SafePowerUp goes there (m2's
+# user range is [-125, 90]: the profile's [-90, 125] is in the motor frame and m2 is indirect).
 ERGO_JR_IDLE: dict[str, float] = {
     "m1": 0.0, "m2": -110.0, "m3": 65.0, "m4": 0.0, "m5": 34.0, "m6": 20.0,
 }  # fmt: skip
 
 # Poppy documentation (poppy_humanoid library): "stand_position: the robot moves to standing
 # position (0 to all motors)".
-# Sit, "legs bent with heels under the buttock" (same documentation). poppy-humanoid's own
-# numbers are not available here; these are chosen: knees bent near their 134° stop, thighs
-# raised 35°, feet flat-ish (ankles at their 45° stop). Left-side signs; the right leg's angle
-# limits in the profile are the left ones negated (e.g. l_knee_y [-3.5, 134], r_knee_y
-# [-134, 3.5]), so the right joints get the negated values.
-HUMANOID_SIT_LEFT: dict[str, float] = {"hip_y": -35.0, "knee_y": 125.0, "ankle_y": -45.0}
+# Sit, "legs bent with heels under the buttock" (same documentation): pypot's numbers
+# (poppy-humanoid, primitives/posture.py, SitPosition): thighs raised 39°, knees bent 134°, the
+# same angles on both legs (the legs' user frames are mirror images: the profiles' limits,
+# motor frame, give l_knee_y and r_knee_y both [-3.5, 134] in the user frame). pypot then frees
+# the knees and ankles; poppy's posture holds them.
+HUMANOID_SIT: dict[str, float] = {
+    "l_hip_y": -39.0, "r_hip_y": -39.0, "l_knee_y": 134.0, "r_knee_y": 134.0,
+    "abs_x": 0.0, "abs_y": 3.0, "abs_z": 0.0, "bust_x": 0.0, "bust_y": 0.0,
+}  # fmt: skip
 
 
 def humanoid_sit() -> dict[str, float]:
-    """The sit posture of both legs (torso and head upright at 0°)."""
-    out = {f"l_{joint}": value for joint, value in HUMANOID_SIT_LEFT.items()}
-    out |= {f"r_{joint}": -value for joint, value in HUMANOID_SIT_LEFT.items()}
-    for name in ("abs_y", "abs_x", "abs_z", "bust_y", "bust_x", "head_z", "head_y"):
-        out[name] = 0.0
-    return out
+    """The sit posture (pypot's SitPosition targets)."""
+    return dict(HUMANOID_SIT)
 
 
 def clamp_to_limits(robot: Robot, posture: Mapping[str, float]) -> dict[str, float]:

@@ -17,11 +17,17 @@ from typing import Literal
 import numpy as np
 
 from poppy_core.errors import ConfigError
-from poppy_core.kinematics.transforms import Matrix, homogeneous, quat_matrix, rpy_matrix
+from poppy_core.kinematics.transforms import (
+    Matrix,
+    axis_angle_matrix,
+    homogeneous,
+    quat_matrix,
+    rpy_matrix,
+)
 
 JointFrame = Literal["motor", "user"]
 """What angle a description's joints take: the motor's own angle ``sign * (user + offset)``
-(pypot's convention for the Poppy URDFs) or the user angle (poppy's MuJoCo models)."""
+(pypot's convention for the Poppy URDFs, and poppy's MuJoCo models), or the user angle."""
 
 MOVING = ("revolute", "continuous", "hinge")
 
@@ -65,7 +71,8 @@ class KinematicDescription:
         name: the robot's name in the file.
         source: the file it was read from.
         joints: every joint, in file order.
-        joint_frame: ``"motor"`` for URDF (pypot's convention), ``"user"`` for MJCF.
+        joint_frame: ``"motor"``: the joints take the motor's own angle (pypot's convention for
+            URDFs; poppy's MuJoCo models too). A config may say ``"user"`` instead.
     """
 
     name: str
@@ -275,18 +282,25 @@ def parse_mjcf(path: Path) -> KinematicDescription:
             if model.jnt_limited[joint]:
                 low, high = model.jnt_range[joint]
                 limits = (math.degrees(float(low)), math.degrees(float(high)))
+            kind = kinds.get(int(model.jnt_type[joint]), "other")
+            axis: Matrix = np.asarray(model.jnt_axis[joint], dtype=float)
+            # A hinge turns its body by (angle - ref): the body is drawn at the ``ref`` angle.
+            ref = float(model.qpos0[model.jnt_qposadr[joint]]) if kind == "hinge" else 0.0
+            unref = homogeneous(axis_angle_matrix(axis, -ref), None)
             joints.append(
                 JointDescription(
                     name=name,
-                    kind=kinds.get(int(model.jnt_type[joint]), "other"),
+                    kind=kind,
                     parent=parent,
                     child=child,
-                    origin=(frame if position == 0 else np.eye(4)).dot(homogeneous(None, anchor)),
-                    axis=np.asarray(model.jnt_axis[joint], dtype=float),
+                    origin=(frame if position == 0 else np.eye(4))
+                    .dot(homogeneous(None, anchor))
+                    .dot(unref),
+                    axis=axis,
                     post=homogeneous(None, -anchor),
                     limits_deg=limits,
                 )
             )
             parent = child
     name = Path(path).stem
-    return KinematicDescription(name, str(path), tuple(joints), "user")
+    return KinematicDescription(name, str(path), tuple(joints), "motor")

@@ -3,12 +3,13 @@
 ```yaml
 kinematics:
   model: poppy_torso.urdf          # URDF or MJCF; relative to the config file's folder
-  joint_frame: motor               # optional: motor (URDF default, pypot's) or user (MJCF default)
+  joint_frame: motor               # optional: motor (the default, pypot's) or user
+  reversed: [r_shoulder_x]         # motors turning against the model's axis, in every chain
   chains:
     l_arm_chain:
       motors: [torso, l_arm]       # motors or groups, base to tip
       passive: [torso]             # joints the solver leaves where they are
-      reversed: []                 # motors turning against the model (pypot's reversed_motors)
+      reversed: []                 # ... in this chain only (pypot's reversed_motors)
       tip: [0, 0.18, 0]            # metres, in the last joint's child frame
 ```
 """
@@ -41,11 +42,16 @@ class ChainSpec:
 
 @dataclass(frozen=True)
 class KinematicsSpec:
-    """The whole section: the model file (as written), its joint frame and the chains."""
+    """The whole section: model file (as written), joint frame, chains, reversed motors.
+
+    ``reversed`` lists the motors that turn against the model's axis in every chain (a model
+    whose axis disagrees with the servo's), on top of each chain's own ``reversed``.
+    """
 
     model: str
     chains: tuple[ChainSpec, ...]
     joint_frame: JointFrame | None = None
+    reversed: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -141,7 +147,8 @@ def parse_kinematics(data: Any, source: str = "config") -> KinematicsSpec:
                 tip=(float(tip[0]), float(tip[1]), float(tip[2])),
             )
         )
-    return KinematicsSpec(model, tuple(chains), frame)
+    reversed_ = _names(data.get("reversed"), f"{SECTION}.reversed")
+    return KinematicsSpec(model, tuple(chains), frame, reversed_)
 
 
 def find_model(model: str, folders: Iterable[Path]) -> Path:
@@ -194,10 +201,18 @@ def build_chains(
             out.extend(n for n in (expand(name) if expand else [name]) if n not in out)
         return out
 
+    for name in flat(spec.reversed):
+        if name not in motors:
+            raise ConfigError(
+                f"{SECTION}.reversed names {name!r}, which is no motor of the robot",
+                field=f"{SECTION}.reversed",
+                value=name,
+            )
     chains: dict[str, Chain] = {}
     for chain in spec.chains:
         names = flat(chain.motors)
-        passive, reversed_ = set(flat(chain.passive)), set(flat(chain.reversed))
+        passive = set(flat(chain.passive))
+        reversed_ = set(flat(chain.reversed)) | set(flat(spec.reversed))
         joints = []
         for name in names:
             motor = motors.get(name)

@@ -65,7 +65,10 @@ class RobotChain:
         self.name = name
         self.control = control
         self._spec = KinematicsSpec(
-            spec.model, tuple(c for c in spec.chains if c.name == name), spec.joint_frame
+            spec.model,
+            tuple(c for c in spec.chains if c.name == name),
+            spec.joint_frame,
+            spec.reversed,
         )
         if not self._spec.chains:
             raise KinematicsError(f"the kinematics section has no chain {name!r}", chain=name)

@@ -77,9 +77,7 @@ def chains_from_config(config: RobotConfig, kind: str | None = None) -> dict[str
     spec, description = found
     motors = {
         name: MotorFrame(
-            1.0 if m.orientation == "direct" else -1.0,
-            float(m.offset),
-            (float(m.angle_limit[0]), float(m.angle_limit[1])),
+            1.0 if m.orientation == "direct" else -1.0, float(m.offset), m.user_angle_limit
         )
         for name, m in config.motors.items()
     }

@@ -27,6 +27,7 @@ from poppy_core.robot.config_checks import (
     whole_config_problems,
 )
 from poppy_core.robot.config_format import DEFAULT_SOURCE, config_error, validation_problems
+from poppy_core.robot.frames import user_limits
 from poppy_core.sensors.config import SensorProblem, check_section
 
 Degrees = Annotated[float, Strict(), Field(allow_inf_nan=False)]
@@ -95,7 +96,11 @@ def _check_pair_shape(value: Any, size: int, shape: str) -> Any:
 
 
 class MotorConfig(BaseModel):
-    """One motor: its ID, servo model, mounting (orientation, offset) and angle limits."""
+    """One motor: its ID, servo model, mounting (orientation, offset) and angle limits.
+
+    ``angle_limit`` is in the motor frame, as in pypot: the servo's own angles, the values its
+    EEPROM limits hold (``user_angle_limit`` gives them in the user frame).
+    """
 
     model_config = ConfigDict(extra="allow")
 
@@ -144,6 +149,11 @@ class MotorConfig(BaseModel):
         if value[0] >= value[1]:
             raise PydanticCustomError("angle_limit", "min must be below max")
         return value
+
+    @property
+    def user_angle_limit(self) -> tuple[float, float]:
+        """``angle_limit`` in the user frame (orientation and offset applied), (min, max)."""
+        return user_limits(self.angle_limit, self.orientation, self.offset)
 
     @field_validator("pid", mode="before")
     @classmethod

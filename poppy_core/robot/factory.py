@@ -65,11 +65,8 @@ def start_simulation(config: RobotConfig) -> Any:
 def _mujoco_plant(config: RobotConfig, controller: str, simulation: Any) -> Plant:
     from poppy_core.sim.plant import JointLink, MujocoPlant
 
-    links = {}
-    for name in config.motors_of_controller(controller):
-        entry = config.motors[name]
-        sign = 1.0 if entry.orientation == "direct" else -1.0
-        links[entry.id] = JointLink(name, sign, float(entry.offset))
+    names = config.motors_of_controller(controller)
+    links = {config.motors[name].id: JointLink(name) for name in names}
     return MujocoPlant(simulation, links)
 
 

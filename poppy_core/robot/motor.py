@@ -1,11 +1,14 @@
 """``Motor``: one servo in SI units, with orientation, offset and limits, cached by the sync loops.
 
-Frames: the *motor frame* is the servo's own (``poppy_core.models`` degrees, 0° mid-range); the
-*user frame* is what a robot script sees. With ``s = +1`` (direct) or ``-1`` (indirect)::
+Frames (``poppy_core.robot.frames``): the *motor frame* is the servo's own (``poppy_core.models``
+degrees, 0° mid-range); the *user frame* is what a robot script sees. With ``s = +1`` (direct)
+or ``-1`` (indirect)::
 
     user = s * motor - offset          motor = s * (user + offset)
 
-Speeds and loads flip their sign with the orientation; angle limits are given in the user frame.
+Speeds and loads flip their sign with the orientation. A ``Motor`` speaks the user frame,
+angle limits included; a config's ``angle_limit`` is in the motor frame, as in pypot (what the
+servo's EEPROM holds), and ``from_config`` converts it.
 
 Nothing here touches the bus: reads return the values the sync loops last read, writes store the
 value and mark it for the next write cycle (``take_pending``).
@@ -19,6 +22,7 @@ from typing import TYPE_CHECKING, Literal
 
 from poppy_core.errors import RegisterError, RobotClosedError
 from poppy_core.models import ServoModel
+from poppy_core.robot import frames
 from poppy_core.robot import registers as regs
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.motor_cache import MotorCache, SIValue
@@ -86,14 +90,18 @@ class Motor(MotorCache):
     def from_config(
         cls, name: str, config: MotorConfig, model: ServoModel, runner: GotoRunner | None = None
     ) -> Motor:
-        """Build a motor from its config entry (``RobotConfig.motors[name]``)."""
+        """Build a motor from its config entry (``RobotConfig.motors[name]``).
+
+        The entry's ``angle_limit`` is in the motor frame (pypot's); the motor's is in the user
+        frame.
+        """
         return cls(
             name,
             model,
             config.id,
             orientation=config.orientation,
             offset=config.offset,
-            angle_limit=(config.angle_limit[0], config.angle_limit[1]),
+            angle_limit=config.user_angle_limit,
             wheel_mode=config.wheel_mode,
             runner=runner,
         )
@@ -113,15 +121,15 @@ class Motor(MotorCache):
 
     @property
     def _sign(self) -> float:
-        return 1.0 if self.direct else -1.0
+        return frames.sign_of(self.orientation)
 
     def to_user(self, motor_deg: float) -> float:
         """A motor-frame angle seen in the user frame."""
-        return self._sign * motor_deg - self.offset
+        return frames.to_user(motor_deg, self.orientation, self.offset)
 
     def to_motor(self, user_deg: float) -> float:
         """A user-frame angle in the motor frame."""
-        return self._sign * (user_deg + self.offset)
+        return frames.to_motor(user_deg, self.orientation, self.offset)
 
     def _user_range(self) -> tuple[float, float]:
         ends = sorted(self.to_user(v) for v in self._range)
@@ -129,8 +137,12 @@ class Motor(MotorCache):
 
     def motor_limits(self) -> tuple[float, float]:
         """The angle limits in the motor frame (min, max), kept inside the model's range."""
-        ends = sorted(self.to_motor(v) for v in self._limits)
-        return max(ends[0], self._range[0]), min(ends[1], self._range[1])
+        low, high = self.config_limits()
+        return max(low, self._range[0]), min(high, self._range[1])
+
+    def config_limits(self) -> tuple[float, float]:
+        """The angle limits in the motor frame, as a config's ``angle_limit`` gives them."""
+        return frames.motor_limits(self._limits, self.orientation, self.offset)
 
     def _checked_limits(self, low: float, high: float) -> tuple[float, float]:
         if not low < high:

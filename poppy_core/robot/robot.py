@@ -378,6 +378,8 @@ class Robot:
     def to_robot_config(self) -> RobotConfig:
         """``to_config`` as a validated ``RobotConfig`` (profile header kept).
 
+        The limits are written in the motor frame, as configs hold them.
+
         Raises:
             ConfigError: the robot was not built from a config.
         """
@@ -389,7 +391,7 @@ class Robot:
             if entry is not None:
                 entry["orientation"] = motor.orientation
                 entry["offset"] = motor.offset
-                entry["angle_limit"] = list(motor.angle_limit)
+                entry["angle_limit"] = list(motor.config_limits())
         return type(self.config).from_dict(data, source="robot")
 
     @property

@@ -2,10 +2,10 @@
 
 Angle limits: like pypot, the configured limits are written to the servos' EEPROM angle limits
 at start-up (only when they differ by more than one step, to spare the EEPROM), so the servo's
-own firmware enforces them too. Unlike pypot, they are converted from the user frame to the
-motor frame first (orientation and offset applied), which fixes pypot's indirect-motor limits
-(pypot issues #231, #304). ``write_angle_limits=False`` leaves the EEPROM alone; goals are
-clamped in software either way.
+own firmware enforces them too. A config's ``angle_limit`` is in the motor frame, as in pypot
+(``pypot.robot.config`` writes it to the EEPROM as it is), so the same values land in the
+EEPROM as with pypot; the ``Motor`` shows them in the user frame. ``write_angle_limits=False``
+leaves the EEPROM alone; goals are clamped in software either way.
 """
 
 from __future__ import annotations

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -31,8 +30,6 @@ class Joint:
     qpos: int
     dof: int
     actuator: int
-    sign: float
-    offset_deg: float
     stall_nm: float
     kp: float
     kv: float
@@ -51,10 +48,10 @@ class Drive:
         self.joints: list[Joint] = []
         empty = np.zeros(0)
         self.qpos = self.dof = self.act = np.zeros(0, dtype=int)
-        self.sign = self.offset_deg = self.stall = self.kp = self.kv = empty
+        self.stall = self.kp = self.kv = empty
         self.target = self.goal = self.speed = self.torque_frac = empty
         self.on = np.zeros(0, dtype=bool)
-        self._deg_sign = self._offset_sign = self._load_sign = empty
+        self._load_scale = empty
         self._dirty = True  # gains or force ranges to write into the model
         self._settled = False  # every target at its goal and in data.ctrl: nothing ramps
 
@@ -64,8 +61,6 @@ class Drive:
         self.qpos = np.append(self.qpos, joint.qpos)
         self.dof = np.append(self.dof, joint.dof)
         self.act = np.append(self.act, joint.actuator)
-        self.sign = np.append(self.sign, joint.sign)
-        self.offset_deg = np.append(self.offset_deg, joint.offset_deg)
         self.stall = np.append(self.stall, joint.stall_nm)
         self.kp = np.append(self.kp, joint.kp)
         self.kv = np.append(self.kv, joint.kv)
@@ -74,10 +69,8 @@ class Drive:
         self.speed = np.append(self.speed, 1.0)
         self.torque_frac = np.append(self.torque_frac, 1.0)
         self.on = np.append(self.on, False)
-        # sense(): motor position = sign * (joint ° + offset); speed and load carry the sign.
-        self._deg_sign = self.sign * (180.0 / math.pi)
-        self._offset_sign = self.sign * self.offset_deg
-        self._load_sign = self.sign * 100.0 / self.stall
+        # sense(): the joint's angle is the motor's own (the model is built so)
+        self._load_scale = 100.0 / self.stall
         self._dirty = True
         self._settled = False
         return len(self.joints) - 1
@@ -109,7 +102,7 @@ class Drive:
             self.target[starting] = data.qpos[self.qpos[starting]]
             self.on[index] = on
             self.torque_frac[index] = fraction
-        self.goal[index] = np.radians(self.sign[index] * table[:, 1] - self.offset_deg[index])
+        self.goal[index] = np.radians(table[:, 1])
         self.speed[index] = np.radians(table[:, 2])
         self._settled = False
 
@@ -172,10 +165,10 @@ class Drive:
 
     def sense(self, data: Any) -> list[State]:
         """Each motor's (position °, speed °/s, load %, moving), in the motor's frame."""
-        position = data.qpos[self.qpos] * self._deg_sign + self._offset_sign
-        speed = data.qvel[self.dof] * self._deg_sign
+        position = np.degrees(data.qpos[self.qpos])
+        speed = np.degrees(data.qvel[self.dof])
         # e-manual: present load is a percentage of the maximum (stall) torque
-        load = data.actuator_force[self.act] * self._load_sign
+        load = data.actuator_force[self.act] * self._load_scale
         load = np.minimum(np.maximum(load, -100.0), 100.0)
         moving = np.abs(speed) > _MOVING_DPS
         if not self._settled:

@@ -3,9 +3,12 @@
 Run ``python -m poppy_core.sim.mjcf [profiles_dir]`` to regenerate ``profiles/<robot>/model.xml``.
 
 Each URDF joint becomes a hinge named like the profile's motor; links get capsules between the
-joint origins (no meshes) and the URDF's mass and inertia. A MuJoCo joint angle is the poppy
-angle of the motor (user frame): ``JOINT_FRAMES`` holds, per joint, the URDF angle at poppy's
-zero and the direction, where the URDF differs (see docs/simulation.md for the checks).
+joint origins (no meshes) and the URDF's mass and inertia. A MuJoCo joint angle is the motor's
+own angle (the one its control table holds), as pypot reads the Poppy URDFs: the URDF angle,
+turned the other way for the motors the profile's ``kinematics.reversed`` lists (a URDF axis
+against the servo's). The bodies are drawn at the robot's home pose (every motor at 0° in the
+user frame) and each joint's ``ref`` is the motor's angle there, so the model starts at home.
+See docs/simulation.md for the evidence.
 """
 
 from __future__ import annotations
@@ -39,23 +42,6 @@ ROBOTS: dict[str, str] = {
     "ergo-jr": "poppy_ergo_jr.urdf",
     "torso": "poppy_torso.urdf",
     "humanoid": "poppy_humanoid.urdf",
-}
-
-# joint -> (URDF angle in degrees at poppy's 0°, direction of poppy's angle about the URDF axis).
-# Ergo Jr: pypot drives the URDF with the motor angle (its IK chain, no reversed motor), so the
-# indirect motors turn the other way. Torso/Humanoid: the URDF limits equal the profile's
-# (user-frame) limits, but its arms are in a T-pose at 0: the shoulders are turned so that
-# poppy's 0 has the arms down, the directions follow the mirrored limits of each side.
-_ARMS: dict[str, tuple[float, float]] = {
-    "l_shoulder_y": (90.0, -1.0),
-    "l_shoulder_x": (90.0, -1.0),
-    "r_shoulder_y": (-90.0, -1.0),
-    "r_shoulder_x": (90.0, 1.0),
-}
-JOINT_FRAMES: dict[str, dict[str, tuple[float, float]]] = {
-    "ergo-jr": {name: (0.0, -1.0) for name in ("m2", "m3", "m5", "m6")},
-    "torso": dict(_ARMS),
-    "humanoid": dict(_ARMS),
 }
 
 
@@ -138,26 +124,59 @@ def _cross(a: Vec3, b: Vec3) -> Vec3:
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
+def load_profile_data(profiles_dir: Path, robot: str) -> dict[str, Any]:
+    """``profiles/<robot>/profile.yaml``, parsed."""
+    data: dict[str, Any] = yaml.safe_load(
+        (profiles_dir / robot / "profile.yaml").read_text(encoding="utf-8")
+    )
+    return data
+
+
 def load_profile_motors(profiles_dir: Path, robot: str) -> dict[str, dict[str, Any]]:
     """The ``motors`` section of ``profiles/<robot>/profile.yaml``."""
-    data = yaml.safe_load((profiles_dir / robot / "profile.yaml").read_text(encoding="utf-8"))
-    motors: dict[str, dict[str, Any]] = data["motors"]
+    motors: dict[str, dict[str, Any]] = load_profile_data(profiles_dir, robot)["motors"]
     return motors
 
 
+def reversed_joints(profiles_dir: Path, robot: str) -> frozenset[str]:
+    """The motors whose URDF axis turns against the servo (``kinematics.reversed``)."""
+    section = load_profile_data(profiles_dir, robot).get("kinematics") or {}
+    return frozenset(section.get("reversed") or ())
+
+
 class _Writer:
-    def __init__(self, robot: str, urdf: Urdf, motors: dict[str, dict[str, Any]]) -> None:
+    def __init__(
+        self,
+        robot: str,
+        urdf: Urdf,
+        motors: dict[str, dict[str, Any]],
+        reversed_: frozenset[str] = frozenset(),
+    ) -> None:
         self.robot = robot
         self.urdf = urdf
         self.motors = motors
+        self.reversed = reversed_
         self.style = STYLES[robot]
-        self.frames = JOINT_FRAMES.get(robot, {})
         self.lines: list[str] = []
 
+    def axis(self, joint: UrdfJoint) -> Vec3:
+        """The hinge axis: the URDF's, the other way round for a reversed motor."""
+        k = -1.0 if joint.name in self.reversed else 1.0
+        return (k * joint.axis[0], k * joint.axis[1], k * joint.axis[2])
+
+    def home_deg(self, joint: UrdfJoint) -> float:
+        """The motor's own angle at the home pose (user 0°): ``sign * offset``."""
+        motor = self.motors.get(joint.name)
+        if motor is None or joint.kind not in ("revolute", "continuous"):
+            return 0.0
+        sign = 1.0 if motor.get("orientation", "direct") == "direct" else -1.0
+        return sign * float(motor.get("offset", 0.0))
+
     def joint_quat(self, joint: UrdfJoint) -> Quat:
-        zero_deg, _ = self.frames.get(joint.name, (0.0, 1.0))
+        """The child body's frame at the home pose (the joint turned to its home angle)."""
         base = quat_from_rpy(joint.rpy)
-        return quat_mul(base, quat_from_axis_angle(joint.axis, math.radians(zero_deg)))
+        turn = quat_from_axis_angle(self.axis(joint), math.radians(self.home_deg(joint)))
+        return quat_mul(base, turn)
 
     def world_frames(self) -> dict[str, tuple[Vec3, Quat]]:
         """World pose of every link at poppy's zero pose (root at the origin)."""
@@ -253,13 +272,13 @@ class _Writer:
         )
         self.inertial(joint.child, indent + "  ")
         if joint.kind in ("revolute", "continuous"):
-            _, direction = self.frames.get(joint.name, (0.0, 1.0))
-            axis = tuple(direction * c for c in joint.axis)
             motor = self.motors.get(joint.name, {})
-            low, high = motor.get("angle_limit", (-150.0, 150.0))
+            low, high = motor.get("angle_limit", (-150.0, 150.0))  # motor frame, as pypot's
             servo = servo_params(model_by_name(motor.get("type", "MX-28")))
+            home = self.home_deg(joint)
+            ref = f' ref="{_f(math.radians(home))}"' if home else ""
             self.lines.append(
-                f'{indent}  <joint name="{joint.name}" axis="{_v(axis)}" '
+                f'{indent}  <joint name="{joint.name}" axis="{_v(self.axis(joint))}"{ref} '
                 f'range="{_f(math.radians(low))} {_f(math.radians(high))}" '
                 f'armature="{_f(servo.armature_kgm2)}" frictionloss="{_f(servo.friction_nm)}"/>'
             )
@@ -353,7 +372,8 @@ class _Writer:
 def generate(robot: str, profiles_dir: Path) -> str:
     """The MJCF text of ``robot`` (``"ergo-jr"``, ``"torso"`` or ``"humanoid"``)."""
     urdf = parse_urdf(profiles_dir / robot / ROBOTS[robot])
-    return _Writer(robot, urdf, load_profile_motors(profiles_dir, robot)).write()
+    motors = load_profile_motors(profiles_dir, robot)
+    return _Writer(robot, urdf, motors, reversed_joints(profiles_dir, robot)).write()
 
 
 def write_all(profiles_dir: Path) -> list[Path]:

@@ -15,23 +15,14 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class JointLink:
-    """How one motor drives one joint: ``joint_deg = sign * motor_deg - offset_deg``.
+    """The joint one motor drives.
 
-    ``sign`` is +1 for a direct motor, -1 for an indirect one; ``offset_deg`` is the profile's
-    offset. The joint angle is poppy's (user-frame) angle, so 30° in poppy is 30° at the joint.
+    The joint's angle is the motor's own angle, the one its control table holds (poppy's models
+    are built so, see ``poppy_core.sim.mjcf``): orientation and offset stay the ``Motor``'s
+    business, on the robot's side of the bus, as with a real servo.
     """
 
     joint: str
-    sign: float = 1.0
-    offset_deg: float = 0.0
-
-    def joint_deg(self, motor_deg: float) -> float:
-        """The joint angle for a motor (control table) angle."""
-        return self.sign * motor_deg - self.offset_deg
-
-    def motor_deg(self, joint_deg: float) -> float:
-        """The motor (control table) angle for a joint angle."""
-        return self.sign * (joint_deg + self.offset_deg)
 
 
 class MujocoPlant:
@@ -46,7 +37,7 @@ class MujocoPlant:
 
     Args:
         simulation: the world shared by every bus of the robot.
-        links: motor id -> its joint, sign and offset.
+        links: motor id -> its joint.
     """
 
     def __init__(self, simulation: Simulation, links: Mapping[int, JointLink]) -> None:
@@ -72,6 +63,5 @@ class MujocoPlant:
         """Nothing to do: the simulation's thread advances the physics (see the class doc)."""
 
     def _move_by_hand(self, motor: VirtualMotor, position_deg: float) -> None:
-        link = self.links[motor.id]
-        self.simulation.set_joint_deg(link.joint, link.joint_deg(position_deg))
+        self.simulation.set_joint_deg(self.links[motor.id].joint, position_deg)
         motor.table.set_si("present_position", position_deg)

@@ -92,8 +92,6 @@ class Simulation:
                 qpos=qpos,
                 dof=dof,
                 actuator=actuator,
-                sign=link.sign,
-                offset_deg=link.offset_deg,
                 stall_nm=float(self.model.actuator_forcerange[actuator][1]),
                 kp=float(self.model.actuator_gainprm[actuator][0]),
                 kv=float(-self.model.actuator_biasprm[actuator][2]),
@@ -107,13 +105,13 @@ class Simulation:
                     break
             else:
                 self._groups.append((motor.lock, [binding]))
-            position = link.motor_deg(math.degrees(target_rad))
+            position = math.degrees(target_rad)
         with motor.lock:
             motor.set_state(position, 0.0, 0.0, False)
             motor.table.set_si("goal_position", position)
 
     def set_joint_deg(self, joint: str, angle_deg: float) -> None:
-        """Put joint ``joint`` at ``angle_deg`` (poppy's frame), at rest."""
+        """Put joint ``joint`` at ``angle_deg`` (the motor's own angle), at rest."""
         with self._lock:
             index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
             if index < 0:
@@ -126,7 +124,7 @@ class Simulation:
             mujoco.mj_forward(self.model, self.data)
 
     def joint_deg(self, joint: str) -> float:
-        """Angle of joint ``joint`` in degrees (poppy's frame)."""
+        """Angle of joint ``joint`` in degrees (the motor's own angle, as its table holds it)."""
         with self._lock:
             index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
             if index < 0:
@@ -222,7 +220,7 @@ class Simulation:
             for binding in self._bindings:
                 target_rad = float(self.data.qpos[self._drive.qpos[binding.index]])
                 self._drive.set_target(binding.index, target_rad)
-                poses.append((binding, binding.link.motor_deg(math.degrees(target_rad))))
+                poses.append((binding, math.degrees(target_rad)))
         for binding, position in poses:
             with binding.motor.lock:
                 binding.motor.table.set_si("goal_position", position)

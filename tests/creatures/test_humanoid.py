@@ -48,7 +48,7 @@ def test_sit_then_stand_reach_their_targets(humanoid: Robot) -> None:
     humanoid.sit_position.start()
     assert humanoid.sit_position.wait_to_stop(5.0)
     sit = humanoid_sit()
-    assert sit["l_knee_y"] == 125.0 and sit["r_knee_y"] == -125.0  # mirrored legs
+    assert sit["l_knee_y"] == sit["r_knee_y"] == 134.0  # pypot's: the same angle on both legs
     assert wait_until(lambda: reached(humanoid, sit), 2.0), positions(humanoid, sit)
     humanoid.stand_position.duration = 0.5
     humanoid.stand_position.start()
@@ -91,7 +91,8 @@ def test_arms_copy_motion_mirrors_the_left_arm_on_the_right(humanoid: Robot) -> 
         for name, user_deg in moved.items():
             virtual(humanoid, name).move_by_hand(humanoid.motor(name).to_motor(user_deg))
         assert wait_until(lambda: reached(humanoid, moved, 1.0), 2.0), positions(humanoid, moved)
-        mirrored = {"r" + n[1:]: -v for n, v in moved.items()}
+        # pypot's PuppetMaster: pitches (shoulder_y, elbow_y) copied, roll and yaw negated
+        mirrored = {"r_shoulder_x": -30.0, "r_elbow_y": -60.0, "r_shoulder_y": -20.0}
         assert wait_until(lambda: reached(humanoid, mirrored), 3.0), positions(humanoid)
     finally:
         copy.stop()

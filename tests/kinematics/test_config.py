@@ -48,7 +48,7 @@ def test_custom_robot_with_an_mjcf_model(tmp_path: Path) -> None:
     pytest.importorskip("mujoco")
     path = _custom(tmp_path, {"model": "model.xml", "chains": {"arm": ARM}}, model="model.xml")
     chains = chains_from_config(load_config(path))
-    # MJCF joints take the user angle: the same pose as the URDF chain for the same angles
+    # MJCF joints take the motor angle, as the URDF's: the same pose for the same angles
     urdf_chain = chains_from_config(load_profile("ergo-jr"))["chain"]
     angles = [30.0, -20.0, 10.0, 40.0, -50.0, 60.0]
     assert np.allclose(chains["arm"].forward(angles), urdf_chain.forward(angles), atol=1e-6)
@@ -104,6 +104,10 @@ def test_pypot_json_of_a_creature_gets_the_profile_chains(tmp_path: Path) -> Non
             "joint_frame is motor or user",
         ),
         ({"model": "poppy_ergo_jr.urdf", "chains": {"m1": ARM}}, "already a motor"),
+        (
+            {"model": "poppy_ergo_jr.urdf", "reversed": ["m7"], "chains": {"arm": ARM}},
+            "reversed names 'm7', which is no motor",
+        ),
     ],
 )
 def test_bad_sections_say_what_is_wrong(

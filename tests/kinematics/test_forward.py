@@ -4,12 +4,20 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from poppy_core.kinematics import Chain, ChainJoint, load_description
+from poppy_core.kinematics import (
+    Chain,
+    MotorFrame,
+    build_chains,
+    load_description,
+    parse_kinematics,
+)
+from poppy_core.motion.chains import group_expander
 from poppy_core.robot import load_profile
 
 DATA = Path(__file__).parent / "data"
@@ -77,21 +85,31 @@ def test_same_tip_as_pypot(
         assert np.allclose(pose[:3, :3], np.array(expected)[:3, :3], atol=1e-6)
 
 
-def test_mjcf_chain_matches_urdf_chain() -> None:
-    """The Ergo Jr's MuJoCo model (user angles) gives the URDF's tip (motor angles)."""
+@pytest.mark.parametrize("kind", ["ergo-jr", "torso", "humanoid"])
+def test_mjcf_chains_match_urdf_chains(kind: str) -> None:
+    """A creature's MuJoCo model and its URDF give the same tips for the same angles.
+
+    Both take the motor's own angle; the URDF's reversed motors are turned in the model itself,
+    and the model's bodies are drawn at the home pose (joint ``ref``).
+    """
     pytest.importorskip("mujoco")
-    config = load_profile("ergo-jr")
-    urdf = load_description(PROFILES / "ergo-jr" / "poppy_ergo_jr.urdf")
-    mjcf = load_description(PROFILES / "ergo-jr" / "model.xml")
-    assert (urdf.joint_frame, mjcf.joint_frame) == ("motor", "user")
-    signs = {n: 1.0 if m.orientation == "direct" else -1.0 for n, m in config.motors.items()}
-    names = [f"m{i}" for i in range(1, 7)]
-    from_urdf = Chain("chain", urdf, [ChainJoint(n, scale=signs[n]) for n in names], (0, 0, -0.07))
-    from_mjcf = Chain("chain", mjcf, [ChainJoint(n) for n in names], (0, 0, -0.07))
+    config = load_profile(kind)
+    spec = parse_kinematics((config.model_extra or {})["kinematics"])
+    urdf = load_description(PROFILES / kind / spec.model)
+    mjcf = load_description(PROFILES / kind / "model.xml")
+    assert (urdf.joint_frame, mjcf.joint_frame) == ("motor", "motor")
+    frames = {
+        n: MotorFrame(1.0 if m.orientation == "direct" else -1.0, m.offset, m.user_angle_limit)
+        for n, m in config.motors.items()
+    }
+    from_urdf = build_chains(spec, urdf, frames, group_expander(config))
+    plain = replace(spec, reversed=(), chains=tuple(replace(c, reversed=()) for c in spec.chains))
+    from_mjcf = build_chains(plain, mjcf, frames, group_expander(config))
     rng = np.random.default_rng(5)
-    for _ in range(20):
-        angles = rng.uniform(-90, 90, 6)
-        assert np.allclose(from_urdf.forward(angles), from_mjcf.forward(angles), atol=1e-6)
+    for name, chain in from_urdf.items():
+        for _ in range(20):
+            angles = {n: rng.uniform(*config.motors[n].user_angle_limit) for n in chain.names}
+            assert np.allclose(chain.forward(angles), from_mjcf[name].forward(angles), atol=1e-5)
 
 
 def test_frames_end_at_the_tip(ergo_chain: Chain) -> None:

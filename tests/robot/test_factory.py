@@ -73,11 +73,14 @@ def test_public_configs_build_virtual_robots(name: str) -> None:
         assert robot.sync_stats()  # loops ran without raising
 
 
-def test_angle_limits_written_in_the_motor_frame() -> None:
+def test_angle_limits_are_written_as_the_config_gives_them() -> None:
+    """A config's angle_limit is in the motor frame (pypot's): the EEPROM gets it as it is,
+    the motor shows it in the user frame (m2 is indirect)."""
     with from_profile("ergo-jr", sim=True) as robot:
         table = robot.emulators["my_dxl_controller"].bus.motor(2).table
-        assert table.get_si("min_position_limit") == pytest.approx(-125, abs=0.3)
-        assert table.get_si("max_position_limit") == pytest.approx(90, abs=0.3)
+        assert table.get_si("min_position_limit") == pytest.approx(-90, abs=0.3)
+        assert table.get_si("max_position_limit") == pytest.approx(125, abs=0.3)
+        assert robot.m2.angle_limit == (-125.0, 90.0)
 
 
 def test_missing_motors_are_listed(served: list[EmulatorServer]) -> None:

@@ -9,6 +9,8 @@ from hypothesis import strategies as st
 from poppy_core.errors import RegisterError
 from poppy_core.models import model_by_name
 from poppy_core.robot import Motor
+from poppy_core.robot.config import MotorConfig
+from poppy_core.robot.frames import motor_limits, user_limits
 
 AX = model_by_name("AX-12A")
 MX = model_by_name("MX-28")
@@ -32,6 +34,33 @@ def stiff(motor: Motor, present_user: float = 0.0) -> Motor:
 def test_frames_are_inverse(orientation: str, offset: float, user: float) -> None:
     motor = Motor("m", MX, 1, orientation=orientation, offset=offset)  # type: ignore[arg-type]
     assert motor.to_user(motor.to_motor(user)) == pytest.approx(user)
+
+
+@given(
+    st.sampled_from(["direct", "indirect"]),
+    st.floats(-90, 90, allow_nan=False),
+    st.floats(-180, 0, allow_nan=False),
+    st.floats(1, 180, allow_nan=False),
+)
+def test_limit_frames_are_inverse_and_ordered(
+    orientation: str, offset: float, low: float, span: float
+) -> None:
+    user = user_limits((low, low + span), orientation, offset)  # type: ignore[arg-type]
+    assert user[0] < user[1]
+    assert motor_limits(user, orientation, offset) == pytest.approx((low, low + span))  # type: ignore[arg-type]
+
+
+def test_config_limits_are_motor_frame_and_the_motor_shows_them_in_the_user_frame() -> None:
+    """pypot's reading of poppy_torso.json: l_elbow_y (direct, offset -90) [-140, 0]."""
+    entry = MotorConfig(id=44, type="MX-28", orientation="direct", offset=-90.0,
+                        angle_limit=(-140.0, 0.0))  # fmt: skip
+    assert entry.user_angle_limit == (-50.0, 90.0)
+    motor = Motor.from_config("l_elbow_y", entry, MX)
+    assert motor.angle_limit == (-50.0, 90.0)
+    assert motor.motor_limits() == (-140.0, 0.0) == motor.config_limits()
+    right = MotorConfig(id=54, type="MX-28", orientation="indirect", offset=-90.0,
+                        angle_limit=(0.0, 147.0))  # fmt: skip
+    assert Motor.from_config("r_elbow_y", right, MX).angle_limit == (-57.0, 90.0)
 
 
 def test_indirect_flips_and_offset_adds() -> None:

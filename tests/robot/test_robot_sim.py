@@ -52,8 +52,8 @@ def test_stiff_motor_reaches_its_goal(ergo: Robot) -> None:
     ergo.m2.goal_position = 40  # indirect: the virtual horn goes to -40
     assert eventually(lambda: abs(ergo.m2.present_position - 40) < 1)
     assert virtual(ergo, 2).present_position_deg == pytest.approx(-40, abs=1)
-    ergo.m2.goal_position = 500  # clamped to the limit (125)
-    assert eventually(lambda: abs(ergo.m2.present_position - 125) < 1)
+    ergo.m2.goal_position = 500  # clamped to the limit: [-90, 125] in the motor frame, 90 here
+    assert eventually(lambda: abs(ergo.m2.present_position - 90) < 1)
     ergo.compliant = True
     assert eventually(lambda: not virtual(ergo, 2).torque_enabled)
     assert ergo.compliant
@@ -93,7 +93,7 @@ def test_minjerk_goto_timing_and_accuracy(ergo: Robot) -> None:
     assert 0.9 <= elapsed < 1.6
     assert eventually(lambda: abs(ergo.m1.present_position - 60) < 1, 1.0)
     assert abs(ergo.m2.present_position + 30) < 1
-    assert abs(ergo.m6.present_position - 90) < 1  # clamped target
+    assert abs(ergo.m6.present_position - 110) < 1  # clamped: [-110, 90] motor frame, indirect
 
 
 def test_dummy_goto_and_cancel(ergo: Robot) -> None:
@@ -145,6 +145,10 @@ def test_to_config_reflects_the_motors(ergo: Robot) -> None:
     assert ergo.to_config()["motors"]["m1"]["angle_limit"] == [-100, 100]
     assert eventually(lambda: virtual(ergo, 1).table.get_si("max_position_limit") == pytest.approx(
         100, abs=0.3), 2.0)
+    ergo.m2.angle_limit = (-120, 80)  # user frame; m2 is indirect
+    assert ergo.to_config().motors["m2"].angle_limit == (-80, 120)  # configs: motor frame
+    assert eventually(lambda: virtual(ergo, 2).table.get_si("max_position_limit") == pytest.approx(
+        120, abs=0.3), 2.0)
 
 
 def test_close_stops_every_thread() -> None:

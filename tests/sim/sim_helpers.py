@@ -7,6 +7,8 @@ from pathlib import Path
 
 from poppy_core.emulator import VirtualBus, VirtualMotor
 from poppy_core.models import model_by_name
+from poppy_core.robot.config import MotorConfig
+from poppy_core.robot.frames import to_motor, to_user
 from poppy_core.robot.profiles import load_profile
 from poppy_core.sim.plant import JointLink, MujocoPlant
 from poppy_core.sim.world import Simulation
@@ -18,22 +20,23 @@ ROBOTS = ("ergo-jr", "torso", "humanoid")
 
 @dataclass
 class World:
-    """A simulation, its motors by name and the joint links (motor name -> JointLink)."""
+    """A simulation, its motors by name and their config entries (orientation, offset)."""
 
     sim: Simulation
     motors: dict[str, VirtualMotor]
-    links: dict[str, JointLink]
+    entries: dict[str, MotorConfig]
 
     def command(self, name: str, user_deg: float, torque: bool = True) -> None:
         """Write a goal in poppy's frame (converted to the motor's) and the torque flag."""
-        motor, link = self.motors[name], self.links[name]
+        motor, entry = self.motors[name], self.entries[name]
         with motor.lock:
-            motor.table.set_si("goal_position", link.motor_deg(user_deg))
+            motor.table.set_si("goal_position", to_motor(user_deg, entry.orientation, entry.offset))
             motor.table.set("torque_enable", int(torque))
 
     def present_user_deg(self, name: str) -> float:
         """The motor's present position, converted to poppy's frame."""
-        return self.links[name].joint_deg(self.motors[name].present_position_deg)
+        entry = self.entries[name]
+        return to_user(self.motors[name].present_position_deg, entry.orientation, entry.offset)
 
     def run(self, seconds: float) -> None:
         """Advance the physics ``seconds`` in 10 ms steps (no thread, deterministic)."""
@@ -46,15 +49,13 @@ def make_world(robot: str) -> World:
     config = load_profile(robot)
     sim = Simulation((PROFILES / robot / "model.xml").read_text(encoding="utf-8"))
     motors: dict[str, VirtualMotor] = {}
-    links: dict[str, JointLink] = {}
     for controller, entry in config.controllers.items():
         ids: dict[int, JointLink] = {}
         bus_motors = []
         for name in config.motors_of_controller(controller):
             motor_entry = config.motors[name]
-            sign = 1.0 if motor_entry.orientation == "direct" else -1.0
-            links[name] = ids[motor_entry.id] = JointLink(name, sign, float(motor_entry.offset))
+            ids[motor_entry.id] = JointLink(name)
             motors[name] = VirtualMotor(model_by_name(motor_entry.type), motor_entry.id)
             bus_motors.append(motors[name])
         VirtualBus(bus_motors, entry.protocol, plant=MujocoPlant(sim, ids), auto_step=False)
-    return World(sim, motors, links)
+    return World(sim, motors, dict(config.motors))

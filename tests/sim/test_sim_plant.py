@@ -7,13 +7,13 @@ import pytest
 from sim_helpers import World
 
 from poppy_core.errors import ConfigError
-from poppy_core.sim.plant import JointLink
+from poppy_core.robot.frames import to_motor, to_user
 
 
-def test_joint_link_converts_both_ways() -> None:
-    link = JointLink("l_shoulder_x", -1.0, -90.0)
-    assert link.joint_deg(link.motor_deg(30.0)) == pytest.approx(30.0)
-    assert link.motor_deg(0.0) == pytest.approx(90.0)  # indirect, offset -90
+def _user_joint(world: World, name: str) -> float:
+    """The joint's angle seen in poppy's (user) frame."""
+    entry = world.entries[name]
+    return to_user(world.sim.joint_deg(name), entry.orientation, entry.offset)
 
 
 def test_motor_tables_start_at_the_model_pose(torso: World) -> None:
@@ -27,33 +27,40 @@ def test_motor_tables_start_at_the_model_pose(torso: World) -> None:
     [("l_shoulder_y", 30.0), ("r_shoulder_x", -30.0), ("r_elbow_y", 30.0), ("l_elbow_y", -30.0),
      ("head_y", 5.0), ("bust_x", -5.0), ("bust_y", 15.0), ("abs_z", 30.0)],
 )  # fmt: skip
-def test_thirty_degrees_in_poppy_is_thirty_at_the_joint(
-    torso: World, name: str, target: float
-) -> None:
-    """Motors of each kind (direct/indirect, with and without offset) reach the poppy angle."""
+def test_the_joint_takes_the_motor_angle(torso: World, name: str, target: float) -> None:
+    """Motors of each kind (direct/indirect, with and without offset): the joint turns to the
+    motor's own angle, which the motor reads back."""
     for other in torso.motors:
         torso.command(other, 0.0)
     torso.command(name, target)
     torso.run(1.5)
-    assert torso.sim.joint_deg(name) == pytest.approx(target, abs=3.0)
-    assert torso.present_user_deg(name) == pytest.approx(torso.sim.joint_deg(name), abs=0.5)
+    entry = torso.entries[name]
+    motor_deg = to_motor(target, entry.orientation, entry.offset)
+    assert torso.sim.joint_deg(name) == pytest.approx(motor_deg, abs=3.0)
+    assert torso.motors[name].present_position_deg == pytest.approx(
+        torso.sim.joint_deg(name), abs=0.5
+    )
+    assert torso.present_user_deg(name) == pytest.approx(target, abs=3.0)
+
+
+FORWARD = -90.0  # l_shoulder_y: the arm raised forward, horizontal
 
 
 def _arm_forward(world: World, torque: bool) -> None:
     for name in world.motors:
         world.command(name, 0.0)
-    world.motors["l_shoulder_y"].move_by_hand(world.links["l_shoulder_y"].motor_deg(90.0))
-    world.command("l_shoulder_y", 90.0, torque=torque)
+    entry = world.entries["l_shoulder_y"]
+    world.motors["l_shoulder_y"].move_by_hand(to_motor(FORWARD, entry.orientation, entry.offset))
+    world.command("l_shoulder_y", FORWARD, torque=torque)
 
 
 def test_compliant_arm_falls_and_stiff_arm_holds(torso: World) -> None:
     _arm_forward(torso, torque=True)
     torso.run(1.0)
-    held = torso.sim.joint_deg("l_shoulder_y")
-    assert held == pytest.approx(90.0, abs=6.0)
-    torso.command("l_shoulder_y", 90.0, torque=False)
+    assert _user_joint(torso, "l_shoulder_y") == pytest.approx(FORWARD, abs=6.0)
+    torso.command("l_shoulder_y", FORWARD, torque=False)
     torso.run(1.0)
-    assert torso.sim.joint_deg("l_shoulder_y") < 45.0
+    assert _user_joint(torso, "l_shoulder_y") > -45.0  # fell toward hanging (0°)
 
 
 def test_present_load_rises_against_gravity(torso: World) -> None:
@@ -76,7 +83,7 @@ def test_torque_limit_lowers_the_force(torso: World) -> None:
     torso.run(1.0)
     limited = abs(torso.motors["l_shoulder_y"].table.get_si("present_load") or 0.0)
     assert limited <= 5.5 < full
-    assert torso.sim.joint_deg("l_shoulder_y") < 60.0  # 5 % cannot hold the arm up
+    assert _user_joint(torso, "l_shoulder_y") > -60.0  # 5 % cannot hold the arm up
 
 
 def test_moving_speed_limits_the_motion(ergo: World) -> None:
@@ -93,9 +100,9 @@ def test_moving_speed_limits_the_motion(ergo: World) -> None:
 
 
 def test_move_by_hand_sets_the_joint(ergo: World) -> None:
-    link = ergo.links["m3"]
-    ergo.motors["m3"].move_by_hand(link.motor_deg(40.0))
-    assert ergo.sim.joint_deg("m3") == pytest.approx(40.0, abs=0.1)
+    ergo.motors["m3"].move_by_hand(-40.0)  # the motor's own angle; m3 is indirect
+    assert ergo.sim.joint_deg("m3") == pytest.approx(-40.0, abs=0.1)
+    assert ergo.present_user_deg("m3") == pytest.approx(40.0, abs=0.3)  # one XL-320 step
 
 
 def test_reset_returns_to_the_initial_pose(torso: World) -> None:
@@ -104,7 +111,7 @@ def test_reset_returns_to_the_initial_pose(torso: World) -> None:
     torso.run(0.5)
     start = {n: torso.sim.get_object_position(n) for n in ("head", "l_forearm")}
     torso.command("abs_z", 40.0)
-    torso.command("l_elbow_y", -80.0)
+    torso.command("l_elbow_y", -40.0)
     torso.run(1.5)
     assert torso.sim.get_object_position("l_forearm") != pytest.approx(start["l_forearm"], abs=0.02)
     torso.sim.reset()

@@ -19,8 +19,10 @@ def test_ergo_jr_goto_ends_near_the_goal_in_the_physics() -> None:
         robot.goto_position(goal, 1.0, wait=True)
         time.sleep(0.5)
         for name, value in goal.items():
-            assert simulation.joint_deg(name) == pytest.approx(value, abs=2.0), name
-            assert robot.motor(name).present_position == pytest.approx(value, abs=2.0), name
+            motor = robot.motor(name)
+            # the joint takes the motor's own angle: m2, m3, m5 and m6 are indirect
+            assert simulation.joint_deg(name) == pytest.approx(motor.to_motor(value), abs=2.0)
+            assert motor.present_position == pytest.approx(value, abs=2.0), name
     assert not simulation.running  # close() stopped the physics thread
 
 
@@ -29,8 +31,7 @@ def test_compliant_robot_can_be_moved_by_hand() -> None:
         robot.compliant = True
         time.sleep(0.2)
         bus = next(iter(robot.emulators.values())).bus
-        link_m1 = bus.plant.links[1]
-        bus.motor(1).move_by_hand(link_m1.motor_deg(50.0))
+        bus.motor(1).move_by_hand(50.0)  # m1: direct, no offset
         time.sleep(0.3)
         assert robot.m1.present_position == pytest.approx(50.0, abs=2.0)
 
