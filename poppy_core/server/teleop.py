@@ -79,6 +79,15 @@ class TeleopRegistry:
             for motor in [m for m, c in self._owners.items() if c is channel]:
                 del self._owners[motor]
 
+    def states(self) -> dict[str, str]:
+        """Motor -> the state of the session teleoperating it (``following``, ``held``...)."""
+        with self._lock:
+            owners = dict(self._owners)
+        return {
+            motor: channel.session.state if channel.session is not None else "idle"
+            for motor, channel in owners.items()
+        }
+
     def close(self) -> None:
         """Stop every session (server shutdown)."""
         with self._lock:
