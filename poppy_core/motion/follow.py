@@ -40,7 +40,7 @@ RAMP_SKIP_DEG = 0.5
 def minimum_jerk_weight(fraction: float) -> float:
     """The minimum-jerk blend 10τ³ − 15τ⁴ + 6τ⁵ of ``fraction`` τ (clamped to 0..1)."""
     tau = min(max(fraction, 0.0), 1.0)
-    return tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau))
+    return min(1.0, tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau)))
 
 
 @dataclass(frozen=True)
@@ -59,7 +59,7 @@ class FollowSession:
         robot: the follower robot.
         motors: the names of the motors driven.
         ramp_s: duration of each ramp; None picks the largest distance over ``ramp_speed_dps``
-            (at least ``MIN_RAMP_S``; none when already there).
+            (at least ``MIN_RAMP_S``). No ramp when every motor is already there.
         ramp_speed_dps: mean speed of an automatic ramp.
         watchdog_s: ``expired`` is True once no target arrived for this long (None: never).
         write_now: send the goals to the bus at each target instead of at the next sync write.
@@ -198,12 +198,10 @@ class FollowSession:
         start = {m.name: m.present_position for m in self.motors}
         distance = max((abs(float(v) - start[n]) for n, v in targets.items()), default=0.0)
         duration = self.ramp_s
-        if duration is None:
-            duration = (
-                0.0
-                if distance < RAMP_SKIP_DEG
-                else max(MIN_RAMP_S, distance / self.ramp_speed_dps)
-            )
+        if distance < RAMP_SKIP_DEG:
+            duration = 0.0
+        elif duration is None:
+            duration = max(MIN_RAMP_S, distance / self.ramp_speed_dps)
         self._ramp_start = start
         self._ramp_t0 = now
         self._ramp_duration = duration

@@ -194,6 +194,9 @@ class RemoteFollower:
                 self.ws_url, additional_headers=headers, open_timeout=self.timeout_s,
                 ping_interval=PING_INTERVAL_S, ping_timeout=PING_TIMEOUT_S, close_timeout=1.0,
             )  # fmt: skip
+            # Entered as its context manager would be (websockets 17 warns otherwise); the
+            # threads below share it and close() ends it.
+            ws.__enter__()
         except InvalidStatus as exc:
             status = exc.response.status_code
             if status == 401:
