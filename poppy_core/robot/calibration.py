@@ -29,7 +29,7 @@ from typing import Any
 
 from poppy_core.errors import ConfigError
 from poppy_core.models import model_by_name
-from poppy_core.robot.config import MotorConfig, RobotConfig
+from poppy_core.robot.config import RobotConfig
 
 SECTION = "calibration"
 DEFAULT_POSTURE = (
@@ -101,8 +101,8 @@ class JointCalibration:
         if not low < high:
             return None
         sign, offset = _sign(orientation), self.offset(orientation)
-        ends = sorted(sign * value - offset for value in (low, high))
-        return _degrees(ends[0]), _degrees(ends[1])
+        ends = sorted(_degrees(sign * value - offset) for value in (low, high))
+        return (ends[0], ends[1]) if ends[0] < ends[1] else None
 
 
 @dataclass(frozen=True)
@@ -118,7 +118,7 @@ class Calibration:
         out: dict[str, dict[str, Any]] = {}
         for name, joint in self.joints.items():
             entry = config.motors[name]
-            limit = joint.angle_limit(entry.orientation, servo_range(entry))
+            limit = joint.angle_limit(entry.orientation, servo_range(entry.type))
             out[name] = {
                 "offset": (entry.offset, _degrees(joint.offset(entry.orientation))),
                 "angle_limit": (tuple(entry.angle_limit), limit or tuple(entry.angle_limit)),
@@ -146,7 +146,7 @@ class Calibration:
                 raise ConfigError(f"the config has no motor {motor!r}", field=f"motors.{motor}")
             out = data["motors"][motor]
             out["offset"] = _degrees(joint.offset(entry.orientation))
-            limit = joint.angle_limit(entry.orientation, servo_range(entry))
+            limit = joint.angle_limit(entry.orientation, servo_range(entry.type))
             if limit is not None:
                 out["angle_limit"] = list(limit)
             record: dict[str, Any] = {"zero": round(joint.zero, 3)}
@@ -180,9 +180,9 @@ def _degrees(value: float) -> float:
     return round(value, 2) + 0.0
 
 
-def servo_range(entry: MotorConfig) -> tuple[float, float]:
-    """The motor-frame range a servo's position limit registers can hold (AX: -150..149.7°)."""
-    register = model_by_name(entry.type).register("min_position_limit")
+def servo_range(model: str) -> tuple[float, float]:
+    """The motor-frame range a servo model's position limit registers hold (AX: -150..149.7°)."""
+    register = model_by_name(model).register("min_position_limit")
     ends = sorted(float(register.to_si(raw)) for raw in (register.min_raw, register.max_raw))
     return ends[0], ends[1]
 
@@ -252,6 +252,10 @@ def check_motors(config: RobotConfig, motors: Iterable[str] | None) -> list[str]
                 and config.controller_of(n) is not None]  # fmt: skip
     chosen: list[str] = []
     for item in motors:
+        if item not in config.motors and item not in config.motorgroups:
+            groups = ", ".join(config.motorgroups) or "none"
+            raise ConfigError(f"no motor or group {item!r} (motors: {', '.join(config.motors)}; "
+                              f"groups: {groups})", field="motors", value=item)  # fmt: skip
         names = config.resolve_group(item)  # a motor name gives that motor alone
         for motor in names:
             if config.motors[motor].wheel_mode:
