@@ -143,18 +143,22 @@ def teleop(
             error_line(f"the leader and the follower cannot share {', '.join(sorted(shared))}: "
                        "give each its own port (or --follower self for one robot)")  # fmt: skip
             raise typer.Exit(EXIT_USAGE)
-    stop = threading.Event()
-    _install_stop(stop)
     with ExitStack() as stack:
-        lead = stack.enter_context(_build(leader_config, None))
-        follow: Any
+        # Everything that can be refused is, before a robot is built (nothing turns compliant).
+        follow: Any = None
         if remote:
             follow = _remote(follower, rate)
             stack.callback(follow.close)
-        elif follower_config is None:
-            follow = lead
+            follower_motors = follow.motor_names
         else:
-            follow = stack.enter_context(_build(follower_config, follower_sim))
+            follower_motors = list((follower_config or leader_config).motors)
+        _check_map(mapping, list(leader_config.motors), follower_motors, follower == SELF)
+        stop = threading.Event()
+        _install_stop(stop)
+        lead = stack.enter_context(_build(leader_config, None))
+        if follow is None:
+            follow = (lead if follower_config is None
+                      else stack.enter_context(_build(follower_config, follower_sim)))  # fmt: skip
         teleop_run = _start(lead, follow, mapping, rate, ramp, duration, path, leader_config,
                             follower)  # fmt: skip
         _watch(teleop_run, stop, show=not json_output)
@@ -171,6 +175,24 @@ def teleop(
         f"(asked {rate:g}); holds: {report.holds}"
         + (f"; recorded {report.recorded_frames} frames to {report.record_path}" if path else "")
     )
+
+
+def _check_map(
+    mapping: JointMap | None, leader: list[str], follower: list[str], same_robot: bool
+) -> None:
+    from poppy_core.motion.teleop_map import JointMap
+
+    if same_robot and mapping is None:
+        raise typer.BadParameter("--follower self needs a --map of other joints, e.g. "
+                                 "r_elbow_y=l_elbow_y", param_hint="--map")  # fmt: skip
+    chosen = mapping or JointMap.same_names(leader, follower)
+    chosen.check(leader, follower)
+    both = sorted(set(chosen.leaders) & set(chosen.followers)) if same_robot else []
+    if both:
+        from poppy_core.errors import ConfigError
+
+        raise ConfigError(f"{', '.join(both)} cannot lead and follow at once: map other joints",
+                          field="map", value=both)  # fmt: skip
 
 
 def _build(config: RobotConfig, sim: str | None) -> Robot:
