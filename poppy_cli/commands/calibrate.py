@@ -89,7 +89,11 @@ class RichAnswers:
         """A yes/no question (Enter: yes)."""
         from rich.prompt import Confirm
 
-        return Confirm.ask(question, default=True, console=err_console)
+        try:
+            return Confirm.ask(question, default=True, console=err_console)
+        except EOFError:  # no more input: the safe answer
+            err_console.print()
+            return False
 
 
 def _read_line() -> str:

@@ -131,10 +131,11 @@ def teleop(
     if path is not None and path.exists() and not force:
         error_line(f"{path} exists: pick another name or pass --force")
         raise typer.Exit(EXIT_USAGE)
-    leader_config = (
-        _config(leader, leader_port, "leader") if leader is not None
-        else robot_config(None, None, leader_port)
-    )  # fmt: skip
+    leader_file = Path(leader).expanduser() if leader is not None else None
+    if leader_file is not None and leader_file.is_file():  # the port: option, env, settings
+        leader_config = robot_config(None, leader_file, leader_port)
+    else:
+        leader_config = robot_config(leader, None, leader_port)
     follower_config = None if remote or follower == SELF else _config(follower, follower_port,
                                                                         "follower")  # fmt: skip
     if follower_config is not None and follower_sim is None:
