@@ -91,7 +91,7 @@ def test_a_stalled_link_holds_the_follower_then_it_resumes_with_a_ramp(
             time.sleep(0.01)
         assert served.states().get("m1") == "following"
         assert wait_for(lambda: abs(served.robot.m1.goal_position - 15.0) < 2.0)
-        assert teleop.status().state == "following"
+        assert wait_for(lambda: teleop.status().state == "following", timeout_s=5.0)
     steps = [abs(b - a) for a, b in itertools.pairwise(goals)]
     assert max(steps, default=0.0) < 12.0  # ramped back, no jump
 
@@ -101,9 +101,9 @@ def test_a_cut_link_holds_at_once_and_the_client_reconnects(leader: Robot, serve
     with Waving(leader, ["m1"]), teleoperate(leader, follower, "m1=m1", rate_hz=50) as teleop:
         assert wait_for(lambda: served.states().get("m1") == "following", timeout_s=5.0)
         served.proxy.cut()  # the server sees the connection close
-        assert wait_for(lambda: follower.reconnects == 1, timeout_s=5.0)
-        assert wait_for(lambda: served.states().get("m1") == "following", timeout_s=5.0)
-        assert teleop.status().state == "following"
+        assert wait_for(lambda: follower.reconnects >= 1, timeout_s=10.0)
+        assert wait_for(lambda: served.states().get("m1") == "following", timeout_s=10.0)
+        assert wait_for(lambda: teleop.status().state == "following", timeout_s=5.0)
 
 
 @pytest.fixture
