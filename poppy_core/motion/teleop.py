@@ -20,21 +20,21 @@ import math
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import TracebackType
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any
 
 from poppy_core.errors import ConfigError, PoppyError
-from poppy_core.motion.follow import FollowChange, FollowSession
+from poppy_core.motion.follow import FollowChange
+from poppy_core.motion.teleop_follower import Follower, LocalFollower
 from poppy_core.motion.teleop_map import JointMap
 from poppy_core.motion.teleop_record import TrajectoryRecorder
-from poppy_core.robot import Robot
+from poppy_core.motion.teleop_stats import TeleopReport, TeleopStatus
 from poppy_core.robot.schedule import Periodic
 
 if TYPE_CHECKING:
-    from poppy_core.robot import Motor
+    from poppy_core.robot import Motor, Robot
 
 logger = logging.getLogger(__name__)
 
@@ -49,180 +49,18 @@ KEPT_SAMPLES = 60_000
 ChangeCallback = Callable[[str, str], None]
 """Called with ``(state, reason)`` when the teleoperation's state changes."""
 
-
-class Follower(Protocol):
-    """What ``teleoperate`` needs of a follower (a ``LocalFollower`` wraps a ``Robot``)."""
-
-    @property
-    def motor_names(self) -> list[str]:
-        """Every motor the follower has."""
-        ...
-
-    @property
-    def state(self) -> str:
-        """``held``, ``ramping``, ``following``, ``stopped`` (a remote one adds ``link lost``)."""
-        ...
-
-    def start(self, motors: Sequence[str]) -> None:
-        """Stiffen ``motors`` where they are; the first targets start a ramp."""
-        ...
-
-    def send(self, targets: Mapping[str, float]) -> None:
-        """New targets (degrees, user frame), written at once."""
-        ...
-
-    def hold(self, reason: str) -> None:
-        """Hold where the motors are; the next targets start a new ramp."""
-        ...
-
-    def positions(self) -> dict[str, float]:
-        """The present positions of the motors started (degrees, user frame)."""
-        ...
-
-    def stop(self) -> None:
-        """Hold where the motors are and end the stream (they stay stiff)."""
-        ...
-
-
-class LocalFollower:
-    """A local robot as a follower (a ``FollowSession`` on its motors).
-
-    Args:
-        robot: the follower robot.
-        ramp_s: duration of the start and resume ramps (None: from the distance).
-        on_change: called with each ``FollowChange``.
-        clock: monotonic time in seconds.
-    """
-
-    def __init__(
-        self,
-        robot: Robot,
-        *,
-        ramp_s: float | None = None,
-        on_change: Callable[[FollowChange], None] | None = None,
-        clock: Callable[[], float] = time.monotonic,
-    ) -> None:
-        self.robot = robot
-        self.ramp_s = ramp_s
-        self.on_change = on_change
-        self._clock = clock
-        self.session: FollowSession | None = None
-
-    @property
-    def motor_names(self) -> list[str]:
-        """Every motor of the robot."""
-        return [m.name for m in self.robot.motors]
-
-    @property
-    def state(self) -> str:
-        """The session's state (``idle`` before ``start``)."""
-        return self.session.state if self.session is not None else "idle"
-
-    def start(self, motors: Sequence[str]) -> None:
-        """Stiffen ``motors`` where they are."""
-        self.session = FollowSession(
-            self.robot, motors, ramp_s=self.ramp_s, on_change=self.on_change, clock=self._clock
-        )
-        self.session.start()
-
-    def send(self, targets: Mapping[str, float]) -> None:
-        """Targets, ramped when a ramp runs, written at once."""
-        self._session().push(targets)
-
-    def hold(self, reason: str) -> None:
-        """Hold where the motors are."""
-        self._session().hold(reason)
-
-    def positions(self) -> dict[str, float]:
-        """Present positions of the motors started."""
-        return self._session().positions()
-
-    def stop(self) -> None:
-        """Hold and end the stream."""
-        if self.session is not None:
-            self.session.stop()
-
-    def _session(self) -> FollowSession:
-        if self.session is None:
-            raise RuntimeError("the follower was not started")
-        return self.session
+__all__ = [
+    "Follower",
+    "LocalFollower",
+    "TeleopReport",
+    "TeleopStatus",
+    "Teleoperation",
+    "teleoperate",
+]
 
 
 class _LeaderLost(Exception):
     """The leader could not be read (the message says why)."""
-
-
-@dataclass(frozen=True)
-class TeleopStatus:
-    """A snapshot of a running teleoperation (for displays).
-
-    Attributes:
-        state: the follower's state, or ``leader lost``.
-        elapsed_s: time since the start.
-        ticks: ticks run.
-        measured_hz: ticks per second so far.
-        holds: times the follower was held because the leader was lost.
-        leader: the leader positions read last.
-        targets: the follower targets sent last.
-        follower: the follower positions last known.
-        reason: why the state last changed.
-    """
-
-    state: str
-    elapsed_s: float
-    ticks: int
-    measured_hz: float
-    holds: int
-    leader: dict[str, float]
-    targets: dict[str, float]
-    follower: dict[str, float]
-    reason: str
-
-
-@dataclass
-class TeleopReport:
-    """What a teleoperation did (``Teleoperation.report()``); times in seconds.
-
-    ``read_s``: the leader read of each tick; ``pipeline_s``: leader read done → targets handed
-    to the follower (for a local follower, written to its bus).
-    """
-
-    rate_hz: float
-    duration_s: float
-    ticks: int
-    measured_hz: float
-    missed_periods: int
-    holds: int
-    read_s: list[float] = field(default_factory=list)
-    pipeline_s: list[float] = field(default_factory=list)
-    record_path: str | None = None
-    recorded_frames: int = 0
-
-    def as_dict(self) -> dict[str, Any]:
-        """Plain data with percentiles instead of the samples (for ``--json``)."""
-        return {
-            "rate_hz": self.rate_hz,
-            "duration_s": round(self.duration_s, 3),
-            "ticks": self.ticks,
-            "measured_hz": round(self.measured_hz, 2),
-            "missed_periods": self.missed_periods,
-            "holds": self.holds,
-            "read_ms": _percentiles_ms(self.read_s),
-            "pipeline_ms": _percentiles_ms(self.pipeline_s),
-            "record_path": self.record_path,
-            "recorded_frames": self.recorded_frames,
-        }
-
-
-def _percentiles_ms(values: Sequence[float]) -> dict[str, float | None]:
-    if not values:
-        return {"p50": None, "p99": None, "max": None}
-    ordered = sorted(values)
-
-    def at(q: float) -> float:
-        return round(ordered[min(len(ordered) - 1, int(q * (len(ordered) - 1) + 0.5))] * 1e3, 3)
-
-    return {"p50": at(0.5), "p99": at(0.99), "max": round(ordered[-1] * 1e3, 3)}
 
 
 class Teleoperation:
@@ -263,6 +101,8 @@ class Teleoperation:
             raise ConfigError(
                 f"the rate must be in (0, {MAX_RATE_HZ:g}] Hz, not {rate_hz:g}", field="rate_hz"
             )
+        from poppy_core.robot.robot import Robot  # at run time: motion loads under robot
+
         self._on_change = on_change
         self._clock = clock
         self.follower: Follower = (
