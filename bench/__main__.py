@@ -14,6 +14,7 @@ from bench import (
     scan_bench,
     server_bench,
     sim_bench,
+    teleop_bench,
 )
 from bench.clients import ensure_peers
 from bench.machine import machine_info
@@ -23,7 +24,10 @@ from bench.report import save_result, write_doc
 logger = logging.getLogger("bench")
 
 # Importing a benchmark module registers it; list them here so `--list` sees them all.
-_MODULES = (scan_bench, robot_bench, move_bench, server_bench, sim_bench, ik_bench, camera_bench)
+_MODULES = (
+    scan_bench, robot_bench, move_bench, server_bench, sim_bench, ik_bench, camera_bench,
+    teleop_bench,
+)  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> int:

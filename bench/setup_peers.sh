@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Create bench/.venv-peers with the peer libraries the benchmarks compare poppy against:
-# pypot (+ poppy-ergo-jr for the REST benchmark) and the Robotis dynamixel-sdk.
+# pypot (+ poppy-ergo-jr for the REST benchmark, poppy-torso for the teleoperation benchmark's
+# arms_copy_motion) and the Robotis dynamixel-sdk.
 # Idempotent and quiet: prints one summary line; pip output goes to .venv-peers/install.log
 # and is shown only when a step fails. Usage: bash bench/setup_peers.sh [--force]
 #
 # pypot declares heavy dependencies it never imports for the bus or REST paths
-# (opencv-contrib-python, matplotlib via hampy, requests, wget). So pypot, poppy-ergo-jr and
-# ikpy are installed with --no-deps and only what their imports need is added
+# (opencv-contrib-python, matplotlib via hampy, requests, wget). So pypot, poppy-ergo-jr,
+# poppy-torso and ikpy are installed with --no-deps and only what their imports need is added
 # (see bench/README.md, "Peers venv").
 set -euo pipefail
 
@@ -16,7 +17,7 @@ PYTHON="${PYTHON:-python3.11}"
 LOG="$VENV/install.log"
 
 # Exact peer versions, so results stay comparable between runs.
-PEERS_NODEPS=(pypot==5.0.2 poppy-ergo-jr==4.0.2 ikpy==3.0.1)
+PEERS_NODEPS=(pypot==5.0.2 poppy-ergo-jr==4.0.2 poppy-torso==3.0.0 ikpy==3.0.1)
 CORE_DEPS=(dynamixel-sdk==4.1.0 "pyserial>=3.5" "numpy>=1.26")
 # Imported by pypot.creatures / pypot.server / poppy_ergo_jr (REST benchmark only).
 REST_DEPS=(scipy sympy tornado bottle opencv-python-headless)
@@ -60,6 +61,7 @@ if [[ "$rest" == "yes" ]]; then
 # creature registry empty (circular import inside pypot.creatures).
 import pypot.creatures, pypot.server.httpserver
 assert "poppy-ergo-jr" in pypot.creatures.installed_poppy_creatures
+from poppy_torso.primitives.interaction import PuppetMaster  # teleop benchmark
 PY
 fi
 
@@ -77,5 +79,5 @@ if ! command -v wrk >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1; then
 fi
 
 versions="$("$VENV/bin/python" -c 'from importlib.metadata import version as v
-print(" ".join(f"{p}={v(p)}" for p in ("pypot", "dynamixel-sdk", "poppy-ergo-jr")))')"
+print(" ".join(f"{p}={v(p)}" for p in ("pypot", "dynamixel-sdk", "poppy-ergo-jr", "poppy-torso")))')"
 echo "setup_peers: $VENV ready ($versions, rest=$rest)"

@@ -9,6 +9,7 @@ import typer
 from typer import _click as click  # typer vendors Click: its exceptions live here
 
 from poppy_cli import state
+from poppy_cli.commands import calibrate as calibrate_cmd
 from poppy_cli.commands import camera, config, demo, emulate, motor_setup, ports, scan
 from poppy_cli.commands import moves as moves_cmd
 from poppy_cli.commands import play as play_cmd
@@ -17,6 +18,7 @@ from poppy_cli.commands import reach as reach_cmd
 from poppy_cli.commands import record as record_cmd
 from poppy_cli.commands import serve as serve_cmd
 from poppy_cli.commands import sim as sim_cmd
+from poppy_cli.commands import teleop as teleop_cmd
 from poppy_cli.commands import tui as tui_cmd
 from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
 
@@ -57,6 +59,8 @@ app.add_typer(primitive_cmd.app, name="primitive")
 app.command("record")(record_cmd.record)
 app.command("play")(play_cmd.play)
 app.add_typer(moves_cmd.app, name="moves")
+app.command("calibrate")(calibrate_cmd.calibrate)
+app.command("teleop")(teleop_cmd.teleop)
 app.command("serve")(serve_cmd.serve)
 app.add_typer(sim_cmd.app, name="sim")
 app.add_typer(camera.app, name="camera")

@@ -25,7 +25,8 @@ The tree (catch the bases, raise the leaves)::
     │   └── UnknownMotorError     a motor (or group) name the robot does not have; carries
     │                             ``motor`` and ``known``
     ├── KinematicsError           a target out of a chain's reach; carries ``nearest``
-    └── SensorError               a camera or other sensor cannot be opened or read; ``sensor``
+    ├── SensorError               a camera or other sensor cannot be opened or read; ``sensor``
+    └── CalibrationCancelled      the user cancelled a calibration (nothing was written)
 
 This module imports nothing of ours, so every layer (protocol included) may use it.
 """
@@ -225,3 +226,7 @@ class SensorError(PoppyError):
         super().__init__(message)
         self.sensor = sensor
         self.device = device
+
+
+class CalibrationCancelled(PoppyError):
+    """The user cancelled a calibration or a check; nothing was written."""

@@ -46,6 +46,15 @@ from poppy_core.motion.player import MovePlayer, PlayProgress
 from poppy_core.motion.primitive import LoopPrimitive, Primitive, PrimitiveFailure
 from poppy_core.motion.recorder import MoveRecorder
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
+from poppy_core.motion.teleop import (
+    Follower,
+    LocalFollower,
+    Teleoperation,
+    TeleopReport,
+    TeleopStatus,
+    teleoperate,
+)
+from poppy_core.motion.teleop_map import JointLink, JointMap
 from poppy_core.motion.trajectory import CONTROLS, MinimumJerk, dummy_speed
 
 __all__ = [
@@ -98,4 +107,16 @@ __all__ += [
     "read_move",
     "save_move",
     "write_move",
+]
+
+# Teleoperation: a follower copies a leader moved by hand.
+__all__ += [
+    "Follower",
+    "JointLink",
+    "JointMap",
+    "LocalFollower",
+    "TeleopReport",
+    "TeleopStatus",
+    "Teleoperation",
+    "teleoperate",
 ]

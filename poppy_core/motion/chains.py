@@ -12,7 +12,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from poppy_core.errors import ConfigError
 from poppy_core.kinematics import (
     Chain,
     KinematicDescription,
@@ -25,7 +24,7 @@ from poppy_core.kinematics import (
 )
 from poppy_core.kinematics.spec import SECTION
 from poppy_core.motion.cartesian import RobotChain
-from poppy_core.robot.profiles import find_profile, load_profile
+from poppy_core.robot.profiles import find_profile, load_profile, profile_folders
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot, RobotConfig
@@ -57,10 +56,7 @@ def kinematics_of(
     header = config.profile
     for name in (header.kind, header.name) if header is not None else ():
         if name:
-            try:
-                folders.append(find_profile(name).directory)
-            except ConfigError:
-                continue
+            folders += profile_folders(name)  # a calibrated user profile hides the installed one
     spec = parse_kinematics(section, source)
     return spec, load_description(find_model(spec.model, folders))
 

@@ -2,7 +2,8 @@
 
 ``RemoteRobot("http://127.0.0.1:8080")`` mirrors ``Robot``: motors and groups as attributes,
 registers as attributes of the motors, ``goto_position``, ``compliant``, primitives and moves.
-It speaks the server's ``/api/v1`` with the standard library only (keep-alive connections).
+It speaks the server's ``/api/v1`` with the standard library only (keep-alive connections);
+``RemoteFollower`` drives it as a teleoperation follower over its WebSocket (``websockets``).
 """
 
 from poppy_core.remote.client import HttpClient
@@ -14,10 +15,12 @@ from poppy_core.remote.robot import (
     RemotePrimitive,
     RemoteRobot,
 )
+from poppy_core.remote.teleop import RemoteFollower
 
 __all__ = [
     "HttpClient",
     "ModelInfo",
+    "RemoteFollower",
     "RemoteGoto",
     "RemoteMotor",
     "RemoteMoves",

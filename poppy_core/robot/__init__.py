@@ -1,5 +1,20 @@
 """Robot layer: configs and profiles (pypot JSON compatible); more is added by the robot modules."""
 
+from poppy_core.robot.calibration import (
+    Calibration,
+    JointCalibration,
+    ReferencePosture,
+    reference_posture,
+)
+from poppy_core.robot.calibration_session import (
+    CalibrationAnswers,
+    CalibrationEvent,
+    CalibrationSession,
+    JointDrift,
+    JointReading,
+    RangeWatch,
+    check_calibration,
+)
 from poppy_core.robot.config import (
     DEFAULT_BAUDRATE,
     ControllerConfig,
@@ -11,6 +26,7 @@ from poppy_core.robot.config_io import config_to_text, dump_config, load_config
 from poppy_core.robot.factory import autodetect, from_config, from_profile, start_emulators
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.motor import Motor
+from poppy_core.robot.profile_store import SavedProfile, save_user_profile
 from poppy_core.robot.profiles import (
     PROFILE_FILE,
     ProfileInfo,
@@ -38,20 +54,31 @@ __all__ = [
     "LIGHT_LOOPS",
     "PROFILE_FILE",
     "BusSync",
+    "Calibration",
+    "CalibrationAnswers",
+    "CalibrationEvent",
+    "CalibrationSession",
     "ControllerConfig",
     "GotoHandle",
     "GotoRunner",
+    "JointCalibration",
+    "JointDrift",
+    "JointReading",
     "LoopSpec",
     "LoopStats",
     "Motor",
     "MotorConfig",
     "ProfileHeader",
     "ProfileInfo",
+    "RangeWatch",
+    "ReferencePosture",
     "ReturnDelayIssue",
     "Robot",
     "RobotConfig",
+    "SavedProfile",
     "SyncStats",
     "autodetect",
+    "check_calibration",
     "config_to_text",
     "dump_config",
     "find_profile",
@@ -62,6 +89,8 @@ __all__ = [
     "load_profile",
     "loops_for",
     "profile_dirs",
+    "reference_posture",
+    "save_user_profile",
     "start_emulators",
     "user_profile_dir",
 ]

@@ -151,6 +151,22 @@ def find_profile(name: str, user_dir: Path | None = None) -> ProfileInfo:
     raise config_error(_SOURCE, "profile", name, f"unknown profile; known: {known}")
 
 
+def profile_folders(name: str, user_dir: Path | None = None) -> list[Path]:
+    """Every folder holding a profile called ``name``, the user's first.
+
+    A user profile named like an installed one (a calibrated ``ergo-jr``) hides it, but files
+    that go with the robot (its URDF, its simulation model) are still found in the installed
+    folder.
+    """
+    key = profile_key(name)
+    return [
+        file.parent
+        for directory in profile_dirs(user_dir)
+        for file in sorted(directory.glob(f"*/{PROFILE_FILE}"))
+        if profile_key(file.parent.name) == key
+    ]
+
+
 def load_profile(name: str, user_dir: Path | None = None) -> RobotConfig:
     """Load and validate a profile's config.
 

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from types import TracebackType
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -359,6 +360,28 @@ class Robot:
         """Stop the sync loops (pending writes are sent first)."""
         for sync in self._syncs:
             sync.stop()
+
+    def run_loop(self, name: str) -> None:
+        """Run the sync loop ``name`` once now on every bus that has it, from the calling thread.
+
+        ``"present"`` reads the present state, ``"goals"`` sends the goals set since the last
+        write. Errors propagate (a silent motor is counted and goes offline as in the thread).
+        """
+        for sync in self._syncs:
+            if sync.has_loop(name):
+                sync.run_once(name)
+
+    @contextmanager
+    def driving(self, name: str) -> Iterator[None]:
+        """Within the block the sync threads skip loop ``name``: the caller runs it with
+        ``run_loop`` at its own pace (teleoperation reads a leader so, right before using it)."""
+        for sync in self._syncs:
+            sync.drive(name)
+        try:
+            yield
+        finally:
+            for sync in self._syncs:
+                sync.release(name)
 
     def sync_stats(self) -> dict[str, SyncStats]:
         """Controller name -> measured loop rates, error counts and offline motors."""

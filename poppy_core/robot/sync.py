@@ -143,6 +143,7 @@ class BusSync:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._blocks: dict[tuple[str, ServoModel], list[regs.Block]] = {}
+        self._driven: set[str] = set()
 
     @property
     def running(self) -> bool:
@@ -198,6 +199,22 @@ class BusSync:
         spec = next(s for s in self._specs if s.name == name)
         self._execute(spec)
 
+    def has_loop(self, name: str) -> bool:
+        """True when this bus has a loop called ``name``."""
+        return any(spec.name == name for spec in self._specs)
+
+    def drive(self, name: str) -> None:
+        """Take loop ``name`` away from the thread: it is skipped until ``release``.
+
+        The caller runs it with ``run_once`` at its own pace (teleoperation reads the leader's
+        present state at its rate, right before using it).
+        """
+        self._driven.add(name)
+
+    def release(self, name: str) -> None:
+        """Give loop ``name`` back to the thread."""
+        self._driven.discard(name)
+
     def stats(self) -> SyncStats:
         """Measured rates, error counts and offline motors."""
         loops = {
@@ -231,6 +248,9 @@ class BusSync:
                 if self._stop.is_set():
                     return
                 if not loop.schedule.due(now):
+                    continue
+                if loop.spec.name in self._driven:
+                    loop.schedule.advance(now)
                     continue
                 loop.meter.tick(now)
                 started = self._clock()

@@ -18,6 +18,7 @@ from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
+from poppy_core.server.teleop import TeleopRegistry
 
 DESCRIPTION_TTL_S = 0.01
 
@@ -47,6 +48,8 @@ class RobotService:
         if builtins:
             attach_builtins(robot)
         self.moves = MoveService(robot)
+        self.teleop = TeleopRegistry()
+        """Which WebSocket connection teleoperates which motor."""
         self._by_name = {m.name: m for m in robot.motors}
         self._description: tuple[float, bytes] | None = None
 
@@ -267,7 +270,8 @@ class RobotService:
     # -- lifetime ----------------------------------------------------------------------------
 
     def close(self) -> None:
-        """Stop the recordings and playbacks this server started."""
+        """Stop the recordings, playbacks and teleoperations this server started."""
+        self.teleop.close()
         self.moves.close()
 
 

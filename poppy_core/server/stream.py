@@ -2,8 +2,10 @@
 
 Frames sent: ``{motor: {present_position, present_speed, present_load, present_temperature,
 led}}`` (pypot's ws server). Frames received: ``{motor: {register: value}}``, checked in full
-before anything is written; a refused command gets ``{"error": "..."}`` back. The send loop runs
-in its own task, so it keeps its rate whatever the client sends and whatever HTTP requests do.
+before anything is written; a refused command gets ``{"error": "..."}`` back. Messages with a
+string ``type`` are teleoperation messages (``poppy_core.server.teleop``: a client streams goal
+positions, a watchdog holds the motors when they stop coming). The send loop runs in its own
+task, so it keeps its rate whatever the client sends and whatever HTTP requests do.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from poppy_core.server.middleware import TokenMiddleware
 from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.refusals import one_line
 from poppy_core.server.service import RobotService
+from poppy_core.server.teleop import TeleopChannel
 
 if TYPE_CHECKING:
     from fastapi import FastAPI
@@ -51,8 +54,16 @@ async def stream(websocket: WebSocket, service: RobotService, rate_hz: float) ->
             await websocket.send_text(json.dumps(data))
 
     sender = asyncio.create_task(_send_states(send, service, clamp_rate(rate_hz)))
+    loop = asyncio.get_running_loop()
+
+    def notify(data: dict[str, Any]) -> None:  # from the teleop worker thread
+        if not loop.is_closed():
+            with contextlib.suppress(RuntimeError):
+                asyncio.run_coroutine_threadsafe(_send_quietly(send, data), loop)
+
+    channel = TeleopChannel(service.robot, service.teleop, notify)
     try:
-        await _receive_commands(websocket, send, service)
+        await _receive_commands(websocket, send, service, channel)
     except WebSocketDisconnect:
         pass
     except Exception:  # a bug: logged here, the client gets a close frame with a reason
@@ -63,6 +74,12 @@ async def stream(websocket: WebSocket, service: RobotService, rate_hz: float) ->
         sender.cancel()
         with contextlib.suppress(asyncio.CancelledError, Exception):
             await sender
+        await asyncio.to_thread(channel.close, "the connection closed")
+
+
+async def _send_quietly(send: Any, data: Any) -> None:
+    with contextlib.suppress(Exception):  # the connection may be gone
+        await send(data)
 
 
 async def _send_states(send: Any, service: RobotService, rate_hz: float) -> None:
@@ -79,7 +96,9 @@ async def _send_states(send: Any, service: RobotService, rate_hz: float) -> None
         await asyncio.sleep(max(0.0, delay))
 
 
-async def _receive_commands(websocket: WebSocket, send: Any, service: RobotService) -> None:
+async def _receive_commands(
+    websocket: WebSocket, send: Any, service: RobotService, channel: TeleopChannel
+) -> None:
     while True:
         message = await websocket.receive()
         if message["type"] == "websocket.disconnect":
@@ -90,11 +109,24 @@ async def _receive_commands(websocket: WebSocket, send: Any, service: RobotServi
         if text is None:
             continue
         try:
-            service.write_many(parse_json(text, what="the message"))
+            data = parse_json(text, what="the message")
+            if isinstance(data, dict) and isinstance(data.get("type"), str):
+                reply = await _teleop(channel, data)
+                if reply is not None:
+                    await send(reply)
+            else:
+                service.write_many(data)
         except ApiError as exc:
             await send({"error": one_line(exc.message)})
         except PoppyError as exc:
             await send({"error": one_line(str(exc))})
+
+
+async def _teleop(channel: TeleopChannel, data: dict[str, Any]) -> dict[str, Any] | None:
+    """Goals are handled on the loop (cheap); start and stop touch the bus: in a thread."""
+    if data["type"] == "teleop.goals":
+        return channel.handle(data)
+    return await asyncio.to_thread(channel.handle, data)
 
 
 def _rate_from(websocket: WebSocket, default_hz: float) -> float:

@@ -37,6 +37,12 @@ async def set_compliant(body: CompliantBody, service: Service) -> RobotInfo:
     return _info(service)
 
 
+@router.get("/teleop", summary="Motors teleoperated over the WebSocket and their state")
+async def teleop_state(service: Service) -> dict[str, str]:
+    """Motor name -> ``ramping``, ``following``, ``held``... (empty when none)."""
+    return service.teleop.states()
+
+
 @router.get("/groups", summary="Group name -> its motors")
 async def groups(service: Service) -> dict[str, list[str]]:
     """Every motor group."""

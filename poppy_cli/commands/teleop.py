@@ -1,0 +1,273 @@
+"""`poppy teleop`: a follower robot copies a leader moved by hand (local, simulated or served).
+
+The work is ``poppy_core.motion.teleop.teleoperate``; this module builds the two robots from the
+options, shows the teleoperation live and prints a summary.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+from contextlib import ExitStack
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+
+from poppy_cli.output import EXIT_USAGE, console, err_console, error_line, print_json
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from poppy_core.motion.teleop import Teleoperation
+    from poppy_core.motion.teleop_map import JointMap
+    from poppy_core.robot import Robot, RobotConfig
+
+REFRESH_S = 0.1
+SELF = "self"
+SIM_ENGINES = ("ideal", "mujoco")
+
+
+def _is_url(text: str) -> bool:
+    return text.startswith(("http://", "https://", "ws://"))
+
+
+def _config(spec: str, port: str | None, role: str) -> RobotConfig:
+    """A profile name or a config file, with ``port`` on its one bus."""
+    from poppy_core.errors import ConfigError
+    from poppy_core.robot import RobotConfig, load_config, load_profile
+
+    path = Path(spec).expanduser()
+    config = load_config(path) if path.is_file() else load_profile(spec)
+    if port is None:
+        return config
+    data = config.to_dict()
+    controllers = data["controllers"]
+    if len(controllers) != 1:
+        raise ConfigError(
+            f"--{role}-port names one bus but the {role} has {len(controllers)} controllers "
+            f"({', '.join(controllers)}): give a config file with each port",
+            field="controllers",
+        )
+    next(iter(controllers.values()))["port"] = port
+    return RobotConfig.from_dict(data, source="command line")
+
+
+def _joint_map(text: str | None, file: Path | None) -> JointMap | None:
+    from poppy_core.motion.teleop_map import JointMap
+
+    if text is not None and file is not None:
+        raise typer.BadParameter("give --map or --map-file, not both", param_hint="--map")
+    if file is not None:
+        return JointMap.load(file)
+    return JointMap.parse(text) if text is not None else None
+
+
+def _ports_of(config: RobotConfig) -> set[str]:
+    return {c.port for c in config.controllers.values() if c.port != "auto"}
+
+
+def teleop(
+    leader: str | None = typer.Option(
+        None, "--leader", help="Leader: a profile name or a config file. [default: user settings]"
+    ),
+    leader_port: str | None = typer.Option(
+        None, "--leader-port", help="Serial port of the leader's bus. [env: POPPY_PORT]"
+    ),
+    follower: str = typer.Option(
+        ...,
+        "--follower",
+        help="Follower: a profile name, a config file, http://HOST:PORT of `poppy serve "
+        "--http`, or 'self' (the leader copies its own joints, e.g. one arm to the other).",
+    ),
+    follower_port: str | None = typer.Option(
+        None, "--follower-port", help="Serial port of the follower's bus."
+    ),
+    follower_sim: str | None = typer.Option(
+        None, "--follower-sim", metavar="ideal|mujoco", help="Simulate the follower."
+    ),
+    joint_map: str | None = typer.Option(
+        None, "--map", help="Joint map FOLLOWER=[-][SCALE*]LEADER[+OFFSET],... (default: same "
+        "motor names)."
+    ),
+    map_file: Path | None = typer.Option(None, "--map-file", help="Joint map file (YAML)."),
+    rate: float = typer.Option(100.0, "--rate", min=1.0, max=1000.0, help="Ticks per second."),
+    ramp: float | None = typer.Option(
+        None, "--ramp", min=0.0, max=30.0, help="Start/resume ramp in s (default: by distance)."
+    ),
+    duration: float | None = typer.Option(
+        None, "--duration", "-d", min=0.1, help="Stop after this many seconds."
+    ),
+    record: str | None = typer.Option(
+        None, "--record", help="Save the follower's trajectory as a move of this name (or path)."
+    ),
+    force: bool = typer.Option(False, "--force", help="Replace an existing move of that name."),
+    json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+) -> None:
+    """Teleoperate: the leader turns compliant, move it by hand; the follower copies it.
+
+    The follower ramps from where it is to the leader, then follows at --rate; it holds where it
+    is when the leader (or the network to a served follower) is lost and ramps again when it
+    comes back. Enter, Ctrl-C or --duration stops: the follower holds where it is, stiff; the
+    leader stays compliant. Angles are compared in each robot's calibrated frame (`poppy
+    calibrate`), so two calibrated robots of one kind agree; other pairs need --map.
+    """
+    from poppy_cli.commands.record import _install_stop
+    from poppy_cli.commands.robot import robot_config
+    from poppy_core.motion import move_path
+
+    if follower_sim is not None and follower_sim not in SIM_ENGINES:
+        raise typer.BadParameter(
+            f"{follower_sim!r}: use ideal or mujoco", param_hint="--follower-sim"
+        )
+    remote = _is_url(follower)
+    if remote and (follower_port or follower_sim):
+        raise typer.BadParameter("a served follower takes no --follower-port or --follower-sim")
+    if follower == SELF and (follower_port or follower_sim):
+        raise typer.BadParameter("--follower self is the leader: no --follower-port/--follower-sim")
+    mapping = _joint_map(joint_map, map_file)
+    path = move_path(record, must_exist=False) if record is not None else None
+    if path is not None and path.exists() and not force:
+        error_line(f"{path} exists: pick another name or pass --force")
+        raise typer.Exit(EXIT_USAGE)
+    leader_file = Path(leader).expanduser() if leader is not None else None
+    if leader_file is not None and leader_file.is_file():  # the port: option, env, settings
+        leader_config = robot_config(None, leader_file, leader_port)
+    else:
+        leader_config = robot_config(leader, None, leader_port)
+    follower_config = None if remote or follower == SELF else _config(follower, follower_port,
+                                                                        "follower")  # fmt: skip
+    if follower_config is not None and follower_sim is None:
+        shared = _ports_of(leader_config) & _ports_of(follower_config)
+        if shared:
+            error_line(f"the leader and the follower cannot share {', '.join(sorted(shared))}: "
+                       "give each its own port (or --follower self for one robot)")  # fmt: skip
+            raise typer.Exit(EXIT_USAGE)
+    with ExitStack() as stack:
+        # Everything that can be refused is, before a robot is built (nothing turns compliant).
+        follow: Any = None
+        if remote:
+            follow = _remote(follower, rate)
+            stack.callback(follow.close)
+            follower_motors = follow.motor_names
+        else:
+            follower_motors = list((follower_config or leader_config).motors)
+        _check_map(mapping, list(leader_config.motors), follower_motors, follower == SELF)
+        stop = threading.Event()
+        _install_stop(stop)
+        lead = stack.enter_context(_build(leader_config, None))
+        if follow is None:
+            follow = (lead if follower_config is None
+                      else stack.enter_context(_build(follower_config, follower_sim)))  # fmt: skip
+        teleop_run = _start(lead, follow, mapping, rate, ramp, duration, path, leader_config,
+                            follower)  # fmt: skip
+        _watch(teleop_run, stop, show=not json_output)
+        report = teleop_run.report()
+        if teleop_run.error is not None:
+            raise teleop_run.error
+    summary = {"leader": leader or "settings", "follower": follower,
+               "map": str(teleop_run.joint_map), **report.as_dict()}  # fmt: skip
+    if json_output:
+        print_json(summary)
+        return
+    console.print(
+        f"teleoperated {report.duration_s:.1f} s at {report.measured_hz:.1f} Hz "
+        f"(asked {rate:g}); holds: {report.holds}"
+        + (f"; recorded {report.recorded_frames} frames to {report.record_path}" if path else "")
+    )
+
+
+def _check_map(
+    mapping: JointMap | None, leader: list[str], follower: list[str], same_robot: bool
+) -> None:
+    from poppy_core.motion.teleop_map import JointMap
+
+    if same_robot and mapping is None:
+        raise typer.BadParameter("--follower self needs a --map of other joints, e.g. "
+                                 "r_elbow_y=l_elbow_y", param_hint="--map")  # fmt: skip
+    chosen = mapping or JointMap.same_names(leader, follower)
+    chosen.check(leader, follower)
+    both = sorted(set(chosen.leaders) & set(chosen.followers)) if same_robot else []
+    if both:
+        from poppy_core.errors import ConfigError
+
+        raise ConfigError(f"{', '.join(both)} cannot lead and follow at once: map other joints",
+                          field="map", value=both)  # fmt: skip
+
+
+def _build(config: RobotConfig, sim: str | None) -> Robot:
+    from poppy_cli.commands.robot import ask_return_delay
+    from poppy_core.creatures import from_config
+
+    return from_config(config, sim=sim or False, fix_return_delay=ask_return_delay, sensors=False)
+
+
+def _remote(url: str, rate: float) -> Any:
+    from poppy_core.remote import RemoteFollower
+
+    if url.startswith("https://"):
+        raise typer.BadParameter("poppy serve speaks http:// (put a TLS proxy in front of it)")
+    return RemoteFollower(url, token=os.environ.get("POPPY_TOKEN") or None, rate_hz=rate)
+
+
+def _start(
+    leader: Robot, follower: Any, mapping: JointMap | None, rate: float, ramp: float | None,
+    duration: float | None, path: Path | None, leader_config: RobotConfig, follower_spec: str,
+) -> Teleoperation:  # fmt: skip
+    from poppy_core.motion.teleop import Teleoperation
+
+    name = leader_config.profile.name if leader_config.profile is not None else "leader"
+    metadata = {"description": f"teleoperated: {name} → {follower_spec}"}
+    if getattr(follower, "config", None) is not None and follower.config.profile is not None:
+        metadata["robot"] = follower.config.profile.name
+    teleop_run = Teleoperation(
+        leader, follower, mapping, rate_hz=rate, ramp_s=ramp, duration_s=duration,
+        record=path, record_metadata=metadata,
+        on_change=lambda state, reason: err_console.print(f"[dim]{state}: {reason}[/]"),
+    )  # fmt: skip
+    err_console.print(
+        f"teleoperating {follower_spec} from the leader at {rate:g} Hz "
+        f"({teleop_run.joint_map}) — move the leader by hand; Enter or Ctrl-C stops",
+        soft_wrap=True,
+    )
+    sys.stderr.flush()
+    return teleop_run.start()
+
+
+def _watch(teleop_run: Teleoperation, stop: threading.Event, *, show: bool) -> None:
+    if not (show and err_console.is_terminal):
+        while teleop_run.running:
+            if stop.wait(REFRESH_S):
+                teleop_run.stop()
+        return
+    from rich.live import Live
+
+    with Live(_table(teleop_run), console=err_console, transient=True) as live:
+        while teleop_run.running:
+            if stop.wait(REFRESH_S):
+                teleop_run.stop()
+            live.update(_table(teleop_run))
+
+
+def _table(teleop_run: Teleoperation) -> Table:
+    from rich.table import Table
+
+    status = teleop_run.status()
+    table = Table(
+        title=f"{status.state} — {status.elapsed_s:.1f} s at {status.measured_hz:.0f} Hz, "
+        f"holds {status.holds} — Enter or Ctrl-C stops"
+    )
+    for column in ("follower joint", "leader", "target", "follower"):
+        table.add_column(column, justify="left" if column == "follower joint" else "right")
+    for link in teleop_run.joint_map.links:
+        leader = status.leader.get(link.leader)
+        target = status.targets.get(link.follower)
+        now = status.follower.get(link.follower)
+        table.add_row(
+            f"{link.follower} ← {link.leader}",
+            "-" if leader is None else f"{leader:.1f}°",
+            "-" if target is None else f"{target:.1f}°",
+            "-" if now is None else f"{now:.1f}°",
+        )
+    return table

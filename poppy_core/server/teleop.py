@@ -1,0 +1,254 @@
+"""Teleoperation over the WebSocket: a client streams goal positions, a watchdog holds on silence.
+
+Messages (JSON objects with a ``type``; the stream's ``{motor: {register: value}}`` commands
+have no string ``type`` and are unchanged)::
+
+    → {"type": "teleop.start", "motors": ["m1", ...] | null, "ramp_s": null, "watchdog_s": 0.25,
+       "client": "an id of the client"}
+    ← {"type": "teleop.started", "motors": [...], "positions": {...}, "watchdog_s": 0.25}
+    → {"type": "teleop.goals", "positions": {"m1": 12.5, ...}}        (at the stream's rate)
+    ← {"type": "teleop.state", "state": "ramping|following|held|stopped", "reason": "..."}
+    → {"type": "teleop.hold", "reason": "..."}                        (the leader was lost)
+    → {"type": "teleop.stop"}
+    ← {"type": "teleop.stopped"}
+
+Each connection has at most one session (a ``FollowSession``) and a worker thread that writes
+the newest goals at once (a burst of late messages collapses into the newest) and holds the
+motors where they are when no goals came for ``watchdog_s`` or the connection closes; the next
+goals resume with a ramp. A motor is teleoperated by one connection at a time, except that a
+client reconnecting with the same ``client`` id takes its motors over from its old connection
+(which the server may not have seen close yet).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from poppy_core.motion.follow import FollowChange, FollowSession
+from poppy_core.robot import Robot
+from poppy_core.server.errors import ApiError
+
+logger = logging.getLogger(__name__)
+
+DEFAULT_WATCHDOG_S = 0.25
+WATCHDOG_RANGE_S = (0.05, 5.0)
+MAX_RAMP_S = 30.0
+TICK_S = 0.02
+"""The worker wakes at least this often to check the watchdog."""
+TIP = "see docs/teleop.md: teleop.start, then teleop.goals at your rate"
+
+Notify = Callable[[dict[str, Any]], None]
+
+
+class TeleopRegistry:
+    """Which connection teleoperates which motor (a motor has one owner at a time)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._owners: dict[str, TeleopChannel] = {}
+
+    def claim(self, channel: TeleopChannel, motors: list[str]) -> None:
+        """Give ``motors`` to ``channel`` (taking them from an older connection of its client).
+
+        Raises:
+            ApiError: ``conflict`` when another client teleoperates one of them.
+        """
+        with self._lock:
+            owners = {self._owners[m] for m in motors if m in self._owners} - {channel}
+        for owner in owners:
+            if channel.client and owner.client == channel.client:
+                owner.close("the client reconnected")
+        with self._lock:
+            taken = [m for m in motors if self._owners.get(m, channel) is not channel]
+            if taken:
+                raise ApiError(
+                    "conflict",
+                    f"{', '.join(taken)} already teleoperated by another connection",
+                    tip="stop the other teleoperation first",
+                )
+            for motor in motors:
+                self._owners[motor] = channel
+
+    def release(self, channel: TeleopChannel) -> None:
+        """Free the motors of ``channel``."""
+        with self._lock:
+            for motor in [m for m, c in self._owners.items() if c is channel]:
+                del self._owners[motor]
+
+    def states(self) -> dict[str, str]:
+        """Motor -> the state of the session teleoperating it (``following``, ``held``...)."""
+        with self._lock:
+            owners = dict(self._owners)
+        return {
+            motor: channel.session.state if channel.session is not None else "idle"
+            for motor, channel in owners.items()
+        }
+
+    def close(self) -> None:
+        """Stop every session (server shutdown)."""
+        with self._lock:
+            channels = set(self._owners.values())
+        for channel in channels:
+            channel.close("the server stops")
+
+
+class TeleopChannel:
+    """The teleoperation of one WebSocket connection.
+
+    Args:
+        robot: the robot served.
+        registry: the motors' owners (shared by the connections).
+        notify: sends a message to this connection (thread-safe; may drop it once closed).
+    """
+
+    def __init__(self, robot: Robot, registry: TeleopRegistry, notify: Notify) -> None:
+        self.robot = robot
+        self.registry = registry
+        self.notify = notify
+        self.session: FollowSession | None = None
+        self.client = ""
+        """The id the client gave (a reconnecting client takes its motors back)."""
+        self._lock = threading.Lock()
+        self._wake = threading.Event()
+        self._newest: dict[str, float] | None = None
+        self._closing = threading.Event()
+        self._close_reason = "the teleoperation ended"
+        self._thread: threading.Thread | None = None
+
+    # -- messages (called on the event loop: cheap, never blocks on the bus) --------------------
+
+    def handle(self, message: Mapping[str, Any]) -> dict[str, Any] | None:
+        """Act on a typed message; returns the answer to send, if any.
+
+        Raises:
+            ApiError: an unknown type, a bad field, a motor already teleoperated.
+        """
+        kind = message.get("type")
+        if kind == "teleop.goals":
+            self._goals(message.get("positions"))
+            return None
+        if kind == "teleop.start":
+            return self._start(message)
+        if kind == "teleop.hold":
+            reason = message.get("reason")
+            session = self.session
+            if session is not None:
+                session.hold(str(reason)[:200] if reason else "the client holds")
+            return None
+        if kind == "teleop.stop":
+            self.close("the client stopped")
+            return {"type": "teleop.stopped"}
+        raise ApiError("invalid", f"unknown message type {kind!r}", tip=TIP)
+
+    def _start(self, message: Mapping[str, Any]) -> dict[str, Any]:
+        names = [m.name for m in self.robot.motors]
+        motors = message.get("motors")
+        if motors is None:
+            motors = names
+        if not (isinstance(motors, list) and motors and all(isinstance(m, str) for m in motors)):
+            raise ApiError("invalid", "motors must be a list of names (or null: all)", tip=TIP)
+        unknown = [m for m in motors if m not in names]
+        if unknown:
+            known = ", ".join(names)
+            raise ApiError("not_found", f"no motor {', '.join(unknown)} (motors: {known})")
+        watchdog = _number(message, "watchdog_s", DEFAULT_WATCHDOG_S, *WATCHDOG_RANGE_S)
+        ramp = message.get("ramp_s")
+        ramp_s = None if ramp is None else _number(message, "ramp_s", 0.0, 0.0, MAX_RAMP_S)
+        client = message.get("client")
+        if client is not None and not isinstance(client, str):
+            raise ApiError("invalid", "client must be a text id", tip=TIP)
+        self.close("a new teleoperation starts")
+        self.client = (client or "")[:100]
+        self.registry.claim(self, list(motors))
+        session = FollowSession(
+            self.robot, motors, ramp_s=ramp_s, watchdog_s=watchdog, on_change=self._changed
+        )
+        with self._lock:
+            self.session = session
+            self._newest = None
+        self._closing.clear()
+        self._thread = threading.Thread(target=self._work, name="teleop channel", daemon=True)
+        self._thread.start()
+        return {
+            "type": "teleop.started",
+            "motors": list(motors),
+            "positions": session.positions(),
+            "watchdog_s": watchdog,
+        }
+
+    def _goals(self, positions: Any) -> None:
+        session = self.session
+        if session is None or session.state == "stopped":
+            raise ApiError("conflict", "no teleoperation: send teleop.start first", tip=TIP)
+        if not isinstance(positions, Mapping) or not positions:
+            raise ApiError("invalid", "positions must be an object {motor: degrees}", tip=TIP)
+        goals: dict[str, float] = {}
+        followed = set(session.motor_names)
+        for name, value in positions.items():
+            if name not in followed:
+                raise ApiError("not_found", f"{name!r} is not teleoperated (motors: "
+                               f"{', '.join(session.motor_names)})")  # fmt: skip
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ApiError("invalid", f"{name}: expected a number of degrees")
+            number = float(value)
+            if not math.isfinite(number):
+                raise ApiError("invalid", f"{name}: expected a finite number of degrees")
+            goals[name] = number
+        with self._lock:
+            self._newest = goals if self._newest is None else {**self._newest, **goals}
+        self._wake.set()
+
+    # -- the worker ------------------------------------------------------------------------------
+
+    def _work(self) -> None:
+        session = self.session
+        if session is None:
+            return
+        try:
+            session.start()
+            while not self._closing.is_set():
+                self._wake.wait(TICK_S)
+                self._wake.clear()
+                with self._lock:
+                    goals, self._newest = self._newest, None
+                if goals:
+                    session.push(goals)
+                elif session.expired():
+                    session.hold(f"no goals for {session.watchdog_s:g} s: link lost?")
+        except Exception:
+            logger.exception("teleoperation channel failed")
+        finally:
+            session.stop(self._close_reason)
+
+    def _changed(self, change: FollowChange) -> None:
+        self.notify({"type": "teleop.state", "state": change.state, "reason": change.reason})
+
+    def close(self, reason: str) -> None:
+        """End the session: the motors hold where they are (stiff). Blocks for the worker."""
+        self._close_reason = reason
+        self._closing.set()
+        self._wake.set()
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(2.0)
+        self._thread = None
+        session = self.session
+        if session is not None and session.state != "stopped":
+            session.stop(reason)
+        self.registry.release(self)
+
+
+def _number(message: Mapping[str, Any], key: str, default: float, low: float, high: float) -> float:
+    value = message.get(key, default)
+    if value is None:
+        value = default
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ApiError("invalid", f"{key} must be a number of seconds", tip=TIP)
+    number = float(value)
+    if not (math.isfinite(number) and low <= number <= high):
+        raise ApiError("invalid", f"{key} must be between {low:g} and {high:g} s", tip=TIP)
+    return number
