@@ -23,6 +23,7 @@ from poppy_cli.output import (
     error_line,
     fmt_value,
     print_json,
+    styled,
 )
 
 if TYPE_CHECKING:
@@ -60,10 +61,10 @@ class RichAnswers:
     def move(self, motors: Sequence[str], watch: RangeWatch) -> bool:
         """Show the joints' ranges live until Enter."""
         which = motors[0] if len(motors) == 1 else "each joint"
-        err_console.print(
-            f"Move [bold]{which}[/] slowly from one end of its range to the other, back to the "
-            "posture, then press Enter (q to cancel)"
-        )
+        err_console.print(styled(
+            "Move [bold]{}[/] slowly from one end of its range to the other, back to the "
+            "posture, then press Enter (q to cancel)", which
+        ))  # fmt: skip
         sys.stderr.flush()
         answer: list[str] = []
         done = threading.Event()
@@ -123,7 +124,7 @@ def _range_table(watch: RangeWatch) -> Table:
 
 def _show_event(event: CalibrationEvent) -> None:
     if event.step == "joints" and event.total > 1:
-        err_console.print(f"[bold]joint {event.index}/{event.total}[/]")
+        err_console.print(styled("[bold]joint {}/{}[/]", event.index, event.total))
     elif event.step == "compliant":
         err_console.print(event.message)
 
@@ -274,7 +275,7 @@ def _report_check(config: RobotConfig, drifts: list[JointDrift], json_output: bo
         for column in ("joint", "expected", "measured", "drift", ""):
             table.add_column(column, justify="left" if column in ("joint", "") else "right")
         for d in drifts:
-            mark = "[green]ok[/]" if d.ok else "[red]drifted[/]"
+            mark = styled("[green]ok[/]") if d.ok else styled("[red]drifted[/]")
             table.add_row(d.motor, _deg(d.expected), _deg(d.measured), _deg(d.drift, "+"), mark)
         console.print(table)
         if drifted:

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.output import EXIT_USAGE, console, err_console, error_line, print_json
+from poppy_cli.output import EXIT_USAGE, console, err_console, error_line, print_json, styled
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -131,6 +131,11 @@ def teleop(
     if path is not None and path.exists() and not force:
         error_line(f"{path} exists: pick another name or pass --force")
         raise typer.Exit(EXIT_USAGE)
+    if path is not None:
+        from poppy_core.files import probe_folder
+        from poppy_core.motion.move_library import is_path
+
+        probe_folder(path.parent, make_folder=not is_path(record or ""))  # before anything moves
     leader_file = Path(leader).expanduser() if leader is not None else None
     if leader_file is not None and leader_file.is_file():  # the port: option, env, settings
         leader_config = robot_config(None, leader_file, leader_port)
@@ -224,7 +229,7 @@ def _start(
     teleop_run = Teleoperation(
         leader, follower, mapping, rate_hz=rate, ramp_s=ramp, duration_s=duration,
         record=path, record_metadata=metadata,
-        on_change=lambda state, reason: err_console.print(f"[dim]{state}: {reason}[/]"),
+        on_change=lambda state, reason: err_console.print(styled("[dim]{}: {}[/]", state, reason)),
     )  # fmt: skip
     err_console.print(
         f"teleoperating {follower_spec} from the leader at {rate:g} Hz "

@@ -25,7 +25,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any
 
-from poppy_core.errors import ConfigError, PoppyError
+from poppy_core.errors import ConfigError, FileError, PoppyError
 from poppy_core.motion.follow import FollowChange
 from poppy_core.motion.teleop_follower import Follower, LocalFollower
 from poppy_core.motion.teleop_map import JointMap
@@ -347,12 +347,13 @@ class Teleoperation:
         if self.recorder is not None:
             try:
                 self.recorder.save()
-            except OSError as exc:
+            except (FileError, OSError) as exc:
                 if self.error is None:
-                    self.error = ConfigError(
-                        f"cannot save the recorded move to {self.recorder.path}: "
-                        f"{exc.strerror or exc}",
-                        file=str(self.recorder.path),
+                    reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+                    self.error = FileError(
+                        f"cannot save the recorded move to {self.recorder.path}: {reason} "
+                        f"({self.recorder.samples} samples kept in memory)",
+                        path=str(self.recorder.path),
                     )
 
     # -- context manager -----------------------------------------------------------------------

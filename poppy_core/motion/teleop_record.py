@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from poppy_core.errors import FileError
 from poppy_core.motion.move import Move, resample
 from poppy_core.motion.move_format import write_move
 
@@ -70,7 +71,7 @@ class TrajectoryRecorder:
             self._next_checkpoint = time_s + self.checkpoint_period_s
             try:
                 self.save()
-            except OSError as exc:  # keep recording in memory; the final save tries again
+            except (FileError, OSError) as exc:  # keep recording in memory; the final save retries
                 logger.warning("checkpoint to %s failed: %s", self.path, exc)
 
     @property
@@ -90,11 +91,11 @@ class TrajectoryRecorder:
         """Write the move so far atomically (nothing before the first sample).
 
         Raises:
-            OSError: the file cannot be written (the samples are kept for another try).
+            FileError: the file cannot be written (the samples are kept for another try).
         """
         move = self.move()
         if not len(move):
             return None
-        write_move(move, self.path)
+        write_move(move, self.path, make_folder=True)
         self.checkpoints += 1
         return self.path

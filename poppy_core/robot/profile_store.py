@@ -77,7 +77,7 @@ def save_user_profile(
             write_file(backup, path.read_bytes(), replace=True)
         write_file(path, text, replace=True)
     except FileError as exc:
-        raise ConfigError(f"{path}: cannot write: {exc}", file=str(path)) from None
+        raise ConfigError(str(exc), file=str(path)) from None
     except OSError as exc:
         raise ConfigError(f"{path}: cannot write: {exc.strerror or exc}", file=str(path)) from None
     return SavedProfile(path, backup)
