@@ -13,6 +13,12 @@ How a scan stays fast:
   replies colliding, noise) mean one may have missed someone, so every ID is pinged one by one.
   The second broadcast costs one round trip, a few ms at 1 Mbps.
 
+Slow adapters: the deadlines assume the adapter latency known for the port (see
+``poppy_core.bus.timing``); a reply slower than that raises it for the rest of the port's scan
+(``poppy_core.bus.latency``). Before motors found at a rate are reported, the line is left quiet
+for a few latencies and they are asked again: a reply that came late from the rate tried before
+(and was taken for an answer at this one) does not answer twice, and is dropped.
+
 A scan opens each port once and switches rates on it. On an abort (``should_abort()`` true) it
 returns what it has found so far.
 """
@@ -26,7 +32,7 @@ from dataclasses import dataclass, field
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.ports import list_ports
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
-from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S
+from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, settle_s
 from poppy_core.bus.transport import Transport
 from poppy_core.errors import CorruptPacketError, PortError, SetupError
 from poppy_core.models import standard_baudrates
@@ -61,6 +67,7 @@ class _Scan:
     total: int
     done: int = 0
     found: list[FoundMotor] = field(default_factory=list)
+    unconfirmed: int = 0  # motors that answered at the rate being scanned, not yet confirmed
     aborted: bool = False
 
     def abort_requested(self) -> bool:
@@ -81,7 +88,7 @@ class _Scan:
                     motor_id,
                     self.done,
                     self.total,
-                    len(self.found),
+                    len(self.found) + self.unconfirmed,
                 )
             )
 
@@ -107,10 +114,28 @@ def _ping(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
         return None
 
 
+def settle(bus: DxlBus) -> set[int]:
+    """Listen for replies still on their way; return the IDs that answered late.
+
+    Whatever came is dropped, so that the next rate starts on a clean line; an adaptive bus
+    has learned from it how slow the adapter really is.
+    """
+    return {status.id for status in bus.listen(settle_s(bus.latency_s))}
+
+
+def answers(bus: DxlBus, motor_id: int) -> bool:
+    """Whether ``motor_id`` answers a ping (one retry, no model read)."""
+    try:
+        return bus.ping(motor_id, retries=1, identify=False) is not None
+    except CorruptPacketError:
+        return False
+
+
 def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> None:
-    """Scan one (port, rate, protocol)."""
-    seen: set[int] = set()
+    """Scan one (port, rate, protocol); motors answering are confirmed before being reported."""
+    candidates: dict[int, PingResult] = {}
     wanted = set(state.ids)
+    trusted = False
     if bus.protocol == 2 and broadcast:
         transport = bus.transport
         corrupt, skipped = transport.corrupt_packets, transport.skipped_bytes
@@ -119,35 +144,69 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> None:
             results = bus.broadcast_ping()
             answered.append({pinged.id for pinged in results})
             for pinged in results:
-                if pinged.id in wanted and pinged.id not in seen:
-                    seen.add(pinged.id)
-                    state.add(_found(port, bus, pinged))
+                if pinged.id in wanted:
+                    candidates.setdefault(pinged.id, pinged)
         clean = transport.corrupt_packets == corrupt and transport.skipped_bytes == skipped
-        if clean and answered[0] == answered[1]:
+        trusted = clean and answered[0] == answered[1]
+        state.unconfirmed = len(candidates)
+        if trusted:
             state.report(port, bus, "broadcast ping", None, len(state.ids))
-            return
-        logger.info(
-            "%s: broadcast pings at %d bps disagree or met garbage; pinging each ID",
-            port,
-            bus.baudrate,
-        )
+        else:
+            logger.info(
+                "%s: broadcast pings at %d bps disagree or met garbage; pinging each ID",
+                port,
+                bus.baudrate,
+            )
     late: set[int] = set()
-    bus.take_strays()
-    for motor_id in state.ids:
-        if state.abort_requested():
-            return
-        if motor_id not in seen:
-            result = _ping(bus, motor_id, retries=0)
-            if result is not None:
-                seen.add(motor_id)
-                state.add(_found(port, bus, result))
-            late.update(s.id for s in bus.take_strays() if s.id in wanted and s.id not in seen)
-        state.report(port, bus, "ping", motor_id, 1)
-    for motor_id in sorted(late - seen):
+    if not trusted:
+        late.update(s.id for s in bus.take_strays() if s.id in wanted)  # late broadcast replies
+        for motor_id in state.ids:
+            if state.abort_requested():
+                break
+            if motor_id not in candidates:
+                result = _ping(bus, motor_id, retries=0)
+                if result is not None:
+                    candidates[motor_id] = result
+                    state.unconfirmed = len(candidates)
+                strays = bus.take_strays()
+                late.update(s.id for s in strays if s.id in wanted and s.id not in candidates)
+            state.report(port, bus, "ping", motor_id, 1)
+    # Replies still coming are late answers of this rate: wait for them before the next rate.
+    late |= settle(bus) & wanted
+    for motor_id in sorted(late - set(candidates)):
         result = _ping(bus, motor_id, retries=1)
         if result is not None:
-            seen.add(motor_id)
+            candidates[motor_id] = result
+    _confirm(state, port, bus, candidates, by_broadcast=trusted)
+
+
+def _confirm(
+    state: _Scan, port: str, bus: DxlBus, candidates: dict[int, PingResult], by_broadcast: bool
+) -> None:
+    """Report the candidates that answer again, now that the line has settled.
+
+    On a slow adapter a reply can come after the settle time, while the next rate is tried: it
+    would be taken for a motor at that rate. A motor really at this rate answers again; a late
+    reply from elsewhere does not.
+    """
+    state.unconfirmed = 0
+    if not candidates:
+        return
+    again: set[int] = set()
+    if by_broadcast:
+        again = {pinged.id for pinged in bus.broadcast_ping()}
+    again |= {i for i in candidates if i not in again and answers(bus, i)}
+    for motor_id, result in candidates.items():
+        if motor_id in again:
             state.add(_found(port, bus, result))
+        else:
+            logger.info(
+                "%s: motor %d answered once at %d bps but not when asked again: a late reply "
+                "from another rate, not counted",
+                port,
+                motor_id,
+                bus.baudrate,
+            )
 
 
 def scan(
@@ -200,6 +259,7 @@ def scan(
                 raise
             logger.warning("skipping %s: %s", port, exc)
             continue
+        learned = latency_s  # a slower adapter than assumed is learned once, for every rate
         try:
             for protocol in protocol_list:
                 for rate in rates[protocol]:
@@ -209,13 +269,15 @@ def scan(
                         port,
                         rate,
                         protocol,
-                        latency_s=latency_s,
+                        latency_s=learned,
                         retries=0,
                         return_delay_s=return_delay_s,
                         transport=transport,
                         min_timeout_s=0.0,
                     )
+                    bus.adaptive_latency = True
                     _scan_rate(state, port, bus, broadcast)
+                    learned = bus.latency_s
         finally:
             transport.close()
     return state.found
@@ -241,8 +303,12 @@ def find_port(
     Returns:
         ``(port, baudrate, protocol)``.
 
+    A motor that answers is asked again once the line has settled, so that a late reply (a
+    slow adapter) is not taken for a motor at the next rate tried; a slower adapter than
+    assumed is learned from its replies (see ``poppy_core.bus.latency``).
+
     Raises:
-        PortError: no serial port at all.
+        PortError: no serial port at all; the only port given (or every one) cannot be opened.
         SetupError: no port/rate/protocol answers for every ID (the message says the closest).
     """
     wanted = list(ids)
@@ -252,12 +318,17 @@ def find_port(
     if not port_list:
         raise PortError("no serial port found: plug the adapter or run `poppy ports`")
     best: tuple[int, str] = (0, "")
+    unopened: list[PortError] = []
     for port in port_list:
         try:
             transport = Transport(port)
         except PortError as exc:
+            if len(port_list) == 1:
+                raise
             logger.warning("skipping %s: %s", port, exc)
+            unopened.append(exc)
             continue
+        learned = latency_s
         try:
             for protocol in protocols:
                 # 1 Mbps first: the rate of Poppy robots and of most set-up buses
@@ -266,8 +337,15 @@ def find_port(
                     key=lambda rate: rate != DEFAULT_SEARCH_FIRST_BPS,
                 )
                 for rate in rates:
-                    bus = DxlBus(port, rate, protocol, latency_s=latency_s, transport=transport)
+                    bus = DxlBus(port, rate, protocol, latency_s=learned, transport=transport)
+                    bus.adaptive_latency = True
                     answered = [i for i in wanted if _ping(bus, i, retries=1) is not None]
+                    late = settle(bus)  # see _scan_rate and _confirm
+                    answered += [
+                        i for i in wanted if i in late and i not in answered and answers(bus, i)
+                    ]
+                    answered = [i for i in answered if answers(bus, i)]
+                    learned = bus.latency_s
                     if len(answered) == len(wanted):
                         return port, rate, protocol
                     if len(answered) > best[0]:
@@ -278,6 +356,9 @@ def find_port(
                         )
         finally:
             transport.close()
+    if len(unopened) == len(port_list):
+        reasons = "; ".join(str(exc) for exc in unopened)
+        raise PortError(f"no port could be opened: {reasons}")
     closest = f"; closest: {best[1]}" if best[0] else ""
     rates_text = "every standard rate" if fixed is None else ", ".join(f"{r} bps" for r in fixed)
     protocols_text = " and ".join(str(p) for p in protocols)

@@ -137,16 +137,28 @@ def change_id(
 def locate(bus: DxlBus, motor_id: int, rates: list[int] | None = None) -> int | None:
     """Search the standard baud rates for ``motor_id``; leave the bus at the rate found.
 
+    Each rate is left quiet a moment before the next, and a motor that answered is asked
+    again, so a slow adapter's late reply is not taken for the motor at the next rate.
+
     Returns:
         The rate where it answers, None when nowhere (the bus's rate is then restored).
     """
-    original = bus.baudrate
-    for rate in rates if rates is not None else standard_baudrates(bus.protocol):
-        bus.baudrate = rate
-        if bus.ping(motor_id) is not None:
-            return rate
-    bus.baudrate = original
-    return None
+    from poppy_core.bus.scan import answers, settle
+
+    original, adaptive = bus.baudrate, bus.adaptive_latency
+    bus.adaptive_latency = True  # a slow adapter is learned from its late replies
+    try:
+        for rate in rates if rates is not None else standard_baudrates(bus.protocol):
+            bus.baudrate = rate
+            found = answers(bus, motor_id)
+            # A late reply is this rate's; confirmed on a settled line (see bus.scan).
+            late = motor_id in settle(bus)
+            if (found or late) and answers(bus, motor_id):
+                return rate
+        bus.baudrate = original
+        return None
+    finally:
+        bus.adaptive_latency = adaptive
 
 
 def change_baudrate(
