@@ -10,6 +10,7 @@ from poppy_core.robot.config import (
 from poppy_core.robot.config_io import config_to_text, dump_config, load_config
 from poppy_core.robot.factory import autodetect, from_config, from_profile, start_emulators
 from poppy_core.robot.goto import GotoHandle, GotoRunner
+from poppy_core.robot.health import BusHealth
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.profiles import (
     PROFILE_FILE,
@@ -37,6 +38,7 @@ __all__ = [
     "DEFAULT_BAUDRATE",
     "LIGHT_LOOPS",
     "PROFILE_FILE",
+    "BusHealth",
     "BusSync",
     "ControllerConfig",
     "GotoHandle",

@@ -58,6 +58,12 @@ class RateMeter:
         self._times.append(now_s)
         self.count += 1
 
+    def rate_at(self, now_s: float, stale_after_s: float) -> float:
+        """``rate_hz``, or 0 when the last run is more than ``stale_after_s`` before ``now_s``."""
+        if not self._times or now_s - self._times[-1] > stale_after_s:
+            return 0.0
+        return self.rate_hz
+
     @property
     def rate_hz(self) -> float:
         """Runs per second over the window (0 until two runs were seen)."""

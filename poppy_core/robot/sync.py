@@ -10,6 +10,11 @@ Reads use ``DxlBus.sync_read`` (sync read, USB2AX sync read, bulk read or single
 bus offers), one transaction per group of motors sharing a register layout. A motor that misses
 ``offline_after`` reads in a row is marked offline: it leaves the fast loops and is pinged once
 per ``retry_period_s`` until it answers again. Deadlines are drift-free (``Periodic``).
+
+A lost port (adapter unplugged, emulator gone: a ``PortError``) is logged once at WARNING, every
+motor of the bus goes offline at once, and the thread reopens the port with backoff
+(``RECONNECT_FIRST_S`` doubling up to ``RECONNECT_MAX_S``); once it opens, the motors are pinged
+and resume (one WARNING says the bus is back). ``health()`` says how the bus is doing.
 """
 
 from __future__ import annotations
@@ -18,12 +23,13 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from poppy_core.bus import DxlBus
-from poppy_core.errors import BusError, MotorError, PoppyError
+from poppy_core.errors import BusError, MotorError, PoppyError, PortError
 from poppy_core.models import ServoModel
 from poppy_core.robot import registers as regs
+from poppy_core.robot.health import BusHealth, LoopStats, SyncStats
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.schedule import Periodic, RateMeter
 
@@ -55,49 +61,28 @@ LIGHT_LOOPS: tuple[LoopSpec, ...] = (
     LoopSpec("sensors", ("present_load", *regs.SENSORS), False, 1.0),
 )
 RETRY = "retry"
+# Reopening a lost port: first attempt after RECONNECT_FIRST_S, then twice as long each time.
+RECONNECT_FIRST_S = 0.1
+RECONNECT_MAX_S = 1.0
+# A loop that has not run for this many periods (at least STALE_MIN_S) reports a rate of 0.
+STALE_PERIODS = 3.0
+STALE_MIN_S = 0.5
+
+__all__ = [
+    "BASE_LOOPS",
+    "LIGHT_LOOPS",
+    "BusHealth",
+    "BusSync",
+    "LoopSpec",
+    "LoopStats",
+    "SyncStats",
+    "loops_for",
+]
 
 
 def loops_for(syncloop: str) -> tuple[LoopSpec, ...]:
     """The loops for a config's ``syncloop`` name (``LightDxlController`` → light, else base)."""
     return LIGHT_LOOPS if "light" in syncloop.lower() else BASE_LOOPS
-
-
-@dataclass(frozen=True)
-class LoopStats:
-    """What one loop did: target and measured rate, runs, skipped periods, errors."""
-
-    name: str
-    target_hz: float
-    measured_hz: float
-    runs: int
-    missed_periods: int
-    errors: int
-    last_duration_s: float
-
-
-@dataclass(frozen=True)
-class SyncStats:
-    """One bus's loops, its motors' health and its bus counters."""
-
-    controller: str
-    port: str
-    running: bool
-    loops: dict[str, LoopStats]
-    motor_errors: dict[str, int]
-    offline: list[str]
-    bus: dict[str, int] = field(default_factory=dict)
-
-    def as_dict(self) -> dict[str, object]:
-        """Plain data (for ``--json``)."""
-        return {
-            "controller": self.controller,
-            "port": self.port,
-            "running": self.running,
-            "loops": {name: vars(loop) for name, loop in self.loops.items()},
-            "motor_errors": dict(self.motor_errors),
-            "offline": list(self.offline),
-            "bus": dict(self.bus),
-        }
 
 
 class _Loop:
@@ -143,6 +128,11 @@ class BusSync:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._blocks: dict[tuple[str, ServoModel], list[regs.Block]] = {}
+        self.connected = True
+        self.losses = 0
+        self._down_since = 0.0
+        self._backoff_s = RECONNECT_FIRST_S
+        self._next_reopen = 0.0
 
     @property
     def running(self) -> bool:
@@ -178,7 +168,7 @@ class BusSync:
         Sync writes get no reply: when something was sent, one ping follows, so the writes
         have been handled once this returns (the bus may be closed right after).
         """
-        if not any(m.online and m.has_pending() for m in self.motors):
+        if not self.connected or not any(m.online and m.has_pending() for m in self.motors):
             return
         for spec in self._specs:
             if spec.write:
@@ -197,6 +187,33 @@ class BusSync:
         """Run one loop now (tests and tools); errors propagate."""
         spec = next(s for s in self._specs if s.name == name)
         self._execute(spec)
+
+    def health(self) -> BusHealth:
+        """Connected or not, loop rates now, error counters, offline motors."""
+        now = self._clock()
+        loops = [loop for loop in self._loops if loop.spec.name != RETRY]
+        stats = self.bus.stats
+        return BusHealth(
+            controller=self.controller,
+            port=self.bus.port,
+            connected=self.connected,
+            running=self.running,
+            down_s=0.0 if self.connected else now - self._down_since,
+            losses=self.losses,
+            loop_hz={
+                loop.spec.name: loop.meter.rate_at(
+                    now, max(STALE_MIN_S, STALE_PERIODS / loop.spec.rate_hz)
+                )
+                for loop in loops
+            },
+            target_hz={loop.spec.name: loop.spec.rate_hz for loop in loops},
+            loop_errors=sum(loop.errors for loop in self._loops),
+            timeouts=stats.timeouts,
+            retries=stats.retries,
+            corrupt_packets=stats.corrupt_packets,
+            motor_errors=stats.motor_errors,
+            offline=[m.name for m in self.motors if not m.online],
+        )
 
     def stats(self) -> SyncStats:
         """Measured rates, error counts and offline motors."""
@@ -226,26 +243,82 @@ class BusSync:
 
     def _run(self) -> None:
         while not self._stop.is_set():
-            now = self._clock()
-            for loop in self._loops:
-                if self._stop.is_set():
-                    return
-                if not loop.schedule.due(now):
-                    continue
-                loop.meter.tick(now)
-                started = self._clock()
-                try:
-                    self._execute(loop.spec)
-                except Exception as exc:
-                    loop.errors += 1
-                    if isinstance(exc, PoppyError | OSError):
-                        logger.debug("%s %s loop: %s", self.controller, loop.spec.name, exc)
-                    else:
-                        logger.exception("%s %s loop failed", self.controller, loop.spec.name)
-                loop.last_duration_s = self._clock() - started
-                loop.schedule.advance(now)
-            wake = min(loop.schedule.next_deadline for loop in self._loops)
-            self._stop.wait(max(0.0, wake - self._clock()))
+            try:
+                if self.connected:
+                    self._run_due_loops()
+                else:
+                    self._reconnect()
+            except Exception:  # never let the thread die: log, breathe, go on
+                logger.exception("%s: sync thread error", self.controller)
+                self._stop.wait(0.1)
+
+    def _run_due_loops(self) -> None:
+        now = self._clock()
+        for loop in self._loops:
+            if self._stop.is_set():
+                return
+            if not loop.schedule.due(now):
+                continue
+            loop.meter.tick(now)
+            started = self._clock()
+            try:
+                self._execute(loop.spec)
+            except PortError as exc:
+                loop.errors += 1
+                self._lost(exc)
+                return
+            except Exception as exc:
+                loop.errors += 1
+                if isinstance(exc, PoppyError | OSError):
+                    logger.debug("%s %s loop: %s", self.controller, loop.spec.name, exc)
+                else:
+                    logger.exception("%s %s loop failed", self.controller, loop.spec.name)
+            loop.last_duration_s = self._clock() - started
+            loop.schedule.advance(now)
+        wake = min(loop.schedule.next_deadline for loop in self._loops)
+        self._stop.wait(max(0.0, wake - self._clock()))
+
+    def _lost(self, exc: PortError) -> None:
+        """The port went away: every motor offline now, one warning, reopen with backoff."""
+        self.connected = False
+        self.losses += 1
+        self._down_since = self._clock()
+        self._backoff_s = RECONNECT_FIRST_S
+        self._next_reopen = self._down_since + self._backoff_s
+        for motor in self.motors:
+            motor.mark_offline()
+        logger.warning(
+            "%s: lost %s (%s); its %d motor(s) are offline, reopening it with backoff",
+            self.controller,
+            self.bus.port,
+            exc,
+            len(self.motors),
+        )
+
+    def _reconnect(self) -> None:
+        if self._stop.wait(max(0.0, self._next_reopen - self._clock())):
+            return
+        try:
+            self.bus.reopen()
+        except PortError as exc:
+            self._backoff_s = min(2 * self._backoff_s, RECONNECT_MAX_S)
+            self._next_reopen = self._clock() + self._backoff_s
+            logger.debug("%s: %s still away (%s)", self.controller, self.bus.port, exc)
+            return
+        now = self._clock()
+        self.connected = True
+        logger.warning(
+            "%s: %s is back after %.1f s; pinging its motors",
+            self.controller,
+            self.bus.port,
+            now - self._down_since,
+        )
+        for loop in self._loops:
+            loop.schedule = Periodic(loop.schedule.period_s, now)
+        try:
+            self._retry()
+        except PortError as exc:
+            self._lost(exc)
 
     def _execute(self, spec: LoopSpec) -> None:
         if spec.name == RETRY:
@@ -332,7 +405,9 @@ class BusSync:
             if motor.online or self._stop.is_set():
                 continue
             try:
-                answered = self.bus.ping(motor.id, retries=0) is not None
+                answered = self.bus.ping(motor.id, retries=0, identify=False) is not None
+            except PortError:
+                raise
             except BusError:
                 answered = False
             if answered:
