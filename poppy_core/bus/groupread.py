@@ -9,6 +9,12 @@ Protocol 1 sync read strategy (found once per bus, kept in ``bus.sync_read_mode`
    plain read.
 
 The USB2AX fills a motor that did not answer with 0xFF bytes: an all-0xFF block maps to None.
+
+A motor missing from a group reply once its retries are spent (a corrupt byte in a long reply,
+a reply chain cut by a silent motor) is read on its own before it is reported as None: a long
+reply is many times likelier to be hit by noise than a short one, and a healthy motor must not
+look silent because a neighbour's reply was garbled. A transient failure never changes the
+method found for the bus.
 """
 
 from __future__ import annotations
@@ -116,6 +122,16 @@ def _sequential(bus: DxlBus, requests: list[tuple[int, int, int]]) -> dict[int, 
     return out
 
 
+def _fill_in(
+    bus: DxlBus, result: dict[int, bytes | None], address: int, length: int
+) -> dict[int, bytes | None]:
+    """Read on its own each motor a group read left without data (see the module doc)."""
+    missing = [(i, address, length) for i, data in result.items() if data is None]
+    if missing:
+        result.update(_sequential(bus, missing))
+    return result
+
+
 def _usb2ax(
     bus: DxlBus, address: int, length: int, ids: list[int]
 ) -> dict[int, bytes | None] | None:
@@ -166,7 +182,7 @@ def sync_read(bus: DxlBus, address: int, length: int, ids: list[int]) -> dict[in
                 lambda missing: ins.sync_read(2, address, length, missing),
                 dict.fromkeys(ids, length),
             )
-            return _checked(bus, replies, ids)
+            return _fill_in(bus, _checked(bus, replies, ids), address, length)
         mode = bus.sync_read_mode
         try_usb2ax = bus.sync_read_enabled is not False and bus.usb2ax is not False
         if mode == "sync" or (mode is None and try_usb2ax):
@@ -174,9 +190,10 @@ def sync_read(bus: DxlBus, address: int, length: int, ids: list[int]) -> dict[in
             if data is not None:
                 bus.usb2ax = True
                 bus.sync_read_mode = "sync"
-                return data
-            if bus.sync_read_enabled is True:
-                return dict.fromkeys(ids)
+                return _fill_in(bus, data, address, length)
+            if bus.usb2ax or bus.sync_read_enabled is True:
+                # The adapter answered before (or must): this reply was lost or garbled.
+                return _sequential(bus, requests)
             logger.info("%s: no USB2AX sync read; trying bulk read", bus.port)
             bus.usb2ax = False
             bus.sync_read_mode = mode = None
@@ -188,7 +205,7 @@ def sync_read(bus: DxlBus, address: int, length: int, ids: list[int]) -> dict[in
         if mode == "bulk" or not missing:
             if got:
                 bus.sync_read_mode = "bulk"
-            return result
+            return _fill_in(bus, result, address, length)
         rest = _sequential(bus, missing)
         result.update(rest)
         if any(value is not None for value in rest.values()):

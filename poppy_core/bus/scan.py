@@ -131,8 +131,12 @@ def answers(bus: DxlBus, motor_id: int) -> bool:
         return False
 
 
-def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> None:
-    """Scan one (port, rate, protocol); motors answering are confirmed before being reported."""
+def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int]:
+    """Scan one (port, rate, protocol); motors answering are confirmed before being reported.
+
+    Returns:
+        IDs heard at this rate that did not confirm: late replies from the rate before.
+    """
     candidates: dict[int, PingResult] = {}
     wanted = set(state.ids)
     trusted = False
@@ -177,21 +181,86 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> None:
         result = _ping(bus, motor_id, retries=1)
         if result is not None:
             candidates[motor_id] = result
-    _confirm(state, port, bus, candidates, by_broadcast=trusted)
+    unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
+    found_here = {f.id for f in state.found if f.baudrate == bus.baudrate}
+    return (unconfirmed | late) - found_here
+
+
+def _scan_bus(
+    port: str,
+    rate: int,
+    protocol: int,
+    transport: Transport,
+    latency_s: float | None,
+    return_delay_s: float,
+) -> DxlBus:
+    """A scan's bus at one rate: no retry, no floor, learning the adapter's latency."""
+    bus = DxlBus(
+        port,
+        rate,
+        protocol,
+        latency_s=latency_s,
+        retries=0,
+        return_delay_s=return_delay_s,
+        transport=transport,
+        min_timeout_s=0.0,
+    )
+    bus.adaptive_latency = True
+    return bus
+
+
+def _answering(bus: DxlBus, wanted: list[int]) -> tuple[list[int], set[int]]:
+    """Which of ``wanted`` answer at the bus's rate, confirmed on a settled line (see _confirm).
+
+    Returns:
+        The IDs confirmed, and the IDs heard but not confirmed (late replies from elsewhere).
+    """
+    heard = {i for i in wanted if _ping(bus, i, retries=1) is not None}
+    heard |= settle(bus) & set(wanted)
+    confirmed = [i for i in wanted if i in heard and answers(bus, i)]
+    return confirmed, heard - set(confirmed)
+
+
+def _revisit(state: _Scan, port: str, bus: DxlBus, ids: set[int]) -> None:
+    """Look again at the rate before for motors whose replies came late into the next one.
+
+    ``bus`` is at that earlier rate, with the latency learned since; a motor found there is
+    confirmed as usual.
+    """
+    known = {(f.id, f.baudrate, f.protocol) for f in state.found}
+    ids = {i for i in ids if (i, bus.baudrate, bus.protocol) not in known}
+    if not ids:
+        return
+    logger.info(
+        "%s: replies from %s came late into the next rate: looking again at %d bps",
+        port,
+        ", ".join(map(str, sorted(ids))),
+        bus.baudrate,
+    )
+    settle(bus)
+    candidates = {}
+    for motor_id in sorted(ids):
+        result = _ping(bus, motor_id, retries=1)
+        if result is not None:
+            candidates[motor_id] = result
+    _confirm(state, port, bus, candidates, by_broadcast=False)
 
 
 def _confirm(
     state: _Scan, port: str, bus: DxlBus, candidates: dict[int, PingResult], by_broadcast: bool
-) -> None:
+) -> set[int]:
     """Report the candidates that answer again, now that the line has settled.
 
     On a slow adapter a reply can come after the settle time, while the next rate is tried: it
     would be taken for a motor at that rate. A motor really at this rate answers again; a late
     reply from elsewhere does not.
+
+    Returns:
+        The candidates that did not answer again.
     """
     state.unconfirmed = 0
     if not candidates:
-        return
+        return set()
     again: set[int] = set()
     if by_broadcast:
         again = {pinged.id for pinged in bus.broadcast_ping()}
@@ -207,6 +276,7 @@ def _confirm(
                 motor_id,
                 bus.baudrate,
             )
+    return set(candidates) - again
 
 
 def scan(
@@ -262,22 +332,19 @@ def scan(
         learned = latency_s  # a slower adapter than assumed is learned once, for every rate
         try:
             for protocol in protocol_list:
+                previous: int | None = None
                 for rate in rates[protocol]:
                     if state.abort_requested():
                         return state.found
-                    bus = DxlBus(
-                        port,
-                        rate,
-                        protocol,
-                        latency_s=learned,
-                        retries=0,
-                        return_delay_s=return_delay_s,
-                        transport=transport,
-                        min_timeout_s=0.0,
-                    )
-                    bus.adaptive_latency = True
-                    _scan_rate(state, port, bus, broadcast)
+
+                    timing = (learned, return_delay_s)
+                    bus = _scan_bus(port, rate, protocol, transport, *timing)
+                    heard_late = _scan_rate(state, port, bus, broadcast)
                     learned = bus.latency_s
+                    if heard_late and previous is not None:
+                        earlier = _scan_bus(port, previous, protocol, transport, learned, timing[1])
+                        _revisit(state, port, earlier, heard_late)
+                    previous = rate
         finally:
             transport.close()
     return state.found
@@ -336,18 +403,21 @@ def find_port(
                     fixed if fixed is not None else standard_baudrates(protocol),
                     key=lambda rate: rate != DEFAULT_SEARCH_FIRST_BPS,
                 )
+                previous: int | None = None
                 for rate in rates:
                     bus = DxlBus(port, rate, protocol, latency_s=learned, transport=transport)
                     bus.adaptive_latency = True
-                    answered = [i for i in wanted if _ping(bus, i, retries=1) is not None]
-                    late = settle(bus)  # see _scan_rate and _confirm
-                    answered += [
-                        i for i in wanted if i in late and i not in answered and answers(bus, i)
-                    ]
-                    answered = [i for i in answered if answers(bus, i)]
+                    answered, heard_late = _answering(bus, wanted)
                     learned = bus.latency_s
                     if len(answered) == len(wanted):
                         return port, rate, protocol
+                    if heard_late and previous is not None:  # see _revisit
+                        earlier = DxlBus(port, previous, protocol, latency_s=learned,
+                                         transport=transport)  # fmt: skip
+                        earlier.adaptive_latency = True
+                        if len(_answering(earlier, wanted)[0]) == len(wanted):
+                            return port, previous, protocol
+                    previous = rate
                     if len(answered) > best[0]:
                         best = (
                             len(answered),

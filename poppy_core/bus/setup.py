@@ -148,13 +148,21 @@ def locate(bus: DxlBus, motor_id: int, rates: list[int] | None = None) -> int | 
     original, adaptive = bus.baudrate, bus.adaptive_latency
     bus.adaptive_latency = True  # a slow adapter is learned from its late replies
     try:
+        previous: int | None = None
         for rate in rates if rates is not None else standard_baudrates(bus.protocol):
             bus.baudrate = rate
-            found = answers(bus, motor_id)
-            # A late reply is this rate's; confirmed on a settled line (see bus.scan).
-            late = motor_id in settle(bus)
-            if (found or late) and answers(bus, motor_id):
-                return rate
+            # Heard now or late (settle), then confirmed on a settled line (see bus.scan); heard
+            # but not confirmed: a late reply from the rate before, looked at again.
+            heard = answers(bus, motor_id)
+            if motor_id in settle(bus) or heard:
+                if answers(bus, motor_id):
+                    return rate
+                if previous is not None:
+                    bus.baudrate = previous
+                    settle(bus)
+                    if answers(bus, motor_id):
+                        return previous
+            previous = rate
         bus.baudrate = original
         return None
     finally:

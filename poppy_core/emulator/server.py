@@ -230,7 +230,13 @@ class EmulatorServer(ABC):
                 reply = pending.popleft()
                 if reply.send_at:
                     sleep_until(reply.send_at)
-                self._send(reply.data)
+                data = reply.data
+                # Replies due by now leave together, as an adapter hands them over in one USB
+                # transfer: no gap between them for the host to take for the end.
+                now = time.perf_counter()
+                while pending and pending[0].send_at <= now:
+                    data += pending.popleft().data
+                self._send(data)
             elif item == _RESET:
                 self.bus.reset_input()
                 self.replies_dropped += len(pending)
