@@ -7,7 +7,7 @@ system-wide monotonic clock, shared with the process that injects the faults). U
 ``stop`` arrives on stdin it records, from outside the library:
 
 * each present-register read of each bus (``DxlBus.sync_read`` wrapped on the instance) and
-  each motor's state update (``Motor.update`` wrapped), counted per second;
+  each update of each motor's present position (``Motor.update`` wrapped), counted per second;
 * every change of each motor's ``online`` flag and each bus's ``connected`` flag (polled every
   ``POLL_S``);
 * once a second, for every motor online for the last ``CHECK_QUIET_S``: its goal position read
@@ -112,7 +112,8 @@ class Recorder:
 
     def _wrap_update(self, name: str, update: Callable[..., Any]) -> Callable[..., Any]:
         def counted(values: Mapping[str, object]) -> Any:
-            self.updates.tick(name, time.monotonic())
+            if "present_position" in values:
+                self.updates.tick(name, time.monotonic())
             return update(values)
 
         return counted

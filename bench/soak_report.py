@@ -117,21 +117,24 @@ def poppy_metrics(record: dict[str, Any], events: list[FaultEvent]) -> dict[str,
 
 
 def pypot_metrics(record: dict[str, Any], events: list[FaultEvent]) -> dict[str, Any]:
-    """Figures of one pypot run: loop rates before the first bus loss and in the last 10 s."""
+    """Figures of one pypot run: loop rates before the first loss of its bus and after it."""
     duration = float(record["duration_s"])
-    losses = [e for e in events if e.kind == "lose"]
-    first_loss = min((e.t_s for e in losses), default=duration)
     before: dict[str, float] = {}
     last: dict[str, float] = {}
     for bus, bins in record["reads_per_s"].items():
-        cut = [(first_loss - MARGIN_BEFORE_S, duration + 1)]
-        before[bus] = healthy_rate(bins, cut, duration)
-        tail = bins[max(0, int(duration) - 11) : int(duration) - 1]
-        last[bus] = statistics.fmean(tail) if tail else 0.0
+        losses = [e for e in events if e.kind == "lose" and e.target == bus]
+        first = min(losses, key=lambda e: e.t_s, default=None)
+        if first is None:
+            before[bus] = healthy_rate(bins, [], duration)
+            last[bus] = before[bus]
+            continue
+        before[bus] = healthy_rate(bins, [(first.t_s - MARGIN_BEFORE_S, duration + 1)], duration)
+        back = first.t_s + first.duration_s + MARGIN_AFTER_S
+        last[bus] = healthy_rate(bins, [(-1.0, back)], duration)
     return {
         "duration_s": duration,
         "loop_hz_before_loss": before,
-        "loop_hz_last_10s": last,
+        "loop_hz_after_loss": last,
         "loop_errors": record.get("loop_errors", {}),
         "last_errors": record.get("last_errors", {}),
         "start": record["start"],
@@ -223,7 +226,7 @@ def _pypot_table(results: dict[str, dict[str, Any]]) -> Table:
         alive = m["alive"]
         return [
             ", ".join(f"{hz:.1f} Hz" for hz in m["loop_hz_before_loss"].values()),
-            ", ".join(f"{hz:.1f} Hz" for hz in m["loop_hz_last_10s"].values()),
+            ", ".join(f"{hz:.1f} Hz" for hz in m["loop_hz_after_loss"].values()),
             ", ".join(str(n) for n in m["loop_errors"].values()),
             f"{sum(alive['sync'].values())}/{len(alive['sync'])}, "
             f"{'yes' if alive['primitive'] else 'no'}",
@@ -233,8 +236,8 @@ def _pypot_table(results: dict[str, dict[str, Any]]) -> Table:
         ]
 
     labels = [
-        "Sync loop rate before the first bus loss",
-        "Sync loop rate, last 10 s",
+        "Sync loop rate before its bus was first lost (per bus)",
+        "Sync loop rate after its bus came back",
         "Loop runs that raised",
         "Threads alive at the end (sync loops, primitive)",
         "RSS start → end",

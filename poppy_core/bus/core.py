@@ -260,8 +260,19 @@ class BusCore:
         wanted = {motor_id for motor_id, _ in expected}
         sizes_by_id = dict(expected)
         got: dict[int, StatusPacket] = {}
+        expected_bytes = sum(sizes)
+        received_before = transport.bytes_received
+        stray_bytes = 0
+
+        def all_came() -> bool:
+            """As many bytes as the replies came, some garbled: no point waiting out the
+            deadline (the retry goes out at once)."""
+            if len(got) + transport.corrupt_packets - corrupt_before >= len(wanted):
+                return True
+            return transport.bytes_received - received_before - stray_bytes >= expected_bytes
+
         while len(got) < len(wanted):
-            status = transport.read_packet(deadline, grace_s=grace)
+            status = transport.read_packet(deadline, grace_s=grace, give_up=all_came)
             if status is None:
                 break
             self._observe(status, time.monotonic())
@@ -271,6 +282,7 @@ class BusCore:
             else:
                 logger.debug("%s: stray status from ID %d kept aside", self._port, status.id)
                 self._strays.append(status)
+                stray_bytes += status_size(self._protocol, len(status.params))
         corrupt = transport.corrupt_packets - corrupt_before
         if len(got) < len(wanted) and not corrupt and transport.skipped_bytes > skipped_before:
             corrupt = 1  # bytes came back but no packet could be found in them: garbage

@@ -62,6 +62,7 @@ def exchange_with_retries(
     expected: dict[int, int],
     *,
     timeout_s: Callable[[list[int]], float] | None = None,
+    retries: int | None = None,
 ) -> dict[int, StatusPacket]:
     """Run a multi-reply instruction, asking again only the motors that did not answer.
 
@@ -70,6 +71,7 @@ def exchange_with_retries(
         make_packet: builds the instruction for a list of motor IDs.
         expected: motor ID -> number of parameter bytes of its reply, in reply order.
         timeout_s: optional first-reply timeout for a list of motor IDs.
+        retries: extra attempts (None: the bus's ``retries``).
 
     Returns:
         The usable replies, by ID (missing motors are absent).
@@ -78,7 +80,7 @@ def exchange_with_retries(
     missing = list(expected)
     with bus.lock:
         bus.stats.transactions += 1
-        for attempt in range(1 + bus.retries):
+        for attempt in range(1 + (bus.retries if retries is None else retries)):
             if attempt:
                 bus.stats.retries += 1
             replies = bus.exchange(
@@ -133,7 +135,7 @@ def _fill_in(
 
 
 def _usb2ax(
-    bus: DxlBus, address: int, length: int, ids: list[int]
+    bus: DxlBus, address: int, length: int, ids: list[int], *, retries: int | None = None
 ) -> dict[int, bytes | None] | None:
     """USB2AX sync read; None when the adapter does not answer (it lacks the instruction)."""
     n_params = length * len(ids)
@@ -148,13 +150,38 @@ def _usb2ax(
         lambda _missing: ins.sync_read(1, address, length, ids),
         {USB2AX_ID: n_params},
         timeout_s=lambda _missing: timeout,
+        retries=retries,
     )
     status = replies.get(USB2AX_ID)
     if status is None:
         return None
+    if bus.usb2ax and status.error and not is_alarm_only(1, status.error):
+        # The adapter reads the motors itself and answers for them: an error in its own
+        # status is noise that passed the 8-bit checksum. Read again as for a garbled reply.
+        logger.debug("%s: USB2AX status with error bits %#04x, read again", bus.port, status.error)
+        return None
     bus.check_status(status)
     blocks = parse_usb2ax_sync_status(status, length, ids)
     return {i: (None if all(b == 0xFF for b in data) else data) for i, data in blocks.items()}
+
+
+def _usb2ax_in_halves(
+    bus: DxlBus, address: int, length: int, ids: list[int]
+) -> dict[int, bytes | None]:
+    """USB2AX sync reads of each half of ``ids``, each half split again if its reply is garbled.
+
+    After a whole-group reply came garbled: on a noisy line a long reply is seldom clean and a
+    short one mostly is, while each reply costs a round trip. Halving finds the balance; a
+    single motor left is read the plain way (see ``_fill_in``).
+    """
+    if len(ids) <= 1:
+        return dict.fromkeys(ids)
+    out: dict[int, bytes | None] = {}
+    middle = (len(ids) + 1) // 2
+    for half in (ids[:middle], ids[middle:]):
+        data = _usb2ax(bus, address, length, half, retries=0)
+        out.update(data if data is not None else _usb2ax_in_halves(bus, address, length, half))
+    return out
 
 
 def _bulk(bus: DxlBus, requests: list[tuple[int, int, int]]) -> dict[int, StatusPacket]:
@@ -186,14 +213,17 @@ def sync_read(bus: DxlBus, address: int, length: int, ids: list[int]) -> dict[in
         mode = bus.sync_read_mode
         try_usb2ax = bus.sync_read_enabled is not False and bus.usb2ax is not False
         if mode == "sync" or (mode is None and try_usb2ax):
-            data = _usb2ax(bus, address, length, ids)
+            # Once the adapter is known to answer, one try for the whole group: if its reply
+            # is garbled, smaller groups get through sooner than the same long one again.
+            data = _usb2ax(bus, address, length, ids, retries=0 if bus.usb2ax else None)
             if data is not None:
                 bus.usb2ax = True
                 bus.sync_read_mode = "sync"
                 return _fill_in(bus, data, address, length)
             if bus.usb2ax or bus.sync_read_enabled is True:
                 # The adapter answered before (or must): this reply was lost or garbled.
-                return _sequential(bus, requests)
+                data = _usb2ax_in_halves(bus, address, length, ids)
+                return _fill_in(bus, data, address, length)
             logger.info("%s: no USB2AX sync read; trying bulk read", bus.port)
             bus.usb2ax = False
             bus.sync_read_mode = mode = None
