@@ -105,8 +105,24 @@ def render_section(result: BenchResult, machine: dict[str, Any]) -> str:
     return "\n\n".join(parts)
 
 
+def _existing_sections(path: Path) -> list[tuple[str, str]]:
+    """(title, text) of each ``## `` section of the current file (``Machine`` included)."""
+    try:
+        text = path.read_text()
+    except OSError:
+        return []
+    sections: list[tuple[str, str]] = []
+    for chunk in text.split("\n## ")[1:]:
+        title = chunk.splitlines()[0].split(" — ")[0].strip()
+        sections.append((title, "## " + chunk.rstrip()))
+    return sections
+
+
 def write_doc(names: Iterable[str], path: Path = DOC_PATH) -> Path:
     """Render docs/performance.md from the latest saved result of each benchmark.
+
+    A section of the current file whose benchmark has no saved result here (it was measured
+    on another machine or checkout) is kept as it is, in its place.
 
     Args:
         names: the registered benchmarks, in report order (those never run are left out).
@@ -116,10 +132,16 @@ def write_doc(names: Iterable[str], path: Path = DOC_PATH) -> Path:
         The path written.
     """
     loaded = [r for r in (load_result(n) for n in names) if r is not None]
-    parts = [DOC_INTRO.rstrip()]
+    fresh = {result.title: render_section(result, machine) for result, machine in loaded}
     if loaded:
         newest = max((m for _, m in loaded), key=lambda m: str(m["date"]))
-        parts.append(_machine_block(newest))
-    parts += [render_section(result, machine) for result, machine in loaded]
+        fresh["Machine"] = _machine_block(newest)
+    parts = [DOC_INTRO.rstrip()]
+    kept = _existing_sections(path)
+    if "Machine" in fresh and all(title != "Machine" for title, _ in kept):
+        parts.append(fresh.pop("Machine"))
+    for title, text in kept:
+        parts.append(fresh.pop(title, text))
+    parts += list(fresh.values())
     path.write_text("\n\n".join(parts) + "\n")
     return path

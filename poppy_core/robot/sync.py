@@ -8,8 +8,10 @@ and load, temperature and voltage at 1 Hz. Writes only send values that changed.
 
 Reads use ``DxlBus.sync_read`` (sync read, USB2AX sync read, bulk read or single reads, as the
 bus offers), one transaction per group of motors sharing a register layout. A motor that misses
-``offline_after`` reads in a row is marked offline: it leaves the fast loops and is pinged once
-per ``retry_period_s`` until it answers again. Deadlines are drift-free (``Periodic``).
+``offline_after`` reads in a row is marked offline: it leaves the fast loops and is pinged (one
+offline motor per ``retry_period_s``, in turn) until it answers again. Deadlines are drift-free
+(``Periodic``); a run that overran its period is followed at once by the next one, so a loop
+whose runs are sometimes long keeps its rate.
 
 A lost port (adapter unplugged, emulator gone: a ``PortError``) is logged once at WARNING, every
 motor of the bus goes offline at once, and the thread reopens the port with backoff
@@ -61,6 +63,10 @@ LIGHT_LOOPS: tuple[LoopSpec, ...] = (
     LoopSpec("sensors", ("present_load", *regs.SENSORS), False, 1.0),
 )
 RETRY = "retry"
+# Offline motors are pinged RETRY_BATCH at a time, in turn, every ``retry_period_s`` (0.2 s): a
+# motor plugged back answers within a fraction of a second, and a bus full of silent motors
+# costs its live ones one ping per run.
+RETRY_BATCH = 1
 # Reopening a lost port: first attempt after RECONNECT_FIRST_S, then twice as long each time.
 RECONNECT_FIRST_S = 0.1
 RECONNECT_MAX_S = 1.0
@@ -88,7 +94,7 @@ def loops_for(syncloop: str) -> tuple[LoopSpec, ...]:
 class _Loop:
     def __init__(self, spec: LoopSpec, start_s: float) -> None:
         self.spec = spec
-        self.schedule = Periodic(1.0 / spec.rate_hz, start_s)
+        self.schedule = Periodic(1.0 / spec.rate_hz, start_s, catch_up=1)
         self.meter = RateMeter()
         self.errors = 0
         self.last_duration_s = 0.0
@@ -103,7 +109,8 @@ class BusSync:
         motors: the motors on it.
         loops: the register groups (``BASE_LOOPS``, ``LIGHT_LOOPS`` or your own).
         offline_after: consecutive missed reads before a motor is marked offline.
-        retry_period_s: how often offline motors are pinged.
+        retry_period_s: time between two pings of offline motors (one motor per ping, in
+            turn; see ``RETRY_BATCH``).
         clock: monotonic clock in seconds.
     """
 
@@ -115,7 +122,7 @@ class BusSync:
         loops: Sequence[LoopSpec] = BASE_LOOPS,
         *,
         offline_after: int = 3,
-        retry_period_s: float = 1.0,
+        retry_period_s: float = 0.2,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.controller = controller
@@ -128,6 +135,7 @@ class BusSync:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._blocks: dict[tuple[str, ServoModel], list[regs.Block]] = {}
+        self._retry_turn = 0
         self.connected = True
         self.losses = 0
         self._down_since = 0.0
@@ -314,9 +322,9 @@ class BusSync:
             now - self._down_since,
         )
         for loop in self._loops:
-            loop.schedule = Periodic(loop.schedule.period_s, now)
+            loop.schedule = Periodic(loop.schedule.period_s, now, catch_up=1)
         try:
-            self._retry()
+            self._retry(every=True)
         except PortError as exc:
             self._lost(exc)
 
@@ -368,12 +376,11 @@ class BusSync:
     def _missed(self, motor: Motor | None, reason: str) -> None:
         if motor is not None and motor.mark_missed(self.offline_after):
             logger.warning(
-                "%s (id %d) on %s stopped answering (%s); retrying every %.1f s",
+                "%s (id %d) on %s stopped answering (%s); pinging it until it answers",
                 motor.name,
                 motor.id,
                 self.bus.port,
                 reason,
-                1.0 / self._specs[-1].rate_hz,
             )
 
     def _write(self, spec: LoopSpec) -> None:
@@ -400,12 +407,20 @@ class BusSync:
                 motor.restore_pending(values)
             raise
 
-    def _retry(self) -> None:
-        for motor in self.motors:
-            if motor.online or self._stop.is_set():
-                continue
+    def _retry(self, every: bool = False) -> None:
+        """Ping offline motors: the next ``RETRY_BATCH`` in turn, or ``every`` one of them."""
+        offline = [m for m in self.motors if not m.online]
+        if not offline:
+            return
+        if not every:
+            start = self._retry_turn % len(offline)
+            offline = (offline[start:] + offline[:start])[:RETRY_BATCH]
+            self._retry_turn += len(offline)
+        for motor in offline:
+            if self._stop.is_set():
+                return
             try:
-                answered = self.bus.ping(motor.id, retries=0, identify=False) is not None
+                answered = self.bus.ping(motor.id, identify=False) is not None
             except PortError:
                 raise
             except BusError:
