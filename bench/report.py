@@ -21,11 +21,13 @@ the same run. Goals come from the project's issues; each table says whether they
 
 Run everything with `make bench` (it runs `.venv/bin/python -m bench`), or one benchmark with
 `.venv/bin/python -m bench scan`. Options: `--repeat N` (default 3), `--no-peers` (poppy
-only), `--list`. The peers live in their own venv, `bench/.venv-peers`, built by
-`bench/setup_peers.sh` on first use (see `bench/README.md`); without it the benchmarks still
-run and say that the peers were not measured. Each run rewrites this file from the latest
-results and keeps the raw measurements in `bench/results/NAME.json` (git-ignored) and a
-time-stamped copy next to it.
+only), `--list`, `--minutes M` (the soak's length per robot and client, default 10). The fault
+soak takes about 45 minutes: it runs only when named (`python -m bench soak`). The peers live
+in their own venv, `bench/.venv-peers`, built by `bench/setup_peers.sh` on first use (see
+`bench/README.md`); without it the benchmarks still run and say that the peers were not
+measured. Each run rewrites the sections of the benchmarks it ran from their latest results
+(the others are kept) and keeps the raw measurements in `bench/results/NAME.json`
+(git-ignored) and a time-stamped copy next to it.
 """
 
 

@@ -76,6 +76,7 @@ class Recorder:
         self.checked = 0
         self.lost: list[dict[str, Any]] = []
         self.unchecked = 0
+        self.misread = 0
         self._stop = threading.Event()
         self._online_since: dict[str, float] = {}
         self._threads: list[threading.Thread] = []
@@ -171,6 +172,18 @@ class Recorder:
                 return
             try:
                 raw = register.decode(bus.read(motor.id, register.address, register.size))
+                if raw != entry[0]:
+                    # Protocol 1's 8-bit checksum lets some garbled replies through: a goal
+                    # really lost reads the same wrong value twice more.
+                    again = [
+                        register.decode(bus.read(motor.id, register.address, register.size))
+                        for _ in range(2)
+                    ]
+                    if entry[0] in again:
+                        self.misread += 1
+                        raw = entry[0]
+                    else:
+                        raw = again[0]
             except PoppyError:
                 self.unchecked += 1
                 return
@@ -255,6 +268,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         record["goal_checks"] = {
             "checked": recorder.checked,
             "unchecked": recorder.unchecked,
+            "misread": recorder.misread,
             "lost": len(recorder.lost),
             "examples": [{**x, "t": round(x["t"] - t0, 3)} for x in recorder.lost[:5]],
         }

@@ -327,7 +327,10 @@ def build_result(raw: dict[str, Any]) -> BenchResult:
         "emulator to the moment the client saw the flag change (polled every 2 ms, one "
         "monotonic clock for all processes). Goal writes are checked once a second on every "
         "motor online for at least 1 s: its goal register, read back under the bus lock, "
-        "must hold the last goal the sync loop wrote to it.",
+        "must hold the last goal the sync loop wrote to it. A wrong value is read twice more: "
+        "protocol 1's 8-bit checksum lets a few garbled replies through (two flipped bits that "
+        "cancel out), which a second read shows; such misreads are counted apart "
+        f"({', '.join(str(m['goal_checks'].get('misread', 0)) for m in poppy.values())}).",
         "Writes lost by a client that flushes before every packet happen in the kernel, not in "
         "the emulator: Linux hands bytes written to a pty slave to the master side in a "
         "deferred worker, and a flush of the slave's output that comes first discards them. "
