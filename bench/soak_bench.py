@@ -25,6 +25,7 @@ packet) against ``poppy emulate`` and ``poppy sim`` and counts lost writes
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import select
@@ -115,7 +116,11 @@ def plan(controllers: dict[str, list[int]], duration_s: float) -> list[Planned]:
 
 
 def _read_ready(proc: subprocess.Popen[str]) -> float:
-    """Wait for the client's ``ready T`` line; return T."""
+    """Wait for the client's ``ready T`` line; return T.
+
+    Raises:
+        EmulatorError: the client ended or printed its error record (given) instead.
+    """
     assert proc.stdout is not None
     end = time.monotonic() + READY_TIMEOUT_S
     while time.monotonic() < end:
@@ -126,6 +131,8 @@ def _read_ready(proc: subprocess.Popen[str]) -> float:
                 break
             if line.startswith("ready "):
                 return float(line.split()[1])
+            if line.startswith("{"):
+                raise EmulatorError(str(json.loads(line).get("error")))
         if proc.poll() is not None:
             break
     raise EmulatorError("the client did not get ready")
@@ -144,11 +151,11 @@ def soak_session(
         )  # fmt: skip
         try:
             t0 = _read_ready(proc)
-        except EmulatorError:
+        except EmulatorError as exc:
             proc.kill()
             _, _ = proc.communicate()
             errors.seek(0)
-            tail = (errors.read().strip().splitlines() or ["no output"])[-1]
+            tail = (errors.read().strip().splitlines() or [str(exc)])[-1]
             return {"error": f"not ready: {tail}"}, events
         emulator.send(f"corrupt {CORRUPT:g}")
         emulator.send(f"drop {DROP:g}")
@@ -172,8 +179,6 @@ def soak_session(
             errors.seek(0)
             tail = (errors.read().strip().splitlines() or [f"exit {proc.returncode}"])[-1]
             return {"error": f"no JSON: {tail}"}, events
-        import json
-
         record: dict[str, Any] = json.loads(lines[-1])
         errors.seek(0)
         record["stderr_lines"] = len(errors.read().splitlines())

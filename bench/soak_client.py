@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 POLL_S = 0.002
+SETUP_ATTEMPTS = 3
 CHECK_PERIOD_S = 1.0
 CHECK_QUIET_S = 1.0
 SINUS_AMPLITUDE_DEG = 10.0
@@ -215,12 +216,16 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         data["controllers"][name]["port"] = port
     config = RobotConfig.from_dict(data, source=args.config)
     start = time.perf_counter()
-    try:
-        robot = from_config(config, fix_return_delay=True, start_sync=False)
-    except PoppyError as exc:
-        record["error"] = f"from_config failed: {type(exc).__name__}: {exc}"
-        return record
+    for attempt in range(1, SETUP_ATTEMPTS + 1):  # a loaded machine may delay a first reply
+        try:
+            robot = from_config(config, fix_return_delay=True, start_sync=False)
+            break
+        except PoppyError as exc:
+            if attempt == SETUP_ATTEMPTS:
+                record["error"] = f"from_config failed: {type(exc).__name__}: {exc}"
+                return record
     record["setup_s"] = time.perf_counter() - start
+    record["setup_attempts"] = attempt
     recorder = Recorder(robot, config)
     closed = False
     try:
