@@ -30,18 +30,27 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
 from poppy_core.bus.dxlbus import DxlBus
-from poppy_core.bus.ports import list_ports
+from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_port
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
-from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, settle_s
+from poppy_core.bus.settle import answers, ping_found, settle
+from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S
 from poppy_core.bus.transport import Transport
-from poppy_core.errors import CorruptPacketError, PortError, SetupError
+from poppy_core.errors import PortError
 from poppy_core.models import standard_baudrates
+
+__all__ = [
+    "DEFAULT_SEARCH_FIRST_BPS",
+    "PROTOCOLS",
+    "SCAN_IDS",
+    "answers",
+    "find_port",
+    "scan",
+    "settle",
+]
 
 logger = logging.getLogger(__name__)
 
 SCAN_IDS = range(254)
-DEFAULT_SEARCH_FIRST_BPS = 1_000_000
-PROTOCOLS = (1, 2)
 
 
 def _found(port: str, bus: DxlBus, result: PingResult) -> FoundMotor:
@@ -106,31 +115,6 @@ class _Scan:
             self.on_found(motor)
 
 
-def _ping(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
-    try:
-        return bus.ping(motor_id, retries=retries)
-    except CorruptPacketError:
-        logger.debug("%s: garbage in reply to ping %d", bus.port, motor_id)
-        return None
-
-
-def settle(bus: DxlBus) -> set[int]:
-    """Listen for replies still on their way; return the IDs that answered late.
-
-    Whatever came is dropped, so that the next rate starts on a clean line; an adaptive bus
-    has learned from it how slow the adapter really is.
-    """
-    return {status.id for status in bus.listen(settle_s(bus.latency_s))}
-
-
-def answers(bus: DxlBus, motor_id: int) -> bool:
-    """Whether ``motor_id`` answers a ping (one retry, no model read)."""
-    try:
-        return bus.ping(motor_id, retries=1, identify=False) is not None
-    except CorruptPacketError:
-        return False
-
-
 def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int]:
     """Scan one (port, rate, protocol); motors answering are confirmed before being reported.
 
@@ -168,7 +152,7 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int
             if state.abort_requested():
                 break
             if motor_id not in candidates:
-                result = _ping(bus, motor_id, retries=0)
+                result = ping_found(bus, motor_id, retries=0)
                 if result is not None:
                     candidates[motor_id] = result
                     state.unconfirmed = len(candidates)
@@ -178,7 +162,7 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int
     # Replies still coming are late answers of this rate: wait for them before the next rate.
     late |= settle(bus) & wanted
     for motor_id in sorted(late - set(candidates)):
-        result = _ping(bus, motor_id, retries=1)
+        result = ping_found(bus, motor_id, retries=1)
         if result is not None:
             candidates[motor_id] = result
     unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
@@ -209,18 +193,6 @@ def _scan_bus(
     return bus
 
 
-def _answering(bus: DxlBus, wanted: list[int]) -> tuple[list[int], set[int]]:
-    """Which of ``wanted`` answer at the bus's rate, confirmed on a settled line (see _confirm).
-
-    Returns:
-        The IDs confirmed, and the IDs heard but not confirmed (late replies from elsewhere).
-    """
-    heard = {i for i in wanted if _ping(bus, i, retries=1) is not None}
-    heard |= settle(bus) & set(wanted)
-    confirmed = [i for i in wanted if i in heard and answers(bus, i)]
-    return confirmed, heard - set(confirmed)
-
-
 def _revisit(state: _Scan, port: str, bus: DxlBus, ids: set[int]) -> None:
     """Look again at the rate before for motors whose replies came late into the next one.
 
@@ -240,7 +212,7 @@ def _revisit(state: _Scan, port: str, bus: DxlBus, ids: set[int]) -> None:
     settle(bus)
     candidates = {}
     for motor_id in sorted(ids):
-        result = _ping(bus, motor_id, retries=1)
+        result = ping_found(bus, motor_id, retries=1)
         if result is not None:
             candidates[motor_id] = result
     _confirm(state, port, bus, candidates, by_broadcast=False)
@@ -348,92 +320,3 @@ def scan(
         finally:
             transport.close()
     return state.found
-
-
-def find_port(
-    ids: Iterable[int],
-    ports: Sequence[str] | None = None,
-    baudrates: Iterable[int] | None = None,
-    protocols: Iterable[int] = PROTOCOLS,
-    *,
-    latency_s: float | None = None,
-) -> tuple[str, int, int]:
-    """Find the bus holding every motor in ``ids``.
-
-    Args:
-        ids: motor IDs that must all answer.
-        ports: ports to try; None tries every port ``list_ports`` finds.
-        baudrates: rates to try; None tries the standard rates of each protocol.
-        protocols: protocols to try.
-        latency_s: adapter latency (None: from the port).
-
-    Returns:
-        ``(port, baudrate, protocol)``.
-
-    A motor that answers is asked again once the line has settled, so that a late reply (a
-    slow adapter) is not taken for a motor at the next rate tried; a slower adapter than
-    assumed is learned from its replies (see ``poppy_core.bus.latency``).
-
-    Raises:
-        PortError: no serial port at all; the only port given (or every one) cannot be opened.
-        SetupError: no port/rate/protocol answers for every ID (the message says the closest).
-    """
-    wanted = list(ids)
-    protocols = list(protocols)
-    fixed = None if baudrates is None else list(baudrates)
-    port_list = list(ports) if ports is not None else [p.device for p in list_ports()]
-    if not port_list:
-        raise PortError("no serial port found: plug the adapter or run `poppy ports`")
-    best: tuple[int, str] = (0, "")
-    unopened: list[PortError] = []
-    for port in port_list:
-        try:
-            transport = Transport(port)
-        except PortError as exc:
-            if len(port_list) == 1:
-                raise
-            logger.warning("skipping %s: %s", port, exc)
-            unopened.append(exc)
-            continue
-        learned = latency_s
-        try:
-            for protocol in protocols:
-                # 1 Mbps first: the rate of Poppy robots and of most set-up buses
-                rates = sorted(
-                    fixed if fixed is not None else standard_baudrates(protocol),
-                    key=lambda rate: rate != DEFAULT_SEARCH_FIRST_BPS,
-                )
-                previous: int | None = None
-                for rate in rates:
-                    bus = DxlBus(port, rate, protocol, latency_s=learned, transport=transport)
-                    bus.adaptive_latency = True
-                    answered, heard_late = _answering(bus, wanted)
-                    learned = bus.latency_s
-                    if len(answered) == len(wanted):
-                        return port, rate, protocol
-                    if heard_late and previous is not None:  # see _revisit
-                        earlier = DxlBus(port, previous, protocol, latency_s=learned,
-                                         transport=transport)  # fmt: skip
-                        earlier.adaptive_latency = True
-                        if len(_answering(earlier, wanted)[0]) == len(wanted):
-                            return port, previous, protocol
-                    previous = rate
-                    if len(answered) > best[0]:
-                        best = (
-                            len(answered),
-                            f"{port} at {rate} bps, protocol {protocol} "
-                            f"has {', '.join(map(str, answered))}",
-                        )
-        finally:
-            transport.close()
-    if len(unopened) == len(port_list):
-        reasons = "; ".join(str(exc) for exc in unopened)
-        raise PortError(f"no port could be opened: {reasons}")
-    closest = f"; closest: {best[1]}" if best[0] else ""
-    rates_text = "every standard rate" if fixed is None else ", ".join(f"{r} bps" for r in fixed)
-    protocols_text = " and ".join(str(p) for p in protocols)
-    raise SetupError(
-        f"no motor {', '.join(map(str, wanted))} answers (searched {', '.join(port_list)} at "
-        f"{rates_text}, protocol {protocols_text}){closest}: check power and wiring, "
-        "or run `poppy scan --all-bauds`"
-    )

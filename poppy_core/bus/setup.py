@@ -143,7 +143,7 @@ def locate(bus: DxlBus, motor_id: int, rates: list[int] | None = None) -> int | 
     Returns:
         The rate where it answers, None when nowhere (the bus's rate is then restored).
     """
-    from poppy_core.bus.scan import answers, settle
+    from poppy_core.bus.settle import answers, settle
 
     original, adaptive = bus.baudrate, bus.adaptive_latency
     bus.adaptive_latency = True  # a slow adapter is learned from its late replies

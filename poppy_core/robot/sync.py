@@ -25,43 +25,19 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 from poppy_core.bus import DxlBus
 from poppy_core.errors import BusError, MotorError, PoppyError, PortError
 from poppy_core.models import ServoModel
 from poppy_core.robot import registers as regs
 from poppy_core.robot.health import BusHealth, LoopStats, SyncStats
+from poppy_core.robot.loops import BASE_LOOPS, LIGHT_LOOPS, LoopSpec, loops_for
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.schedule import Periodic, RateMeter
 
 logger = logging.getLogger(__name__)
 
 
-@dataclass(frozen=True)
-class LoopSpec:
-    """One register group: its registers, direction and rate."""
-
-    name: str
-    registers: tuple[str, ...]
-    write: bool
-    rate_hz: float
-
-
-BASE_LOOPS: tuple[LoopSpec, ...] = (
-    LoopSpec("present", regs.PRESENT, False, 50.0),
-    LoopSpec("goals", regs.GOALS, True, 50.0),
-    LoopSpec("gains", regs.GAINS, True, 10.0),
-    LoopSpec("limits", regs.LIMITS, True, 1.0),
-    LoopSpec("sensors", regs.SENSORS, False, 1.0),
-)
-LIGHT_LOOPS: tuple[LoopSpec, ...] = (
-    LoopSpec("present", ("present_position", "present_speed"), False, 50.0),
-    LoopSpec("goals", regs.GOALS, True, 50.0),
-    LoopSpec("gains", regs.GAINS, True, 10.0),
-    LoopSpec("limits", regs.LIMITS, True, 1.0),
-    LoopSpec("sensors", ("present_load", *regs.SENSORS), False, 1.0),
-)
 RETRY = "retry"
 # Offline motors are pinged RETRY_BATCH at a time, in turn, every ``retry_period_s`` (0.2 s): a
 # motor plugged back answers within a fraction of a second, and a bus full of silent motors
@@ -84,11 +60,6 @@ __all__ = [
     "SyncStats",
     "loops_for",
 ]
-
-
-def loops_for(syncloop: str) -> tuple[LoopSpec, ...]:
-    """The loops for a config's ``syncloop`` name (``LightDxlController`` → light, else base)."""
-    return LIGHT_LOOPS if "light" in syncloop.lower() else BASE_LOOPS
 
 
 class _Loop:

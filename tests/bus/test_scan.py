@@ -120,7 +120,7 @@ def test_find_port(emulate: Emulate) -> None:
 
 
 def test_find_port_without_ports(monkeypatch: pytest.MonkeyPatch) -> None:
-    module = importlib.import_module("poppy_core.bus.scan")
+    module = importlib.import_module("poppy_core.bus.find")
     monkeypatch.setattr(module, "list_ports", lambda: [])
     with pytest.raises(PortError):
         find_port([1])
