@@ -14,6 +14,7 @@ from bench import (
     scan_bench,
     server_bench,
     sim_bench,
+    soak_bench,
     teleop_bench,
 )
 from bench.clients import ensure_peers
@@ -26,7 +27,7 @@ logger = logging.getLogger("bench")
 # Importing a benchmark module registers it; list them here so `--list` sees them all.
 _MODULES = (
     scan_bench, robot_bench, move_bench, server_bench, sim_bench, ik_bench, camera_bench,
-    teleop_bench,
+    teleop_bench, soak_bench,
 )  # fmt: skip
 
 
@@ -44,16 +45,22 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=3, help="runs per measurement (default 3)")
     parser.add_argument("--no-peers", action="store_true", help="measure poppy only")
     parser.add_argument("--list", action="store_true", help="list the benchmarks and exit")
+    parser.add_argument(
+        "--minutes", type=float, default=None, help="duration of the soak, per robot (default 10)"
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="bench: %(message)s")
     if args.list:
         for bench in BENCHMARKS.values():
-            sys.stdout.write(f"{bench.name:10} {bench.summary}\n")
+            note = " (long: runs only when named)" if bench.long else ""
+            sys.stdout.write(f"{bench.name:10} {bench.summary}{note}\n")
         return 0
     unknown = [n for n in args.names if n not in BENCHMARKS]
     if unknown or args.repeat < 1:
         parser.error(f"unknown benchmark(s) {', '.join(unknown)}" if unknown else "--repeat < 1")
-    ctx = BenchContext(repeat=args.repeat)
+    if args.minutes is not None and not args.minutes > 0:
+        parser.error("--minutes must be > 0")
+    ctx = BenchContext(repeat=args.repeat, minutes=args.minutes)
     if args.no_peers:
         ctx.peers_note = "run with --no-peers"
     else:
@@ -63,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
             logger.warning("peers unavailable, measuring poppy only: %s", ctx.peers_note)
     machine = machine_info(ctx.peers_python)
     all_passed = True
-    for name in args.names or list(BENCHMARKS):
+    for name in args.names or [n for n, b in BENCHMARKS.items() if not b.long]:
         logger.info("running %s", name)
         result = BENCHMARKS[name].func(ctx)
         path = save_result(result, machine)

@@ -31,6 +31,9 @@ class EmulatorProcess:
         port: the pty path, once started.
     """
 
+    stdin: int = subprocess.DEVNULL
+    """What the process reads: a subclass sending it commands sets ``subprocess.PIPE``."""
+
     def __init__(self, motors: str, *, latency_ms: float = 1.0, wire_timing: bool = True) -> None:
         """Prepare (not start) an emulator serving ``motors``."""
         self.motors = motors
@@ -62,7 +65,7 @@ class EmulatorProcess:
             self._args,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
-            stdin=subprocess.DEVNULL,
+            stdin=self.stdin,
             text=True,
         )
         assert self._proc.stdout is not None

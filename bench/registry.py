@@ -22,11 +22,13 @@ class BenchContext:
         repeat: how many times each measurement is repeated (the median is reported).
         peers_python: the peers venv's interpreter, or None when the peers are unavailable.
         peers_note: why the peers are unavailable (empty when they are).
+        minutes: duration of the long benchmarks (``soak``), None for their default.
     """
 
     repeat: int = 3
     peers_python: Path | None = None
     peers_note: str = ""
+    minutes: float | None = None
 
 
 @dataclass
@@ -71,17 +73,19 @@ class Benchmark:
     name: str
     summary: str
     func: BenchFunc
+    long: bool = False
 
 
 BENCHMARKS: dict[str, Benchmark] = {}
 
 
-def register(name: str, summary: str) -> Callable[[BenchFunc], BenchFunc]:
+def register(name: str, summary: str, *, long: bool = False) -> Callable[[BenchFunc], BenchFunc]:
     """Decorator adding a benchmark function to ``BENCHMARKS`` under ``name``.
 
     Args:
         name: the name given on the command line (``python -m bench NAME``).
         summary: one line shown by ``python -m bench --list``.
+        long: runs only when named (``python -m bench soak``), not in ``python -m bench``.
 
     Returns:
         The decorator; it returns the function unchanged.
@@ -90,7 +94,7 @@ def register(name: str, summary: str) -> Callable[[BenchFunc], BenchFunc]:
     def decorate(func: BenchFunc) -> BenchFunc:
         if name in BENCHMARKS:
             raise ValueError(f"benchmark {name!r} registered twice")
-        BENCHMARKS[name] = Benchmark(name, summary, func)
+        BENCHMARKS[name] = Benchmark(name, summary, func, long)
         return func
 
     return decorate

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import re
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -22,14 +21,15 @@ the same run. Goals come from the project's issues; each table says whether they
 
 Run everything with `make bench` (it runs `.venv/bin/python -m bench`), or one benchmark with
 `.venv/bin/python -m bench scan`. Options: `--repeat N` (default 3), `--no-peers` (poppy
-only), `--list`. The peers live in their own venv, `bench/.venv-peers`, built by
-`bench/setup_peers.sh` on first use (see `bench/README.md`); without it the benchmarks still
-run and say that the peers were not measured. Each run rewrites this file from the latest
-result of the benchmarks it ran (the sections of the others stay as they were) and keeps the
-raw measurements in `bench/results/NAME.json` (git-ignored) and a time-stamped copy next to it.
+only), `--list`, `--minutes M` (the soak's length per robot and client, default 10). The fault
+soak takes about 45 minutes: it runs only when named (`python -m bench soak`). The peers live
+in their own venv, `bench/.venv-peers`, built by `bench/setup_peers.sh` on first use (see
+`bench/README.md`); without it the benchmarks still run and say that the peers were not
+measured. Each run rewrites the sections of the benchmarks it ran from their latest results
+(the others are kept) and keeps the raw measurements in `bench/results/NAME.json`
+(git-ignored) and a time-stamped copy next to it.
 """
 
-_SECTION_NAME = re.compile(r"`python -m bench ([\w-]+)`")
 
 
 def _stamp(date: str) -> str:
@@ -108,25 +108,24 @@ def render_section(result: BenchResult, machine: dict[str, Any]) -> str:
     return "\n\n".join(parts)
 
 
-def existing_sections(path: Path) -> dict[str, str]:
-    """The benchmark sections of an existing report, keyed by benchmark name."""
+def _existing_sections(path: Path) -> list[tuple[str, str]]:
+    """(title, text) of each ``## `` section of the current file (``Machine`` included)."""
     try:
         text = path.read_text()
     except OSError:
-        return {}
-    sections: dict[str, str] = {}
-    for chunk in re.split(r"\n(?=## )", text):
-        match = _SECTION_NAME.search(chunk) if chunk.startswith("## ") else None
-        if match and not chunk.startswith("## Machine"):
-            sections[match.group(1)] = chunk.strip()
+        return []
+    sections: list[tuple[str, str]] = []
+    for chunk in text.split("\n## ")[1:]:
+        title = chunk.splitlines()[0].split(" — ")[0].strip()
+        sections.append((title, "## " + chunk.rstrip()))
     return sections
 
 
 def write_doc(names: Iterable[str], path: Path = DOC_PATH) -> Path:
     """Render docs/performance.md from the latest saved result of each benchmark.
 
-    A benchmark with no saved result here keeps the section the report already had, so a run
-    of one benchmark on a fresh clone does not drop the others' figures.
+    A section of the current file whose benchmark has no saved result here (it was measured
+    on another machine or checkout) is kept as it is, in its place.
 
     Args:
         names: the registered benchmarks, in report order (those never run are left out).
@@ -135,31 +134,18 @@ def write_doc(names: Iterable[str], path: Path = DOC_PATH) -> Path:
     Returns:
         The path written.
     """
-    kept = existing_sections(path)
+    loaded = [r for r in (load_result(n) for n in names) if r is not None]
+    fresh = {result.title: render_section(result, machine) for result, machine in loaded}
+    if loaded:
+        newest = max((m for _, m in loaded), key=lambda m: str(m["date"]))
+        fresh["Machine"] = _machine_block(newest)
     parts = [DOC_INTRO.rstrip()]
-    sections: list[str] = []
-    machines: list[dict[str, Any]] = []
-    for name in names:
-        loaded = load_result(name)
-        if loaded is not None:
-            result, machine = loaded
-            machines.append(machine)
-            sections.append(render_section(result, machine))
-        elif name in kept:
-            sections.append(kept[name])
-    if machines:
-        parts.append(_machine_block(max(machines, key=lambda m: str(m["date"]))))
-    elif kept and (machine_block := _kept_machine_block(path)):
-        parts.append(machine_block)
-    parts += sections
+    kept = _existing_sections(path)
+    if "Machine" in fresh and all(title != "Machine" for title, _ in kept):
+        parts.append(fresh.pop("Machine"))
+    for title, text in kept:
+        parts.append(fresh.pop(title, text))
+    parts += list(fresh.values())
     path.write_text("\n\n".join(parts) + "\n")
     return path
 
-
-def _kept_machine_block(path: Path) -> str | None:
-    try:
-        text = path.read_text()
-    except OSError:
-        return None
-    match = re.search(r"^## Machine\n.*?(?=\n## |\Z)", text, flags=re.S | re.M)
-    return match.group(0).strip() if match else None

@@ -5,6 +5,7 @@ from __future__ import annotations
 import signal
 import sys
 import threading
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
@@ -14,6 +15,7 @@ from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
 
 if TYPE_CHECKING:
     from poppy_core.emulator import VirtualBus
+    from poppy_core.emulator.control import EmulatorControl
 
 
 def parse_hostport(text: str) -> tuple[str, int]:
@@ -52,9 +54,36 @@ def emulate(
     usb2ax: bool = typer.Option(
         False, "--usb2ax", help="Act as a USB2AX adapter (answers protocol 1 SYNC_READ 0x84)."
     ),
+    link: list[Path] | None = typer.Option(
+        None,
+        "--link",
+        help="Keep this symlink pointing at the pty (one per bus, in order); it survives `lose`.",
+    ),
+    corrupt: float = typer.Option(
+        0.0, "--corrupt", min=0.0, max=1.0, help="Fault: probability that a reply byte is flipped."
+    ),
+    drop: float = typer.Option(
+        0.0, "--drop", min=0.0, max=1.0, help="Fault: probability that a reply is lost."
+    ),
+    delay_ms: float = typer.Option(
+        0.0, "--delay-ms", min=0.0, help="Fault: extra delay added to every reply, in ms."
+    ),
+    unplug: list[str] | None = typer.Option(
+        None,
+        "--unplug",
+        metavar="ID@T[+D]",
+        help="Fault: unplug motor ID T seconds after start (for D seconds). Repeatable.",
+    ),
+    control: bool = typer.Option(
+        False,
+        "--control",
+        help="Read fault commands from stdin, one per line (`help` lists them; see docs).",
+    ),
+    seed: int = typer.Option(0, "--seed", help="Seed of the fault injection's random numbers."),
 ) -> None:
     """Serve virtual motors: print the pty path (or socket:// URL), then serve until Ctrl-C."""
     from poppy_core.emulator import build_bus_from_spec, serve_pty, serve_tcp
+    from poppy_core.emulator.control import ControlError, EmulatorControl, ScheduledUnplug
 
     if (profile is None) == (motors is None):
         error_line("give either --profile NAME or --motors MODEL:IDS (e.g. --motors XL-320:1-6)")
@@ -62,7 +91,19 @@ def emulate(
     if pty and tcp:
         error_line("give either --pty or --tcp, not both")
         raise typer.Exit(EXIT_USAGE)
-    options: dict[str, object] = {"wire_timing": wire_timing, "latency_s": latency_ms / 1000.0}
+    try:
+        scheduled = [ScheduledUnplug.parse(text) for text in unplug or []]
+    except ControlError as exc:
+        error_line(f"--unplug: {exc}")
+        raise typer.Exit(EXIT_USAGE) from None
+    if link and tcp:
+        error_line("--link names a pty: it cannot be used with --tcp")
+        raise typer.Exit(EXIT_USAGE)
+    options: dict[str, object] = {
+        "wire_timing": wire_timing,
+        "latency_s": latency_ms / 1000.0,
+        "seed": seed,
+    }
     buses: list[tuple[str, VirtualBus]]
     if profile is not None:
         from poppy_core.robot.factory import virtual_buses
@@ -84,21 +125,34 @@ def emulate(
             motors, protocol=protocol, baudrate=baud or 1_000_000, adapter=adapter, **options
         )
         buses = [("bus", bus)]
+    links = list(link or [])
+    if links and len(links) != len(buses):
+        error_line(f"give one --link per bus: this robot has {len(buses)} ({len(links)} given)")
+        raise typer.Exit(EXIT_USAGE)
+    for _, bus in buses:
+        bus.corrupt_rate, bus.drop_rate, bus.extra_delay_s = corrupt, drop, delay_ms / 1000.0
     hostport = parse_hostport(tcp) if tcp else None
     # Handlers go in before the URL is printed: a client may stop us as soon as it reads it.
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
     servers = []
+    faults = None
     try:
         for index, (_name, bus) in enumerate(buses):
             if hostport is None:
-                servers.append(serve_pty(bus))
+                servers.append(serve_pty(bus, links[index] if links else None))
             else:
                 host, port = hostport
                 servers.append(serve_tcp(bus, host, port + index if port else 0))
-        for server in servers:
-            sys.stdout.write(server.url + "\n")
+        faults = EmulatorControl({name: s for (name, _), s in zip(buses, servers, strict=True)})
+        try:
+            faults.schedule(scheduled)
+        except ControlError as exc:
+            error_line(f"--unplug: {exc}")
+            raise typer.Exit(EXIT_USAGE) from None
+        for index, server in enumerate(servers):
+            sys.stdout.write(f"{links[index] if links else server.url}\n")
         sys.stdout.flush()
         for (name, bus), server in zip(buses, servers, strict=True):
             ids = ", ".join(str(m.id) for m in bus.motors)
@@ -108,8 +162,34 @@ def emulate(
                 f"(ids {ids}) protocol {bus.protocol} at {bus.baudrate} bps on {server.url}"
                 " — Ctrl-C to stop"
             ))
+        if control:
+            _read_commands(faults, stop)
         while not stop.wait(0.5):
             pass
     finally:
+        if faults is not None:
+            faults.close()
         for server in servers:
             server.stop()
+
+
+def _read_commands(faults: EmulatorControl, stop: threading.Event) -> None:
+    """Run fault commands read from stdin, one per line, in a thread (answers on stderr)."""
+    from poppy_core.emulator.control import ControlError
+
+    if sys.stdin.isatty():
+        err_console.print("fault commands: type `help` (unplug 3 · lose 2 · drop 0.01 …)")
+
+    def run() -> None:
+        for line in sys.stdin:
+            if stop.is_set():
+                return
+            try:
+                answer = faults.execute(line)
+            except ControlError as exc:
+                error_line(str(exc))
+                continue
+            if answer:
+                err_console.print(answer, markup=False, highlight=False)
+
+    threading.Thread(target=run, name="emulator commands", daemon=True).start()

@@ -192,6 +192,47 @@ def status_table(robot: Robot | RemoteRobot, title: str = "robot status") -> Tab
     return table
 
 
+def robot_health(robot: Robot | RemoteRobot) -> dict[str, dict[str, Any]]:
+    """Controller name -> its bus's health as plain values (``Robot.health``)."""
+    return {
+        name: health if isinstance(health, dict) else health.as_dict()
+        for name, health in robot.health().items()
+    }
+
+
+def health_table(health: dict[str, dict[str, Any]]) -> Table:
+    """A Rich table of each bus: link, loop rates, error counters, offline motors."""
+    from rich.table import Table
+    from rich.text import Text
+
+    table = Table(title="buses")
+    for column in ("bus", "port", "link", "loops (Hz)", "timeouts", "retries", "corrupt"):
+        table.add_column(
+            column, justify="right" if column in ("timeouts", "retries", "corrupt") else "left"
+        )
+    table.add_column("offline")
+    for name, bus in health.items():
+        if bus["connected"]:
+            link = Text("connected" if bus["running"] else "stopped")
+        else:
+            link = Text(f"LOST {bus['down_s']:.1f} s (reopening)", style="red")
+        loops = ", ".join(
+            f"{loop} {hz:.0f}/{bus['target_hz'][loop]:g}" for loop, hz in bus["loop_hz"].items()
+        )
+        offline = Text(", ".join(bus["offline"]) or "none", style="red" if bus["offline"] else "")
+        table.add_row(
+            Text(name),
+            Text(bus["port"]),
+            link,
+            loops,
+            str(bus["timeouts"]),
+            str(bus["retries"]),
+            str(bus["corrupt_packets"]),
+            offline,
+        )
+    return table
+
+
 @app.command("status")
 def status(
     profile: str | None = ProfileOpt,
@@ -202,22 +243,33 @@ def status(
     json_output: bool = JsonOpt,
     remote: str | None = RemoteOpt,
 ) -> None:
-    """Show every motor: position, goal, speed, load, temperature, voltage, compliance, link."""
+    """Show every motor (position, goal, speed, load, temperature, voltage, compliance, link)
+    and each bus's health (link, loop rates, errors, offline motors).
+
+    --json prints {"motors": {NAME: state}, "health": {CONTROLLER: health}}.
+    """
     opened = open_remote(remote) if remote else build_robot(profile, config_file, port, sim)
     with opened as robot:
+        if not remote:
+            time.sleep(SETTLE_S)  # a few loop runs, so that the loop rates are measured
         if json_output:
-            print_json(robot_state(robot))
+            print_json({"motors": robot_state(robot), "health": robot_health(robot)})
             return
         if not watch:
             console.print(status_table(robot))
+            console.print(health_table(robot_health(robot)))
             return
+        from rich.console import Group
         from rich.live import Live
 
+        def view(title: str) -> Group:
+            return Group(status_table(robot, title), health_table(robot_health(robot)))
+
         try:
-            with Live(status_table(robot), console=console, refresh_per_second=10) as live:
+            with Live(view("robot status"), console=console, refresh_per_second=10) as live:
                 while True:
                     time.sleep(0.1)
-                    live.update(status_table(robot, "robot status (Ctrl-C to stop)"))
+                    live.update(view("robot status (Ctrl-C to stop)"))
         except KeyboardInterrupt:
             return
 

@@ -15,12 +15,15 @@ Retries: a timeout or a corrupt reply is retried ``retries`` times (``MotorError
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import threading
+import time
 from collections import deque
 from collections.abc import Sequence
 from types import TracebackType
 
+from poppy_core.bus.latency import ReplyClock, learned_latency_s
 from poppy_core.bus.results import BusStats
 from poppy_core.bus.timing import (
     DEFAULT_RETURN_DELAY_S,
@@ -31,8 +34,15 @@ from poppy_core.bus.timing import (
     status_size,
 )
 from poppy_core.bus.transport import Transport
-from poppy_core.errors import BusTimeout, CorruptPacketError, MotorError, ProtocolError
-from poppy_core.protocol import InstructionPacket, StatusPacket, decode_errors, encode_instruction
+from poppy_core.errors import BusTimeout, CorruptPacketError, MotorError, PortError, ProtocolError
+from poppy_core.protocol import (
+    BROADCAST_ID,
+    Instruction,
+    InstructionPacket,
+    StatusPacket,
+    decode_errors,
+    encode_instruction,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -68,6 +78,8 @@ class BusCore:
             None until found out.
         usb2ax: whether the adapter answers the USB2AX sync read (None until tried).
         alarms: motor ID -> alarm names from its last status packet (empty list once cleared).
+        adaptive_latency: raise ``latency_s`` when a reply shows the adapter is slower than
+            assumed (scans set it; see ``poppy_core.bus.latency``).
     """
 
     def __init__(
@@ -132,6 +144,8 @@ class BusCore:
         self.sync_read_enabled = sync_read
         self.sync_read_mode: str | None = None
         self.usb2ax: bool | None = None
+        self.adaptive_latency = False
+        self._replies = ReplyClock()
         logger.debug(
             "bus %s: %d bps, protocol %d, latency %.1f ms",
             port,
@@ -165,8 +179,28 @@ class BusCore:
 
     @property
     def latency_s(self) -> float:
-        """Adapter latency assumed in timeouts."""
+        """Adapter latency assumed in timeouts; setting it changes the deadlines."""
         return self._latency_s
+
+    @latency_s.setter
+    def latency_s(self, latency_s: float) -> None:
+        with self._lock:
+            self._latency_s = latency_s
+            self._timing = LinkTiming(self.baudrate, self._timing.return_delay_s, latency_s)
+
+    def _observe(self, status: StatusPacket, at_s: float) -> None:
+        """Time a reply against its instruction; learn a slower adapter (``adaptive_latency``)."""
+        if not self.adaptive_latency:
+            return
+        shown = self._replies.latency_of(status, at_s, self._timing, self._protocol)
+        if shown is not None and shown > self._latency_s:
+            self.latency_s = learned_latency_s(shown)
+            logger.info(
+                "%s: a reply took %.1f ms more than the wire needs: waiting %.1f ms from now on",
+                self._port,
+                shown * 1000,
+                self._latency_s * 1000,
+            )
 
     @property
     def timing(self) -> LinkTiming:
@@ -186,6 +220,7 @@ class BusCore:
         expected: Sequence[tuple[int, int]],
         *,
         timeout_s: float | None = None,
+        min_timeout_s: float | None = None,
     ) -> dict[int, StatusPacket]:
         """Send one instruction and collect the replies of ``expected`` motors (one attempt).
 
@@ -196,36 +231,58 @@ class BusCore:
             packet: the instruction.
             expected: ``(id, n_params)`` of each reply, in the order motors send them.
             timeout_s: wait for the first reply this long instead of the physical estimate.
+            min_timeout_s: the shortest wait for the first reply (None: ``min_timeout_s``).
 
         Returns:
             The replies that arrived, by ID.
         """
         transport = self._transport
-        self._strays.extend(transport.drain())
+        drained_at = time.monotonic()
+        for stray in transport.drain():
+            self._observe(stray, drained_at)
+            self._strays.append(stray)
         corrupt_before, skipped_before = transport.corrupt_packets, transport.skipped_bytes
         data = encode_instruction(self._protocol, packet)
         transport.write(data)
+        if packet.id != BROADCAST_ID:
+            self._replies.sent(packet.id, time.monotonic(), len(data))
+        elif self._protocol == 2 and packet.instruction == Instruction.PING:
+            self._replies.sent_to_all(time.monotonic(), len(data))
         if not expected:
             return {}
         sizes = [status_size(self._protocol, n) for _, n in expected]
         first = timeout_s if timeout_s is not None else self.timeout_s
         if first is None:
             first = self._timing.reply_timeout_s(len(data), sizes[0])
-        deadline = Deadline(max(first, self.min_timeout_s))
+        floor = self.min_timeout_s if min_timeout_s is None else min_timeout_s
+        deadline = Deadline(max(first, floor))
         grace = self._timing.grace_s(max(sizes))
         wanted = {motor_id for motor_id, _ in expected}
         sizes_by_id = dict(expected)
         got: dict[int, StatusPacket] = {}
+        expected_bytes = sum(sizes)
+        received_before = transport.bytes_received
+        stray_bytes = 0
+
+        def all_came() -> bool:
+            """As many bytes as the replies came, some garbled: no point waiting out the
+            deadline (the retry goes out at once)."""
+            if len(got) + transport.corrupt_packets - corrupt_before >= len(wanted):
+                return True
+            return transport.bytes_received - received_before - stray_bytes >= expected_bytes
+
         while len(got) < len(wanted):
-            status = transport.read_packet(deadline, grace_s=grace)
+            status = transport.read_packet(deadline, grace_s=grace, give_up=all_came)
             if status is None:
                 break
+            self._observe(status, time.monotonic())
             if status.id in wanted and status.id not in got and self._fits(status, sizes_by_id):
                 got[status.id] = status
                 deadline.extend(self._timing.quiet_gap_s(max(sizes)))
             else:
                 logger.debug("%s: stray status from ID %d kept aside", self._port, status.id)
                 self._strays.append(status)
+                stray_bytes += status_size(self._protocol, len(status.params))
         corrupt = transport.corrupt_packets - corrupt_before
         if len(got) < len(wanted) and not corrupt and transport.skipped_bytes > skipped_before:
             corrupt = 1  # bytes came back but no packet could be found in them: garbage
@@ -243,6 +300,20 @@ class BusCore:
             return True
         return bool(status.error) and not is_alarm_only(self._protocol, status.error)
 
+    def listen(self, duration_s: float) -> list[StatusPacket]:
+        """Wait ``duration_s`` for late replies; return them with the strays kept aside.
+
+        Each reply is timed as it arrives (an ``adaptive_latency`` bus learns from it).
+        """
+        with self._lock:
+            late = list(self._strays)
+            self._strays.clear()
+            deadline = Deadline(duration_s)
+            while (status := self._transport.read_packet(deadline)) is not None:
+                self._observe(status, time.monotonic())
+                late.append(status)
+            return late
+
     def take_strays(self) -> list[StatusPacket]:
         """Return and forget the status packets that arrived for no pending transaction."""
         with self._lock:
@@ -251,7 +322,13 @@ class BusCore:
             return late
 
     def _transact(
-        self, packet: InstructionPacket, motor_id: int, n_params: int, *, retries: int | None = None
+        self,
+        packet: InstructionPacket,
+        motor_id: int,
+        n_params: int,
+        *,
+        retries: int | None = None,
+        min_timeout_s: float | None = None,
     ) -> StatusPacket:
         """One instruction to one motor with retries; returns its checked-in reply."""
         attempts = 1 + (self.retries if retries is None else retries)
@@ -262,7 +339,8 @@ class BusCore:
                 if attempt:
                     self.stats.retries += 1
                 before = self.stats.corrupt_packets
-                status = self.exchange(packet, [(motor_id, n_params)]).get(motor_id)
+                expected = [(motor_id, n_params)]
+                status = self.exchange(packet, expected, min_timeout_s=min_timeout_s).get(motor_id)
                 if status is not None:
                     if status.error and not is_alarm_only(self._protocol, status.error):
                         return status
@@ -328,6 +406,26 @@ class BusCore:
     def transport(self) -> Transport:
         """The underlying transport."""
         return self._transport
+
+    def reopen(self) -> None:
+        """Open the port again after it was lost (adapter re-plugged, emulator restarted).
+
+        Counters, alarms and the sync read method found are kept.
+
+        Raises:
+            PortError: the port is still not there, or the bus was given its transport.
+        """
+        with self._lock:
+            if not self._owns_transport:
+                raise PortError(
+                    f"{self._port}: the bus was given its transport, it cannot reopen it",
+                    port=self._port,
+                )
+            with contextlib.suppress(Exception):  # a lost port may fail to close cleanly
+                self._transport.close()
+            self._transport = Transport(self._port, self.baudrate, self._protocol)
+            self._strays.clear()
+            self._replies.forget()
 
     def close(self) -> None:
         """Close the port (unless the transport was given by the caller). Idempotent."""

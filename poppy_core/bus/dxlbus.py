@@ -13,6 +13,7 @@ from collections.abc import Mapping, Sequence
 from poppy_core.bus import groupread
 from poppy_core.bus.core import BusCore
 from poppy_core.bus.results import PingResult
+from poppy_core.bus.timing import MIN_REPLY_TIMEOUT_S
 from poppy_core.errors import BusTimeout, CorruptPacketError, ProtocolError, RegisterError
 from poppy_core.models import ServoModel, model_by_number
 from poppy_core.protocol import BROADCAST_ID, InstructionPacket
@@ -40,7 +41,9 @@ class DxlBus(BusCore):
 
     # -- single-motor transactions ------------------------------------------------------------
 
-    def ping(self, id: int, *, retries: int | None = None) -> PingResult | None:
+    def ping(
+        self, id: int, *, retries: int | None = None, identify: bool = True
+    ) -> PingResult | None:
         """Ping motor ``id``; None when nothing answers.
 
         Protocol 1 pings carry no model number: it and the firmware are read right after.
@@ -48,6 +51,8 @@ class DxlBus(BusCore):
         Args:
             id: motor ID (0-253).
             retries: extra attempts (None: the bus's ``retries``).
+            identify: read the protocol 1 model number; False only checks that it answers
+                (the result then has no model).
 
         Raises:
             CorruptPacketError: only garbage came back on every attempt.
@@ -62,13 +67,29 @@ class DxlBus(BusCore):
             if self._protocol == 2:
                 number = int.from_bytes(status.params[:2], "little")
                 return PingResult(id, number, status.params[2], model_by_number(number))
+            if not identify:
+                return PingResult(id, None, None, None)
             try:
-                info = self.read(id, V1_MODEL_NUMBER_ADDRESS, V1_MODEL_INFO_LENGTH)
+                info = self._read_model_info(id)
             except (BusTimeout, CorruptPacketError) as exc:
                 logger.warning("motor %d answered a ping but not a read: %s", id, exc)
                 return PingResult(id, None, None, None)
         number = int.from_bytes(info[:2], "little")
         return PingResult(id, number, info[2], model_by_number(number))
+
+    def _read_model_info(self, id: int) -> bytes:
+        """Protocol 1 model number and firmware of a motor that just answered a ping.
+
+        The motor is known to be there: its reply gets the usual floor and at least one retry,
+        whatever the ping had (a scan pings with no retry and no floor).
+        """
+        packet = ins.read(self._protocol, id, V1_MODEL_NUMBER_ADDRESS, V1_MODEL_INFO_LENGTH)
+        floor = max(self.min_timeout_s, MIN_REPLY_TIMEOUT_S)
+        status = self._transact(
+            packet, id, V1_MODEL_INFO_LENGTH, retries=max(1, self.retries), min_timeout_s=floor
+        )
+        self.check_status(status)
+        return status.params
 
     def read(self, id: int, address: int, length: int) -> bytes:
         """Read ``length`` bytes at ``address`` of motor ``id``.

@@ -9,6 +9,12 @@ Protocol 1 sync read strategy (found once per bus, kept in ``bus.sync_read_mode`
    plain read.
 
 The USB2AX fills a motor that did not answer with 0xFF bytes: an all-0xFF block maps to None.
+
+A motor missing from a group reply once its retries are spent (a corrupt byte in a long reply,
+a reply chain cut by a silent motor) is read on its own before it is reported as None: a long
+reply is many times likelier to be hit by noise than a short one, and a healthy motor must not
+look silent because a neighbour's reply was garbled. A transient failure never changes the
+method found for the bus.
 """
 
 from __future__ import annotations
@@ -56,6 +62,7 @@ def exchange_with_retries(
     expected: dict[int, int],
     *,
     timeout_s: Callable[[list[int]], float] | None = None,
+    retries: int | None = None,
 ) -> dict[int, StatusPacket]:
     """Run a multi-reply instruction, asking again only the motors that did not answer.
 
@@ -64,6 +71,7 @@ def exchange_with_retries(
         make_packet: builds the instruction for a list of motor IDs.
         expected: motor ID -> number of parameter bytes of its reply, in reply order.
         timeout_s: optional first-reply timeout for a list of motor IDs.
+        retries: extra attempts (None: the bus's ``retries``).
 
     Returns:
         The usable replies, by ID (missing motors are absent).
@@ -72,7 +80,7 @@ def exchange_with_retries(
     missing = list(expected)
     with bus.lock:
         bus.stats.transactions += 1
-        for attempt in range(1 + bus.retries):
+        for attempt in range(1 + (bus.retries if retries is None else retries)):
             if attempt:
                 bus.stats.retries += 1
             replies = bus.exchange(
@@ -116,8 +124,18 @@ def _sequential(bus: DxlBus, requests: list[tuple[int, int, int]]) -> dict[int, 
     return out
 
 
+def _fill_in(
+    bus: DxlBus, result: dict[int, bytes | None], address: int, length: int
+) -> dict[int, bytes | None]:
+    """Read on its own each motor a group read left without data (see the module doc)."""
+    missing = [(i, address, length) for i, data in result.items() if data is None]
+    if missing:
+        result.update(_sequential(bus, missing))
+    return result
+
+
 def _usb2ax(
-    bus: DxlBus, address: int, length: int, ids: list[int]
+    bus: DxlBus, address: int, length: int, ids: list[int], *, retries: int | None = None
 ) -> dict[int, bytes | None] | None:
     """USB2AX sync read; None when the adapter does not answer (it lacks the instruction)."""
     n_params = length * len(ids)
@@ -132,13 +150,38 @@ def _usb2ax(
         lambda _missing: ins.sync_read(1, address, length, ids),
         {USB2AX_ID: n_params},
         timeout_s=lambda _missing: timeout,
+        retries=retries,
     )
     status = replies.get(USB2AX_ID)
     if status is None:
         return None
+    if bus.usb2ax and status.error and not is_alarm_only(1, status.error):
+        # The adapter reads the motors itself and answers for them: an error in its own
+        # status is noise that passed the 8-bit checksum. Read again as for a garbled reply.
+        logger.debug("%s: USB2AX status with error bits %#04x, read again", bus.port, status.error)
+        return None
     bus.check_status(status)
     blocks = parse_usb2ax_sync_status(status, length, ids)
     return {i: (None if all(b == 0xFF for b in data) else data) for i, data in blocks.items()}
+
+
+def _usb2ax_in_halves(
+    bus: DxlBus, address: int, length: int, ids: list[int]
+) -> dict[int, bytes | None]:
+    """USB2AX sync reads of each half of ``ids``, each half split again if its reply is garbled.
+
+    After a whole-group reply came garbled: on a noisy line a long reply is seldom clean and a
+    short one mostly is, while each reply costs a round trip. Halving finds the balance; a
+    single motor left is read the plain way (see ``_fill_in``).
+    """
+    if len(ids) <= 1:
+        return dict.fromkeys(ids)
+    out: dict[int, bytes | None] = {}
+    middle = (len(ids) + 1) // 2
+    for half in (ids[:middle], ids[middle:]):
+        data = _usb2ax(bus, address, length, half, retries=0)
+        out.update(data if data is not None else _usb2ax_in_halves(bus, address, length, half))
+    return out
 
 
 def _bulk(bus: DxlBus, requests: list[tuple[int, int, int]]) -> dict[int, StatusPacket]:
@@ -166,17 +209,21 @@ def sync_read(bus: DxlBus, address: int, length: int, ids: list[int]) -> dict[in
                 lambda missing: ins.sync_read(2, address, length, missing),
                 dict.fromkeys(ids, length),
             )
-            return _checked(bus, replies, ids)
+            return _fill_in(bus, _checked(bus, replies, ids), address, length)
         mode = bus.sync_read_mode
         try_usb2ax = bus.sync_read_enabled is not False and bus.usb2ax is not False
         if mode == "sync" or (mode is None and try_usb2ax):
-            data = _usb2ax(bus, address, length, ids)
+            # Once the adapter is known to answer, one try for the whole group: if its reply
+            # is garbled, smaller groups get through sooner than the same long one again.
+            data = _usb2ax(bus, address, length, ids, retries=0 if bus.usb2ax else None)
             if data is not None:
                 bus.usb2ax = True
                 bus.sync_read_mode = "sync"
-                return data
-            if bus.sync_read_enabled is True:
-                return dict.fromkeys(ids)
+                return _fill_in(bus, data, address, length)
+            if bus.usb2ax or bus.sync_read_enabled is True:
+                # The adapter answered before (or must): this reply was lost or garbled.
+                data = _usb2ax_in_halves(bus, address, length, ids)
+                return _fill_in(bus, data, address, length)
             logger.info("%s: no USB2AX sync read; trying bulk read", bus.port)
             bus.usb2ax = False
             bus.sync_read_mode = mode = None
@@ -188,7 +235,7 @@ def sync_read(bus: DxlBus, address: int, length: int, ids: list[int]) -> dict[in
         if mode == "bulk" or not missing:
             if got:
                 bus.sync_read_mode = "bulk"
-            return result
+            return _fill_in(bus, result, address, length)
         rest = _sequential(bus, missing)
         result.update(rest)
         if any(value is not None for value in rest.values()):

@@ -13,6 +13,12 @@ How a scan stays fast:
   replies colliding, noise) mean one may have missed someone, so every ID is pinged one by one.
   The second broadcast costs one round trip, a few ms at 1 Mbps.
 
+Slow adapters: the deadlines assume the adapter latency known for the port (see
+``poppy_core.bus.timing``); a reply slower than that raises it for the rest of the port's scan
+(``poppy_core.bus.latency``). Before motors found at a rate are reported, the line is left quiet
+for a few latencies and they are asked again: a reply that came late from the rate tried before
+(and was taken for an answer at this one) does not answer twice, and is dropped.
+
 A scan opens each port once and switches rates on it. On an abort (``should_abort()`` true) it
 returns what it has found so far.
 """
@@ -24,18 +30,27 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
 from poppy_core.bus.dxlbus import DxlBus
-from poppy_core.bus.ports import list_ports
+from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_port
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
+from poppy_core.bus.settle import answers, ping_found, settle
 from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S
 from poppy_core.bus.transport import Transport
-from poppy_core.errors import CorruptPacketError, PortError, SetupError
+from poppy_core.errors import PortError
 from poppy_core.models import standard_baudrates
+
+__all__ = [
+    "DEFAULT_SEARCH_FIRST_BPS",
+    "PROTOCOLS",
+    "SCAN_IDS",
+    "answers",
+    "find_port",
+    "scan",
+    "settle",
+]
 
 logger = logging.getLogger(__name__)
 
 SCAN_IDS = range(254)
-DEFAULT_SEARCH_FIRST_BPS = 1_000_000
-PROTOCOLS = (1, 2)
 
 
 def _found(port: str, bus: DxlBus, result: PingResult) -> FoundMotor:
@@ -61,6 +76,7 @@ class _Scan:
     total: int
     done: int = 0
     found: list[FoundMotor] = field(default_factory=list)
+    unconfirmed: int = 0  # motors that answered at the rate being scanned, not yet confirmed
     aborted: bool = False
 
     def abort_requested(self) -> bool:
@@ -81,7 +97,7 @@ class _Scan:
                     motor_id,
                     self.done,
                     self.total,
-                    len(self.found),
+                    len(self.found) + self.unconfirmed,
                 )
             )
 
@@ -99,18 +115,15 @@ class _Scan:
             self.on_found(motor)
 
 
-def _ping(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
-    try:
-        return bus.ping(motor_id, retries=retries)
-    except CorruptPacketError:
-        logger.debug("%s: garbage in reply to ping %d", bus.port, motor_id)
-        return None
+def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int]:
+    """Scan one (port, rate, protocol); motors answering are confirmed before being reported.
 
-
-def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> None:
-    """Scan one (port, rate, protocol)."""
-    seen: set[int] = set()
+    Returns:
+        IDs heard at this rate that did not confirm: late replies from the rate before.
+    """
+    candidates: dict[int, PingResult] = {}
     wanted = set(state.ids)
+    trusted = False
     if bus.protocol == 2 and broadcast:
         transport = bus.transport
         corrupt, skipped = transport.corrupt_packets, transport.skipped_bytes
@@ -119,35 +132,123 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> None:
             results = bus.broadcast_ping()
             answered.append({pinged.id for pinged in results})
             for pinged in results:
-                if pinged.id in wanted and pinged.id not in seen:
-                    seen.add(pinged.id)
-                    state.add(_found(port, bus, pinged))
+                if pinged.id in wanted:
+                    candidates.setdefault(pinged.id, pinged)
         clean = transport.corrupt_packets == corrupt and transport.skipped_bytes == skipped
-        if clean and answered[0] == answered[1]:
+        trusted = clean and answered[0] == answered[1]
+        state.unconfirmed = len(candidates)
+        if trusted:
             state.report(port, bus, "broadcast ping", None, len(state.ids))
-            return
-        logger.info(
-            "%s: broadcast pings at %d bps disagree or met garbage; pinging each ID",
-            port,
-            bus.baudrate,
-        )
+        else:
+            logger.info(
+                "%s: broadcast pings at %d bps disagree or met garbage; pinging each ID",
+                port,
+                bus.baudrate,
+            )
     late: set[int] = set()
-    bus.take_strays()
-    for motor_id in state.ids:
-        if state.abort_requested():
-            return
-        if motor_id not in seen:
-            result = _ping(bus, motor_id, retries=0)
-            if result is not None:
-                seen.add(motor_id)
-                state.add(_found(port, bus, result))
-            late.update(s.id for s in bus.take_strays() if s.id in wanted and s.id not in seen)
-        state.report(port, bus, "ping", motor_id, 1)
-    for motor_id in sorted(late - seen):
-        result = _ping(bus, motor_id, retries=1)
+    if not trusted:
+        late.update(s.id for s in bus.take_strays() if s.id in wanted)  # late broadcast replies
+        for motor_id in state.ids:
+            if state.abort_requested():
+                break
+            if motor_id not in candidates:
+                result = ping_found(bus, motor_id, retries=0)
+                if result is not None:
+                    candidates[motor_id] = result
+                    state.unconfirmed = len(candidates)
+                strays = bus.take_strays()
+                late.update(s.id for s in strays if s.id in wanted and s.id not in candidates)
+            state.report(port, bus, "ping", motor_id, 1)
+    # Replies still coming are late answers of this rate: wait for them before the next rate.
+    late |= settle(bus) & wanted
+    for motor_id in sorted(late - set(candidates)):
+        result = ping_found(bus, motor_id, retries=1)
         if result is not None:
-            seen.add(motor_id)
+            candidates[motor_id] = result
+    unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
+    found_here = {f.id for f in state.found if f.baudrate == bus.baudrate}
+    return (unconfirmed | late) - found_here
+
+
+def _scan_bus(
+    port: str,
+    rate: int,
+    protocol: int,
+    transport: Transport,
+    latency_s: float | None,
+    return_delay_s: float,
+) -> DxlBus:
+    """A scan's bus at one rate: no retry, no floor, learning the adapter's latency."""
+    bus = DxlBus(
+        port,
+        rate,
+        protocol,
+        latency_s=latency_s,
+        retries=0,
+        return_delay_s=return_delay_s,
+        transport=transport,
+        min_timeout_s=0.0,
+    )
+    bus.adaptive_latency = True
+    return bus
+
+
+def _revisit(state: _Scan, port: str, bus: DxlBus, ids: set[int]) -> None:
+    """Look again at the rate before for motors whose replies came late into the next one.
+
+    ``bus`` is at that earlier rate, with the latency learned since; a motor found there is
+    confirmed as usual.
+    """
+    known = {(f.id, f.baudrate, f.protocol) for f in state.found}
+    ids = {i for i in ids if (i, bus.baudrate, bus.protocol) not in known}
+    if not ids:
+        return
+    logger.info(
+        "%s: replies from %s came late into the next rate: looking again at %d bps",
+        port,
+        ", ".join(map(str, sorted(ids))),
+        bus.baudrate,
+    )
+    settle(bus)
+    candidates = {}
+    for motor_id in sorted(ids):
+        result = ping_found(bus, motor_id, retries=1)
+        if result is not None:
+            candidates[motor_id] = result
+    _confirm(state, port, bus, candidates, by_broadcast=False)
+
+
+def _confirm(
+    state: _Scan, port: str, bus: DxlBus, candidates: dict[int, PingResult], by_broadcast: bool
+) -> set[int]:
+    """Report the candidates that answer again, now that the line has settled.
+
+    On a slow adapter a reply can come after the settle time, while the next rate is tried: it
+    would be taken for a motor at that rate. A motor really at this rate answers again; a late
+    reply from elsewhere does not.
+
+    Returns:
+        The candidates that did not answer again.
+    """
+    state.unconfirmed = 0
+    if not candidates:
+        return set()
+    again: set[int] = set()
+    if by_broadcast:
+        again = {pinged.id for pinged in bus.broadcast_ping()}
+    again |= {i for i in candidates if i not in again and answers(bus, i)}
+    for motor_id, result in candidates.items():
+        if motor_id in again:
             state.add(_found(port, bus, result))
+        else:
+            logger.info(
+                "%s: motor %d answered once at %d bps but not when asked again: a late reply "
+                "from another rate, not counted",
+                port,
+                motor_id,
+                bus.baudrate,
+            )
+    return set(candidates) - again
 
 
 def scan(
@@ -200,89 +301,22 @@ def scan(
                 raise
             logger.warning("skipping %s: %s", port, exc)
             continue
+        learned = latency_s  # a slower adapter than assumed is learned once, for every rate
         try:
             for protocol in protocol_list:
+                previous: int | None = None
                 for rate in rates[protocol]:
                     if state.abort_requested():
                         return state.found
-                    bus = DxlBus(
-                        port,
-                        rate,
-                        protocol,
-                        latency_s=latency_s,
-                        retries=0,
-                        return_delay_s=return_delay_s,
-                        transport=transport,
-                        min_timeout_s=0.0,
-                    )
-                    _scan_rate(state, port, bus, broadcast)
+
+                    timing = (learned, return_delay_s)
+                    bus = _scan_bus(port, rate, protocol, transport, *timing)
+                    heard_late = _scan_rate(state, port, bus, broadcast)
+                    learned = bus.latency_s
+                    if heard_late and previous is not None:
+                        earlier = _scan_bus(port, previous, protocol, transport, learned, timing[1])
+                        _revisit(state, port, earlier, heard_late)
+                    previous = rate
         finally:
             transport.close()
     return state.found
-
-
-def find_port(
-    ids: Iterable[int],
-    ports: Sequence[str] | None = None,
-    baudrates: Iterable[int] | None = None,
-    protocols: Iterable[int] = PROTOCOLS,
-    *,
-    latency_s: float | None = None,
-) -> tuple[str, int, int]:
-    """Find the bus holding every motor in ``ids``.
-
-    Args:
-        ids: motor IDs that must all answer.
-        ports: ports to try; None tries every port ``list_ports`` finds.
-        baudrates: rates to try; None tries the standard rates of each protocol.
-        protocols: protocols to try.
-        latency_s: adapter latency (None: from the port).
-
-    Returns:
-        ``(port, baudrate, protocol)``.
-
-    Raises:
-        PortError: no serial port at all.
-        SetupError: no port/rate/protocol answers for every ID (the message says the closest).
-    """
-    wanted = list(ids)
-    protocols = list(protocols)
-    fixed = None if baudrates is None else list(baudrates)
-    port_list = list(ports) if ports is not None else [p.device for p in list_ports()]
-    if not port_list:
-        raise PortError("no serial port found: plug the adapter or run `poppy ports`")
-    best: tuple[int, str] = (0, "")
-    for port in port_list:
-        try:
-            transport = Transport(port)
-        except PortError as exc:
-            logger.warning("skipping %s: %s", port, exc)
-            continue
-        try:
-            for protocol in protocols:
-                # 1 Mbps first: the rate of Poppy robots and of most set-up buses
-                rates = sorted(
-                    fixed if fixed is not None else standard_baudrates(protocol),
-                    key=lambda rate: rate != DEFAULT_SEARCH_FIRST_BPS,
-                )
-                for rate in rates:
-                    bus = DxlBus(port, rate, protocol, latency_s=latency_s, transport=transport)
-                    answered = [i for i in wanted if _ping(bus, i, retries=1) is not None]
-                    if len(answered) == len(wanted):
-                        return port, rate, protocol
-                    if len(answered) > best[0]:
-                        best = (
-                            len(answered),
-                            f"{port} at {rate} bps, protocol {protocol} "
-                            f"has {', '.join(map(str, answered))}",
-                        )
-        finally:
-            transport.close()
-    closest = f"; closest: {best[1]}" if best[0] else ""
-    rates_text = "every standard rate" if fixed is None else ", ".join(f"{r} bps" for r in fixed)
-    protocols_text = " and ".join(str(p) for p in protocols)
-    raise SetupError(
-        f"no motor {', '.join(map(str, wanted))} answers (searched {', '.join(port_list)} at "
-        f"{rates_text}, protocol {protocols_text}){closest}: check power and wiring, "
-        "or run `poppy scan --all-bauds`"
-    )

@@ -137,16 +137,36 @@ def change_id(
 def locate(bus: DxlBus, motor_id: int, rates: list[int] | None = None) -> int | None:
     """Search the standard baud rates for ``motor_id``; leave the bus at the rate found.
 
+    Each rate is left quiet a moment before the next, and a motor that answered is asked
+    again, so a slow adapter's late reply is not taken for the motor at the next rate.
+
     Returns:
         The rate where it answers, None when nowhere (the bus's rate is then restored).
     """
-    original = bus.baudrate
-    for rate in rates if rates is not None else standard_baudrates(bus.protocol):
-        bus.baudrate = rate
-        if bus.ping(motor_id) is not None:
-            return rate
-    bus.baudrate = original
-    return None
+    from poppy_core.bus.settle import answers, settle
+
+    original, adaptive = bus.baudrate, bus.adaptive_latency
+    bus.adaptive_latency = True  # a slow adapter is learned from its late replies
+    try:
+        previous: int | None = None
+        for rate in rates if rates is not None else standard_baudrates(bus.protocol):
+            bus.baudrate = rate
+            # Heard now or late (settle), then confirmed on a settled line (see bus.scan); heard
+            # but not confirmed: a late reply from the rate before, looked at again.
+            heard = answers(bus, motor_id)
+            if motor_id in settle(bus) or heard:
+                if answers(bus, motor_id):
+                    return rate
+                if previous is not None:
+                    bus.baudrate = previous
+                    settle(bus)
+                    if answers(bus, motor_id):
+                        return previous
+            previous = rate
+        bus.baudrate = original
+        return None
+    finally:
+        bus.adaptive_latency = adaptive
 
 
 def change_baudrate(

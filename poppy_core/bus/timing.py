@@ -45,6 +45,12 @@ MIN_MARGIN_S = 0.001
 MIN_REPLY_TIMEOUT_S = 0.010
 MARGIN_FRACTION = 0.1
 
+# Quiet time after a search at one rate, before the next: every reply still coming (a slow
+# adapter's) arrives in it and is not taken for an answer at the next rate. This many adapter
+# latencies, at least SETTLE_MIN_S (the OS may run the other end late).
+SETTLE_LATENCIES = 3.0
+SETTLE_MIN_S = 0.01
+
 # Factory return delay of AX/MX/X servos: 250 x 2 µs (e-manual: "Return Delay Time", address 5
 # on protocol 1 models, 9 on X series).
 DEFAULT_RETURN_DELAY_S = 0.0005
@@ -68,6 +74,11 @@ def instruction_size(protocol: int, n_params: int) -> int:
 def status_size(protocol: int, n_params: int) -> int:
     """Bytes of a status packet carrying ``n_params`` parameter bytes (before stuffing)."""
     return _STATUS_OVERHEAD[protocol] + n_params
+
+
+def settle_s(latency_s: float) -> float:
+    """How long to listen for late replies on an adapter of ``latency_s`` (see above)."""
+    return max(SETTLE_MIN_S, SETTLE_LATENCIES * latency_s)
 
 
 def scheduling_margin_s(physical_s: float) -> float:

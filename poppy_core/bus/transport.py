@@ -10,6 +10,7 @@ import socket
 import sys
 import time
 from collections import deque
+from collections.abc import Callable
 from typing import Any
 
 import serial
@@ -89,6 +90,8 @@ class Transport:
         self.port = port
         self._decoder = PacketDecoder(protocol, "status")
         self._packets: deque[StatusPacket] = deque()
+        self.bytes_received = 0
+        """Bytes read from the line since the port was opened."""
         kwargs: dict[str, Any] = {"baudrate": baudrate, "timeout": 0, "do_not_open": True}
         if exclusive and "://" not in port and os.name == "posix":
             kwargs["exclusive"] = True
@@ -188,13 +191,21 @@ class Transport:
         except (serial.SerialException, OSError) as exc:
             raise PortError(f"lost {self.port} while reading: {exc}", port=self.port) from exc
 
-    def read_packet(self, deadline: Deadline, *, grace_s: float = 0.0) -> StatusPacket | None:
+    def read_packet(
+        self,
+        deadline: Deadline,
+        *,
+        grace_s: float = 0.0,
+        give_up: Callable[[], bool] | None = None,
+    ) -> StatusPacket | None:
         """Return the next complete status packet, or None when the deadline passes first.
 
         Args:
             deadline: when to give up.
             grace_s: once bytes arrive without completing a packet, the deadline is pushed to
                 at least this long after their arrival (a reply that has started is not cut).
+            give_up: checked after bytes arrive without a packet; True stops waiting now (the
+                reply came but was garbled: no point waiting out the deadline).
 
         Raises:
             PortError: the port went away.
@@ -205,13 +216,17 @@ class Transport:
             data = self._read_available(deadline.time_left())
             if data:
                 self._feed(data)
-                if not self._packets and grace_s > 0:
-                    deadline.extend(grace_s)
+                if not self._packets:
+                    if give_up is not None and give_up():
+                        return None
+                    if grace_s > 0:
+                        deadline.extend(grace_s)
                 continue
             if deadline.expired():
                 return None
 
     def _feed(self, data: bytes) -> None:
+        self.bytes_received += len(data)
         for packet in self._decoder.feed(data):
             if isinstance(packet, StatusPacket):
                 self._packets.append(packet)

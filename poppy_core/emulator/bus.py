@@ -166,9 +166,7 @@ class VirtualBus:
 
     def hears(self, motor: VirtualMotor, line_bps: int) -> bool:
         """Whether ``motor`` is plugged and its UART decodes bytes sent at ``line_bps``."""
-        return not self.faults.is_unplugged(motor.id) and baud_matches(
-            line_bps, motor.baudrate_bps
-        )
+        return not self.faults.is_unplugged(motor.id) and baud_matches(line_bps, motor.baudrate_bps)
 
     # ------------------------------------------------------------------ plant
 

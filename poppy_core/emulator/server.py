@@ -1,114 +1,45 @@
-"""Serve a VirtualBus on a pseudo-terminal or a TCP socket, from a background thread."""
+"""Serve a VirtualBus on a pseudo-terminal or a TCP socket (see ``serving`` for the threads)."""
 
 from __future__ import annotations
 
 import contextlib
 import logging
 import os
-import select
 import socket
-import threading
 import time
 import tty
-from abc import ABC, abstractmethod
-from collections.abc import Callable
-from types import TracebackType
+from pathlib import Path
 
-from poppy_core.emulator.bus import Reply, VirtualBus
+from poppy_core.emulator.bus import VirtualBus
 from poppy_core.emulator.linespeed import read_pty_baudrate
-from poppy_core.emulator.timing import sleep_until
+from poppy_core.emulator.serving import CHUNK, RESET, EmulatorServer
 from poppy_core.errors import PortError
 
+__all__ = ["EmulatorServer", "PtyServer", "TcpServer", "serve_pty", "serve_tcp"]
+
 logger = logging.getLogger(__name__)
-
-_CHUNK = 4096
-_POLL_S = 0.5
-
-
-class EmulatorServer(ABC):
-    """A running emulator endpoint; ``url`` is what a client opens with pyserial.
-
-    Use :func:`serve_pty` or :func:`serve_tcp` to create one. Stop it with :meth:`stop` or a
-    ``with`` block.
-
-    Attributes:
-        bus: the virtual bus being served.
-        url: the pty slave path (``/dev/pts/N``) or ``socket://host:port``.
-    """
-
-    def __init__(self, bus: VirtualBus, url: str) -> None:
-        self.bus = bus
-        self.url = url
-        self._stop = threading.Event()
-        self._wake_r, self._wake_w = os.pipe()
-        self._thread = threading.Thread(target=self._run, name=f"emulator {url}", daemon=True)
-
-    def __enter__(self) -> EmulatorServer:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.stop()
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}({self.url!r})"
-
-    @property
-    def running(self) -> bool:
-        """True while the serving thread is alive."""
-        return self._thread.is_alive()
-
-    def start(self) -> None:
-        """Start the serving thread (the ``serve_*`` functions do it)."""
-        self._thread.start()
-
-    def stop(self) -> None:
-        """Stop serving, join the thread and close the endpoint (idempotent)."""
-        if self._stop.is_set():
-            return
-        self._stop.set()
-        os.write(self._wake_w, b"\0")
-        if self._thread.is_alive() and self._thread is not threading.current_thread():
-            self._thread.join(timeout=5.0)
-        self._close()
-        os.close(self._wake_r)
-        os.close(self._wake_w)
-
-    def _run(self) -> None:
-        try:
-            self._serve()
-        except Exception:
-            logger.exception("emulator server %s crashed", self.url)
-
-    @staticmethod
-    def _deliver(replies: list[Reply], write: Callable[[bytes], None]) -> None:
-        """Write each reply when it is due (precise sleep), through ``write``."""
-        for reply in replies:
-            if reply.send_at:
-                sleep_until(reply.send_at)
-            write(reply.data)
-
-    @abstractmethod
-    def _serve(self) -> None:
-        """Read instruction bytes and answer until stopped."""
-
-    @abstractmethod
-    def _close(self) -> None:
-        """Release the endpoint's file descriptors or sockets."""
 
 
 class PtyServer(EmulatorServer):
     """Serves on a pseudo-terminal; the client opens the slave path at some baud rate.
 
-    The pair shares one line discipline: the baud rate the client sets on the slave is read
+    The pair shares one line discipline: the baud rate the client set on the slave is read
     back (``TCGETS2``) for each chunk, and motors only hear packets sent at their rate.
+
+    Args:
+        bus: the virtual bus.
+        link: a symlink made to point at the slave (replaced atomically, removed on stop), so
+            clients have a path that survives :meth:`lose`, as ``/dev/serial/by-id`` does.
     """
 
-    def __init__(self, bus: VirtualBus) -> None:
+    def __init__(self, bus: VirtualBus, link: str | os.PathLike[str] | None = None) -> None:
+        self._master: int | None = None
+        self._slave: int | None = None
+        self.link = Path(link) if link is not None else None
+        url = self._open_pty()
+        super().__init__(bus, url)
+
+    def _open_pty(self) -> str:
         master, slave = os.openpty()
         # Raw mode on both ends: no echo, no line editing, no CR/LF translation.
         tty.setraw(master)
@@ -116,36 +47,65 @@ class PtyServer(EmulatorServer):
         os.set_blocking(master, False)
         self._master = master
         self._slave = slave  # kept open: the pty survives clients closing and reopening it
-        super().__init__(bus, os.ttyname(slave))
-
-    def _write(self, data: bytes) -> None:
-        try:
-            os.write(self._master, data)
-        except BlockingIOError:
-            logger.debug("pty %s: client not reading, %d bytes dropped", self.url, len(data))
-
-    def _serve(self) -> None:
-        while not self._stop.is_set():
-            ready, _, _ = select.select([self._master, self._wake_r], [], [], _POLL_S)
-            if self._master not in ready:
-                continue
+        path = os.ttyname(slave)
+        if self.link is not None:
+            temporary = self.link.with_name(f".{self.link.name}.{os.getpid()}.tmp")
+            with contextlib.suppress(FileNotFoundError):
+                temporary.unlink()
             try:
-                data = os.read(self._master, _CHUNK)
-            except (BlockingIOError, InterruptedError):
-                continue
-            except OSError as exc:  # EIO: slave side hung up for good
-                logger.debug("pty %s: read failed (%s)", self.url, exc)
-                time.sleep(0.01)
-                continue
-            received_at = time.perf_counter()
-            line_bps = read_pty_baudrate(self._slave)
-            replies = self.bus.receive(data, line_bps=line_bps, received_at=received_at)
-            self._deliver(replies, self._write)
+                os.symlink(path, temporary)
+                os.replace(temporary, self.link)
+            except OSError as exc:
+                os.close(master)
+                os.close(slave)
+                raise PortError(
+                    f"cannot link {self.link} to {path}: {exc}", port=str(self.link)
+                ) from exc
+        return path
 
-    def _close(self) -> None:
-        for fd in (self._master, self._slave):
+    def _watched(self) -> list[int | socket.socket]:
+        return [] if self._master is None else [self._master]
+
+    def _on_readable(self, ready: list[int | socket.socket]) -> None:
+        master, slave = self._master, self._slave
+        if master is None or master not in ready:
+            return
+        try:
+            data = os.read(master, CHUNK)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError as exc:  # EIO: no slave open (cannot happen while we hold one)
+            logger.debug("pty %s: read failed (%s)", self.url, exc)
+            time.sleep(0.01)
+            return
+        line_bps = read_pty_baudrate(slave) if slave is not None else None
+        self._put(data, line_bps)
+
+    def _write_some(self, view: memoryview) -> int | None:
+        if self._master is None:
+            return None
+        try:
+            return os.write(self._master, view)
+        except BlockingIOError:
+            return 0
+
+    def _writable_fd(self) -> int | None:
+        return self._master
+
+    def _open_endpoint(self) -> bool:
+        self.url = self._open_pty()
+        return True
+
+    def _close_endpoint(self) -> None:
+        if self.link is not None and self._slave is not None:
             with contextlib.suppress(OSError):
-                os.close(fd)
+                if os.readlink(self.link) == self.url:
+                    self.link.unlink()
+        for fd in (self._master, self._slave):
+            if fd is not None:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+        self._master = self._slave = None
 
 
 class TcpServer(EmulatorServer):
@@ -156,74 +116,113 @@ class TcpServer(EmulatorServer):
     """
 
     def __init__(self, bus: VirtualBus, host: str, port: int) -> None:
+        self._client: socket.socket | None = None
+        self._listener: socket.socket | None = None
+        self._address = (host, port)
+        try:
+            self._listener = self._listen(host, port)
+        except (OSError, OverflowError) as exc:  # OverflowError: a port outside 0-65535
+            address = f"{host}:{port}"
+            raise PortError(f"cannot listen on {address}: {exc}", port=address) from exc
+        bound_host, bound_port = self._listener.getsockname()[:2]
+        self._address = (bound_host, bound_port)
+        super().__init__(bus, f"socket://{bound_host}:{bound_port}")
+
+    @staticmethod
+    def _listen(host: str, port: int) -> socket.socket:
         listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             listener.bind((host, port))
-        except (OSError, OverflowError) as exc:  # OverflowError: a port outside 0-65535
+            listener.listen(1)
+        except BaseException:
             listener.close()
-            address = f"{host}:{port}"
-            raise PortError(f"cannot listen on {address}: {exc}", port=address) from exc
-        listener.listen(1)
-        self._listener = listener
-        self._client: socket.socket | None = None
-        bound_host, bound_port = listener.getsockname()[:2]
-        super().__init__(bus, f"socket://{bound_host}:{bound_port}")
+            raise
+        return listener
 
-    def _send(self, data: bytes) -> None:
-        if self._client is None:
+    def _watched(self) -> list[int | socket.socket]:
+        watched: list[int | socket.socket] = []
+        if self._listener is not None:
+            watched.append(self._listener)
+        if self._client is not None:
+            watched.append(self._client)
+        return watched
+
+    def _on_readable(self, ready: list[int | socket.socket]) -> None:
+        listener = self._listener
+        if listener is not None and listener in ready:
+            try:
+                conn, peer = listener.accept()
+            except OSError:
+                return
+            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            conn.setblocking(False)
+            with self._io_lock:
+                self._drop_client()
+                self._client = conn
+            self._inbox.put(RESET)
+            logger.debug("%s: client %s connected", self.url, peer)
+        client = self._client
+        if client is None or client not in ready:
             return
         try:
-            self._client.sendall(data)
-        except OSError as exc:
-            logger.debug("%s: send failed (%s)", self.url, exc)
+            data = client.recv(CHUNK)
+        except BlockingIOError:
+            return
+        except OSError:
+            data = b""
+        if not data:
+            with self._io_lock:
+                if self._client is client:
+                    self._drop_client()
+            return
+        self._put(data)
+
+    def _write_some(self, view: memoryview) -> int | None:
+        if self._client is None:
+            return None
+        try:
+            return self._client.send(view)
+        except BlockingIOError:
+            return 0
+
+    def _writable_fd(self) -> socket.socket | None:
+        return self._client
 
     def _drop_client(self) -> None:
         if self._client is not None:
             self._client.close()
             self._client = None
 
-    def _serve(self) -> None:
-        while not self._stop.is_set():
-            watched: list[socket.socket | int] = [self._listener, self._wake_r]
-            if self._client is not None:
-                watched.append(self._client)
-            ready, _, _ = select.select(watched, [], [], _POLL_S)
-            if self._listener in ready:
-                conn, peer = self._listener.accept()
-                conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-                self._drop_client()
-                self._client = conn
-                self.bus.reset_input()
-                logger.debug("%s: client %s connected", self.url, peer)
-            client = self._client
-            if client is None or client not in ready:
-                continue
-            try:
-                data = client.recv(_CHUNK)
-            except OSError:
-                data = b""
-            if not data:
-                self._drop_client()
-                continue
-            replies = self.bus.receive(data, received_at=time.perf_counter())
-            self._deliver(replies, self._send)
+    def _open_endpoint(self) -> bool:
+        try:
+            self._listener = self._listen(*self._address)
+        except OSError as exc:
+            logger.warning("%s: cannot listen again yet (%s)", self.url, exc)
+            return False
+        return True
 
-    def _close(self) -> None:
+    def _close_endpoint(self) -> None:
         self._drop_client()
-        self._listener.close()
+        if self._listener is not None:
+            self._listener.close()
+            self._listener = None
 
 
-def serve_pty(bus: VirtualBus) -> EmulatorServer:
+def serve_pty(bus: VirtualBus, link: str | os.PathLike[str] | None = None) -> EmulatorServer:
     """Serve ``bus`` on a new pseudo-terminal.
 
     Args:
         bus: the virtual bus.
+        link: optional symlink kept pointing at the pty (see :class:`PtyServer`).
 
     Returns:
         The running server; open ``server.url`` (e.g. ``/dev/pts/7``) with pyserial.
+
+    Raises:
+        PortError: the link cannot be made.
     """
-    server = PtyServer(bus)
+    server = PtyServer(bus, link)
     server.start()
     return server
 

@@ -103,9 +103,13 @@ class ControlTable:
     def store(self, register: Register, raw: int) -> None:
         """Store a raw value in ``register`` without checks, clamped to what its bytes hold."""
         bits = 8 * register.size
-        low, high = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if register.signed else (
-            0,
-            (1 << bits) - 1,
+        low, high = (
+            (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+            if register.signed
+            else (
+                0,
+                (1 << bits) - 1,
+            )
         )
         raw = min(max(raw, low), high)
         self.data[register.address : register.address + register.size] = register.encode(raw)

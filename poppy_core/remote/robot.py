@@ -342,6 +342,12 @@ class RemoteRobot:
         assert isinstance(answer, dict)
         return answer
 
+    def health(self) -> dict[str, dict[str, Any]]:
+        """Controller name -> its bus's health as the server sees it (``Robot.health``)."""
+        answer = self._client.get(path_of("robot", "health"))
+        assert isinstance(answer, dict)
+        return answer
+
     @property
     def primitive_names(self) -> list[str]:
         """Names of the primitives attached on the server."""

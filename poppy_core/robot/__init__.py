@@ -25,6 +25,7 @@ from poppy_core.robot.config import (
 from poppy_core.robot.config_io import config_to_text, dump_config, load_config
 from poppy_core.robot.factory import autodetect, from_config, from_profile, start_emulators
 from poppy_core.robot.goto import GotoHandle, GotoRunner
+from poppy_core.robot.health import BusHealth
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.profile_store import SavedProfile, save_user_profile
 from poppy_core.robot.profiles import (
@@ -53,6 +54,7 @@ __all__ = [
     "DEFAULT_BAUDRATE",
     "LIGHT_LOOPS",
     "PROFILE_FILE",
+    "BusHealth",
     "BusSync",
     "Calibration",
     "CalibrationAnswers",

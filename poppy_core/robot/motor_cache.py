@@ -125,6 +125,13 @@ class MotorCache:
                 if value is not None:
                     self._store(name, value)
 
+    def mark_offline(self) -> bool:
+        """Mark the motor offline at once (its bus was lost); True when it was online."""
+        with self._lock:
+            was_online = self.online
+            self.online = False
+            return was_online
+
     def mark_missed(self, offline_after: int) -> bool:
         """Record a failed read; True when the motor just went offline."""
         with self._lock:

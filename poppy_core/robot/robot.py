@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING, Any, Protocol
 from poppy_core.bus import DxlBus
 from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError, UnknownMotorError
 from poppy_core.robot.goto import GotoHandle, GotoRunner
+from poppy_core.robot.health import BusHealth, SyncStats
 from poppy_core.robot.motor import Motor
-from poppy_core.robot.sync import BusSync, SyncStats
+from poppy_core.robot.sync import BusSync
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import RobotConfig
@@ -386,6 +387,10 @@ class Robot:
     def sync_stats(self) -> dict[str, SyncStats]:
         """Controller name -> measured loop rates, error counts and offline motors."""
         return {sync.controller: sync.stats() for sync in self._syncs}
+
+    def health(self) -> dict[str, BusHealth]:
+        """Controller name -> its bus's health: connected, loop rates, errors, offline motors."""
+        return {sync.controller: sync.health() for sync in self._syncs}
 
     # -- config and lifetime -----------------------------------------------------------------
 

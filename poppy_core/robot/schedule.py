@@ -9,13 +9,17 @@ from collections import deque
 class Periodic:
     """Deadlines at ``start + k * period``: late runs skip the periods they missed, no drift.
 
+    With ``catch_up=1`` a run that ended late keeps the one deadline it overran (the next run
+    starts at once): a loop whose runs take about its period on average, a few longer, keeps
+    its rate; only periods missed by more than that are skipped.
+
     Attributes:
         period_s: time between deadlines.
         next_deadline: when the next run is due (same clock as the times passed in).
         missed: periods skipped because a run came too late.
     """
 
-    def __init__(self, period_s: float, start_s: float) -> None:
+    def __init__(self, period_s: float, start_s: float, catch_up: int = 0) -> None:
         """Create a schedule whose first deadline is ``start_s``.
 
         Raises:
@@ -26,6 +30,7 @@ class Periodic:
         self.period_s = period_s
         self.next_deadline = start_s
         self.missed = 0
+        self.catch_up = catch_up
 
     def due(self, now_s: float) -> bool:
         """True when the deadline has come."""
@@ -39,8 +44,9 @@ class Periodic:
         """
         self.next_deadline += self.period_s
         skipped = 0
-        if now_s >= self.next_deadline:
-            skipped = math.floor((now_s - self.next_deadline) / self.period_s) + 1
+        kept = self.catch_up * self.period_s  # overdue deadlines still run
+        if now_s >= self.next_deadline + kept:
+            skipped = math.floor((now_s - self.next_deadline - kept) / self.period_s) + 1
             self.next_deadline += skipped * self.period_s
         self.missed += skipped
         return skipped
@@ -57,6 +63,12 @@ class RateMeter:
         """Record one run at ``now_s``."""
         self._times.append(now_s)
         self.count += 1
+
+    def rate_at(self, now_s: float, stale_after_s: float) -> float:
+        """``rate_hz``, or 0 when the last run is more than ``stale_after_s`` before ``now_s``."""
+        if not self._times or now_s - self._times[-1] > stale_after_s:
+            return 0.0
+        return self.rate_hz
 
     @property
     def rate_hz(self) -> float:

@@ -8,8 +8,15 @@ and load, temperature and voltage at 1 Hz. Writes only send values that changed.
 
 Reads use ``DxlBus.sync_read`` (sync read, USB2AX sync read, bulk read or single reads, as the
 bus offers), one transaction per group of motors sharing a register layout. A motor that misses
-``offline_after`` reads in a row is marked offline: it leaves the fast loops and is pinged once
-per ``retry_period_s`` until it answers again. Deadlines are drift-free (``Periodic``).
+``offline_after`` reads in a row is marked offline: it leaves the fast loops and is pinged (one
+offline motor per ``retry_period_s``, in turn) until it answers again. Deadlines are drift-free
+(``Periodic``); a run that overran its period is followed at once by the next one, so a loop
+whose runs are sometimes long keeps its rate.
+
+A lost port (adapter unplugged, emulator gone: a ``PortError``) is logged once at WARNING, every
+motor of the bus goes offline at once, and the thread reopens the port with backoff
+(``RECONNECT_FIRST_S`` doubling up to ``RECONNECT_MAX_S``); once it opens, the motors are pinged
+and resume (one WARNING says the bus is back). ``health()`` says how the bus is doing.
 """
 
 from __future__ import annotations
@@ -18,92 +25,47 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 
 from poppy_core.bus import DxlBus
-from poppy_core.errors import BusError, MotorError, PoppyError
+from poppy_core.errors import BusError, MotorError, PoppyError, PortError
 from poppy_core.models import ServoModel
 from poppy_core.robot import registers as regs
+from poppy_core.robot.health import BusHealth, LoopStats, SyncStats
+from poppy_core.robot.loops import BASE_LOOPS, LIGHT_LOOPS, LoopSpec, loops_for
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.schedule import Periodic, RateMeter
 
 logger = logging.getLogger(__name__)
 
 
-@dataclass(frozen=True)
-class LoopSpec:
-    """One register group: its registers, direction and rate."""
-
-    name: str
-    registers: tuple[str, ...]
-    write: bool
-    rate_hz: float
-
-
-BASE_LOOPS: tuple[LoopSpec, ...] = (
-    LoopSpec("present", regs.PRESENT, False, 50.0),
-    LoopSpec("goals", regs.GOALS, True, 50.0),
-    LoopSpec("gains", regs.GAINS, True, 10.0),
-    LoopSpec("limits", regs.LIMITS, True, 1.0),
-    LoopSpec("sensors", regs.SENSORS, False, 1.0),
-)
-LIGHT_LOOPS: tuple[LoopSpec, ...] = (
-    LoopSpec("present", ("present_position", "present_speed"), False, 50.0),
-    LoopSpec("goals", regs.GOALS, True, 50.0),
-    LoopSpec("gains", regs.GAINS, True, 10.0),
-    LoopSpec("limits", regs.LIMITS, True, 1.0),
-    LoopSpec("sensors", ("present_load", *regs.SENSORS), False, 1.0),
-)
 RETRY = "retry"
+# Offline motors are pinged RETRY_BATCH at a time, in turn, every ``retry_period_s`` (0.2 s): a
+# motor plugged back answers within a fraction of a second, and a bus full of silent motors
+# costs its live ones one ping per run.
+RETRY_BATCH = 1
+# Reopening a lost port: first attempt after RECONNECT_FIRST_S, then twice as long each time.
+RECONNECT_FIRST_S = 0.1
+RECONNECT_MAX_S = 1.0
+# A loop that has not run for this many periods (at least STALE_MIN_S) reports a rate of 0.
+STALE_PERIODS = 3.0
+STALE_MIN_S = 0.5
 
-
-def loops_for(syncloop: str) -> tuple[LoopSpec, ...]:
-    """The loops for a config's ``syncloop`` name (``LightDxlController`` → light, else base)."""
-    return LIGHT_LOOPS if "light" in syncloop.lower() else BASE_LOOPS
-
-
-@dataclass(frozen=True)
-class LoopStats:
-    """What one loop did: target and measured rate, runs, skipped periods, errors."""
-
-    name: str
-    target_hz: float
-    measured_hz: float
-    runs: int
-    missed_periods: int
-    errors: int
-    last_duration_s: float
-
-
-@dataclass(frozen=True)
-class SyncStats:
-    """One bus's loops, its motors' health and its bus counters."""
-
-    controller: str
-    port: str
-    running: bool
-    loops: dict[str, LoopStats]
-    motor_errors: dict[str, int]
-    offline: list[str]
-    bus: dict[str, int] = field(default_factory=dict)
-
-    def as_dict(self) -> dict[str, object]:
-        """Plain data (for ``--json``)."""
-        return {
-            "controller": self.controller,
-            "port": self.port,
-            "running": self.running,
-            "loops": {name: vars(loop) for name, loop in self.loops.items()},
-            "motor_errors": dict(self.motor_errors),
-            "offline": list(self.offline),
-            "bus": dict(self.bus),
-        }
+__all__ = [
+    "BASE_LOOPS",
+    "LIGHT_LOOPS",
+    "BusHealth",
+    "BusSync",
+    "LoopSpec",
+    "LoopStats",
+    "SyncStats",
+    "loops_for",
+]
 
 
 class _Loop:
     def __init__(self, spec: LoopSpec, start_s: float) -> None:
         self.spec = spec
-        self.schedule = Periodic(1.0 / spec.rate_hz, start_s)
+        self.schedule = Periodic(1.0 / spec.rate_hz, start_s, catch_up=1)
         self.meter = RateMeter()
         self.errors = 0
         self.last_duration_s = 0.0
@@ -118,7 +80,8 @@ class BusSync:
         motors: the motors on it.
         loops: the register groups (``BASE_LOOPS``, ``LIGHT_LOOPS`` or your own).
         offline_after: consecutive missed reads before a motor is marked offline.
-        retry_period_s: how often offline motors are pinged.
+        retry_period_s: time between two pings of offline motors (one motor per ping, in
+            turn; see ``RETRY_BATCH``).
         clock: monotonic clock in seconds.
     """
 
@@ -130,7 +93,7 @@ class BusSync:
         loops: Sequence[LoopSpec] = BASE_LOOPS,
         *,
         offline_after: int = 3,
-        retry_period_s: float = 1.0,
+        retry_period_s: float = 0.2,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.controller = controller
@@ -144,6 +107,12 @@ class BusSync:
         self._thread: threading.Thread | None = None
         self._blocks: dict[tuple[str, ServoModel], list[regs.Block]] = {}
         self._driven: set[str] = set()
+        self._retry_turn = 0
+        self.connected = True
+        self.losses = 0
+        self._down_since = 0.0
+        self._backoff_s = RECONNECT_FIRST_S
+        self._next_reopen = 0.0
 
     @property
     def running(self) -> bool:
@@ -179,7 +148,7 @@ class BusSync:
         Sync writes get no reply: when something was sent, one ping follows, so the writes
         have been handled once this returns (the bus may be closed right after).
         """
-        if not any(m.online and m.has_pending() for m in self.motors):
+        if not self.connected or not any(m.online and m.has_pending() for m in self.motors):
             return
         for spec in self._specs:
             if spec.write:
@@ -215,6 +184,33 @@ class BusSync:
         """Give loop ``name`` back to the thread."""
         self._driven.discard(name)
 
+    def health(self) -> BusHealth:
+        """Connected or not, loop rates now, error counters, offline motors."""
+        now = self._clock()
+        loops = [loop for loop in self._loops if loop.spec.name != RETRY]
+        stats = self.bus.stats
+        return BusHealth(
+            controller=self.controller,
+            port=self.bus.port,
+            connected=self.connected,
+            running=self.running,
+            down_s=0.0 if self.connected else now - self._down_since,
+            losses=self.losses,
+            loop_hz={
+                loop.spec.name: loop.meter.rate_at(
+                    now, max(STALE_MIN_S, STALE_PERIODS / loop.spec.rate_hz)
+                )
+                for loop in loops
+            },
+            target_hz={loop.spec.name: loop.spec.rate_hz for loop in loops},
+            loop_errors=sum(loop.errors for loop in self._loops),
+            timeouts=stats.timeouts,
+            retries=stats.retries,
+            corrupt_packets=stats.corrupt_packets,
+            motor_errors=stats.motor_errors,
+            offline=[m.name for m in self.motors if not m.online],
+        )
+
     def stats(self) -> SyncStats:
         """Measured rates, error counts and offline motors."""
         loops = {
@@ -243,29 +239,85 @@ class BusSync:
 
     def _run(self) -> None:
         while not self._stop.is_set():
-            now = self._clock()
-            for loop in self._loops:
-                if self._stop.is_set():
-                    return
-                if not loop.schedule.due(now):
-                    continue
-                if loop.spec.name in self._driven:
-                    loop.schedule.advance(now)
-                    continue
-                loop.meter.tick(now)
-                started = self._clock()
-                try:
-                    self._execute(loop.spec)
-                except Exception as exc:
-                    loop.errors += 1
-                    if isinstance(exc, PoppyError | OSError):
-                        logger.debug("%s %s loop: %s", self.controller, loop.spec.name, exc)
-                    else:
-                        logger.exception("%s %s loop failed", self.controller, loop.spec.name)
-                loop.last_duration_s = self._clock() - started
+            try:
+                if self.connected:
+                    self._run_due_loops()
+                else:
+                    self._reconnect()
+            except Exception:  # never let the thread die: log, breathe, go on
+                logger.exception("%s: sync thread error", self.controller)
+                self._stop.wait(0.1)
+
+    def _run_due_loops(self) -> None:
+        now = self._clock()
+        for loop in self._loops:
+            if self._stop.is_set():
+                return
+            if not loop.schedule.due(now):
+                continue
+            if loop.spec.name in self._driven:
                 loop.schedule.advance(now)
-            wake = min(loop.schedule.next_deadline for loop in self._loops)
-            self._stop.wait(max(0.0, wake - self._clock()))
+                continue
+            loop.meter.tick(now)
+            started = self._clock()
+            try:
+                self._execute(loop.spec)
+            except PortError as exc:
+                loop.errors += 1
+                self._lost(exc)
+                return
+            except Exception as exc:
+                loop.errors += 1
+                if isinstance(exc, PoppyError | OSError):
+                    logger.debug("%s %s loop: %s", self.controller, loop.spec.name, exc)
+                else:
+                    logger.exception("%s %s loop failed", self.controller, loop.spec.name)
+            loop.last_duration_s = self._clock() - started
+            loop.schedule.advance(now)
+        wake = min(loop.schedule.next_deadline for loop in self._loops)
+        self._stop.wait(max(0.0, wake - self._clock()))
+
+    def _lost(self, exc: PortError) -> None:
+        """The port went away: every motor offline now, one warning, reopen with backoff."""
+        self.connected = False
+        self.losses += 1
+        self._down_since = self._clock()
+        self._backoff_s = RECONNECT_FIRST_S
+        self._next_reopen = self._down_since + self._backoff_s
+        for motor in self.motors:
+            motor.mark_offline()
+        logger.warning(
+            "%s: lost %s (%s); its %d motor(s) are offline, reopening it with backoff",
+            self.controller,
+            self.bus.port,
+            exc,
+            len(self.motors),
+        )
+
+    def _reconnect(self) -> None:
+        if self._stop.wait(max(0.0, self._next_reopen - self._clock())):
+            return
+        try:
+            self.bus.reopen()
+        except PortError as exc:
+            self._backoff_s = min(2 * self._backoff_s, RECONNECT_MAX_S)
+            self._next_reopen = self._clock() + self._backoff_s
+            logger.debug("%s: %s still away (%s)", self.controller, self.bus.port, exc)
+            return
+        now = self._clock()
+        self.connected = True
+        logger.warning(
+            "%s: %s is back after %.1f s; pinging its motors",
+            self.controller,
+            self.bus.port,
+            now - self._down_since,
+        )
+        for loop in self._loops:
+            loop.schedule = Periodic(loop.schedule.period_s, now, catch_up=1)
+        try:
+            self._retry(every=True)
+        except PortError as exc:
+            self._lost(exc)
 
     def _execute(self, spec: LoopSpec) -> None:
         if spec.name == RETRY:
@@ -315,12 +367,11 @@ class BusSync:
     def _missed(self, motor: Motor | None, reason: str) -> None:
         if motor is not None and motor.mark_missed(self.offline_after):
             logger.warning(
-                "%s (id %d) on %s stopped answering (%s); retrying every %.1f s",
+                "%s (id %d) on %s stopped answering (%s); pinging it until it answers",
                 motor.name,
                 motor.id,
                 self.bus.port,
                 reason,
-                1.0 / self._specs[-1].rate_hz,
             )
 
     def _write(self, spec: LoopSpec) -> None:
@@ -347,12 +398,22 @@ class BusSync:
                 motor.restore_pending(values)
             raise
 
-    def _retry(self) -> None:
-        for motor in self.motors:
-            if motor.online or self._stop.is_set():
-                continue
+    def _retry(self, every: bool = False) -> None:
+        """Ping offline motors: the next ``RETRY_BATCH`` in turn, or ``every`` one of them."""
+        offline = [m for m in self.motors if not m.online]
+        if not offline:
+            return
+        if not every:
+            start = self._retry_turn % len(offline)
+            offline = (offline[start:] + offline[:start])[:RETRY_BATCH]
+            self._retry_turn += len(offline)
+        for motor in offline:
+            if self._stop.is_set():
+                return
             try:
-                answered = self.bus.ping(motor.id, retries=0) is not None
+                answered = self.bus.ping(motor.id, identify=False) is not None
+            except PortError:
+                raise
             except BusError:
                 answered = False
             if answered:

@@ -25,6 +25,26 @@ class RobotInfo(BaseModel):
     compliant: bool
 
 
+class BusHealthInfo(BaseModel):
+    """One bus's health (``Robot.health()``): is it there, how fast its loops run, what fails."""
+
+    controller: str
+    port: str
+    ok: bool = Field(description="connected, running, and every motor answering")
+    connected: bool = Field(description="false while the port is lost; it is reopened")
+    running: bool = Field(description="the sync thread is alive")
+    down_s: float = Field(description="seconds since the port was lost (0 when connected)")
+    losses: int = Field(description="times the port was lost")
+    loop_hz: dict[str, float] = Field(description="loop name -> rate measured now")
+    target_hz: dict[str, float] = Field(description="loop name -> rate asked for")
+    loop_errors: int
+    timeouts: int
+    retries: int
+    corrupt_packets: int
+    motor_errors: int
+    offline: list[str] = Field(description="motors that do not answer (retried)")
+
+
 class CompliantBody(BaseModel):
     """Compliance of the whole robot."""
 

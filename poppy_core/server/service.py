@@ -120,6 +120,10 @@ class RobotService:
         """Motor name -> its streamed state."""
         return {m.name: values.motor_state(m) for m in self.robot.motors}
 
+    def health(self) -> dict[str, dict[str, Any]]:
+        """Controller name -> its bus's health (``BusHealth.as_dict``)."""
+        return {name: health.as_dict() for name, health in self.robot.health().items()}
+
     def set_compliant(self, compliant: bool) -> None:
         """Make every motor compliant or stiff."""
         self.robot.compliant = compliant

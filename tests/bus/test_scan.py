@@ -41,10 +41,11 @@ def test_scan_protocol_2_uses_the_broadcast_ping(emulate: Emulate) -> None:
             (3, "XL430-W250", 57_600, 2),
             (7, "XL-320", 57_600, 2),
         ]
-        # Two agreeing broadcast pings per rate and no per-ID ping: the line was clean.
+        # Two agreeing broadcast pings per rate and no per-ID ping: the line was clean; one
+        # more broadcast confirms the motors found once the line settled.
         assert [p.step for p in progress] == ["broadcast ping", "broadcast ping"]
         assert progress[-1].fraction == 1.0
-        assert virtual.packets_received == 4
+        assert virtual.packets_received == 5
 
 
 def test_scan_without_broadcast_pings_each_id(emulate: Emulate) -> None:
@@ -119,7 +120,7 @@ def test_find_port(emulate: Emulate) -> None:
 
 
 def test_find_port_without_ports(monkeypatch: pytest.MonkeyPatch) -> None:
-    module = importlib.import_module("poppy_core.bus.scan")
+    module = importlib.import_module("poppy_core.bus.find")
     monkeypatch.setattr(module, "list_ports", lambda: [])
     with pytest.raises(PortError):
         find_port([1])

@@ -28,7 +28,7 @@ def write_settings(xdg: Path, text: str) -> Path:
 def test_status_sim_json(poppy: Any) -> None:
     result = poppy("robot", "status", "--sim", "--profile", "ergo-jr", "--json")
     assert result.code == 0, result.stderr
-    data = result.json()
+    data = result.json()["motors"]
     assert sorted(data) == [f"m{i}" for i in range(1, 7)]
     for name, state in data.items():
         assert abs(state["position"]) < 2, name
@@ -76,12 +76,12 @@ def test_no_robot_given(poppy: Any) -> None:
 
 def test_compliant_off_then_status(poppy: Any, ergo_jr: Any) -> None:
     common = ("--profile", "ergo-jr", "--port", ergo_jr.url)
-    before = poppy("robot", "status", *common, "--json").json()
+    before = poppy("robot", "status", *common, "--json").json()["motors"]
     assert all(state["compliant"] for state in before.values())
     off = poppy("robot", "compliant", "off", "base", *common, "--json")
     assert off.code == 0, off.stderr
     assert off.json() == {"m1": False, "m2": False, "m3": False}
-    after = poppy("robot", "status", *common, "--json").json()
+    after = poppy("robot", "status", *common, "--json").json()["motors"]
     assert [after[f"m{i}"]["compliant"] for i in range(1, 7)] == [False] * 3 + [True] * 3
 
 
@@ -97,19 +97,19 @@ def test_settings_file_then_env_override(
     write_settings(xdg, "profile: torso\n")
     from_file = poppy("robot", "status", "--sim", "--json")
     assert from_file.code == 0, from_file.stderr
-    assert len(from_file.json()) == 13
+    assert len(from_file.json()["motors"]) == 13
     monkeypatch.setenv("POPPY_PROFILE", "ergo-jr")
     from_env = poppy("robot", "status", "--sim", "--json")
-    assert sorted(from_env.json()) == [f"m{i}" for i in range(1, 7)]
+    assert sorted(from_env.json()["motors"]) == [f"m{i}" for i in range(1, 7)]
     from_option = poppy("robot", "status", "--sim", "--json", "--profile", "torso")
-    assert len(from_option.json()) == 13
+    assert len(from_option.json()["motors"]) == 13
 
 
 def test_settings_port_used_for_the_bus(poppy: Any, xdg: Path, ergo_jr: Any) -> None:
     write_settings(xdg, f"profile: ergo-jr\nport: {ergo_jr.url}\n")
     result = poppy("robot", "status", "--json")
     assert result.code == 0, result.stderr
-    assert len(result.json()) == 6
+    assert len(result.json()["motors"]) == 6
 
 
 def test_malformed_settings_file(poppy: Any, xdg: Path) -> None:

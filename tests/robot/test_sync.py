@@ -25,6 +25,15 @@ def test_periodic_is_drift_free_and_counts_skips() -> None:
         Periodic(0, 0)
 
 
+def test_periodic_catch_up_keeps_one_overdue_deadline() -> None:
+    schedule = Periodic(0.02, 1.0, catch_up=1)
+    assert schedule.advance(1.025) == 0  # overran 1.02: it stays due, the next run starts now
+    assert schedule.next_deadline == pytest.approx(1.02) and schedule.due(1.026)
+    assert schedule.advance(1.071) == 1  # more than a period late: 1.04 skipped, 1.06 kept
+    assert schedule.next_deadline == pytest.approx(1.06)
+    assert schedule.missed == 1
+
+
 def test_rate_meter() -> None:
     meter = RateMeter(window=10)
     assert meter.rate_hz == 0

@@ -90,7 +90,7 @@ def _poppy(*args: str) -> subprocess.CompletedProcess[str]:
 def test_robot_commands_with_remote(served: Any) -> None:
     status = _poppy("robot", "status", "--remote", served.url, "--json")
     assert status.returncode == 0, status.stderr
-    state = json.loads(status.stdout)
+    state = json.loads(status.stdout)["motors"]
     assert list(state) == ["m1", "m2", "m3", "m4", "m5", "m6"]
     assert state["m1"]["model"] == "XL-320" and state["m1"]["online"] is True
 

@@ -24,6 +24,7 @@ if TYPE_CHECKING:
 
 REFRESH_S = 0.1
 COLUMNS = ("motor", "id", "pos °", "goal °", "speed", "load %", "temp", "compliant")
+HEALTH_COLUMNS = ("bus", "link", "present Hz", "goals Hz", "timeouts", "retries", "offline")
 
 
 def parse_goto(text: str, known: list[str]) -> dict[str, float]:
@@ -82,6 +83,7 @@ class RobotPanel(Vertical):
         Binding("2", "view('robot-primitives')", "Primitives", show=False),
         Binding("3", "view('robot-moves')", "Moves", show=False),
         Binding("4", "view('robot-chains')", "Chains", show=False),
+        Binding("5", "view('robot-health')", "Health", show=False),
     ]
 
     def __init__(self, *, id: str | None = None) -> None:
@@ -113,11 +115,16 @@ class RobotPanel(Vertical):
                 yield self.moves
             with TabPane("Chains 4", id="robot-chains"):
                 yield self.chains
+            with TabPane("Health 5", id="robot-health"):
+                yield DataTable[str](id="health-table", cursor_type="row")
 
     def on_mount(self) -> None:
         table = self.query_one("#robot-table", DataTable)
         for column in COLUMNS:
             table.add_column(column, key=column)
+        health = self.query_one("#health-table", DataTable)
+        for column in HEALTH_COLUMNS:
+            health.add_column(column, key=column)
         self.set_interval(REFRESH_S, self.refresh_table)
 
     def action_view(self, pane: str) -> None:
@@ -127,6 +134,7 @@ class RobotPanel(Vertical):
             "robot-motors": "#robot-table",
             "robot-primitives": "#primitive-table",
             "robot-chains": "#chain-table",
+            "robot-health": "#health-table",
         }
         self.query_one(focus.get(pane, "#moves-table")).focus()
 
@@ -152,6 +160,10 @@ class RobotPanel(Vertical):
         table.clear()
         for motor in message.robot.motors:
             table.add_row(*self._cells(motor.name), key=motor.name)
+        health = self.query_one("#health-table", DataTable)
+        health.clear()
+        for controller, cells in self._health_rows().items():
+            health.add_row(*cells, key=controller)
         groups = [("all", "*"), *((name, name) for name in message.robot.motorgroups)]
         self.query_one("#robot-group", Select).set_options(groups)
         self.notify(f"robot {message.title}: {len(message.robot.motors)} motors")
@@ -171,6 +183,23 @@ class RobotPanel(Vertical):
             ("yes" if motor.compliant else "no") + link,
         )
 
+    def _health_rows(self) -> dict[str, tuple[str, ...]]:
+        """Controller -> its health cells (``Robot.health``: no I/O)."""
+        assert self.robot is not None
+        rows: dict[str, tuple[str, ...]] = {}
+        for controller, bus in self.robot.health().items():
+            link = "connected" if bus.connected else f"LOST {bus.down_s:.1f} s, reopening"
+            rows[controller] = (
+                controller,
+                link,
+                f"{bus.loop_hz.get('present', 0.0):.0f}",
+                f"{bus.loop_hz.get('goals', 0.0):.0f}",
+                str(bus.timeouts),
+                str(bus.retries),
+                ", ".join(bus.offline) or "none",
+            )
+        return rows
+
     def refresh_table(self) -> None:
         """Show the motors' cached values (the sync loops keep them fresh), the primitives'
         states and the recording or playback progress: polling only, no I/O."""
@@ -180,6 +209,10 @@ class RobotPanel(Vertical):
         for motor in self.robot.motors:
             for column, text in zip(COLUMNS, self._cells(motor.name), strict=True):
                 table.update_cell(motor.name, column, text)
+        health = self.query_one("#health-table", DataTable)
+        for controller, cells in self._health_rows().items():
+            for column, text in zip(HEALTH_COLUMNS, cells, strict=True):
+                health.update_cell(controller, column, text)
         self.primitives.refresh_states()
         self.moves.poll()
         self.chains.poll()

@@ -3,7 +3,7 @@
 from fastapi import APIRouter  # noqa: TID253 (the server room is FastAPI's)
 
 from poppy_core.server.deps import Service
-from poppy_core.server.schemas import CompliantBody, Problem, RobotInfo
+from poppy_core.server.schemas import BusHealthInfo, CompliantBody, Problem, RobotInfo
 from poppy_core.server.values import STATE_REGISTERS
 
 router = APIRouter(tags=["robot"], responses={404: {"model": Problem}, 422: {"model": Problem}})
@@ -28,6 +28,12 @@ async def robot_info(service: Service) -> RobotInfo:
 async def robot_state(service: Service) -> dict[str, dict[str, float | bool | str | None]]:
     """Motor name -> its present state (what the WebSocket streams)."""
     return service.state()
+
+
+@router.get("/robot/health", summary="Each bus: connected, loop rates, errors, offline motors")
+async def robot_health(service: Service) -> dict[str, BusHealthInfo]:
+    """Controller name -> its bus's health; a lost bus is reopened by the robot on its own."""
+    return {name: BusHealthInfo(**data) for name, data in service.health().items()}
 
 
 @router.put("/robot/compliant", summary="Make every motor compliant or stiff")

@@ -1,0 +1,63 @@
+"""A noisy line: garbled replies are retried at once and in smaller groups, never taken for
+silence, and never change how the bus reads."""
+
+from __future__ import annotations
+
+import time
+
+from poppy_core.bus import DxlBus
+from poppy_core.emulator import FaultInjector, build_bus_from_spec, serve_pty
+from poppy_core.protocol import ping
+
+MX_PRESENT = 36  # MX-28 present position (e-manual), 2 bytes
+XL_PRESENT = 37  # XL-320 present position (e-manual), 2 bytes
+
+
+class GarbleReplies(FaultInjector):
+    """Flips a bit in the middle of the replies numbered in ``which`` (1 = the first)."""
+
+    def __init__(self, which: set[int]) -> None:
+        super().__init__()
+        self.which = which
+        self.count = 0
+
+    def filter_reply(self, data: bytes) -> bytes | None:
+        self.count += 1
+        if self.count not in self.which:
+            return data
+        garbled = bytearray(data)
+        garbled[len(data) // 2] ^= 0x10
+        return bytes(garbled)
+
+
+def test_a_garbled_usb2ax_reply_keeps_the_sync_read() -> None:
+    faults = GarbleReplies(set())
+    virtual = build_bus_from_spec("MX-28:1-6", adapter="usb2ax", faults=faults)
+    ids = [1, 2, 3, 4, 5, 6]
+    with serve_pty(virtual) as server, DxlBus(server.url) as bus:
+        expected = {i: bus.read(i, MX_PRESENT, 2) for i in ids}
+        assert bus.sync_read(MX_PRESENT, 2, ids) == expected
+        assert (bus.sync_read_mode, bus.usb2ax) == ("sync", True)
+        faults.which = {faults.count + 1, faults.count + 2, faults.count + 3}
+        assert bus.sync_read(MX_PRESENT, 2, ids) == expected  # read in smaller groups
+        assert (bus.sync_read_mode, bus.usb2ax) == ("sync", True)
+
+
+def test_a_motor_garbled_in_every_group_reply_is_read_on_its_own() -> None:
+    faults = GarbleReplies(set())
+    virtual = build_bus_from_spec("XL-320:1-3", protocol=2, faults=faults)
+    with serve_pty(virtual) as server, DxlBus(server.url, protocol=2) as bus:
+        expected = {i: bus.read(i, XL_PRESENT, 2) for i in (1, 2, 3)}
+        # the sync read: replies 1-3; its retry asks motor 2 alone: reply 4
+        faults.which = {faults.count + 2, faults.count + 4}
+        assert bus.sync_read(XL_PRESENT, 2, [1, 2, 3]) == expected
+
+
+def test_a_garbled_reply_does_not_wait_out_the_deadline() -> None:
+    faults = GarbleReplies({1})
+    virtual = build_bus_from_spec("XL-320:1", protocol=2, faults=faults)
+    with serve_pty(virtual) as server, DxlBus(server.url, protocol=2, timeout_s=3.0) as bus:
+        started = time.monotonic()
+        assert bus.exchange(ping(1), [(1, 3)]) == {}
+        assert time.monotonic() - started < 1.5  # garbled at once; the deadline was 3 s
+        assert bus.stats.corrupt_packets == 1

@@ -1,0 +1,78 @@
+"""Scans and searches on adapters slower than assumed, late model reads, ports that cannot open."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import pytest
+
+from poppy_core.bus import DxlBus, find_port, locate, scan
+from poppy_core.emulator import FaultInjector, VirtualBus, VirtualMotor, serve_pty
+from poppy_core.errors import PortError
+from poppy_core.models import model_by_name
+
+if TYPE_CHECKING:
+    from tests.bus.conftest import Emulate
+
+SLOW = {"wire_timing": True, "latency_s": 0.008}  # an adapter holding replies 8 ms
+
+
+def _found(found: list) -> list[tuple[int, int]]:  # type: ignore[type-arg]
+    return sorted((f.id, f.baudrate) for f in found)
+
+
+@pytest.mark.parametrize("broadcast", [True, False])
+def test_scan_on_a_slow_adapter_reports_the_right_rate(emulate: Emulate, broadcast: bool) -> None:
+    with emulate("XL-320:1-3", protocol=2, **SLOW) as (_, url):
+        found = scan(url, [1_000_000, 2_000_000], [2], ids=range(6), broadcast=broadcast)
+    assert _found(found) == [(1, 1_000_000), (2, 1_000_000), (3, 1_000_000)]
+    assert all(f.model == "XL-320" for f in found)
+
+
+def test_protocol_1_scan_on_a_slow_adapter(emulate: Emulate) -> None:
+    with emulate("MX-28:1-2", **SLOW) as (_, url):
+        found = scan(url, [1_000_000, 500_000, 400_000], [1], ids=range(4))
+    assert _found(found) == [(1, 1_000_000), (2, 1_000_000)]
+    assert all(f.model == "MX-28" for f in found)
+
+
+def test_find_port_on_a_slow_adapter(emulate: Emulate) -> None:
+    with emulate("XL-320:1-2", protocol=2, wire_timing=True, latency_s=0.03) as (_, url):
+        assert find_port([1, 2], [url]) == (url, 1_000_000, 2)
+
+
+def test_locate_on_a_slow_adapter(emulate: Emulate) -> None:
+    slow = emulate("XL-320:1-2", protocol=2, wire_timing=True, latency_s=0.03)
+    with slow as (_, url), DxlBus(url, 57_600, 2) as bus:
+        assert locate(bus, 2) == 1_000_000
+        assert bus.baudrate == 1_000_000
+
+
+class DropOnce(FaultInjector):
+    """Loses the reply numbered ``which`` (1 = the first), as a reply that came too late."""
+
+    def __init__(self, which: int) -> None:
+        super().__init__()
+        self.which = which
+        self.count = 0
+
+    def filter_reply(self, data: bytes) -> bytes | None:
+        self.count += 1
+        return None if self.count == self.which else data
+
+
+def test_a_late_model_read_after_a_ping_is_retried() -> None:
+    # Protocol 1 pings carry no model: it is read right after. A scan pings without retry;
+    # the model read must still get the usual retry, not record an unknown model.
+    motor = VirtualMotor(model_by_name("MX-28"), 7, 1_000_000)
+    virtual = VirtualBus([motor], 1, faults=DropOnce(2))
+    with serve_pty(virtual) as server:
+        (found,) = scan(server.url, [1_000_000], [1], ids=[7])
+    assert (found.id, found.model, found.model_number) == (7, "MX-28", 29)
+
+
+def test_find_port_on_a_port_that_cannot_open_is_a_port_error(tmp_path: object) -> None:
+    with pytest.raises(PortError, match="no such port"):
+        find_port([3], ["/dev/ttyUSB_poppy_missing_3"])
+    with pytest.raises(PortError, match="no port could be opened"):
+        find_port([3], ["/dev/ttyUSB_poppy_missing_4", "/dev/ttyUSB_poppy_missing_5"])

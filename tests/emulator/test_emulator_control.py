@@ -1,0 +1,104 @@
+"""Fault commands on running emulators (what `poppy emulate --control` and `--unplug` run)."""
+
+from __future__ import annotations
+
+import re
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from poppy_core.bus import DxlBus
+from poppy_core.emulator import EmulatorServer, build_bus_from_spec, serve_tcp
+from poppy_core.emulator.control import ControlError, EmulatorControl, ScheduledUnplug
+
+
+@pytest.fixture
+def served() -> Iterator[tuple[EmulatorControl, EmulatorServer]]:
+    server = serve_tcp(build_bus_from_spec("XL-320:1-3", protocol=2))
+    control = EmulatorControl({"bus": server})
+    yield control, server
+    control.close()
+    server.stop()
+
+
+def _until(check: object, timeout_s: float = 3.0) -> bool:
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        if check():  # type: ignore[operator]
+            return True
+        time.sleep(0.01)
+    return False
+
+
+def test_fault_commands_set_the_knobs(served: tuple[EmulatorControl, EmulatorServer]) -> None:
+    control, server = served
+    assert control.execute("corrupt 0.01") == "corrupt 0.01 on bus"
+    assert control.execute("DROP 0.5 bus") == "drop 0.5 on bus"
+    assert control.execute("delay 12") == "delay 12 ms on bus"
+    assert (server.bus.corrupt_rate, server.bus.drop_rate) == (0.01, 0.5)
+    assert server.bus.extra_delay_s == pytest.approx(0.012)
+    assert "unplugged: none" in control.execute("status")
+    assert control.execute("") == ""
+    assert control.execute("help").startswith("commands:")
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        ("jump 3", "unknown command 'jump'"),
+        ("unplug", "usage: unplug ID"),
+        ("unplug 9", "no motor 9 (motors: 1, 2, 3)"),
+        ("unplug 2 -1", "seconds >= 0"),
+        ("corrupt 2", "between 0 and 1"),
+        ("drop x", "between 0 and 1"),
+        ("delay -3", "milliseconds >= 0"),
+        ("drop 0.1 other", "no bus 'other' (buses: bus)"),
+        ("lose soon", "usage: lose"),
+    ],
+)
+def test_bad_commands_are_one_line_errors(
+    served: tuple[EmulatorControl, EmulatorServer], line: str, message: str
+) -> None:
+    control, _ = served
+    with pytest.raises(ControlError, match=re.escape(message)) as caught:
+        control.execute(line)
+    assert "\n" not in str(caught.value)
+
+
+def test_unplug_for_a_while_then_back(served: tuple[EmulatorControl, EmulatorServer]) -> None:
+    control, server = served
+    with DxlBus(server.url, 1_000_000, 2) as bus:
+        assert control.execute("unplug 2 0.3") == "motor 2 unplugged for 0.3 s"
+        assert bus.ping(2) is None
+        assert _until(lambda: bus.ping(2) is not None)
+        control.execute("unplug 3")
+        assert bus.ping(3) is None and bus.ping(1) is not None
+        assert control.execute("plug 3") == "motor 3 plugged"
+        assert bus.ping(3) is not None
+
+
+def test_lose_takes_the_line_away(served: tuple[EmulatorControl, EmulatorServer]) -> None:
+    control, server = served
+    assert control.execute("lose 0.3") == "bus lost for 0.3 s"
+    assert _until(lambda: not server.connected, 1.0)
+    assert _until(lambda: server.connected)
+
+
+def test_scheduled_unplugs() -> None:
+    assert ScheduledUnplug.parse("3@10") == ScheduledUnplug(3, 10.0, None)
+    assert ScheduledUnplug.parse("3@1.5+2") == ScheduledUnplug(3, 1.5, 2.0)
+    for bad in ("3", "x@1", "3@", "3@-1", "3@1+", "3@nan"):
+        with pytest.raises(ControlError, match="ID@SECONDS"):
+            ScheduledUnplug.parse(bad)
+    server = serve_tcp(build_bus_from_spec("XL-320:1-2", protocol=2))
+    control = EmulatorControl({"bus": server})
+    try:
+        control.schedule([ScheduledUnplug(2, 0.0, 0.4)])
+        assert _until(lambda: server.bus.faults.is_unplugged(2), 1.0)
+        assert _until(lambda: not server.bus.faults.is_unplugged(2), 2.0)
+        with pytest.raises(ControlError, match="no motor 7"):
+            control.schedule([ScheduledUnplug(7, 0.0)])
+    finally:
+        control.close()
+        server.stop()

@@ -1,0 +1,107 @@
+"""A lost bus says so (one warning, motors offline, health), is reopened, and its motors resume."""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from poppy_core.emulator import EmulatorServer, VirtualBus, serve_pty, serve_tcp
+from poppy_core.robot import Robot, from_profile, load_profile
+from poppy_core.robot.factory import virtual_buses
+
+WAIT_S = 10.0  # generous: a loaded machine may be slow, the goals are measured in bench soak
+
+
+def until(check: Callable[[], bool], timeout_s: float = WAIT_S) -> bool:
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        if check():
+            return True
+        time.sleep(0.01)
+    return False
+
+
+def ergo_jr_virtual() -> VirtualBus:
+    (bus,) = virtual_buses(load_profile("ergo-jr")).values()
+    return bus
+
+
+@pytest.fixture(params=["tcp", "pty link"])
+def served(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[tuple[EmulatorServer, str]]:
+    """An Ergo Jr bus served on TCP, or on a pty through a symlink (as /dev/serial/by-id)."""
+    virtual = ergo_jr_virtual()
+    if request.param == "tcp":
+        server = serve_tcp(virtual)
+        port = server.url
+    else:
+        port = str(tmp_path / "ttyDXL")
+        server = serve_pty(virtual, link=port)
+    yield server, port
+    server.stop()
+
+
+def sync_warnings(caplog: pytest.LogCaptureFixture, text: str) -> list[str]:
+    records = [r for r in caplog.records if r.name == "poppy_core.robot.sync"]
+    warnings = [r.getMessage() for r in records if r.levelno == logging.WARNING]
+    return [message for message in warnings if text in message]
+
+
+def test_health_of_a_healthy_robot(served: tuple[EmulatorServer, str]) -> None:
+    _, port = served
+    with from_profile("ergo-jr", port=port) as robot:
+        assert until(lambda: robot.health()["my_dxl_controller"].loop_hz["present"] > 0)
+        health = robot.health()["my_dxl_controller"]
+        assert health.connected and health.running and health.ok
+        assert health.offline == [] and health.losses == 0 and health.down_s == 0
+        assert health.target_hz["present"] == 50.0
+        data = health.as_dict()
+        assert data["ok"] is True and data["port"] == port
+
+
+def test_a_lost_bus_is_loud_then_comes_back(
+    served: tuple[EmulatorServer, str], caplog: pytest.LogCaptureFixture
+) -> None:
+    server, port = served
+    caplog.set_level(logging.WARNING, logger="poppy_core.robot.sync")
+    with from_profile("ergo-jr", port=port) as robot:
+        assert until(lambda: all(m.online for m in robot.motors))
+        server.lose(1.0)
+        assert until(lambda: not any(m.online for m in robot.motors))
+        health = robot.health()["my_dxl_controller"]
+        assert not health.connected and health.losses == 1
+        assert sorted(health.offline) == sorted(m.name for m in robot.motors)
+        assert until(lambda: robot.health()["my_dxl_controller"].loop_hz["present"] == 0)
+        # back: reopened by the sync thread, motors answer again, writes reach them
+        assert until(lambda: all(m.online for m in robot.motors))
+        assert robot.health()["my_dxl_controller"].connected
+        robot.m3.compliant = False
+        robot.m3.goal_position = 20.0
+        motor = server.bus.motor(robot.m3.id)
+        wanted = robot.m3.to_motor(20.0)
+        assert until(lambda: motor.torque_enabled and abs(motor.goal_position_deg - wanted) < 1)
+        assert until(lambda: abs(robot.m3.present_position - 20.0) < 2)
+    assert len(sync_warnings(caplog, "my_dxl_controller: lost ")) == 1
+    assert len(sync_warnings(caplog, " is back after ")) == 1
+    assert not any("stopped answering" in r.getMessage() for r in caplog.records)
+
+
+def test_a_bus_that_never_comes_back_is_retried_quietly(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    caplog.set_level(logging.WARNING, logger="poppy_core.robot.sync")
+    server = serve_tcp(ergo_jr_virtual())
+    robot: Robot = from_profile("ergo-jr", port=server.url)
+    try:
+        server.stop()  # gone for good
+        assert until(lambda: not robot.health()["my_dxl_controller"].connected)
+        time.sleep(1.5)  # a few reopen attempts
+        assert robot.health()["my_dxl_controller"].running
+        assert len(sync_warnings(caplog, "my_dxl_controller: lost ")) == 1
+        started = time.monotonic()
+    finally:
+        robot.close()
+    assert time.monotonic() - started < 5.0
