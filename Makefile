@@ -35,7 +35,7 @@ completions: $(VENV)/.installed
 	_POPPY_COMPLETE=source_fish $(BIN)/poppy > completions/poppy.fish
 
 # Offscreen rendering for `poppy sim render` (EGL, or OSMesa on machines without a GPU).
-SIM_PACKAGES := libegl1 libgl1 libosmesa6
+SIM_PACKAGES := libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libosmesa6
 sim-deps:
 	$(if $(filter 0,$(shell id -u)),,sudo) apt-get install -y $(SIM_PACKAGES)
 

@@ -218,7 +218,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     start = time.perf_counter()
     for attempt in range(1, SETUP_ATTEMPTS + 1):  # a loaded machine may delay a first reply
         try:
-            robot = from_config(config, fix_return_delay=True, start_sync=False)
+            robot = from_config(config, fix_return_delay=True, start_sync=False, sensors=False)
             break
         except PoppyError as exc:
             if attempt == SETUP_ATTEMPTS:

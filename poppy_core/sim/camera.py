@@ -16,15 +16,15 @@ from typing import Any, ClassVar
 import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
 import numpy as np
 
-from poppy_core.errors import SensorError
+from poppy_core.errors import ConfigError, SensorError
 from poppy_core.sensors.camera import DEFAULT_FPS, DEFAULT_RESOLUTION, Camera, CameraCalibration
 from poppy_core.sensors.config import CameraMaker
+from poppy_core.sim.gl import GL_HELP, check_offscreen_gl
 
 logger = logging.getLogger(__name__)
 
 _OFF = (mujoco.mjtRndFlag.mjRND_SHADOW, mujoco.mjtRndFlag.mjRND_REFLECTION,
         mujoco.mjtRndFlag.mjRND_SKYBOX)  # fmt: skip
-GL_HELP = "install libegl1 libgl1 or libosmesa6 (`make sim-deps`) and set MUJOCO_GL=egl or osmesa"
 
 
 def camera_names(model: Any) -> list[str]:
@@ -90,6 +90,11 @@ class SimCamera(Camera):
     def _make_renderer(self) -> None:
         sim = self.simulation
         width, height = self._resolution
+        try:
+            check_offscreen_gl()
+        except ConfigError as exc:
+            self.fail(str(exc))
+            raise SensorError(f"camera {self.name!r}: {exc}") from exc
         with sim.lock:
             model = sim.model
             samples = int(model.vis.quality.offsamples)

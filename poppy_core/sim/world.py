@@ -20,6 +20,7 @@ from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.errors import ConfigError
 from poppy_core.sim.drive import Drive, Joint
 from poppy_core.sim.exchange import MotorPort
+from poppy_core.sim.gl import check_offscreen_gl
 from poppy_core.sim.objects import ObjectSpec, add_objects, facing_quat
 from poppy_core.sim.plant import JointLink
 
@@ -389,6 +390,7 @@ class Simulation:
         Raises:
             ConfigError: no OpenGL backend (set MUJOCO_GL to egl or osmesa).
         """
+        check_offscreen_gl()
         with self._lock:
             key = (width, height)
             try:
