@@ -9,7 +9,7 @@ import threading
 
 from poppy_core.errors import ConfigError
 
-PROBE_TIMEOUT_S = 60.0
+PROBE_TIMEOUT_S = 30.0
 GL_HELP = "install libegl1 libgl1 or libosmesa6 (`make sim-deps`) and set MUJOCO_GL=egl or osmesa"
 # A one-geom scene drawn into a 16×16 buffer: what every renderer of ours does, in miniature.
 _PROBE = (
@@ -79,3 +79,18 @@ def check_offscreen_gl(timeout_s: float = PROBE_TIMEOUT_S) -> None:
         f"offscreen rendering with MUJOCO_GL={backend} fails here ({reason}); {advice}",
         field="MUJOCO_GL",
     )
+
+
+def working_backend(timeout_s: float = PROBE_TIMEOUT_S) -> str | None:
+    """The first of this process's ``MUJOCO_GL``, ``egl``, ``osmesa`` that renders here."""
+    first = os.environ.get("MUJOCO_GL", "").lower()
+    candidates = [b for b in (first, "egl", "osmesa") if b]
+    return next((b for b in dict.fromkeys(candidates) if _known(b, timeout_s) is None), None)
+
+
+if __name__ == "__main__":  # `python -m poppy_core.sim.gl`: print a backend that works, if any
+    found = working_backend()
+    if found is None:
+        print(f"no offscreen OpenGL here: {GL_HELP}", file=sys.stderr)
+        sys.exit(1)
+    print(found)
