@@ -13,7 +13,7 @@ async def test_health_view_shows_the_bus_and_offline_motors() -> None:
     app = sim_app()
     async with app.run_test(size=SIZE) as pilot:
         panel, robot = await open_sim(pilot, app)
-        await pilot.press("4")
+        await pilot.press("5")
         table = panel.query_one("#health-table", DataTable)
         assert table.has_focus
         assert table.get_cell("my_dxl_controller", "link") == "connected"
