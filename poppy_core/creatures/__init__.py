@@ -15,6 +15,7 @@ from poppy_core.creatures.registry import (
     normalize_kind,
 )
 from poppy_core.creatures.safety import LimitTorque, TemperatureMonitor
+from poppy_core.creatures.tracking import MarkerFollow, TrackingFeedback
 
 __all__ = [
     "CREATURES",
@@ -29,8 +30,10 @@ __all__ = [
     "HeadIdleMotion",
     "Jump",
     "LimitTorque",
+    "MarkerFollow",
     "SafePowerUp",
     "TemperatureMonitor",
+    "TrackingFeedback",
     "UpperBodyIdleMotion",
     "attach_creature",
     "detect_kind",

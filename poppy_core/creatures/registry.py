@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 from poppy_core.creatures import body, ergo_jr, interaction, postures, safety
 from poppy_core.creatures.head_follow import HeadFollow
+from poppy_core.creatures.tracking import MarkerFollow, TrackingFeedback
 from poppy_core.errors import ConfigError, RegisterError
 from poppy_core.motion import Primitive, primitive_manager
 from poppy_core.motion.chains import attach_chains
@@ -197,7 +198,8 @@ def attach_creature(robot: Robot, kind: str, *, start_defaults: bool = True) -> 
     those started by default (``temperature_monitoring``). Attaching again returns the
     primitives already there. The creature's kinematic chains (``robot.chain``,
     ``robot.l_arm_chain``...) come from the config's ``kinematics`` section, or the creature's
-    profile; a simulated Ergo Jr (MuJoCo) also gets ``head_follow``.
+    profile; a simulated Ergo Jr (MuJoCo) also gets ``head_follow``, and an Ergo Jr with a marker
+    detector ``tracking_feedback`` and ``marker_follow``.
 
     Args:
         robot: the robot.
@@ -231,6 +233,12 @@ def attach_creature(robot: Robot, kind: str, *, start_defaults: bool = True) -> 
     if known == "ergo-jr" and "chain" in chains and robot.simulation is not None:
         attached["head_follow"] = HeadFollow(robot, "chain")
         robot.attach_primitive(attached["head_follow"], "head_follow")
+    if known == "ergo-jr" and any(s.name == "marker_detector" for s in robot.sensors):
+        attached["tracking_feedback"] = TrackingFeedback(robot)
+        robot.attach_primitive(attached["tracking_feedback"], "tracking_feedback")
+        if "chain" in chains:
+            attached["marker_follow"] = MarkerFollow(robot, "chain")
+            robot.attach_primitive(attached["marker_follow"], "marker_follow")
     creature = Creature(known, spec.goto_control, attached)
     robot.attach("creature", creature)
     if start_defaults and not robot.closed:

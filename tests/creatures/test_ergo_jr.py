@@ -17,6 +17,7 @@ from tests.creatures.helpers import positions, reached, virtual, wait_until
 
 ERGO_JR_PRIMITIVES = [
     "safe_power_up", "dance", "base_posture", "rest_posture", "curious_posture", "jump",
+    "tracking_feedback", "marker_follow",
 ]  # fmt: skip
 
 
