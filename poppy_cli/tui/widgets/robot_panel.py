@@ -109,6 +109,7 @@ class RobotPanel(Vertical):
                     yield Select[str]([], prompt="group", id="robot-group")
                     yield Button("Compliant", id="group-compliant")
                     yield Button("Stiff", id="group-stiff")
+                    yield Button("Calibrate", id="robot-calibrate")
             with TabPane("Primitives 2", id="robot-primitives"):
                 yield self.primitives
             with TabPane("Moves 3", id="robot-moves"):
@@ -281,3 +282,25 @@ class RobotPanel(Vertical):
         )
         for motor in motors:
             motor.compliant = event.button.id == "group-compliant"
+
+    @on(Button.Pressed, "#robot-calibrate")
+    def _calibrate(self) -> None:
+        """Calibrate the chosen group (or every joint) into the robot's user profile."""
+        from poppy_cli.tui.widgets.calibration import CalibrationScreen
+
+        robot = self.robot
+        if robot is None:
+            self.notify("open a robot first", severity="warning")
+            return
+        profile = robot.config.profile if robot.config is not None else None
+        if profile is None:
+            self.notify("this robot has no profile name to calibrate into: use "
+                        "`poppy calibrate --name NAME`", severity="warning")  # fmt: skip
+            return
+        choice = self.query_one("#robot-group", Select).value
+        motors = (
+            [m.name for m in robot.group(str(choice))]
+            if isinstance(choice, str) and choice != "*"
+            else None
+        )
+        self.app.push_screen(CalibrationScreen(robot, profile.name, motors))

@@ -1,0 +1,75 @@
+"""The Robot tab's calibration: guided in a modal screen, reviewed, written to the user profile."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+from textual.widgets import Button  # noqa: TID253  (a TUI test)
+
+from poppy_cli.tui.widgets.calibration import CalibrationScreen
+from tests.tui.conftest import run_async, wait_for
+from tests.tui.test_robot_tab import SIZE, hand, open_sim, sim_app
+
+
+@pytest.fixture(autouse=True)
+def user_dirs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
+    return tmp_path / "xdg"
+
+
+def step_title(screen: CalibrationScreen) -> str:
+    return str(screen.query_one("#calibration-title").render())
+
+
+@run_async
+async def test_a_calibration_from_the_robot_tab_is_saved(user_dirs: Path) -> None:
+    app = sim_app()
+    async with app.run_test(size=(100, 40)) as pilot:
+        panel, robot = await open_sim(pilot, app)
+        panel.query_one("#robot-calibrate", Button).press()
+        await wait_for(pilot, lambda: isinstance(app.screen, CalibrationScreen), what="screen")
+        screen = app.screen
+        assert isinstance(screen, CalibrationScreen)
+        await wait_for(pilot, lambda: bool(screen.query("#calibration-continue")), what="buttons")
+        go = screen.query_one("#calibration-continue", Button)
+        await wait_for(pilot, lambda: "posture" in step_title(screen).lower() and not go.disabled,
+                       what="posture step")  # fmt: skip
+        for motor_id in range(1, 7):
+            hand(robot, motor_id).move_by_hand(5.0)  # the posture reads 5° off the old zero
+        go.press()
+        for step in range(6):  # one joint at a time: each swept through 60°
+            await wait_for(pilot, lambda: step_title(screen) == "Ranges" and not go.disabled,
+                           what=f"range step {step + 1}")  # fmt: skip
+            virtual = hand(robot, step + 1)
+            for angle in (-25.0, 35.0, 5.0):
+                virtual.move_by_hand(angle)
+                await pilot.pause(0.15)
+            go.press()
+        await wait_for(pilot, lambda: step_title(screen) in ("Review", "Question"), what="review")
+        assert step_title(screen) == "Review", str(screen.query_one("#calibration-text").render())
+        assert go.label.plain == "Save"
+        go.press()
+        await wait_for(pilot, lambda: not isinstance(app.screen, CalibrationScreen), what="saved")
+    saved = user_dirs / "poppy" / "profiles" / "ergo-jr" / "profile.yaml"
+    assert saved.is_file(), list(user_dirs.rglob("*"))
+    motors = yaml.safe_load(saved.read_text())["motors"]
+    assert all(abs(abs(motors[f"m{i}"]["offset"]) - 5.0) < 1.0 for i in range(1, 7)), motors
+
+
+@run_async
+async def test_cancelling_writes_nothing(user_dirs: Path) -> None:
+    app = sim_app()
+    async with app.run_test(size=SIZE) as pilot:
+        panel, _ = await open_sim(pilot, app)
+        panel.query_one("#robot-calibrate", Button).press()
+        await wait_for(pilot, lambda: isinstance(app.screen, CalibrationScreen), what="screen")
+        screen = app.screen
+        assert isinstance(screen, CalibrationScreen)
+        await wait_for(pilot, lambda: bool(screen.query("#calibration-continue")), what="buttons")
+        go = screen.query_one("#calibration-continue", Button)
+        await wait_for(pilot, lambda: not go.disabled, what="posture step")
+        await pilot.press("escape")
+        await wait_for(pilot, lambda: not isinstance(app.screen, CalibrationScreen), what="closed")
+    assert not list(user_dirs.rglob("profile.yaml"))
