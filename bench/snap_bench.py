@@ -113,6 +113,7 @@ def _ms(value: float | None) -> str:
 def snap_bench(ctx: BenchContext) -> BenchResult:
     """Measure both Snap! servers on every scenario."""
     raw: dict[str, Any] = {"clients": CLIENTS, "duration_s": DURATION_S}
+    load_start = os.getloadavg()[0]
     raw["poppy"] = _measure("poppy", ctx)
     notes = []
     if ctx.peers_python is not None:
@@ -156,6 +157,9 @@ def snap_bench(ctx: BenchContext) -> BenchResult:
         + f", {math.ceil(DURATION_S) if wrk else DURATION_S} s per run, median of "
         f"{ctx.repeat} runs (by req/s). Each server drives its own `poppy emulate --profile "
         "ergo-jr --wire-timing --latency-ms 1` process."
+        f" Machine load (1-minute average) at start and end: {load_start:.2f} → "
+        f"{os.getloadavg()[0]:.2f} on {os.cpu_count()} cores: above about 1, other programs "
+        "shared the CPU and the figures (p99 above all) vary from run to run."
     )
     return BenchResult(
         name="snap",

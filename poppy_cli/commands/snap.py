@@ -34,7 +34,7 @@ def _write(
     from poppy_core.files import output_path, write_file
     from poppy_core.server import RobotService
     from poppy_core.server.snap import robot_facts
-    from poppy_core.server.snap.blocks import document, project_names
+    from poppy_core.server.snap.examples import document, project_names
 
     if name not in project_names():
         error_line(f"no Snap! project {name!r}: choose one of {', '.join(project_names())}")

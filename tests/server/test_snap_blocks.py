@@ -14,8 +14,9 @@ from starlette.routing import Match
 from poppy_core.creatures import from_profile
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, robot_facts, start_snap_server
-from poppy_core.server.snap.blocks import project_names
 from poppy_core.server.snap.catalog import BLOCKS, Block
+from poppy_core.server.snap.examples import project_names
+from poppy_core.server.snap.routing import TextRouter
 
 Served = tuple[Robot, SnapServer, httpx.Client]
 
@@ -49,9 +50,12 @@ def url_of(definition: ET.Element) -> str | None:
     return text.removeprefix("http://{host}:{port}")
 
 
-def served_route(app: object, path: str) -> str | None:
-    """The path of the text route matching ``path``, or None."""
-    for route in app.routes:  # type: ignore[attr-defined]
+def served_route(router: TextRouter, path: str) -> str | None:
+    """The template of the route ``path`` reaches, or None."""
+    found = router.match(path)
+    if found:
+        return found[0].path
+    for route in router.app.routes:  # type: ignore[attr-defined]  # the documents, /ip/
         match, _ = route.matches({"type": "http", "path": path, "method": "GET"})
         if match is Match.FULL:
             return str(route.path)
@@ -72,7 +76,8 @@ def test_every_project_is_a_well_formed_snap_project(snap: Served, name: str) ->
     french = name.endswith("-fr")
     labels = {d.get("s") for d in definitions}
     assert {b.fr if french else b.en for b in BLOCKS} <= labels
-    app = server.thread.server.config.app.app  # inside the OriginGuard
+    router = server.thread.server.config.app.app  # inside the OriginGuard
+    assert isinstance(router, TextRouter)
     for definition in definitions:
         template = url_of(definition)
         if template is None:
@@ -81,7 +86,7 @@ def test_every_project_is_a_well_formed_snap_project(snap: Served, name: str) ->
         defaults = [i.text or "" for i in definition.findall("./inputs/input")]
         values = {"motor": "m1", **dict(zip(names, defaults, strict=True))}
         sample = template.format(**values)
-        assert served_route(app, sample), f"{definition.get('s')}: {template} is not served"
+        assert served_route(router, sample), f"{definition.get('s')}: {template} is not served"
     uses = {u.get("s") for u in root.iter("custom-block")}
     defined = {d.get("s").replace("%'", "%").split("%")[0] for d in definitions}  # type: ignore[union-attr]
     for spec in uses:

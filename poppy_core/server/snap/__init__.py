@@ -3,7 +3,7 @@
 Importing this package loads Starlette (the CLI imports it only inside ``poppy serve --snap``).
 """
 
-from poppy_core.server.snap.blocks import RobotFacts, SnapSite
+from poppy_core.server.snap.blocks import RobotFacts
 from poppy_core.server.snap.server import (
     DEFAULT_PORT,
     SnapServer,
@@ -12,6 +12,7 @@ from poppy_core.server.snap.server import (
     snap_policy,
     start_snap_server,
 )
+from poppy_core.server.snap.site import SnapSite
 
 __all__ = [
     "DEFAULT_PORT",

@@ -21,7 +21,8 @@ from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.runner import ServerThread
 from poppy_core.server.service import RobotService
 from poppy_core.server.snap.app import APP_PREFIX, create_snap_app
-from poppy_core.server.snap.blocks import RobotFacts, SnapSite
+from poppy_core.server.snap.blocks import RobotFacts
+from poppy_core.server.snap.site import SnapSite
 
 logger = logging.getLogger(__name__)
 
