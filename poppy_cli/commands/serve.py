@@ -111,7 +111,15 @@ def serve(
         snap_server = None
         if snap:
             snap_server = snap_server_for(
-                robot, app.state.service, host, snap_port, cors, allow_host, snap_dir, _report
+                robot,
+                app.state.service,
+                host,
+                snap_port,
+                cors,
+                allow_host,
+                snap_dir,
+                token or None,
+                _report,
             )
             servers.append(snap_server.thread)
         try:
@@ -126,7 +134,7 @@ def serve(
             if http:
                 print(f"http://{base}:{servers[0].port}", flush=True)
             if ws:
-                print(f"ws://{base}:{servers[-1].port}/", flush=True)
+                print(f"ws://{base}:{servers[1 if http else 0].port}/", flush=True)
             if http:
                 print(f"docs: http://{base}:{servers[0].port}/docs", flush=True)
             if snap_server is not None:

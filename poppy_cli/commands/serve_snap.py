@@ -52,6 +52,7 @@ def snap_server_for(
     cors: list[str] | None,
     allow_hosts: list[str] | None,
     snap_dir: Path | None,
+    token: str | None,
     report: Callable[[str], None],
 ) -> SnapServer:
     """The Snap! server of `poppy serve`, sharing the HTTP server's robot service."""
@@ -66,6 +67,7 @@ def snap_server_for(
             cors=cors or (),
             allow_hosts=allow_hosts or (),
             snap_dir=snap_dir,
+            token=token,
             report=report,
         )
     except ValueError as exc:

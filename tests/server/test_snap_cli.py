@@ -27,7 +27,8 @@ def test_serve_snap_with_http_prints_the_snap_urls_and_serves_both(tmp_path: Pat
     snap_dir = tmp_path / "snap"
     snap_dir.mkdir()
     (snap_dir / "snap.html").write_text("<html>a local Snap!</html>")
-    args = ["serve", "--http", "--http-port", "0", "--snap", "--snap-port", "0"]
+    args = ["serve", "--http", "--http-port", "0", "--snap", "--snap-port", "0", "--ws"]
+    args += ["--ws-port", "0"]
     args += ["--sim", "--profile", "ergo-jr", "--snap-dir", str(snap_dir)]
     proc = subprocess.Popen(
         [*POPPY, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -35,11 +36,14 @@ def test_serve_snap_with_http_prints_the_snap_urls_and_serves_both(tmp_path: Pat
     )  # fmt: skip
     try:
         assert proc.stdout is not None
-        lines = [proc.stdout.readline().strip() for _ in range(4)]
-        http_url = lines[0]
+        lines = [proc.stdout.readline().strip() for _ in range(5)]
+        http_url, ws_url = lines[0], lines[1]
         snap_url = next(line for line in lines if line.startswith("snap: ")).split()[1]
         editor = next(line for line in lines if line.startswith("Snap! with the Poppy blocks: "))
         assert snap_url.startswith("http://127.0.0.1:")
+        assert ws_url.startswith("ws://127.0.0.1:")
+        assert len({http_url.rsplit(":", 1)[1], ws_url.rsplit(":", 1)[1].strip("/"),
+                    snap_url.rsplit(":", 1)[1]}) == 3  # fmt: skip
         assert editor.endswith(f"{snap_url}/app/snap.html#open:{snap_url}/snap-blocks.xml")
         assert _get(f"{snap_url}/motors/motors") == "m1/m2/m3/m4/m5/m6"
         assert "a local Snap!" in _get(f"{snap_url}/app/snap.html")

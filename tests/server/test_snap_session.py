@@ -192,3 +192,21 @@ def test_snap_berkeley_edu_is_allowed_and_other_pages_are_not(
     blocks = http.get("/snap-blocks.xml", headers={"Sec-Fetch-Site": "cross-site"})
     assert blocks.status_code == 200  # documents open from a link
     assert http.get("/motors/motors", headers={"Host": "evil.example"}).status_code == 400
+
+
+def test_a_token_is_needed_and_carried_by_the_blocks(moves_folder: str) -> None:
+    with from_profile("ergo-jr", sim=True) as robot:
+        server = start_snap_server(robot, port=0, token="s3cret/+")
+        try:
+            base = f"http://127.0.0.1:{server.port}"
+            assert httpx.get(f"{base}/motors/motors", timeout=20).status_code == 401
+            assert httpx.get(f"{base}/snap-blocks.xml", timeout=20).status_code == 401
+            ok = httpx.get(f"{base}/motors/motors", params={"token": "s3cret/+"}, timeout=20)
+            assert ok.text == "m1/m2/m3/m4/m5/m6"
+            assert server.editor_url.endswith("/snap-blocks.xml?token=s3cret%2F%2B")
+            xml = httpx.get(server.blocks_url, timeout=20).text
+            assert xml.count("<l>?token=s3cret%2F%2B</l>") >= 20  # every block's URL
+            header = {"Authorization": "Bearer s3cret/+"}
+            assert httpx.get(f"{base}/ip/", headers=header, timeout=20).text == "127.0.0.1"
+        finally:
+            server.stop()

@@ -20,9 +20,11 @@ from starlette.requests import Request
 from starlette.responses import PlainTextResponse, Response
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
+from starlette.types import ASGIApp, Receive, Scope, Send
 
 from poppy_core.errors import PoppyError
 from poppy_core.server.errors import ApiError
+from poppy_core.server.middleware import TokenMiddleware, request_token
 from poppy_core.server.service import RobotService
 from poppy_core.server.snap.robot import SnapRobot
 from poppy_core.server.snap.routes import ROUTES
@@ -42,15 +44,28 @@ def route_paths() -> list[str]:
 SITE_PATHS = ("/", "/ip/", "/ip/{host}", "/frame.png", "/snap-blocks.xml", "/snap/{project}")
 
 
+def _token(request: Request) -> str:
+    """The token the request carried: a server with ``--token`` only answers ones that did."""
+    if not request.app.state.token_required:
+        return ""
+    return request_token(request.scope) or ""
+
+
 def create_snap_app(
-    service: RobotService, site: SnapSite, *, snap_dir: Path | None = None
-) -> TextRouter:
+    service: RobotService,
+    site: SnapSite,
+    *,
+    snap_dir: Path | None = None,
+    token: str | None = None,
+) -> ASGIApp:
     """The Snap! app over ``service`` (which the caller keeps and closes): text routes, then site.
 
     Args:
         service: the robot's service (shared with the HTTP server when both run).
         site: the blocks and projects generated for this robot, and the server's address.
         snap_dir: a local copy of Snap! to serve under ``/app/`` (its ``snap.html``).
+        token: when set, every route but the local Snap!'s files needs it (Bearer header or
+            ``?token=``); the documents then carry it in every block's URL.
     """
     snap = SnapRobot(service)
 
@@ -70,11 +85,12 @@ def create_snap_app(
         return Response(data, media_type="image/png")
 
     async def blocks(request: Request) -> Response:
-        return Response(site.blocks(request.headers.get("host")), media_type=XML)
+        body = site.blocks(request.headers.get("host"), token=_token(request))
+        return Response(body, media_type=XML)
 
     async def project(request: Request) -> Response:
         name = request.path_params["project"].removesuffix(".xml")
-        body = site.project(name, request.headers.get("host"))
+        body = site.project(name, request.headers.get("host"), _token(request))
         if body is None:
             known = ", ".join(site.project_names())
             line = f"Error: no Snap! project {name[:60]!r} (projects: {known})"
@@ -105,4 +121,16 @@ def create_snap_app(
     )
     site_app.state.snap = snap
     site_app.state.site = site
-    return TextRouter(site_app, snap, ROUTES)
+    site_app.state.token_required = bool(token)
+    router = TextRouter(site_app, snap, ROUTES)
+    if not token:
+        return router
+    guarded = TokenMiddleware(router, token)
+
+    async def app(scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] == "http" and str(scope.get("path", "")).startswith(APP_PREFIX + "/"):
+            await router(scope, receive, send)  # Snap!'s own files hold nothing of the robot
+        else:
+            await guarded(scope, receive, send)
+
+    return app

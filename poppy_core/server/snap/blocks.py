@@ -13,6 +13,7 @@ import re
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from urllib.parse import quote
 
 from poppy_core.server.snap.catalog import BLOCKS, Block, Input
 
@@ -131,6 +132,15 @@ def url_expression(template: str, loop_var: str | None = None) -> ET.Element:
     return prim("reportJoinWords", listed(*parts))
 
 
+def add_token(root: ET.Element, token: str) -> None:
+    """Append ``?token=...`` to every URL the blocks of ``root`` build."""
+    suffix = f"?token={quote(token, safe='')}"
+    for joined in root.iter("list"):
+        first = joined[0] if len(joined) else None
+        if first is not None and first.tag == "l" and first.text == "http://":
+            joined.append(lit(suffix))
+
+
 def show_error() -> ET.Element:
     """Say the answer when it is an error (every error answer starts with ``Error``)."""
     first = prim("reportLetter", lit("1"), var("answer"))
@@ -232,8 +242,12 @@ def project(
     lang: str,
     facts: RobotFacts,
     scripts: list[ET.Element] | None = None,
+    token: str = "",
 ) -> bytes:
-    """A Snap! project holding every Poppy block, ``host``/``port``, and the sprite's scripts."""
+    """A Snap! project holding every Poppy block, ``host``/``port``, and the sprite's scripts.
+
+    With ``token`` (a server started with ``--token``), every URL the blocks call carries it.
+    """
     root = E("project", name=name, app=APP, version="1")
     sub(root, "notes", notes)
     sub(root, "thumbnail")
@@ -267,5 +281,7 @@ def project(
     variables = sub(root, "variables")
     sub(sub(variables, "variable", name="host"), "l", host)
     sub(sub(variables, "variable", name="port"), "l", str(port))
+    if token:
+        add_token(root, token)
     ET.indent(root, space=" ")
     return bytes(ET.tostring(root, encoding="utf-8", xml_declaration=False))

@@ -11,6 +11,7 @@ import logging
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
+from urllib.parse import quote
 
 from starlette.types import Scope
 
@@ -82,6 +83,7 @@ class SnapServer:
         *,
         owns_service: bool,
         local_app: bool,
+        token: str | None = None,
     ) -> None:
         self.thread = thread
         self.service = service
@@ -89,6 +91,7 @@ class SnapServer:
         self.site = site
         self._owns_service = owns_service
         self._local_app = local_app
+        self._query = f"?token={quote(token, safe='')}" if token else ""
 
     @property
     def port(self) -> int:
@@ -104,8 +107,8 @@ class SnapServer:
 
     @property
     def blocks_url(self) -> str:
-        """Where the Poppy blocks are served."""
-        return f"{self.url}/snap-blocks.xml"
+        """Where the Poppy blocks are served (with ``?token=`` when the server needs one)."""
+        return f"{self.url}/snap-blocks.xml{self._query}"
 
     @property
     def editor_url(self) -> str:
@@ -161,6 +164,7 @@ def create_snap_server(
     cors: Iterable[str] = (),
     allow_hosts: Iterable[str] = (),
     snap_dir: Path | None = None,
+    token: str | None = None,
     report: Callable[[str], None] | None = None,
 ) -> SnapServer:
     """A Snap! server over ``robot``, not yet started (``.thread.bind()`` to learn its port).
@@ -175,15 +179,18 @@ def create_snap_server(
         cors: more origins allowed besides snap.berkeley.edu (``"*"``: any page).
         allow_hosts: more Host names answered (see ``OriginPolicy``).
         snap_dir: a downloaded Snap! (the folder holding ``snap.html``) to serve under ``/app/``.
+        token: require it on every route (``--token``); the blocks then carry it in their URLs.
         report: called with one line the first time an origin or a Host name is refused.
     """
     owns = service is None
     service = service or RobotService(robot)
     policy = policy or snap_policy(host, cors=cors, allow_hosts=allow_hosts, report=report)
     site = SnapSite(lambda: robot_facts(service), host, port)
-    app = create_snap_app(service, site, snap_dir=snap_dir)
+    app = create_snap_app(service, site, snap_dir=snap_dir, token=token)
     thread = ServerThread(OriginGuard(app, policy, changes_state=changes_state), host, port)
-    return SnapServer(thread, service, policy, site, owns_service=owns, local_app=bool(snap_dir))
+    return SnapServer(
+        thread, service, policy, site, owns_service=owns, local_app=bool(snap_dir), token=token
+    )
 
 
 def start_snap_server(

@@ -55,17 +55,17 @@ class SnapSite:
         """``/ip/``."""
         return local_address(server, self.host)
 
-    def blocks(self, host_header: str | None = None, lang: str = "en") -> bytes:
+    def blocks(self, host_header: str | None = None, lang: str = "en", token: str = "") -> bytes:
         """The Poppy blocks library."""
         name = "poppy-blocks-fr" if lang == "fr" else "poppy-blocks"
-        body = self.project(name, host_header)
+        body = self.project(name, host_header, token)
         assert body is not None
         return body
 
-    def project(self, name: str, host_header: str | None = None) -> bytes | None:
-        """A project by name, or None."""
+    def project(self, name: str, host_header: str | None = None, token: str = "") -> bytes | None:
+        """A project by name, or None (``token``: the server's, written into the blocks' URLs)."""
         host, port = self._where(host_header)
-        return document(name, self.facts(), host, port)
+        return document(name, self.facts(), host, port, token)
 
     @staticmethod
     def project_names() -> list[str]:
