@@ -263,10 +263,16 @@ class SnapRobot:
     def detect(self, marker: str) -> str:
         """``/detect/<marker>``: ``True`` when that card is in view."""
         try:
-            self.sensors.detector()
+            detector = self.sensors.detector()
         except ApiError:
             raise ApiError("not_found", NO_DETECTOR) from None
-        return str(self.sensors.sees(marker))
+        try:
+            return str(self.sensors.sees(marker))
+        except ApiError as exc:
+            if exc.kind != "not_found":
+                raise
+            known = ", ".join(detector.card_ids) or "none"
+            raise ApiError("not_found", f"no card {marker[:40]!r} (cards: {known})") from None
 
     def frame_png(self) -> bytes:
         """``/frame.png``: the first camera's latest frame."""
