@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 import urllib.request
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -29,11 +30,15 @@ def test_serve_snap_with_http_prints_the_snap_urls_and_serves_both(tmp_path: Pat
     (snap_dir / "snap.html").write_text("<html>a local Snap!</html>")
     args = ["serve", "--http", "--http-port", "0", "--snap", "--snap-port", "0", "--ws"]
     args += ["--ws-port", "0"]
-    args += ["--sim", "--profile", "ergo-jr", "--snap-dir", str(snap_dir)]
+    args += ["--sim", "--profile", "ergo-jr", "--snap-dir", str(snap_dir), "--open"]
+    opened = tmp_path / "opened.txt"
+    browser = tmp_path / "browser.sh"  # what --open runs: $BROWSER, read by webbrowser
+    browser.write_text(f'#!/bin/sh\necho "$1" > {opened}\n')
+    browser.chmod(0o755)
+    env = {**_env(tmp_path / "moves"), "BROWSER": f"{browser} %s"}
     proc = subprocess.Popen(
-        [*POPPY, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        env=_env(tmp_path / "moves"),
-    )  # fmt: skip
+        [*POPPY, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
     try:
         assert proc.stdout is not None
         lines = [proc.stdout.readline().strip() for _ in range(5)]
@@ -45,6 +50,10 @@ def test_serve_snap_with_http_prints_the_snap_urls_and_serves_both(tmp_path: Pat
         assert len({http_url.rsplit(":", 1)[1], ws_url.rsplit(":", 1)[1].strip("/"),
                     snap_url.rsplit(":", 1)[1]}) == 3  # fmt: skip
         assert editor.endswith(f"{snap_url}/app/snap.html#open:{snap_url}/snap-blocks.xml")
+        deadline = time.monotonic() + 30
+        while not opened.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert opened.read_text().strip() == editor.split(": ", 1)[1]
         assert _get(f"{snap_url}/motors/motors") == "m1/m2/m3/m4/m5/m6"
         assert "a local Snap!" in _get(f"{snap_url}/app/snap.html")
         assert ET.fromstring(_get(f"{snap_url}/snap-blocks.xml")).tag == "project"
