@@ -14,6 +14,7 @@ from bench import (
     scan_bench,
     server_bench,
     sim_bench,
+    snap_bench,
     soak_bench,
     teleop_bench,
 )
@@ -27,7 +28,7 @@ logger = logging.getLogger("bench")
 # Importing a benchmark module registers it; list them here so `--list` sees them all.
 _MODULES = (
     scan_bench, robot_bench, move_bench, server_bench, sim_bench, ik_bench, camera_bench,
-    teleop_bench, soak_bench,
+    teleop_bench, soak_bench, snap_bench,
 )  # fmt: skip
 
 

@@ -18,6 +18,7 @@ from poppy_cli.commands import reach as reach_cmd
 from poppy_cli.commands import record as record_cmd
 from poppy_cli.commands import serve as serve_cmd
 from poppy_cli.commands import sim as sim_cmd
+from poppy_cli.commands import snap as snap_cmd
 from poppy_cli.commands import teleop as teleop_cmd
 from poppy_cli.commands import tui as tui_cmd
 from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
@@ -63,6 +64,7 @@ app.command("calibrate")(calibrate_cmd.calibrate)
 app.command("teleop")(teleop_cmd.teleop)
 app.command("serve")(serve_cmd.serve)
 app.add_typer(sim_cmd.app, name="sim")
+app.add_typer(snap_cmd.app, name="snap")
 app.add_typer(camera.app, name="camera")
 
 

@@ -110,8 +110,13 @@ def show(
     console.print(table)
     for name, controller in config.controllers.items():
         console.print(
-            styled("controller [bold]{}[/]: port {}, protocol {}, {} bps", name, controller.port,
-                   controller.protocol, controller.baudrate)
+            styled(
+                "controller [bold]{}[/]: port {}, protocol {}, {} bps",
+                name,
+                controller.port,
+                controller.protocol,
+                controller.baudrate,
+            )
         )
     for name in config.motorgroups:
         console.print(styled("group [bold]{}[/]: {}", name, ", ".join(config.resolve_group(name))))

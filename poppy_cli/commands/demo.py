@@ -51,8 +51,9 @@ def demo(
     virtual = ergo_jr_bus(wire_timing=wire_timing, latency_s=0.001 if wire_timing else 0.0)
     with serve_pty(virtual) as server:
         console.print(
-            styled("[bold]Virtual Poppy Ergo Jr[/]: 6 XL-320 on {} (protocol 2, 1 Mbps)",
-                   server.url)
+            styled(
+                "[bold]Virtual Poppy Ergo Jr[/]: 6 XL-320 on {} (protocol 2, 1 Mbps)", server.url
+            )
         )
         with console.status(plain("scanning IDs 0-253 at 1 Mbps, protocol 2…")):
             found = run_scan(server.url, [1_000_000], [2])
@@ -149,8 +150,11 @@ def record_and_replay(robot: Robot, time_factor: float) -> None:
     for name in arm:
         robot.motor(name).compliant = True
     time.sleep(0.1)
-    console.print(styled("[bold]Recording[/] {} for {} s, moved by hand…", ", ".join(arm),
-                         f"{duration_s:.1f}"))
+    console.print(
+        styled(
+            "[bold]Recording[/] {} for {} s, moved by hand…", ", ".join(arm), f"{duration_s:.1f}"
+        )
+    )
     with MoveRecorder(robot, 50, arm) as recorder:
         start = time.monotonic()
         while (elapsed := time.monotonic() - start) < duration_s:

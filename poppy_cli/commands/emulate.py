@@ -156,12 +156,15 @@ def emulate(
         sys.stdout.flush()
         for (name, bus), server in zip(buses, servers, strict=True):
             ids = ", ".join(str(m.id) for m in bus.motors)
-            err_console.print(styled(
-                "[green]serving[/] {}", f"{name}: {len(bus.motors)} {bus.motors[0].model.name}"
-                f"{'…' if len({m.model.name for m in bus.motors}) > 1 else ''} "
-                f"(ids {ids}) protocol {bus.protocol} at {bus.baudrate} bps on {server.url}"
-                " — Ctrl-C to stop"
-            ))
+            err_console.print(
+                styled(
+                    "[green]serving[/] {}",
+                    f"{name}: {len(bus.motors)} {bus.motors[0].model.name}"
+                    f"{'…' if len({m.model.name for m in bus.motors}) > 1 else ''} "
+                    f"(ids {ids}) protocol {bus.protocol} at {bus.baudrate} bps on {server.url}"
+                    " — Ctrl-C to stop",
+                )
+            )
         if control:
             _read_commands(faults, stop)
         while not stop.wait(0.5):

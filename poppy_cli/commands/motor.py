@@ -70,8 +70,13 @@ def print_setup(result: SetupResult, json_output: bool) -> None:
         console.print(styled("[dim]{}[/]", note))
     check = "[green]verified[/]" if result.verified else "[yellow]not verified[/]"
     console.print(
-        styled("motor {} on {} at {} bps (protocol {}): " + check, result.motor_id, result.port,
-               result.baudrate, result.protocol)
+        styled(
+            "motor {} on {} at {} bps (protocol {}): " + check,
+            result.motor_id,
+            result.port,
+            result.baudrate,
+            result.protocol,
+        )
     )
 
 

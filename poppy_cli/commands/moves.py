@@ -103,9 +103,15 @@ def show(name: str = NameArg, json_output: bool = JsonOpt) -> None:
         print_json(header)
         return
     console.print(
-        styled("[bold]{}[/] ({}, {}): {} frames at {} Hz = {} s", header["name"], header["format"],
-               _size(header["size_bytes"]), header["frames"], f"{header['framerate']:g}",
-               f"{header['duration_s']:.2f}")
+        styled(
+            "[bold]{}[/] ({}, {}): {} frames at {} Hz = {} s",
+            header["name"],
+            header["format"],
+            _size(header["size_bytes"]),
+            header["frames"],
+            f"{header['framerate']:g}",
+            f"{header['duration_s']:.2f}",
+        )
     )
     for key, value in header["metadata"].items():
         console.print(f"  {key}: {value}")

@@ -66,8 +66,10 @@ def play(
     with from_config(config, sim=sim, sensors=False) as robot:
         player = MovePlayer(robot, move, speed=speed, backwards=reverse, loops=loop)
         for motor, beyond in player.clamped.items():
-            warn_line(f"{motor}: the move goes {beyond:.1f}° past its angle limits "
-                      f"{fmt_limits(robot.motor(motor).angle_limit)}: played at the limit")
+            warn_line(
+                f"{motor}: the move goes {beyond:.1f}° past its angle limits "
+                f"{fmt_limits(robot.motor(motor).angle_limit)}: played at the limit"
+            )
         stop = threading.Event()
         for signum in (signal.SIGINT, signal.SIGTERM):
             signal.signal(signum, lambda *_: stop.set())

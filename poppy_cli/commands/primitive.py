@@ -144,7 +144,12 @@ def _wait(primitive: Primitive, duration: float | None, on_tick: Any) -> None:
 def run(
     name: str = typer.Argument(..., help="Primitive name (see `poppy primitive list`)."),
     duration: float | None = typer.Option(
-        None, "--duration", "-d", min=0.0, max=MAX_DURATION_S, callback=finite,
+        None,
+        "--duration",
+        "-d",
+        min=0.0,
+        max=MAX_DURATION_S,
+        callback=finite,
         help="Stop after this many seconds (default: Ctrl-C).",
     ),
     settings: list[str] | None = typer.Option(

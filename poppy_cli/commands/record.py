@@ -100,11 +100,18 @@ def record(
         50.0, "--freq", "-f", min=1.0, max=1000.0, callback=finite, help="Frames per s."
     ),
     duration: float | None = typer.Option(
-        None, "--duration", "-d", min=0.1, max=MAX_DURATION_S, callback=finite,
+        None,
+        "--duration",
+        "-d",
+        min=0.1,
+        max=MAX_DURATION_S,
+        callback=finite,
         help="Stop after this many seconds.",
     ),
     output: Path | None = typer.Option(
-        None, "--output", "-o",
+        None,
+        "--output",
+        "-o",
         help="Save the take here (a file, or a folder for NAME.move) instead of the library.",
     ),
     force: bool = typer.Option(

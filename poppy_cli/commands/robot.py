@@ -315,7 +315,12 @@ def parse_targets(
 def goto(
     targets: list[str] = typer.Argument(..., help="Targets as NAME=DEGREES, e.g. m1=30 m2=-10."),
     duration: float = typer.Option(
-        1.0, "--duration", "-d", min=0.0, max=MAX_DURATION_S, callback=finite,
+        1.0,
+        "--duration",
+        "-d",
+        min=0.0,
+        max=MAX_DURATION_S,
+        callback=finite,
         help="Seconds to move.",
     ),
     wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),

@@ -54,7 +54,10 @@ def render_found(motors: list[FoundMotor]) -> None:
 def scan(
     port: str | None = typer.Option(None, "--port", "-p", help=PORT_HELP),
     baud: list[int] | None = typer.Option(
-        None, "--baud", "-b", help="Baud rate to try (repeat for several). Default: 1000000.",
+        None,
+        "--baud",
+        "-b",
+        help="Baud rate to try (repeat for several). Default: 1000000.",
         **BAUD_LIMITS,
     ),
     all_bauds: bool = typer.Option(

@@ -1,4 +1,4 @@
-"""`poppy serve --http [--ws]`: serve a robot over REST (pypot's routes + /api/v1) and WebSocket."""
+"""`poppy serve --http [--ws] [--snap]`: serve a robot over REST, WebSocket and Snap!'s routes."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 import typer
 
 from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, build_robot
+from poppy_cli.commands.serve_snap import announce_snap, check_snap_options, snap_server_for
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, warn_line
 
 if TYPE_CHECKING:
@@ -53,15 +54,34 @@ def serve(
     no_sensors: bool = typer.Option(
         False, "--no-sensors", help="Leave the config's cameras closed (e.g. no camera plugged)."
     ),
+    snap: bool = typer.Option(
+        False, "--snap", help="Serve pypot's Snap! routes and the Poppy blocks (see docs/snap.md)."
+    ),
+    snap_port: int = typer.Option(6969, "--snap-port", min=0, max=65535, help="Snap! port."),
+    snap_dir: Path | None = typer.Option(
+        None,
+        "--snap-dir",
+        help="A downloaded Snap! (folder holding snap.html) to serve at /app/ on the Snap! port.",
+    ),
+    open_browser: bool = typer.Option(
+        False, "--open", help="Open Snap! with the Poppy blocks in the browser (with --snap)."
+    ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
-    if not (http or ws):
-        _usage("nothing to serve: pass --http and/or --ws")
+    if not (http or ws or snap):
+        _usage("nothing to serve: pass --http, --ws and/or --snap")
     if http and ws and http_port == ws_port and http_port != 0:
         _usage(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
             "server streams the same state at /api/v1/ws)"
         )
+    check_snap_options(
+        snap,
+        snap_port,
+        snap_dir,
+        open_browser,
+        {"--http-port": http_port if http else 0, "--ws-port": ws_port if ws else 0},
+    )
     from poppy_core.server import OriginPolicy, ServerThread, create_app, create_stream_app
 
     try:
@@ -88,19 +108,37 @@ def serve(
         if ws:
             stream_app = create_stream_app(app.state.service, ws_rate, token or None, policy)
             servers.append(ServerThread(stream_app, host, ws_port))
+        snap_server = None
+        if snap:
+            snap_server = snap_server_for(
+                robot,
+                app.state.service,
+                host,
+                snap_port,
+                cors,
+                allow_host,
+                snap_dir,
+                token or None,
+                _report,
+            )
+            servers.append(snap_server.thread)
         try:
             for server in servers:  # bind every port before serving any: errors come first
                 server.bind()
             policy.with_ports(server.port for server in servers)
+            if snap_server is not None:
+                snap_server.bound([server.port for server in servers])
             for server in servers:
                 server.start()
             base = _host(host)
             if http:
                 print(f"http://{base}:{servers[0].port}", flush=True)
             if ws:
-                print(f"ws://{base}:{servers[-1].port}/", flush=True)
+                print(f"ws://{base}:{servers[1 if http else 0].port}/", flush=True)
             if http:
                 print(f"docs: http://{base}:{servers[0].port}/docs", flush=True)
+            if snap_server is not None:
+                announce_snap(snap_server, open_browser)
             _wait_for_signal(servers)
         except RuntimeError as exc:
             error_line(f"{exc} (the server's log above says why)")

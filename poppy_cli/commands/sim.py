@@ -171,9 +171,12 @@ def _serve(profile: str, speed: float, tcp: str | None, view: bool) -> None:
             bus = server.bus
             ids = ", ".join(str(m.id) for m in bus.motors)
             err_console.print(
-                styled("[green]simulating[/] {}", f"{profile} {name}: {len(bus.motors)} motors "
-                       f"(ids {ids}), protocol {bus.protocol} at {bus.baudrate} bps on "
-                       f"{server.url}, MuJoCo at {speed:g}× real time — Ctrl-C to stop")
+                styled(
+                    "[green]simulating[/] {}",
+                    f"{profile} {name}: {len(bus.motors)} motors "
+                    f"(ids {ids}), protocol {bus.protocol} at {bus.baudrate} bps on "
+                    f"{server.url}, MuJoCo at {speed:g}× real time — Ctrl-C to stop",
+                )
             )
         viewer = _open_viewer(simulation) if view else None
         while not stop.wait(1 / 30 if viewer is not None else 0.5):
@@ -197,7 +200,11 @@ def sim(
         None, "--profile", help="Robot profile with a simulation model: ergo-jr, torso, humanoid."
     ),
     speed: float = typer.Option(
-        1.0, "--speed", min=0.01, max=1000.0, callback=finite,
+        1.0,
+        "--speed",
+        min=0.01,
+        max=1000.0,
+        callback=finite,
         help="Simulated seconds per real second (1 = real time).",
     ),
     pty: bool = typer.Option(False, "--pty", help="Serve on pseudo-terminals (the default)."),

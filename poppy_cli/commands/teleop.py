@@ -88,8 +88,9 @@ def teleop(
         None, "--follower-sim", metavar="ideal|mujoco", help="Simulate the follower."
     ),
     joint_map: str | None = typer.Option(
-        None, "--map", help="Joint map FOLLOWER=[-][SCALE*]LEADER[+OFFSET],... (default: same "
-        "motor names)."
+        None,
+        "--map",
+        help="Joint map FOLLOWER=[-][SCALE*]LEADER[+OFFSET],... (default: same motor names).",
     ),
     map_file: Path | None = typer.Option(None, "--map-file", help="Joint map file (YAML)."),
     rate: float = typer.Option(100.0, "--rate", min=1.0, max=1000.0, help="Ticks per second."),

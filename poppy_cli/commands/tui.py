@@ -36,7 +36,10 @@ def tui(
         None, "--port", "-p", help="Open this bus at start and scan it (device, pty or URL)."
     ),
     baud: int | None = typer.Option(
-        None, "--baud", "-b", help="Scan --port at this rate only (default: every standard rate).",
+        None,
+        "--baud",
+        "-b",
+        help="Scan --port at this rate only (default: every standard rate).",
         **BAUD_LIMITS,
     ),
     protocol: int | None = typer.Option(

@@ -1,0 +1,148 @@
+"""The Snap! documents poppy generates: well-formed projects whose blocks call served routes."""
+
+from __future__ import annotations
+
+import re
+import time
+import xml.etree.ElementTree as ET
+from collections.abc import Iterator
+
+import httpx
+import pytest
+from starlette.routing import Match
+
+from poppy_core.creatures import from_profile
+from poppy_core.robot import Robot
+from poppy_core.server.snap import SnapServer, robot_facts, start_snap_server
+from poppy_core.server.snap.catalog import BLOCKS, Block
+from poppy_core.server.snap.examples import project_names
+from poppy_core.server.snap.routing import TextRouter
+
+Served = tuple[Robot, SnapServer, httpx.Client]
+
+
+@pytest.fixture(scope="module")
+def snap(moves_folder: str) -> Iterator[Served]:
+    """A virtual Ergo Jr (with its behaviours and chain) served by the Snap! server."""
+    robot = from_profile("ergo-jr", sim=True)
+    server = start_snap_server(robot, port=0)
+    try:
+        with httpx.Client(base_url=f"http://127.0.0.1:{server.port}", timeout=20.0) as http:
+            yield robot, server, http
+    finally:
+        server.stop()
+        robot.close()
+
+
+def url_of(definition: ET.Element) -> str | None:
+    """The route template a block definition calls, rebuilt from its XML (inputs as {name})."""
+    call = definition.find(".//block[@s='reportURL']/block[@s='reportJoinWords']/list")
+    if call is None:
+        return None
+    parts = []
+    for item in call:
+        if item.tag == "l":
+            parts.append(item.text or "")
+        else:
+            parts.append("{" + item.attrib["var"] + "}")
+    text = "".join(parts)
+    assert text.startswith("http://{host}:{port}/")
+    return text.removeprefix("http://{host}:{port}")
+
+
+def served_route(router: TextRouter, path: str) -> str | None:
+    """The template of the route ``path`` reaches, or None."""
+    found = router.match(path)
+    if found:
+        return found[0].path
+    for route in router.app.routes:  # type: ignore[attr-defined]  # the documents, /ip/
+        match, _ = route.matches({"type": "http", "path": path, "method": "GET"})
+        if match is Match.FULL:
+            return str(route.path)
+    return None
+
+
+@pytest.mark.parametrize("name", project_names())
+def test_every_project_is_a_well_formed_snap_project(snap: Served, name: str) -> None:
+    _, server, http = snap
+    answer = http.get(f"/snap/{name}")
+    assert answer.status_code == 200
+    root = ET.fromstring(answer.content)
+    assert root.tag == "project" and root.get("name") == name
+    variables = {v.get("name"): v.findtext("l") for v in root.findall("./variables/variable")}
+    assert variables == {"host": "127.0.0.1", "port": str(server.port)}  # as the client reached it
+    definitions = root.findall("./blocks/block-definition")
+    assert len(definitions) == len(BLOCKS) + 1  # and "set robot host"
+    french = name.endswith("-fr")
+    labels = {d.get("s") for d in definitions}
+    assert {b.fr if french else b.en for b in BLOCKS} <= labels
+    router = server.thread.server.config.app.app  # inside the OriginGuard
+    assert isinstance(router, TextRouter)
+    for definition in definitions:
+        template = url_of(definition)
+        if template is None:
+            continue
+        names = re.findall(r"%'(\w+)'", definition.get("s", ""))
+        defaults = [i.text or "" for i in definition.findall("./inputs/input")]
+        values = {"motor": "m1", **dict(zip(names, defaults, strict=True))}
+        sample = template.format(**values)
+        assert served_route(router, sample), f"{definition.get('s')}: {template} is not served"
+    uses = {u.get("s") for u in root.iter("custom-block")}
+    defined = {d.get("s").replace("%'", "%").split("%")[0] for d in definitions}  # type: ignore[union-attr]
+    for spec in uses:
+        assert spec and spec.split("%")[0] in defined, spec
+
+
+def test_blocks_xml_is_the_english_library_with_french_translations(snap: Served) -> None:
+    http = snap[2]
+    root = ET.fromstring(http.get("/snap-blocks.xml").content)
+    goto = next(
+        d for d in root.iter("block-definition") if d.get("s", "").startswith("move motors")
+    )
+    assert goto.findtext("translations", "").startswith("fr:tourner les moteurs _ à _")
+    defaults = [i.text for i in goto.findall("./inputs/input")]
+    assert defaults == ["m1;m2;m3", "0", "1"]  # the served robot's motors
+
+
+def fill(block: Block, facts_default: dict[str, str]) -> list[str]:
+    """The URLs a block calls with its default inputs (once per motor for ``each`` blocks)."""
+    values = {i.name: facts_default[i.name] for i in block.inputs}
+    if block.each:
+        motors = values[block.each].split(";")
+        return [block.template.format(**{**values, "motor": m}) for m in motors]
+    return [block.template.format(**values)]
+
+
+def test_each_block_url_template_is_called_and_answers(snap: Served) -> None:
+    _, server, http = snap
+    facts = robot_facts(server.service)
+    for block in BLOCKS:
+        defaults = {i.name: facts.default(i.default) for i in block.inputs}
+        for url in fill(block, defaults):
+            answer = http.get(url)
+            assert answer.status_code == 200, f"{block.key}: {url} -> {answer.text}"
+            assert "\n" not in answer.text
+            if block.answer == "done":
+                assert answer.text == "Done!", f"{block.key}: {url} -> {answer.text}"
+            if block.answer == "bool":
+                assert answer.text in ("True", "False")
+            if block.answer == "number":
+                assert float(answer.text) >= 0
+        if block.key == "record":
+            time.sleep(0.3)  # a few frames before "save"
+        if block.key == "primitive":
+            http.get(f"/primitive/{defaults['primitive']}/stop")
+
+
+def test_blocks_follow_the_robot_served(moves_folder: str) -> None:
+    with from_profile("torso", sim=True) as robot:
+        server = start_snap_server(robot, port=0)
+        try:
+            xml = httpx.get(f"http://127.0.0.1:{server.port}/snap-blocks.xml", timeout=20).text
+        finally:
+            server.stop()
+    root = ET.fromstring(xml)
+    tip = next(
+        d for d in root.iter("block-definition") if d.get("s", "").startswith("tip position")
+    )
+    assert tip.findtext("./inputs/input") == "l_arm_chain"

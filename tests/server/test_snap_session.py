@@ -1,0 +1,211 @@
+"""A teacher's Snap! session replayed in order on poppy's Snap! server (a virtual Ergo Jr).
+
+The session and pypot 5.0.2's answers to it are in ``data/snap_session.json`` (recorded from
+pypot's Snap! server over ``poppy emulate`` by ``bench/peers/record_snap_session.py``). Where
+pypot's answer is deterministic, poppy answers the same text; where the robot moved, its state
+is checked; where pypot answered 500, poppy answers a 4xx line starting with ``Error``.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+
+from poppy_core.creatures import from_profile
+from poppy_core.motion import list_moves, load_move
+from poppy_core.robot import Robot
+from poppy_core.server.snap import SnapServer, start_snap_server
+from tests.server.snap_helpers import near, wait_until
+
+SESSION = json.loads((Path(__file__).parent / "data" / "snap_session.json").read_text())
+STEPS: list[dict[str, Any]] = SESSION["steps"]
+
+
+@pytest.fixture(scope="module")
+def snap(moves_folder: str) -> Iterator[tuple[Robot, SnapServer, httpx.Client]]:
+    """A virtual Ergo Jr (with its behaviours) served by the Snap! server on a free port."""
+    robot = from_profile("ergo-jr", sim=True)
+    server = start_snap_server(robot, port=0)
+    try:
+        with httpx.Client(base_url=f"http://127.0.0.1:{server.port}", timeout=20.0) as http:
+            yield robot, server, http
+    finally:
+        server.stop()
+        robot.close()
+
+
+def test_the_session_answers_as_pypot_and_moves_the_robot(
+    snap: tuple[Robot, SnapServer, httpx.Client],
+) -> None:
+    robot, server, http = snap
+    answers: dict[int, httpx.Response] = {}
+    for index, step in enumerate(STEPS):
+        answer = http.get(step["path"])
+        answers[index] = answer
+        pypot = step["pypot"]
+        where = f"step {index} {step['path']} ({step['what']})"
+        assert "\n" not in answer.text, where
+        if step["compare"]:
+            assert (answer.status_code, answer.text) == (pypot["status"], pypot["text"]), where
+        elif pypot["status"] >= 500:
+            # pypot fails; poppy does the right thing or refuses in one line
+            assert answer.status_code == 200 or (
+                400 <= answer.status_code < 500 and answer.text.startswith("Error: ")
+            ), where
+        check_state(robot, server, step["path"], answer)
+
+
+def check_state(robot: Robot, server: SnapServer, path: str, answer: httpx.Response) -> None:
+    """The robot's state after the step at ``path`` (polled: motion takes time)."""
+    service = server.service
+    if path.startswith("/motors/set/registers/m1:compliant"):
+        assert all(not m.compliant for m in robot.motors)
+    elif path == "/motor/m3/set/led/blue":
+        assert [m.led for m in robot.motors[:3]] == ["red", "green", "blue"]
+    elif path == "/motor/m1/goto/30/0.5":
+        assert wait_until(lambda: near(robot.m1.present_position, 30))
+    elif path.startswith("/motors/set/goto/"):
+        assert wait_until(
+            lambda: near(robot.m2.present_position, -20) and near(robot.m3.present_position, 15)
+        )
+    elif path == "/motors/get/positions":
+        values = [float(v) for v in answer.text.split(";")]
+        assert len(values) == 6 and near(values[0], 30) and near(values[1], -20)
+    elif path == "/primitive/dance/start":
+        assert service.primitive("dance").is_alive()
+    elif path == "/primitive/dance/pause":
+        assert service.primitive("dance").describe()["state"] == "paused"
+    elif path == "/primitive/dance/stop":
+        assert not service.primitive("dance").is_alive()
+    elif path == "/motor/m1/goto/-20/0.6":
+        assert wait_until(lambda: near(robot.m1.present_position, -20))
+        time.sleep(0.3)  # a few frames at the end of the move
+    elif path == "/primitive/MoveRecorder/wave/stop":
+        # the same library as `poppy record`
+        assert "wave" in [entry.name for entry in list_moves()]
+        move = load_move("wave")
+        assert list(move.motors) == ["m1", "m2", "m3"]
+        assert near(move.frame(0)["m1"], 30, 3) and near(move.frame(len(move) - 1)["m1"], -20, 3)
+    elif path == "/motor/m1/goto/0/0.5":
+        assert wait_until(lambda: near(robot.m1.present_position, 0))
+    elif path.startswith("/primitive/MovePlayer/wave/start"):
+        duration = float(answer.text)
+        full = load_move("wave").duration_s
+        factor = 2.0 if "/start/2" in path else 1.0
+        assert duration == pytest.approx(full / factor, abs=0.01)
+        assert wait_until(lambda: "wave" not in service.moves.playing())
+        end = 30 if path.endswith("/backwards") else -20
+        assert wait_until(lambda: near(robot.m1.present_position, end, 3))
+    elif path == "/primitive/MoveRecorder/wave/remove":
+        assert "wave" not in [entry.name for entry in list_moves()]
+    elif path.startswith("/ik/chain/goto/"):
+        assert answer.text == "Done!"
+        chain = robot.chain
+        target = [0.02, -0.15, 0.16]
+        assert wait_until(
+            lambda: sum((a - b) ** 2 for a, b in zip(chain.position, target, strict=True)) < 1e-4
+        )
+    elif path == "/ik/chain/endeffector":
+        parts = answer.text.split(",")
+        assert len(parts) == 3
+        tip = [float(v) for v in parts]
+        assert tip == pytest.approx([round(float(v), 4) for v in robot.chain.position], abs=2e-3)
+
+
+@pytest.mark.parametrize(
+    ("path", "status", "says"),
+    [
+        ("/motor/m9/get/present_position", 404, "no motor 'm9'"),
+        ("/motors/nope", 404, "no group 'nope'"),
+        ("/motors/m1;m9/get/led", 404, "no motor 'm9'"),
+        ("/motor/m1/get/nothing", 404, "no register 'nothing'"),
+        ("/motor/m1/set/goal_position/abc", 400, "expected a number"),
+        ("/motor/m1/goto/500/1", 400, "outside the angle limits"),
+        ("/motor/m1/goto/10/-1", 400, "duration"),
+        ("/motors/set/goto/m1:10", 400, "motor:position:duration"),
+        ("/motors/set/registers/m1:led", 400, "motor:register:value"),
+        ("/primitive/nope/start", 404, "no primitive 'nope'"),
+        ("/primitive/dance/get/nothing", 404, "no property 'nothing'"),
+        ("/primitive/MovePlayer/nope/start", 404, "no move 'nope'"),
+        ("/primitive/MovePlayer/a.b/start", 400, "not a move name"),
+        ("/primitive/MoveRecorder/r1/start/m1;zz", 404, "no motor 'zz'"),
+        ("/ik/nochain/endeffector", 404, "does not exist"),
+        ("/ik/chain/goto/5/5/5/1", 400, "cannot reach"),
+        ("/ik/chain/goto/a/0/0/1", 400, "x must be a number"),
+        ("/snap/nope", 404, "no Snap! project"),
+        ("/detect/nope", 404, "no card 'nope' (cards: "),
+        ("/no/such/route", 404, "no Snap! route"),
+    ],
+)
+def test_refusals_are_one_line_4xx(
+    snap: tuple[Robot, SnapServer, httpx.Client], path: str, status: int, says: str
+) -> None:
+    answer = snap[2].get(path)
+    assert answer.status_code == status, answer.text
+    assert answer.text.startswith("Error: ") and says in answer.text
+    assert "\n" not in answer.text and answer.headers["content-type"].startswith("text/plain")
+
+
+def test_values_read_as_pypot_writes_them(snap: tuple[Robot, SnapServer, httpx.Client]) -> None:
+    robot, _, http = snap
+    assert http.get("/motor/m4/set/compliant/false").text == "Done!"  # Snap!'s own spelling
+    assert not robot.m4.compliant
+    assert http.get("/motor/m4/get/registers").text.startswith("['")
+    assert http.get("/primitive/dance/methodes").text == "start/stop/pause/resume"
+    assert http.get("/primitive/dance/set/tempo_scale/0.5").text == ""
+    assert http.get("/primitive/dance/get/tempo_scale").text == "0.5"
+    assert http.get("/motors/set/positions/5;6;7;").text == "Done!"
+    assert wait_until(lambda: near(robot.m3.present_position, 7))
+    assert http.get("/ip/").text == "127.0.0.1"
+    frame = http.get("/frame.png")  # the Ergo Jr's camera (blank when simulated without MuJoCo)
+    assert frame.status_code == 200 and frame.content.startswith(b"\x89PNG")
+    assert http.get("/detect/caribou").text == "False"  # no card in view
+
+
+def test_snap_berkeley_edu_is_allowed_and_other_pages_are_not(
+    snap: tuple[Robot, SnapServer, httpx.Client],
+) -> None:
+    http = snap[2]
+    allowed = http.get("/motors/motors", headers={"Origin": "https://snap.berkeley.edu"})
+    assert allowed.status_code == 200
+    assert allowed.headers["access-control-allow-origin"] == "https://snap.berkeley.edu"
+    preflight = http.options(
+        "/snap-blocks.xml",
+        headers={
+            "Origin": "https://snap.berkeley.edu",
+            "Access-Control-Request-Method": "GET",
+            "Access-Control-Request-Private-Network": "true",
+        },
+    )
+    assert preflight.status_code == 204
+    assert preflight.headers["access-control-allow-private-network"] == "true"
+    assert http.get("/motors/motors", headers={"Origin": "https://evil.example"}).status_code == 403
+    linked = http.get("/motor/m1/goto/0/1", headers={"Sec-Fetch-Site": "cross-site"})
+    assert linked.status_code == 403  # a link or an image on another site cannot move it
+    blocks = http.get("/snap-blocks.xml", headers={"Sec-Fetch-Site": "cross-site"})
+    assert blocks.status_code == 200  # documents open from a link
+    assert http.get("/motors/motors", headers={"Host": "evil.example"}).status_code == 400
+
+
+def test_a_token_is_needed_and_carried_by_the_blocks(moves_folder: str) -> None:
+    with from_profile("ergo-jr", sim=True) as robot:
+        server = start_snap_server(robot, port=0, token="s3cret/+")
+        try:
+            base = f"http://127.0.0.1:{server.port}"
+            assert httpx.get(f"{base}/motors/motors", timeout=20).status_code == 401
+            assert httpx.get(f"{base}/snap-blocks.xml", timeout=20).status_code == 401
+            ok = httpx.get(f"{base}/motors/motors", params={"token": "s3cret/+"}, timeout=20)
+            assert ok.text == "m1/m2/m3/m4/m5/m6"
+            assert server.editor_url.endswith("/snap-blocks.xml?token=s3cret%2F%2B")
+            xml = httpx.get(server.blocks_url, timeout=20).text
+            assert xml.count("<l>?token=s3cret%2F%2B</l>") >= 20  # every block's URL
+            header = {"Authorization": "Bearer s3cret/+"}
+            assert httpx.get(f"{base}/ip/", headers=header, timeout=20).text == "127.0.0.1"
+        finally:
+            server.stop()
