@@ -7,6 +7,7 @@ also guard WebSocket handshakes.
 from __future__ import annotations
 
 import hmac
+from collections.abc import Callable
 from urllib.parse import parse_qs
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
@@ -38,19 +39,32 @@ class TokenMiddleware:
     Args:
         app: the wrapped app.
         token: the secret.
+        public: paths served without the token (GET only: the web page and its assets, which
+            must load to ask for the token and hold no robot data).
     """
 
-    def __init__(self, app: ASGIApp, token: str) -> None:
+    def __init__(
+        self, app: ASGIApp, token: str, public: Callable[[str], bool] | None = None
+    ) -> None:
         self.app = app
         self.token = token.encode()
+        self.public = public
 
     def allowed(self, scope: Scope) -> bool:
         """True when ``scope`` carries the token."""
         given = request_token(scope)
         return given is not None and hmac.compare_digest(given.encode(), self.token)
 
+    def _public(self, scope: Scope) -> bool:
+        return (
+            self.public is not None
+            and scope["type"] == "http"
+            and scope["method"] in ("GET", "HEAD")
+            and self.public(scope["path"])
+        )
+
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] not in ("http", "websocket") or self.allowed(scope):
+        if scope["type"] not in ("http", "websocket") or self._public(scope) or self.allowed(scope):
             await self.app(scope, receive, send)
             return
         await refuse(
