@@ -27,7 +27,7 @@ logger = logging.getLogger(__name__)
 
 router = APIRouter(prefix="/web", tags=["web page"], responses={422: {"model": Problem}})
 
-LED_CHOICES = ("off", "red", "green", "yellow", "blue", "pink", "cyan", "white", "on")
+LED_CHOICES = ("off", "red", "green", "yellow", "blue", "pink", "cyan", "white")
 """LED values the page offers, kept for each motor when its model accepts them."""
 
 
@@ -76,17 +76,17 @@ def _chain_names(robot: Robot) -> list[str]:
     return list(robot_chains(robot))
 
 
-def led_values(motor: Motor) -> list[str]:
-    """The LED values of ``LED_CHOICES`` the motor's model accepts."""
+def led_values(motor: Motor) -> list[str | bool]:
+    """The LED values the motor's model takes: colour names (XL-320), else off/on as booleans."""
     register = motor.model.register("led")
-    accepted = []
+    accepted: list[str | bool] = []
     for value in LED_CHOICES:
         try:
             register.from_si(value)
         except (PoppyError, ValueError, TypeError, KeyError):
             continue
         accepted.append(value)
-    return accepted
+    return accepted or [False, True]
 
 
 def motor_details(motor: Motor) -> dict[str, Any]:
@@ -140,7 +140,7 @@ async def motors_route(service: Service) -> dict[str, Any]:
 
 
 @router.get("/motors/leds", summary="The LED values each motor accepts")
-async def leds_route(service: Service) -> dict[str, list[str]]:
+async def leds_route(service: Service) -> dict[str, list[str | bool]]:
     """Motor name -> the LED values its model takes."""
     return {m.name: led_values(m) for m in service.robot.motors}
 

@@ -72,11 +72,11 @@ function setupStop() {
     } catch (error) { say(error.message, true); }
     refresh(); refreshPrimitives(); refreshMoves();
   });
-  let lastEscape = 0;
+  // Escape anywhere opens the confirmation with Stop focused: Escape then Enter stops all
   document.addEventListener("keydown", (event) => {
     if (event.key !== "Escape" || document.querySelector("dialog[open]")) return;
-    if (performance.now() - lastEscape < 600) document.getElementById("stop-all").click();
-    lastEscape = performance.now();
+    event.preventDefault();
+    document.getElementById("stop-all").click();
   });
 }
 
@@ -93,15 +93,18 @@ function rateMeter() {
 async function main() {
   window.poppy = { stats };
   setupStop();
-  const about = await get("/api/v1/web/about");
-  showAbout(about);
-  const robot = await get("/api/v1/robot");
-  await buildTable(robot.motors);
   const conn = document.getElementById("conn");
+  // the stream opens at once and every first request goes out together: first values sooner
   openStream(STREAM_HZ, onFrame, (up) => {
     conn.textContent = up ? "connected" : "disconnected";
     conn.className = `badge ${up ? "ok" : "bad"}`;
   });
+  const [about, robot, details, leds] = await Promise.all([
+    get("/api/v1/web/about"), get("/api/v1/robot"),
+    get("/api/v1/web/motors"), get("/api/v1/web/motors/leds"),
+  ]);
+  showAbout(about);
+  buildTable(robot.motors, details, leds);
   setupRecorder(robot.motors);
   showCameras(about.cameras);
   showChains(about.chains);

@@ -67,9 +67,13 @@ function motorRow(name, info, leds) {
   compliant.addEventListener("change", () => setCompliant([name], compliant.checked));
   const led = el("select");
   led.setAttribute("aria-label", `${name} LED`);
-  for (const value of leds) led.append(el("option", { value, textContent: value }));
+  // values are JSON: colour names (XL-320) or false/true (shown off/on)
+  for (const value of leds) {
+    const text = value === true ? "on" : value === false ? "off" : value;
+    led.append(el("option", { value: JSON.stringify(value), textContent: text }));
+  }
   led.addEventListener("change", async () => {
-    try { await put(`/api/v1/motors/${name}/registers/led`, led.value); } catch (e) { say(e.message, true); }
+    try { await put(`/api/v1/motors/${name}/registers/led`, JSON.parse(led.value)); } catch (e) { say(e.message, true); }
   });
   const online = el("td", { className: "online" });
   const tr = el("tr", { id: `motor-${name}` },
@@ -111,8 +115,8 @@ function groupButtons(container, groups) {
   for (const [group, names] of Object.entries(groups)) add(group, (v) => setCompliant(names, v));
 }
 
-export async function buildTable(motorNames) {
-  const [details, leds] = await Promise.all([get("/api/v1/web/motors"), get("/api/v1/web/motors/leds")]);
+// The table of `motorNames` from `details` (/api/v1/web/motors) and `leds` (.../motors/leds).
+export function buildTable(motorNames, details, leds) {
   const table = document.getElementById("motor-table");
   for (const body of table.querySelectorAll("tbody")) body.remove();
   rows.clear();
@@ -148,12 +152,13 @@ export async function refresh() {
 }
 
 export function onFrame(frame) {
+  if (!rows.size) return; // frames before the table is built: the next one will do
   stats.frames += 1;
   if (stats.firstFrameAt === null) stats.firstFrameAt = performance.now();
   for (const [name, state] of Object.entries(frame)) {
     const row = rows.get(name);
     if (!row) continue;
     for (const key of FAST) row.cells[key].textContent = fmt(state[key]);
-    if (document.activeElement !== row.led && state.led !== undefined) row.led.value = String(state.led);
+    if (document.activeElement !== row.led && state.led !== undefined) row.led.value = JSON.stringify(state.led);
   }
 }

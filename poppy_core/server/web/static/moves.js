@@ -76,8 +76,10 @@ export async function plot(name) {
     svg.append(line);
   });
   svg.setAttribute("aria-label", `positions of ${move.motors.join(", ")} over ${move.duration_s.toFixed(1)} s`);
-  document.getElementById("plot-title").textContent =
-    `${name}: ${move.motors.map((m, i) => `${m} (${COLOURS[i % COLOURS.length]})`).join(", ")}, ${move.duration_s.toFixed(1)} s`;
+  const legend = move.motors.map((m, i) =>
+    el("span", { className: "swatch", textContent: m, style: `border-color: ${COLOURS[i % COLOURS.length]}` }));
+  document.getElementById("plot-title").replaceChildren(
+    `${name} (${move.duration_s.toFixed(1)} s): `, ...legend);
   document.getElementById("plot").hidden = false;
 }
 
