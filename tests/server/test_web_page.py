@@ -170,6 +170,22 @@ def test_stop_stops_a_running_primitive(page: Any, served: Served) -> None:
     eventually(lambda: "Stop from the web page" in page.inner_text("#log-lines"), "the log line")
 
 
+def test_a_refused_goal_is_shown(page: Any, served: Served) -> None:
+    motor = served.robot.m5
+    old = motor.angle_limit
+    motor.angle_limit = (-10.0, 10.0)  # narrowed after the page drew its slider (-90..90)
+    try:
+        slider = page.locator("#motor-m5 input[type=range]")
+        slider.fill("60")
+        slider.dispatch_event("change")
+        eventually(lambda: "refused" in page.inner_text("#message"), "the refusal")
+        assert "outside the angle limits" in page.inner_text("#message")
+        assert "refused" in (page.get_attribute("#motor-m5", "class") or "")
+        assert motor.goal_position <= 10.0
+    finally:
+        motor.angle_limit = old
+
+
 def test_the_phone_layout_fits_the_screen(browser: Any, served: Served) -> None:
     context = browser.new_context(viewport={"width": 390, "height": 844}, is_mobile=True)
     phone = context.new_page()
@@ -214,3 +230,42 @@ def test_with_a_token_the_page_works_after_it_is_entered(browser: Any, with_toke
     assert not tab.is_visible("#token-dialog")
     context.close()
     with_token.robot.compliant = True
+
+
+@pytest.fixture(scope="module")
+def creature(moves_folder: str) -> Iterator[Served]:
+    """A virtual Ergo Jr as ``poppy serve`` builds it: its chain and camera attached."""
+    from poppy_core.creatures import from_profile
+    from poppy_core.server import ServerThread, create_app
+
+    robot = from_profile("ergo-jr", sim=True)
+    app = create_app(robot)
+    server = ServerThread(app).start()
+    try:
+        yield Served(server.url, robot, app)
+    finally:
+        server.stop()
+        robot.close()
+
+
+def test_camera_and_chain_jog(browser: Any, creature: Served) -> None:
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    tab = context.new_page()
+    tab.set_default_timeout(WAIT_S * 1000)
+    tab.goto(creature.url + "/")
+    tab.wait_for_function("window.poppy && window.poppy.ready")
+    tab.click("#camera-views button")
+    eventually(
+        lambda: tab.evaluate("document.querySelector('#camera-views img').naturalWidth") > 0,
+        "a camera frame in the page",
+    )
+    tab.click("#camera-views button")  # hidden again: the stream is closed
+    robot = creature.robot
+    robot.compliant = False
+    chain = robot.chain
+    before = chain.position.copy()
+    tab.click("button[aria-label='chain z plus 1 cm']")
+    eventually(lambda: chain.position[2] - before[2] > 0.005, "the tip to rise by about 1 cm")
+    eventually(lambda: tab.inner_text("#chain-chain output") != "", "the tip shown")
+    context.close()
+    robot.compliant = True

@@ -3,6 +3,7 @@ import { api, get, post, put } from "./api.js";
 import { el, say } from "./ui.js";
 
 const FAST = ["present_position", "present_speed", "present_load", "present_temperature"];
+let pending = null; // the latest frame received before the table existed
 const rows = new Map(); // motor name -> {cells, slider, compliant, led, online}
 export const stats = { frames: 0, firstFrameAt: null, started: performance.now() };
 
@@ -128,6 +129,8 @@ export function buildTable(motorNames, details, leds) {
   }
   groupButtons(document.getElementById("group-toggles"), details.groups);
   applyDetails(details.motors);
+  if (pending) onFrame(pending);
+  pending = null;
 }
 
 function applyDetails(motors) {
@@ -152,7 +155,7 @@ export async function refresh() {
 }
 
 export function onFrame(frame) {
-  if (!rows.size) return; // frames before the table is built: the next one will do
+  if (!rows.size) { pending = frame; return; } // shown as soon as the table is built
   stats.frames += 1;
   if (stats.firstFrameAt === null) stats.firstFrameAt = performance.now();
   for (const [name, state] of Object.entries(frame)) {
