@@ -30,7 +30,7 @@ GOAL_FIRST_MS = 500.0
 GOAL_RATE_HZ = 10.0
 GOAL_CPU = 0.10
 """Server CPU attributable to one open page, as a fraction of one core."""
-READY = "window.poppy && window.poppy.stats.firstFrameAt !== null"
+READY = "() => window.poppy && window.poppy.stats.firstFrameAt !== null"
 
 
 def _seconds() -> float:

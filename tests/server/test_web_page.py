@@ -24,6 +24,10 @@ pytestmark = pytest.mark.skipif(
 )
 
 WAIT_S = 30.0
+# arrow functions: Playwright evaluates a bare expression string with eval, which the page's
+# Content-Security-Policy refuses
+READY = "() => window.poppy && window.poppy.ready"
+LIVE = "() => window.poppy && window.poppy.ready && window.poppy.stats.frames > 0"
 
 
 def eventually(check: Callable[[], Any], what: str, timeout_s: float = WAIT_S) -> Any:
@@ -54,8 +58,14 @@ def page(browser: Any, served: Served) -> Iterator[Any]:
     opened.set_default_timeout(WAIT_S * 1000)
     errors: list[str] = []
     opened.on("pageerror", lambda error: errors.append(str(error)))
+    opened.on(
+        "console",
+        lambda message: (
+            errors.append(message.text) if "Content Security Policy" in message.text else None
+        ),
+    )
     opened.goto(served.url + "/")
-    opened.wait_for_function("window.poppy && window.poppy.ready && window.poppy.stats.frames > 0")
+    opened.wait_for_function(LIVE)
     yield opened
     context.close()
     assert not errors, errors
@@ -190,7 +200,7 @@ def test_the_phone_layout_fits_the_screen(browser: Any, served: Served) -> None:
     context = browser.new_context(viewport={"width": 390, "height": 844}, is_mobile=True)
     phone = context.new_page()
     phone.goto(served.url + "/")
-    phone.wait_for_function("window.poppy && window.poppy.ready")
+    phone.wait_for_function(READY)
     width = phone.evaluate("document.documentElement.scrollWidth")
     assert width <= 390, f"the page is {width} px wide on a 390 px phone"
     assert phone.is_visible("#stop-all")
@@ -219,14 +229,14 @@ def test_with_a_token_the_page_works_after_it_is_entered(browser: Any, with_toke
     assert "refused" in tab.inner_text("#token-error")
     tab.fill("#token-input", "s3cret-page")
     tab.click("#token-ok")
-    tab.wait_for_function("window.poppy && window.poppy.ready && window.poppy.stats.frames > 0")
+    tab.wait_for_function(LIVE)
     assert tab.inner_text("#robot-name") == "ergo-jr"
     tab.uncheck("#motor-m2 input[type=checkbox]")
     eventually(lambda: with_token.robot.m2.compliant is False, "m2 stiff with the token")
     assert not [u for u in urls if "s3cret" in u], "the token went into a URL"
     # the token is kept: a reload asks nothing
     tab.reload()
-    tab.wait_for_function("window.poppy && window.poppy.ready")
+    tab.wait_for_function(READY)
     assert not tab.is_visible("#token-dialog")
     context.close()
     with_token.robot.compliant = True
@@ -253,7 +263,7 @@ def test_camera_and_chain_jog(browser: Any, creature: Served) -> None:
     tab = context.new_page()
     tab.set_default_timeout(WAIT_S * 1000)
     tab.goto(creature.url + "/")
-    tab.wait_for_function("window.poppy && window.poppy.ready")
+    tab.wait_for_function(READY)
     tab.click("#camera-views button")
     eventually(
         lambda: tab.evaluate("document.querySelector('#camera-views img').naturalWidth") > 0,

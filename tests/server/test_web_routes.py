@@ -17,6 +17,7 @@ def test_the_page_and_its_assets_are_served(client: httpx.Client) -> None:
     page = client.get("/")
     assert page.status_code == 200 and page.headers["content-type"].startswith("text/html")
     assert '<script type="module" src="/web/app.js">' in page.text
+    assert "frame-ancestors 'none'" in page.headers["content-security-policy"]
     for asset in ("app.js", "api.js", "motors.js", "style.css", "favicon.svg"):
         answer = client.get(f"/web/{asset}")
         assert answer.status_code == 200, asset

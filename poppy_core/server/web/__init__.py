@@ -13,6 +13,16 @@ if TYPE_CHECKING:
 
 STATIC_PREFIX = "/web/"
 """Where the page's assets are served (public: they hold no robot data)."""
+PAGE_HEADERS = {
+    # its own files only; no other site may frame it (a framed Stop or slider could be clicked
+    # through a decoy page)
+    "Content-Security-Policy": (
+        "default-src 'self'; img-src 'self' blob: data:; connect-src 'self'; "
+        "frame-ancestors 'none'; base-uri 'none'; form-action 'self'"
+    ),
+    "X-Frame-Options": "DENY",
+    "Referrer-Policy": "no-referrer",
+}
 PUBLIC_PATHS = ("/", "/favicon.ico")
 """Paths served without the token: the page must load to ask for it."""
 
@@ -38,7 +48,7 @@ def add_web_page(app: FastAPI) -> None:
     index = f"{static_folder()}/index.html"
 
     async def page() -> Response:
-        return FileResponse(index, headers={"Cache-Control": "no-cache"})
+        return FileResponse(index, headers={"Cache-Control": "no-cache", **PAGE_HEADERS})
 
     async def favicon() -> Response:
         return FileResponse(f"{static_folder()}/favicon.svg", media_type="image/svg+xml")
