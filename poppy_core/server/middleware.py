@@ -18,8 +18,37 @@ MAX_BODY_BYTES = 64 * 1024
 """Largest request body accepted (bytes)."""
 
 
+TOKEN_PROTOCOL = "poppy-token."
+"""A WebSocket subprotocol ``poppy-token.<token in hex>`` carries the token: browsers cannot
+give a WebSocket a header, and a subprotocol keeps it out of the URL (the web page uses it)."""
+
+
+def protocol_token(scope: Scope) -> str | None:
+    """The token of a ``poppy-token.<hex>`` WebSocket subprotocol, if one was offered."""
+    for protocol in scope.get("subprotocols", []):
+        if isinstance(protocol, str) and protocol.startswith(TOKEN_PROTOCOL):
+            try:
+                return bytes.fromhex(protocol[len(TOKEN_PROTOCOL) :]).decode("utf-8")
+            except ValueError:
+                return None
+    return None
+
+
+def token_protocol(scope: Scope) -> str | None:
+    """The ``poppy-token.`` subprotocol a WebSocket client offered (the server accepts it)."""
+    for protocol in scope.get("subprotocols", []):
+        if isinstance(protocol, str) and protocol.startswith(TOKEN_PROTOCOL):
+            return protocol
+    return None
+
+
 def request_token(scope: Scope) -> str | None:
-    """The token a request carries: ``Authorization: Bearer …`` or ``?token=…``."""
+    """The token a request carries: ``Authorization: Bearer …``, ``?token=…``, or (WebSocket)
+    a ``poppy-token.<hex>`` subprotocol."""
+    if scope["type"] == "websocket":
+        token = protocol_token(scope)
+        if token is not None:
+            return token
     for key, value in scope.get("headers", []):
         if key == b"authorization":
             scheme, _, token = bytes(value).decode("latin-1").partition(" ")

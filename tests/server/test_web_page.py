@@ -218,6 +218,7 @@ def test_with_a_token_the_page_works_after_it_is_entered(browser: Any, with_toke
     tab.set_default_timeout(WAIT_S * 1000)
     urls: list[str] = []
     tab.on("request", lambda request: urls.append(request.url))
+    tab.on("websocket", lambda socket: urls.append(socket.url))
     tab.goto(with_token.url + "/")
     tab.wait_for_selector("#token-dialog[open]")
     # nothing works without the token: no motor, no robot name
@@ -233,6 +234,7 @@ def test_with_a_token_the_page_works_after_it_is_entered(browser: Any, with_toke
     assert tab.inner_text("#robot-name") == "ergo-jr"
     tab.uncheck("#motor-m2 input[type=checkbox]")
     eventually(lambda: with_token.robot.m2.compliant is False, "m2 stiff with the token")
+    assert any("/api/v1/ws" in u for u in urls)
     assert not [u for u in urls if "s3cret" in u], "the token went into a URL"
     # the token is kept: a reload asks nothing
     tab.reload()

@@ -1,13 +1,17 @@
 // The robot's API as the page uses it: fetch with the token, and the WebSocket state stream.
 // The token is asked once and kept in localStorage; HTTP requests carry it in the
-// Authorization header. Browsers cannot give a WebSocket a header: its URL carries it
-// (WebSocket URLs enter no history, and poppy serve keeps no access log).
+// Authorization header. Browsers cannot give a WebSocket a header: it goes as a subprotocol
+// "poppy-token.<hex>", so no URL ever holds it.
 
 const TOKEN_KEY = "poppy-token";
 let asking = null;
 
 export function token() {
   return localStorage.getItem(TOKEN_KEY) || "";
+}
+
+function hex(text) {
+  return [...new TextEncoder().encode(text)].map((b) => b.toString(16).padStart(2, "0")).join("");
 }
 
 export class ApiError extends Error {
@@ -77,9 +81,8 @@ export function openStream(rateHz, onFrame, onStatus) {
   let retry = 500;
   function connect() {
     const scheme = location.protocol === "https:" ? "wss" : "ws";
-    const query = new URLSearchParams({ rate_hz: String(rateHz) });
-    if (token()) query.set("token", token());
-    socket = new WebSocket(`${scheme}://${location.host}/api/v1/ws?${query}`);
+    const url = `${scheme}://${location.host}/api/v1/ws?rate_hz=${rateHz}`;
+    socket = token() ? new WebSocket(url, [`poppy-token.${hex(token())}`]) : new WebSocket(url);
     socket.onopen = () => { retry = 500; onStatus(true); };
     socket.onmessage = (event) => {
       const data = JSON.parse(event.data);
