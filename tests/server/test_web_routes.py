@@ -46,8 +46,9 @@ def test_motor_details_and_leds(client: httpx.Client) -> None:
     assert set(details["motors"]) == {f"m{i}" for i in range(1, 7)}
     assert details["motors"]["m2"]["angle_limit"] == [-125.0, 90.0]
     assert details["groups"] == {"base": ["m1", "m2", "m3"], "tip": ["m4", "m5", "m6"]}
-    leds = client.get("/api/v1/web/motors/leds").json()
-    assert "red" in leds["m1"] and "off" in leds["m1"]
+    assert "leds" not in details["motors"]["m1"]
+    leds = client.get("/api/v1/web/motors?leds=true").json()["motors"]["m1"]["leds"]
+    assert "red" in leds and "off" in leds
 
 
 def test_logs_show_what_the_server_logged(client: httpx.Client) -> None:

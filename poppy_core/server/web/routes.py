@@ -132,17 +132,18 @@ async def about_route(request: Request, service: Service) -> dict[str, Any]:
     return about(service.robot, request)
 
 
-@router.get("/motors", summary="Each motor's goal, voltage, compliance, limits, LED values")
-async def motors_route(service: Service) -> dict[str, Any]:
-    """The slow columns of the motor table (the stream has the fast ones) and the groups."""
+@router.get("/motors", summary="Each motor's goal, voltage, compliance, limits (LED values)")
+async def motors_route(
+    service: Service,
+    leds: bool = Query(False, description="also the LED values each motor takes"),
+) -> dict[str, Any]:
+    """The slow columns of the motor table (the stream has the fast ones), in config order,
+    and the groups."""
     motors = {m.name: motor_details(m) for m in service.robot.motors}
+    if leds:
+        for motor in service.robot.motors:
+            motors[motor.name]["leds"] = led_values(motor)
     return {"motors": motors, "groups": service.groups()}
-
-
-@router.get("/motors/leds", summary="The LED values each motor accepts")
-async def leds_route(service: Service) -> dict[str, list[str | bool]]:
-    """Motor name -> the LED values its model takes."""
-    return {m.name: led_values(m) for m in service.robot.motors}
 
 
 @router.get("/logs", summary="The last lines the server logged")

@@ -99,13 +99,13 @@ async function main() {
     conn.textContent = up ? "connected" : "disconnected";
     conn.className = `badge ${up ? "ok" : "bad"}`;
   });
-  const [about, robot, details, leds] = await Promise.all([
-    get("/api/v1/web/about"), get("/api/v1/robot"),
-    get("/api/v1/web/motors"), get("/api/v1/web/motors/leds"),
+  const [about, details] = await Promise.all([
+    get("/api/v1/web/about"), get("/api/v1/web/motors?leds=true"),
   ]);
   showAbout(about);
-  buildTable(robot.motors, details, leds);
-  setupRecorder(robot.motors);
+  const motors = Object.keys(details.motors); // in the robot's order
+  buildTable(motors, details);
+  setupRecorder(motors);
   showCameras(about.cameras);
   showChains(about.chains);
   rateMeter();

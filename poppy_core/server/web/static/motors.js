@@ -116,15 +116,15 @@ function groupButtons(container, groups) {
   for (const [group, names] of Object.entries(groups)) add(group, (v) => setCompliant(names, v));
 }
 
-// The table of `motorNames` from `details` (/api/v1/web/motors) and `leds` (.../motors/leds).
-export function buildTable(motorNames, details, leds) {
+// The table of `motorNames` from `details` (/api/v1/web/motors?leds=true).
+export function buildTable(motorNames, details) {
   const table = document.getElementById("motor-table");
   for (const body of table.querySelectorAll("tbody")) body.remove();
   rows.clear();
   for (const [group, names] of sections(motorNames, details.groups)) {
     const body = el("tbody", {},
       el("tr", { className: "group" }, el("th", { colSpan: 10, scope: "rowgroup", textContent: group })));
-    for (const name of names) body.append(motorRow(name, details.motors[name], leds[name]));
+    for (const name of names) body.append(motorRow(name, details.motors[name], details.motors[name].leds));
     table.append(body);
   }
   groupButtons(document.getElementById("group-toggles"), details.groups);
