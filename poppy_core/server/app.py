@@ -1,4 +1,4 @@
-"""``create_app(robot)``: the FastAPI app serving a robot (pypot's routes, /api/v1, WebSocket)."""
+"""``create_app(robot)``: the FastAPI app serving a robot (home page, pypot routes, v1, WS)."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ from poppy_core.server.fastpath import RegisterFastPath
 from poppy_core.server.middleware import MAX_BODY_BYTES, BodyLimitMiddleware, TokenMiddleware
 from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.service import RobotService
+from poppy_core.server.web import add_web_page, is_public
 
 if TYPE_CHECKING:
     from fastapi import FastAPI
@@ -68,8 +69,12 @@ def create_app(
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        yield
-        service.close()
+        app.state.web_logs.attach()
+        try:
+            yield
+        finally:
+            app.state.web_logs.detach()
+            service.close()
 
     app = FastAPI(
         title="poppy robot API",
@@ -87,6 +92,7 @@ def create_app(
     app.state.policy = policy
     app.state.stream_rate_hz = stream_rate_hz
     install_error_handlers(app)
+    add_web_page(app)  # the home page at / (its assets and /api/v1/web)
     # pypot's routes first: the hottest ones (register values) are matched soonest.
     for router in (
         pypot_motors.router,
@@ -108,7 +114,7 @@ def create_app(
     app.add_middleware(RegisterFastPath, service=service)
     app.add_middleware(BodyLimitMiddleware, max_bytes=max_body_bytes)
     if token:
-        app.add_middleware(TokenMiddleware, token=token)
+        app.add_middleware(TokenMiddleware, token=token, public=is_public)
     app.add_middleware(OriginGuard, policy=policy)  # outermost: before the token and the fast path
     return app
 

@@ -7,6 +7,7 @@ also guard WebSocket handshakes.
 from __future__ import annotations
 
 import hmac
+from collections.abc import Callable
 from urllib.parse import parse_qs
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
@@ -17,8 +18,37 @@ MAX_BODY_BYTES = 64 * 1024
 """Largest request body accepted (bytes)."""
 
 
+TOKEN_PROTOCOL = "poppy-token."
+"""A WebSocket subprotocol ``poppy-token.<token in hex>`` carries the token: browsers cannot
+give a WebSocket a header, and a subprotocol keeps it out of the URL (the web page uses it)."""
+
+
+def protocol_token(scope: Scope) -> str | None:
+    """The token of a ``poppy-token.<hex>`` WebSocket subprotocol, if one was offered."""
+    for protocol in scope.get("subprotocols", []):
+        if isinstance(protocol, str) and protocol.startswith(TOKEN_PROTOCOL):
+            try:
+                return bytes.fromhex(protocol[len(TOKEN_PROTOCOL) :]).decode("utf-8")
+            except ValueError:
+                return None
+    return None
+
+
+def token_protocol(scope: Scope) -> str | None:
+    """The ``poppy-token.`` subprotocol a WebSocket client offered (the server accepts it)."""
+    for protocol in scope.get("subprotocols", []):
+        if isinstance(protocol, str) and protocol.startswith(TOKEN_PROTOCOL):
+            return protocol
+    return None
+
+
 def request_token(scope: Scope) -> str | None:
-    """The token a request carries: ``Authorization: Bearer …`` or ``?token=…``."""
+    """The token a request carries: ``Authorization: Bearer …``, ``?token=…``, or (WebSocket)
+    a ``poppy-token.<hex>`` subprotocol."""
+    if scope["type"] == "websocket":
+        token = protocol_token(scope)
+        if token is not None:
+            return token
     for key, value in scope.get("headers", []):
         if key == b"authorization":
             scheme, _, token = bytes(value).decode("latin-1").partition(" ")
@@ -38,19 +68,32 @@ class TokenMiddleware:
     Args:
         app: the wrapped app.
         token: the secret.
+        public: paths served without the token (GET only: the web page and its assets, which
+            must load to ask for the token and hold no robot data).
     """
 
-    def __init__(self, app: ASGIApp, token: str) -> None:
+    def __init__(
+        self, app: ASGIApp, token: str, public: Callable[[str], bool] | None = None
+    ) -> None:
         self.app = app
         self.token = token.encode()
+        self.public = public
 
     def allowed(self, scope: Scope) -> bool:
         """True when ``scope`` carries the token."""
         given = request_token(scope)
         return given is not None and hmac.compare_digest(given.encode(), self.token)
 
+    def _public(self, scope: Scope) -> bool:
+        return (
+            self.public is not None
+            and scope["type"] == "http"
+            and scope["method"] in ("GET", "HEAD")
+            and self.public(scope["path"])
+        )
+
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] not in ("http", "websocket") or self.allowed(scope):
+        if scope["type"] not in ("http", "websocket") or self._public(scope) or self.allowed(scope):
             await self.app(scope, receive, send)
             return
         await refuse(

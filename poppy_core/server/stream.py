@@ -23,7 +23,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 from poppy_core.errors import PoppyError
 from poppy_core.server.errors import ApiError
 from poppy_core.server.jsonio import parse_json
-from poppy_core.server.middleware import TokenMiddleware
+from poppy_core.server.middleware import TokenMiddleware, token_protocol
 from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.refusals import one_line
 from poppy_core.server.service import RobotService
@@ -46,7 +46,8 @@ def clamp_rate(rate_hz: float) -> float:
 
 async def stream(websocket: WebSocket, service: RobotService, rate_hz: float) -> None:
     """Serve one WebSocket client until it leaves."""
-    await websocket.accept()
+    # a client that gave its token as a subprotocol must get it back (browsers require it)
+    await websocket.accept(subprotocol=token_protocol(websocket.scope))
     send_lock = asyncio.Lock()
 
     async def send(data: Any) -> None:

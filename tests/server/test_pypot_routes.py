@@ -147,6 +147,6 @@ def test_no_store_and_options_like_pypot(client: httpx.Client) -> None:
 
 
 def test_index_lists_the_routes(client: httpx.Client) -> None:
-    answer = client.get("/")
+    answer = client.get("/routes")
     assert answer.status_code == 200
     assert "/robot.json" in answer.text and "/api/v1/gotos" in answer.text

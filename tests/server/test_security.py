@@ -62,6 +62,21 @@ def test_websocket_needs_the_token(guarded: Served) -> None:
         assert "m1" in ws.recv(timeout=2)
 
 
+def test_websocket_token_as_a_subprotocol(guarded: Served) -> None:
+    """What the home page sends: ``poppy-token.<hex>``, echoed back, the URL left clean."""
+    from websockets.typing import Subprotocol
+
+    base = guarded.url.replace("http://", "ws://") + "/api/v1/ws"
+    offered = Subprotocol("poppy-token." + TOKEN.encode().hex())
+    with connect(base, subprotocols=[offered]) as ws:
+        assert ws.subprotocol == offered
+        assert "m1" in ws.recv(timeout=2)
+    wrong = Subprotocol("poppy-token." + b"nope".hex())
+    for bad in (wrong, Subprotocol("poppy-token.zz")):
+        with pytest.raises(InvalidStatus), connect(base, subprotocols=[bad]):
+            pass
+
+
 def test_cors_only_for_the_allowed_origin(guarded: Served) -> None:
     with httpx.Client(base_url=guarded.url) as http:
         allowed = http.options("/robot.json", headers={"Origin": "http://app.local"})

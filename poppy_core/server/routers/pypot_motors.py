@@ -24,9 +24,9 @@ GOTOS_TIP = (
 )
 
 
-@router.get("/", response_class=HTMLResponse, summary="The routes of the API")
+@router.get("/routes", response_class=HTMLResponse, summary="The routes of the API")
 async def index(request: Request) -> HTMLResponse:
-    """Every route, as pypot's server lists them."""
+    """Every route, as pypot's server listed them at ``/`` (``/`` is now the home page)."""
     lines = ["<b>All url paths available:</b><br>"]
     for path, operations in request.app.openapi()["paths"].items():
         methods = ", ".join(m.upper() for m in operations)

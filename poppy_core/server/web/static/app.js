@@ -1,0 +1,121 @@
+// The robot's home page: fetches who the robot is, builds each part, keeps them live.
+import { get, openStream, post } from "./api.js";
+import { showCameras, showChains } from "./extras.js";
+import { buildTable, onFrame, refresh, stats } from "./motors.js";
+import { refreshMoves, setupRecorder } from "./moves.js";
+import { refreshPrimitives } from "./primitives.js";
+import { el, every, say } from "./ui.js";
+
+const STREAM_HZ = 20;
+let uptimeBase = null;
+
+function duration(seconds) {
+  const s = Math.floor(seconds);
+  const h = Math.floor(s / 3600), m = Math.floor((s % 3600) / 60);
+  return h ? `${h} h ${m} min` : m ? `${m} min ${s % 60} s` : `${s} s`;
+}
+
+function showAbout(about) {
+  document.getElementById("robot-name").textContent = about.name;
+  document.title = `${about.name} · poppy`;
+  document.getElementById("creature").textContent = about.creature;
+  document.getElementById("description").textContent = about.description;
+  document.getElementById("sim-badge").hidden = !about.simulated;
+  uptimeBase = { at: performance.now(), uptime: about.uptime_s };
+  const buses = document.getElementById("buses");
+  buses.replaceChildren(...Object.entries(about.buses).map(([name, bus]) => {
+    const rate = bus.loop_hz?.present ?? 0;
+    const text = bus.ok ? `ok · ${rate.toFixed(0)} Hz` : `${bus.connected ? "trouble" : "lost"}` +
+      (bus.offline?.length ? ` · offline: ${bus.offline.join(", ")}` : "");
+    return el("li", { className: bus.ok ? "ok" : "bad" },
+      el("strong", { textContent: name }), ` ${bus.port}: ${text}`);
+  }));
+  const links = document.getElementById("links");
+  links.replaceChildren(...Object.entries(about.links).map(([name, url]) =>
+    el("a", { href: url, textContent: name, target: name === "routes" ? "" : "_blank", rel: "noopener" })));
+}
+
+function tickUptime() {
+  if (uptimeBase) {
+    const now = uptimeBase.uptime + (performance.now() - uptimeBase.at) / 1000;
+    document.getElementById("uptime").textContent = duration(now);
+  }
+}
+
+let lastLog = 0;
+async function refreshLogs() {
+  let lines;
+  try { lines = await get(`/api/v1/web/logs?after=${lastLog}`); } catch { return; }
+  const list = document.getElementById("log-lines");
+  for (const line of lines) {
+    lastLog = line.n;
+    const time = new Date(line.time * 1000).toLocaleTimeString();
+    list.append(el("li", { className: line.level.toLowerCase() },
+      el("time", { textContent: time }), ` ${line.level} ${line.logger}: ${line.message}`));
+  }
+  while (list.children.length > 200) list.firstChild.remove();
+  if (lines.length) list.scrollTop = list.scrollHeight;
+}
+
+function setupStop() {
+  const dialog = document.getElementById("stop-dialog");
+  document.getElementById("stop-all").addEventListener("click", () => {
+    dialog.showModal();
+    document.getElementById("stop-confirm").focus();
+  });
+  dialog.addEventListener("close", async () => {
+    if (dialog.returnValue !== "stop") return;
+    const then = dialog.querySelector("input[name=then]:checked").value;
+    try {
+      const done = await post("/api/v1/web/stop", { then });
+      say(`Stopped: ${done.primitives.length} primitive(s), ${done.moves.length} move(s); motors ${then === "hold" ? "held" : "compliant"}`);
+    } catch (error) { say(error.message, true); }
+    refresh(); refreshPrimitives(); refreshMoves();
+  });
+  // Escape anywhere opens the confirmation with Stop focused: Escape then Enter stops all
+  document.addEventListener("keydown", (event) => {
+    if (event.key !== "Escape" || document.querySelector("dialog[open]")) return;
+    event.preventDefault();
+    document.getElementById("stop-all").click();
+  });
+}
+
+function rateMeter() {
+  let frames = stats.frames, at = performance.now();
+  setInterval(() => {
+    const now = performance.now();
+    stats.rateHz = ((stats.frames - frames) * 1000) / (now - at);
+    frames = stats.frames; at = now;
+    document.getElementById("rate").textContent = `live · ${stats.rateHz.toFixed(0)} updates/s`;
+  }, 2000);
+}
+
+async function main() {
+  window.poppy = { stats };
+  setupStop();
+  const conn = document.getElementById("conn");
+  // the stream opens at once and every first request goes out together: first values sooner
+  openStream(STREAM_HZ, onFrame, (up) => {
+    conn.textContent = up ? "connected" : "disconnected";
+    conn.className = `badge ${up ? "ok" : "bad"}`;
+  });
+  const [about, details] = await Promise.all([
+    get("/api/v1/web/about"), get("/api/v1/web/motors?leds=true"),
+  ]);
+  showAbout(about);
+  const motors = Object.keys(details.motors); // in the robot's order
+  buildTable(motors, details);
+  setupRecorder(motors);
+  showCameras(about.cameras);
+  showChains(about.chains);
+  rateMeter();
+  every(1, tickUptime);
+  every(0.5, refresh);
+  every(1, refreshPrimitives);
+  every(1.5, refreshMoves);
+  every(2, refreshLogs);
+  every(5, async () => { try { showAbout(await get("/api/v1/web/about")); } catch { /* badge */ } });
+  window.poppy.ready = true;
+}
+
+main().catch((error) => say(`the page could not start: ${error.message}`, true));

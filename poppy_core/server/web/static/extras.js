@@ -1,0 +1,73 @@
+// What only some robots have: cameras (MJPEG) and kinematic chains (tip and a cartesian jog).
+import { get, post, token } from "./api.js";
+import { button, el, say } from "./ui.js";
+
+export function showCameras(cameras) {
+  if (!cameras.length) return;
+  const views = document.getElementById("camera-views");
+  for (const name of cameras) {
+    const img = el("img", { alt: `camera ${name}`, width: 320 });
+    const start = button(`show ${name}`, async () => {
+      if (img.src) { img.removeAttribute("src"); start.textContent = `show ${name}`; return; }
+      // an <img> cannot send a header: with a token, the stream is read with fetch instead
+      if (token()) { await streamWithFetch(name, img); } else { img.src = `/api/v1/sensors/${name}/stream.mjpg?fps=10`; }
+      start.textContent = `hide ${name}`;
+    });
+    views.append(el("figure", {}, img, el("figcaption", {}, start)));
+  }
+  document.getElementById("camera").hidden = false;
+}
+
+// Polls single frames with the Authorization header (about 5 per second).
+async function streamWithFetch(name, img) {
+  img.src = "data:,";
+  const tick = async () => {
+    if (!img.src) return;
+    try {
+      const response = await fetch(`/api/v1/sensors/${name}/frame.jpg`, { headers: { Authorization: `Bearer ${token()}` } });
+      if (response.ok) {
+        const old = img.src;
+        img.src = URL.createObjectURL(await response.blob());
+        if (old.startsWith("blob:")) URL.revokeObjectURL(old);
+      }
+    } catch { /* try again */ }
+    setTimeout(tick, 200);
+  };
+  tick();
+}
+
+const STEP_M = 0.01;
+
+async function jog(chain, axis, sign, tipText) {
+  try {
+    const now = await get(`/api/v1/chains/${chain}`);
+    const target = [...now.position];
+    target[axis] += sign * STEP_M;
+    const answer = await post(`/api/v1/chains/${chain}/goto`, { position: target, duration: 0.5, wait: true });
+    tipText.textContent = answer.position.map((v) => (v * 100).toFixed(1)).join(", ");
+  } catch (error) {
+    say(`${chain}: ${error.message}`, true);
+  }
+}
+
+export async function showChains(names) {
+  if (!names.length) return;
+  const list = document.getElementById("chain-list");
+  for (const name of names) {
+    const tip = el("output");
+    const pad = el("div", { className: "jog", role: "group" });
+    pad.setAttribute("aria-label", `jog ${name} by 1 cm`);
+    ["x", "y", "z"].forEach((axis, i) => {
+      pad.append(button(`${axis}−`, () => jog(name, i, -1, tip), `${name} ${axis} minus 1 cm`),
+        button(`${axis}+`, () => jog(name, i, 1, tip), `${name} ${axis} plus 1 cm`));
+    });
+    list.append(el("article", { className: "card", id: `chain-${name}` },
+      el("h3", { textContent: name }), el("p", {}, "tip (cm): ", tip), pad));
+    const refresh = async () => {
+      try { tip.textContent = (await get(`/api/v1/chains/${name}`)).position.map((v) => (v * 100).toFixed(1)).join(", "); } catch { /* shown elsewhere */ }
+    };
+    refresh();
+    setInterval(refresh, 2000);
+  }
+  document.getElementById("chains").hidden = false;
+}
