@@ -128,6 +128,10 @@ def serve(
             policy.with_ports(server.port for server in servers)
             if snap_server is not None:
                 snap_server.bound([server.port for server in servers])
+            if snap_server is not None and http:
+                from poppy_core.server.web import add_link
+
+                add_link(app, "Snap! with the Poppy blocks", snap_server.editor_url)
             for server in servers:
                 server.start()
             base = _host(host)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -58,6 +59,8 @@ def test_serve_snap_with_http_prints_the_snap_urls_and_serves_both(tmp_path: Pat
         assert "a local Snap!" in _get(f"{snap_url}/app/snap.html")
         assert ET.fromstring(_get(f"{snap_url}/snap-blocks.xml")).tag == "project"
         assert '"motors"' in _get(f"{http_url}/motors/list.json")
+        links = json.loads(_get(f"{http_url}/api/v1/web/about"))["links"]
+        assert links["Snap! with the Poppy blocks"] == editor.split(": ", 1)[1]  # the home page
         # a move recorded from Snap! is seen by the REST routes: one library
         assert _get(f"{snap_url}/primitive/MoveRecorder/from-snap/start/m1") == "Done!"
         assert _get(f"{snap_url}/primitive/MoveRecorder/from-snap/stop") == "Done!"
