@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 
 import httpx
@@ -59,7 +60,14 @@ def test_pypot_goto_moves_and_answers_the_pose(http: httpx.Client, ergo: tuple[s
     body = {"xyz": ",".join(map(str, target)), "duration": "0.5", "wait": "True"}
     answer = http.post("/ik/chain/goto.json", json=body)
     assert answer.status_code == 200, answer.text
-    assert np.linalg.norm(np.array(_floats(answer.json()["xyz"])) - target) < 0.005
+    # The answer is the pose read when the goto ended (the sync loops read 50 times a second,
+    # later still on a loaded machine); the arm then settles on the target.
+    assert np.linalg.norm(np.array(_floats(answer.json()["xyz"])) - target) < 0.02
+    robot = ergo[1]
+    deadline = time.monotonic() + 5.0
+    while np.linalg.norm(np.array(robot.chain.position) - target) >= 0.005:
+        assert time.monotonic() < deadline, robot.chain.position
+        time.sleep(0.05)
     # a list works too, and a vector orientation
     answer = http.post(
         "/ik/chain/goto.json", json={"xyz": target, "rot": [0, 0, 1], "duration": 0.3}
