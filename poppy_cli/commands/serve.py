@@ -1,4 +1,5 @@
-"""`poppy serve --http [--ws]`: serve a robot over REST (pypot's routes + /api/v1) and WebSocket."""
+"""`poppy serve --http [--ws] [--zmq]`: serve a robot over REST (pypot's routes + /api/v1),
+WebSocket and pypot's ZMQ request/reply API."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, 
 
 if TYPE_CHECKING:
     from poppy_core.server import ServerThread
+    from poppy_core.server.zmqserver import ZmqRobotServer
 
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 
@@ -50,13 +52,17 @@ def serve(
         help="Also answer requests for this host name, e.g. poppy.local (repeat it; '*' any). "
         "Loopback names, IP addresses and --host are always answered.",
     ),
+    zmq: bool = typer.Option(
+        False, "--zmq", help="Also serve pypot's ZMQ request/reply API (JSON requests)."
+    ),
+    zmq_port: int = typer.Option(6768, "--zmq-port", min=0, max=65535, help="ZMQ port."),
     no_sensors: bool = typer.Option(
         False, "--no-sensors", help="Leave the config's cameras closed (e.g. no camera plugged)."
     ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
-    if not (http or ws):
-        _usage("nothing to serve: pass --http and/or --ws")
+    if not (http or ws or zmq):
+        _usage("nothing to serve: pass --http, --ws and/or --zmq")
     if http and ws and http_port == ws_port and http_port != 0:
         _usage(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
@@ -70,6 +76,11 @@ def serve(
         )
     except ValueError as exc:
         _usage(f"{exc} (--cors takes an origin or '*', --allow-host a host name)")
+    if zmq and host not in LOOPBACK:
+        warn_line(
+            f"serving the ZMQ API on {host}: it has no token, anyone who can reach this machine "
+            "can move the robot; keep --host 127.0.0.1 unless the network is yours"
+        )
     if host not in LOOPBACK and not token:
         warn_line(
             f"serving on {host} without --token: anyone who can reach this machine can move "
@@ -88,9 +99,14 @@ def serve(
         if ws:
             stream_app = create_stream_app(app.state.service, ws_rate, token or None, policy)
             servers.append(ServerThread(stream_app, host, ws_port))
+        zmq_server: ZmqRobotServer | None = None
         try:
             for server in servers:  # bind every port before serving any: errors come first
                 server.bind()
+            if zmq:
+                from poppy_core.server.zmqserver import ZmqRobotServer
+
+                zmq_server = ZmqRobotServer(robot, host, zmq_port)  # binds: ListenError here
             policy.with_ports(server.port for server in servers)
             for server in servers:
                 server.start()
@@ -99,13 +115,17 @@ def serve(
                 print(f"http://{base}:{servers[0].port}", flush=True)
             if ws:
                 print(f"ws://{base}:{servers[-1].port}/", flush=True)
+            if zmq_server is not None:
+                print(f"zmq: tcp://{base}:{zmq_server.start().port}", flush=True)
             if http:
                 print(f"docs: http://{base}:{servers[0].port}/docs", flush=True)
-            _wait_for_signal(servers)
+            _wait_for_signal([*servers, *([zmq_server] if zmq_server else [])])
         except RuntimeError as exc:
             error_line(f"{exc} (the server's log above says why)")
             raise typer.Exit(EXIT_FAILURE) from None
         finally:
+            if zmq_server is not None:
+                zmq_server.stop()
             for server in reversed(servers):
                 server.stop()
     print("stopped", file=sys.stderr, flush=True)

@@ -6,6 +6,12 @@ from poppy_core.creatures.factory import from_config, from_profile
 from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.creatures.interaction import ArmsCopyMotion, ArmsTurnCompliant
 from poppy_core.creatures.postures import CreaturePosture
+from poppy_core.creatures.pypot_creatures import (
+    AbstractPoppyCreature,
+    PoppyErgoJr,
+    PoppyHumanoid,
+    PoppyTorso,
+)
 from poppy_core.creatures.registry import (
     CREATURES,
     Creature,
@@ -18,6 +24,7 @@ from poppy_core.creatures.safety import LimitTorque, TemperatureMonitor
 
 __all__ = [
     "CREATURES",
+    "AbstractPoppyCreature",
     "ArmsCopyMotion",
     "ArmsTurnCompliant",
     "Creature",
@@ -29,6 +36,9 @@ __all__ = [
     "HeadIdleMotion",
     "Jump",
     "LimitTorque",
+    "PoppyErgoJr",
+    "PoppyHumanoid",
+    "PoppyTorso",
     "SafePowerUp",
     "TemperatureMonitor",
     "UpperBodyIdleMotion",

@@ -37,7 +37,8 @@ from poppy_core.robot.profiles import (
     profile_dirs,
     user_profile_dir,
 )
-from poppy_core.robot.robot import Robot
+from poppy_core.robot.pypot_factories import from_json, from_remote
+from poppy_core.robot.robot import MotorGroup, Robot
 from poppy_core.robot.startup import ReturnDelayIssue
 from poppy_core.robot.sync import (
     BASE_LOOPS,
@@ -70,6 +71,7 @@ __all__ = [
     "LoopStats",
     "Motor",
     "MotorConfig",
+    "MotorGroup",
     "ProfileHeader",
     "ProfileInfo",
     "RangeWatch",
@@ -85,7 +87,9 @@ __all__ = [
     "dump_config",
     "find_profile",
     "from_config",
+    "from_json",
     "from_profile",
+    "from_remote",
     "list_profiles",
     "load_config",
     "load_profile",

@@ -46,6 +46,88 @@ def _is_motor(item: object) -> bool:
     )
 
 
+GROUP_SETTABLE = frozenset({
+    "compliant", "compliant_behavior", "goto_behavior", "goal_position", "goal_speed",
+    "moving_speed", "torque_limit", "max_torque", "led", "pid",
+})  # fmt: skip
+"""Motor attributes a group sets on each of its motors (``robot.head.compliant = False``)."""
+
+
+class MotorGroup(list[Motor]):
+    """A named group of motors (a list, as in pypot) that also acts on all its motors:
+    ``group.compliant = False``, ``group.goto_position(0, 2)``, ``group.moving_speed = 50``.
+
+    Args:
+        name: the group's name.
+        motors: its motors, in order.
+    """
+
+    name: str
+
+    def __init__(self, name: str, motors: Iterable[Motor]) -> None:
+        super().__init__(motors)
+        object.__setattr__(self, "name", name)
+
+    def __repr__(self) -> str:
+        return f"<MotorGroup {self.name} {[m.name for m in self]}>"
+
+    def __setattr__(self, attribute: str, value: Any) -> None:
+        if attribute not in GROUP_SETTABLE:
+            raise AttributeError(
+                f"a motor group sets only {', '.join(sorted(GROUP_SETTABLE))}, not {attribute!r}"
+            )
+        for motor in self:
+            setattr(motor, attribute, value)
+
+    @property
+    def compliant(self) -> bool:
+        """True when every motor of the group is compliant."""
+        return all(m.compliant for m in self)
+
+    def goto_position(
+        self,
+        position: float | Mapping[str, float] | Sequence[float],
+        duration: float,
+        control: str | None = None,
+        wait: bool = False,
+    ) -> GotoHandle:
+        """Move the group's motors together: one angle for all, a motor name -> angle mapping,
+        or one angle per motor in the group's order (degrees, user frame).
+
+        Raises:
+            ArgumentError: a list of angles whose length is not the group's, an unknown control
+                or a bad duration.
+        """
+        if isinstance(position, Mapping):
+            targets = {self._member(n): _degrees(n, p) for n, p in position.items()}
+        elif isinstance(position, int | float):
+            targets = {m: _degrees(m.name, position) for m in self}
+        else:
+            values = list(position)
+            if len(values) != len(self):
+                raise ArgumentError(
+                    f"group {self.name}: {len(values)} positions for {len(self)} motors",
+                    field="position", value=values,
+                )  # fmt: skip
+            targets = {m: _degrees(m.name, p) for m, p in zip(self, values, strict=True)}
+        if not self:
+            return GotoHandle(0, 0.0)
+        runner = self[0]._runner
+        handle = runner.start(targets, duration, control)
+        if wait:
+            handle.wait()
+        return handle
+
+    def _member(self, name: str) -> Motor:
+        for motor in self:
+            if motor.name == name:
+                return motor
+        raise UnknownMotorError(
+            f"group {self.name} has no motor {name!r} (motors: {', '.join(m.name for m in self)})",
+            motor=name, known=[m.name for m in self],
+        )  # fmt: skip
+
+
 class Behaviour(Protocol):
     """What ``attach_primitive`` needs of a primitive (``poppy_core.motion.Primitive``)."""
 
@@ -86,7 +168,7 @@ class Robot:
         self._by_name = {m.name: m for m in self._motors}
         if len(self._by_name) != len(self._motors):
             raise ConfigError("two motors have the same name", field="motors")
-        self._groups: dict[str, list[Motor]] = {}
+        self._groups: dict[str, MotorGroup] = {}
         for name, members in (groups or {}).items():
             missing = [n for n in members if n not in self._by_name]
             if missing:
@@ -94,7 +176,7 @@ class Robot:
                     f"group {name!r} names unknown motors: {', '.join(missing)}",
                     field=f"motorgroups.{name}",
                 )
-            self._groups[name] = [self._by_name[n] for n in members]
+            self._groups[name] = MotorGroup(name, (self._by_name[n] for n in members))
         self._sensors: dict[str, Sensor] = dict(sensors or {})
         clash = sorted(set(self._sensors) & {*self._by_name, *self._groups})
         if clash:
@@ -158,6 +240,18 @@ class Robot:
     def motorgroups(self) -> dict[str, list[Motor]]:
         """Group name -> its motors."""
         return {name: list(members) for name, members in self._groups.items()}
+
+    @property
+    def alias(self) -> list[str]:
+        """The group names (pypot's ``robot.alias``); each group is ``robot.<name>``."""
+        return list(self._groups)
+
+    @property
+    def _primitive_manager(self) -> Any:
+        """The primitive manager (pypot's name; also ``robot.primitive_manager``)."""
+        from poppy_core.motion import primitive_manager  # motion sits above robot
+
+        return primitive_manager(self)
 
     def motor(self, name: str) -> Motor:
         """The motor called ``name`` (typed access).
@@ -277,6 +371,8 @@ class Robot:
             ConfigError: see ``attach``.
         """
         self.attach(name, primitive)
+        if isinstance(getattr(type(primitive), "name", None), property):
+            primitive.name = name  # type: ignore[attr-defined]
         if name not in self._primitive_names:
             self._primitive_names.append(name)
 
@@ -322,7 +418,7 @@ class Robot:
         self,
         position_for_motors: Mapping[str, float],
         duration: float,
-        control: str = "minjerk",
+        control: str | None = None,
         wait: bool = False,
     ) -> GotoHandle:
         """Move several motors so that they all arrive together.
@@ -330,7 +426,8 @@ class Robot:
         Args:
             position_for_motors: motor name -> target in degrees (user frame).
             duration: seconds the motion lasts.
-            control: ``"minjerk"`` or ``"dummy"`` (see ``Motor.goto_position``).
+            control: ``"minjerk"`` or ``"dummy"`` (see ``Motor.goto_position``); None: each
+                motor's ``goto_behavior``.
             wait: block until every motor arrived.
 
         Returns:
