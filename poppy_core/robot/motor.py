@@ -334,6 +334,15 @@ class Motor(MotorCache):
                 self._set_torque(False)
                 self._apply_safe_compliance()
 
+    @property
+    def safe_compliant(self) -> bool:
+        """pypot's flag: True when the compliant behaviour is ``"safe"``."""
+        return self._behavior == "safe"
+
+    @safe_compliant.setter
+    def safe_compliant(self, value: bool) -> None:
+        self.compliant_behavior = "safe" if value else "dummy"
+
     def _apply_safe_compliance(self) -> None:
         """Safe compliance: stiffen a compliant motor pushed past a limit, free it once back."""
         if not (self._compliant and self._behavior == "safe") or self.wheel_mode:
@@ -419,6 +428,7 @@ class Motor(MotorCache):
             "present_temperature", "present_voltage",
             "goal_position", "goal_speed", "moving_speed", "compliant", "compliant_behavior",
             "led", "lower_limit", "upper_limit", "goto_behavior", "control_mode", "registers",
+            "safe_compliant",
         ]  # fmt: skip
         if self.model.has_torque_limit:
             names += ["torque_limit", "max_torque"]

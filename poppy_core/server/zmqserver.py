@@ -63,12 +63,14 @@ class ZmqRequests:
             "stop_primitive": lambda primitive: self._control(primitive, "stop"),
             "pause_primitive": lambda primitive: self._control(primitive, "pause"),
             "resume_primitive": lambda primitive: self._control(primitive, "resume"),
-            "get_primitive_properties_list": service.property_names,
-            "get_primitive_property": service.get_property,
-            "set_primitive_property": lambda primitive, property, value: service.set_property(
-                primitive, property, value
+            "get_primitive_properties_list": lambda primitive: service.property_names(primitive),
+            "get_primitive_property": lambda primitive, property: service.get_property(
+                primitive, property
             ),
-            "get_primitive_methods_list": service.method_names,
+            "set_primitive_property": lambda primitive, property, value: self._none(
+                service.set_property(primitive, property, value)
+            ),
+            "get_primitive_methods_list": lambda primitive: service.method_names(primitive),
             "call_primitive_method": self.call_primitive_method,
             "start_move_recorder": self.start_move_recorder,
             "stop_move_recorder": lambda move_name: self._none(service.moves.save(move_name)),

@@ -79,13 +79,18 @@ def test_primitives_start_and_stop(robot: Robot, client: Any) -> None:
     assert "sinus" not in ask(client, {"robot": {"get_running_primitives_list": {}}})
     props = ask(client, {"robot": {"get_primitive_properties_list": {"primitive": "sinus"}}})
     assert "amplitude" in props
+    amplitude = {"primitive": "sinus", "property": "amplitude"}
+    assert ask(client, {"robot": {"set_primitive_property": {**amplitude, "value": "12.5"}}}) == {}
+    assert ask(client, {"robot": {"get_primitive_property": amplitude}}) == 12.5
+    assert "start" in ask(client, {"robot": {"get_primitive_methods_list": {"primitive": "sinus"}}})
 
 
 def test_goto_with_wait(robot: Robot, client: Any) -> None:
     robot.head_z.compliant = False
     goto = {"motor": "head_z", "position": 15, "duration": 0.3, "wait": True}
     assert ask(client, {"robot": {"set_goto_position_for_motor": goto}}) == {}
-    assert robot.head_z.present_position == pytest.approx(15.0, abs=2.0)
+    assert robot.head_z.goal_position == pytest.approx(15.0, abs=0.5)  # the motion is over
+    assert wait_until(lambda: abs(robot.head_z.present_position - 15.0) < 2.0, 10.0)
 
 
 @pytest.mark.parametrize(
@@ -128,3 +133,40 @@ def test_a_taken_port_is_one_clear_line(robot: Robot) -> None:
 
     with pytest.raises(ListenError, match=r"cannot listen on 127\.0\.0\.1"):
         ZmqRobotServer(robot, "127.0.0.1", robot.zmq.port)
+
+
+def test_poppy_serve_zmq() -> None:
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "poppy_cli", "serve", "--sim", "--profile", "ergo-jr", "--zmq",
+         "--zmq-port", "0"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+    )  # fmt: skip
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline().strip()
+        assert line.startswith("zmq: tcp://127.0.0.1:")
+        context = zmq.Context()
+        socket = context.socket(zmq.REQ)
+        socket.setsockopt(zmq.RCVTIMEO, TIMEOUT_MS)
+        socket.setsockopt(zmq.LINGER, 0)
+        socket.connect(line.removeprefix("zmq: "))
+        try:
+            assert ask(socket, {"robot": {"get_motors_list": {}}})[0] == "m1"
+        finally:
+            socket.close()
+            context.term()
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=15) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        for stream in (proc.stdout, proc.stderr):
+            if stream is not None:
+                stream.close()
