@@ -239,11 +239,12 @@ class ZmqRobotServer:
         import zmq
 
         socket = self._socket
+        socket.setsockopt(zmq.RCVTIMEO, POLL_MS)  # wake up to see stop() without a poll per request
         while not self._stop.is_set():
             try:
-                if not socket.poll(POLL_MS):
-                    continue
                 raw = socket.recv()
+            except zmq.Again:
+                continue
             except zmq.ZMQError as exc:
                 if self._stop.is_set():
                     break
