@@ -25,6 +25,7 @@ from poppy_core.robot.config import (
 from poppy_core.robot.config_io import config_to_text, dump_config, load_config
 from poppy_core.robot.factory import autodetect, from_config, from_profile, start_emulators
 from poppy_core.robot.goto import GotoHandle, GotoRunner
+from poppy_core.robot.group import MotorGroup
 from poppy_core.robot.health import BusHealth
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.profile_store import SavedProfile, save_user_profile
@@ -38,7 +39,7 @@ from poppy_core.robot.profiles import (
     user_profile_dir,
 )
 from poppy_core.robot.pypot_factories import from_json, from_remote
-from poppy_core.robot.robot import MotorGroup, Robot
+from poppy_core.robot.robot import Robot
 from poppy_core.robot.startup import ReturnDelayIssue
 from poppy_core.robot.sync import (
     BASE_LOOPS,

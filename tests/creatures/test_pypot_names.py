@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib.util
 import io
 import json
+from collections.abc import Iterator
 from contextlib import closing
 from pathlib import Path
 
@@ -19,10 +20,10 @@ from tests.creatures.helpers import wait_until
 
 
 @pytest.fixture(scope="module")
-def ergo() -> Robot:
-    robot = PoppyErgoJr(simulator="dummy")
-    yield robot  # type: ignore[misc]
-    robot.close()
+def ergo() -> Iterator[Robot]:
+    """One virtual Ergo Jr built as pypot users build it."""
+    with PoppyErgoJr(simulator="dummy") as robot:
+        yield robot
 
 
 def test_to_config_then_from_json_as_the_documentation(ergo: Robot, tmp_path: Path) -> None:
