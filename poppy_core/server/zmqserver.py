@@ -289,6 +289,10 @@ class ZmqRobotServer:
         self.service.close()
 
 
+ZMQRobotServer = ZmqRobotServer
+"""pypot's name: ``server = ZMQRobotServer(robot, "127.0.0.1", 6768); server.run()``."""
+
+
 def start_zmq_server(
     robot: Robot, host: str = "127.0.0.1", port: int = DEFAULT_PORT, *, start: bool = True
 ) -> ZmqRobotServer:

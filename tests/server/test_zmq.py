@@ -170,3 +170,27 @@ def test_poppy_serve_zmq() -> None:
         for stream in (proc.stdout, proc.stderr):
             if stream is not None:
                 stream.close()
+
+
+def test_the_documentation_server_in_a_thread(robot: Robot) -> None:
+    # "ZMQ server" section: build the server, run it in a thread (address loopback, free port).
+    import threading
+
+    from poppy_core.server import ZMQRobotServer
+
+    server = ZMQRobotServer(robot, "127.0.0.1", 0)
+    runner = threading.Thread(target=lambda: server.run())
+    runner.start()
+    context = zmq.Context()
+    socket = context.socket(zmq.REQ)
+    socket.setsockopt(zmq.RCVTIMEO, TIMEOUT_MS)
+    socket.setsockopt(zmq.LINGER, 0)
+    socket.connect(server.url)
+    try:
+        assert "head_z" in ask(socket, {"robot": {"get_motors_list": {}}})
+    finally:
+        socket.close()
+        context.term()
+        server.stop()
+        runner.join(10)
+    assert not runner.is_alive()
