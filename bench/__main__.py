@@ -18,6 +18,7 @@ from bench import (
     soak_bench,
     teleop_bench,
     web_bench,
+    zmq_bench,
 )
 from bench.clients import ensure_peers
 from bench.machine import machine_info
@@ -29,7 +30,7 @@ logger = logging.getLogger("bench")
 # Importing a benchmark module registers it; list them here so `--list` sees them all.
 _MODULES = (
     scan_bench, robot_bench, move_bench, server_bench, sim_bench, ik_bench, camera_bench,
-    teleop_bench, soak_bench, snap_bench, web_bench,
+    teleop_bench, soak_bench, snap_bench, web_bench, zmq_bench,
 )  # fmt: skip
 
 

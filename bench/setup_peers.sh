@@ -19,8 +19,8 @@ LOG="$VENV/install.log"
 # Exact peer versions, so results stay comparable between runs.
 PEERS_NODEPS=(pypot==5.0.2 poppy-ergo-jr==4.0.2 poppy-torso==3.0.0 ikpy==3.0.1)
 CORE_DEPS=(dynamixel-sdk==4.1.0 "pyserial>=3.5" "numpy>=1.26")
-# Imported by pypot.creatures / pypot.server / poppy_ergo_jr (REST benchmark only).
-REST_DEPS=(scipy sympy tornado bottle opencv-python-headless)
+# Imported by pypot.creatures / pypot.server / poppy_ergo_jr (REST benchmark; pyzmq: ZMQ benchmark).
+REST_DEPS=(scipy sympy tornado bottle opencv-python-headless pyzmq)
 
 STAMP_TEXT="$PYTHON ${PEERS_NODEPS[*]} ${CORE_DEPS[*]} ${REST_DEPS[*]}"
 STAMP="$VENV/.installed"

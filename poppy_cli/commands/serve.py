@@ -1,4 +1,5 @@
-"""`poppy serve --http [--ws] [--snap]`: serve a robot over REST, WebSocket and Snap!'s routes."""
+"""`poppy serve --http [--ws] [--snap] [--zmq]`: serve a robot over REST (pypot's routes +
+/api/v1), WebSocket, Snap!'s routes and pypot's ZMQ request/reply API."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, 
 
 if TYPE_CHECKING:
     from poppy_core.server import ServerThread
+    from poppy_core.server.zmqserver import ZmqRobotServer
 
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 
@@ -51,6 +53,10 @@ def serve(
         help="Also answer requests for this host name, e.g. poppy.local (repeat it; '*' any). "
         "Loopback names, IP addresses and --host are always answered.",
     ),
+    zmq: bool = typer.Option(
+        False, "--zmq", help="Also serve pypot's ZMQ request/reply API (JSON requests)."
+    ),
+    zmq_port: int = typer.Option(6768, "--zmq-port", min=0, max=65535, help="ZMQ port."),
     no_sensors: bool = typer.Option(
         False, "--no-sensors", help="Leave the config's cameras closed (e.g. no camera plugged)."
     ),
@@ -68,8 +74,8 @@ def serve(
     ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
-    if not (http or ws or snap):
-        _usage("nothing to serve: pass --http, --ws and/or --snap")
+    if not (http or ws or snap or zmq):
+        _usage("nothing to serve: pass --http, --ws, --snap and/or --zmq")
     if http and ws and http_port == ws_port and http_port != 0:
         _usage(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
@@ -90,6 +96,11 @@ def serve(
         )
     except ValueError as exc:
         _usage(f"{exc} (--cors takes an origin or '*', --allow-host a host name)")
+    if zmq and host not in LOOPBACK:
+        warn_line(
+            f"serving the ZMQ API on {host}: it has no token, anyone who can reach this machine "
+            "can move the robot; keep --host 127.0.0.1 unless the network is yours"
+        )
     if host not in LOOPBACK and not token:
         warn_line(
             f"serving on {host} without --token: anyone who can reach this machine can move "
@@ -122,9 +133,14 @@ def serve(
                 _report,
             )
             servers.append(snap_server.thread)
+        zmq_server: ZmqRobotServer | None = None
         try:
             for server in servers:  # bind every port before serving any: errors come first
                 server.bind()
+            if zmq:
+                from poppy_core.server.zmqserver import ZmqRobotServer
+
+                zmq_server = ZmqRobotServer(robot, host, zmq_port)  # binds: ListenError here
             policy.with_ports(server.port for server in servers)
             if snap_server is not None:
                 snap_server.bound([server.port for server in servers])
@@ -139,15 +155,19 @@ def serve(
                 print(f"http://{base}:{servers[0].port}", flush=True)
             if ws:
                 print(f"ws://{base}:{servers[1 if http else 0].port}/", flush=True)
+            if zmq_server is not None:
+                print(f"zmq: tcp://{base}:{zmq_server.start().port}", flush=True)
             if http:
                 print(f"docs: http://{base}:{servers[0].port}/docs", flush=True)
             if snap_server is not None:
                 announce_snap(snap_server, open_browser)
-            _wait_for_signal(servers)
+            _wait_for_signal([*servers, *([zmq_server] if zmq_server else [])])
         except RuntimeError as exc:
             error_line(f"{exc} (the server's log above says why)")
             raise typer.Exit(EXIT_FAILURE) from None
         finally:
+            if zmq_server is not None:
+                zmq_server.stop()
             for server in reversed(servers):
                 server.stop()
     print("stopped", file=sys.stderr, flush=True)

@@ -2,6 +2,7 @@
 
 from poppy_core.bus.core import is_alarm_only
 from poppy_core.bus.dxlbus import DxlBus
+from poppy_core.bus.dxlio import Dxl320IO, DxlIO, get_available_ports
 from poppy_core.bus.ports import (
     KNOWN_ADAPTERS,
     PortInfo,
@@ -32,7 +33,9 @@ __all__ = [
     "KNOWN_ADAPTERS",
     "BusStats",
     "Deadline",
+    "Dxl320IO",
     "DxlBus",
+    "DxlIO",
     "FoundMotor",
     "LinkTiming",
     "PingResult",
@@ -46,6 +49,7 @@ __all__ = [
     "describe_ports",
     "factory_reset",
     "find_port",
+    "get_available_ports",
     "identify",
     "is_alarm_only",
     "is_virtual_port",

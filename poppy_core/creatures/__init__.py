@@ -6,6 +6,12 @@ from poppy_core.creatures.factory import from_config, from_profile
 from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.creatures.interaction import ArmsCopyMotion, ArmsTurnCompliant
 from poppy_core.creatures.postures import CreaturePosture
+from poppy_core.creatures.pypot_creatures import (
+    AbstractPoppyCreature,
+    PoppyErgoJr,
+    PoppyHumanoid,
+    PoppyTorso,
+)
 from poppy_core.creatures.registry import (
     CREATURES,
     Creature,
@@ -19,6 +25,7 @@ from poppy_core.creatures.tracking import MarkerFollow, TrackingFeedback
 
 __all__ = [
     "CREATURES",
+    "AbstractPoppyCreature",
     "ArmsCopyMotion",
     "ArmsTurnCompliant",
     "Creature",
@@ -31,6 +38,9 @@ __all__ = [
     "Jump",
     "LimitTorque",
     "MarkerFollow",
+    "PoppyErgoJr",
+    "PoppyHumanoid",
+    "PoppyTorso",
     "SafePowerUp",
     "TemperatureMonitor",
     "TrackingFeedback",

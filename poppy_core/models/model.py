@@ -113,6 +113,9 @@ class ServoModel:
     def __repr__(self) -> str:
         return f"ServoModel({self.name!r}, model_numbers={self.model_numbers})"
 
+    def __str__(self) -> str:
+        return self.name  # print(motor.model) shows "XL-320", as pypot's model string
+
     @property
     def model_number(self) -> int:
         """The main model number (the one written to a factory-fresh control table)."""

@@ -223,25 +223,35 @@ class PositionWatcher(LoopPrimitive):
         for name, positions in self.record_positions.items():
             positions.append(self.robot.motor(name).present_position)
 
-    def plot(self, path: str | Path) -> Path:
-        """Save the recorded positions over time as a PNG image.
+    def plot(self, target: str | Path | Any) -> Any:
+        """Draw the recorded positions over time: on a matplotlib axis (pypot's
+        ``watcher.plot(ax)``), or into a PNG file.
 
         Args:
-            path: the image file to write.
+            target: a matplotlib ``Axes`` to draw on, or the image file to write.
 
         Returns:
-            The path written (atomically; an existing regular file is replaced).
+            The axis drawn on, or the path written (atomically; an existing regular file is
+            replaced).
 
         Raises:
             FileError: the file cannot be written, or is not a regular file.
         """
+        if hasattr(target, "plot") and hasattr(target, "set_xlabel"):
+            self._draw(target)
+            return target
         import matplotlib
 
         matplotlib.use("Agg")
         from matplotlib.figure import Figure
 
         figure = Figure(figsize=(8, 4.5))
-        axes = figure.add_subplot()
+        self._draw(figure.add_subplot())
+        image = io.BytesIO()
+        figure.savefig(image, format="png")
+        return write_file(Path(target), image.getvalue(), replace=True)
+
+    def _draw(self, axes: Any) -> None:
         times = list(self.times)
         for name, positions in self.record_positions.items():
             count = min(len(times), len(positions))
@@ -250,9 +260,6 @@ class PositionWatcher(LoopPrimitive):
         axes.set_ylabel("present position (°)")
         if self.record_positions:
             axes.legend(loc="upper right")
-        image = io.BytesIO()
-        figure.savefig(image, format="png")
-        return write_file(Path(path), image.getvalue(), replace=True)
 
 
 class SimplePosture(Primitive):

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Iterator, Mapping, Sequence
+from typing import IO, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -56,6 +56,17 @@ def check_size(framerate: float, frames: int, motors: int) -> None:
         )  # fmt: skip
 
 
+class PositionArray(np.ndarray[Any, np.dtype[np.float64]]):
+    """A move's positions array that pypot scripts may also call: ``move.positions()``."""
+
+    move: Move | None = None
+
+    def __call__(self) -> dict[float, dict[str, list[float]]]:
+        if self.move is None:
+            raise TypeError("only a move's own positions can be called")
+        return self.move.timed_positions()
+
+
 class Move:
     """A recorded motion: frame ``i`` holds every motor's position at ``i / framerate`` seconds.
 
@@ -77,8 +88,8 @@ class Move:
     def __init__(
         self,
         framerate: float,
-        motors: Sequence[str],
-        positions: npt.ArrayLike,
+        motors: Sequence[str] = (),
+        positions: npt.ArrayLike = (),
         *,
         speeds: npt.ArrayLike | None = None,
         metadata: Mapping[str, Any] | None = None,
@@ -150,6 +161,87 @@ class Move:
                 )
             rows.append([float(frame[m]) for m in motors])
         return cls(framerate, motors, rows, metadata=metadata)
+
+    # -- pypot's Move API -----------------------------------------------------------------------
+
+    def add_position(self, pos: Mapping[str, Any], time: float | None = None) -> None:
+        """Append a frame, as pypot's ``move.add_position(pos, time)``.
+
+        Args:
+            pos: motor name -> degrees, or -> ``[degrees, speed]`` as pypot's recorder stores.
+            time: the frame's time; frames are kept in order at the framerate, so it is only
+                checked to come after the previous frame's.
+
+        Raises:
+            ArgumentError: a frame whose motors differ from the move's, a value that is not a
+                number, a time before the last frame's.
+        """
+        names = tuple(pos)
+        if len(self) == 0 and not self.motors:
+            self.motors = names
+            self.positions = np.empty((0, len(names)))
+        if set(names) != set(self.motors):
+            raise ArgumentError(
+                f"the frame's motors ({', '.join(names)}) are not the move's "
+                f"({', '.join(self.motors)})", field="pos", value=names,
+            )  # fmt: skip
+        if time is not None and len(self) and float(time) < self.duration_s:
+            raise ArgumentError(f"frame time {time} s comes before the last frame's",
+                                field="time", value=time)  # fmt: skip
+        values = [pos[m][0] if isinstance(pos[m], list | tuple) else pos[m] for m in self.motors]
+        row = self._checked([values], "pos", MAX_POSITION_DEG)
+        check_size(self.framerate, len(self) + 1, len(self.motors))
+        self.positions = np.vstack([self.positions, row])
+        self.speeds = None
+
+    @property
+    def positions(self) -> PositionArray:
+        """Shape ``(frames, motors)``, degrees; called, pypot's ``move.positions()``: time ->
+        motor name -> ``[degrees, speed]``."""
+        view = self._positions.view(PositionArray)
+        view.move = self
+        return view
+
+    @positions.setter
+    def positions(self, value: FloatArray) -> None:
+        self._positions = np.asarray(value, dtype=np.float64)
+
+    def timed_positions(self) -> dict[float, dict[str, list[float]]]:
+        """pypot's ``move.positions()``: time -> motor name -> ``[degrees, speed]``."""
+        speeds = self.speeds if self.speeds is not None else np.zeros_like(self.positions)
+        return {
+            float(t): {m: [float(p), float(v)] for m, p, v in zip(self.motors, prow, vrow,
+                                                                   strict=True)}
+            for t, prow, vrow in zip(self.times(), self.positions, speeds, strict=True)
+        }  # fmt: skip
+
+    def iterpositions(self) -> Iterator[tuple[float, dict[str, list[float]]]]:
+        """pypot's ``iterpositions()``: (time, frame) pairs."""
+        return iter(self.timed_positions().items())
+
+    def save(self, file: IO[str]) -> None:
+        """Write the move as pypot's move JSON to an open text file (pypot's ``save``)."""
+        from poppy_core.motion.move_format import encode_pypot
+
+        file.write(encode_pypot(self).decode())
+
+    @classmethod
+    def load(cls, file: IO[str] | IO[bytes]) -> Move:
+        """Read pypot's move JSON from an open file (pypot's ``Move.load``).
+
+        Raises:
+            ConfigError: not pypot move JSON (the file's name and the reason).
+        """
+        from poppy_core.motion.move_format import decode_pypot
+
+        return decode_pypot(file.read(), str(getattr(file, "name", "<file>")))
+
+    @classmethod
+    def loads(cls, text: str | bytes) -> Move:
+        """Read pypot's move JSON from a string (pypot's ``Move.loads``)."""
+        from poppy_core.motion.move_format import decode_pypot
+
+        return decode_pypot(text)
 
     def __repr__(self) -> str:
         return (

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import math
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -20,6 +21,7 @@ import numpy as np
 
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.move import Move
+from poppy_core.motion.move_format import read_move
 from poppy_core.robot.schedule import Periodic
 
 if TYPE_CHECKING:
@@ -121,6 +123,9 @@ class MovePlayer:
         ramp_s: duration of the ramp to the first frame; None picks the largest distance over
             ``ramp_speed_dps`` (at least ``MIN_RAMP_S``; none when already there).
         ramp_speed_dps: mean speed of the automatic ramp.
+        play_speed: pypot's name for ``speed`` (negative: backwards).
+        move_filename: pypot's: a move file to play instead of ``move``.
+        start_max_speed: pypot's name for ``ramp_speed_dps``.
         rate_hz: goal update rate; None uses the robot's write rate.
         on_progress: called at each update with a ``PlayProgress``.
         clock: the time source (seconds).
@@ -137,7 +142,7 @@ class MovePlayer:
     def __init__(
         self,
         robot: Robot,
-        move: Move,
+        move: Move | None = None,
         speed: float = 1.0,
         backwards: bool = False,
         loops: int = 1,
@@ -147,7 +152,19 @@ class MovePlayer:
         rate_hz: float | None = None,
         on_progress: ProgressCallback | None = None,
         clock: Callable[[], float] = time.monotonic,
+        play_speed: float | None = None,
+        move_filename: str | os.PathLike[str] | None = None,
+        start_max_speed: float | None = None,
     ) -> None:
+        if play_speed is not None:  # pypot's name; a negative speed plays backwards, as pypot
+            speed, backwards = abs(play_speed) or 1.0, backwards != (play_speed < 0)
+        if start_max_speed is not None:
+            ramp_speed_dps = start_max_speed
+        if move is None:
+            if move_filename is None:
+                raise ArgumentError("give the move, or move_filename= a move file",
+                                    field="move")  # fmt: skip
+            move = read_move(move_filename)
         if not (math.isfinite(speed) and MIN_SPEED <= speed <= MAX_SPEED):
             raise ArgumentError(
                 f"speed must be {MIN_SPEED:g}-{MAX_SPEED:g} (1 = as recorded), got {speed}",
@@ -253,6 +270,20 @@ class MovePlayer:
     def playing(self) -> bool:
         """True while the thread runs."""
         return self._thread is not None and self._thread.is_alive()
+
+    # -- pypot's names (its MovePlayer is a primitive) -------------------------------------------
+
+    def wait_to_stop(self, timeout_s: float | None = None) -> bool:
+        """``wait``: block until the playback ends."""
+        return self.wait(timeout_s)
+
+    def is_alive(self) -> bool:
+        """``playing``."""
+        return self.playing
+
+    def duration(self) -> float:
+        """``duration_s``: the time the playback takes, ramps excluded."""
+        return self.duration_s
 
     # -- thread ------------------------------------------------------------------------------
 

@@ -52,6 +52,10 @@ class PrimitiveFailure:
         return {"type": self.type, "message": self.message, "traceback": self.traceback}
 
 
+def _snake_case(name: str) -> str:
+    return "".join(f"_{c.lower()}" if c.isupper() and i else c.lower() for i, c in enumerate(name))
+
+
 class Primitive:
     """A behaviour in its own thread: ``setup()``, ``run()``, ``teardown()``; restartable.
 
@@ -79,6 +83,7 @@ class Primitive:
         self._stop_event = threading.Event()
         self._resume_event = threading.Event()
         self._resume_event.set()
+        self._started_event = threading.Event()
         self.robot = MockupRobot(robot, self._stop_event)
         self._manager: PrimitiveManager = primitive_manager(robot)
         self._thread: threading.Thread | None = None
@@ -132,6 +137,7 @@ class Primitive:
                 target=self._main, name=f"primitive {type(self).__name__}", daemon=True
             )
             self._thread.start()
+            self._started_event.set()
         logger.info("%s started", type(self).__name__)
 
     def stop(self, wait: bool = True) -> None:
@@ -209,6 +215,30 @@ class Primitive:
         A failed primitive keeps its ``error`` until it is started again.
         """
         return self._state
+
+    @property
+    def name(self) -> str:
+        """The name it is attached under (``robot.<name>``), else its class name in snake case."""
+        given = self.__dict__.get("_name")
+        return given if given else _snake_case(type(self).__name__)
+
+    @name.setter
+    def name(self, value: str) -> None:
+        self.__dict__["_name"] = str(value)
+
+    @property
+    def running(self) -> bool:
+        """True from ``start()`` until it is asked to stop or ends (also when paused; pypot's)."""
+        return self.is_alive() and not self.should_stop()
+
+    @property
+    def started(self) -> bool:
+        """True once it was started (pypot's)."""
+        return self._started_event.is_set()
+
+    def wait_to_start(self, timeout_s: float | None = None) -> bool:
+        """Block until it was started (by another thread); False when ``timeout_s`` ran out."""
+        return self._started_event.wait(timeout_s)
 
     def is_alive(self) -> bool:
         """True while the thread runs (also when paused)."""

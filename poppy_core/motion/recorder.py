@@ -220,6 +220,36 @@ class MoveRecorder:
         self.saved_path = written
         return written
 
+    def add_tracked_motors(self, motors: MotorSpec) -> None:
+        """Record these motors too (pypot's name); before ``start()`` only.
+
+        Raises:
+            ArgumentError: already recording.
+            UnknownMotorError: a name the robot does not have.
+        """
+        if self.recording:
+            raise ArgumentError("add the motors before start(): a recording keeps its motors",
+                                field="motors")  # fmt: skip
+        added = [m for m in resolve_motors(self.robot, motors) if m not in self.motors]
+        self.motors = [*self.motors, *added]
+        self._samples = _Samples(1 + len(self.motors) * (2 if self.with_speeds else 1))
+
+    @property
+    def tracked_motors(self) -> list[Motor]:
+        """The recorded motors (pypot's name)."""
+        return list(self.motors)
+
+    def wait_to_stop(self, timeout_s: float | None = None) -> bool:
+        """Block until the recording thread ended (pypot's name)."""
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout_s)
+        return not self.recording
+
+    def is_alive(self) -> bool:
+        """``recording`` (pypot's name)."""
+        return self.recording
+
     @property
     def recording(self) -> bool:
         """True while the thread runs."""

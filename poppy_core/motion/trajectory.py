@@ -12,6 +12,23 @@ from poppy_core.errors import ArgumentError
 
 CONTROLS: tuple[str, ...] = ("minjerk", "dummy")
 """The ``control`` names ``goto_position`` accepts."""
+CONTROL_SPELLINGS: dict[str, str] = {"minijerk": "minjerk"}
+"""Other spellings accepted for a control (the Poppy documentation writes ``'minijerk'``)."""
+
+
+def control_name(control: str) -> str:
+    """The control ``control`` spells (``"minijerk"`` is ``"minjerk"``), checked.
+
+    Raises:
+        ArgumentError: not a known control.
+    """
+    name = CONTROL_SPELLINGS.get(control, control) if isinstance(control, str) else control
+    if name not in CONTROLS:
+        raise ArgumentError(
+            f"control must be one of {', '.join(CONTROLS)}, not {control!r}",
+            field="control", value=control,
+        )  # fmt: skip
+    return name
 
 MAX_DURATION_S = 24 * 3600.0
 """The longest goto (a day): longer ones are typing mistakes that would never end."""
@@ -24,11 +41,7 @@ def check_goto(duration_s: float, control: str) -> None:
         ArgumentError: unknown ``control``, or a duration that is negative, not finite or longer
             than ``MAX_DURATION_S``.
     """
-    if control not in CONTROLS:
-        raise ArgumentError(
-            f"control must be one of {', '.join(CONTROLS)}, not {control!r}",
-            field="control", value=control,
-        )  # fmt: skip
+    control_name(control)
     if not 0 <= duration_s <= MAX_DURATION_S:  # also refuses NaN
         raise ArgumentError(
             f"duration must be 0-{MAX_DURATION_S:g} s, got {duration_s} s",

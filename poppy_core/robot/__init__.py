@@ -25,6 +25,7 @@ from poppy_core.robot.config import (
 from poppy_core.robot.config_io import config_to_text, dump_config, load_config
 from poppy_core.robot.factory import autodetect, from_config, from_profile, start_emulators
 from poppy_core.robot.goto import GotoHandle, GotoRunner
+from poppy_core.robot.group import MotorGroup
 from poppy_core.robot.health import BusHealth
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.profile_store import SavedProfile, save_user_profile
@@ -37,6 +38,7 @@ from poppy_core.robot.profiles import (
     profile_dirs,
     user_profile_dir,
 )
+from poppy_core.robot.pypot_factories import from_json, from_remote
 from poppy_core.robot.robot import Robot
 from poppy_core.robot.startup import ReturnDelayIssue
 from poppy_core.robot.sync import (
@@ -70,6 +72,7 @@ __all__ = [
     "LoopStats",
     "Motor",
     "MotorConfig",
+    "MotorGroup",
     "ProfileHeader",
     "ProfileInfo",
     "RangeWatch",
@@ -85,7 +88,9 @@ __all__ = [
     "dump_config",
     "find_profile",
     "from_config",
+    "from_json",
     "from_profile",
+    "from_remote",
     "list_profiles",
     "load_config",
     "load_profile",

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from poppy_core.errors import RobotClosedError
-from poppy_core.motion.trajectory import MinimumJerk, check_goto, dummy_speed
+from poppy_core.motion.trajectory import MinimumJerk, check_goto, control_name, dummy_speed
 from poppy_core.robot.schedule import Periodic
 
 if TYPE_CHECKING:
@@ -87,14 +87,22 @@ class GotoRunner:
         with self._lock:
             return len(self._moves)
 
-    def start(self, targets: Mapping[Motor, float], duration_s: float, control: str) -> GotoHandle:
+    def start(
+        self, targets: Mapping[Motor, float], duration_s: float, control: str | None
+    ) -> GotoHandle:
         """Start moving each motor to its target (degrees, user frame) in ``duration_s``.
+
+        ``control`` None: each motor's ``goto_behavior``; ``"minijerk"`` is ``"minjerk"``.
 
         Raises:
             ArgumentError: unknown ``control``, a negative or not finite duration.
             RobotClosedError: the runner (its robot) is closed.
         """
-        check_goto(duration_s, control)
+        check_goto(duration_s, control or "minjerk")
+        controls = {
+            motor: control_name(control if control is not None else motor.goto_behavior)
+            for motor in targets
+        }
         handle = GotoHandle(len(targets), duration_s)
         now = self._clock()
         with self._lock:
@@ -106,7 +114,7 @@ class GotoRunner:
                 goal = float(target) if motor.wheel_mode else min(max(float(target), low), high)
                 start = motor.present_position
                 trajectory = None
-                if control == "dummy" or duration_s == 0:
+                if controls[motor] == "dummy" or duration_s == 0:
                     speed = dummy_speed(start, goal, duration_s)
                     register = motor.model.register("moving_speed")
                     motor.moving_speed = max(speed, abs(float(register.to_si(1)))) if speed else 0

@@ -20,8 +20,9 @@ import functools
 import logging
 from typing import TYPE_CHECKING, Literal
 
-from poppy_core.errors import RegisterError, RobotClosedError
+from poppy_core.errors import ArgumentError, RegisterError, RobotClosedError
 from poppy_core.models import ServoModel
+from poppy_core.motion.trajectory import control_name
 from poppy_core.robot import frames
 from poppy_core.robot import registers as regs
 from poppy_core.robot.goto import GotoHandle, GotoRunner
@@ -37,6 +38,26 @@ BEHAVIORS: tuple[str, ...] = ("dummy", "safe")
 # A motor stiffened by safe compliance goes compliant again once this far inside its limits.
 SAFE_RELEASE_MARGIN_DEG = 1.0
 FULL_TORQUE_PCT = 100.0
+# poppy's gotos are smooth by default (pypot's motors default to 'dummy'; its Torso and Humanoid
+# set 'minjerk'): the pypot creature classes set their creature's control.
+DEFAULT_GOTO_BEHAVIOR = "minjerk"
+
+
+class CompliantBehaviorSetting(str):
+    """A motor's compliant behaviour: a string (``"dummy"``/``"safe"``) that can be called to set
+    it, as the Poppy documentation writes ``robot.head_z.compliant_behavior('safe')``."""
+
+    __slots__ = ("_motor",)
+    _motor: Motor
+
+    def __new__(cls, value: str, motor: Motor) -> CompliantBehaviorSetting:
+        setting = super().__new__(cls, value)
+        setting._motor = motor
+        return setting
+
+    def __call__(self, value: str) -> None:
+        """Set the motor's compliant behaviour to ``value``."""
+        self._motor.compliant_behavior = value
 
 
 class Motor(MotorCache):
@@ -76,6 +97,7 @@ class Motor(MotorCache):
         self.offset = float(offset)
         self.wheel_mode = wheel_mode
         self._behavior: CompliantBehavior = "dummy"
+        self._goto_behavior = DEFAULT_GOTO_BEHAVIOR
         self._goal_speed: float | None = None
         self._runner = runner if runner is not None else GotoRunner(name=f"goto {name}")
         self._closed = False
@@ -291,9 +313,13 @@ class Motor(MotorCache):
         self._store("torque_enable", on)
 
     @property
-    def compliant_behavior(self) -> CompliantBehavior:
-        """``"dummy"``: compliant means free; ``"safe"``: free inside the limits, stiff at them."""
-        return self._behavior
+    def compliant_behavior(self) -> CompliantBehaviorSetting:
+        """``"dummy"``: compliant means free; ``"safe"``: free inside the limits, stiff at them.
+
+        Set it (``m.compliant_behavior = "safe"``) or call it as the Poppy documentation does
+        (``m.compliant_behavior("safe")``); read, it compares and prints as the name.
+        """
+        return CompliantBehaviorSetting(self._behavior, self)
 
     @compliant_behavior.setter
     def compliant_behavior(self, value: str) -> None:
@@ -307,6 +333,15 @@ class Motor(MotorCache):
             if self._compliant:
                 self._set_torque(False)
                 self._apply_safe_compliance()
+
+    @property
+    def safe_compliant(self) -> bool:
+        """pypot's flag: True when the compliant behaviour is ``"safe"``."""
+        return self._behavior == "safe"
+
+    @safe_compliant.setter
+    def safe_compliant(self, value: bool) -> None:
+        self.compliant_behavior = "safe" if value else "dummy"
 
     def _apply_safe_compliance(self) -> None:
         """Safe compliance: stiffen a compliant motor pushed past a limit, free it once back."""
@@ -325,7 +360,45 @@ class Motor(MotorCache):
         ):
             self._set_torque(False)
 
+    @property
+    def goto_behavior(self) -> str:
+        """The control of gotos that name none: ``"minjerk"`` or ``"dummy"`` (pypot's name)."""
+        return self._goto_behavior
+
+    @goto_behavior.setter
+    def goto_behavior(self, value: str) -> None:
+        try:
+            self._goto_behavior = control_name(value)
+        except ArgumentError as exc:
+            raise RegisterError(
+                f"{self.name}: goto_behavior must be 'minjerk' or 'dummy', not {value!r}",
+                register="goto_behavior", motor=self.name,
+            ) from exc
+
     # -- limits ------------------------------------------------------------------------------
+
+    @property
+    def lower_limit(self) -> float:
+        """The lower angle limit in degrees, user frame (pypot's name; ``angle_limit[0]``)."""
+        return self._limits[0]
+
+    @lower_limit.setter
+    def lower_limit(self, value: float) -> None:
+        self.angle_limit = (float(value), self._limits[1])
+
+    @property
+    def upper_limit(self) -> float:
+        """The upper angle limit in degrees, user frame (pypot's name; ``angle_limit[1]``)."""
+        return self._limits[1]
+
+    @upper_limit.setter
+    def upper_limit(self, value: float) -> None:
+        self.angle_limit = (self._limits[0], float(value))
+
+    @property
+    def control_mode(self) -> str:
+        """``"wheel"`` (endless turn) or ``"joint"`` (position control), as pypot names them."""
+        return "wheel" if self.wheel_mode else "joint"
 
     @property
     def angle_limit(self) -> tuple[float, float]:
@@ -354,7 +427,8 @@ class Motor(MotorCache):
             "present_position", "present_speed", "present_load",
             "present_temperature", "present_voltage",
             "goal_position", "goal_speed", "moving_speed", "compliant", "compliant_behavior",
-            "led",
+            "led", "lower_limit", "upper_limit", "goto_behavior", "control_mode", "registers",
+            "safe_compliant",
         ]  # fmt: skip
         if self.model.has_torque_limit:
             names += ["torque_limit", "max_torque"]
@@ -382,7 +456,7 @@ class Motor(MotorCache):
         self,
         position: float,
         duration: float,
-        control: str = "minjerk",
+        control: str | None = None,
         wait: bool = False,
     ) -> GotoHandle:
         """Go to ``position`` (degrees, user frame) in ``duration`` seconds.
@@ -390,7 +464,8 @@ class Motor(MotorCache):
         Args:
             position: the target, clamped to the angle limits.
             duration: seconds to get there.
-            control: ``"minjerk"`` (smooth, on time) or ``"dummy"`` (one goal, constant speed).
+            control: ``"minjerk"`` (smooth, on time) or ``"dummy"`` (one goal, constant speed);
+                None: ``goto_behavior``.
             wait: block until the motion is over.
 
         Returns:

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from poppy_core.bus import DxlBus
 from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError, UnknownMotorError
 from poppy_core.robot.goto import GotoHandle, GotoRunner
+from poppy_core.robot.group import MotorGroup, degrees
 from poppy_core.robot.health import BusHealth, SyncStats
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.sync import BusSync
@@ -86,7 +87,7 @@ class Robot:
         self._by_name = {m.name: m for m in self._motors}
         if len(self._by_name) != len(self._motors):
             raise ConfigError("two motors have the same name", field="motors")
-        self._groups: dict[str, list[Motor]] = {}
+        self._groups: dict[str, MotorGroup] = {}
         for name, members in (groups or {}).items():
             missing = [n for n in members if n not in self._by_name]
             if missing:
@@ -94,7 +95,7 @@ class Robot:
                     f"group {name!r} names unknown motors: {', '.join(missing)}",
                     field=f"motorgroups.{name}",
                 )
-            self._groups[name] = [self._by_name[n] for n in members]
+            self._groups[name] = MotorGroup(name, (self._by_name[n] for n in members))
         self._sensors: dict[str, Sensor] = dict(sensors or {})
         clash = sorted(set(self._sensors) & {*self._by_name, *self._groups})
         if clash:
@@ -158,6 +159,18 @@ class Robot:
     def motorgroups(self) -> dict[str, list[Motor]]:
         """Group name -> its motors."""
         return {name: list(members) for name, members in self._groups.items()}
+
+    @property
+    def alias(self) -> list[str]:
+        """The group names (pypot's ``robot.alias``); each group is ``robot.<name>``."""
+        return list(self._groups)
+
+    @property
+    def _primitive_manager(self) -> Any:
+        """The primitive manager (pypot's name; also ``robot.primitive_manager``)."""
+        from poppy_core.motion import primitive_manager  # motion sits above robot
+
+        return primitive_manager(self)
 
     def motor(self, name: str) -> Motor:
         """The motor called ``name`` (typed access).
@@ -277,6 +290,8 @@ class Robot:
             ConfigError: see ``attach``.
         """
         self.attach(name, primitive)
+        if isinstance(getattr(type(primitive), "name", None), property):
+            primitive.name = name  # type: ignore[attr-defined]
         if name not in self._primitive_names:
             self._primitive_names.append(name)
 
@@ -322,7 +337,7 @@ class Robot:
         self,
         position_for_motors: Mapping[str, float],
         duration: float,
-        control: str = "minjerk",
+        control: str | None = None,
         wait: bool = False,
     ) -> GotoHandle:
         """Move several motors so that they all arrive together.
@@ -330,7 +345,8 @@ class Robot:
         Args:
             position_for_motors: motor name -> target in degrees (user frame).
             duration: seconds the motion lasts.
-            control: ``"minjerk"`` or ``"dummy"`` (see ``Motor.goto_position``).
+            control: ``"minjerk"`` or ``"dummy"`` (see ``Motor.goto_position``); None: each
+                motor's ``goto_behavior``.
             wait: block until every motor arrived.
 
         Returns:
@@ -344,7 +360,7 @@ class Robot:
         """
         if self._closed:
             raise RobotClosedError("the robot is closed: no more motions")
-        targets = {self.motor(n): _degrees(n, pos) for n, pos in position_for_motors.items()}
+        targets = {self.motor(n): degrees(n, pos) for n, pos in position_for_motors.items()}
         handle = self._runner.start(targets, duration, control)
         if wait:
             handle.wait()
@@ -466,18 +482,3 @@ class Robot:
         tb: TracebackType | None,
     ) -> None:
         self.close()
-
-
-def _degrees(name: str, value: object) -> float:
-    try:
-        number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ArgumentError(
-            f"{name}: {value!r} is not a number of degrees", field=name, value=value, motor=name
-        ) from None
-    if number != number or number in (float("inf"), float("-inf")):
-        raise ArgumentError(
-            f"{name}: the target must be a finite number of degrees, got {value!r}",
-            field=name, value=value, motor=name,
-        )  # fmt: skip
-    return number

@@ -9,6 +9,7 @@ from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.runner import ServerThread, bind_sockets, uvicorn_server
 from poppy_core.server.service import RobotService
 from poppy_core.server.stream import create_stream_app
+from poppy_core.server.zmqserver import ZMQRobotServer, ZmqRobotServer
 
 __all__ = [
     "ListenError",
@@ -16,6 +17,8 @@ __all__ = [
     "OriginPolicy",
     "RobotService",
     "ServerThread",
+    "ZMQRobotServer",
+    "ZmqRobotServer",
     "bind_sockets",
     "create_app",
     "create_stream_app",

@@ -12,6 +12,7 @@ from starlette.responses import HTMLResponse
 
 from poppy_core.server.errors import install_error_handlers
 from poppy_core.server.fastpath import RegisterFastPath
+from poppy_core.server.legacy_paths import LegacyPaths
 from poppy_core.server.middleware import MAX_BODY_BYTES, BodyLimitMiddleware, TokenMiddleware
 from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.service import RobotService
@@ -111,6 +112,7 @@ def create_app(
         app.include_router(router, prefix="/api/v1")
     add_stream_routes(app)
     add_docs_route(app)
+    app.add_middleware(LegacyPaths)  # innermost: the old spellings reach the routers rewritten
     app.add_middleware(RegisterFastPath, service=service)
     app.add_middleware(BodyLimitMiddleware, max_bytes=max_body_bytes)
     if token:

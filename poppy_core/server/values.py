@@ -179,6 +179,12 @@ def _behavior(motor: Motor, name: str, value: Any) -> str:
     return str(value)
 
 
+def _goto_behavior(motor: Motor, name: str, value: Any) -> str:
+    if value not in ("minjerk", "dummy", "minijerk"):
+        raise _bad(motor, name, "expected 'minjerk' or 'dummy'")
+    return str(value)
+
+
 def _led(motor: Motor, name: str, value: Any) -> Any:
     if not isinstance(value, bool | str | int):
         raise _bad(motor, name, f"expected a boolean or a colour name, got {json_type(value)}")
@@ -237,6 +243,8 @@ WRITABLE: dict[str, Checker] = {
     "max_torque": _torque,
     "compliant": _boolean,
     "compliant_behavior": _behavior,
+    "safe_compliant": _boolean,
+    "goto_behavior": _goto_behavior,
     "led": _led,
     "pid": _triple,
     "compliance_margin": _pair_of(regs.AX_MARGINS),

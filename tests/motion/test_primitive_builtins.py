@@ -105,6 +105,12 @@ def test_position_watcher_records_and_plots(ergo: Robot, tmp_path: Path) -> None
     out = watcher.call_method("plot", tmp_path / "positions.png")
     data = Path(out).read_bytes()
     assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 1000
+    from matplotlib.figure import Figure
+
+    ax = Figure().add_subplot()
+    assert watcher.plot(ax) is ax  # pypot's call: draw on the caller's axis
+    assert sorted(line.get_label() for line in ax.get_lines()) == ["m1", "m2"]
+    assert len(ax.get_lines()[0].get_xdata()) == samples
 
 
 def test_attach_builtins(ergo: Robot) -> None:

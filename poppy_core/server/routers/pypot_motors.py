@@ -2,6 +2,7 @@
 
 import html
 import math
+import socket
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
@@ -39,6 +40,34 @@ async def index(request: Request) -> HTMLResponse:
 async def robot_json(service: Service) -> JSONResponse:
     """pypot's robot description (also answered by the fast path)."""
     return JSONResponse(service.description())
+
+
+# TEST-NET-1 (RFC 5737): connecting a UDP socket there only picks the outgoing interface, no
+# packet is sent (pypot asks the same of 8.8.8.8).
+ROUTE_PROBE = ("192.0.2.1", 9)
+
+
+def local_ip() -> str | None:
+    """The address other machines reach this one at (the default route's), None if none."""
+    try:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+            probe.connect(ROUTE_PROBE)
+            return str(probe.getsockname()[0])
+    except OSError:
+        return None
+
+
+@router.get("/ip.json", summary="The robot's IP address")
+def ip_json() -> JSONResponse:
+    """``{"ip": address}`` as pypot; 404 with an error and a tip when there is no network."""
+    ip = local_ip()
+    if ip is None:
+        return JSONResponse(
+            {"error": "Cannot find ip of your Poppy Robot",
+             "tip": "this machine has no network route: check its connection (ip addr)"},
+            status_code=404,
+        )  # fmt: skip
+    return JSONResponse({"ip": ip})
 
 
 @router.get("/motors/list.json", summary="The motor names")

@@ -8,6 +8,7 @@ default: Snap! runs there and calls the robot from the browser.
 from __future__ import annotations
 
 import logging
+import threading
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -86,6 +87,7 @@ class SnapServer:
         token: str | None = None,
     ) -> None:
         self.thread = thread
+        self._stopped = threading.Event()
         self.service = service
         self.policy = policy
         self.site = site
@@ -129,8 +131,15 @@ class SnapServer:
         self.thread.start()
         return self
 
+    def run(self, timeout_s: float | None = None) -> None:
+        """Serve (if not yet) and block until ``stop()`` (pypot's ``server.run()``)."""
+        if not self.thread.running:
+            self.start()
+        self._stopped.wait(timeout_s)
+
     def stop(self) -> None:
         """Stop serving; stop the recordings and playbacks it started (when it owns its service)."""
+        self._stopped.set()
         self.thread.stop()
         if self._owns_service:
             self.service.close()

@@ -1,0 +1,211 @@
+"""pypot's creature classes: ``PoppyErgoJr(...)``, ``PoppyTorso(...)``, ``PoppyHumanoid(...)``.
+
+As in pypot, calling the class builds and returns the robot (a ``Robot`` made by the one factory,
+``poppy_core.creatures.from_profile`` / ``from_config``) with the creature's behaviours attached,
+and the servers asked for started. The constructor takes pypot's arguments; each is honoured or
+refused with a one-line error saying what to use instead.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping
+from os import PathLike
+from typing import Any, ClassVar
+
+from poppy_core.creatures.factory import from_config, from_profile
+from poppy_core.creatures.registry import CREATURES, attach_creature
+from poppy_core.creatures.services import ServiceRequest, start_services
+from poppy_core.errors import ArgumentError, ConfigError
+from poppy_core.robot import Robot
+
+logger = logging.getLogger(__name__)
+
+SIMULATORS: dict[str | None, bool | str] = {None: False, "dummy": True, "mujoco": "mujoco"}
+"""pypot's ``simulator=`` values -> the factory's ``sim``: virtual servos with the ideal plant
+(``'dummy'``), with MuJoCo physics (``'mujoco'``), or hardware (None)."""
+LOOPBACK = "127.0.0.1"
+DEFAULT_PORTS = {"http": 8080, "snap": 6969, "ws": 9009, "zmq": 6768}
+"""pypot's default ports (``zmq``: the documentation's ZMQ example)."""
+
+
+def _simulator(value: object) -> bool | str:
+    if value == "vrep":
+        raise ConfigError(
+            "simulator='vrep' is not supported: V-REP is replaced by MuJoCo, use "
+            "simulator='mujoco' (or 'dummy' for virtual servos without physics)",
+            field="simulator", value=value,
+        )  # fmt: skip
+    if value == "poppy-simu":
+        return True
+    if value not in SIMULATORS:
+        raise ConfigError(
+            f"unknown simulator {value!r}: use None (hardware), 'dummy' or 'mujoco'",
+            field="simulator", value=value,
+        )  # fmt: skip
+    return SIMULATORS[value]
+
+
+class AbstractPoppyCreature:
+    """The creature class of pypot: ``PoppyErgoJr()`` returns the running robot.
+
+    Args (pypot's names):
+        base_path: refused (the creature's files are poppy's profiles).
+        config: a config (dict, or JSON/YAML file) instead of the creature's profile.
+        simulator: None (hardware), ``'dummy'`` (virtual servos, ideal plant), ``'mujoco'``
+            (virtual servos in MuJoCo physics; ``robot.simulation``); ``'vrep'`` is refused.
+        scene: refused unless None (MuJoCo uses the profile's ``model.xml``).
+        use_http, http_host, http_port: the REST server (``robot.http``).
+        use_ws, ws_host, ws_port: the state stream WebSocket (``robot.ws``).
+        use_zmq, zmq_host, zmq_port: pypot's ZMQ request/reply server (``robot.zmq``).
+        use_snap, snap_host, snap_port: the Snap! server (``robot.snap``).
+        use_remote: refused (pypot's zerorpc server): use ``use_zmq``.
+        start_background_services: serve now; False binds the servers only and the script
+            serves with ``robot.http.run()``...
+        sync: start the sync loops.
+        port: the serial port of the creature's controller (pypot: the V-REP port, refused
+            as a number).
+        **extra: pypot's sensor switches (``camera='dummy'``): a real robot is then built
+            without its sensors.
+
+    Hosts default to loopback (pypot: every interface): pass ``http_host='0.0.0.0'`` to serve
+    the network.
+    """
+
+    kind: ClassVar[str] = ""
+
+    def __new__(  # type: ignore[misc]  # pypot's: calling the class returns the robot
+        cls,
+        base_path: str | None = None,
+        config: str | PathLike[str] | Mapping[str, Any] | None = None,
+        simulator: str | None = None,
+        scene: str | None = None,
+        host: str = "localhost",
+        port: str | int | None = None,
+        id: int | None = None,
+        shared_vrep_io: object = None,
+        use_snap: bool = False,
+        snap_host: str = LOOPBACK,
+        snap_port: int = DEFAULT_PORTS["snap"],
+        snap_quiet: bool = True,
+        use_http: bool = False,
+        http_host: str = LOOPBACK,
+        http_port: int = DEFAULT_PORTS["http"],
+        http_quiet: bool = True,
+        use_remote: bool = False,
+        remote_host: str = LOOPBACK,
+        remote_port: int = 4242,
+        use_ws: bool = False,
+        ws_host: str = LOOPBACK,
+        ws_port: int = DEFAULT_PORTS["ws"],
+        use_zmq: bool = False,
+        zmq_host: str = LOOPBACK,
+        zmq_port: int = DEFAULT_PORTS["zmq"],
+        start_background_services: bool = True,
+        sync: bool = True,
+        **extra: Any,
+    ) -> Robot:
+        if not cls.kind:
+            raise ConfigError("AbstractPoppyCreature is abstract: use PoppyErgoJr, PoppyTorso "
+                              "or PoppyHumanoid", field="kind")  # fmt: skip
+        sim = _simulator(simulator)
+        if simulator == "poppy-simu":
+            use_http = True  # pypot: poppy-simu is the dummy robot served over HTTP
+        _refuse_vrep_options(base_path, scene, port, id, shared_vrep_io, use_remote)
+        sensors = _sensor_switches(extra)
+        requests = [
+            ServiceRequest(name, host_, port_)
+            for name, wanted, host_, port_ in (
+                ("http", use_http, http_host, http_port),
+                ("ws", use_ws, ws_host, ws_port),
+                ("zmq", use_zmq, zmq_host, zmq_port),
+                ("snap", use_snap, snap_host, snap_port),
+            )
+            if wanted
+        ]
+        options: dict[str, Any] = {"start_sync": sync}
+        if not sensors:
+            options["sensors"] = False
+        serial_port = port if isinstance(port, str) else None
+        if config is None:
+            robot = from_profile(cls.kind, serial_port, sim, **options)
+        else:
+            robot = from_config(_config_source(config), sim, **options)
+        try:
+            cls.setup(robot)
+            start_services(robot, requests, start_background_services)
+        except BaseException:
+            robot.close()
+            raise
+        return robot
+
+    @classmethod
+    def setup(cls, robot: Robot) -> None:
+        """Make ``robot`` this creature: its behaviours (if the config did not name it) and
+        pypot's goto behaviour of the creature on every motor."""
+        creature = robot.extensions.get("creature")
+        if getattr(creature, "kind", None) != cls.kind:
+            attach_creature(robot, cls.kind)
+        control = CREATURES[cls.kind].goto_control
+        for motor in robot.motors:
+            motor.goto_behavior = control
+
+
+def _config_source(config: object) -> Any:
+    if isinstance(config, str | PathLike | Mapping):
+        return config
+    raise ConfigError(
+        f"config must be a file path or a dict, not {type(config).__name__}", field="config"
+    )
+
+
+def _refuse_vrep_options(
+    base_path: object, scene: object, port: object, id: object, shared: object, remote: bool
+) -> None:
+    if base_path is not None:
+        raise ConfigError("base_path is not supported: the creature's files are poppy profiles; "
+                          "give config= a config file instead", field="base_path")  # fmt: skip
+    if scene is not None:
+        raise ConfigError("scene= is a V-REP option: with simulator='mujoco' the scene is the "
+                          "profile's model.xml", field="scene", value=scene)  # fmt: skip
+    if port is not None and not isinstance(port, str):
+        raise ConfigError(f"port={port!r} is V-REP's port: give the serial port as a string "
+                          "(port='/dev/ttyUSB0') or leave it out", field="port")  # fmt: skip
+    if id is not None or shared is not None:
+        raise ConfigError("id= and shared_vrep_io= are V-REP options: leave them out",
+                          field="id")  # fmt: skip
+    if remote:
+        raise ConfigError("use_remote (pypot's zerorpc server) is not supported: use "
+                          "use_zmq=True (pypot's ZMQ server) or use_http=True",
+                          field="use_remote")  # fmt: skip
+
+
+def _sensor_switches(extra: Mapping[str, Any]) -> bool:
+    """False when pypot's ``<sensor>='dummy'`` switches ask for no real sensor."""
+    for key, value in extra.items():
+        if value != "dummy":
+            raise ArgumentError(
+                f"unexpected argument {key}={value!r}: the creature classes take pypot's "
+                "arguments (config, simulator, use_http, http_port, use_ws, use_zmq, use_snap, "
+                "start_background_services, sync...) and <sensor>='dummy'",
+                field=key, value=value,
+            )  # fmt: skip
+    return not extra
+
+
+class PoppyErgoJr(AbstractPoppyCreature):
+    """Poppy Ergo Jr: ``PoppyErgoJr()`` (hardware) or ``PoppyErgoJr(simulator='dummy')``."""
+
+    kind = "ergo-jr"
+
+
+class PoppyTorso(AbstractPoppyCreature):
+    """Poppy Torso: ``PoppyTorso()`` or ``PoppyTorso(simulator='mujoco')``."""
+
+    kind = "torso"
+
+
+class PoppyHumanoid(AbstractPoppyCreature):
+    """Poppy Humanoid: ``PoppyHumanoid()`` or ``PoppyHumanoid(simulator='mujoco')``."""
+
+    kind = "humanoid"

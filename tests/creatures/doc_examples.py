@@ -1,0 +1,273 @@
+"""The Poppy documentation's Python examples, as a pypot user runs them on poppy.
+
+Each is the documentation's code (``../shared/reference``, line given) with its import line
+changed to poppy's and Python 2 prints and typographic quotes written as Python 3. ``run``
+executes one with the documentation's durations shortened: ``time.sleep`` and ``time.time``
+are the only names it touches, and it scales both, so an example's timing logic is unchanged.
+"""
+
+from __future__ import annotations
+
+import textwrap
+import time
+from typing import Any
+
+TIME_SCALE = 0.2
+"""Real seconds per documentation second."""
+
+
+def _sleep(seconds: float) -> None:
+    time.sleep(seconds * TIME_SCALE)
+
+
+def _clock() -> float:
+    return time.monotonic() / TIME_SCALE
+
+
+def run(code: str, **names: Any) -> dict[str, Any]:
+    """Run an example with ``names`` defined (``poppy``...); its namespace afterwards."""
+    source = textwrap.dedent(code)
+    source = source.replace("time.sleep(", "_doc_sleep(").replace("time.time()", "_doc_clock()")
+    namespace: dict[str, Any] = {"_doc_sleep": _sleep, "_doc_clock": _clock, **names}
+    exec(compile(source, "<documentation example>", "exec"), namespace)
+    return namespace
+
+
+# -- constructors (1.4 "Programming with Python"; the creature libraries) -----------------------
+
+CREATE_ERGO_JR = """
+from poppy_core.creatures import PoppyErgoJr
+poppy = PoppyErgoJr(simulator=SIMULATOR)
+"""  # line 462, with the simulator the test runs on
+
+# -- motors and groups (line 484-591) -----------------------------------------------------------
+
+LIST_MOTORS = """
+print(poppy.motors)
+for m in poppy.motors:
+    print('motor {} in position {}'.format(m.name, m.present_position))
+"""  # lines 484, 520
+
+GROUPS = """
+for group in poppy.alias:
+    print("motor group ", group)
+
+# assuming "head" is one of the motor groups (use "top" for a ergo_jr)
+for m in poppy.head:
+    print('motor {} in position {}'.format(m.name, m.present_position))
+"""  # line 527
+
+COMPLIANCE = """
+# set the whole robot compliant
+poppy.compliant = True
+
+# set the whole motor group non-compliant
+poppy.head.compliant = False
+
+# set thone motor non-compliant
+poppy.l_shoulder_x.compliant = False
+"""  # line 546
+
+GOAL_POSITION = """
+import time
+
+poppy.head_z.goal_position = 20.
+poppy.head_y.goal_position = 10.
+
+time.sleep(2) # wait 2 seconds
+
+poppy.head_y.goal_position = -10.
+"""  # line 561
+
+MOVING_SPEED = """
+import time
+
+poppy.head_y.moving_speed = 150.
+poppy.head_y.goal_position = 10.
+
+time.sleep(2) # wait 2 seconds
+poppy.head_y.moving_speed = 50.
+poppy.head_y.goal_position = -10.
+"""  # line 576
+
+GOTO = """
+poppy.head_y.goto_position(10.,1.,wait=True)
+poppy.head_y.goto_position(-10.,2.,wait=False)
+"""  # line 591
+
+# -- the robot API (3.x "Robot", lines 3057-3253; `robot` is the documentation's name) ----------
+
+ROBOT_GOTO = """
+robot.goto_position({'head_z':0., 'head_y':20}, 3)
+"""  # line 3095
+
+ROBOT_GOTO_DUMMY = """
+robot.goto_position({'head_z':0., 'head_y':20}, 3, control='dummy', wait=True)
+"""  # line 3107
+
+MOTOR_INFO = """
+for m in robot.motors:
+    print("motor ", m.name, "(", m.model, "), id: ", m.id)
+    print('temperature: ', m.temperature)
+    print("load: ", m.load)
+"""  # line 3160
+
+SAFE_COMPLIANCE = """
+print(robot.head_z.angle_limit)
+robot.head_z.compliant_behavior('safe')
+robot.head_z.compliant = True
+#now try moving the head with your hands beyond the angle limits
+"""  # line 3177
+
+MAX_TORQUE = """
+robot.head_z.max_torque = 20
+"""  # line 3186
+
+ALL_TO_ZERO = """
+for m in robot.motors:
+    m.compliant = False
+    m.goal_position = 0
+
+time.sleep(2)
+
+for m in robot.motors:
+    print("position: ", m.present_position, "(limits: ", m.angle_limit, ")")
+"""  # line 3196
+
+GOAL_SPEED = """
+goal = 20
+
+t_init = time.time()
+
+while time.time() - t_init < 20:
+
+    if abs(robot.head_y.present_position) > abs(goal):
+        goal = -goal
+
+    speed = 0.1*(goal - robot.head_y.present_position)
+    robot.head_y.goal_speed = speed
+
+    time.sleep(0.1)
+"""  # line 3213
+
+MOTOR_GOTO = """
+robot.head_z.goto_position(20, 3)
+"""  # line 3239
+
+MOTOR_GOTO_DUMMY = """
+robot.head_z.goto_position(20, 3, control='dummy', wait=True)
+"""  # line 3253
+
+# -- primitives (line 3289) ---------------------------------------------------------------------
+
+SINUS = """
+from poppy_core.motion import Sinus
+
+sinus_prim_z = Sinus(poppy, 50, "head_z", amp=30, freq=0.5, offset=0, phase=0)
+
+#set phase to 90° to have the y sinus 1/4 of phase late compared to the z sinus
+sinus_prim_y = Sinus(poppy, 50, "head_y", amp=20, freq=1, offset=0, phase=90)
+
+print("start moving")
+sinus_prim_z.start()
+sinus_prim_y.start()
+
+time.sleep(20)
+
+print("pause move")
+sinus_prim_z.pause()
+sinus_prim_y.pause()
+
+time.sleep(5)
+
+print("restart move")
+sinus_prim_z.resume()
+sinus_prim_y.resume()
+
+time.sleep(20)
+
+print("stop moving")
+sinus_prim_z.stop()
+sinus_prim_y.stop()
+"""
+
+# -- record and replay (lines 2677, 2707) -------------------------------------------------------
+
+RECORD = """
+from poppy_core.motion import Move, MoveRecorder, MovePlayer
+
+record_frequency = 20.0 # This means that a new position will be recorded 50 times per second
+recorded_motors = poppy.motors # We will record the position of all motors
+
+#disable torque for all motors
+for m in recorded_motors:
+    m.compliant = True
+
+#create the recorder primitive
+recorder = MoveRecorder(poppy, record_frequency, recorded_motors)
+
+print("start recording")
+recorder.start()
+
+time.sleep(20)
+
+print("stop recording")
+recorder.stop()
+
+#save the recorded move in a file
+with open('mymove.json', 'w') as f:
+    recorder.move.save(f)
+"""
+
+REPLAY = """
+#read the file containing the move
+with open('mymove.json') as f:
+    loaded_move = Move.load(f)
+
+#create the primitive
+player = MovePlayer(poppy, loaded_move)
+
+#enable torque for all motors
+for m in poppy.motors:
+    m.compliant = False
+
+print("starting")
+player.start()
+player.wait_to_stop()
+print("finished")
+
+#disable torque for all motors
+for m in poppy.motors:
+    m.compliant = True
+
+time.sleep(0.1)
+"""
+
+# -- the Humanoid's setup (line 2138), on a built robot -----------------------------------------
+
+HUMANOID_SETUP = """
+from functools import partial
+import numpy
+
+robot._primitive_manager._filter = partial(numpy.sum, axis=0)
+
+for m in robot.motors:
+    m.goto_behavior = 'minjerk'
+
+for m in robot.torso:
+    m.compliant_behavior = 'safe'
+"""
+
+# -- pypot.robot.from_config with the Ergo's config (line 2636) ---------------------------------
+
+FROM_CONFIG = """
+import poppy_core.robot
+
+ergo_robot = poppy_core.robot.from_config(my_config, sim=True)
+print(ergo_robot.m2.present_position) #get register present_position of motor m2
+
+ergo_robot.m6.compliant = False          #enable torque of the m6 motor
+ergo_robot.m6.goal_position = 20         #set goal position of motor m6 to 20 degree
+
+time.sleep(2)                           #wait for the robot to move
+"""  # `sim=True`: the documentation's robot is real; the module path is poppy's
