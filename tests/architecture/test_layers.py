@@ -40,6 +40,7 @@ LEAF_EXCEPTIONS = {("robot", "poppy_core.motion.trajectory"), ("robot", "poppy_c
 FILE_EXCEPTIONS = {
     ("creatures/services.py", "poppy_core.server.background"),
     ("creatures/services.py", "poppy_core.server.zmqserver"),
+    ("creatures/services.py", "poppy_core.server.snap"),
 }
 
 
