@@ -80,14 +80,14 @@ def tui(
 
 @contextmanager
 def mujoco_ergo_jr() -> Iterator[Path]:
-    """A MuJoCo Ergo Jr served on a pty for this process; yields a config file that opens it."""
+    """A MuJoCo Ergo Jr linked in this process (``emu://``); yields a config file that opens it."""
     from poppy_core.robot import load_profile
     from poppy_core.robot.config_io import dump_config
     from poppy_core.robot.factory import start_emulators, start_simulation
 
     config = load_profile("ergo-jr")
     simulation = start_simulation(config)
-    servers = start_emulators(config, simulation)
+    servers = start_emulators(config, simulation, in_process=True)
     try:
         simulation.start()
         data = config.to_dict()

@@ -2,6 +2,7 @@
 
 from poppy_core.bus.core import is_alarm_only
 from poppy_core.bus.dxlbus import DxlBus
+from poppy_core.bus.line import Line, LineOpener, SerialLine, open_line, register_scheme
 from poppy_core.bus.ports import (
     KNOWN_ADAPTERS,
     PortInfo,
@@ -34,10 +35,13 @@ __all__ = [
     "Deadline",
     "DxlBus",
     "FoundMotor",
+    "Line",
+    "LineOpener",
     "LinkTiming",
     "PingResult",
     "PortInfo",
     "ScanProgress",
+    "SerialLine",
     "SetupResult",
     "Transport",
     "change_baudrate",
@@ -52,11 +56,13 @@ __all__ = [
     "latency_advice",
     "list_ports",
     "locate",
+    "open_line",
     "port_error",
     "port_info",
     "read_ftdi_latency_ms",
     "reboot",
     "recognise_adapter",
+    "register_scheme",
     "reset_motor",
     "scan",
     "set_angle_limits",

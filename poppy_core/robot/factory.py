@@ -1,7 +1,8 @@
 """Build a ``Robot``: from a config, a profile, or whatever motors a scan finds; real or simulated.
 
 ``sim=True`` starts one in-process emulator per controller (a ``VirtualBus`` with the configured
-models, IDs and baud rate, served on a pty), so the robot talks the same bytes as with hardware.
+models, IDs and baud rate, reached through the in-process link ``emu://NAME``), so the robot
+talks the same bytes as with hardware without a pty or serving threads in between.
 ``sim="mujoco"`` does the same with MuJoCo physics behind the virtual servos (one world for the
 whole robot, ``robot.simulation``); ``sim=True`` / ``"ideal"`` keep the ideal servo plant.
 """
@@ -13,7 +14,15 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 from poppy_core.bus import DxlBus, find_port, list_ports, scan
-from poppy_core.emulator import Adapter, Plant, VirtualBus, VirtualMotor, serve_pty
+from poppy_core.emulator import (
+    Adapter,
+    Endpoint,
+    Plant,
+    VirtualBus,
+    VirtualMotor,
+    serve_link,
+    serve_pty,
+)
 from poppy_core.errors import ConfigError, PortError, RegisterError, SetupError
 from poppy_core.models import model_by_name
 from poppy_core.robot import startup
@@ -113,15 +122,23 @@ def virtual_buses(
     return buses
 
 
-def start_emulators(config: RobotConfig, simulation: Any = None) -> dict[str, Any]:
-    """One emulator per controller, served on a pty: controller name -> ``EmulatorServer``.
+def start_emulators(
+    config: RobotConfig, simulation: Any = None, *, in_process: bool = False
+) -> dict[str, Any]:
+    """One emulator per controller: controller name -> its server.
 
     The buses are ``virtual_buses(config, simulation)``: motors already set up (return delay 0).
+
+    Args:
+        config: the robot.
+        simulation: a MuJoCo world behind the motors (``start_simulation``).
+        in_process: offer each bus at ``emu://NAME`` (a robot in this process); False serves
+            each on a pty, for other programs.
     """
-    servers: dict[str, Any] = {}
+    servers: dict[str, Endpoint] = {}
     try:
         for name, bus in virtual_buses(config, simulation).items():
-            servers[name] = serve_pty(bus)
+            servers[name] = serve_link(bus) if in_process else serve_pty(bus)
     except BaseException:
         for server in servers.values():
             server.stop()
@@ -194,7 +211,7 @@ def from_config(
     simulation = start_simulation(cfg) if mode == "mujoco" else None
     try:
         if mode is not None:
-            emulators = start_emulators(cfg, simulation)
+            emulators = start_emulators(cfg, simulation, in_process=True)
             if simulation is not None:
                 simulation.start()
         motors: dict[str, list[Motor]] = {}

@@ -1,4 +1,4 @@
-"""Fixtures of the TUI tests: virtual buses served on a pty, and helpers to wait in a pilot."""
+"""Fixtures of the TUI tests: virtual buses linked in this process, helpers to wait in a pilot."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 
 from poppy_core.bus import PortInfo
-from poppy_core.emulator import EmulatorServer, build_bus_from_spec, serve_pty
+from poppy_core.emulator import Endpoint, build_bus_from_spec, serve_link
 
 
 def no_ports() -> list[PortInfo]:
@@ -20,17 +20,17 @@ def no_ports() -> list[PortInfo]:
 
 
 @pytest.fixture
-def xl320_server() -> Iterator[EmulatorServer]:
-    """Three XL-320 (ids 1-3, protocol 2, 1 Mbps) on a pty."""
-    server = serve_pty(build_bus_from_spec("XL-320:1-3", protocol=2, baudrate=1_000_000))
+def xl320_server() -> Iterator[Endpoint]:
+    """Three XL-320 (ids 1-3, protocol 2, 1 Mbps) at ``emu://N``."""
+    server = serve_link(build_bus_from_spec("XL-320:1-3", protocol=2, baudrate=1_000_000))
     yield server
     server.stop()
 
 
 @pytest.fixture
-def big_server() -> Iterator[EmulatorServer]:
-    """25 MX-28 (ids 1-25, protocol 1, 1 Mbps) on a pty."""
-    server = serve_pty(build_bus_from_spec("MX-28:1-25", protocol=1, baudrate=1_000_000))
+def big_server() -> Iterator[Endpoint]:
+    """25 MX-28 (ids 1-25, protocol 1, 1 Mbps) at ``emu://N``."""
+    server = serve_link(build_bus_from_spec("MX-28:1-25", protocol=1, baudrate=1_000_000))
     yield server
     server.stop()
 
