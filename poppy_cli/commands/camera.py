@@ -78,8 +78,8 @@ def _source(
         return
     if device is not None:
         _usage("--device names a real camera: leave out --sim")
-    from poppy_cli.commands.robot import robot_config
-    from poppy_core.robot import RobotConfig, from_config
+    from poppy_cli.commands.robot import robot_config, start_robot
+    from poppy_core.robot import RobotConfig
     from poppy_core.sensors import Camera
 
     config = robot_config(profile, config_file, None)
@@ -89,7 +89,7 @@ def _source(
             if spec.get("type") in ("OpenCVCamera", "DummyCamera"):
                 spec["resolution"] = list(resolution)
         config = RobotConfig.from_dict(data, source="command line")
-    with from_config(config, sim=sim) as robot:
+    with start_robot(config, sim, sensors=True) as robot:
         cameras = [s for s in robot.sensors if isinstance(s, Camera)]
         if not cameras:
             _usage("this robot's config has no camera (its sensors section)")
