@@ -2,31 +2,17 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from contextlib import AbstractContextManager, contextmanager
-from typing import Any
-
 import pytest
 
-from poppy_core.emulator import VirtualBus, build_bus_from_spec, serve_link, serve_pty, serve_tcp
+from tests.helpers.bus import Emulate, emulate_bus
 
-Emulate = Callable[..., AbstractContextManager[tuple[VirtualBus, str]]]
-
-
-@contextmanager
-def _emulate(
-    spec: str, *, via: str = "link", baudrate: int = 1_000_000, **options: Any
-) -> Iterator[tuple[VirtualBus, str]]:
-    bus = build_bus_from_spec(spec, baudrate=baudrate, **options)
-    servers = {"link": serve_link, "pty": serve_pty, "tcp": serve_tcp}
-    with servers[via](bus) as server:
-        yield bus, server.url
+__all__ = ["Emulate"]
 
 
 @pytest.fixture
 def emulate() -> Emulate:
     """``with emulate("MX-28:1-3", via="tcp") as (virtual_bus, url): ...`` (default: ``"link"``)."""
-    return _emulate
+    return emulate_bus
 
 
 @pytest.fixture(params=["link", "pty", "tcp"])

@@ -4,24 +4,16 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 import pytest
 
 from poppy_core.errors import ConfigError, RobotClosedError
 from poppy_core.robot import Robot, from_profile
+from tests.helpers import eventually
 
 CONTROLLER = "my_dxl_controller"
 
-
-def eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
-    """Poll ``check`` until it holds (True) or the timeout runs out (False)."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if check():
-            return True
-        time.sleep(0.01)
-    return check()
 
 
 @pytest.fixture

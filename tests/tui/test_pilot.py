@@ -14,7 +14,7 @@ from poppy_cli.tui.widgets.live import LivePanel
 from poppy_cli.tui.widgets.motor_panel import MotorPanel
 from poppy_cli.tui.widgets.motor_tree import MotorTree
 from poppy_core.emulator import Endpoint
-from tests.tui.conftest import no_ports, run_async, wait_for
+from tests.helpers.tui import no_ports, run_async, wait_for
 
 SIZE = (100, 40)
 

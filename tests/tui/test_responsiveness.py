@@ -10,7 +10,7 @@ from poppy_cli.tui.app import make_app
 from poppy_cli.tui.widgets.live import LivePanel
 from poppy_cli.tui.widgets.motor_tree import MotorTree
 from poppy_core.emulator import Endpoint
-from tests.tui.conftest import no_ports, run_async, wait_for
+from tests.helpers.tui import no_ports, run_async, wait_for
 
 SIZE = (100, 40)
 
