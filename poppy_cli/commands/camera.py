@@ -68,7 +68,9 @@ def _source(
     if (marker is not None or card) and sim != "mujoco":
         _usage("--marker and --card put a card in a simulated scene: add --sim mujoco")
     if sim is None:
-        camera = OpenCVCamera("camera", device if device is not None else 0, 20.0, resolution)
+        camera: Camera = OpenCVCamera(
+            "camera", device if device is not None else 0, 20.0, resolution
+        )
         detector = MarkerDetector("marker_detector", [camera], 5.0)
         try:
             yield camera, detector

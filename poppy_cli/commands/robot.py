@@ -8,7 +8,16 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.options import MAX_DURATION_S, finite
+from poppy_cli.options import (  # the shared options, also imported from here by commands
+    MAX_DURATION_S,
+    ConfigOpt,
+    JsonOpt,
+    PortOpt,
+    ProfileOpt,
+    RemoteOpt,
+    SimOpt,
+    finite,
+)
 from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
@@ -18,39 +27,11 @@ if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot, RobotConfig
     from poppy_core.robot.startup import ReturnDelayIssue
 
+__all__ = ["ConfigOpt", "JsonOpt", "PortOpt", "ProfileOpt", "RemoteOpt", "SimOpt"]
+
 app = typer.Typer(
     help="Drive a whole robot: status, goto, compliance (a profile, a config file or --sim).",
     no_args_is_help=True,
-)
-
-ProfileOpt = typer.Option(
-    None, "--profile", help="Robot profile, e.g. ergo-jr. [env: POPPY_PROFILE, or user settings]"
-)
-ConfigOpt = typer.Option(None, "--config", "-c", help="Robot config file (JSON or YAML).")
-PortOpt = typer.Option(
-    None, "--port", "-p", help="Serial port of the robot's bus. [env: POPPY_PORT]"
-)
-
-
-def _sim_engine(value: str | None) -> str | None:
-    """Check the engine of ``--sim`` (the root group turns a bare ``--sim`` into ``ideal``)."""
-    if value is not None and value not in ("ideal", "mujoco"):
-        raise typer.BadParameter(f"{value!r}: use --sim (ideal servos) or --sim mujoco (physics)")
-    return value
-
-
-SimOpt = typer.Option(
-    None,
-    "--sim",
-    metavar="[mujoco]",
-    callback=_sim_engine,
-    help="Build a virtual robot: --sim (ideal servos) or --sim mujoco (MuJoCo physics).",
-)
-JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
-RemoteOpt = typer.Option(
-    None,
-    "--remote",
-    help="Drive a robot served by `poppy serve --http` at this URL (token: env POPPY_TOKEN).",
 )
 
 SETTLE_S = 0.1

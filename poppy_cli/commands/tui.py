@@ -11,7 +11,7 @@ from pathlib import Path
 
 import typer
 
-from poppy_cli.options import BAUD_LIMITS
+from poppy_cli.options import MAX_BAUD, MIN_BAUD
 from poppy_cli.output import console
 
 
@@ -37,7 +37,7 @@ def tui(
     ),
     baud: int | None = typer.Option(
         None, "--baud", "-b", help="Scan --port at this rate only (default: every standard rate).",
-        **BAUD_LIMITS,
+        min=MIN_BAUD, max=MAX_BAUD,
     ),
     protocol: int | None = typer.Option(
         None, "--protocol", min=1, max=2, help="Scan --port in this protocol only (1 or 2)."
