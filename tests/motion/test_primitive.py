@@ -31,7 +31,7 @@ def state(primitive: Primitive) -> str:
 
 @pytest.fixture
 def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True)
+    robot = from_profile("ergo-jr", sim=True, creature=False)  # no Ergo Jr primitives
     try:
         yield robot
     finally:

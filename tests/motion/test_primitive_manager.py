@@ -22,7 +22,7 @@ from tests.helpers import eventually
 
 @pytest.fixture
 def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True)
+    robot = from_profile("ergo-jr", sim=True, creature=False)  # no Ergo Jr primitives
     robot.compliant = False
     try:
         yield robot
