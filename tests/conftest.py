@@ -1,7 +1,8 @@
 """Marks the slow tests: ``make test-fast`` (``pytest -m "not slow"``) skips them.
 
 A test is slow when it starts programs (``poppy`` subprocesses, tmux, a browser), runs a Textual
-app or MuJoCo physics, or waits for things on purpose (bus loss, soak-like runs, fuzzing). Whole
+app, an HTTP server or MuJoCo physics, moves whole simulated creatures, or waits for things on
+purpose (bus loss, soak-like runs, fuzzing). Whole
 folders and modules of that kind are listed here, so that a test added to them is marked too;
 a single slow test elsewhere takes ``@pytest.mark.slow``. ``make test`` runs everything.
 """
@@ -13,18 +14,12 @@ from pathlib import Path
 import pytest
 
 TESTS = Path(__file__).resolve().parent
-SLOW_FOLDERS = {"cli", "sim", "teleop", "tui"}
+SLOW_FOLDERS = {"cli", "creatures", "server", "sim", "teleop", "tui"}
 SLOW_MODULES = {
-    "creatures/test_humanoid.py",
-    "creatures/test_torso.py",
     "emulator/test_emulator_threads.py",
     "kinematics/test_sim_chain.py",
     "robot/test_bus_loss.py",
     "robot/test_config_hypothesis.py",
-    "server/test_browser.py",
-    "server/test_concurrency_stream.py",
-    "server/test_fuzz.py",
-    "server/test_serve_cmd.py",
 }
 
 
