@@ -57,7 +57,7 @@ def sync_warnings(caplog: pytest.LogCaptureFixture, text: str) -> list[str]:
 
 def test_health_of_a_healthy_robot(served: tuple[Endpoint, str]) -> None:
     _, port = served
-    with from_profile("ergo-jr", port=port) as robot:
+    with from_profile("ergo-jr", port=port, sensors=False) as robot:
         assert until(lambda: robot.health()["my_dxl_controller"].loop_hz["present"] > 0)
         health = robot.health()["my_dxl_controller"]
         assert health.connected and health.running and health.ok
@@ -72,7 +72,7 @@ def test_a_lost_bus_is_loud_then_comes_back(
 ) -> None:
     server, port = served
     caplog.set_level(logging.WARNING, logger="poppy_core.robot.sync")
-    with from_profile("ergo-jr", port=port) as robot:
+    with from_profile("ergo-jr", port=port, sensors=False) as robot:
         assert until(lambda: all(m.online for m in robot.motors))
         server.lose(1.0)
         assert until(lambda: not any(m.online for m in robot.motors))
@@ -99,7 +99,7 @@ def test_a_bus_that_never_comes_back_is_retried_quietly(
 ) -> None:
     caplog.set_level(logging.WARNING, logger="poppy_core.robot.sync")
     server = serve_tcp(ergo_jr_virtual())
-    robot: Robot = from_profile("ergo-jr", port=server.url)
+    robot: Robot = from_profile("ergo-jr", port=server.url, sensors=False)
     try:
         server.stop()  # gone for good
         assert until(lambda: not robot.health()["my_dxl_controller"].connected)

@@ -138,7 +138,7 @@ def test_to_config_reflects_the_motors(ergo: Robot) -> None:
     assert eventually(lambda: virtual(ergo, 1).table.get_si("max_position_limit") == pytest.approx(
         100, abs=0.3), 2.0)
     ergo.m2.angle_limit = (-120, 80)  # user frame; m2 is indirect
-    assert ergo.to_config().motors["m2"].angle_limit == (-80, 120)  # configs: motor frame
+    assert ergo.to_robot_config().motors["m2"].angle_limit == (-80, 120)  # configs: motor frame
     assert eventually(lambda: virtual(ergo, 2).table.get_si("max_position_limit") == pytest.approx(
         120, abs=0.3), 2.0)
 
