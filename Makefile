@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 
-.PHONY: run test lint completions bench clean sim-deps
+.PHONY: run test test-fast lint completions bench clean sim-deps
 
 $(BIN)/activate:
 	$(PYTHON) -m venv $(VENV)
@@ -24,6 +24,11 @@ test: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
 	$(BIN)/mypy
 	$(BIN)/pytest
+
+# The inner loop (under 90 s on a quiet machine): lint, then every test not marked `slow`.
+test-fast: $(VENV)/.installed-test
+	$(BIN)/ruff check poppy_core poppy_cli tests bench
+	$(BIN)/pytest -q -m "not slow"
 
 lint: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench

@@ -1,4 +1,4 @@
-"""Option parsers shared by commands: ID ranges, baud rates, protocols, bus selection."""
+"""Options shared by commands (robot, bus, output) and their parsers: IDs, baud rates, protocols."""
 
 from __future__ import annotations
 
@@ -57,7 +57,8 @@ def default_port(port: str | None) -> str | None:
 MIN_BAUD = 1_200
 MAX_BAUD = 12_000_000
 BAUD_LIMITS = {"min": MIN_BAUD, "max": MAX_BAUD}
-"""``typer.Option(..., **BAUD_LIMITS)``: a rate out of range is a usage error (exit 2)."""
+"""Kept for callers; write ``typer.Option(..., min=MIN_BAUD, max=MAX_BAUD)`` (typed): a rate
+out of range is a usage error (exit 2)."""
 
 
 MAX_DURATION_S = 86_400.0
@@ -78,3 +79,36 @@ PORT_HELP = (
 )
 BAUD_HELP = "Baud rate in bps (default: search the standard rates)."
 PROTOCOL_HELP = "Dynamixel protocol: 1 or 2 (default: search both)."
+
+
+# -- the robot options of every command that builds one ----------------------------------------
+
+ProfileOpt = typer.Option(
+    None, "--profile", help="Robot profile, e.g. ergo-jr. [env: POPPY_PROFILE, or user settings]"
+)
+ConfigOpt = typer.Option(None, "--config", "-c", help="Robot config file (JSON or YAML).")
+PortOpt = typer.Option(
+    None, "--port", "-p", help="Serial port of the robot's bus. [env: POPPY_PORT]"
+)
+
+
+def _sim_engine(value: str | None) -> str | None:
+    """Check the engine of ``--sim`` (the root group turns a bare ``--sim`` into ``ideal``)."""
+    if value is not None and value not in ("ideal", "mujoco"):
+        raise typer.BadParameter(f"{value!r}: use --sim (ideal servos) or --sim mujoco (physics)")
+    return value
+
+
+SimOpt = typer.Option(
+    None,
+    "--sim",
+    metavar="[mujoco]",
+    callback=_sim_engine,
+    help="Build a virtual robot: --sim (ideal servos) or --sim mujoco (MuJoCo physics).",
+)
+JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
+RemoteOpt = typer.Option(
+    None,
+    "--remote",
+    help="Drive a robot served by `poppy serve --http` at this URL (token: env POPPY_TOKEN).",
+)

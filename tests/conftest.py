@@ -1,17 +1,43 @@
-"""Suite-wide guard: a test stuck where no signal reaches it ends the run with every stack."""
+"""Suite-wide: the slow marker for ``make test-fast``, and a guard against tests stuck in C.
+
+A test is slow when it starts programs (``poppy`` subprocesses, tmux, a browser), runs a Textual
+app, an HTTP server or MuJoCo physics, moves whole simulated creatures, or waits for things on
+purpose (bus loss, soak-like runs, fuzzing). Whole folders and modules of that kind are listed
+here, so that a test added to them is marked too; a single slow test elsewhere takes
+``@pytest.mark.slow``. ``make test`` runs everything.
+"""
 
 from __future__ import annotations
 
 import faulthandler
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
+TESTS = Path(__file__).resolve().parent
+SLOW_FOLDERS = {"cli", "creatures", "server", "sim", "teleop", "tui"}
+SLOW_MODULES = {
+    "emulator/test_emulator_threads.py",
+    "kinematics/test_sim_chain.py",
+    "robot/test_bus_loss.py",
+    "robot/test_config_hypothesis.py",
+}
 # pytest-timeout (120 s, by signal) stops a test that waits in Python. A thread stuck inside a
 # C library (an OpenGL driver, a serial ioctl) never sees the signal; this watchdog then prints
 # every thread's stack and exits, so CI reports where it hung instead of running out its budget.
 HANG_LIMIT_S = 600
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        try:
+            relative = Path(str(item.path)).resolve().relative_to(TESTS)
+        except ValueError:
+            continue
+        if relative.parts[0] in SLOW_FOLDERS or relative.as_posix() in SLOW_MODULES:
+            item.add_marker(pytest.mark.slow)
 
 
 @pytest.hookimpl(hookwrapper=True)

@@ -68,7 +68,9 @@ def _source(
     if (marker is not None or card) and sim != "mujoco":
         _usage("--marker and --card put a card in a simulated scene: add --sim mujoco")
     if sim is None:
-        camera = OpenCVCamera("camera", device if device is not None else 0, 20.0, resolution)
+        camera: Camera = OpenCVCamera(
+            "camera", device if device is not None else 0, 20.0, resolution
+        )
         detector = MarkerDetector("marker_detector", [camera], 5.0)
         try:
             yield camera, detector
@@ -78,8 +80,8 @@ def _source(
         return
     if device is not None:
         _usage("--device names a real camera: leave out --sim")
-    from poppy_cli.commands.robot import robot_config
-    from poppy_core.robot import RobotConfig, from_config
+    from poppy_cli.commands.robot import robot_config, start_robot
+    from poppy_core.robot import RobotConfig
     from poppy_core.sensors import Camera
 
     config = robot_config(profile, config_file, None)
@@ -89,7 +91,7 @@ def _source(
             if spec.get("type") in ("OpenCVCamera", "DummyCamera"):
                 spec["resolution"] = list(resolution)
         config = RobotConfig.from_dict(data, source="command line")
-    with from_config(config, sim=sim) as robot:
+    with start_robot(config, sim, sensors=True) as robot:
         cameras = [s for s in robot.sensors if isinstance(s, Camera)]
         if not cameras:
             _usage("this robot's config has no camera (its sensors section)")

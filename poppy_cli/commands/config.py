@@ -7,7 +7,14 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.options import BAUD_HELP, BAUD_LIMITS, PORT_HELP, PROTOCOL_HELP, default_port
+from poppy_cli.options import (
+    BAUD_HELP,
+    MAX_BAUD,
+    MIN_BAUD,
+    PORT_HELP,
+    PROTOCOL_HELP,
+    default_port,
+)
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
@@ -197,7 +204,9 @@ def generate(
         ..., "--output", "-o", help="File to write (.json or .yaml), or a folder (robot.yaml)."
     ),
     port: str | None = typer.Option(None, "--port", "-p", help=PORT_HELP),
-    baud: int | None = typer.Option(None, "--baud", "-b", help=BAUD_HELP, **BAUD_LIMITS),
+    baud: int | None = typer.Option(
+        None, "--baud", "-b", help=BAUD_HELP, min=MIN_BAUD, max=MAX_BAUD
+    ),
     protocol: int | None = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2),
     name: str = typer.Option("m", "--name", help="Motor name prefix: <prefix><ID>."),
     force: bool = ForceOpt,

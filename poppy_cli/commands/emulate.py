@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.options import BAUD_LIMITS
+from poppy_cli.options import MAX_BAUD, MIN_BAUD
 from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
 
 if TYPE_CHECKING:
@@ -39,7 +39,7 @@ def emulate(
         None, "--protocol", min=1, max=2, help="Protocol (default: the models')."
     ),
     baud: int | None = typer.Option(
-        None, "--baud", "-b", help="Baud rate (default 1000000).", **BAUD_LIMITS
+        None, "--baud", "-b", help="Baud rate (default 1000000).", min=MIN_BAUD, max=MAX_BAUD
     ),
     pty: bool = typer.Option(False, "--pty", help="Serve on a pseudo-terminal (the default)."),
     tcp: str | None = typer.Option(

@@ -9,9 +9,11 @@ import typer
 from poppy_cli.connect import open_bus, ping_model
 from poppy_cli.options import (
     BAUD_HELP,
-    BAUD_LIMITS,
+    MAX_BAUD,
+    MIN_BAUD,
     PORT_HELP,
     PROTOCOL_HELP,
+    JsonOpt,
     default_port,
     parse_ids,
 )
@@ -20,6 +22,7 @@ from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_j
 if TYPE_CHECKING:
     from poppy_core.bus.results import SetupResult
     from poppy_core.models import Register
+    from poppy_core.models.register import SIValue
 
 app = typer.Typer(
     help="Read, write and set up motors: IDs, baud rates, limits, torque, LED, reset.",
@@ -27,9 +30,8 @@ app = typer.Typer(
 )
 
 PortOpt = typer.Option(None, "--port", "-p", help=PORT_HELP)
-BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP, **BAUD_LIMITS)
+BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP, min=MIN_BAUD, max=MAX_BAUD)
 ProtoOpt = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2)
-JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
 
 
 def require_port(port: str | None) -> str:
@@ -40,7 +42,7 @@ def require_port(port: str | None) -> str:
     return chosen
 
 
-def parse_value(register: Register, text: str) -> object:
+def parse_value(register: Register, text: str) -> SIValue:
     """Turn command-line text into the SI value ``register.from_si`` expects."""
     from poppy_core.models.register import Choice
 

@@ -9,13 +9,13 @@ import typer
 
 from poppy_cli.commands.motor import (
     BaudOpt,
-    JsonOpt,
     PortOpt,
     ProtoOpt,
     app,
     print_setup,
     require_port,
 )
+from poppy_cli.options import JsonOpt
 
 if TYPE_CHECKING:
     from poppy_core.bus.dxlbus import DxlBus

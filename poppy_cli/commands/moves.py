@@ -7,6 +7,7 @@ from typing import Any
 
 import typer
 
+from poppy_cli.options import JsonOpt
 from poppy_cli.output import EXIT_USAGE, console, error_line, print_json, styled
 
 app = typer.Typer(
@@ -14,7 +15,6 @@ app = typer.Typer(
     no_args_is_help=True,
 )
 
-JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
 ForceOpt = typer.Option(False, "--force", "-f", help="Replace an existing file.")
 NameArg = typer.Argument(..., help="Library name of the move, or a file path.")
 

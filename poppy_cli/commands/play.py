@@ -16,6 +16,7 @@ from poppy_cli.commands.robot import (
     RemoteOpt,
     SimOpt,
     robot_config,
+    start_robot,
 )
 from poppy_cli.options import finite
 from poppy_cli.output import console, err_console, print_json, warn_line
@@ -50,7 +51,6 @@ def play(
         return
     from poppy_core.errors import ConfigError
     from poppy_core.motion import MovePlayer, load_move, move_path
-    from poppy_core.robot import from_config
 
     path = move_path(name)
     move = load_move(path)
@@ -63,7 +63,7 @@ def play(
             field="motors",
             value=missing,
         )
-    with from_config(config, sim=sim, sensors=False) as robot:
+    with start_robot(config, sim) as robot:
         player = MovePlayer(robot, move, speed=speed, backwards=reverse, loops=loop)
         for motor, beyond in player.clamped.items():
             warn_line(

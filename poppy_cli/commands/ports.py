@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import typer
 
 from poppy_cli.output import console, print_json, styled
+
+if TYPE_CHECKING:
+    from rich.text import Text
 
 
 def ports(
@@ -43,7 +48,7 @@ def ports(
     for column in ("port", "adapter", "USB id", "latency", "access", "description"):
         table.add_column(column)
     for p in found:
-        latency = "-" if p.latency_timer_ms is None else f"{p.latency_timer_ms} ms"
+        latency: str | Text = "-" if p.latency_timer_ms is None else f"{p.latency_timer_ms} ms"
         if p.latency_timer_ms is not None and p.latency_timer_ms > 1:
             latency = styled("[yellow]{}[/]", latency)
         access = styled("[green]ok[/]") if p.accessible else styled("[red]denied[/]")

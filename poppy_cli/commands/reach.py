@@ -166,7 +166,7 @@ def reach(
         if wait:
             time.sleep(SETTLE_S)
         reached = [float(v) for v in chain.position] if wait else None
-    result = {
+    result: dict[str, Any] = {
         "chain": chain.name,
         "target": target,
         "angles": angles,

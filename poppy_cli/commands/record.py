@@ -11,7 +11,14 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, robot_config
+from poppy_cli.commands.robot import (
+    ConfigOpt,
+    PortOpt,
+    ProfileOpt,
+    SimOpt,
+    robot_config,
+    start_robot,
+)
 from poppy_cli.options import MAX_DURATION_S, finite
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, print_json
 
@@ -135,7 +142,6 @@ def record(
     from poppy_core.files import output_path, probe_folder
     from poppy_core.motion import MoveRecorder, move_path
     from poppy_core.motion.move_library import is_path
-    from poppy_core.robot import from_config
 
     in_library = output is None and not is_path(name)
     if output is not None:
@@ -153,7 +159,7 @@ def record(
     stop = threading.Event()
     watcher = _install_stop(stop)
     save_failure: FileError | None = None  # the take is still held by the recorder
-    with from_config(config, sim=sim, sensors=False) as robot:
+    with start_robot(config, sim) as robot:
         recorder = MoveRecorder(robot, freq, names, checkpoint_path=path, replace=force,
                                 make_folder=in_library)  # fmt: skip
         recorder.start()  # refused here when another `poppy record` writes the same file

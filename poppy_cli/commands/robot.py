@@ -8,7 +8,16 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.options import MAX_DURATION_S, finite
+from poppy_cli.options import (  # the shared options, also imported from here by commands
+    MAX_DURATION_S,
+    ConfigOpt,
+    JsonOpt,
+    PortOpt,
+    ProfileOpt,
+    RemoteOpt,
+    SimOpt,
+    finite,
+)
 from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
@@ -18,39 +27,11 @@ if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot, RobotConfig
     from poppy_core.robot.startup import ReturnDelayIssue
 
+__all__ = ["ConfigOpt", "JsonOpt", "PortOpt", "ProfileOpt", "RemoteOpt", "SimOpt"]
+
 app = typer.Typer(
     help="Drive a whole robot: status, goto, compliance (a profile, a config file or --sim).",
     no_args_is_help=True,
-)
-
-ProfileOpt = typer.Option(
-    None, "--profile", help="Robot profile, e.g. ergo-jr. [env: POPPY_PROFILE, or user settings]"
-)
-ConfigOpt = typer.Option(None, "--config", "-c", help="Robot config file (JSON or YAML).")
-PortOpt = typer.Option(
-    None, "--port", "-p", help="Serial port of the robot's bus. [env: POPPY_PORT]"
-)
-
-
-def _sim_engine(value: str | None) -> str | None:
-    """Check the engine of ``--sim`` (the root group turns a bare ``--sim`` into ``ideal``)."""
-    if value is not None and value not in ("ideal", "mujoco"):
-        raise typer.BadParameter(f"{value!r}: use --sim (ideal servos) or --sim mujoco (physics)")
-    return value
-
-
-SimOpt = typer.Option(
-    None,
-    "--sim",
-    metavar="[mujoco]",
-    callback=_sim_engine,
-    help="Build a virtual robot: --sim (ideal servos) or --sim mujoco (MuJoCo physics).",
-)
-JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
-RemoteOpt = typer.Option(
-    None,
-    "--remote",
-    help="Drive a robot served by `poppy serve --http` at this URL (token: env POPPY_TOKEN).",
 )
 
 SETTLE_S = 0.1
@@ -63,8 +44,7 @@ def robot_config(profile: str | None, config_file: Path | None, port: str | None
     A port (option, POPPY_PORT or user settings) replaces the port of a one-bus robot.
     """
     from poppy_cli.settings import resolve
-    from poppy_core.errors import ConfigError
-    from poppy_core.robot import RobotConfig, load_config, load_profile
+    from poppy_core.robot import load_config, load_profile, with_ports
 
     chosen = resolve(profile, port)
     if config_file is not None:
@@ -79,16 +59,7 @@ def robot_config(profile: str | None, config_file: Path | None, port: str | None
         raise typer.Exit(EXIT_USAGE)
     if chosen.port is None:
         return config
-    data = config.to_dict()
-    controllers = data["controllers"]
-    if len(controllers) != 1:
-        raise ConfigError(
-            f"--port names one bus but this robot has {len(controllers)} controllers "
-            f"({', '.join(controllers)}): set each port in a config file",
-            field="controllers",
-        )
-    next(iter(controllers.values()))["port"] = chosen.port
-    return RobotConfig.from_dict(data, source="command line")
+    return with_ports(config, chosen.port, source="command line")
 
 
 def build_robot(
@@ -99,23 +70,23 @@ def build_robot(
     *,
     sensors: bool = False,
 ) -> Robot:
-    """Build and start the robot the shared options describe.
+    """Build and start the robot the shared options describe (see :func:`start_robot`)."""
+    return start_robot(robot_config(profile, config_file, port), sim, sensors=sensors)
+
+
+def start_robot(config: RobotConfig, sim: bool | str | None, *, sensors: bool = False) -> Robot:
+    """Build and start the robot of ``config``: the one way every command builds a robot.
 
     A Poppy creature (Ergo Jr, Torso, Humanoid: named by its profile, or recognised by its motor
-    names) gets its behaviours attached (``poppy_core.creatures``).
+    names) gets its behaviours attached (``poppy_core.robot.from_config`` does it).
 
     Motors answering after a return delay above 0 µs slow every transaction: on a terminal the
     user is asked whether to set it to 0; otherwise it is only reported (a warning).
     The config's sensors (cameras) are built only when ``sensors`` (commands that show them).
     """
-    from poppy_core.creatures import from_config
+    from poppy_core.robot import from_config
 
-    return from_config(
-        robot_config(profile, config_file, port),
-        sim=sim or False,
-        fix_return_delay=ask_return_delay,
-        sensors=sensors,
-    )
+    return from_config(config, sim=sim or False, fix_return_delay=ask_return_delay, sensors=sensors)
 
 
 def open_remote(url: str) -> RemoteRobot:
@@ -352,9 +323,7 @@ def goto(
             for name, motor in config.motors.items()
         }
         goals = parse_targets(targets, list(config.motors), limits)
-        from poppy_core.robot import from_config
-
-        robot = from_config(config, sim=sim, sensors=False)
+        robot = start_robot(config, sim)
         wait = wait or bool(sim) or control == "minjerk"
     with robot:
         for name in goals:
@@ -410,9 +379,7 @@ def compliant(
             )
         chosen.extend(n for n in members.get(name, [name]) if n not in chosen)
     if not remote:
-        from poppy_core.robot import from_config
-
-        robot = from_config(config, sim=sim, sensors=False)
+        robot = start_robot(config, sim)
     with robot:
         for name in chosen:
             robot.motor(name).compliant = value

@@ -6,7 +6,14 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.options import BAUD_LIMITS, PORT_HELP, default_port, parse_ids, parse_protocols
+from poppy_cli.options import (
+    MAX_BAUD,
+    MIN_BAUD,
+    PORT_HELP,
+    default_port,
+    parse_ids,
+    parse_protocols,
+)
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
@@ -58,7 +65,8 @@ def scan(
         "--baud",
         "-b",
         help="Baud rate to try (repeat for several). Default: 1000000.",
-        **BAUD_LIMITS,
+        min=MIN_BAUD,
+        max=MAX_BAUD,
     ),
     all_bauds: bool = typer.Option(
         False, "--all-bauds", help="Try every standard baud rate of each protocol."

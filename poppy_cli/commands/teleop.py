@@ -203,10 +203,9 @@ def _check_map(
 
 
 def _build(config: RobotConfig, sim: str | None) -> Robot:
-    from poppy_cli.commands.robot import ask_return_delay
-    from poppy_core.creatures import from_config
+    from poppy_cli.commands.robot import start_robot
 
-    return from_config(config, sim=sim or False, fix_return_delay=ask_return_delay, sensors=False)
+    return start_robot(config, sim)
 
 
 def _remote(url: str, rate: float) -> Any:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import typer
 
-from poppy_cli.options import BAUD_LIMITS
+from poppy_cli.options import MAX_BAUD, MIN_BAUD
 from poppy_cli.output import console
 
 
@@ -40,7 +40,8 @@ def tui(
         "--baud",
         "-b",
         help="Scan --port at this rate only (default: every standard rate).",
-        **BAUD_LIMITS,
+        min=MIN_BAUD,
+        max=MAX_BAUD,
     ),
     protocol: int | None = typer.Option(
         None, "--protocol", min=1, max=2, help="Scan --port in this protocol only (1 or 2)."
@@ -83,14 +84,14 @@ def tui(
 
 @contextmanager
 def mujoco_ergo_jr() -> Iterator[Path]:
-    """A MuJoCo Ergo Jr served on a pty for this process; yields a config file that opens it."""
+    """A MuJoCo Ergo Jr linked in this process (``emu://``); yields a config file that opens it."""
     from poppy_core.robot import load_profile
     from poppy_core.robot.config_io import dump_config
     from poppy_core.robot.factory import start_emulators, start_simulation
 
     config = load_profile("ergo-jr")
     simulation = start_simulation(config)
-    servers = start_emulators(config, simulation)
+    servers = start_emulators(config, simulation, in_process=True)
     try:
         simulation.start()
         data = config.to_dict()

@@ -72,9 +72,9 @@ class PoppyApp(App[None]):
         protocols = [self.start_protocol] if self.start_protocol else None
         port = self.start_port
         if self.sim:
-            from poppy_core.emulator import ergo_jr_bus, serve_pty
+            from poppy_core.emulator import ergo_jr_bus, serve_link
 
-            self.emulator = serve_pty(ergo_jr_bus())
+            self.emulator = serve_link(ergo_jr_bus())
             port, baudrates, protocols = self.emulator.url, [1_000_000], [2]
             self.main.query_one(RobotPanel).open("ergo-jr", True)
         if self.robot_source is not None:

@@ -8,15 +8,13 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 
-from poppy_core.bus import DxlBus, Transport, is_virtual_port
+from poppy_core.bus import DxlBus, Transport
 from poppy_core.errors import PoppyError, RegisterError, SetupError
 from poppy_core.models import Register, ServoModel, model_by_name
 
 logger = logging.getLogger(__name__)
 
 SIValue = float | int | bool | str
-# An emulator in this process shares the interpreter with the UI: give its replies more time.
-VIRTUAL_TIMEOUT_S = 0.25
 LIVE_REGISTERS = (
     "present_position",
     "present_speed",
@@ -115,14 +113,7 @@ class BusPool:
             if transport is None:
                 transport = Transport(motor.port)
                 self._transports[motor.port] = transport
-            reply_s = VIRTUAL_TIMEOUT_S if is_virtual_port(motor.port) else None
-            yield DxlBus(
-                motor.port,
-                motor.baudrate,
-                motor.protocol,
-                transport=transport,
-                timeout_s=reply_s,
-            )
+            yield DxlBus(motor.port, motor.baudrate, motor.protocol, transport=transport)
         except PoppyError:
             self._drop(motor.port)
             raise

@@ -3,6 +3,7 @@
 from poppy_core.bus.core import is_alarm_only
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.dxlio import Dxl320IO, DxlIO, get_available_ports
+from poppy_core.bus.line import Line, LineOpener, SerialLine, open_line, register_scheme
 from poppy_core.bus.ports import (
     KNOWN_ADAPTERS,
     PortInfo,
@@ -37,10 +38,13 @@ __all__ = [
     "DxlBus",
     "DxlIO",
     "FoundMotor",
+    "Line",
+    "LineOpener",
     "LinkTiming",
     "PingResult",
     "PortInfo",
     "ScanProgress",
+    "SerialLine",
     "SetupResult",
     "Transport",
     "change_baudrate",
@@ -56,11 +60,13 @@ __all__ = [
     "latency_advice",
     "list_ports",
     "locate",
+    "open_line",
     "port_error",
     "port_info",
     "read_ftdi_latency_ms",
     "reboot",
     "recognise_adapter",
+    "register_scheme",
     "reset_motor",
     "scan",
     "set_angle_limits",

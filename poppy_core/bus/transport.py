@@ -1,88 +1,46 @@
-"""Byte transport over pyserial (device, pty, socket://, loop://) reading whole status packets."""
+"""Transport: whole status packets read off any ``Line`` (pyserial, the in-process link)."""
 
 from __future__ import annotations
 
-import errno
-import logging
-import os
-import select
-import socket
-import sys
-import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any
 
-import serial
-
-from poppy_core.bus.ports import DIALOUT_ADVICE
+from poppy_core.bus.line import Line, open_line, port_error
 from poppy_core.bus.timing import Deadline
-from poppy_core.errors import PortError
 from poppy_core.protocol import PacketDecoder, StatusPacket
 
-logger = logging.getLogger(__name__)
-
-# Without a file descriptor to wait on (loop://, Windows), poll the input buffer this often.
-POLL_INTERVAL_S = 0.0002
-_READ_CHUNK = 4096
-
-
-def port_error(port: str, exc: BaseException) -> PortError:
-    """Turn a pyserial/OS error raised while opening ``port`` into a one-line ``PortError``.
-
-    Args:
-        port: the device path or URL.
-        exc: the exception pyserial raised.
-
-    Returns:
-        A ``PortError`` whose message says what to do.
-    """
-    code = getattr(exc, "errno", None)
-    text = str(exc)
-    lowered = text.lower()
-    if code == errno.ENOENT or "no such file" in lowered or "filenotfounderror" in lowered:
-        message = f"no such port {port}: plug the adapter or run `poppy ports`"
-    elif code == errno.EBUSY or "busy" in lowered or "exclusively lock" in lowered:
-        message = (
-            f"{port} is busy: another program (another poppy, Dynamixel Wizard, a serial "
-            "monitor) has it open; close it and retry"
-        )
-    elif code in (errno.EACCES, errno.EPERM) or "permission" in lowered or "denied" in lowered:
-        if sys.platform.startswith("linux"):
-            message = f"permission denied on {port}: {DIALOUT_ADVICE}"
-        elif sys.platform.startswith("win"):
-            message = f"{port} is busy or access is denied: close any program using it and retry"
-        else:
-            message = f"permission denied on {port}: check that your user may open it"
-    elif "refused" in lowered or code == errno.ECONNREFUSED:
-        message = f"nothing answers at {port}: start the emulator or server, or check host and port"
-    else:
-        message = f"cannot open {port}: {text}"
-    return PortError(message, port=port)
+__all__ = ["Transport", "port_error"]
 
 
 class Transport:
     """A serial line that writes instruction bytes and reads decoded status packets.
 
-    Opens ``serial.serial_for_url(port, baudrate)``, so it works with a device path
-    (``/dev/ttyUSB0``, ``COM3``), a pty path, ``socket://host:port`` or ``loop://``. Reads never
-    block past the given deadline: it waits on the port's file descriptor when there is one and
-    polls ``in_waiting`` otherwise.
+    The bytes travel on a :class:`~poppy_core.bus.line.Line` opened from ``port``: a device
+    path (``/dev/ttyUSB0``, ``COM3``), a pty path, ``socket://host:port``, ``loop://`` (pyserial)
+    or a registered scheme such as the emulator's in-process ``emu://NAME``. Reads never block
+    past the given deadline, whatever the line.
 
     Attributes:
         port: the device path or URL.
     """
 
     def __init__(
-        self, port: str, baudrate: int = 1_000_000, protocol: int = 1, *, exclusive: bool = True
+        self,
+        port: str,
+        baudrate: int = 1_000_000,
+        protocol: int = 1,
+        *,
+        exclusive: bool = True,
+        line: Line | None = None,
     ) -> None:
         """Open the port.
 
         Args:
-            port: device path or pyserial URL.
+            port: device path or URL.
             baudrate: line speed in bit/s.
             protocol: Dynamixel protocol of the status packets to decode (1 or 2).
             exclusive: lock a device path against other programs (POSIX ``flock``).
+            line: an open line to use instead of opening ``port`` (closed with the transport).
 
         Raises:
             PortError: the port is missing, busy or not accessible.
@@ -92,32 +50,14 @@ class Transport:
         self._packets: deque[StatusPacket] = deque()
         self.bytes_received = 0
         """Bytes read from the line since the port was opened."""
-        kwargs: dict[str, Any] = {"baudrate": baudrate, "timeout": 0, "do_not_open": True}
-        if exclusive and "://" not in port and os.name == "posix":
-            kwargs["exclusive"] = True
-        try:
-            self._serial = serial.serial_for_url(port, **kwargs)
-            self._serial.open()
-        except (serial.SerialException, OSError, ValueError) as exc:
-            raise port_error(port, exc) from exc
-        # socket://: send each small instruction at once (Nagle would hold it until the previous
-        # segment is acknowledged, up to the peer's delayed-ACK time of ~40 ms).
-        sock = getattr(self._serial, "_socket", None)
-        if isinstance(sock, socket.socket):
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self._fd: int | None = None
-        try:
-            self._fd = int(self._serial.fileno())
-        except (AttributeError, NotImplementedError, OSError, ValueError, TypeError):
-            self._fd = None
-        logger.debug("opened %s at %d bps (fd %s)", port, baudrate, self._fd)
+        self._line = line if line is not None else open_line(port, baudrate, exclusive=exclusive)
 
     # -- configuration ------------------------------------------------------------------------
 
     @property
     def baudrate(self) -> int:
         """Current line speed in bit/s."""
-        return int(self._serial.baudrate)
+        return self._line.baudrate
 
     def set_baudrate(self, baudrate: int) -> None:
         """Change the line speed and drop any received bytes.
@@ -125,12 +65,7 @@ class Transport:
         Raises:
             PortError: the OS refused the rate.
         """
-        try:
-            self._serial.baudrate = baudrate
-        except (serial.SerialException, OSError, ValueError) as exc:
-            raise PortError(
-                f"cannot set {self.port} to {baudrate} bps: {exc}", port=self.port
-            ) from exc
+        self._line.set_baudrate(baudrate)
         self.reset_input_buffer()
 
     @property
@@ -157,9 +92,14 @@ class Transport:
     @property
     def is_open(self) -> bool:
         """True until ``close``."""
-        return bool(self._serial.is_open)
+        return self._line.is_open
 
     # -- I/O --------------------------------------------------------------------------------------
+
+    @property
+    def line(self) -> Line:
+        """The byte line under this transport."""
+        return self._line
 
     def write(self, data: bytes) -> None:
         """Send bytes on the line.
@@ -167,29 +107,11 @@ class Transport:
         Raises:
             PortError: the port went away (adapter unplugged, server closed).
         """
-        try:
-            self._serial.write(data)
-        except (serial.SerialException, OSError) as exc:
-            raise PortError(f"lost {self.port} while writing: {exc}", port=self.port) from exc
+        self._line.write(data)
 
     def _read_available(self, wait_s: float | None) -> bytes:
         """Wait up to ``wait_s`` (None: forever) for bytes and return what is there."""
-        try:
-            if self._fd is not None:
-                ready, _, _ = select.select([self._fd], [], [], wait_s)
-                if not ready:
-                    return b""
-                return bytes(self._serial.read(_READ_CHUNK))
-            end = None if wait_s is None else time.monotonic() + wait_s
-            while True:
-                waiting = int(self._serial.in_waiting)
-                if waiting:
-                    return bytes(self._serial.read(waiting))
-                if end is not None and time.monotonic() >= end:
-                    return b""
-                time.sleep(POLL_INTERVAL_S)
-        except (serial.SerialException, OSError) as exc:
-            raise PortError(f"lost {self.port} while reading: {exc}", port=self.port) from exc
+        return self._line.read(wait_s)
 
     def read_packet(
         self,
@@ -248,18 +170,13 @@ class Transport:
 
     def reset_input_buffer(self) -> None:
         """Drop every received byte and partial packet."""
-        try:
-            self._serial.reset_input_buffer()
-        except (serial.SerialException, OSError) as exc:
-            raise PortError(f"lost {self.port}: {exc}", port=self.port) from exc
+        self._line.reset_input()
         self._packets.clear()
         self._decoder.reset()
 
     def close(self) -> None:
         """Close the port (idempotent)."""
-        if self._serial.is_open:
-            self._serial.close()
-            logger.debug("closed %s", self.port)
+        self._line.close()
 
     def __enter__(self) -> Transport:
         return self

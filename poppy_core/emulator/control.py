@@ -27,7 +27,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
 
-from poppy_core.emulator.server import EmulatorServer
+from poppy_core.emulator.server import Endpoint
 
 logger = logging.getLogger(__name__)
 
@@ -102,7 +102,7 @@ class EmulatorControl:
 
     def __init__(
         self,
-        servers: Mapping[str, EmulatorServer],
+        servers: Mapping[str, Endpoint],
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.servers = dict(servers)
@@ -141,7 +141,7 @@ class EmulatorControl:
             raise ControlError(f"unknown command {words[0]!r}; {HELP}")
         return handler(args)
 
-    def _server_of_motor(self, motor_id: int) -> EmulatorServer:
+    def _server_of_motor(self, motor_id: int) -> Endpoint:
         for server in self.servers.values():
             if any(m.id == motor_id for m in server.bus.motors):
                 return server

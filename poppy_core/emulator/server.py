@@ -9,15 +9,51 @@ import socket
 import time
 import tty
 from pathlib import Path
+from typing import Protocol
 
 from poppy_core.emulator.bus import VirtualBus
 from poppy_core.emulator.linespeed import read_pty_baudrate
+from poppy_core.emulator.link import LinkServer
 from poppy_core.emulator.serving import CHUNK, RESET, EmulatorServer
 from poppy_core.errors import PortError
 
-__all__ = ["EmulatorServer", "PtyServer", "TcpServer", "serve_pty", "serve_tcp"]
+__all__ = [
+    "EmulatorServer",
+    "Endpoint",
+    "LinkServer",
+    "PtyServer",
+    "TcpServer",
+    "serve_pty",
+    "serve_tcp",
+]
 
 logger = logging.getLogger(__name__)
+
+
+class Endpoint(Protocol):
+    """What serves a ``VirtualBus``: a pty/TCP ``EmulatorServer`` or an in-process link."""
+
+    bus: VirtualBus
+    url: str
+    replies_dropped: int
+
+    @property
+    def running(self) -> bool:
+        """True while serving."""
+        ...
+
+    @property
+    def connected(self) -> bool:
+        """False while the line is down."""
+        ...
+
+    def stop(self) -> None:
+        """Stop serving (idempotent)."""
+        ...
+
+    def lose(self, duration_s: float) -> None:
+        """Take the line away for ``duration_s`` seconds."""
+        ...
 
 
 class PtyServer(EmulatorServer):

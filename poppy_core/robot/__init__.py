@@ -23,7 +23,13 @@ from poppy_core.robot.config import (
     RobotConfig,
 )
 from poppy_core.robot.config_io import config_to_text, dump_config, load_config
-from poppy_core.robot.factory import autodetect, from_config, from_profile, start_emulators
+from poppy_core.robot.factory import (
+    autodetect,
+    from_config,
+    from_profile,
+    start_emulators,
+    with_ports,
+)
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.group import MotorGroup
 from poppy_core.robot.health import BusHealth
@@ -100,4 +106,5 @@ __all__ = [
     "save_user_profile",
     "start_emulators",
     "user_profile_dir",
+    "with_ports",
 ]

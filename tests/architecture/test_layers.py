@@ -9,9 +9,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 
-# room -> rooms of ours it may import (ARCHITECTURE.md); `errors`, `files` (safe writes) and
-# `documents` (bounded JSON/YAML reads) are leaves every room may use.
-LEAVES = {"errors", "files", "documents"}
+# room -> rooms of ours it may import (ARCHITECTURE.md); `errors`, `files` (safe writes),
+# `documents` (bounded JSON/YAML reads) and `line` (the byte-line contract and its URL schemes)
+# are leaves every room may use.
+LEAVES = {"errors", "files", "documents", "line"}
 ALLOWED: dict[str, set[str]] = {
     "protocol": set(),
     "models": {"protocol"},

@@ -1,35 +1,21 @@
-"""Fixtures for the bus tests: virtual motors served on a real pty or a TCP socket."""
+"""Fixtures for the bus tests: virtual motors on the in-process link, a real pty or a TCP socket."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from contextlib import AbstractContextManager, contextmanager
-from typing import Any
-
 import pytest
 
-from poppy_core.emulator import VirtualBus, build_bus_from_spec, serve_pty, serve_tcp
+from tests.helpers.bus import Emulate, emulate_bus
 
-Emulate = Callable[..., AbstractContextManager[tuple[VirtualBus, str]]]
-
-
-@contextmanager
-def _emulate(
-    spec: str, *, via: str = "pty", baudrate: int = 1_000_000, **options: Any
-) -> Iterator[tuple[VirtualBus, str]]:
-    bus = build_bus_from_spec(spec, baudrate=baudrate, **options)
-    server = serve_pty(bus) if via == "pty" else serve_tcp(bus)
-    with server:
-        yield bus, server.url
+__all__ = ["Emulate"]
 
 
 @pytest.fixture
 def emulate() -> Emulate:
-    """``with emulate("MX-28:1-3", via="tcp") as (virtual_bus, url): ...``."""
-    return _emulate
+    """``with emulate("MX-28:1-3", via="tcp") as (virtual_bus, url): ...`` (default: ``"link"``)."""
+    return emulate_bus
 
 
-@pytest.fixture(params=["pty", "tcp"])
+@pytest.fixture(params=["link", "pty", "tcp"])
 def via(request: pytest.FixtureRequest) -> str:
-    """Run a test over a pty and over socket://."""
+    """Run a test over the in-process link, a pty and socket://."""
     return str(request.param)

@@ -16,7 +16,7 @@ MX_GOAL, MX_PRESENT = 30, 36
 X_GOAL, X_PRESENT = 116, 132
 
 if TYPE_CHECKING:
-    from tests.bus.conftest import Emulate
+    from tests.helpers.bus import Emulate
 
 
 def test_ping_read_write(emulate: Emulate, via: str) -> None:

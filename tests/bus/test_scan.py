@@ -12,7 +12,7 @@ from poppy_core.bus import FoundMotor, ScanProgress, find_port, scan
 from poppy_core.errors import PortError, SetupError
 
 if TYPE_CHECKING:
-    from tests.bus.conftest import Emulate
+    from tests.helpers.bus import Emulate
 
 
 def _ids(found: list[FoundMotor]) -> list[tuple[int, str | None, int, int]]:

@@ -20,7 +20,7 @@ from poppy_core.errors import RegisterError, SetupError
 from poppy_core.models import MX_28, ServoModel, SIValue
 
 if TYPE_CHECKING:
-    from tests.bus.conftest import Emulate
+    from tests.helpers.bus import Emulate
 
 
 def test_change_id_verified(emulate: Emulate, via: str) -> None:

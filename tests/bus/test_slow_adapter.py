@@ -12,7 +12,7 @@ from poppy_core.errors import PortError
 from poppy_core.models import model_by_name
 
 if TYPE_CHECKING:
-    from tests.bus.conftest import Emulate
+    from tests.helpers.bus import Emulate
 
 SLOW = {"wire_timing": True, "latency_s": 0.008}  # an adapter holding replies 8 ms
 

@@ -2,39 +2,16 @@
 
 from __future__ import annotations
 
-import json
-import os
 import signal
 import subprocess
-import sys
 from collections.abc import Iterator
-from dataclasses import dataclass
 from typing import Any
 
 import pytest
 
-POPPY = [sys.executable, "-m", "poppy_cli"]
+from tests.helpers.cli import POPPY, Result, run_poppy
 
-
-@dataclass
-class Result:
-    """What a `poppy` run printed and returned."""
-
-    code: int
-    stdout: str
-    stderr: str
-
-    def json(self) -> Any:
-        return json.loads(self.stdout)
-
-
-def run_poppy(*args: str, timeout: float = 60, input: str | None = None) -> Result:
-    """Run `poppy ARGS...` and capture its output."""
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    proc = subprocess.run(
-        [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=env, input=input
-    )
-    return Result(proc.returncode, proc.stdout, proc.stderr)
+__all__ = ["POPPY", "Result", "run_poppy"]
 
 
 class Emulator:

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 import yaml
 
-from tests.cli.conftest import POPPY
+from tests.helpers.cli import POPPY
 
 
 @pytest.fixture(autouse=True)

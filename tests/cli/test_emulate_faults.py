@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from tests.cli.conftest import POPPY
+from tests.helpers.cli import POPPY
 
 
 def _ids(poppy: Any, port: str) -> list[int]:

@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 
 from poppy_core.motion import read_move
-from tests.cli.conftest import POPPY
+from tests.helpers.cli import POPPY
 
 SIM = ("--sim", "--profile", "ergo-jr")
 

@@ -16,7 +16,7 @@ from poppy_core.emulator import EmulatorServer, VirtualBus, serve_pty
 from poppy_core.motion import read_move
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
-from tests.cli.conftest import POPPY, Result
+from tests.helpers.cli import POPPY, Result
 
 
 @pytest.fixture(autouse=True)

@@ -6,13 +6,13 @@ ones: checksums, CRCs, byte stuffing, status layouts, sync/bulk/fast-sync replie
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Any
 
 import pytest
 
 from poppy_core.emulator import EmulatorServer, VirtualBus, build_bus_from_spec, serve_pty
+from tests.helpers import eventually
 
 sdk: Any = pytest.importorskip("dynamixel_sdk")
 
@@ -32,15 +32,6 @@ class SdkSession:
     def close(self) -> None:
         self.port.closePort()
 
-
-def eventually(predicate: Callable[[], bool], timeout_s: float = 1.0) -> bool:
-    """Broadcast writes get no reply: wait until the emulator thread has applied them."""
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.005)
-    return True
 
 
 def reg(bus: VirtualBus, motor_id: int, name: str) -> tuple[int, int]:

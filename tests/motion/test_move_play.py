@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +14,7 @@ import pytest
 from poppy_core.errors import ConfigError
 from poppy_core.motion import Move, MovePlayer, MoveRecorder, PlayProgress, read_move
 from poppy_core.robot import Robot, from_profile
+from tests.helpers import eventually
 
 CONTROLLER = "my_dxl_controller"
 TOLERANCE_DEG = 1.0  # the bound between playback and recording
@@ -28,12 +29,6 @@ def ergo() -> Iterator[Robot]:
     finally:
         robot.close()
 
-
-def eventually(check: Callable[[], bool], timeout_s: float = 2.0) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline and not check():
-        time.sleep(0.01)
-    return check()
 
 
 def virtual_position(robot: Robot, name: str) -> float:

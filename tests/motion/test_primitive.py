@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 import pytest
 
@@ -21,16 +21,7 @@ from poppy_core.motion import (
     primitive_manager,
 )
 from poppy_core.robot import Robot, from_profile
-
-
-def eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
-    """Poll ``check`` until it holds (True) or the timeout runs out (False)."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if check():
-            return True
-        time.sleep(0.01)
-    return check()
+from tests.helpers import eventually
 
 
 def state(primitive: Primitive) -> str:
@@ -40,7 +31,7 @@ def state(primitive: Primitive) -> str:
 
 @pytest.fixture
 def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True)
+    robot = from_profile("ergo-jr", sim=True, creature=False)  # no Ergo Jr primitives
     try:
         yield robot
     finally:

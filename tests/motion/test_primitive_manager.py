@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 
 import pytest
 
@@ -17,21 +17,12 @@ from poppy_core.motion import (
     primitive_manager,
 )
 from poppy_core.robot import Robot, from_profile
-
-
-def eventually(check: Callable[[], bool], timeout_s: float = 3.0) -> bool:
-    """Poll ``check`` until it holds (True) or the timeout runs out (False)."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if check():
-            return True
-        time.sleep(0.01)
-    return check()
+from tests.helpers import eventually
 
 
 @pytest.fixture
 def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True)
+    robot = from_profile("ergo-jr", sim=True, creature=False)  # no Ergo Jr primitives
     robot.compliant = False
     try:
         yield robot

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core.emulator import EmulatorServer, VirtualBus, serve_pty, serve_tcp
+from poppy_core.emulator import Endpoint, VirtualBus, serve_link, serve_pty, serve_tcp
 from poppy_core.robot import Robot, from_profile, load_profile
 from poppy_core.robot.factory import virtual_buses
 
@@ -30,12 +30,17 @@ def ergo_jr_virtual() -> VirtualBus:
     return bus
 
 
-@pytest.fixture(params=["tcp", "pty link"])
-def served(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[tuple[EmulatorServer, str]]:
-    """An Ergo Jr bus served on TCP, or on a pty through a symlink (as /dev/serial/by-id)."""
+@pytest.fixture(params=["tcp", "pty link", "in-process"])
+def served(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[tuple[Endpoint, str]]:
+    """An Ergo Jr bus served on TCP, on a pty through a symlink (as /dev/serial/by-id), or
+    linked in this process (``emu://``)."""
     virtual = ergo_jr_virtual()
+    server: Endpoint
     if request.param == "tcp":
         server = serve_tcp(virtual)
+        port = server.url
+    elif request.param == "in-process":
+        server = serve_link(virtual)
         port = server.url
     else:
         port = str(tmp_path / "ttyDXL")
@@ -50,7 +55,7 @@ def sync_warnings(caplog: pytest.LogCaptureFixture, text: str) -> list[str]:
     return [message for message in warnings if text in message]
 
 
-def test_health_of_a_healthy_robot(served: tuple[EmulatorServer, str]) -> None:
+def test_health_of_a_healthy_robot(served: tuple[Endpoint, str]) -> None:
     _, port = served
     with from_profile("ergo-jr", port=port, sensors=False) as robot:
         assert until(lambda: robot.health()["my_dxl_controller"].loop_hz["present"] > 0)
@@ -63,7 +68,7 @@ def test_health_of_a_healthy_robot(served: tuple[EmulatorServer, str]) -> None:
 
 
 def test_a_lost_bus_is_loud_then_comes_back(
-    served: tuple[EmulatorServer, str], caplog: pytest.LogCaptureFixture
+    served: tuple[Endpoint, str], caplog: pytest.LogCaptureFixture
 ) -> None:
     server, port = served
     caplog.set_level(logging.WARNING, logger="poppy_core.robot.sync")

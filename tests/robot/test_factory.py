@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core.emulator import VirtualBus, VirtualMotor, serve_pty
+from poppy_core.emulator import VirtualBus, VirtualMotor, serve_link
 from poppy_core.emulator.server import EmulatorServer
 from poppy_core.errors import SetupError
 from poppy_core.models import model_by_name
@@ -45,7 +45,7 @@ def served() -> Iterator[list[EmulatorServer]]:
 
 
 def serve(servers: list[EmulatorServer], bus: VirtualBus) -> str:
-    server = serve_pty(bus)
+    server = serve_link(bus)
     servers.append(server)
     return str(server.url)
 

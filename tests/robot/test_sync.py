@@ -7,7 +7,7 @@ from collections.abc import Iterator
 import pytest
 
 from poppy_core.bus import DxlBus
-from poppy_core.emulator import VirtualBus, VirtualMotor, serve_pty
+from poppy_core.emulator import VirtualBus, VirtualMotor, serve_link
 from poppy_core.models import model_by_name
 from poppy_core.robot import BASE_LOOPS, BusSync, Motor, loops_for
 from poppy_core.robot.schedule import Periodic, RateMeter
@@ -55,7 +55,7 @@ def line() -> Iterator[tuple[VirtualBus, DxlBus]]:
         VirtualMotor(model_by_name("MX-28"), 2, 1_000_000),
     ]
     virtual = VirtualBus(motors, 1, adapter="usb2ax")
-    server = serve_pty(virtual)
+    server = serve_link(virtual)
     bus = DxlBus(server.url, 1_000_000, 1)
     yield virtual, bus
     bus.close()

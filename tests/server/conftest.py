@@ -4,23 +4,13 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterator
-from dataclasses import dataclass
-from typing import Any
 
 import httpx
 import pytest
 
-from poppy_core.robot import Robot, from_profile
-from poppy_core.server import ServerThread, create_app
+from tests.helpers.server import Served, serve
 
-
-@dataclass
-class Served:
-    """A served robot: its URL, the robot itself and the app."""
-
-    url: str
-    robot: Robot
-    app: Any
+__all__ = ["Served", "serve"]  # for tests of other helpers that still import them from here
 
 
 @pytest.fixture(scope="module")
@@ -34,18 +24,6 @@ def moves_folder(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
         os.environ.pop("POPPY_MOVES_DIR", None)
     else:
         os.environ["POPPY_MOVES_DIR"] = old
-
-
-def serve(moves_folder: str, **options: Any) -> Iterator[Served]:
-    """Serve a fresh virtual Ergo Jr until the generator is closed."""
-    robot = from_profile("ergo-jr", sim=True)
-    app = create_app(robot, **options)
-    server = ServerThread(app).start()
-    try:
-        yield Served(server.url, robot, app)
-    finally:
-        server.stop()
-        robot.close()
 
 
 @pytest.fixture(scope="module")

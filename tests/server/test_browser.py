@@ -22,7 +22,7 @@ from typing import Any
 import pytest
 
 from poppy_core.server import OriginPolicy
-from tests.server.conftest import Served, serve
+from tests.helpers.server import Served, serve
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="needs Debian's chromium")

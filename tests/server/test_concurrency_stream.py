@@ -12,7 +12,7 @@ import httpx
 import pytest
 from websockets.sync.client import connect
 
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 
 def test_gets_are_answered_while_a_waiting_goto_runs(served: Served, client: httpx.Client) -> None:

@@ -16,7 +16,7 @@ from websockets.exceptions import ConnectionClosedError
 from websockets.sync.client import connect
 
 from poppy_core.motion import Primitive, attach_primitive
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 DIGITS_5000 = "1" + "0" * 5000
 DIGITS_400 = "1" + "0" * 400

@@ -9,7 +9,7 @@ import schemathesis
 from hypothesis import HealthCheck, settings
 from schemathesis.checks import not_a_server_error
 
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 
 @pytest.fixture(scope="module")

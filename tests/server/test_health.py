@@ -7,7 +7,7 @@ import time
 import httpx
 
 from poppy_core.remote import RemoteRobot
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 
 def test_health_route(client: httpx.Client, served: Served) -> None:

@@ -20,7 +20,7 @@ from websockets.sync.client import connect
 
 from poppy_core.server import OriginPolicy
 from poppy_core.server.origins import Verdict, is_ip, is_loopback, normalize_origin, split_host
-from tests.server.conftest import Served, serve
+from tests.helpers.server import Served, serve
 
 EVIL = "https://evil.example"
 SNAP = "https://snap.berkeley.edu"

@@ -7,7 +7,7 @@ import time
 import httpx
 import pytest
 
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 MOTORS = ["m1", "m2", "m3", "m4", "m5", "m6"]
 

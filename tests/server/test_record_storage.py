@@ -18,7 +18,7 @@ from poppy_core.robot import from_profile
 from poppy_core.server import moves as moves_module
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
-from tests.server.conftest import Served, serve
+from tests.helpers.server import Served, serve
 
 
 def test_a_failed_save_keeps_the_recording(

@@ -9,7 +9,7 @@ from pathlib import Path
 import httpx
 import pytest
 
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 
 def test_record_save_list_play_stop_delete(

@@ -8,7 +8,7 @@ import pytest
 
 from poppy_core.errors import CommunicationError, ConfigError, RegisterError
 from poppy_core.remote import RemoteRobot
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 
 @pytest.fixture

@@ -10,7 +10,7 @@ from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
 from poppy_core.server import OriginPolicy
-from tests.server.conftest import Served, serve
+from tests.helpers.server import Served, serve
 
 TOKEN = "s3cret-token"
 

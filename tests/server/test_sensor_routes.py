@@ -7,7 +7,7 @@ import httpx
 import numpy as np
 import pytest
 
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 cv2 = pytest.importorskip("cv2")
 

@@ -7,7 +7,7 @@ import time
 import httpx
 import pytest
 
-from tests.server.conftest import Served
+from tests.helpers.server import Served
 
 
 def test_openapi_documents_v1(client: httpx.Client) -> None:

@@ -6,12 +6,8 @@ from collections.abc import Iterator
 
 import pytest
 
-from poppy_core.robot import Robot, from_profile
-
-
-def ergo_jr() -> Robot:
-    """A simulated Ergo Jr without its camera."""
-    return from_profile("ergo-jr", sim=True, sensors=False)
+from poppy_core.robot import Robot
+from tests.helpers.robots import sim_ergo_jr as ergo_jr
 
 
 @pytest.fixture

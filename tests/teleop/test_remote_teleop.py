@@ -19,7 +19,7 @@ from poppy_core.motion.teleop import teleoperate
 from poppy_core.remote import RemoteFollower
 from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app
-from tests.teleop.conftest import ergo_jr
+from tests.helpers.robots import sim_ergo_jr as ergo_jr
 from tests.teleop.hands import wait_for
 from tests.teleop.test_teleoperate import Waving
 

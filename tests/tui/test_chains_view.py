@@ -7,7 +7,7 @@ from textual.widgets import DataTable, Input  # noqa: TID253  (a TUI test)
 
 from poppy_cli.tui.app import PoppyApp, make_app
 from poppy_cli.tui.widgets.robot_panel import RobotPanel
-from tests.tui.conftest import no_ports, run_async, wait_for
+from tests.helpers.tui import no_ports, run_async, wait_for
 
 SIZE = (80, 24)
 

@@ -13,8 +13,8 @@ from poppy_cli.tui.widgets.control_table import ControlTable
 from poppy_cli.tui.widgets.live import LivePanel
 from poppy_cli.tui.widgets.motor_panel import MotorPanel
 from poppy_cli.tui.widgets.motor_tree import MotorTree
-from poppy_core.emulator import EmulatorServer
-from tests.tui.conftest import no_ports, run_async, wait_for
+from poppy_core.emulator import Endpoint
+from tests.helpers.tui import no_ports, run_async, wait_for
 
 SIZE = (100, 40)
 
@@ -42,7 +42,7 @@ async def open_motor(pilot: object, screen: MainScreen, motor_id: int) -> MotorP
 
 
 @run_async
-async def test_scan_finds_the_virtual_motors(xl320_server: EmulatorServer) -> None:
+async def test_scan_finds_the_virtual_motors(xl320_server: Endpoint) -> None:
     app = make_app(xl320_server.url, 1_000_000, 2, port_lister=no_ports, live_period_s=0)
     async with app.run_test(size=SIZE) as pilot:
         screen = app.main
@@ -53,7 +53,7 @@ async def test_scan_finds_the_virtual_motors(xl320_server: EmulatorServer) -> No
 
 
 @run_async
-async def test_id_change_lands_on_the_emulator(xl320_server: EmulatorServer) -> None:
+async def test_id_change_lands_on_the_emulator(xl320_server: Endpoint) -> None:
     app = make_app(xl320_server.url, 1_000_000, 2, port_lister=no_ports, live_period_s=0)
     async with app.run_test(size=SIZE) as pilot:
         screen = app.main
@@ -73,7 +73,7 @@ async def test_id_change_lands_on_the_emulator(xl320_server: EmulatorServer) -> 
 
 
 @run_async
-async def test_goal_dial_moves_the_virtual_motor(xl320_server: EmulatorServer) -> None:
+async def test_goal_dial_moves_the_virtual_motor(xl320_server: Endpoint) -> None:
     app = make_app(xl320_server.url, 1_000_000, 2, port_lister=no_ports)
     async with app.run_test(size=SIZE) as pilot:
         screen = app.main
@@ -98,7 +98,7 @@ async def test_goal_dial_moves_the_virtual_motor(xl320_server: EmulatorServer) -
 
 
 @run_async
-async def test_eeprom_edit_with_torque_on_is_refused(xl320_server: EmulatorServer) -> None:
+async def test_eeprom_edit_with_torque_on_is_refused(xl320_server: Endpoint) -> None:
     app = make_app(xl320_server.url, 1_000_000, 2, port_lister=no_ports, live_period_s=0)
     notes: list[str] = []
     async with app.run_test(size=SIZE) as pilot:
@@ -127,7 +127,7 @@ async def test_eeprom_edit_with_torque_on_is_refused(xl320_server: EmulatorServe
 
 
 @run_async
-async def test_bad_value_stays_in_the_modal(xl320_server: EmulatorServer) -> None:
+async def test_bad_value_stays_in_the_modal(xl320_server: Endpoint) -> None:
     app = make_app(xl320_server.url, 1_000_000, 2, port_lister=no_ports, live_period_s=0)
     async with app.run_test(size=SIZE) as pilot:
         screen = app.main
@@ -145,7 +145,7 @@ async def test_bad_value_stays_in_the_modal(xl320_server: EmulatorServer) -> Non
 
 
 @run_async
-async def test_multi_apply_writes_every_marked_motor(xl320_server: EmulatorServer) -> None:
+async def test_multi_apply_writes_every_marked_motor(xl320_server: Endpoint) -> None:
     app = make_app(xl320_server.url, 1_000_000, 2, port_lister=no_ports, live_period_s=0)
     async with app.run_test(size=SIZE) as pilot:
         screen = app.main
@@ -165,7 +165,7 @@ async def test_multi_apply_writes_every_marked_motor(xl320_server: EmulatorServe
 
 
 @run_async
-async def test_reboot_asks_first(xl320_server: EmulatorServer) -> None:
+async def test_reboot_asks_first(xl320_server: Endpoint) -> None:
     app = make_app(xl320_server.url, 1_000_000, 2, port_lister=no_ports, live_period_s=0)
     async with app.run_test(size=SIZE) as pilot:
         screen = app.main
@@ -178,7 +178,7 @@ async def test_reboot_asks_first(xl320_server: EmulatorServer) -> None:
 
 
 @run_async
-async def test_abort_stops_a_scan(xl320_server: EmulatorServer) -> None:
+async def test_abort_stops_a_scan(xl320_server: Endpoint) -> None:
     app = make_app(xl320_server.url, port_lister=no_ports, live_period_s=0)  # every rate, both
     async with app.run_test(size=SIZE) as pilot:
         screen = app.main

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from textual.widgets import DataTable  # noqa: TID253  (a TUI test)
 
-from tests.tui.conftest import run_async, wait_for
+from tests.helpers.tui import run_async, wait_for
 from tests.tui.test_robot_tab import SIZE, hand, open_sim, sim_app
 
 

@@ -12,7 +12,7 @@ from poppy_cli.tui.app import PoppyApp, make_app
 from poppy_cli.tui.widgets.robot_panel import RobotPanel
 from poppy_core.motion import MOVES_DIR_ENV, Primitive, attach_primitive, load_move
 from poppy_core.robot import Robot
-from tests.tui.conftest import no_ports, run_async, wait_for
+from tests.helpers.tui import no_ports, run_async, wait_for
 
 SIZE = (80, 24)
 

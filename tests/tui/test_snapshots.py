@@ -18,7 +18,7 @@ from poppy_cli.tui.widgets.robot_panel import RobotPanel
 from poppy_core.bus import PortInfo
 from poppy_core.emulator import EmulatorServer, build_bus_from_spec, serve_tcp
 from poppy_core.errors import PortError
-from tests.tui.conftest import wait_for
+from tests.helpers.tui import wait_for
 
 TCP_PORT = 47311
 URL = f"socket://127.0.0.1:{TCP_PORT}"

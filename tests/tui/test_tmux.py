@@ -6,17 +6,25 @@ import shutil
 import subprocess
 import time
 import uuid
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from poppy_core.emulator import EmulatorServer
+from poppy_core.emulator import EmulatorServer, build_bus_from_spec, serve_pty
 
 ROOT = Path(__file__).resolve().parents[2]
 POPPY = ROOT / ".venv" / "bin" / "poppy"
 TMUX = shutil.which("tmux")
 
 pytestmark = pytest.mark.skipif(TMUX is None or not POPPY.exists(), reason="needs tmux")
+
+
+@pytest.fixture
+def pty_server() -> Iterator[EmulatorServer]:
+    """Three XL-320 (ids 1-3, protocol 2, 1 Mbps) on a pty: the TUI runs in another process."""
+    with serve_pty(build_bus_from_spec("XL-320:1-3", protocol=2, baudrate=1_000_000)) as server:
+        yield server
 
 
 def capture(session: str) -> str:
@@ -37,10 +45,10 @@ def wait_screen(session: str, text: str, timeout_s: float = 15.0) -> str:
     raise AssertionError(f"{text!r} never showed:\n{screen}")
 
 
-def test_tui_in_tmux_shows_found_motors(xl320_server: EmulatorServer) -> None:
+def test_tui_in_tmux_shows_found_motors(pty_server: EmulatorServer) -> None:
     assert TMUX is not None
     session = f"poppy-{uuid.uuid4().hex[:8]}"
-    command = f"{POPPY} tui --port {xl320_server.url} --baud 1000000 --protocol 2"
+    command = f"{POPPY} tui --port {pty_server.url} --baud 1000000 --protocol 2"
     subprocess.run(
         [TMUX, "new-session", "-d", "-s", session, "-x", "100", "-y", "30", command], check=True
     )

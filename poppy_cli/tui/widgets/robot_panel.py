@@ -55,9 +55,9 @@ def parse_goto(text: str, known: list[str]) -> dict[str, float]:
 def open_robot(source: str, sim: SimMode) -> Robot:
     """Build a robot from a config file path or a profile name (blocking).
 
-    It goes through ``poppy_core.creatures``: a Poppy creature gets its behaviours attached.
+    It goes through ``poppy_core.robot``: a Poppy creature gets its behaviours attached.
     """
-    from poppy_core.creatures import from_config, from_profile
+    from poppy_core.robot import from_config, from_profile
 
     if Path(source).is_file():
         return from_config(Path(source), sim, sensors=False)
