@@ -20,10 +20,12 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/activate
 run: $(VENV)/.installed
 	$(BIN)/poppy demo
 
+# The whole suite; the OpenGL tests run in a pytest process of their own (see tests/conftest.py).
 test: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
 	$(BIN)/mypy
-	$(BIN)/pytest
+	$(BIN)/pytest -m "not gl"
+	$(BIN)/pytest -m gl
 
 # The inner loop (under 90 s on a quiet machine): lint, then every test not marked `slow`.
 test-fast: $(VENV)/.installed-test

@@ -24,6 +24,15 @@ SLOW_MODULES = {
     "robot/test_bus_loss.py",
     "robot/test_config_hypothesis.py",
 }
+# Tests that render with OpenGL in the test process. `make test` runs them in a pytest process
+# of their own (`-m gl`): in one long run, Mesa's EGL was seen to hang in `mjr_makeContext` at
+# 0 % CPU after hundreds of other tests (never when these run on their own); see
+# docs/simulation.md.
+GL_MODULES = {
+    "sim/test_sim_camera.py",
+    "sim/test_sim_plant.py",
+    "sim/test_sim_tracking.py",
+}
 # pytest-timeout (120 s, by signal) stops a test that waits in Python. A thread stuck inside a
 # C library (an OpenGL driver, a serial ioctl) never sees the signal; this watchdog then prints
 # every thread's stack and exits, so CI reports where it hung instead of running out its budget.
@@ -38,6 +47,8 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             continue
         if relative.parts[0] in SLOW_FOLDERS or relative.as_posix() in SLOW_MODULES:
             item.add_marker(pytest.mark.slow)
+        if relative.as_posix() in GL_MODULES:
+            item.add_marker(pytest.mark.gl)
 
 
 @pytest.hookimpl(hookwrapper=True)

@@ -57,6 +57,8 @@ def kinematics_of(
     for name in (header.kind, header.name) if header is not None else ():
         if name:
             folders += profile_folders(name)  # a calibrated user profile hides the installed one
+    if kind is not None:  # a config given as a dict (pypot's JSON) names the creature's model
+        folders += profile_folders(kind)
     spec = parse_kinematics(section, source)
     return spec, load_description(find_model(spec.model, folders))
 
