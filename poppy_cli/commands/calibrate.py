@@ -201,8 +201,7 @@ def calibrate(
 def _save(
     config: RobotConfig, calibration: Calibration, name: str, *, yes: bool, json_output: bool
 ) -> None:
-    from poppy_core.robot import save_user_profile
-    from poppy_core.robot.profile_store import user_profile_path
+    from poppy_core.robot.profile_store import save_calibration, user_profile_path
 
     changes = calibration.changes(config)
     if not json_output:
@@ -211,12 +210,7 @@ def _save(
     if not yes and not RichAnswers().confirm(f"Write the calibration to {path}?"):
         err_console.print("nothing written")
         raise typer.Exit(EXIT_FAILURE)
-    updated = calibration.apply(config, name)
-    base = config.profile.name if config.profile is not None else "a config"
-    saved = save_user_profile(updated, name, comment=(
-        f"Profile {name!r}: {base} calibrated by `poppy calibrate` on {calibration.created}.\n"
-        "The file it replaced, if any, is kept beside it as profile.yaml.bak."
-    ))  # fmt: skip
+    saved = save_calibration(config, calibration, name, by="poppy calibrate")
     summary = {
         "profile": name,
         "path": str(saved.path),

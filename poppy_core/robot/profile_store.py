@@ -13,6 +13,7 @@ from pathlib import Path
 
 from poppy_core.errors import ConfigError, FileError
 from poppy_core.files import write_file
+from poppy_core.robot.calibration import Calibration
 from poppy_core.robot.config import RobotConfig
 from poppy_core.robot.config_io import config_to_text
 from poppy_core.robot.profiles import PROFILE_FILE, user_profile_dir
@@ -81,3 +82,24 @@ def save_user_profile(
     except OSError as exc:
         raise ConfigError(f"{path}: cannot write: {exc.strerror or exc}", file=str(path)) from None
     return SavedProfile(path, backup)
+
+
+def save_calibration(
+    config: RobotConfig, calibration: Calibration, name: str, *, by: str
+) -> SavedProfile:
+    """Write ``config`` with ``calibration`` applied as the user profile ``name``.
+
+    Args:
+        config: the robot's config before the calibration.
+        calibration: what the session recorded.
+        name: the user profile written.
+        by: what calibrated it, for the file's header comment (``poppy calibrate``).
+
+    Raises:
+        ConfigError: a bad name, or a file that cannot be written (the previous one is intact).
+    """
+    base = config.profile.name if config.profile is not None else "a config"
+    return save_user_profile(calibration.apply(config, name), name, comment=(
+        f"Profile {name!r}: {base} calibrated by `{by}` on {calibration.created}.\n"
+        "The file it replaced, if any, is kept beside it as profile.yaml.bak."
+    ))  # fmt: skip

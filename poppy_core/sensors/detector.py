@@ -114,7 +114,12 @@ class MarkerDetector(Sensor):
         return any(m.id in wanted for m in self.markers)
 
     def detect(self, camera: Camera | None = None) -> list[Marker]:
-        """Detect now in ``camera``'s latest frame (the first camera by default), in this thread."""
+        """The markers in ``camera``'s latest frame (the first camera by default): detected now,
+        in this thread, unless the background detection already looked at that frame."""
         chosen = camera or self.cameras[0]
         frame = chosen.latest()
-        return self.finder.find(frame.image, chosen.calibration, chosen.name)
+        number, found = self._seen.get(chosen.name, (0, []))
+        if number != frame.number:
+            found = self.finder.find(frame.image, chosen.calibration, chosen.name)
+            self._seen[chosen.name] = (frame.number, found)
+        return list(found)

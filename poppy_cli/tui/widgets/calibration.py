@@ -244,20 +244,12 @@ class CalibrationScreen(ModalScreen[str | None]):
             self.answered.set()
 
     def _save(self) -> None:
-        from poppy_core.robot import save_user_profile
+        from poppy_core.robot.profile_store import save_calibration
 
         assert self.calibration is not None and self.robot.config is not None
-        config = self.robot.config
-        base = config.profile.name if config.profile is not None else "a config"
         try:
-            saved = save_user_profile(
-                self.calibration.apply(config, self.profile_name),
-                self.profile_name,
-                comment=(
-                    f"Profile {self.profile_name!r}: {base} calibrated in `poppy tui` on "
-                    f"{self.calibration.created}.\nThe file it replaced, if any, is kept beside "
-                    "it as profile.yaml.bak."
-                ),
+            saved = save_calibration(
+                self.robot.config, self.calibration, self.profile_name, by="poppy tui"
             )
         except PoppyError as exc:
             self.notify(str(exc), severity="error")
