@@ -48,6 +48,11 @@ from poppy_core.creatures import PoppyErgoJr
 poppy = PoppyErgoJr(simulator=SIMULATOR)
 """  # line 462, with the simulator the test runs on
 
+FROM_JSON = """
+import poppy_core.robot
+poppy = poppy_core.robot.from_json('my_config.json', use_dummy_io=True)
+"""  # line 476 (`use_dummy_io`: virtual servos, no hardware here)
+
 # -- motors and groups (line 484-591) -----------------------------------------------------------
 
 LIST_MOTORS = """
@@ -463,3 +468,51 @@ with closing(poppy_core.robot.from_json('myconfig.json', use_dummy_io=True)) as 
     # do stuff without having to make sure not to forget to close my_robot!
     pass
 """  # line 3116
+
+# -- a minimal config file (line 2570) ----------------------------------------------------------
+
+MINIMAL_CONFIG_JSON = """
+{
+    "controllers": {
+        "head_controller": {
+            "sync_read": true,
+            "attached_motors": [
+                "head"
+            ],
+            "port": "auto"
+        }
+    },
+    "motorgroups": {
+        "head": [
+            "head_z",
+            "head_y"
+        ]
+    },
+    "motors": {
+        "head_y": {
+            "offset": 20.0,
+            "type": "AX-12",
+            "id": 37,
+            "angle_limit": [
+                -40,
+                8
+            ],
+            "orientation": "indirect"
+        },
+        "head_z": {
+            "offset": 0.0,
+            "type": "AX-12",
+            "id": 36,
+            "angle_limit": [
+                -100,
+                100
+            ],
+            "orientation": "direct"
+        }
+    }
+}
+"""  # line 2570 (its trailing comma after "head" dropped: JSON has none)
+
+BASE_POSTURE = """
+poppy.base_posture.start()
+"""  # line 2037 ("so you can directly use `poppy.base_posture.start()`")

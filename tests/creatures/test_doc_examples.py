@@ -242,6 +242,10 @@ def test_ergo_jr_constructor_and_behaviours(simulator: str) -> None:
         assert not poppy.dance.running
         poppy.rest_posture.start()
         poppy.rest_posture.wait_to_stop()
+        doc.run(doc.BASE_POSTURE, poppy=poppy)
+        assert poppy.base_posture.wait_to_stop(30.0) and poppy.base_posture.error is None
+        zeros = {m.name: 0.0 for m in poppy.motors}
+        assert wait_until(lambda: reached(poppy, zeros, TOLERANCE_DEG[simulator]), 5.0)
 
 
 def test_ergo_jr_from_config_as_the_documentation(capsys: pytest.CaptureFixture[str]) -> None:
@@ -318,6 +322,23 @@ def test_torso_behaviours(torso: Robot) -> None:
         assert wait_until(lambda: abs(torso.head_z.present_position - start) > 1.0, 10.0)
     finally:
         torso.head_idle_motion.stop()
+
+
+def test_a_minimal_config_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "my_config.json").write_text(doc.MINIMAL_CONFIG_JSON)
+    with doc.run(doc.FROM_JSON)["poppy"] as poppy:
+        assert [(m.name, m.id, m.model.name) for m in poppy.motors] == [
+            ("head_z", 36, "AX-12A"), ("head_y", 37, "AX-12A"),
+        ]  # fmt: skip
+        assert poppy.alias == ["head"] and poppy.head == [poppy.head_z, poppy.head_y]
+        poppy.head.compliant = False
+        poppy.head_z.goal_position = 30
+        assert wait_until(lambda: _near_deg(poppy.head_z.present_position, 30.0), 10.0)
+
+
+def _near_deg(value: float, target: float) -> bool:
+    return abs(value - target) <= TOLERANCE_DEG["dummy"]
 
 
 def test_servers_stop_with_the_robot() -> None:
