@@ -133,6 +133,8 @@ class AbstractPoppyCreature:
             robot = from_config(_config_source(config), sim, **options)
         try:
             cls.setup(robot)
+            if sim:
+                hold_start_pose(robot)
             start_services(robot, requests, start_background_services)
         except BaseException:
             robot.close()
@@ -149,6 +151,23 @@ class AbstractPoppyCreature:
         control = CREATURES[cls.kind].goto_control
         for motor in robot.motors:
             motor.goto_behavior = control
+
+
+def hold_start_pose(robot: Robot) -> None:
+    """Turn the torque on and hold the pose the robot starts in, as pypot's simulated robots do.
+
+    pypot's V-REP and dummy robots follow their goals from the start, so the documentation's
+    simulation examples set ``goal_position`` without turning compliance off first. Virtual
+    servos power on compliant, as real ones do: a free-standing MuJoCo Humanoid would fall
+    before the script's first line. In MuJoCo the world is reset to its start pose (the robot
+    standing, seated on its support...) and the motors hold it.
+    """
+    robot.compliant = False  # each motor's goal: its present position
+    simulation = robot.simulation
+    if simulation is not None:
+        simulation.reset()
+        for motor in robot.motors:
+            motor.goal_position = motor.to_user(simulation.joint_deg(motor.name))
 
 
 def _config_source(config: object) -> Any:

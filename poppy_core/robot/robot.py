@@ -20,6 +20,7 @@ from poppy_core.robot.group import MotorGroup, degrees
 from poppy_core.robot.health import BusHealth, SyncStats
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.sync import BusSync
+from poppy_core.robot.vrep_names import VrepNames
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import RobotConfig
@@ -55,7 +56,7 @@ class Behaviour(Protocol):
         ...
 
 
-class Robot:
+class Robot(VrepNames):
     """Motors by name (``robot.m1``), groups by name (``robot.base``, a list of Motor).
 
     Args:

@@ -16,7 +16,7 @@ from poppy_core.emulator import (
 from poppy_core.errors import ConfigError
 from poppy_core.models import model_by_name
 from poppy_core.robot.config import RobotConfig
-from poppy_core.robot.profiles import profile_dirs
+from poppy_core.robot.profiles import list_profiles, load_profile, profile_dirs
 
 __all__ = ["start_emulators", "start_simulation", "virtual_buses"]
 
@@ -29,13 +29,26 @@ def start_simulation(config: RobotConfig) -> Any:
     """
     from poppy_core.sim.world import Simulation  # mujoco loads only here
 
-    kind = (config.profile.kind or config.profile.name) if config.profile is not None else ""
+    kind = _model_kind(config)
     for directory in profile_dirs():
         path = directory / kind / "model.xml"
         if kind and path.is_file():
             return Simulation(path.read_text(encoding="utf-8"))
     raise ConfigError(f"no simulation model for robot kind {kind!r} (profiles/<kind>/model.xml)",
                       field="profile.kind", value=kind)  # fmt: skip
+
+
+def _model_kind(config: RobotConfig) -> str:
+    """The profile whose model the config's robot is: its header's kind, or for a config
+    without one (pypot's JSON, ``to_pypot_dict()``) the profile with exactly its motor names."""
+    if config.profile is not None:
+        return config.profile.kind or config.profile.name
+    names = set(config.motors)
+    for info in list_profiles():
+        has_model = (info.directory / "model.xml").is_file()
+        if has_model and set(load_profile(info.name).motors) == names:
+            return info.kind or info.name
+    return ""
 
 
 def _mujoco_plant(config: RobotConfig, controller: str, simulation: Any) -> Plant:

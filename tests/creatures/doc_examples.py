@@ -3,7 +3,8 @@
 Each is the documentation's code (``../shared/reference``, line given) with its import line
 changed to poppy's and Python 2 prints and typographic quotes written as Python 3. ``run``
 executes one with the documentation's durations shortened: ``time.sleep`` and ``time.time``
-are the only names it touches, and it scales both, so an example's timing logic is unchanged.
+and a primitive's ``self.elapsed_time`` are the only names it touches, and it scales them all, so
+an example's timing logic is unchanged.
 """
 
 from __future__ import annotations
@@ -24,11 +25,18 @@ def _clock() -> float:
     return time.monotonic() / TIME_SCALE
 
 
+def _elapsed(primitive: Any) -> float:
+    return float(primitive.elapsed_time) / TIME_SCALE
+
+
 def run(code: str, **names: Any) -> dict[str, Any]:
     """Run an example with ``names`` defined (``poppy``...); its namespace afterwards."""
     source = textwrap.dedent(code)
     source = source.replace("time.sleep(", "_doc_sleep(").replace("time.time()", "_doc_clock()")
-    namespace: dict[str, Any] = {"_doc_sleep": _sleep, "_doc_clock": _clock, **names}
+    source = source.replace("self.elapsed_time", "_doc_elapsed(self)")
+    namespace: dict[str, Any] = {
+        "_doc_sleep": _sleep, "_doc_clock": _clock, "_doc_elapsed": _elapsed, **names
+    }  # fmt: skip
     exec(compile(source, "<documentation example>", "exec"), namespace)
     return namespace
 
@@ -39,6 +47,11 @@ CREATE_ERGO_JR = """
 from poppy_core.creatures import PoppyErgoJr
 poppy = PoppyErgoJr(simulator=SIMULATOR)
 """  # line 462, with the simulator the test runs on
+
+FROM_JSON = """
+import poppy_core.robot
+poppy = poppy_core.robot.from_json('my_config.json', use_dummy_io=True)
+"""  # line 476 (`use_dummy_io`: virtual servos, no hardware here)
 
 # -- motors and groups (line 484-591) -----------------------------------------------------------
 
@@ -271,3 +284,235 @@ ergo_robot.m6.goal_position = 20         #set goal position of motor m6 to 20 de
 
 time.sleep(2)                           #wait for the robot to move
 """  # `sim=True`: the documentation's robot is real; the module path is poppy's
+
+# -- the creature libraries (lines 1845, 1945) and their behaviours ------------------------------
+
+CREATE_HUMANOID = """
+from poppy_core.creatures import PoppyHumanoid
+
+poppy = PoppyHumanoid(simulator=SIMULATOR)
+
+print(poppy.motors)
+"""  # line 1845, with the simulator the test runs on
+
+CREATE_TORSO = """
+from poppy_core.creatures import PoppyTorso
+poppy = PoppyTorso(simulator=SIMULATOR)
+print(poppy.motors)
+"""  # line 1945
+
+SIT_POSITION = """
+poppy.sit_position.start()
+"""  # line 1871 ("so you can directly use `poppy.sit_position.start()`")
+
+LIMIT_TORQUE = """
+poppy.limit_torque.start()
+"""  # line 1969 ("so you can directly use `poppy.limit_torque.start()`")
+
+# -- the simulated Humanoid (2.2 "Using V-REP", lines 850-867) -----------------------------------
+
+SIMULATED_HEAD = """
+# print all motors
+print(poppy.motors)
+#ask a new position for the head
+poppy.head_z.goal_position = -10
+
+#wait a bit
+import time
+time.sleep(2.)
+
+#print head_z position
+print(poppy.head_z.present_position)
+"""  # line 850
+
+RESET_SIMULATION = """
+poppy.reset_simulation()
+"""  # line 867
+
+OBJECT_POSITION = """
+print(poppy.get_object_position('l_forearm_visual'))
+print(poppy.get_object_position('l_forearm_visual', 'head_visual'))
+"""  # lines 893, 899 (V-REP's names; a bare expression in the documentation, printed here)
+
+# -- the robot object (lines 3058-3078) ---------------------------------------------------------
+
+ROBOT_OVERVIEW = """
+for m in robot.motors:
+    print(m.name)
+
+print(robot.head_z.present_position)
+
+for m in robot.head:
+    print(m.name)
+
+robot.compliant = True
+"""  # lines 3058, 3065, 3071, 3078
+
+# -- sensors (lines 607-642) --------------------------------------------------------------------
+
+SENSORS = """
+print(poppy.sensors)
+print([sensor.name for sensor in poppy.sensors])
+print (poppy.camera)
+print(poppy.camera.registers)
+print (poppy.camera.resolution)
+"""  # lines 607, 615, 622, 634, 641
+
+# -- writing your own primitive (lines 3372-3452) -----------------------------------------------
+
+DANCE_PRIMITIVE = """
+import time
+
+import poppy_core.motion
+class DancePrimitive(poppy_core.motion.Primitive):
+
+    def __init__(self, robot, amp=30, freq=0.5):
+        self.robot = robot
+        self.amp = amp
+        self.freq = freq
+        poppy_core.motion.Primitive.__init__(self, robot)
+
+    def run(self):
+        amp = self.amp
+        freq = self.freq
+        # self.elapsed_time gives you the time (in s) since the primitive has been running
+        while self.elapsed_time < 30:
+            x = amp * numpy.sin(2 * numpy.pi * freq * self.elapsed_time)
+
+            self.robot.base_pan.goal_position = x
+            self.robot.head_pan.goal_position = -x
+
+            time.sleep(0.02)
+"""  # line 3372; base_pan, head_pan: the old Poppy Ergo's (see ``ergo_motor_names``)
+
+DANCE_START = """
+dance = DancePrimitive(ergo_robot, amp=60, freq=0.6)
+dance.start()
+"""  # line 3399, after its placeholder `ergo_robot = pypot.robot.from_config(...)`
+
+LOOP_DANCE_PRIMITIVE = """
+class LoopDancePrimitive(poppy_core.motion.LoopPrimitive):
+    def __init__(self, robot, refresh_freq, amp=30, freq=0.5):
+        self.robot = robot
+        self.amp = amp
+        self.freq = freq
+        LoopPrimitive.__init__(self, robot, refresh_freq)
+
+    # The update function is automatically called at the frequency given on the constructor
+    def update(self):
+        amp = self.amp
+        freq = self.freq
+        x = amp * numpy.sin(2 * numpy.pi * freq * self.elapsed_time)
+
+        self.robot.base_pan.goal_position = x
+        self.robot.head_pan.goal_position = -x
+"""  # line 3410
+
+LOOP_DANCE_START = """
+dance = LoopDancePrimitive(ergo_robot, 50, amp = 40, freq = 0.3)
+# The robot will dance until you call dance.stop()
+dance.start()
+"""  # line 3428
+
+ATTACH_DANCE = """
+ergo_robot.attach_primitive(DancePrimitive(ergo_robot), 'dance')
+ergo_robot.dance.start()
+"""  # line 3440
+
+SELECTOR_PRIMITIVE = """
+class SelectorPrimitive(poppy_core.motion.Primitive):
+    def run(self):
+        if song == 'my_favorite_song_to_dance' and not self.robot.dance.is_alive():
+            self.robot.dance.start()
+"""  # line 3449
+
+# The old Poppy Ergo's motors, named in the primitive examples -> the Ergo Jr's that turn about
+# the same vertical axes at rest: the base (m1) and the head's pan (m4).
+ERGO_MOTOR_NAMES = {"base_pan": "m1", "head_pan": "m4"}
+
+
+def ergo_motor_names(code: str) -> str:
+    """An example for the old Poppy Ergo with the Ergo Jr's motor names (its one adaptation)."""
+    for old, new in ERGO_MOTOR_NAMES.items():
+        code = code.replace(f".{old}.", f".{new}.")
+    return code
+
+
+# -- saving and loading a config (lines 3002-3017, 3116-3123) -----------------------------------
+
+SAVE_CONFIG = """
+import json
+
+config = my_robot.to_config()
+
+with open('myconfig.json', 'w') as f:
+    json.dump(config, f, indent=2)
+"""  # line 3002
+
+LOAD_CONFIG = """
+import json
+import poppy_core.robot
+
+ergo = poppy_core.robot.from_json('myconfig.json', use_dummy_io=True)
+"""  # line 3014 (the documentation reads 'ergo.json'; `use_dummy_io`: no hardware here)
+
+CLOSING = """
+from contextlib import closing
+
+import poppy_core.robot
+
+# The closing decorator make sure that the close function will be called
+# on the object passed as argument when the with block is exited.
+
+with closing(poppy_core.robot.from_json('myconfig.json', use_dummy_io=True)) as my_robot:
+    # do stuff without having to make sure not to forget to close my_robot!
+    pass
+"""  # line 3116
+
+# -- a minimal config file (line 2570) ----------------------------------------------------------
+
+MINIMAL_CONFIG_JSON = """
+{
+    "controllers": {
+        "head_controller": {
+            "sync_read": true,
+            "attached_motors": [
+                "head"
+            ],
+            "port": "auto"
+        }
+    },
+    "motorgroups": {
+        "head": [
+            "head_z",
+            "head_y"
+        ]
+    },
+    "motors": {
+        "head_y": {
+            "offset": 20.0,
+            "type": "AX-12",
+            "id": 37,
+            "angle_limit": [
+                -40,
+                8
+            ],
+            "orientation": "indirect"
+        },
+        "head_z": {
+            "offset": 0.0,
+            "type": "AX-12",
+            "id": 36,
+            "angle_limit": [
+                -100,
+                100
+            ],
+            "orientation": "direct"
+        }
+    }
+}
+"""  # line 2570 (its trailing comma after "head" dropped: JSON has none)
+
+BASE_POSTURE = """
+poppy.base_posture.start()
+"""  # line 2037 ("so you can directly use `poppy.base_posture.start()`")

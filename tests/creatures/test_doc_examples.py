@@ -7,18 +7,22 @@ asserts what the example is for. The examples' text is in ``doc_examples.py``.
 
 from __future__ import annotations
 
+import ast
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from poppy_core.creatures import PoppyErgoJr, PoppyHumanoid, PoppyTorso
+from poppy_core.creatures import PoppyErgoJr, PoppyTorso
+from poppy_core.creatures.postures import clamp_to_limits, humanoid_sit
 from poppy_core.errors import ConfigError
-from poppy_core.motion import Move, PositionWatcher
-from poppy_core.robot import MotorGroup, Robot
+from poppy_core.motion import LoopPrimitive, Move, PositionWatcher
+from poppy_core.robot import MotorGroup, Robot, from_config, load_profile
 from tests.creatures import doc_examples as doc
-from tests.creatures.helpers import stop_all, virtual, wait_until
+from tests.creatures.helpers import positions, reached, stop_all, virtual, wait_until
 
 SIMULATORS = ["dummy", "mujoco"]
 TOLERANCE_DEG = {"dummy": 1.5, "mujoco": 4.0}
@@ -29,7 +33,7 @@ def torso(request: pytest.FixtureRequest) -> Iterator[Robot]:
     """A Poppy Torso as the documentation builds one, on each simulator."""
     if request.param == "mujoco":
         pytest.importorskip("mujoco")
-    robot = PoppyTorso(simulator=request.param)
+    robot = doc.run(doc.CREATE_TORSO, SIMULATOR=request.param)["poppy"]
     robot.extensions["doc_simulator"] = request.param
     yield robot
     robot.close()
@@ -238,6 +242,10 @@ def test_ergo_jr_constructor_and_behaviours(simulator: str) -> None:
         assert not poppy.dance.running
         poppy.rest_posture.start()
         poppy.rest_posture.wait_to_stop()
+        doc.run(doc.BASE_POSTURE, poppy=poppy)
+        assert poppy.base_posture.wait_to_stop(30.0) and poppy.base_posture.error is None
+        zeros = {m.name: 0.0 for m in poppy.motors}
+        assert wait_until(lambda: reached(poppy, zeros, TOLERANCE_DEG[simulator]), 5.0)
 
 
 def test_ergo_jr_from_config_as_the_documentation(capsys: pytest.CaptureFixture[str]) -> None:
@@ -250,17 +258,87 @@ def test_ergo_jr_from_config_as_the_documentation(capsys: pytest.CaptureFixture[
     assert capsys.readouterr().out.strip()
 
 
-def test_humanoid_behaviours_and_setup() -> None:
-    with PoppyHumanoid(simulator="dummy") as robot:
+@pytest.mark.parametrize("simulator", SIMULATORS)
+def test_humanoid_behaviours_and_setup(simulator: str, capsys: pytest.CaptureFixture[str]) -> None:
+    if simulator == "mujoco":
+        pytest.importorskip("mujoco")
+    tolerance = TOLERANCE_DEG[simulator]
+    with doc.run(doc.CREATE_HUMANOID, SIMULATOR=simulator)["poppy"] as robot:
+        assert "l_hip_x" in capsys.readouterr().out
         for name in ("stand_position", "sit_position", "limit_torque", "temperature_monitoring"):
             assert name in robot.primitive_names
         assert robot.temperature_monitoring.running  # started by default, as documented
         assert all(m.compliant_behavior == "safe" for m in robot.torso)
+        # pypot's simulated robots hold their start pose: the Humanoid stands, servos on
+        assert not robot.compliant
+        if simulator == "mujoco":
+            assert robot.get_object_position("head")[2] > 0.6
+        doc.run(doc.SIMULATED_HEAD, poppy=robot)  # the simulation quickstart turns the head
+        assert float(capsys.readouterr().out.split()[-1]) == pytest.approx(-10.0, abs=tolerance)
+
         doc.run(doc.HUMANOID_SETUP, robot=robot)
         assert robot._primitive_manager._filter([1.0, 2.0]) == 3.0
-        robot.compliant = False
+        doc.run(doc.SIT_POSITION, poppy=robot)
+        assert robot.sit_position.wait_to_stop(30.0) and robot.sit_position.error is None
+        sit = clamp_to_limits(robot, humanoid_sit())
+        assert wait_until(lambda: reached(robot, sit, tolerance), 5.0), positions(robot, sit)
         robot.stand_position.start()
-        assert robot.stand_position.wait_to_stop(30.0)
+        assert robot.stand_position.wait_to_stop(30.0) and robot.stand_position.error is None
+        zeros = {m.name: 0.0 for m in robot.motors}
+        assert wait_until(lambda: reached(robot, zeros, tolerance), 5.0), positions(robot)
+        if simulator == "mujoco":
+            # sitting, the free-standing robot (no chair in the scene) ends on the floor
+            assert robot.get_object_position("pelvis")[2] < 0.3
+            doc.run(doc.RESET_SIMULATION, poppy=robot)
+            assert wait_until(lambda: robot.get_object_position("head")[2] > 0.6, 5.0)
+            doc.run(doc.OBJECT_POSITION, poppy=robot)
+            lines = capsys.readouterr().out.splitlines()
+            assert lines[0] == str(robot.simulation.get_object_position("l_forearm"))
+            forearm_from_head = ast.literal_eval(lines[1])
+            assert 0.15 < sum(v * v for v in forearm_from_head) ** 0.5 < 0.6
+
+
+def test_torso_behaviours(torso: Robot) -> None:
+    # the documentation's list (line 1969)
+    assert torso.primitive_names == [
+        "limit_torque", "temperature_monitoring", "dance_beat_motion", "upper_body_idle_motion",
+        "head_idle_motion", "arms_turn_compliant", "arms_copy_motion",
+    ]  # fmt: skip
+    assert torso.temperature_monitoring.running
+    stop_all(torso)
+    torso.compliant = False  # "Remember to remove compliance before starting the primitives!"
+    before = torso.head_z.torque_limit
+    doc.run(doc.LIMIT_TORQUE, poppy=torso)
+    try:
+        assert wait_until(lambda: torso.head_z.torque_limit < 50.0, 5.0)  # at its goal
+        torso.head_z.goto_position(30, 0.5, wait=True)
+        assert wait_until(lambda: _near(torso, "head_z", 30.0), 5.0)  # still reaches goals
+    finally:
+        torso.limit_torque.stop()
+    assert wait_until(lambda: torso.head_z.torque_limit == pytest.approx(before), 5.0)
+    torso.head_idle_motion.start()
+    try:
+        start = torso.head_z.present_position
+        assert wait_until(lambda: abs(torso.head_z.present_position - start) > 1.0, 10.0)
+    finally:
+        torso.head_idle_motion.stop()
+
+
+def test_a_minimal_config_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "my_config.json").write_text(doc.MINIMAL_CONFIG_JSON)
+    with doc.run(doc.FROM_JSON)["poppy"] as poppy:
+        assert [(m.name, m.id, m.model.name) for m in poppy.motors] == [
+            ("head_z", 36, "AX-12A"), ("head_y", 37, "AX-12A"),
+        ]  # fmt: skip
+        assert poppy.alias == ["head"] and poppy.head == [poppy.head_z, poppy.head_y]
+        poppy.head.compliant = False
+        poppy.head_z.goal_position = 30
+        assert wait_until(lambda: _near_deg(poppy.head_z.present_position, 30.0), 10.0)
+
+
+def _near_deg(value: float, target: float) -> bool:
+    return abs(value - target) <= TOLERANCE_DEG["dummy"]
 
 
 def test_servers_stop_with_the_robot() -> None:
@@ -281,3 +359,113 @@ def test_unknown_arguments_are_refused_in_one_line() -> None:
         PoppyErgoJr(simulator="dummy", colour="red")
     with pytest.raises(ConfigError, match="use_zmq"):
         PoppyErgoJr(simulator="dummy", use_remote=True)
+
+
+def test_robot_overview(poppy: Robot, capsys: pytest.CaptureFixture[str]) -> None:
+    doc.run(doc.ROBOT_OVERVIEW, robot=poppy)
+    lines = capsys.readouterr().out.splitlines()
+    names = [m.name for m in poppy.motors]
+    assert lines[: len(names)] == names
+    assert float(lines[len(names)]) == pytest.approx(poppy.head_z.present_position, abs=2.0)
+    assert lines[len(names) + 1 :] == ["head_z", "head_y"]
+    assert poppy.compliant
+
+
+def test_saving_and_loading_the_config(
+    poppy: Robot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    doc.run(doc.SAVE_CONFIG, my_robot=poppy)
+    with doc.run(doc.LOAD_CONFIG)["ergo"] as ergo:
+        assert [m.name for m in ergo.motors] == [m.name for m in poppy.motors]
+        assert ergo.alias == poppy.alias
+    my_robot = doc.run(doc.CLOSING)["my_robot"]
+    assert my_robot.closed and len(my_robot.motors) == len(poppy.motors)
+
+
+@pytest.mark.parametrize(
+    "simulator", ["dummy", pytest.param("mujoco", marks=pytest.mark.gl)]
+)  # reading the MuJoCo camera renders the scene with OpenGL
+def test_sensors_of_the_ergo_jr(simulator: str, capsys: pytest.CaptureFixture[str]) -> None:
+    if simulator == "mujoco":
+        pytest.importorskip("mujoco")
+    with doc.run(doc.CREATE_ERGO_JR, SIMULATOR=simulator)["poppy"] as poppy:
+        doc.run(doc.SENSORS, poppy=poppy)
+    lines = capsys.readouterr().out.splitlines()
+    assert "['camera', 'marker_detector']" in lines
+    assert "'frame'" in lines[3] and "'resolution'" in lines[3]
+    assert lines[4] == "[640, 480]"
+
+
+# -- writing your own primitive (the old Poppy Ergo's motors named as the Ergo Jr's) ------------
+
+SIM_MODES: dict[str, bool | str] = {"dummy": True, "mujoco": "mujoco"}
+
+
+@pytest.fixture(scope="module", params=SIMULATORS)
+def ergo_robot(request: pytest.FixtureRequest) -> Iterator[Robot]:
+    """The examples' ``ergo_robot = pypot.robot.from_config(...)``: the Ergo Jr's pypot config,
+    on virtual servos, stiff ("Remember to remove compliance before starting the primitives")."""
+    if request.param == "mujoco":
+        pytest.importorskip("mujoco")
+    my_config = load_profile("ergo-jr").to_pypot_dict()
+    with from_config(my_config, sim=SIM_MODES[request.param]) as robot:
+        robot.compliant = False
+        yield robot
+
+
+def _swings_opposite(robot: Robot, seconds: float, amplitude: float) -> None:
+    """m1 swings both ways by ``amplitude`` and m4 the other way (base_pan x, head_pan -x)."""
+    watcher = PositionWatcher(robot, 25, ["m1", "m4"])
+    watcher.start()
+    time.sleep(seconds)
+    watcher.stop()
+    base, head = watcher.record_positions["m1"], watcher.record_positions["m4"]
+    assert max(base) > amplitude and min(base) < -amplitude, base
+    assert float(np.corrcoef(base, head)[0, 1]) < -0.8  # head_pan = -base_pan
+
+
+def _custom(*parts: str) -> str:
+    return doc.ergo_motor_names("".join(parts))
+
+
+# What the documentation's primitive examples use without defining it: numpy, LoopPrimitive
+# (written unqualified) and the selector's song.
+MISSING_NAMES = {"numpy": np, "LoopPrimitive": LoopPrimitive, "song": "my_favorite_song_to_dance"}
+
+
+def test_own_primitive_runs_its_30_seconds(ergo_robot: Robot) -> None:
+    names = doc.run(_custom(doc.DANCE_PRIMITIVE, doc.DANCE_START), ergo_robot=ergo_robot,
+                    **MISSING_NAMES)  # fmt: skip
+    dance = names["dance"]
+    assert dance.running
+    _swings_opposite(ergo_robot, 1.5, 15.0)  # amp 60
+    assert dance.wait_to_stop(30.0)  # ends by itself (30 documentation seconds)
+    assert dance.error is None and not dance.running
+
+
+def test_loop_primitive_dances_until_stopped(ergo_robot: Robot) -> None:
+    names = doc.run(_custom(doc.DANCE_PRIMITIVE, doc.LOOP_DANCE_PRIMITIVE, doc.LOOP_DANCE_START),
+                    ergo_robot=ergo_robot, **MISSING_NAMES)  # fmt: skip
+    dance = names["dance"]
+    try:
+        _swings_opposite(ergo_robot, 1.5, 15.0)  # amp 40
+        assert dance.recent_update_frequencies
+    finally:
+        dance.stop()
+    assert not dance.is_alive() and dance.error is None
+
+
+def test_attached_primitive_started_by_another(ergo_robot: Robot) -> None:
+    names = doc.run(_custom(doc.DANCE_PRIMITIVE, doc.ATTACH_DANCE, doc.SELECTOR_PRIMITIVE),
+                    ergo_robot=ergo_robot, **MISSING_NAMES)  # fmt: skip
+    dance = ergo_robot.dance
+    assert isinstance(dance, names["DancePrimitive"]) and dance.name == "dance"
+    assert dance in ergo_robot.primitives and dance.running
+    _swings_opposite(ergo_robot, 1.0, 10.0)  # amp 30
+    assert dance.wait_to_stop(30.0)
+    selector = names["SelectorPrimitive"](ergo_robot)
+    selector.start()  # the dance has ended: the selector starts it again
+    assert selector.wait_to_stop(10.0) and selector.error is None
+    assert dance.running
+    assert dance.wait_to_stop(30.0) and dance.error is None

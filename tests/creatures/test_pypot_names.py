@@ -15,7 +15,7 @@ import pytest
 from poppy_core.creatures import PoppyErgoJr
 from poppy_core.errors import ArgumentError, ConfigError, RegisterError
 from poppy_core.motion import Move, MovePlayer, MoveRecorder
-from poppy_core.robot import Robot, from_json, from_remote
+from poppy_core.robot import Robot, from_config, from_json, from_remote, load_profile
 from tests.creatures.helpers import wait_until
 
 
@@ -150,3 +150,29 @@ def test_refused_pypot_options_name_what_to_do() -> None:
         PoppyErgoJr(simulator="dummy", port=19997)
     with pytest.raises(ConfigError, match="'mujoco'"):
         PoppyErgoJr(simulator="gazebo")
+
+
+def test_simulated_creatures_hold_their_start_pose_as_pypot_simulators() -> None:
+    # pypot's V-REP and dummy robots follow goals from the start: the documentation's
+    # simulation quickstart sets goal_position without turning compliance off.
+    with PoppyErgoJr(simulator="dummy") as robot:
+        assert not robot.compliant
+        robot.m1.goal_position = 20
+        assert wait_until(lambda: abs(robot.m1.present_position - 20) < 1.5, 10.0)
+        with pytest.raises(ConfigError, match="simulator='mujoco'"):
+            robot.reset_simulation()
+        with pytest.raises(ConfigError, match="simulator='mujoco'"):
+            robot.get_object_position("head")
+
+
+def test_a_pypot_config_dict_finds_its_simulation_model() -> None:
+    pytest.importorskip("mujoco")
+    my_config = load_profile("ergo-jr").to_pypot_dict()  # no profile header: motor names only
+    with from_config(my_config, sim="mujoco") as robot:
+        assert robot.simulation is not None
+        assert "head_follow" in robot.primitive_names  # recognised as a simulated Ergo Jr
+        robot.simulation.stop()  # the compliant arm may sag: compare one frozen world
+        # V-REP's "<link>_visual" names read as the link
+        assert robot.get_object_position("tip_visual") == robot.simulation.get_object_position(
+            "tip"
+        )
