@@ -19,6 +19,7 @@ from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.group import MotorGroup, degrees
 from poppy_core.robot.health import BusHealth, SyncStats
 from poppy_core.robot.motor import Motor
+from poppy_core.robot.motor_link import link_of
 from poppy_core.robot.sync import BusSync
 
 if TYPE_CHECKING:
@@ -115,7 +116,7 @@ class Robot:
         ``reset()``, ``get_object_position``, ``add_object``, ``colliding``, ``render``..."""
         self._runner = goto_runner if goto_runner is not None else GotoRunner(name="goto robot")
         for motor in self._motors:
-            motor.attach_runner(self._runner)
+            link_of(motor).runner = self._runner
         self.extensions: dict[str, object] = {}
         """Named objects reachable as ``robot.<name>`` (attached primitives, their manager)."""
         self._primitive_names: list[str] = []
@@ -461,7 +462,7 @@ class Robot:
         for sync in self._syncs:
             sync.stop()
         for motor in self._motors:  # after the loops: only callers' writes are refused now
-            motor.mark_closed()
+            link_of(motor).mark_closed()
         for name, bus in self.buses.items():
             try:
                 bus.close()
