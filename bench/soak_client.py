@@ -7,7 +7,8 @@ system-wide monotonic clock, shared with the process that injects the faults). U
 ``stop`` arrives on stdin it records, from outside the library:
 
 * each present-register read of each bus (``DxlBus.sync_read`` wrapped on the instance) and
-  each update of each motor's present position (``Motor.update`` wrapped), counted per second;
+  each update of each motor's present position (its ``MotorLink.update`` wrapped), counted per
+  second;
 * every change of each motor's ``online`` flag and each bus's ``connected`` flag (polled every
   ``POLL_S``);
 * once a second, for every motor online for the last ``CHECK_QUIET_S``: its goal position read
@@ -87,8 +88,11 @@ class Recorder:
             goal = motors[0].model.register("goal_position")
             bus.sync_read = self._wrap_read(name, present, bus.sync_read)  # type: ignore[method-assign]
             bus.sync_write = self._wrap_write(name, bus, goal, bus.sync_write)  # type: ignore[method-assign]
+        from poppy_core.robot.motor_link import link_of
+
         for motor in robot.motors:
-            motor.update = self._wrap_update(motor.name, motor.update)  # type: ignore[method-assign]
+            link = link_of(motor)
+            link.update = self._wrap_update(motor.name, link.update)  # type: ignore[method-assign]
 
     def _wrap_read(self, bus: str, address: int, read: Callable[..., Any]) -> Callable[..., Any]:
         def timed(at: int, length: int, ids: Sequence[int]) -> Any:

@@ -24,6 +24,7 @@ from poppy_core.robot.calibration import (
     ReferencePosture,
     reference_posture,
 )
+from poppy_core.robot.motor_link import link_of
 
 if TYPE_CHECKING:
     from poppy_core.robot.motor import Motor
@@ -94,6 +95,11 @@ class CalibrationAnswers(Protocol):
         ...
 
 
+def _motor_frame_position(motor: Motor) -> float:
+    """The present position as last read, in the motor frame (the frame calibration measures)."""
+    return link_of(motor).number("present_position")
+
+
 class RangeWatch:
     """Samples some joints in a thread and keeps their extremes (motor frame)."""
 
@@ -102,7 +108,7 @@ class RangeWatch:
         self._offsets = offsets
         self._period_s = period_s
         self._lock = threading.Lock()
-        first = {m.name: m.cached_number("present_position") for m in self._motors}
+        first = {m.name: _motor_frame_position(m) for m in self._motors}
         self._low = dict(first)
         self._high = dict(first)
         self._current = dict(first)
@@ -127,7 +133,7 @@ class RangeWatch:
             for motor in self._motors:
                 if not motor.online:
                     continue
-                value = motor.cached_number("present_position")
+                value = _motor_frame_position(motor)
                 self._current[motor.name] = value
                 self._low[motor.name] = min(self._low[motor.name], value)
                 self._high[motor.name] = max(self._high[motor.name], value)
@@ -298,7 +304,7 @@ def read_motor_frame(robot: Robot, motors: Sequence[Motor], settle_s: float) -> 
     if silent:
         raise ConfigError(f"{', '.join(silent)} not answering: check the cables and power",
                           field="motors", value=silent)  # fmt: skip
-    return {m.name: m.cached_number("present_position") for m in motors}
+    return {m.name: _motor_frame_position(m) for m in motors}
 
 
 @dataclass(frozen=True)

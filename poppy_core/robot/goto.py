@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 from poppy_core.errors import RobotClosedError
 from poppy_core.motion.trajectory import MinimumJerk, check_goto, control_name, dummy_speed
+from poppy_core.robot.motor_link import link_of
 from poppy_core.robot.schedule import Periodic
 
 if TYPE_CHECKING:
@@ -118,7 +119,7 @@ class GotoRunner:
                     speed = dummy_speed(start, goal, duration_s)
                     register = motor.model.register("moving_speed")
                     motor.moving_speed = max(speed, abs(float(register.to_si(1)))) if speed else 0
-                    motor.set_goal(goal)
+                    link_of(motor).set_goal(goal)
                 else:
                     motor.moving_speed = 0.0  # full speed: the trajectory sets the pace
                     trajectory = MinimumJerk(start, goal, duration_s)
@@ -159,7 +160,7 @@ class GotoRunner:
             for key, move in list(self._moves.items()):
                 try:
                     if move.trajectory is not None:
-                        move.motor.set_goal(move.trajectory.position(now - move.t0))
+                        link_of(move.motor).set_goal(move.trajectory.position(now - move.t0))
                 except Exception:
                     logger.exception("goto of %s failed; stopping it", move.motor.name)
                     del self._moves[key]
@@ -167,7 +168,7 @@ class GotoRunner:
                     continue
                 if now >= move.end:
                     if move.trajectory is not None:
-                        move.motor.set_goal(move.goal)
+                        link_of(move.motor).set_goal(move.goal)
                     del self._moves[key]
                     move.handle._finish_one(cancelled=False)
             if not self._moves or self._closed:

@@ -8,6 +8,7 @@ from typing import Any
 from poppy_core.errors import ArgumentError, UnknownMotorError
 from poppy_core.robot.goto import GotoHandle
 from poppy_core.robot.motor import Motor
+from poppy_core.robot.motor_link import link_of
 
 GROUP_SETTABLE = frozenset({
     "compliant", "compliant_behavior", "goto_behavior", "goal_position", "goal_speed",
@@ -75,7 +76,7 @@ class MotorGroup(list[Motor]):
             targets = {m: degrees(m.name, p) for m, p in zip(self, values, strict=True)}
         if not self:
             return GotoHandle(0, 0.0)
-        runner = self[0]._runner
+        runner = link_of(self[0]).runner
         handle = runner.start(targets, duration, control)
         if wait:
             handle.wait()

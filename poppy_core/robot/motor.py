@@ -11,22 +11,23 @@ angle limits included; a config's ``angle_limit`` is in the motor frame, as in p
 servo's EEPROM holds), and ``from_config`` converts it.
 
 Nothing here touches the bus: reads return the values the sync loops last read, writes store the
-value and mark it for the next write cycle (``take_pending``).
+value and mark it for the next write cycle. That side (register cache, pending writes, online
+state) is the motor's ``MotorLink`` (``poppy_core.robot.motor_link``), which only the robot's
+internals reach (``link_of``): a ``Motor``'s public names are the user's API. pypot's other
+names and the model-specific registers are in ``poppy_core.robot.motor_pypot``.
 """
 
 from __future__ import annotations
 
-import functools
 import logging
 from typing import TYPE_CHECKING, Literal
 
-from poppy_core.errors import ArgumentError, RegisterError, RobotClosedError
+from poppy_core.errors import RegisterError
 from poppy_core.models import ServoModel
-from poppy_core.motion.trajectory import control_name
 from poppy_core.robot import frames
-from poppy_core.robot import registers as regs
 from poppy_core.robot.goto import GotoHandle, GotoRunner
-from poppy_core.robot.motor_cache import MotorCache, SIValue
+from poppy_core.robot.motor_link import MotorLink
+from poppy_core.robot.motor_pypot import CompliantBehaviorSetting, PypotMotorMixin
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import MotorConfig
@@ -43,24 +44,7 @@ FULL_TORQUE_PCT = 100.0
 DEFAULT_GOTO_BEHAVIOR = "minjerk"
 
 
-class CompliantBehaviorSetting(str):
-    """A motor's compliant behaviour: a string (``"dummy"``/``"safe"``) that can be called to set
-    it, as the Poppy documentation writes ``robot.head_z.compliant_behavior('safe')``."""
-
-    __slots__ = ("_motor",)
-    _motor: Motor
-
-    def __new__(cls, value: str, motor: Motor) -> CompliantBehaviorSetting:
-        setting = super().__new__(cls, value)
-        setting._motor = motor
-        return setting
-
-    def __call__(self, value: str) -> None:
-        """Set the motor's compliant behaviour to ``value``."""
-        self._motor.compliant_behavior = value
-
-
-class Motor(MotorCache):
+class Motor(PypotMotorMixin):
     """A servo on a robot: registers by name in SI units, user frame.
 
     Args:
@@ -91,7 +75,8 @@ class Motor(MotorCache):
                 f"{name}: orientation must be 'direct' or 'indirect', not {orientation!r}",
                 register="orientation", motor=name,
             )
-        super().__init__(name, model)
+        self.name = name
+        self.model = model
         self.id = id
         self.orientation: Literal["direct", "indirect"] = orientation
         self.offset = float(offset)
@@ -99,8 +84,13 @@ class Motor(MotorCache):
         self._behavior: CompliantBehavior = "dummy"
         self._goto_behavior = DEFAULT_GOTO_BEHAVIOR
         self._goal_speed: float | None = None
-        self._runner = runner if runner is not None else GotoRunner(name=f"goto {name}")
-        self._closed = False
+        self._link = MotorLink(
+            name,
+            model,
+            runner if runner is not None else GotoRunner(name=f"goto {name}"),
+            on_position=self._apply_safe_compliance,
+            set_goal=self._set_goal,
+        )
         # The motor-frame range a position limit register can hold (AX -150..149.7°).
         register = model.register("min_position_limit")
         ends = sorted(float(register.to_si(r)) for r in (register.min_raw, register.max_raw))
@@ -179,57 +169,69 @@ class Motor(MotorCache):
     @property
     def present_position(self) -> float:
         """Position in degrees (user frame), as last read."""
-        return self.to_user(self._number("present_position"))
+        return self.to_user(self._link.number("present_position"))
 
     @property
     def present_speed(self) -> float:
         """Speed in deg/s (user frame sign), as last read."""
-        return self._sign * self._number("present_speed")
+        return self._sign * self._link.number("present_speed")
 
     @property
     def present_load(self) -> float:
         """Load in % of the maximum (user frame sign; mA on XM430/XL330), as last read."""
-        return self._sign * self._number("present_load")
+        return self._sign * self._link.number("present_load")
 
     @property
     def present_temperature(self) -> float:
         """Temperature in °C, as last read (read at a low rate)."""
-        return self._number("present_temperature")
+        return self._link.number("present_temperature")
 
     @property
     def present_voltage(self) -> float:
         """Supply voltage in V, as last read (read at a low rate)."""
-        return self._number("present_voltage")
+        return self._link.number("present_voltage")
 
     temperature = present_temperature
     voltage = present_voltage
     load = present_load
+
+    @property
+    def online(self) -> bool:
+        """False once the sync loop found the motor silent: its values are then stale (it is
+        pinged until it answers again)."""
+        return self._link.online
+
+    @property
+    def errors(self) -> int:
+        """Failed reads so far."""
+        return self._link.errors
 
     # -- goals -------------------------------------------------------------------------------
 
     @property
     def goal_position(self) -> float:
         """Goal in degrees (user frame); set values are clamped to ``angle_limit``."""
-        return self.to_user(self._number("goal_position"))
+        return self.to_user(self._link.number("goal_position"))
 
     @goal_position.setter
     def goal_position(self, value: float) -> None:
-        self._runner.cancel(self)
-        self.set_goal(value)
+        self._link.runner.cancel(self)
+        self._set_goal(value)
 
-    def set_goal(self, user_deg: float) -> None:
-        """Set the goal position without cancelling a running goto (used by the goto runner)."""
+    def _set_goal(self, user_deg: float) -> None:
+        """Set the goal position without cancelling a running goto (the goto runner's way, through
+        ``MotorLink.set_goal``)."""
         low, high = self._limits
         target = float(user_deg) if self.wheel_mode else min(max(float(user_deg), low), high)
         motor_deg = self.to_motor(target)
         bottom, top = self._range if self.wheel_mode else self.motor_limits()
-        self._store("goal_position", min(max(motor_deg, bottom), top))
+        self._link.store("goal_position", min(max(motor_deg, bottom), top))
         self._goal_speed = None
 
     @property
     def moving_speed(self) -> float:
         """Speed limit toward the goal in deg/s (0 = the servo's full speed)."""
-        return abs(self._number("moving_speed"))
+        return abs(self._link.number("moving_speed"))
 
     @moving_speed.setter
     def moving_speed(self, value: float) -> None:
@@ -238,7 +240,7 @@ class Motor(MotorCache):
                 f"{self.name}: moving_speed is a magnitude (>= 0), got {value}",
                 register="moving_speed", motor=self.name,
             )
-        self._store("moving_speed", float(value))
+        self._link.store("moving_speed", float(value))
 
     @property
     def goal_speed(self) -> float:
@@ -252,18 +254,18 @@ class Motor(MotorCache):
 
     @goal_speed.setter
     def goal_speed(self, value: float) -> None:
-        self._runner.cancel(self)
+        self._link.runner.cancel(self)
         speed = float(value)
         register = self.model.register("moving_speed")
         smallest = abs(float(register.to_si(1)))  # 0 means full speed: never send it
         if abs(speed) < smallest / 2:
-            self.set_goal(self.present_position)
+            self._set_goal(self.present_position)
             self._goal_speed = 0.0
             return
         magnitude = min(max(abs(speed), smallest), self.model.no_load_speed_dps)
         low, high = self._limits if not self.wheel_mode else self._user_range()
         self.moving_speed = magnitude
-        self.set_goal(high if speed > 0 else low)
+        self._set_goal(high if speed > 0 else low)
         self._goal_speed = magnitude if speed > 0 else -magnitude
 
     @property
@@ -271,7 +273,7 @@ class Motor(MotorCache):
         """Torque limit in % (RAM); always 100 on models without one (X-series)."""
         if not self.model.has_torque_limit:
             return FULL_TORQUE_PCT
-        return self._number("torque_limit")
+        return self._link.number("torque_limit")
 
     @torque_limit.setter
     def torque_limit(self, value: float) -> None:
@@ -280,37 +282,31 @@ class Motor(MotorCache):
                 f"{self.name}: {self.model.name} has no torque limit register",
                 register="torque_limit", motor=self.name,
             )
-        self._store("torque_limit", float(value))
-
-    max_torque = torque_limit
-    """pypot's name for the torque limit (the RAM register; EEPROM Max Torque is left alone)."""
+        self._link.store("torque_limit", float(value))
 
     # -- compliance --------------------------------------------------------------------------
 
     @property
     def compliant(self) -> bool:
         """True when the motor is meant to be free (torque off)."""
-        return self._compliant
+        return self._link.compliant
 
     @compliant.setter
     def compliant(self, value: bool) -> None:
-        with self._lock:
-            self._compliant = bool(value)
-            if self._compliant:
-                self._set_torque(False)
+        link = self._link
+        with link.lock:
+            link.compliant = bool(value)
+            if link.compliant:
+                link.set_torque(False)
                 self._apply_safe_compliance()
-            elif not self._torque:
-                self.set_goal(self.present_position)
-                self._set_torque(True)
+            elif not link.torque:
+                self._set_goal(self.present_position)
+                link.set_torque(True)
 
     @property
     def torque_enabled(self) -> bool:
         """True when the torque is (meant to be) on, including a safe-compliance stiffening."""
-        return self._torque
-
-    def _set_torque(self, on: bool) -> None:
-        self._torque = on
-        self._store("torque_enable", on)
+        return self._link.torque
 
     @property
     def compliant_behavior(self) -> CompliantBehaviorSetting:
@@ -328,77 +324,35 @@ class Motor(MotorCache):
                 f"{self.name}: compliant behavior must be 'dummy' or 'safe', not {value!r}",
                 register="compliant_behavior", motor=self.name,
             )
-        with self._lock:
+        link = self._link
+        with link.lock:
             self._behavior = "safe" if value == "safe" else "dummy"
-            if self._compliant:
-                self._set_torque(False)
+            if link.compliant:
+                link.set_torque(False)
                 self._apply_safe_compliance()
 
-    @property
-    def safe_compliant(self) -> bool:
-        """pypot's flag: True when the compliant behaviour is ``"safe"``."""
-        return self._behavior == "safe"
-
-    @safe_compliant.setter
-    def safe_compliant(self, value: bool) -> None:
-        self.compliant_behavior = "safe" if value else "dummy"
-
     def _apply_safe_compliance(self) -> None:
-        """Safe compliance: stiffen a compliant motor pushed past a limit, free it once back."""
-        if not (self._compliant and self._behavior == "safe") or self.wheel_mode:
+        """Safe compliance: stiffen a compliant motor pushed past a limit, free it once back.
+
+        Runs under the link's lock (after each present position read, or from a setter).
+        """
+        link = self._link
+        if not (link.compliant and self._behavior == "safe") or self.wheel_mode:
             return
-        if "present_position" not in self._values:
+        if link.cached("present_position") is None:
             return
         position = self.present_position
         low, high = self._limits
-        if not self._torque and not low <= position <= high:
+        if not link.torque and not low <= position <= high:
             logger.debug("%s pushed past its limits (%.1f°): holding it", self.name, position)
-            self.set_goal(position)
-            self._set_torque(True)
-        elif self._torque and low + SAFE_RELEASE_MARGIN_DEG <= position <= high - (
+            self._set_goal(position)
+            link.set_torque(True)
+        elif link.torque and low + SAFE_RELEASE_MARGIN_DEG <= position <= high - (
             SAFE_RELEASE_MARGIN_DEG
         ):
-            self._set_torque(False)
-
-    @property
-    def goto_behavior(self) -> str:
-        """The control of gotos that name none: ``"minjerk"`` or ``"dummy"`` (pypot's name)."""
-        return self._goto_behavior
-
-    @goto_behavior.setter
-    def goto_behavior(self, value: str) -> None:
-        try:
-            self._goto_behavior = control_name(value)
-        except ArgumentError as exc:
-            raise RegisterError(
-                f"{self.name}: goto_behavior must be 'minjerk' or 'dummy', not {value!r}",
-                register="goto_behavior", motor=self.name,
-            ) from exc
+            link.set_torque(False)
 
     # -- limits ------------------------------------------------------------------------------
-
-    @property
-    def lower_limit(self) -> float:
-        """The lower angle limit in degrees, user frame (pypot's name; ``angle_limit[0]``)."""
-        return self._limits[0]
-
-    @lower_limit.setter
-    def lower_limit(self, value: float) -> None:
-        self.angle_limit = (float(value), self._limits[1])
-
-    @property
-    def upper_limit(self) -> float:
-        """The upper angle limit in degrees, user frame (pypot's name; ``angle_limit[1]``)."""
-        return self._limits[1]
-
-    @upper_limit.setter
-    def upper_limit(self, value: float) -> None:
-        self.angle_limit = (self._limits[0], float(value))
-
-    @property
-    def control_mode(self) -> str:
-        """``"wheel"`` (endless turn) or ``"joint"`` (position control), as pypot names them."""
-        return "wheel" if self.wheel_mode else "joint"
 
     @property
     def angle_limit(self) -> tuple[float, float]:
@@ -410,47 +364,10 @@ class Motor(MotorCache):
         self._limits = self._checked_limits(limits[0], limits[1])
         if not self.wheel_mode:
             low, high = self.motor_limits()
-            self._store("min_position_limit", low)
-            self._store("max_position_limit", high)
+            self._link.store("min_position_limit", low)
+            self._link.store("max_position_limit", high)
 
-    # -- introspection and motion --------------------------------------------------------------
-
-    @property
-    def registers(self) -> list[str]:
-        """The attribute names this motor offers (they depend on the model)."""
-        return list(self._register_names)
-
-    @functools.cached_property
-    def _register_names(self) -> tuple[str, ...]:
-        names = [
-            "id", "name", "model", "orientation", "offset", "angle_limit",
-            "present_position", "present_speed", "present_load",
-            "present_temperature", "present_voltage",
-            "goal_position", "goal_speed", "moving_speed", "compliant", "compliant_behavior",
-            "led", "lower_limit", "upper_limit", "goto_behavior", "control_mode", "registers",
-            "safe_compliant",
-        ]  # fmt: skip
-        if self.model.has_torque_limit:
-            names += ["torque_limit", "max_torque"]
-        if regs.pid_names(self.model) is not None:
-            names.append("pid")
-        if regs.has_compliance_slopes(self.model):
-            names += ["compliance_margin", "compliance_slope"]
-        return tuple(names)
-
-    def mark_closed(self) -> None:
-        """The robot is closed: later writes raise ``RobotClosedError`` (reads keep the last
-        values)."""
-        self._closed = True
-
-    def _store(self, name: str, value: SIValue) -> None:
-        if self._closed:
-            raise RobotClosedError(f"{self.name}: the robot is closed, {name} cannot be written")
-        super()._store(name, value)
-
-    def attach_runner(self, runner: GotoRunner) -> None:
-        """Use the robot's goto runner (the private one is dropped)."""
-        self._runner = runner
+    # -- motion --------------------------------------------------------------------------------
 
     def goto_position(
         self,
@@ -471,7 +388,8 @@ class Motor(MotorCache):
         Returns:
             A handle to wait on; a later goto or goal on this motor cancels it.
         """
-        handle = self._runner.start({self: position}, duration, control)
+        handle = self._link.runner.start({self: position}, duration, control)
         if wait:
             handle.wait()
         return handle
+

@@ -1,24 +1,29 @@
 """``Robot``: named motors and groups over one or more buses, their sync loops and gotos.
 
 Build one with ``poppy_core.robot.from_config``, ``from_profile`` or ``autodetect``; a Robot owns
-its buses, threads and (with ``sim=True``) emulators, and ``close()`` stops them all.
+its buses, threads and (with ``sim=True``) emulators, and ``close()`` stops them all. pypot's
+names for its groups and primitives are in ``robot_pypot``; ``motors_of`` resolves specs with
+``motor_spec``.
 """
 
 from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from types import TracebackType
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any
 
 from poppy_core.bus import DxlBus
-from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError, UnknownMotorError
+from poppy_core.errors import ConfigError, RobotClosedError, UnknownMotorError
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.group import MotorGroup, degrees
 from poppy_core.robot.health import BusHealth, SyncStats
 from poppy_core.robot.motor import Motor
+from poppy_core.robot.motor_link import link_of
+from poppy_core.robot.motor_spec import MotorSpec, NamedMotor, resolve
+from poppy_core.robot.robot_pypot import Behaviour, PypotRobotMixin
 from poppy_core.robot.sync import BusSync
 from poppy_core.robot.vrep_names import VrepNames
 
@@ -28,35 +33,10 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-
-class NamedMotor(Protocol):
-    """Anything standing for a motor by its name (a ``Motor``, a primitive's ``MockupMotor``)."""
-
-    @property
-    def name(self) -> str:
-        """The motor's name in the robot."""
-        ...
+__all__ = ["Behaviour", "MotorSpec", "NamedMotor", "Robot"]
 
 
-MotorSpec = str | NamedMotor | Iterable[str | NamedMotor]
-"""A motor or group name, a motor, or a list of them (see ``Robot.motors_of``)."""
-
-
-def _is_motor(item: object) -> bool:
-    return not isinstance(item, str) and isinstance(getattr(item, "name", None), str) and hasattr(
-        item, "present_position"
-    )
-
-
-class Behaviour(Protocol):
-    """What ``attach_primitive`` needs of a primitive (``poppy_core.motion.Primitive``)."""
-
-    def is_alive(self) -> bool:
-        """True while it runs."""
-        ...
-
-
-class Robot(VrepNames):
+class Robot(PypotRobotMixin, VrepNames):
     """Motors by name (``robot.m1``), groups by name (``robot.base``, a list of Motor).
 
     Args:
@@ -116,7 +96,7 @@ class Robot(VrepNames):
         ``reset()``, ``get_object_position``, ``add_object``, ``colliding``, ``render``..."""
         self._runner = goto_runner if goto_runner is not None else GotoRunner(name="goto robot")
         for motor in self._motors:
-            motor.attach_runner(self._runner)
+            link_of(motor).runner = self._runner
         self.extensions: dict[str, object] = {}
         """Named objects reachable as ``robot.<name>`` (attached primitives, their manager)."""
         self._primitive_names: list[str] = []
@@ -156,23 +136,6 @@ class Robot(VrepNames):
         """Every motor, in config order."""
         return list(self._motors)
 
-    @property
-    def motorgroups(self) -> dict[str, list[Motor]]:
-        """Group name -> its motors."""
-        return {name: list(members) for name, members in self._groups.items()}
-
-    @property
-    def alias(self) -> list[str]:
-        """The group names (pypot's ``robot.alias``); each group is ``robot.<name>``."""
-        return list(self._groups)
-
-    @property
-    def _primitive_manager(self) -> Any:
-        """The primitive manager (pypot's name; also ``robot.primitive_manager``)."""
-        from poppy_core.motion import primitive_manager  # motion sits above robot
-
-        return primitive_manager(self)
-
     def motor(self, name: str) -> Motor:
         """The motor called ``name`` (typed access).
 
@@ -195,47 +158,7 @@ class Robot(VrepNames):
             UnknownMotorError: a name that is neither a motor nor a group (known ones listed).
             ArgumentError: an item that is neither a name nor a motor.
         """
-        if spec is None:
-            return list(self._motors)
-        items: object = [spec] if isinstance(spec, str) or _is_motor(spec) else spec
-        if not isinstance(items, Iterable):
-            raise ArgumentError(
-                f"motors must be a name, a motor or a list of them, not {spec!r}",
-                field="motors", value=spec,
-            )  # fmt: skip
-        chosen: list[Motor] = []
-        for item in items:
-            for motor in self._named(item):
-                if motor not in chosen:
-                    chosen.append(motor)
-        return chosen
-
-    def _named(self, item: object) -> list[Motor]:
-        if isinstance(item, str):
-            if item in self._groups:
-                return list(self._groups[item])
-            if item in self._by_name:
-                return [self._by_name[item]]
-            known = list(self._by_name)
-            groups = ", ".join(self._groups) or "none"
-            raise UnknownMotorError(
-                f"no motor or group {item!r} (motors: {', '.join(known)}; groups: {groups})",
-                motor=item, known=known,
-            )  # fmt: skip
-        if _is_motor(item):
-            name = getattr(item, "name", None)
-            if isinstance(name, str) and name in self._by_name:
-                return [self._by_name[name]]
-            known = list(self._by_name)
-            raise UnknownMotorError(
-                f"{name!r} is not a motor of this robot (motors: {', '.join(known)})",
-                motor=str(name), known=known,
-            )  # fmt: skip
-        known = list(self._by_name)
-        raise UnknownMotorError(
-            f"{item!r} is not a motor name (motors: {', '.join(known)})",
-            motor=str(item), known=known,
-        )  # fmt: skip
+        return resolve(spec, self._by_name, self._groups)
 
     @property
     def sensors(self) -> list[Sensor]:
@@ -283,33 +206,6 @@ class Robot(VrepNames):
                 f"{name!r} is already a motor, group or attribute of the robot", field=name
             )
         self.extensions[name] = obj
-
-    def attach_primitive(self, primitive: Behaviour, name: str) -> None:
-        """Attach a primitive as ``robot.<name>`` and list it in ``primitives`` (pypot's order).
-
-        Raises:
-            ConfigError: see ``attach``.
-        """
-        self.attach(name, primitive)
-        if isinstance(getattr(type(primitive), "name", None), property):
-            primitive.name = name  # type: ignore[attr-defined]
-        if name not in self._primitive_names:
-            self._primitive_names.append(name)
-
-    @property
-    def primitive_names(self) -> list[str]:
-        """Names of the attached primitives, in attach order."""
-        return [n for n in self._primitive_names if n in self.extensions]
-
-    @property
-    def primitives(self) -> list[Any]:
-        """The attached primitives, in attach order."""
-        return [self.extensions[n] for n in self.primitive_names]
-
-    @property
-    def active_primitives(self) -> list[Any]:
-        """The attached primitives that are running (or paused)."""
-        return [p for p in self.primitives if p.is_alive()]
 
     def on_close(self, callback: Callable[[], None]) -> None:
         """Run ``callback`` first thing in ``close`` (e.g. to stop the primitives' threads)."""
@@ -411,15 +307,6 @@ class Robot(VrepNames):
 
     # -- config and lifetime -----------------------------------------------------------------
 
-    def to_config(self) -> dict[str, Any]:
-        """The robot's config as pypot's JSON-ready dict, with the motors' present orientation,
-        offset and angle limits (``json.dump(robot.to_config(), f)`` saves it).
-
-        Raises:
-            ConfigError: the robot was not built from a config.
-        """
-        return self.to_robot_config().to_pypot_dict()
-
     def to_robot_config(self) -> RobotConfig:
         """``to_config`` as a validated ``RobotConfig`` (profile header kept).
 
@@ -462,7 +349,7 @@ class Robot(VrepNames):
         for sync in self._syncs:
             sync.stop()
         for motor in self._motors:  # after the loops: only callers' writes are refused now
-            motor.mark_closed()
+            link_of(motor).mark_closed()
         for name, bus in self.buses.items():
             try:
                 bus.close()

@@ -18,6 +18,7 @@ from poppy_core.bus import DxlBus
 from poppy_core.errors import BusError, MotorError, RegisterError
 from poppy_core.robot import registers as regs
 from poppy_core.robot.motor import Motor
+from poppy_core.robot.motor_link import link_of
 
 logger = logging.getLogger(__name__)
 
@@ -47,7 +48,7 @@ def where(bus: DxlBus) -> str:
 def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> list[str]:
     """Ping every motor; return one readable problem per missing motor or wrong model.
 
-    Motors that do not answer are marked offline (``motor.online = False``).
+    Motors that do not answer are marked offline (``motor.online`` is False).
     """
     missing: list[str] = []
     wrong: list[str] = []
@@ -57,7 +58,7 @@ def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> lis
         except BusError:
             found = None
         if found is None:
-            motor.online = False
+            link_of(motor).mark_offline()
             missing.append(f"{motor.name} (id {motor.id})")
             continue
         if found.model is None or found.model.name != motor.model.name:
@@ -80,7 +81,7 @@ def load_state(bus: DxlBus, motors: Sequence[Motor]) -> None:
         if not motor.online:
             continue
         data = bus.read(motor.id, 0, motor.model.table_size)
-        motor.update(regs.decode_table(motor.model, data))
+        link_of(motor).update(regs.decode_table(motor.model, data))
 
 
 def return_delay_issues(
@@ -91,7 +92,7 @@ def return_delay_issues(
     for motor in motors:
         if not motor.online:
             continue
-        delay = motor.cached_number("return_delay_time")
+        delay = link_of(motor).number("return_delay_time")
         target = targets_us.get(motor.name, 0.0)
         if delay > target:
             issues.append(ReturnDelayIssue(motor.name, motor.id, delay, target))
@@ -130,7 +131,7 @@ def fix_return_delays(
             logger.warning("%s: could not set the return delay: %s", issue.motor, exc)
             left.append(issue)
             continue
-        motor.update({"return_delay_time": issue.target_us})
+        link_of(motor).update({"return_delay_time": issue.target_us})
         logger.info("%s: return delay set to %g µs", issue.motor, issue.target_us)
     return left
 
@@ -144,7 +145,7 @@ def write_angle_limits(bus: DxlBus, motors: Sequence[Motor]) -> None:
         step = model.position_range_deg / model.resolution
         wanted = motor.motor_limits()
         names = ("min_position_limit", "max_position_limit")
-        present = (motor.cached_number(names[0]), motor.cached_number(names[1]))
+        present = (link_of(motor).number(names[0]), link_of(motor).number(names[1]))
         if all(abs(w - p) <= step for w, p in zip(wanted, present, strict=True)):
             continue
         try:
@@ -158,7 +159,7 @@ def write_angle_limits(bus: DxlBus, motors: Sequence[Motor]) -> None:
                 exc,
             )
             continue
-        motor.update(dict(zip(names, wanted, strict=True)))
+        link_of(motor).update(dict(zip(names, wanted, strict=True)))
         logger.info(
             "%s: EEPROM angle limits %s -> %s (motor frame)",
             motor.name,

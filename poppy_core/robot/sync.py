@@ -11,7 +11,8 @@ bus offers), one transaction per group of motors sharing a register layout. A mo
 ``offline_after`` reads in a row is marked offline: it leaves the fast loops and is pinged (one
 offline motor per ``retry_period_s``, in turn) until it answers again. Deadlines are drift-free
 (``Periodic``); a run that overran its period is followed at once by the next one, so a loop
-whose runs are sometimes long keeps its rate.
+whose runs are sometimes long keeps its rate. Reads are stored into, writes taken from and
+misses counted on each motor's ``MotorLink`` (``link_of(motor)``), the robot side of a ``Motor``.
 
 A lost port (adapter unplugged, emulator gone: a ``PortError``) is logged once at WARNING, every
 motor of the bus goes offline at once, and the thread reopens the port with backoff
@@ -33,6 +34,7 @@ from poppy_core.robot import registers as regs
 from poppy_core.robot.health import BusHealth, LoopStats, SyncStats
 from poppy_core.robot.loops import BASE_LOOPS, LIGHT_LOOPS, LoopSpec, loops_for
 from poppy_core.robot.motor import Motor
+from poppy_core.robot.motor_link import link_of
 from poppy_core.robot.schedule import Periodic, RateMeter
 
 logger = logging.getLogger(__name__)
@@ -148,7 +150,9 @@ class BusSync:
         Sync writes get no reply: when something was sent, one ping follows, so the writes
         have been handled once this returns (the bus may be closed right after).
         """
-        if not self.connected or not any(m.online and m.has_pending() for m in self.motors):
+        if not self.connected or not any(
+            m.online and link_of(m).has_pending() for m in self.motors
+        ):
             return
         for spec in self._specs:
             if spec.write:
@@ -285,7 +289,7 @@ class BusSync:
         self._backoff_s = RECONNECT_FIRST_S
         self._next_reopen = self._down_since + self._backoff_s
         for motor in self.motors:
-            motor.mark_offline()
+            link_of(motor).mark_offline()
         logger.warning(
             "%s: lost %s (%s); its %d motor(s) are offline, reopening it with backoff",
             self.controller,
@@ -356,16 +360,17 @@ class BusSync:
                 if payload is None or len(payload) != length:
                     self._missed(motor, f"no reply to the {spec.name} read")
                     continue
-                motor.update(block.decode(payload))
+                link_of(motor).update(block.decode(payload))
                 self._answered(motor)
 
     def _answered(self, motor: Motor) -> None:
-        if motor.mark_answered():
+        link = link_of(motor)
+        if link.mark_answered():
             logger.info("%s (id %d) answers again", motor.name, motor.id)
-            motor.resend_state()
+            link.resend_state()
 
     def _missed(self, motor: Motor | None, reason: str) -> None:
-        if motor is not None and motor.mark_missed(self.offline_after):
+        if motor is not None and link_of(motor).mark_missed(self.offline_after):
             logger.warning(
                 "%s (id %d) on %s stopped answering (%s); pinging it until it answers",
                 motor.name,
@@ -378,7 +383,7 @@ class BusSync:
         taken: list[tuple[Motor, dict[str, int]]] = []
         for motor in self.motors:
             if motor.online:
-                values = motor.take_pending(spec.registers)
+                values = link_of(motor).take_pending(spec.registers)
                 if values:
                     taken.append((motor, values))
         if not taken:
@@ -395,7 +400,7 @@ class BusSync:
                     self.bus.sync_write(address, data)
         except BusError:
             for motor, values in taken:
-                motor.restore_pending(values)
+                link_of(motor).restore_pending(values)
             raise
 
     def _retry(self, every: bool = False) -> None:

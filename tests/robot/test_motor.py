@@ -11,6 +11,7 @@ from poppy_core.models import model_by_name
 from poppy_core.robot import Motor
 from poppy_core.robot.config import MotorConfig
 from poppy_core.robot.frames import motor_limits, user_limits
+from poppy_core.robot.motor_link import link_of
 
 AX = model_by_name("AX-12A")
 MX = model_by_name("MX-28")
@@ -20,9 +21,9 @@ XM = model_by_name("XM430-W350")
 
 def stiff(motor: Motor, present_user: float = 0.0) -> Motor:
     """Give the motor a present position (as a read would) and switch its torque on."""
-    motor.update({"present_position": motor.to_motor(present_user)})
+    link_of(motor).update({"present_position": motor.to_motor(present_user)})
     motor.compliant = False
-    motor.take_pending(["goal_position", "torque_enable"])
+    link_of(motor).take_pending(["goal_position", "torque_enable"])
     return motor
 
 
@@ -65,7 +66,7 @@ def test_config_limits_are_motor_frame_and_the_motor_shows_them_in_the_user_fram
 
 def test_indirect_flips_and_offset_adds() -> None:
     motor = Motor("m", AX, 1, orientation="indirect", offset=20.0, angle_limit=(-40, 8))
-    motor.update({"present_position": 10.0, "present_speed": 5.0, "present_load": -12.0})
+    link_of(motor).update({"present_position": 10.0, "present_speed": 5.0, "present_load": -12.0})
     assert motor.present_position == pytest.approx(-30.0)  # -(10) - 20
     assert motor.present_speed == -5.0
     assert motor.present_load == 12.0
@@ -73,7 +74,7 @@ def test_indirect_flips_and_offset_adds() -> None:
     motor.goal_position = 0.0
     assert motor.goal_position == pytest.approx(0.0)
     register = AX.register("goal_position")
-    raw = motor.take_pending(["goal_position"])["goal_position"]
+    raw = link_of(motor).take_pending(["goal_position"])["goal_position"]
     assert register.to_si(raw) == pytest.approx(-20.0, abs=0.3)  # motor = -(0 + 20)
 
 
@@ -86,16 +87,16 @@ def test_goal_clamped_to_user_limits_and_model_range() -> None:
     assert motor.motor_limits() == (-125, 90)
     whole = stiff(Motor("w", AX, 3, angle_limit=(-150, 150)))
     whole.goal_position = 150  # past the last raw step (149.7°): clamped, no RegisterError
-    assert whole.take_pending(["goal_position"]) == {"goal_position": 1023}
+    assert link_of(whole).take_pending(["goal_position"]) == {"goal_position": 1023}
 
 
 def test_goal_waits_while_compliant() -> None:
     motor = Motor("m", MX, 1)
-    motor.update({"present_position": 12.0})
+    link_of(motor).update({"present_position": 12.0})
     motor.goal_position = 30
-    assert motor.take_pending(["goal_position"]) == {}
+    assert link_of(motor).take_pending(["goal_position"]) == {}
     motor.compliant = False  # goal = present, then torque on
-    pending = motor.take_pending(["goal_position", "torque_enable"])
+    pending = link_of(motor).take_pending(["goal_position", "torque_enable"])
     assert pending["torque_enable"] == 1
     goal = MX.register("goal_position").to_si(pending["goal_position"])
     assert goal == pytest.approx(12, abs=0.1)
@@ -120,17 +121,17 @@ def test_safe_compliance_stiffens_past_a_limit() -> None:
     motor = Motor("m", MX, 1, angle_limit=(-30, 30))
     motor.compliant_behavior = "safe"
     motor.compliant = True
-    motor.update({"present_position": 10.0})
+    link_of(motor).update({"present_position": 10.0})
     assert not motor.torque_enabled
-    motor.update({"present_position": 42.0})
+    link_of(motor).update({"present_position": 42.0})
     assert motor.torque_enabled and motor.compliant
     assert motor.goal_position == 30
-    motor.update({"present_position": 29.5})  # still at the wall: keeps holding
+    link_of(motor).update({"present_position": 29.5})  # still at the wall: keeps holding
     assert motor.torque_enabled
-    motor.update({"present_position": 20.0})  # pulled back inside: free again
+    link_of(motor).update({"present_position": 20.0})  # pulled back inside: free again
     assert not motor.torque_enabled
     motor.compliant_behavior = "dummy"
-    motor.update({"present_position": 50.0})
+    link_of(motor).update({"present_position": 50.0})
     assert not motor.torque_enabled
     with pytest.raises(RegisterError):
         motor.compliant_behavior = "soft"
@@ -142,7 +143,8 @@ def test_model_specific_registers() -> None:
     assert "pid" in mx.registers and "torque_limit" not in xm.registers
     mx.pid = (4.0, 0.0, 1.0)
     assert mx.pid == (4.0, 0.0, 1.0)
-    assert set(mx.take_pending(["p_gain", "i_gain", "d_gain"])) == {"p_gain", "i_gain", "d_gain"}
+    gains = ["p_gain", "i_gain", "d_gain"]
+    assert set(link_of(mx).take_pending(gains)) == set(gains)
     ax.compliance_margin = 2
     assert ax.compliance_margin == (2, 2)
     with pytest.raises(RegisterError):
@@ -163,10 +165,10 @@ def test_model_specific_registers() -> None:
 def test_restore_keeps_newer_values() -> None:
     motor = stiff(Motor("m", MX, 1))
     motor.moving_speed = 10
-    taken = motor.take_pending(["moving_speed"])
+    taken = link_of(motor).take_pending(["moving_speed"])
     motor.moving_speed = 20
-    motor.restore_pending(taken)
-    newer = motor.take_pending(["moving_speed"])["moving_speed"]
+    link_of(motor).restore_pending(taken)
+    newer = link_of(motor).take_pending(["moving_speed"])["moving_speed"]
     assert MX.register("moving_speed").to_si(newer) == pytest.approx(20, abs=0.7)
 
 
@@ -176,3 +178,30 @@ def test_bad_limits_refused() -> None:
     motor = Motor("m", MX, 1)
     with pytest.raises(RegisterError):
         motor.angle_limit = (5, 5)
+
+
+SYNC_SIDE = {
+    "update", "take_pending", "restore_pending", "has_pending", "mark_missed", "mark_answered",
+    "mark_offline", "mark_closed", "resend_state", "set_goal", "set_torque", "attach_runner",
+    "cached", "cached_number", "store", "runner", "lock", "torque",
+}  # fmt: skip
+USER_API = {
+    "id", "name", "model", "orientation", "offset", "direct", "wheel_mode", "online", "errors",
+    "present_position", "present_speed", "present_load", "present_temperature",
+    "present_voltage", "temperature", "voltage", "load", "goal_position", "goal_speed",
+    "moving_speed", "torque_limit", "max_torque", "compliant", "compliant_behavior",
+    "safe_compliant", "torque_enabled", "goto_behavior", "goto_position", "angle_limit",
+    "lower_limit", "upper_limit", "control_mode", "registers", "led", "to_user", "to_motor",
+    "motor_limits", "config_limits", "from_config",
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("model", [AX, MX, XL, XM], ids=lambda m: m.name)
+def test_tab_completion_shows_the_user_api_and_not_the_sync_side(model: object) -> None:
+    motor = Motor("m", model, 1)  # type: ignore[arg-type]
+    public = {n for n in dir(motor) if not n.startswith("_")}
+    assert public & SYNC_SIDE == set()
+    assert USER_API - public == set()
+    assert set(motor.registers) - public == set()
+    link = link_of(motor)  # the robot's side is still there, one step away
+    assert SYNC_SIDE - {"attach_runner", "cached_number"} - set(dir(link)) == set()

@@ -7,6 +7,7 @@ import time
 import httpx
 import pytest
 
+from poppy_core.robot.motor_link import link_of
 from tests.helpers.server import Served
 
 MOTORS = ["m1", "m2", "m3", "m4", "m5", "m6"]
@@ -96,7 +97,8 @@ def test_bad_register_values_are_4xx_and_never_reach_the_motor(
     assert (motor.goal_position, motor.moving_speed, motor.torque_limit, motor.led, motor.pid) == (
         before
     )
-    assert not motor.has_pending() or motor.take_pending(["goal_position"]) == {}
+    link = link_of(motor)
+    assert not link.has_pending() or link.take_pending(["goal_position"]) == {}
 
 
 def test_motor_goto_and_motors_goto(client: httpx.Client, served: Served) -> None:

@@ -1,0 +1,92 @@
+"""pypot's robot names: groups as ``alias``/``motorgroups``, attached primitives, ``to_config``.
+
+``PypotRobotMixin`` is a base of ``Robot`` (``poppy_core.robot.robot``); everything here is user
+API over what ``Robot`` holds.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, Protocol, cast
+
+from poppy_core.robot.group import MotorGroup
+from poppy_core.robot.motor import Motor
+
+if TYPE_CHECKING:
+    from poppy_core.robot.config import RobotConfig
+    from poppy_core.robot.robot import Robot
+
+
+class Behaviour(Protocol):
+    """What ``attach_primitive`` needs of a primitive (``poppy_core.motion.Primitive``)."""
+
+    def is_alive(self) -> bool:
+        """True while it runs."""
+        ...
+
+
+class PypotRobotMixin:
+    """pypot's names for a robot's groups and primitives, and its config as pypot's dict."""
+
+    # Provided by Robot.
+    extensions: dict[str, object]
+    _groups: dict[str, MotorGroup]
+    _primitive_names: list[str]
+
+    if TYPE_CHECKING:
+
+        def attach(self, name: str, obj: object) -> None: ...
+
+        def to_robot_config(self) -> RobotConfig: ...
+
+    @property
+    def motorgroups(self) -> dict[str, list[Motor]]:
+        """Group name -> its motors."""
+        return {name: list(members) for name, members in self._groups.items()}
+
+    @property
+    def alias(self) -> list[str]:
+        """The group names (pypot's ``robot.alias``); each group is ``robot.<name>``."""
+        return list(self._groups)
+
+    @property
+    def _primitive_manager(self) -> Any:
+        """The primitive manager (pypot's name; also ``robot.primitive_manager``)."""
+        from poppy_core.motion import primitive_manager  # motion sits above robot
+
+        return primitive_manager(cast("Robot", self))
+
+    def attach_primitive(self, primitive: Behaviour, name: str) -> None:
+        """Attach a primitive as ``robot.<name>`` and list it in ``primitives`` (pypot's order).
+
+        Raises:
+            ConfigError: see ``attach``.
+        """
+        self.attach(name, primitive)
+        if isinstance(getattr(type(primitive), "name", None), property):
+            primitive.name = name  # type: ignore[attr-defined]
+        if name not in self._primitive_names:
+            self._primitive_names.append(name)
+
+    @property
+    def primitive_names(self) -> list[str]:
+        """Names of the attached primitives, in attach order."""
+        return [n for n in self._primitive_names if n in self.extensions]
+
+    @property
+    def primitives(self) -> list[Any]:
+        """The attached primitives, in attach order."""
+        return [self.extensions[n] for n in self.primitive_names]
+
+    @property
+    def active_primitives(self) -> list[Any]:
+        """The attached primitives that are running (or paused)."""
+        return [p for p in self.primitives if p.is_alive()]
+
+    def to_config(self) -> dict[str, Any]:
+        """The robot's config as pypot's JSON-ready dict, with the motors' present orientation,
+        offset and angle limits (``json.dump(robot.to_config(), f)`` saves it).
+
+        Raises:
+            ConfigError: the robot was not built from a config.
+        """
+        return self.to_robot_config().to_pypot_dict()
