@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, build_robot
+from poppy_cli.options import json_option
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
@@ -159,7 +160,7 @@ def calibrate(
         3.0, "--tolerance", min=0.0, help="--check: drift allowed, in degrees."
     ),
     yes: bool = typer.Option(False, "--yes", "-y", help="Write the profile without asking."),
-    json_output: bool = typer.Option(False, "--json", help="Print the result as JSON."),
+    json_output: bool = json_option("Print the result as JSON."),
 ) -> None:
     """Calibrate a robot: each joint's zero (in its reference posture) and reachable range.
 

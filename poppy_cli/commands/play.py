@@ -18,7 +18,7 @@ from poppy_cli.commands.robot import (
     robot_config,
     start_robot,
 )
-from poppy_cli.options import finite
+from poppy_cli.options import JsonSummaryOpt, finite
 from poppy_cli.output import console, err_console, print_json, warn_line
 
 if TYPE_CHECKING:
@@ -36,7 +36,7 @@ def play(
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
     sim: str | None = SimOpt,
-    json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+    json_output: bool = JsonSummaryOpt,
     remote: str | None = RemoteOpt,
 ) -> None:
     """Play a move: a gentle ramp to its first frame, then the frames at the chosen speed.

@@ -19,7 +19,7 @@ from poppy_cli.commands.robot import (
     robot_config,
     start_robot,
 )
-from poppy_cli.options import MAX_DURATION_S, finite
+from poppy_cli.options import MAX_DURATION_S, JsonSummaryOpt, finite
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, print_json
 
 if TYPE_CHECKING:
@@ -128,7 +128,7 @@ def record(
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
     sim: str | None = SimOpt,
-    json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+    json_output: bool = JsonSummaryOpt,
 ) -> None:
     """Record a move: the motors turn compliant, move them by hand, Enter or Ctrl-C stops.
 

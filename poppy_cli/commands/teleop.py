@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from poppy_cli.options import SIM_ENGINES, JsonSummaryOpt
 from poppy_cli.output import EXIT_USAGE, console, err_console, error_line, print_json, styled
 
 if TYPE_CHECKING:
@@ -26,7 +27,6 @@ if TYPE_CHECKING:
 
 REFRESH_S = 0.1
 SELF = "self"
-SIM_ENGINES = ("ideal", "mujoco")
 
 
 def _is_url(text: str) -> bool:
@@ -104,7 +104,7 @@ def teleop(
         None, "--record", help="Save the follower's trajectory as a move of this name (or path)."
     ),
     force: bool = typer.Option(False, "--force", help="Replace an existing move of that name."),
-    json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+    json_output: bool = JsonSummaryOpt,
 ) -> None:
     """Teleoperate: the leader turns compliant, move it by hand; the follower copies it.
 
