@@ -130,9 +130,7 @@ JsonSummaryOpt = json_option("Print a JSON summary.")
 ProfileOpt = profile_option("Robot profile, e.g. ergo-jr. [env: POPPY_PROFILE, or user settings]")
 ConfigOpt = typer.Option(None, "--config", "-c", help="Robot config file (JSON or YAML).")
 PortOpt = port_option("Serial port of the robot's bus. [env: POPPY_PORT]")
-SimOpt = sim_option(
-    "Build a virtual robot: --sim (ideal servos) or --sim mujoco (MuJoCo physics)."
-)
+SimOpt = sim_option("Build a virtual robot: --sim (ideal servos) or --sim mujoco (MuJoCo physics).")
 RemoteOpt = typer.Option(
     None,
     "--remote",

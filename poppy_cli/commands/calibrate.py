@@ -14,8 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, build_robot
-from poppy_cli.options import json_option
+from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, json_option
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
@@ -26,6 +25,7 @@ from poppy_cli.output import (
     print_json,
     styled,
 )
+from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -169,7 +169,7 @@ def calibrate(
     profile.yaml.bak) that --profile NAME then uses. Ctrl-C or q leaves the previous calibration
     untouched. --check reads the robot in its posture and reports how far each joint drifted.
     """
-    from poppy_cli.commands.robot import robot_config
+    from poppy_cli.robots import robot_config
     from poppy_core.robot import CalibrationSession, check_calibration
     from poppy_core.robot.calibration import check_motors
     from poppy_core.robot.profile_store import check_profile_name

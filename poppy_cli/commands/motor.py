@@ -21,7 +21,6 @@ app = typer.Typer(
 )
 
 
-
 def require_port(port: str | None) -> str:
     chosen = default_port(port)
     if not chosen:

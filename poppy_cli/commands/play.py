@@ -9,17 +9,17 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.commands.robot import (
+from poppy_cli.options import (
     ConfigOpt,
+    JsonSummaryOpt,
     PortOpt,
     ProfileOpt,
     RemoteOpt,
     SimOpt,
-    robot_config,
-    start_robot,
+    finite,
 )
-from poppy_cli.options import JsonSummaryOpt, finite
 from poppy_cli.output import console, err_console, print_json, warn_line
+from poppy_cli.robots import robot_config, start_robot
 
 if TYPE_CHECKING:
     from poppy_core.motion import MovePlayer, PlayProgress

@@ -11,16 +11,17 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import (
+from poppy_cli.options import (
+    MAX_DURATION_S,
     ConfigOpt,
+    JsonSummaryOpt,
     PortOpt,
     ProfileOpt,
     SimOpt,
-    robot_config,
-    start_robot,
+    finite,
 )
-from poppy_cli.options import MAX_DURATION_S, JsonSummaryOpt, finite
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, print_json
+from poppy_cli.robots import robot_config, start_robot
 
 if TYPE_CHECKING:
     from rich.table import Table
