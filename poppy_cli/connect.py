@@ -14,15 +14,18 @@ if TYPE_CHECKING:
 
 @contextmanager
 def open_bus(port: str, ids: list[int], baud: int | None, protocol: int | None) -> Iterator[DxlBus]:
-    """Open a ``DxlBus`` where ``ids`` answer (searching when baud or protocol is unknown)."""
+    """Open a ``DxlBus`` where ``ids`` answer (searching when baud or protocol is unknown).
+
+    The port is opened once: a search hands on the bus it found the motors on.
+    """
     from poppy_core.bus.dxlbus import DxlBus
-    from poppy_core.bus.scan import find_port
+    from poppy_core.bus.find import PROTOCOLS, find_bus
 
     if baud is None or protocol is None:
-        _, baud, protocol = find_port(
-            ids, [port], None if baud is None else [baud], [protocol] if protocol else (1, 2)
-        )
-    bus = DxlBus(port, baud, protocol)
+        rates = None if baud is None else [baud]
+        bus = find_bus(ids, [port], rates, PROTOCOLS if protocol is None else [protocol])
+    else:
+        bus = DxlBus(port, baud, protocol)
     try:
         yield bus
     finally:

@@ -21,6 +21,7 @@ from poppy_cli.commands import sim as sim_cmd
 from poppy_cli.commands import snap as snap_cmd
 from poppy_cli.commands import teleop as teleop_cmd
 from poppy_cli.commands import tui as tui_cmd
+from poppy_cli.options import SimArgsGroup
 from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
 
 app = typer.Typer(
@@ -29,7 +30,7 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     rich_markup_mode="rich",
-    cls=sim_cmd.SimArgsGroup,  # `--sim [ideal|mujoco]`: see poppy_cli/commands/sim.py
+    cls=SimArgsGroup,  # `--sim [ideal|mujoco]`: see poppy_cli/options.py
 )
 
 

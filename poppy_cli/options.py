@@ -1,11 +1,16 @@
-"""Options shared by commands (robot, bus, output) and their parsers: IDs, baud rates, protocols."""
+"""Options shared by commands (robot, bus, output, --sim); parsers of IDs, rates, protocols."""
 
 from __future__ import annotations
 
 import math
 import os
+from typing import TYPE_CHECKING, Any
 
 import typer
+from typer.core import TyperGroup
+
+if TYPE_CHECKING:
+    from typer import _click
 
 
 def parse_ids(text: str) -> list[int]:
@@ -79,36 +84,119 @@ PORT_HELP = (
 )
 BAUD_HELP = "Baud rate in bps (default: search the standard rates)."
 PROTOCOL_HELP = "Dynamixel protocol: 1 or 2 (default: search both)."
+SIM_ENGINES = ("ideal", "mujoco")
 
 
-# -- the robot options of every command that builds one ----------------------------------------
+# -- each shared option is defined here once; a command may say in its help what it does -------
 
-ProfileOpt = typer.Option(
-    None, "--profile", help="Robot profile, e.g. ergo-jr. [env: POPPY_PROFILE, or user settings]"
-)
-ConfigOpt = typer.Option(None, "--config", "-c", help="Robot config file (JSON or YAML).")
-PortOpt = typer.Option(
-    None, "--port", "-p", help="Serial port of the robot's bus. [env: POPPY_PORT]"
-)
+
+def port_option(help: str = PORT_HELP) -> Any:
+    """``--port/-p PORT`` (None when not given; ``default_port`` adds POPPY_PORT)."""
+    return typer.Option(None, "--port", "-p", help=help)
+
+
+def json_option(help: str = "Print JSON instead of a table.") -> Any:
+    """``--json``: print JSON for scripts instead of the human output."""
+    return typer.Option(False, "--json", help=help)
+
+
+def profile_option(help: str, default: str | None = None) -> Any:
+    """``--profile NAME``: a robot profile (``poppy_core.robot.profiles``)."""
+    return typer.Option(default, "--profile", help=help)
 
 
 def _sim_engine(value: str | None) -> str | None:
     """Check the engine of ``--sim`` (the root group turns a bare ``--sim`` into ``ideal``)."""
-    if value is not None and value not in ("ideal", "mujoco"):
+    if value is not None and value not in SIM_ENGINES:
         raise typer.BadParameter(f"{value!r}: use --sim (ideal servos) or --sim mujoco (physics)")
     return value
 
 
-SimOpt = typer.Option(
-    None,
-    "--sim",
-    metavar="[mujoco]",
-    callback=_sim_engine,
-    help="Build a virtual robot: --sim (ideal servos) or --sim mujoco (MuJoCo physics).",
-)
-JsonOpt = typer.Option(False, "--json", help="Print JSON instead of a table.")
+def sim_option(help: str) -> Any:
+    """``--sim [mujoco]``: a bare ``--sim`` is ``ideal`` (see ``SimArgsGroup``)."""
+    return typer.Option(None, "--sim", metavar="[mujoco]", callback=_sim_engine, help=help)
+
+
+BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP, min=MIN_BAUD, max=MAX_BAUD)
+ProtoOpt = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2)
+BusPortOpt = port_option()
+"""``--port`` of the commands that work on a bus (scan, motor, config generate)."""
+JsonOpt = json_option()
+JsonSummaryOpt = json_option("Print a JSON summary.")
+
+
+# -- the robot options of every command that builds one ----------------------------------------
+
+ProfileOpt = profile_option("Robot profile, e.g. ergo-jr. [env: POPPY_PROFILE, or user settings]")
+ConfigOpt = typer.Option(None, "--config", "-c", help="Robot config file (JSON or YAML).")
+PortOpt = port_option("Serial port of the robot's bus. [env: POPPY_PORT]")
+SimOpt = sim_option("Build a virtual robot: --sim (ideal servos) or --sim mujoco (MuJoCo physics).")
 RemoteOpt = typer.Option(
     None,
     "--remote",
     help="Drive a robot served by `poppy serve --http` at this URL (token: env POPPY_TOKEN).",
 )
+
+
+# -- `--sim [ENGINE]`: an option whose value may be left out ---------------------------------
+
+
+def _leaf_command(group: TyperGroup, ctx: _click.Context, args: list[str]) -> Any:
+    """The command ``args`` will run (through nested groups), or None."""
+    command: Any = group
+    for token in args:
+        if token == "--":
+            break
+        if token.startswith("-"):
+            continue
+        if not hasattr(command, "get_command"):
+            break
+        found = command.get_command(ctx, token)
+        if found is None:
+            break
+        command = found
+    return None if command is group else command
+
+
+def _sim_takes_value(command: Any) -> bool:
+    for param in getattr(command, "params", []):
+        if "--sim" in getattr(param, "opts", []):
+            return not getattr(param, "is_flag", True)
+    return False
+
+
+def normalise_sim_args(args: list[str], engines: tuple[str, ...] = SIM_ENGINES) -> list[str]:
+    """``--sim`` alone -> ``--sim=ideal``; ``--sim ENGINE`` -> ``--sim=ENGINE`` (words kept).
+
+    So ``--sim`` stays a bare flag in every command line (``poppy robot goto --sim m1=30``)
+    while ``--sim mujoco`` picks the physics engine.
+    """
+    out: list[str] = []
+    index = 0
+    while index < len(args):
+        token = args[index]
+        if token == "--":
+            return out + args[index:]
+        if token == "--sim":
+            following = args[index + 1] if index + 1 < len(args) else None
+            if following in engines:
+                out.append(f"--sim={following}")
+                index += 2
+                continue
+            token = "--sim=ideal"
+        out.append(token)
+        index += 1
+    return out
+
+
+class SimArgsGroup(TyperGroup):
+    """The root group: lets ``--sim`` take an optional engine (see ``normalise_sim_args``).
+
+    Only commands whose ``--sim`` option takes a value get their arguments rewritten.
+    """
+
+    def parse_args(self, ctx: _click.Context, args: list[str]) -> list[str]:
+        """Rewrite ``--sim [ENGINE]`` for the command about to run, then parse as usual."""
+        if "--sim" in args and _sim_takes_value(_leaf_command(self, ctx, args)):
+            args = normalise_sim_args(args)
+        return super().parse_args(ctx, args)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, build_robot
+from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, json_option
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
@@ -25,6 +25,7 @@ from poppy_cli.output import (
     print_json,
     styled,
 )
+from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -159,7 +160,7 @@ def calibrate(
         3.0, "--tolerance", min=0.0, help="--check: drift allowed, in degrees."
     ),
     yes: bool = typer.Option(False, "--yes", "-y", help="Write the profile without asking."),
-    json_output: bool = typer.Option(False, "--json", help="Print the result as JSON."),
+    json_output: bool = json_option("Print the result as JSON."),
 ) -> None:
     """Calibrate a robot: each joint's zero (in its reference posture) and reachable range.
 
@@ -168,7 +169,7 @@ def calibrate(
     profile.yaml.bak) that --profile NAME then uses. Ctrl-C or q leaves the previous calibration
     untouched. --check reads the robot in its posture and reports how far each joint drifted.
     """
-    from poppy_cli.commands.robot import robot_config
+    from poppy_cli.robots import robot_config
     from poppy_core.robot import CalibrationSession, check_calibration
     from poppy_core.robot.calibration import check_motors
     from poppy_core.robot.profile_store import check_profile_name

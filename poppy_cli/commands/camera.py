@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import ConfigOpt, JsonOpt, ProfileOpt, SimOpt
+from poppy_cli.options import ConfigOpt, JsonOpt, ProfileOpt, SimOpt
 from poppy_cli.output import EXIT_USAGE, console, error_line, print_json
 
 if TYPE_CHECKING:
@@ -80,7 +80,7 @@ def _source(
         return
     if device is not None:
         _usage("--device names a real camera: leave out --sim")
-    from poppy_cli.commands.robot import robot_config, start_robot
+    from poppy_cli.robots import robot_config, start_robot
     from poppy_core.robot import RobotConfig
     from poppy_core.sensors import Camera
 

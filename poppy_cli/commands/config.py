@@ -7,14 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.options import (
-    BAUD_HELP,
-    MAX_BAUD,
-    MIN_BAUD,
-    PORT_HELP,
-    PROTOCOL_HELP,
-    default_port,
-)
+from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, ProtoOpt, default_port, json_option
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
@@ -84,7 +77,7 @@ def convert(
 @app.command("show")
 def show(
     profile: str = typer.Argument(..., help="Profile name (see `poppy config list`) or a file."),
-    json_output: bool = typer.Option(False, "--json", help="Print the config as JSON."),
+    json_output: bool = json_option("Print the config as JSON."),
     yaml_output: bool = typer.Option(False, "--yaml", help="Print the config as YAML."),
 ) -> None:
     """Show a profile's (or config file's) motors, controllers and groups."""
@@ -131,7 +124,7 @@ def show(
 
 @app.command("list")
 def list_cmd(
-    json_output: bool = typer.Option(False, "--json", help="Print JSON instead of a table."),
+    json_output: bool = JsonOpt,
 ) -> None:
     """List the installed and user profiles."""
     from rich.table import Table
@@ -203,11 +196,9 @@ def generate(
     output: Path = typer.Option(
         ..., "--output", "-o", help="File to write (.json or .yaml), or a folder (robot.yaml)."
     ),
-    port: str | None = typer.Option(None, "--port", "-p", help=PORT_HELP),
-    baud: int | None = typer.Option(
-        None, "--baud", "-b", help=BAUD_HELP, min=MIN_BAUD, max=MAX_BAUD
-    ),
-    protocol: int | None = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2),
+    port: str | None = BusPortOpt,
+    baud: int | None = BaudOpt,
+    protocol: int | None = ProtoOpt,
     name: str = typer.Option("m", "--name", help="Motor name prefix: <prefix><ID>."),
     force: bool = ForceOpt,
 ) -> None:

@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from poppy_cli.options import sim_option
 from poppy_cli.output import console, fmt_value, plain, styled
 
 if TYPE_CHECKING:
@@ -30,16 +31,11 @@ def demo(
         True, "--wire-timing/--no-wire-timing", help="Emulate the wire's timing (1 Mbps)."
     ),
     quick: bool = typer.Option(False, "--quick", help="Play the choreography ten times faster."),
-    sim: str | None = typer.Option(
-        None,
-        "--sim",
-        metavar="[mujoco]",
-        help="The dancing robot's servos: --sim (ideal, the default) or --sim mujoco (physics).",
+    sim: str | None = sim_option(
+        "The dancing robot's servos: --sim (ideal, the default) or --sim mujoco (physics)."
     ),
 ) -> None:
     """Start a virtual Ergo Jr (six XL-320), scan it, show it, then play a short dance."""
-    if sim not in (None, "ideal", "mujoco"):
-        raise typer.BadParameter(f"{sim!r}: use --sim (ideal servos) or --sim mujoco (physics)")
     from rich.table import Table
 
     from poppy_cli.commands.scan import render_found

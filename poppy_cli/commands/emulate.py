@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.options import MAX_BAUD, MIN_BAUD
+from poppy_cli.options import MAX_BAUD, MIN_BAUD, profile_option
 from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
 
 if TYPE_CHECKING:
@@ -29,8 +29,8 @@ def parse_hostport(text: str) -> tuple[str, int]:
 
 
 def emulate(
-    profile: str | None = typer.Option(
-        None, "--profile", help="Robot profile: ergo-jr (6 XL-320, ids 1-6), torso, humanoid."
+    profile: str | None = profile_option(
+        "Robot profile: ergo-jr (6 XL-320, ids 1-6), torso, humanoid."
     ),
     motors: str | None = typer.Option(
         None, "--motors", help="Models and IDs, e.g. MX-28:11-15,AX-12A:36-37."

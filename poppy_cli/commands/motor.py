@@ -7,16 +7,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from poppy_cli.connect import open_bus, ping_model
-from poppy_cli.options import (
-    BAUD_HELP,
-    MAX_BAUD,
-    MIN_BAUD,
-    PORT_HELP,
-    PROTOCOL_HELP,
-    JsonOpt,
-    default_port,
-    parse_ids,
-)
+from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, ProtoOpt, default_port, parse_ids
 from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
@@ -28,10 +19,6 @@ app = typer.Typer(
     help="Read, write and set up motors: IDs, baud rates, limits, torque, LED, reset.",
     no_args_is_help=True,
 )
-
-PortOpt = typer.Option(None, "--port", "-p", help=PORT_HELP)
-BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP, min=MIN_BAUD, max=MAX_BAUD)
-ProtoOpt = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2)
 
 
 def require_port(port: str | None) -> str:
@@ -85,7 +72,7 @@ def print_setup(result: SetupResult, json_output: bool) -> None:
 @app.command("info")
 def info(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -141,7 +128,7 @@ def info(
 def get(
     ids: str = typer.Argument(..., help="Motor ID(s): 11, or 1-6, or 1,3,5."),
     registers: list[str] = typer.Argument(..., help="Register name(s), e.g. present_position."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -181,7 +168,7 @@ def set_register(
     ids: str = typer.Argument(..., help="Motor ID(s): 11, or 1-6, or 1,3,5."),
     register: str = typer.Argument(..., help="Register name, e.g. goal_position."),
     value: str = typer.Argument(..., help="Value in SI units (degrees, deg/s, %, on/off...)."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -232,7 +219,7 @@ def _toggle(
 def torque(
     ids: str = typer.Argument(..., help="Motor ID(s)."),
     state: str = typer.Argument(..., help="on or off."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -245,7 +232,7 @@ def torque(
 def led(
     ids: str = typer.Argument(..., help="Motor ID(s)."),
     state: str = typer.Argument(..., help="on/off, or a colour on the XL-320 (red, green, ...)."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,

@@ -7,15 +7,8 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.commands.motor import (
-    BaudOpt,
-    PortOpt,
-    ProtoOpt,
-    app,
-    print_setup,
-    require_port,
-)
-from poppy_cli.options import JsonOpt
+from poppy_cli.commands.motor import app, print_setup, require_port
+from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, ProtoOpt
 
 if TYPE_CHECKING:
     from poppy_core.bus.dxlbus import DxlBus
@@ -48,7 +41,7 @@ def _run_setup(
 def set_id(
     motor_id: int = typer.Argument(..., help="Current ID.", min=0, max=253),
     new_id: int = typer.Argument(..., help="New ID.", min=0, max=253),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -70,7 +63,7 @@ def set_id(
 def set_baudrate(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
     rate: int = typer.Argument(..., help="New baud rate in bps, e.g. 1000000."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -92,7 +85,7 @@ def set_baudrate(
 def set_return_delay(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
     delay_us: float = typer.Argument(..., help="Return delay in µs (0 for a fast bus)."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -115,7 +108,7 @@ def angle_limits(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
     min_deg: float | None = typer.Argument(None, help="Lower limit in degrees."),
     max_deg: float | None = typer.Argument(None, help="Upper limit in degrees."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -150,7 +143,7 @@ def angle_limits(
 @app.command("reboot")
 def reboot(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -178,7 +171,7 @@ def factory_reset(
         False, "--reset-baudrate", help="Also reset the baud rate to the factory one."
     ),
     yes: bool = typer.Option(False, "--yes", "-y", help="Do not ask for confirmation."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
@@ -215,7 +208,7 @@ def reset(
         None, "--angle-limits", help="Angle limits MIN,MAX in degrees, e.g. -150,150."
     ),
     zero: bool = typer.Option(False, "--zero", help="Move the motor to 0° afterwards."),
-    port: str | None = PortOpt,
+    port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,

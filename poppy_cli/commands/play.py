@@ -9,17 +9,17 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.commands.robot import (
+from poppy_cli.options import (
     ConfigOpt,
+    JsonSummaryOpt,
     PortOpt,
     ProfileOpt,
     RemoteOpt,
     SimOpt,
-    robot_config,
-    start_robot,
+    finite,
 )
-from poppy_cli.options import finite
 from poppy_cli.output import console, err_console, print_json, warn_line
+from poppy_cli.robots import robot_config, start_robot
 
 if TYPE_CHECKING:
     from poppy_core.motion import MovePlayer, PlayProgress
@@ -36,7 +36,7 @@ def play(
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
     sim: str | None = SimOpt,
-    json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+    json_output: bool = JsonSummaryOpt,
     remote: str | None = RemoteOpt,
 ) -> None:
     """Play a move: a gentle ramp to its first frame, then the frames at the chosen speed.

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import typer
-
+from poppy_cli.options import JsonOpt
 from poppy_cli.output import console, print_json, styled
 
 if TYPE_CHECKING:
@@ -13,7 +12,7 @@ if TYPE_CHECKING:
 
 
 def ports(
-    json_output: bool = typer.Option(False, "--json", help="Print JSON instead of a table."),
+    json_output: bool = JsonOpt,
 ) -> None:
     """List serial ports, recognise Dynamixel adapters, and say what to fix."""
     from rich.table import Table

@@ -8,17 +8,18 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import (
+from poppy_cli.options import (
+    MAX_DURATION_S,
     ConfigOpt,
     JsonOpt,
     PortOpt,
     ProfileOpt,
     RemoteOpt,
     SimOpt,
-    build_robot,
+    finite,
 )
-from poppy_cli.options import MAX_DURATION_S, finite
 from poppy_cli.output import EXIT_FAILURE, console, error_line, print_json
+from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
     from rich.table import Table

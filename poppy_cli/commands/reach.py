@@ -12,17 +12,10 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import (
-    SETTLE_S,
-    ConfigOpt,
-    JsonOpt,
-    PortOpt,
-    ProfileOpt,
-    SimOpt,
-    app,
-    build_robot,
-)
+from poppy_cli.commands.robot import SETTLE_S, app
+from poppy_cli.options import ConfigOpt, JsonOpt, PortOpt, ProfileOpt, SimOpt
 from poppy_cli.output import console, print_json
+from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
     from poppy_core.motion.cartesian import RobotChain

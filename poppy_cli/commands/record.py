@@ -11,16 +11,17 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.commands.robot import (
+from poppy_cli.options import (
+    MAX_DURATION_S,
     ConfigOpt,
+    JsonSummaryOpt,
     PortOpt,
     ProfileOpt,
     SimOpt,
-    robot_config,
-    start_robot,
+    finite,
 )
-from poppy_cli.options import MAX_DURATION_S, finite
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, print_json
+from poppy_cli.robots import robot_config, start_robot
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -128,7 +129,7 @@ def record(
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
     sim: str | None = SimOpt,
-    json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+    json_output: bool = JsonSummaryOpt,
 ) -> None:
     """Record a move: the motors turn compliant, move them by hand, Enter or Ctrl-C stops.
 

@@ -23,7 +23,7 @@ def list_remote(url: str, json_output: bool) -> None:
     """`poppy primitive list --remote URL`."""
     from rich.table import Table
 
-    from poppy_cli.commands.robot import open_remote
+    from poppy_cli.robots import open_remote
 
     robot = open_remote(url)
     try:
@@ -51,7 +51,7 @@ def run_remote(
     json_output: bool,
 ) -> None:
     """`poppy primitive run NAME --remote URL`: start it on the server, follow it, stop it."""
-    from poppy_cli.commands.robot import open_remote
+    from poppy_cli.robots import open_remote
 
     robot = open_remote(url)
     interrupted = False
@@ -88,7 +88,7 @@ def play_remote(
     url: str, name: str, speed: float, reverse: bool, loops: int, json_output: bool
 ) -> None:
     """`poppy play NAME --remote URL`: play a move of the server's library, ``loops`` times."""
-    from poppy_cli.commands.robot import open_remote
+    from poppy_cli.robots import open_remote
 
     robot = open_remote(url)
     interrupted = False

@@ -9,8 +9,9 @@ import typer
 from poppy_cli.options import (
     MAX_BAUD,
     MIN_BAUD,
-    PORT_HELP,
+    BusPortOpt,
     default_port,
+    json_option,
     parse_ids,
     parse_protocols,
 )
@@ -59,7 +60,7 @@ def render_found(motors: list[FoundMotor]) -> None:
 
 
 def scan(
-    port: str | None = typer.Option(None, "--port", "-p", help=PORT_HELP),
+    port: str | None = BusPortOpt,
     baud: list[int] | None = typer.Option(
         None,
         "--baud",
@@ -73,7 +74,7 @@ def scan(
     ),
     protocol: str = typer.Option("both", "--protocol", help="Protocol: 1, 2 or both."),
     ids: str = typer.Option("0-253", "--ids", help="IDs to look for, e.g. 0-253 or 1-6,11."),
-    json_output: bool = typer.Option(False, "--json", help="Print a JSON list instead of a table."),
+    json_output: bool = json_option("Print a JSON list instead of a table."),
 ) -> None:
     """Find the motors on a bus: every ID at the given baud rates, in protocol 1 and/or 2."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn

@@ -11,9 +11,10 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import typer
 
-from poppy_cli.commands.robot import ConfigOpt, PortOpt, ProfileOpt, SimOpt, build_robot
 from poppy_cli.commands.serve_snap import announce_snap, check_snap_options, snap_server_for
+from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, warn_line
+from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
     from poppy_core.server import ServerThread

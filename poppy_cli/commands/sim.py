@@ -11,9 +11,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import typer
-from typer.core import TyperGroup
 
-from poppy_cli.options import finite
+from poppy_cli.options import finite, profile_option
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
@@ -25,11 +24,8 @@ from poppy_cli.output import (
 )
 
 if TYPE_CHECKING:
-    from typer import _click
-
     from poppy_core.robot import RobotConfig
 
-SIM_ENGINES = ("ideal", "mujoco")
 RENDER_PACKAGES = "libegl1 libgl1 (EGL) or libosmesa6 (OSMesa)"
 GIF_FPS = 15.0
 SETTLE_S = 0.5  # physics time before the first frame: the robot takes its pose
@@ -39,70 +35,6 @@ app = typer.Typer(
     invoke_without_command=True,
     no_args_is_help=False,
 )
-
-
-# ---------------------------------------------------------------------------------- --sim VALUE
-
-
-def _leaf_command(group: TyperGroup, ctx: _click.Context, args: list[str]) -> Any:
-    """The command ``args`` will run (through nested groups), or None."""
-    command: Any = group
-    for token in args:
-        if token == "--":
-            break
-        if token.startswith("-"):
-            continue
-        if not hasattr(command, "get_command"):
-            break
-        found = command.get_command(ctx, token)
-        if found is None:
-            break
-        command = found
-    return None if command is group else command
-
-
-def _sim_takes_value(command: Any) -> bool:
-    for param in getattr(command, "params", []):
-        if "--sim" in getattr(param, "opts", []):
-            return not getattr(param, "is_flag", True)
-    return False
-
-
-def normalise_sim_args(args: list[str], engines: tuple[str, ...] = SIM_ENGINES) -> list[str]:
-    """``--sim`` alone -> ``--sim=ideal``; ``--sim ENGINE`` -> ``--sim=ENGINE`` (words kept).
-
-    So ``--sim`` stays a bare flag in every command line (``poppy robot goto --sim m1=30``)
-    while ``--sim mujoco`` picks the physics engine.
-    """
-    out: list[str] = []
-    index = 0
-    while index < len(args):
-        token = args[index]
-        if token == "--":
-            return out + args[index:]
-        if token == "--sim":
-            following = args[index + 1] if index + 1 < len(args) else None
-            if following in engines:
-                out.append(f"--sim={following}")
-                index += 2
-                continue
-            token = "--sim=ideal"
-        out.append(token)
-        index += 1
-    return out
-
-
-class SimArgsGroup(TyperGroup):
-    """The root group: lets ``--sim`` take an optional engine (see ``normalise_sim_args``).
-
-    Only commands whose ``--sim`` option takes a value get their arguments rewritten.
-    """
-
-    def parse_args(self, ctx: _click.Context, args: list[str]) -> list[str]:
-        """Rewrite ``--sim [ENGINE]`` for the command about to run, then parse as usual."""
-        if "--sim" in args and _sim_takes_value(_leaf_command(self, ctx, args)):
-            args = normalise_sim_args(args)
-        return super().parse_args(ctx, args)
 
 
 # ---------------------------------------------------------------------------------- serving
@@ -196,8 +128,8 @@ def _serve(profile: str, speed: float, tcp: str | None, view: bool) -> None:
 @app.callback()
 def sim(
     ctx: typer.Context,
-    profile: str | None = typer.Option(
-        None, "--profile", help="Robot profile with a simulation model: ergo-jr, torso, humanoid."
+    profile: str | None = profile_option(
+        "Robot profile with a simulation model: ergo-jr, torso, humanoid."
     ),
     speed: float = typer.Option(
         1.0,
@@ -359,7 +291,7 @@ def render(
     output: Path = typer.Option(
         ..., "--output", "-o", help="out.png (a still) or out.gif, or a folder (PROFILE.png/gif)."
     ),
-    profile: str = typer.Option("ergo-jr", "--profile", help="Robot profile to render."),
+    profile: str = profile_option("Robot profile to render.", default="ergo-jr"),
     move: str | None = typer.Option(
         None, "--move", help="Play this move (library name or file) and render it (use a .gif)."
     ),

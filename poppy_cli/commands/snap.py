@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from poppy_cli.commands.robot import ConfigOpt, ProfileOpt
+from poppy_cli.options import ConfigOpt, ProfileOpt
 from poppy_cli.output import EXIT_USAGE, console, error_line
 
 app = typer.Typer(
@@ -30,7 +30,7 @@ def _write(
     port: int,
     force: bool,
 ) -> None:
-    from poppy_cli.commands.robot import build_robot
+    from poppy_cli.robots import build_robot
     from poppy_core.files import output_path, write_file
     from poppy_core.server import RobotService
     from poppy_core.server.snap import robot_facts

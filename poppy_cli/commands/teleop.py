@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from poppy_cli.options import SIM_ENGINES, JsonSummaryOpt
 from poppy_cli.output import EXIT_USAGE, console, err_console, error_line, print_json, styled
 
 if TYPE_CHECKING:
@@ -26,7 +27,6 @@ if TYPE_CHECKING:
 
 REFRESH_S = 0.1
 SELF = "self"
-SIM_ENGINES = ("ideal", "mujoco")
 
 
 def _is_url(text: str) -> bool:
@@ -36,22 +36,16 @@ def _is_url(text: str) -> bool:
 def _config(spec: str, port: str | None, role: str) -> RobotConfig:
     """A profile name or a config file, with ``port`` on its one bus."""
     from poppy_core.errors import ConfigError
-    from poppy_core.robot import RobotConfig, load_config, load_profile
+    from poppy_core.robot import load_config, load_profile, with_ports
 
     path = Path(spec).expanduser()
     config = load_config(path) if path.is_file() else load_profile(spec)
     if port is None:
         return config
-    data = config.to_dict()
-    controllers = data["controllers"]
-    if len(controllers) != 1:
-        raise ConfigError(
-            f"--{role}-port names one bus but the {role} has {len(controllers)} controllers "
-            f"({', '.join(controllers)}): give a config file with each port",
-            field="controllers",
-        )
-    next(iter(controllers.values()))["port"] = port
-    return RobotConfig.from_dict(data, source="command line")
+    try:
+        return with_ports(config, port, source="command line")
+    except ConfigError as exc:
+        raise ConfigError(f"--{role}-port: {exc}", field=exc.field) from None
 
 
 def _joint_map(text: str | None, file: Path | None) -> JointMap | None:
@@ -104,7 +98,7 @@ def teleop(
         None, "--record", help="Save the follower's trajectory as a move of this name (or path)."
     ),
     force: bool = typer.Option(False, "--force", help="Replace an existing move of that name."),
-    json_output: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+    json_output: bool = JsonSummaryOpt,
 ) -> None:
     """Teleoperate: the leader turns compliant, move it by hand; the follower copies it.
 
@@ -115,7 +109,7 @@ def teleop(
     calibrate`), so two calibrated robots of one kind agree; other pairs need --map.
     """
     from poppy_cli.commands.record import _install_stop
-    from poppy_cli.commands.robot import robot_config
+    from poppy_cli.robots import robot_config
     from poppy_core.motion import move_path
 
     if follower_sim is not None and follower_sim not in SIM_ENGINES:
@@ -203,7 +197,7 @@ def _check_map(
 
 
 def _build(config: RobotConfig, sim: str | None) -> Robot:
-    from poppy_cli.commands.robot import start_robot
+    from poppy_cli.robots import start_robot
 
     return start_robot(config, sim)
 

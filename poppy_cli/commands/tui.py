@@ -11,7 +11,7 @@ from pathlib import Path
 
 import typer
 
-from poppy_cli.options import MAX_BAUD, MIN_BAUD
+from poppy_cli.options import MAX_BAUD, MIN_BAUD, port_option, sim_option
 from poppy_cli.output import console
 
 
@@ -32,9 +32,7 @@ def serve_command(
 
 
 def tui(
-    port: str | None = typer.Option(
-        None, "--port", "-p", help="Open this bus at start and scan it (device, pty or URL)."
-    ),
+    port: str | None = port_option("Open this bus at start and scan it (device, pty or URL)."),
     baud: int | None = typer.Option(
         None,
         "--baud",
@@ -46,12 +44,9 @@ def tui(
     protocol: int | None = typer.Option(
         None, "--protocol", min=1, max=2, help="Scan --port in this protocol only (1 or 2)."
     ),
-    sim: str | None = typer.Option(
-        None,
-        "--sim",
-        metavar="[mujoco]",
-        help="Start a virtual Ergo Jr: --sim (emulated bus and robot tab) or --sim mujoco "
-        "(the robot tab drives a MuJoCo-simulated Ergo Jr).",
+    sim: str | None = sim_option(
+        "Start a virtual Ergo Jr: --sim (emulated bus and robot tab) or --sim mujoco "
+        "(the robot tab drives a MuJoCo-simulated Ergo Jr)."
     ),
     serve: bool = typer.Option(False, "--serve", help="Serve the app to a web browser."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to serve on (with --serve)."),
@@ -73,8 +68,6 @@ def tui(
         return
     from poppy_cli.tui.app import make_app
 
-    if sim not in (None, "ideal", "mujoco"):
-        raise typer.BadParameter(f"{sim!r}: use --sim (ideal servos) or --sim mujoco (physics)")
     if sim == "mujoco":
         with mujoco_ergo_jr() as config_path:
             make_app(port, baud, protocol, False, robot_source=str(config_path)).run()

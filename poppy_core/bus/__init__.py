@@ -15,7 +15,7 @@ from poppy_core.bus.ports import (
     recognise_adapter,
 )
 from poppy_core.bus.results import BusStats, FoundMotor, PingResult, ScanProgress, SetupResult
-from poppy_core.bus.scan import find_port, scan
+from poppy_core.bus.scan import find_bus, find_port, scan
 from poppy_core.bus.setup import (
     change_baudrate,
     change_id,
@@ -52,6 +52,7 @@ __all__ = [
     "default_latency_s",
     "describe_ports",
     "factory_reset",
+    "find_bus",
     "find_port",
     "get_available_ports",
     "identify",

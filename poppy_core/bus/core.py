@@ -427,6 +427,11 @@ class BusCore:
             self._strays.clear()
             self._replies.forget()
 
+    def adopt_transport(self) -> None:
+        """Close the transport it was given on ``close`` (a search hands on the port it opened)."""
+        with self._lock:
+            self._owns_transport = True
+
     def close(self) -> None:
         """Close the port (unless the transport was given by the caller). Idempotent."""
         with self._lock:

@@ -1,9 +1,10 @@
-"""``find_port``: the port, baud rate and protocol where given motors all answer."""
+"""``find_bus``: the open bus where given motors all answer (``find_port``: its address)."""
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.ports import list_ports
@@ -15,6 +16,8 @@ from poppy_core.models import standard_baudrates
 logger = logging.getLogger(__name__)
 
 DEFAULT_SEARCH_FIRST_BPS = 1_000_000
+FACTORY_BPS = 57_600
+"""The factory rate of MX and X-series motors: searched second, so a new motor is found early."""
 PROTOCOLS = (1, 2)
 
 
@@ -30,15 +33,82 @@ def _answering(bus: DxlBus, wanted: list[int]) -> tuple[list[int], set[int]]:
     return confirmed, heard - set(confirmed)
 
 
-def find_port(
+@dataclass
+class _Closest:
+    """The best partial answer of a search, for its error message."""
+
+    count: int = 0
+    text: str = ""
+
+    def offer(self, bus: DxlBus, answered: list[int]) -> None:
+        if len(answered) > self.count:
+            self.count = len(answered)
+            self.text = (
+                f"{bus.port} at {bus.baudrate} bps, protocol {bus.protocol} "
+                f"has {', '.join(map(str, answered))}"
+            )
+
+
+def _search_order(protocols: list[int], fixed: list[int] | None) -> list[tuple[int, list[int]]]:
+    """The rates to try, each with the protocols to try at it: 1 Mbps first, then 57,600 bps.
+
+    1 Mbps is the rate of Poppy robots and of most set-up buses, so the common case is found
+    at the first rate, whichever its protocol; 57,600 bps is the factory rate of MX and
+    X-series motors; then each protocol's standard rates in order.
+    """
+    order: dict[int, list[int]] = {}
+    for protocol in protocols:
+        for rate in fixed if fixed is not None else standard_baudrates(protocol):
+            order.setdefault(rate, []).append(protocol)
+    first = (DEFAULT_SEARCH_FIRST_BPS, FACTORY_BPS)
+    return sorted(order.items(), key=lambda item: first.index(item[0]) if item[0] in first else 2)
+
+
+def _search_bus(
+    port: str, rate: int, protocol: int, transport: Transport, latency_s: float | None
+) -> DxlBus:
+    bus = DxlBus(port, rate, protocol, latency_s=latency_s, transport=transport)
+    bus.adaptive_latency = True
+    return bus
+
+
+def _search(
+    port: str,
+    transport: Transport,
+    wanted: list[int],
+    plan: list[tuple[int, list[int]]],
+    latency_s: float | None,
+    closest: _Closest,
+) -> DxlBus | None:
+    """Try ``plan`` on one open port; the bus (not owning ``transport``) where all answer."""
+    learned = latency_s
+    previous: dict[int, int] = {}  # per protocol, the rate tried before (see scan._revisit)
+    for rate, protocols in plan:
+        for protocol in protocols:
+            bus = _search_bus(port, rate, protocol, transport, learned)
+            answered, heard_late = _answering(bus, wanted)
+            learned = bus.latency_s
+            if len(answered) == len(wanted):
+                return bus
+            earlier = previous.get(protocol)
+            if heard_late and earlier is not None:
+                again = _search_bus(port, earlier, protocol, transport, learned)
+                if len(_answering(again, wanted)[0]) == len(wanted):
+                    return again
+            previous[protocol] = rate
+            closest.offer(bus, answered)
+    return None
+
+
+def find_bus(
     ids: Iterable[int],
     ports: Sequence[str] | None = None,
     baudrates: Iterable[int] | None = None,
     protocols: Iterable[int] = PROTOCOLS,
     *,
     latency_s: float | None = None,
-) -> tuple[str, int, int]:
-    """Find the bus holding every motor in ``ids``.
+) -> DxlBus:
+    """Open the bus holding every motor in ``ids``: each port is opened once and searched.
 
     Args:
         ids: motor IDs that must all answer.
@@ -48,7 +118,9 @@ def find_port(
         latency_s: adapter latency (None: from the port).
 
     Returns:
-        ``(port, baudrate, protocol)``.
+        The open ``DxlBus`` at the rate and protocol found (the caller closes it; it is a
+        context manager). Rates are tried in the outer loop, 1 Mbps first, and the protocols
+        at each rate in the inner one, so a Poppy robot is found at the first rate tried.
 
     A motor that answers is asked again once the line has settled, so that a late reply (a
     slow adapter) is not taken for a motor at the next rate tried; a slower adapter than
@@ -61,10 +133,11 @@ def find_port(
     wanted = list(ids)
     protocols = list(protocols)
     fixed = None if baudrates is None else list(baudrates)
+    plan = _search_order(protocols, fixed)
     port_list = list(ports) if ports is not None else [p.device for p in list_ports()]
     if not port_list:
         raise PortError("no serial port found: plug the adapter or run `poppy ports`")
-    best: tuple[int, str] = (0, "")
+    closest = _Closest()
     unopened: list[PortError] = []
     for port in port_list:
         try:
@@ -75,45 +148,47 @@ def find_port(
             logger.warning("skipping %s: %s", port, exc)
             unopened.append(exc)
             continue
-        learned = latency_s
+        found = None
         try:
-            for protocol in protocols:
-                # 1 Mbps first: the rate of Poppy robots and of most set-up buses
-                rates = sorted(
-                    fixed if fixed is not None else standard_baudrates(protocol),
-                    key=lambda rate: rate != DEFAULT_SEARCH_FIRST_BPS,
-                )
-                previous: int | None = None
-                for rate in rates:
-                    bus = DxlBus(port, rate, protocol, latency_s=learned, transport=transport)
-                    bus.adaptive_latency = True
-                    answered, heard_late = _answering(bus, wanted)
-                    learned = bus.latency_s
-                    if len(answered) == len(wanted):
-                        return port, rate, protocol
-                    if heard_late and previous is not None:  # see _revisit
-                        earlier = DxlBus(port, previous, protocol, latency_s=learned,
-                                         transport=transport)  # fmt: skip
-                        earlier.adaptive_latency = True
-                        if len(_answering(earlier, wanted)[0]) == len(wanted):
-                            return port, previous, protocol
-                    previous = rate
-                    if len(answered) > best[0]:
-                        best = (
-                            len(answered),
-                            f"{port} at {rate} bps, protocol {protocol} "
-                            f"has {', '.join(map(str, answered))}",
-                        )
+            found = _search(port, transport, wanted, plan, latency_s, closest)
         finally:
-            transport.close()
+            if found is None:
+                transport.close()
+        if found is not None:
+            bus = DxlBus(
+                port, found.baudrate, found.protocol, latency_s=found.latency_s, transport=transport
+            )
+            bus.adopt_transport()
+            return bus
     if len(unopened) == len(port_list):
         reasons = "; ".join(str(exc) for exc in unopened)
         raise PortError(f"no port could be opened: {reasons}")
-    closest = f"; closest: {best[1]}" if best[0] else ""
+    nearest = f"; closest: {closest.text}" if closest.count else ""
     rates_text = "every standard rate" if fixed is None else ", ".join(f"{r} bps" for r in fixed)
     protocols_text = " and ".join(str(p) for p in protocols)
     raise SetupError(
         f"no motor {', '.join(map(str, wanted))} answers (searched {', '.join(port_list)} at "
-        f"{rates_text}, protocol {protocols_text}){closest}: check power and wiring, "
+        f"{rates_text}, protocol {protocols_text}){nearest}: check power and wiring, "
         "or run `poppy scan --all-bauds`"
     )
+
+
+def find_port(
+    ids: Iterable[int],
+    ports: Sequence[str] | None = None,
+    baudrates: Iterable[int] | None = None,
+    protocols: Iterable[int] = PROTOCOLS,
+    *,
+    latency_s: float | None = None,
+) -> tuple[str, int, int]:
+    """Find the bus holding every motor in ``ids`` (see ``find_bus``, which keeps it open).
+
+    Returns:
+        ``(port, baudrate, protocol)``.
+
+    Raises:
+        PortError: no serial port at all; the only port given (or every one) cannot be opened.
+        SetupError: no port/rate/protocol answers for every ID (the message says the closest).
+    """
+    with find_bus(ids, ports, baudrates, protocols, latency_s=latency_s) as bus:
+        return bus.port, bus.baudrate, bus.protocol

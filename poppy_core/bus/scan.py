@@ -30,7 +30,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
 from poppy_core.bus.dxlbus import DxlBus
-from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_port
+from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_bus, find_port
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
 from poppy_core.bus.settle import answers, ping_found, settle
 from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S
@@ -43,6 +43,7 @@ __all__ = [
     "PROTOCOLS",
     "SCAN_IDS",
     "answers",
+    "find_bus",
     "find_port",
     "scan",
     "settle",

@@ -20,6 +20,7 @@ from poppy_core.robot.assembly import SIM_MODES, Assembly, SimMode, sim_mode
 from poppy_core.robot.config import RobotConfig
 from poppy_core.robot.config_io import ConfigSource, as_config
 from poppy_core.robot.creature_hook import attach_behaviours
+from poppy_core.robot.profile_match import matching_profile
 from poppy_core.robot.profiles import load_profile
 from poppy_core.robot.robot import Robot
 from poppy_core.robot.startup import ReturnDelayConsent
@@ -161,16 +162,23 @@ def autodetect(
     ids: Iterable[int] = range(254),
     **options: Any,
 ) -> Robot:
-    """Scan for motors and build a robot of them (named ``m<id>``, one controller per port).
+    """Scan for motors and build a robot of them.
 
-    The angle limits are the ones stored in the motors (the whole range when unset).
+    When the motors found are exactly a profile's (IDs, models, one bus per controller at its
+    rate and protocol: an Ergo Jr, a Torso...), the robot is built from that profile, as
+    :func:`from_profile` on the ports found would: its names, groups, orientations, limits and
+    its creature (``robot.dance``...). Otherwise (or with ``creature=False``) the motors are
+    named ``m<id>``, one controller per port, with the angle limits stored in the motors (the
+    whole range when unset).
 
     Args:
         port: the port to scan; None scans every port.
         baudrates: rates to try (None: the standard ones).
         protocols: protocols to try.
         ids: IDs to look for.
-        **options: passed to :func:`from_config`.
+        **options: passed to :func:`from_config`; ``creature=False`` builds a bare robot of
+            the motors found. ``sensors`` defaults to False here (a scan finds motors, not
+            cameras): pass ``sensors=True`` for a matched profile's camera.
 
     Raises:
         SetupError: no motor found.
@@ -180,6 +188,12 @@ def autodetect(
     found = [f for f in found if f.model is not None]
     if not found:
         raise SetupError(f"no known motor found on {', '.join(ports) or 'any port'}")
+    options.setdefault("sensors", False)
+    match = matching_profile(found) if options.get("creature", True) else None
+    if match is not None:
+        name, profile, profile_ports = match
+        logger.info("the motors found are a %s: building it from its profile", name)
+        return from_config(with_ports(profile, profile_ports, source=f"profile {name}"), **options)
     controllers: dict[str, Any] = {}
     motors: dict[str, Any] = {}
     for index, device in enumerate(sorted({f.port for f in found}), start=1):

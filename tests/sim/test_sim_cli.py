@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from poppy_cli.commands.sim import normalise_sim_args
+from poppy_cli.options import normalise_sim_args
 
 ROOT = Path(__file__).resolve().parents[2]
 POPPY = [sys.executable, "-m", "poppy_cli"]
