@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from poppy_core.errors import ConfigError, RegisterError
-from poppy_core.motion.trajectory import MinimumJerk, check_goto, dummy_speed
+from poppy_core.trajectory import MinimumJerk, check_goto, dummy_speed
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from poppy_core.errors import RobotClosedError
-from poppy_core.motion.trajectory import MinimumJerk, check_goto, control_name, dummy_speed
 from poppy_core.robot.schedule import Periodic
+from poppy_core.trajectory import MinimumJerk, check_goto, control_name, dummy_speed
 
 if TYPE_CHECKING:
     from poppy_core.robot.motor import Motor

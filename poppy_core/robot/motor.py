@@ -22,11 +22,11 @@ from typing import TYPE_CHECKING, Literal
 
 from poppy_core.errors import ArgumentError, RegisterError, RobotClosedError
 from poppy_core.models import ServoModel
-from poppy_core.motion.trajectory import control_name
 from poppy_core.robot import frames
 from poppy_core.robot import registers as regs
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.motor_cache import MotorCache, SIValue
+from poppy_core.trajectory import control_name
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import MotorConfig

@@ -168,9 +168,9 @@ class Robot:
     @property
     def _primitive_manager(self) -> Any:
         """The primitive manager (pypot's name; also ``robot.primitive_manager``)."""
-        from poppy_core.motion import primitive_manager  # motion sits above robot
+        from poppy_core.robot.creature_hook import MANAGER_HOOK, resolve_hook
 
-        return primitive_manager(self)
+        return resolve_hook(MANAGER_HOOK)(self)  # motion sits above robot: an entry point
 
     def motor(self, name: str) -> Motor:
         """The motor called ``name`` (typed access).
