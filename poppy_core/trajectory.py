@@ -147,3 +147,52 @@ def dummy_speed(start: float, goal: float, duration_s: float) -> float:
     if duration_s <= 0:
         return 0.0
     return abs(goal - start) / duration_s
+
+
+@dataclass(frozen=True)
+class GotoPlan:
+    """How one motor makes a goto: a trajectory to sample, or one goal at a constant speed.
+
+    Attributes:
+        goal: where the motor ends (the target, clamped to the angle limits).
+        trajectory: the minimum-jerk curve whose positions become goals at the write rate; None
+            for the ``dummy`` control and for a goto of no duration (send ``goal`` once).
+        speed: the moving speed to set first (0: full speed, the trajectory sets the pace).
+    """
+
+    goal: float
+    trajectory: MinimumJerk | None
+    speed: float
+
+
+def plan_goto(
+    start: float,
+    target: float,
+    duration_s: float,
+    control: str,
+    limits: tuple[float, float] | None,
+    *,
+    min_speed: float = 0.0,
+) -> GotoPlan:
+    """Plan a goto from ``start`` to ``target`` in ``duration_s`` seconds: the one goto of poppy
+    (``Motor.goto_position`` and a primitive's mockup motors both run it).
+
+    Args:
+        start: where the motion starts (degrees).
+        target: where it should end (degrees).
+        duration_s: its length; 0 sends the goal at once at full speed.
+        control: ``"minjerk"`` (``"minijerk"``) or ``"dummy"``.
+        limits: the angle limits the goal is clamped to; None for a wheel (no limits).
+        min_speed: the smallest speed the servo can be given (one register step): a ``dummy``
+            goto slower than that is sent at this speed, since 0 would mean full speed.
+
+    Raises:
+        ArgumentError: unknown ``control``, a negative, not finite or too long duration.
+    """
+    name = control_name(control)
+    check_goto(duration_s, name)
+    goal = target if limits is None else min(max(target, limits[0]), limits[1])
+    if name == "dummy" or duration_s == 0:
+        speed = dummy_speed(start, goal, duration_s)
+        return GotoPlan(goal, None, max(speed, min_speed) if speed else 0.0)
+    return GotoPlan(goal, MinimumJerk(start, goal, duration_s), 0.0)
