@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from poppy_core.emulator import VirtualBus, VirtualMotor
-from poppy_core.motion.trajectory import MinimumJerk
 from poppy_core.protocol import Instruction, InstructionPacket, PacketDecoder
+from poppy_core.trajectory import MinimumJerk
 
 READS = {Instruction.READ, Instruction.SYNC_READ, Instruction.SYNC_READ_USB2AX,
          Instruction.FAST_SYNC_READ, Instruction.BULK_READ}  # fmt: skip

@@ -67,7 +67,7 @@ out of range is a usage error (exit 2)."""
 
 
 MAX_DURATION_S = 86_400.0
-"""A day: the longest goto or move core accepts (``poppy_core.motion.trajectory`` and
+"""A day: the longest goto or move core accepts (``poppy_core.trajectory`` and
 ``poppy_core.motion.move``); longer is a typing mistake that would never end."""
 
 

@@ -30,11 +30,8 @@ def require_port(port: str | None) -> str:
 
 
 def parse_value(register: Register, text: str) -> SIValue:
-    """Turn command-line text into the SI value ``register.from_si`` expects."""
-    from poppy_core.models.register import Choice
-
-    if register.name == "led" and isinstance(register.conversion, Choice) and text.strip() == "on":
-        return "white"  # the XL-320 LED takes a colour; "on" means all three LEDs
+    """Turn command-line text into the SI value ``register.from_si`` expects (the XL-320 LED
+    takes a colour: ``on`` is white, all three LEDs)."""
     return register.parse(text)
 
 
@@ -87,8 +84,7 @@ def info(
         raw = bus.read(motor_id, 0, model.table_size)
     rows = []
     for reg in sorted(model.registers.values(), key=lambda r: r.address):
-        value = reg.to_si(reg.decode(raw[reg.address : reg.address + reg.size]))
-        rows.append((reg, value))
+        rows.append((reg, reg.decode_si(raw, start=0)))
     if json_output:
         print_json(
             {

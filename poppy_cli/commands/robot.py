@@ -20,6 +20,7 @@ from poppy_cli.options import (
 )
 from poppy_cli.output import console, fmt_value, print_json, styled
 from poppy_cli.robots import build_robot, open_remote, robot_config, start_robot
+from poppy_cli.targets import TargetSyntaxError, parse_targets
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -168,41 +169,16 @@ def status(
             return
 
 
-def parse_targets(
-    pairs: list[str],
+def _goals(
+    targets: list[str],
     known: list[str],
     limits: dict[str, tuple[float, float] | None] | None = None,
 ) -> dict[str, float]:
-    """Parse ``NAME=DEGREES`` words, checking the names against ``known`` and the angles
-    against ``limits`` (motor -> its angle limits, None for a wheel), as the REST API does."""
-    targets: dict[str, float] = {}
-    for pair in pairs:
-        name, sep, text = pair.partition("=")
-        name = name.strip()
-        if not sep or not name:
-            raise typer.BadParameter(f"{pair!r} is not NAME=DEGREES (e.g. m1=30)")
-        if name not in known:
-            from poppy_core.errors import ConfigError
-
-            raise ConfigError(
-                f"no motor {name!r} (motors: {', '.join(known)})", field=name, value=name
-            )
-        try:
-            value = float(text)
-        except ValueError:
-            raise typer.BadParameter(f"{pair!r}: {text!r} is not a number of degrees") from None
-        if value != value or value in (float("inf"), float("-inf")):
-            raise typer.BadParameter(f"{pair!r}: the angle must be a finite number")
-        bounds = (limits or {}).get(name)
-        if bounds is not None and not bounds[0] <= value <= bounds[1]:
-            from poppy_core.errors import ArgumentError
-
-            raise ArgumentError(
-                f"{name}: {value:g}° is outside the angle limits [{bounds[0]:g}, {bounds[1]:g}]",
-                field=name, value=value, motor=name,
-            )  # fmt: skip
-        targets[name] = value
-    return targets
+    """The targets of `robot goto`; a word that is not NAME=DEGREES is a usage error."""
+    try:
+        return parse_targets(targets, known, limits)
+    except TargetSyntaxError as exc:
+        raise typer.BadParameter(str(exc)) from None
 
 
 @app.command("goto")
@@ -238,14 +214,14 @@ def goto(
     robot: Robot | RemoteRobot
     if remote:
         robot = open_remote(remote)
-        goals = parse_targets(targets, [m.name for m in robot.motors])
+        goals = _goals(targets, [m.name for m in robot.motors])
     else:
         config = robot_config(profile, config_file, port)
         limits = {
             name: None if motor.wheel_mode else motor.angle_limit
             for name, motor in config.motors.items()
         }
-        goals = parse_targets(targets, list(config.motors), limits)
+        goals = _goals(targets, list(config.motors), limits)
         robot = start_robot(config, sim)
         wait = wait or bool(sim) or control == "minjerk"
     with robot:

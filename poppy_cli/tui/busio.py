@@ -152,9 +152,7 @@ def read_table(bus: DxlBus, motor_id: int, model: ServoModel) -> list[RegisterVa
     rows = []
     for reg in registers:
         try:
-            value: SIValue | None = reg.to_si(
-                reg.decode(data[reg.address : reg.address + reg.size])
-            )
+            value: SIValue | None = reg.decode_si(data, start=0)
         except RegisterError:
             value = None
         rows.append(RegisterValue(reg, value))
@@ -163,7 +161,7 @@ def read_table(bus: DxlBus, motor_id: int, model: ServoModel) -> list[RegisterVa
 
 def _read_one(bus: DxlBus, motor_id: int, reg: Register) -> SIValue | None:
     try:
-        return reg.to_si(reg.decode(bus.read(motor_id, reg.address, reg.size)))
+        return reg.decode_si(bus.read(motor_id, reg.address, reg.size))
     except PoppyError:
         return None
 
@@ -174,10 +172,7 @@ def read_live(bus: DxlBus, motor_id: int, model: ServoModel) -> LiveValues:
     start = min(reg.address for reg in regs)
     end = max(reg.address + reg.size for reg in regs)
     data = bus.read(motor_id, start, end - start)
-    values = [
-        float(reg.to_si(reg.decode(data[reg.address - start : reg.address - start + reg.size])))
-        for reg in regs
-    ]
+    values = [float(reg.decode_si(data, start)) for reg in regs]
     return LiveValues(*values)
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from poppy_cli.tui.busio import BusPool, MotorRef, SIValue
 from poppy_core.bus import change_baudrate, change_id, factory_reset, reboot
 from poppy_core.errors import PoppyError, SetupError
+from poppy_core.models.register import Register
 
 
 @dataclass
@@ -65,11 +66,9 @@ def write_value(
     return outcome
 
 
-def toggled(current: SIValue | None, register_kind: str) -> SIValue:
+def toggled(current: SIValue | None, register: Register) -> SIValue:
     """The value a toggle key writes: booleans flip, an XL-320 LED colour goes off/white."""
-    if register_kind == "choice":
-        return "white" if current in (None, "off") else "off"
-    return not bool(current)
+    return register.switched(current is None or current == register.switched(False))
 
 
 def restart(pool: BusPool, motor: MotorRef, action: str) -> MotorRef:

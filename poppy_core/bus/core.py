@@ -62,6 +62,18 @@ def is_alarm_only(protocol: int, error: int) -> bool:
     return error & V2_ERROR_NUMBER_MASK == 0
 
 
+def reply_fits(protocol: int, status: StatusPacket, n_params: int) -> bool:
+    """A reply to keep: ``n_params`` bytes of data, or a refusal (which carries none and is
+    checked later).
+
+    A status of another size is a late answer to an earlier instruction (for instance a write
+    sent with ``reply=False`` that was answered all the same): it is kept aside.
+    """
+    if len(status.params) == n_params:
+        return True
+    return bool(status.error) and not is_alarm_only(protocol, status.error)
+
+
 class BusCore:
     """One Dynamixel bus: a port, a baud rate, a protocol, and one lock for every transaction.
 
@@ -276,7 +288,11 @@ class BusCore:
             if status is None:
                 break
             self._observe(status, time.monotonic())
-            if status.id in wanted and status.id not in got and self._fits(status, sizes_by_id):
+            if (
+                status.id in wanted
+                and status.id not in got
+                and reply_fits(self._protocol, status, sizes_by_id[status.id])
+            ):
                 got[status.id] = status
                 deadline.extend(self._timing.quiet_gap_s(max(sizes)))
             else:
@@ -289,16 +305,6 @@ class BusCore:
         self.stats.corrupt_packets += corrupt
         self.stats.timeouts += len(wanted) - len(got)
         return got
-
-    def _fits(self, status: StatusPacket, n_params: dict[int, int]) -> bool:
-        """A reply of the expected size, or a refusal (which carries no data).
-
-        A status of another size is a late answer to an earlier instruction (for instance a
-        write sent with ``reply=False`` that was answered all the same): it is kept aside.
-        """
-        if len(status.params) == n_params[status.id]:
-            return True
-        return bool(status.error) and not is_alarm_only(self._protocol, status.error)
 
     def listen(self, duration_s: float) -> list[StatusPacket]:
         """Wait ``duration_s`` for late replies; return them with the strays kept aside.

@@ -168,7 +168,7 @@ class DxlBus(BusCore):
         """
         register = model.register(name)
         data = self.read(id, register.address, register.size)
-        return register.to_si(register.decode(data))
+        return register.decode_si(data)
 
     def write_register(
         self, id: int, model: ServoModel, name: str, value: float | int | bool | str

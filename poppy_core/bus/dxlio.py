@@ -20,6 +20,7 @@ from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.ports import list_ports
 from poppy_core.errors import ArgumentError, CommunicationError, RegisterError
 from poppy_core.models import ServoModel
+from poppy_core.models.register import SIValue
 
 # pypot's getters named is_<flag> and their registers.
 FLAGS = {"is_led_on": "led", "is_moving": "moving", "is_torque_enabled": "torque_enable"}
@@ -171,9 +172,8 @@ class DxlIO:
         for motor_id in _ids(ids):
             self.set("led", {motor_id: self._led_value(motor_id, on=False)})
 
-    def _led_value(self, motor_id: int, *, on: bool) -> bool | str:
-        colours = "white" in self._model(motor_id).register("led").conversion.describe(0, 7)
-        return ("white" if on else "off") if colours else on
+    def _led_value(self, motor_id: int, *, on: bool) -> SIValue:
+        return self._model(motor_id).register("led").switched(on)
 
     def get_angle_limit(self, ids: Iterable[int]) -> tuple[tuple[float, float], ...]:
         """(min, max) position limits in degrees."""

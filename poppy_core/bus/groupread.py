@@ -23,7 +23,7 @@ import logging
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from poppy_core.bus.core import is_alarm_only
+from poppy_core.bus.core import is_alarm_only, reply_fits
 from poppy_core.bus.results import PingResult
 from poppy_core.bus.timing import Deadline, status_size
 from poppy_core.errors import BusTimeout, CorruptPacketError
@@ -47,13 +47,6 @@ logger = logging.getLogger(__name__)
 # The USB2AX reads each motor itself; allow this much per motor on top of the wire time for its
 # firmware and for a motor that does not answer (USB2AX firmware waits about a millisecond).
 USB2AX_PER_MOTOR_S = 0.0015
-
-
-def _usable(bus: DxlBus, status: StatusPacket, n_params: int) -> bool:
-    """A reply to keep: refused (checked later) or carrying the expected number of bytes."""
-    if status.error and not is_alarm_only(bus.protocol, status.error):
-        return True
-    return len(status.params) == n_params
 
 
 def exchange_with_retries(
@@ -89,7 +82,7 @@ def exchange_with_retries(
                 timeout_s=None if timeout_s is None else timeout_s(missing),
             )
             for motor_id, status in replies.items():
-                if _usable(bus, status, expected[motor_id]):
+                if reply_fits(bus.protocol, status, expected[motor_id]):
                     got[motor_id] = status
                 else:
                     bus.stats.corrupt_packets += 1

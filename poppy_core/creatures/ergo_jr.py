@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, ClassVar
 from poppy_core.creatures.postures import ERGO_JR_IDLE, clamp_to_limits
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import LoopPrimitive, Primitive
-from poppy_core.motion.trajectory import CONTROLS
+from poppy_core.trajectory import CONTROLS
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot

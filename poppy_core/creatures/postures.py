@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, ClassVar
 
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import SimplePosture
-from poppy_core.motion.trajectory import CONTROLS
+from poppy_core.trajectory import CONTROLS
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import difflib
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
 from poppy_core.errors import RegisterError
-from poppy_core.models.register import Baudrate, Register
+from poppy_core.models.register import Baudrate, Register, SIValue
 
 # The names every model resolves, directly or through an alias (docs/internals.md).
 COMMON_NAMES: tuple[str, ...] = (
@@ -152,6 +152,26 @@ class ServoModel:
         hint = f"; did you mean {', '.join(close)}?" if close else ""
         raise RegisterError(f"{self.name} has no register {name!r}{hint}", register=name)
 
+    def decode_table(
+        self, data: bytes, names: Iterable[str] | None = None, *, start: int = 0
+    ) -> dict[str, SIValue]:
+        """SI values of the registers ``names`` (all, in address order, for None) found whole in
+        ``data``, bytes read from address ``start``; names the model lacks are left out.
+
+        Raises:
+            RegisterError: a raw value that cannot be read (an unknown code).
+        """
+        if names is None:
+            names = [reg.name for reg in sorted(self.registers.values(), key=_address)]
+        out: dict[str, SIValue] = {}
+        for name in names:
+            register = self.find_register(name)
+            if register is None:
+                continue
+            if register.address >= start and register.address + register.size <= start + len(data):
+                out[name] = register.decode_si(data, start)
+        return out
+
     def register_at(self, address: int) -> Register | None:
         """Return the register starting at ``address``, if any."""
         for reg in self.registers.values():
@@ -194,3 +214,7 @@ class ServoModel:
             RegisterError: no code of this model gives that rate.
         """
         return self.registers["baudrate"].from_si(bps)
+
+
+def _address(register: Register) -> int:
+    return register.address

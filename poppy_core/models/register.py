@@ -160,12 +160,17 @@ class Boolean:
 
 @dataclass(frozen=True)
 class Choice:
-    """Raw codes with names (XL-320 LED colours); writes take a name (any case) or the code."""
+    """Raw codes with names (XL-320 LED colours); writes take a name (any case) or the code.
+
+    ``on`` names the value that means "on" (the XL-320 LED: ``"white"``, all three colours) and
+    code 0 means "off": such a register switches like an on/off one (``Register.switched``).
+    """
 
     names: tuple[tuple[int, str], ...]
     synonyms: tuple[tuple[str, int], ...] = ()
     mask: int = 0xFF
     unit: str = ""
+    on: str | None = None
 
     def to_si(self, raw: int) -> str:
         code = raw & self.mask
@@ -322,7 +327,8 @@ class Register:
         """Turn typed text (a command line, a form field) into the SI value ``from_si`` takes.
 
         ``on``/``off`` (or true/false, 1/0, yes/no) for on/off registers, a name or a number for
-        choices (XL-320 LED colours), a number otherwise. The range is not checked here.
+        choices (XL-320 LED colours; ``on`` is white), a number otherwise. The range is not
+        checked here.
 
         Raises:
             RegisterError: text that is not a value of this kind (the message says what is).
@@ -335,6 +341,8 @@ class Register:
                 return False
             raise RegisterError(f"{self.name} takes on or off, not {text!r}", register=self.name)
         if isinstance(self.conversion, Choice):
+            if lowered == "on" and self.conversion.on is not None:
+                return self.conversion.on
             return int(lowered) if lowered.isdigit() else lowered
         try:
             number = float(lowered)
@@ -344,6 +352,35 @@ class Register:
                 register=self.name,
             ) from None
         return int(number) if number.is_integer() else number
+
+    def switched(self, on: bool) -> SIValue:
+        """The value that turns this register on or off: True/False, or for the XL-320 LED
+        (colours) ``"white"`` (all three) and ``"off"``.
+
+        Raises:
+            RegisterError: a register that does not switch (a number, a choice without "on").
+        """
+        if isinstance(self.conversion, Boolean):
+            return on
+        if isinstance(self.conversion, Choice) and self.conversion.on is not None:
+            return self.conversion.on if on else self.conversion.to_si(0)
+        raise RegisterError(f"{self.name} is not an on/off register", register=self.name)
+
+    def decode_si(self, data: bytes, start: int | None = None) -> SIValue:
+        """The SI value of this register in ``data``, bytes read from address ``start`` (None:
+        ``data`` starts at this register).
+
+        Raises:
+            RegisterError: ``data`` does not hold the whole register, or a raw value it cannot
+                read.
+        """
+        offset = 0 if start is None else self.address - start
+        if offset < 0:
+            raise RegisterError(
+                f"{self.name}: data from address {start} does not hold address {self.address}",
+                register=self.name,
+            )
+        return self.to_si(self.decode(data[offset : offset + self.size]))
 
     def decode(self, data: bytes) -> int:
         """Read this register's raw value from its little-endian bytes."""

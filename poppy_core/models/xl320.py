@@ -37,6 +37,7 @@ XL320_LED = Choice(
     ),
     synonyms=(("purple", 5),),
     mask=0x07,
+    on="white",  # "on" lights all three LEDs
 )
 
 _POSITION = position(300.0, 1024)

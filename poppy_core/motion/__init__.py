@@ -55,7 +55,7 @@ from poppy_core.motion.teleop import (
     teleoperate,
 )
 from poppy_core.motion.teleop_map import JointLink, JointMap
-from poppy_core.motion.trajectory import CONTROLS, MinimumJerk, dummy_speed
+from poppy_core.trajectory import CONTROLS, MinimumJerk, dummy_speed
 
 __all__ = [
     "BUILTINS",

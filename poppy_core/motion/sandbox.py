@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from poppy_core.errors import ConfigError, RegisterError
-from poppy_core.motion.trajectory import MinimumJerk, check_goto, dummy_speed
+from poppy_core.trajectory import MinimumJerk, check_goto, plan_goto
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -192,19 +192,22 @@ class MockupMotor:
         Raises:
             ArgumentError: unknown control, a negative or not finite duration.
         """
-        check_goto(duration, control)
-        low, high = self._motor.angle_limit
-        goal = min(max(_number(self._motor.name, "goal_position", position), low), high)
-        start = self._requested_goal() if self._has_goal() else self._motor.present_position
-        if control == "dummy" or duration == 0:
-            self.moving_speed = dummy_speed(start, goal, duration)
-            self.goal_position = goal
+        check_goto(duration, control)  # before the position: the error a caller expects first
+        motor = self._motor
+        target = _number(motor.name, "goal_position", position)
+        start = self._requested_goal() if self._has_goal() else motor.present_position
+        plan = plan_goto(
+            start, target, duration, control, motor.angle_limit,
+            min_speed=abs(float(motor.model.register("moving_speed").to_si(1))),
+        )  # fmt: skip
+        if plan.trajectory is None:
+            self.moving_speed = plan.speed
+            self.goal_position = plan.goal
         else:
-            curve = MinimumJerk(start, goal, duration)
             with self._lock:
-                self._requests["moving_speed"] = 0.0  # full speed: the trajectory sets the pace
+                self._requests["moving_speed"] = plan.speed
                 self._requests.pop("goal_position", None)
-                self._trajectory = _Trajectory(curve, self._clock())
+                self._trajectory = _Trajectory(plan.trajectory, self._clock())
         if wait:
             self._stopped.wait(duration)
 

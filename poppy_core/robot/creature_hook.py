@@ -6,6 +6,7 @@ Poppy robot its creature: primitives, postures, chains. The link is an entry poi
 ``CREATURE_HOOK`` names ``poppy_core.creatures.attach:attach_behaviours``, which looks at the
 config (profile kind, or pypot motor names) and attaches the matching creature, or the kinematic
 chains the config describes for any other robot. Another package may pass its own hook.
+``MANAGER_HOOK`` reaches pypot's ``robot._primitive_manager`` (in ``motion``) the same way.
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ if TYPE_CHECKING:
     from poppy_core.robot.robot import Robot
 
 CREATURE_HOOK = "poppy_core.creatures.attach:attach_behaviours"
+MANAGER_HOOK = "poppy_core.motion.manager:primitive_manager"
+"""The robot's primitive manager (``robot._primitive_manager``): ``motion`` sits above ``robot``."""
 
 Hook = Callable[..., Any]
 

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from poppy_core.errors import RobotClosedError
-from poppy_core.motion.trajectory import MinimumJerk, check_goto, control_name, dummy_speed
 from poppy_core.robot.motor_link import link_of
 from poppy_core.robot.schedule import Periodic
+from poppy_core.trajectory import MinimumJerk, check_goto, control_name, plan_goto
 
 if TYPE_CHECKING:
     from poppy_core.robot.motor import Motor
@@ -111,20 +111,16 @@ class GotoRunner:
                 raise RobotClosedError("the robot is closed: no more motions")
             for motor, target in targets.items():
                 self._cancel_locked(motor)
-                low, high = motor.angle_limit
-                goal = float(target) if motor.wheel_mode else min(max(float(target), low), high)
-                start = motor.present_position
-                trajectory = None
-                if controls[motor] == "dummy" or duration_s == 0:
-                    speed = dummy_speed(start, goal, duration_s)
-                    register = motor.model.register("moving_speed")
-                    motor.moving_speed = max(speed, abs(float(register.to_si(1)))) if speed else 0
-                    link_of(motor).set_goal(goal)
-                else:
-                    motor.moving_speed = 0.0  # full speed: the trajectory sets the pace
-                    trajectory = MinimumJerk(start, goal, duration_s)
+                plan = plan_goto(
+                    motor.present_position, float(target), duration_s, controls[motor],
+                    None if motor.wheel_mode else motor.angle_limit,
+                    min_speed=abs(float(motor.model.register("moving_speed").to_si(1))),
+                )  # fmt: skip
+                motor.moving_speed = plan.speed
+                if plan.trajectory is None:
+                    link_of(motor).set_goal(plan.goal)
                 self._moves[id(motor)] = _Move(
-                    motor, goal, trajectory, now, now + duration_s, handle
+                    motor, plan.goal, plan.trajectory, now, now + duration_s, handle
                 )
             if self._moves and self._thread is None:
                 self._wake.clear()

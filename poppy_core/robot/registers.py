@@ -62,7 +62,7 @@ class Block:
         """SI values (motor frame) of every field in ``data``."""
         out: dict[str, float | int | bool | str] = {}
         for name, offset, register in self.fields:
-            out[name] = register.to_si(register.decode(data[offset : offset + register.size]))
+            out[name] = register.decode_si(data, start=register.address - offset)
         return out
 
 
@@ -94,12 +94,4 @@ def read_blocks(model: ServoModel, names: Sequence[str]) -> list[Block]:
 
 def decode_table(model: ServoModel, data: bytes, names: Sequence[str] = STATE) -> dict[str, object]:
     """SI values of ``names`` found in a control-table dump starting at address 0."""
-    out: dict[str, object] = {}
-    for name in names:
-        if not model.has_register(name):
-            continue
-        register = model.register(name)
-        end = register.address + register.size
-        if end <= len(data):
-            out[name] = register.to_si(register.decode(data[register.address : end]))
-    return out
+    return dict(model.decode_table(data, names))

@@ -6,14 +6,13 @@ API over what ``Robot`` holds.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Protocol, cast
+from typing import TYPE_CHECKING, Any, Protocol
 
 from poppy_core.robot.group import MotorGroup
 from poppy_core.robot.motor import Motor
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import RobotConfig
-    from poppy_core.robot.robot import Robot
 
 
 class Behaviour(Protocol):
@@ -51,9 +50,9 @@ class PypotRobotMixin:
     @property
     def _primitive_manager(self) -> Any:
         """The primitive manager (pypot's name; also ``robot.primitive_manager``)."""
-        from poppy_core.motion import primitive_manager  # motion sits above robot
+        from poppy_core.robot.creature_hook import MANAGER_HOOK, resolve_hook
 
-        return primitive_manager(cast("Robot", self))
+        return resolve_hook(MANAGER_HOOK)(self)  # motion sits above robot: an entry point
 
     def attach_primitive(self, primitive: Behaviour, name: str) -> None:
         """Attach a primitive as ``robot.<name>`` and list it in ``primitives`` (pypot's order).

@@ -233,3 +233,44 @@ def test_parse_turns_typed_text_into_si_values() -> None:
         mx.register("goal_position").parse("thirty")
     with pytest.raises(RegisterError, match="on or off"):
         mx.register("torque_enable").parse("maybe")
+
+
+def test_on_and_off_are_one_mapping() -> None:
+    """The XL-320 LED takes colours: "on" is white (all three LEDs), "off" is off; on/off
+    registers take booleans. The bus IO, the CLI and the TUI all ask ``Register.switched``."""
+    led = XL_320.register("led")
+    assert (led.switched(True), led.switched(False)) == ("white", "off")
+    assert led.parse("on") == led.parse(" ON ") == "white"
+    assert led.parse("off") == "off" and led.parse("3") == 3
+    for register in (AX_12A.register("led"), XL_320.register("torque_enable")):
+        assert (register.switched(True), register.switched(False)) == (True, False)
+    with pytest.raises(RegisterError, match="on/off"):
+        XL_320.register("goal_position").switched(True)
+
+
+def test_decode_si_reads_a_register_wherever_its_bytes_start() -> None:
+    table = bytearray(MX_28.table_size)
+    position = MX_28.register("goal_position")
+    table[position.address : position.address + 2] = position.encode(3072)
+    expected = position.to_si(3072)
+    assert position.decode_si(bytes(table), start=0) == expected
+    assert position.decode_si(bytes(table[position.address :])) == expected
+    assert position.decode_si(bytes(table[20:]), start=20) == expected
+    with pytest.raises(RegisterError):
+        position.decode_si(bytes(table[:31]), start=0)  # ends inside the register
+    with pytest.raises(RegisterError):
+        position.decode_si(bytes(table[40:]), start=40)  # starts after it
+
+
+def test_decode_table_gives_the_registers_the_bytes_hold() -> None:
+    table = bytes(XL_320.table_size)
+    values = XL_320.decode_table(table)
+    assert list(values) == [r.name for r in sorted(XL_320.registers.values(),
+                                                      key=lambda r: r.address)]  # fmt: skip
+    assert values["led"] == "off" and values["goal_position"] == XL_320.register(
+        "goal_position"
+    ).to_si(0)
+    goal = XL_320.register("goal_position")
+    names = ["goal_position", "moving_speed", "led", "no_such"]
+    part = XL_320.decode_table(table[goal.address : goal.address + 4], names, start=goal.address)
+    assert set(part) == {"goal_position", "moving_speed"}  # led lies outside, no_such is unknown

@@ -82,6 +82,17 @@ def test_mockup_goto_samples_a_trajectory(ergo: Robot) -> None:
         mock.goto_position(10.0, 1.0, control="teleport")
 
 
+def test_mockup_dummy_goto_slower_than_a_step_is_not_full_speed(ergo: Robot) -> None:
+    """The one goto plan (``plan_goto``) floors a dummy speed at one register step for
+    primitives too: a moving speed of 0 would send the servo at full speed."""
+    mock = MockupMotor(ergo.m1)
+    mock.goal_position = 0.0
+    mock.goto_position(0.001, 1000.0, control="dummy")
+    step = abs(float(ergo.m1.model.register("moving_speed").to_si(1)))
+    assert step > 0
+    assert mock.requests() == {"moving_speed": pytest.approx(step), "goal_position": 0.001}
+
+
 def test_mockup_goal_speed_heads_for_the_limit(ergo: Robot) -> None:
     mock = MockupMotor(ergo.m1)
     mock.goal_speed = 30.0

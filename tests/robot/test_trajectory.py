@@ -9,7 +9,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from poppy_core.errors import ArgumentError
 from poppy_core.motion import MinimumJerk, dummy_speed
+from poppy_core.trajectory import plan_goto
 
 angles = st.floats(-300, 300, allow_nan=False)
 rates = st.floats(-200, 200, allow_nan=False)
@@ -62,3 +64,20 @@ def test_dummy_speed() -> None:
     assert dummy_speed(10, -20, 3) == pytest.approx(10)
     assert dummy_speed(5, 5, 1) == 0
     assert dummy_speed(0, 90, 0) == 0
+
+
+def test_goto_plan() -> None:
+    smooth = plan_goto(0.0, 500.0, 2.0, "minijerk", (-90.0, 90.0))
+    assert smooth.goal == 90.0 and smooth.speed == 0.0  # clamped; full speed, the curve paces
+    assert smooth.trajectory is not None and smooth.trajectory.position(2.0) == 90.0
+    wheel = plan_goto(0.0, 500.0, 2.0, "dummy", None)
+    assert (wheel.goal, wheel.trajectory, wheel.speed) == (500.0, None, pytest.approx(250.0))
+    slow = plan_goto(0.0, 0.001, 100.0, "dummy", None, min_speed=0.7)
+    assert slow.speed == 0.7  # one register step, never 0 (= full speed)
+    assert plan_goto(5.0, 5.0, 1.0, "dummy", None, min_speed=0.7).speed == 0.0
+    at_once = plan_goto(0.0, 10.0, 0.0, "minjerk", (-90.0, 90.0))
+    assert (at_once.trajectory, at_once.speed) == (None, 0.0)
+    with pytest.raises(ArgumentError, match="control"):
+        plan_goto(0.0, 1.0, 1.0, "teleport", None)
+    with pytest.raises(ArgumentError, match="duration"):
+        plan_goto(0.0, 1.0, -1.0, "dummy", None)

@@ -27,7 +27,6 @@ from poppy_cli.tui.widgets.control_table import ControlTable, format_value
 from poppy_cli.tui.widgets.live import LivePanel
 from poppy_core.errors import PoppyError, SetupError
 from poppy_core.models import ServoModel
-from poppy_core.models.register import Choice
 
 BUSY_WAIT_S = 0.2
 
@@ -262,8 +261,7 @@ class MotorPanel(Horizontal):
         if self.motor is None or model is None or not model.has_register(name):
             return
         register = model.register(name)
-        kind = "choice" if isinstance(register.conversion, Choice) else "bool"
-        value = toggled(self.value(name), kind)
+        value = toggled(self.value(name), register)
         self.query_one(ControlTable).set_value(register.name, value)
         self._show_goal()
         self.write(self.targets, register.name, value)

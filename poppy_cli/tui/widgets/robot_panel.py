@@ -12,11 +12,12 @@ from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Checkbox, DataTable, Input, Select, TabbedContent, TabPane
 
+from poppy_cli.targets import parse_targets
 from poppy_cli.tui.messages import BusFailed, RobotOpened
 from poppy_cli.tui.widgets.chains import ChainsPanel
 from poppy_cli.tui.widgets.moves import MovesPanel
 from poppy_cli.tui.widgets.primitives import PrimitivesPanel
-from poppy_core.errors import ConfigError, PoppyError
+from poppy_core.errors import PoppyError
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
@@ -25,31 +26,6 @@ if TYPE_CHECKING:
 REFRESH_S = 0.1
 COLUMNS = ("motor", "id", "pos °", "goal °", "speed", "load %", "temp", "compliant")
 HEALTH_COLUMNS = ("bus", "link", "present Hz", "goals Hz", "timeouts", "retries", "offline")
-
-
-def parse_goto(text: str, known: list[str]) -> dict[str, float]:
-    """Parse ``"m1=30 m2=-10"`` into motor name -> degrees.
-
-    Raises:
-        ConfigError: a word that is not NAME=DEGREES, or an unknown motor.
-    """
-    targets: dict[str, float] = {}
-    for word in text.replace(",", " ").split():
-        name, sep, number = word.partition("=")
-        if not sep or not name:
-            raise ConfigError(f"{word!r} is not NAME=DEGREES (e.g. m1=30)", field="goto")
-        if name not in known:
-            raise ConfigError(f"no motor {name!r} (motors: {', '.join(known)})", field=name)
-        try:
-            value = float(number)
-        except ValueError:
-            raise ConfigError(f"{word!r}: {number!r} is not a number", field=name) from None
-        if value != value or abs(value) == float("inf"):
-            raise ConfigError(f"{word!r}: the angle must be finite", field=name)
-        targets[name] = value
-    if not targets:
-        raise ConfigError("no target: type e.g. m1=30 m2=-10", field="goto")
-    return targets
 
 
 def open_robot(source: str, sim: SimMode) -> Robot:
@@ -247,9 +223,8 @@ class RobotPanel(Vertical):
             self.notify("open a robot first", severity="warning")
             return
         try:
-            targets = parse_goto(
-                self.query_one("#goto", Input).value, [m.name for m in self.robot.motors]
-            )
+            words = self.query_one("#goto", Input).value.replace(",", " ").split()
+            targets = parse_targets(words, [m.name for m in self.robot.motors])
             duration = float(self.query_one("#goto-duration", Input).value or 1.0)
             for name in targets:
                 self.robot.motor(name).compliant = False
