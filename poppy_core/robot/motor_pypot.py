@@ -11,9 +11,9 @@ from typing import TYPE_CHECKING
 
 from poppy_core.errors import ArgumentError, RegisterError
 from poppy_core.models import ServoModel
-from poppy_core.motion.trajectory import control_name
 from poppy_core.robot import registers as regs
 from poppy_core.robot.motor_link import MotorLink, SIValue
+from poppy_core.trajectory import control_name
 
 if TYPE_CHECKING:
     from poppy_core.robot.motor import Motor
