@@ -1,4 +1,4 @@
-"""Fixtures: `poppy` run as a subprocess against `poppy emulate` processes."""
+"""Fixtures: `poppy` run in the test process against `poppy emulate` processes."""
 
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ class Emulator:
 
 @pytest.fixture
 def poppy() -> Any:
-    """Run `poppy ARGS...` as a subprocess: ``poppy("scan", "--json")``."""
+    """Run `poppy ARGS...` (in this process, as a fresh one would): ``poppy("scan", "--json")``."""
     return run_poppy
 
 
