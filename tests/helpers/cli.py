@@ -18,7 +18,7 @@ import subprocess
 import sys
 import tempfile
 import traceback
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
@@ -41,17 +41,21 @@ class Result:
         return json.loads(self.stdout)
 
 
-def run_poppy_process(*args: str, timeout: float = 60, input: str | None = None) -> Result:
-    """Run `poppy ARGS...` as a subprocess and capture its output."""
-    env = dict(os.environ, **ENV)
+def run_poppy_process(
+    *args: str, timeout: float = 60, input: str | None = None, env: Mapping[str, str] | None = None
+) -> Result:
+    """Run `poppy ARGS...` as a subprocess (``env``: added to its environment)."""
+    full = dict(os.environ, **ENV, **(env or {}))
     proc = subprocess.run(
-        [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=env, input=input
+        [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=full, input=input
     )
     return Result(proc.returncode, proc.stdout, proc.stderr)
 
 
-def run_poppy(*args: str, timeout: float = 60, input: str | None = None) -> Result:
-    """Run `poppy ARGS...` in this process and capture its output.
+def run_poppy(
+    *args: str, timeout: float = 60, input: str | None = None, env: Mapping[str, str] | None = None
+) -> Result:
+    """Run `poppy ARGS...` in this process (``env``: added to its environment).
 
     ``timeout`` is kept for the callers' sake: pytest-timeout stops a command that hangs.
     """
@@ -59,13 +63,13 @@ def run_poppy(*args: str, timeout: float = 60, input: str | None = None) -> Resu
     from poppy_cli.main import main
 
     stdout, stderr = _stream(), _stream()
-    with _as_a_process(args, stdout, stderr, input):
+    with _as_a_process(args, stdout, stderr, input, {**ENV, **(env or {})}):
         try:
             main()
             code = 0
         except SystemExit as exc:
             code = _exit_code(exc.code, stderr)
-        except BaseException:  # what Python prints for an uncaught exception (`--debug`)
+        except Exception:  # what Python prints for an uncaught exception (`--debug`)
             traceback.print_exc(file=stderr)
             code = 1
     return Result(code, stdout.getvalue(), stderr.getvalue())
@@ -96,7 +100,11 @@ def _exit_code(code: object, stderr: io.TextIOBase) -> int:
 
 @contextmanager
 def _as_a_process(
-    args: tuple[str, ...], stdout: io.TextIOBase, stderr: io.TextIOBase, input: str | None
+    args: tuple[str, ...],
+    stdout: io.TextIOBase,
+    stderr: io.TextIOBase,
+    input: str | None,
+    env: Mapping[str, str],
 ) -> Iterator[None]:
     """Give the command what a fresh `poppy` process would have, and take it back after."""
     from poppy_cli import state
@@ -104,7 +112,7 @@ def _as_a_process(
 
     saved_streams = sys.stdin, sys.stdout, sys.stderr
     saved_argv = sys.argv
-    saved_env = {name: os.environ.get(name) for name in ENV}
+    saved_env = {name: os.environ.get(name) for name in env}
     root = logging.getLogger()
     saved_logging = root.handlers[:], root.level
     handlers = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
@@ -114,7 +122,7 @@ def _as_a_process(
     sys.stdin = io.StringIO(input or "")
     sys.stdout, sys.stderr = stdout, stderr  # type: ignore[assignment]
     sys.argv = ["poppy", *args]
-    os.environ.update(ENV)
+    os.environ.update(env)
     root.handlers = []  # `--debug` / `-v` configure logging as in a new process
     for c, _, _ in consoles:
         c.width = WIDTH
