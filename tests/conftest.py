@@ -10,11 +10,13 @@ here, so that a test added to them is marked too; a single slow test elsewhere t
 from __future__ import annotations
 
 import faulthandler
+import os
 import sys
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
 
 TESTS = Path(__file__).resolve().parent
 SLOW_FOLDERS = {"cli", "creatures", "server", "sim", "teleop", "tui"}
@@ -37,6 +39,11 @@ GL_MODULES = {
 # C library (an OpenGL driver, a serial ioctl) never sees the signal; this watchdog then prints
 # every thread's stack and exits, so CI reports where it hung instead of running out its budget.
 HANG_LIMIT_S = 600
+# Property tests run Hypothesis's default number of examples; `HYPOTHESIS_PROFILE=thorough`
+# runs ten times as many (before a release, or when a codec or parser changed). Tests whose
+# examples are costly (a whole HTTP API fuzzed) scale from ``settings.default.max_examples``.
+settings.register_profile("thorough", max_examples=1000)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -1,14 +1,17 @@
-"""Fixtures: `poppy` run as a subprocess against `poppy emulate` processes."""
+"""Fixtures: `poppy` run in the test process against `poppy emulate` processes."""
 
 from __future__ import annotations
 
 import signal
 import subprocess
 from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 import pytest
 
+from poppy_core.emulator import VirtualBus
+from tests.helpers.bus import emulate_bus
 from tests.helpers.cli import POPPY, Result, run_poppy
 
 __all__ = ["POPPY", "Result", "run_poppy"]
@@ -42,7 +45,7 @@ class Emulator:
 
 @pytest.fixture
 def poppy() -> Any:
-    """Run `poppy ARGS...` as a subprocess: ``poppy("scan", "--json")``."""
+    """Run `poppy ARGS...` (in this process, as a fresh one would): ``poppy("scan", "--json")``."""
     return run_poppy
 
 
@@ -60,13 +63,23 @@ def emulator_factory() -> Iterator[Any]:
         emulator.stop()
 
 
-@pytest.fixture
-def ergo_jr(emulator_factory: Any) -> Emulator:
-    """A virtual Ergo Jr bus (six XL-320, ids 1-6, protocol 2, 1 Mbps) in its own process."""
-    return emulator_factory("--profile", "ergo-jr")  # type: ignore[no-any-return]
+@dataclass
+class LinkedBus:
+    """Virtual motors in this process, at ``url`` (``emu://NAME``) for an in-process `poppy`."""
+
+    bus: VirtualBus
+    url: str
 
 
 @pytest.fixture
-def mx_bus(emulator_factory: Any) -> Emulator:
-    """Three MX-28 (ids 11-13) and one AX-12A (36), protocol 1, 1 Mbps."""
-    return emulator_factory("--motors", "MX-28:11-13,AX-12A:36")  # type: ignore[no-any-return]
+def ergo_jr() -> Iterator[LinkedBus]:
+    """A virtual Ergo Jr bus (six XL-320, ids 1-6, protocol 2, 1 Mbps) on the in-process link."""
+    with emulate_bus("XL-320:1-6", protocol=2) as (bus, url):
+        yield LinkedBus(bus, url)
+
+
+@pytest.fixture
+def mx_bus() -> Iterator[LinkedBus]:
+    """Three MX-28 (ids 11-13) and one AX-12A (36), protocol 1, 1 Mbps, on the in-process link."""
+    with emulate_bus("MX-28:11-13,AX-12A:36", protocol=1) as (bus, url):
+        yield LinkedBus(bus, url)

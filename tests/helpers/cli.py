@@ -1,15 +1,32 @@
-"""CLI test helpers: `poppy` run as a subprocess, and what it printed."""
+"""CLI test helpers: `poppy` run in this process (fast) or as a subprocess, and what it printed.
+
+``run_poppy`` runs ``poppy_cli.main.main`` in the test process with the streams, arguments and
+environment a subprocess would get: starting a Python interpreter and importing the CLI costs
+one to two seconds on a loaded machine, and the CLI tests run a few hundred commands. Tests
+whose subject is the process itself (Ctrl-C, signals, what an import pulls in, a program
+serving until stopped) start ``POPPY`` with ``subprocess`` (``run_poppy_process``).
+"""
 
 from __future__ import annotations
 
+import io
 import json
+import logging
 import os
+import signal
 import subprocess
 import sys
+import tempfile
+import traceback
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
+# What a `poppy` subprocess of the tests sees: a wide terminal, no colours.
+ENV = {"COLUMNS": "200", "NO_COLOR": "1"}
+WIDTH = int(ENV["COLUMNS"])
 
 
 @dataclass
@@ -24,10 +41,107 @@ class Result:
         return json.loads(self.stdout)
 
 
-def run_poppy(*args: str, timeout: float = 60, input: str | None = None) -> Result:
-    """Run `poppy ARGS...` and capture its output."""
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+def run_poppy_process(
+    *args: str, timeout: float = 60, input: str | None = None, env: Mapping[str, str] | None = None
+) -> Result:
+    """Run `poppy ARGS...` as a subprocess (``env``: added to its environment)."""
+    full = dict(os.environ, **ENV, **(env or {}))
     proc = subprocess.run(
-        [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=env, input=input
+        [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=full, input=input
     )
     return Result(proc.returncode, proc.stdout, proc.stderr)
+
+
+def run_poppy(
+    *args: str, timeout: float = 60, input: str | None = None, env: Mapping[str, str] | None = None
+) -> Result:
+    """Run `poppy ARGS...` in this process (``env``: added to its environment).
+
+    ``timeout`` is kept for the callers' sake: pytest-timeout stops a command that hangs.
+    """
+    del timeout
+    from poppy_cli.main import main
+
+    stdout, stderr = _stream(), _stream()
+    with _as_a_process(args, stdout, stderr, input, {**ENV, **(env or {})}):
+        try:
+            main()
+            code = 0
+        except SystemExit as exc:
+            code = _exit_code(exc.code, stderr)
+        except Exception:  # what Python prints for an uncaught exception (`--debug`)
+            traceback.print_exc(file=stderr)
+            code = 1
+    return Result(code, stdout.getvalue(), stderr.getvalue())
+
+
+def _stream() -> io.TextIOWrapper:
+    """A text stream like a pipe's (with a ``buffer``), readable after the command."""
+    return _Captured(io.BytesIO(), encoding="utf-8", newline="", write_through=True)
+
+
+class _Captured(io.TextIOWrapper):
+    def getvalue(self) -> str:
+        self.flush()
+        buffer = self.buffer
+        assert isinstance(buffer, io.BytesIO)
+        return buffer.getvalue().decode("utf-8")
+
+
+def _exit_code(code: object, stderr: io.TextIOBase) -> int:
+    """The exit status Python gives ``sys.exit(code)``."""
+    if code is None:
+        return 0
+    if isinstance(code, int):
+        return code
+    print(code, file=stderr)
+    return 1
+
+
+@contextmanager
+def _as_a_process(
+    args: tuple[str, ...],
+    stdout: io.TextIOBase,
+    stderr: io.TextIOBase,
+    input: str | None,
+    env: Mapping[str, str],
+) -> Iterator[None]:
+    """Give the command what a fresh `poppy` process would have, and take it back after."""
+    from poppy_cli import state
+    from poppy_cli.output import console, err_console
+
+    saved_streams = sys.stdin, sys.stdout, sys.stderr
+    saved_argv = sys.argv
+    saved_env = {name: os.environ.get(name) for name in env}
+    root = logging.getLogger()
+    saved_logging = root.handlers[:], root.level
+    handlers = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    consoles = [(c, c._width, c._color_system) for c in (console, err_console)]
+    saved_tempdir = tempfile.tempdir
+    tempfile.tempdir = None  # found again from TMPDIR, as a new process does
+    sys.stdin = io.StringIO(input or "")
+    sys.stdout, sys.stderr = stdout, stderr  # type: ignore[assignment]
+    sys.argv = ["poppy", *args]
+    os.environ.update(env)
+    root.handlers = []  # `--debug` / `-v` configure logging as in a new process
+    for c, _, _ in consoles:
+        c.width = WIDTH
+        c._color_system = None
+    try:
+        yield
+    finally:
+        tempfile.tempdir = saved_tempdir
+        for c, width, colors in consoles:
+            c._width, c._color_system = width, colors
+        root.handlers, _ = saved_logging
+        root.setLevel(saved_logging[1])
+        for name, value in saved_env.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
+        sys.argv = saved_argv
+        sys.stdin, sys.stdout, sys.stderr = saved_streams
+        for signum, handler in handlers.items():
+            signal.signal(signum, handler)
+        state.debug = False

@@ -34,7 +34,7 @@ PEAK_BYTES = 64 << 20
 """The most a loader may allocate for one of these small documents."""
 
 FUZZ = settings(
-    max_examples=150,
+    max_examples=settings.default.max_examples,  # 100; ten times as many when thorough
     deadline=None,  # no wall-clock: the child's CPU limit bounds time
     database=None,
     derandomize=True,

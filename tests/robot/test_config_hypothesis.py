@@ -99,7 +99,8 @@ def robot_configs(draw: st.DrawFn) -> dict[str, Any]:
     return data
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# Hypothesis's default number of examples (tests/conftest.py: ten times as many when thorough)
+@settings(deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(robot_configs())
 def test_round_trips(data: dict[str, Any]) -> None:
     config = RobotConfig.from_dict(data, source="generated")

@@ -23,9 +23,14 @@ def api_schema(served: Served) -> Any:
 schema = schemathesis.pytest.from_fixture("api_schema")
 
 
+# Ten examples per operation (a hundred under `HYPOTHESIS_PROFILE=thorough`): every route and
+# method is still fuzzed in every run; the profile explores further.
+EXAMPLES_PER_OPERATION = settings.default.max_examples // 10
+
+
 @schema.parametrize()
 @settings(
-    max_examples=30,
+    max_examples=EXAMPLES_PER_OPERATION,
     deadline=None,
     suppress_health_check=list(HealthCheck),
 )

@@ -13,6 +13,8 @@ from typing import Any
 
 import pytest
 
+from tests.helpers.cli import run_poppy
+
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
 
@@ -61,30 +63,29 @@ def test_serve_prints_urls_and_stops(signum: int) -> None:
 
 def test_public_host_without_token_warns() -> None:
     # An unknown profile stops the command after the warning, before anything is bound.
-    proc = _start("--http", "--host", "0.0.0.0", "--profile", "no-such-robot", "--sim")
-    _, err = proc.communicate(timeout=30)
+    proc = _poppy("serve", "--http", "--host", "0.0.0.0", "--profile", "no-such-robot", "--sim")
+    err = proc.stderr
     assert proc.returncode != 0
     assert "without --token" in err and "anyone" in err
 
 
 def test_open_cors_warns() -> None:
-    proc = _start("--http", "--cors", "*", "--profile", "no-such-robot", "--sim")
-    _, err = proc.communicate(timeout=30)
+    proc = _poppy("serve", "--http", "--cors", "*", "--profile", "no-such-robot", "--sim")
+    err = proc.stderr
     assert proc.returncode != 0
     assert "--cors '*': every web page you open can move the robot" in err
 
 
 def test_nothing_to_serve_is_a_usage_error() -> None:
-    proc = _start("--sim", "--profile", "ergo-jr")
-    _, err = proc.communicate(timeout=30)
+    proc = _poppy("serve", "--sim", "--profile", "ergo-jr")
+    err = proc.stderr
     assert proc.returncode == 2 and "--http" in err
 
 
 def _poppy(*args: str) -> subprocess.CompletedProcess[str]:
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    return subprocess.run(
-        [*POPPY, *args], capture_output=True, text=True, timeout=60, env=env, check=False
-    )
+    """`poppy ARGS` run in this process (as a fresh one would), for commands that end."""
+    result = run_poppy(*args)
+    return subprocess.CompletedProcess(args, result.code, result.stdout, result.stderr)
 
 
 def test_robot_commands_with_remote(served: Any) -> None:

@@ -12,6 +12,8 @@ import urllib.request
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from tests.helpers.cli import run_poppy
+
 POPPY = [sys.executable, "-m", "poppy_cli"]
 TIMEOUT_S = 90
 
@@ -74,9 +76,9 @@ def test_serve_snap_with_http_prints_the_snap_urls_and_serves_both(tmp_path: Pat
 
 
 def _run(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [*POPPY, *args], capture_output=True, text=True, timeout=TIMEOUT_S, env=_env(cwd / "m")
-    )
+    """`poppy ARGS` in this process (as a fresh one would), with its library in ``cwd/m``."""
+    result = run_poppy(*args, env={"POPPY_MOVES_DIR": str(cwd / "m")})
+    return subprocess.CompletedProcess(args, result.code, result.stdout, result.stderr)
 
 
 def test_snap_options_are_checked_before_the_robot_is_built(tmp_path: Path) -> None:

@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from poppy_cli.options import normalise_sim_args
+from tests.helpers.cli import run_poppy
 
 ROOT = Path(__file__).resolve().parents[2]
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -26,6 +27,12 @@ def run(
     full = dict(os.environ, COLUMNS="200", NO_COLOR="1", **(env or {}))
     return subprocess.run([*POPPY, *args], capture_output=True, text=True, timeout=timeout,
                           env=full, check=False)  # fmt: skip
+
+
+def run_here(*args: str) -> subprocess.CompletedProcess[str]:
+    """`poppy ARGS` in this process (as a fresh one would), for commands that do not render."""
+    result = run_poppy(*args)
+    return subprocess.CompletedProcess(args, result.code, result.stdout, result.stderr)
 
 
 class SimProcess:
@@ -71,18 +78,18 @@ def test_sim_option_takes_an_optional_engine(args: list[str], expected: list[str
 
 def test_sim_serves_a_physical_ergo_jr(sim_ergo: SimProcess) -> None:
     assert sim_ergo.url.startswith("/dev/")
-    found = run("scan", "--port", sim_ergo.url, "--baud", "1000000", "--protocol", "2", "--json")
+    port = ("--port", sim_ergo.url, "--baud", "1000000", "--protocol", "2")
+    found = run_here("scan", *port, "--json")
     assert found.returncode == 0, found.stderr
     motors = json.loads(found.stdout)
     assert sorted(m["id"] for m in motors) == [1, 2, 3, 4, 5, 6]
     assert {m["model"] for m in motors} == {"XL-320"}
-    port = ("--port", sim_ergo.url, "--baud", "1000000", "--protocol", "2")
-    assert run("motor", "torque", "1", "on", *port).returncode == 0
-    assert run("motor", "set", "1", "goal_position", "30", *port).returncode == 0
+    assert run_here("motor", "torque", "1", "on", *port).returncode == 0
+    assert run_here("motor", "set", "1", "goal_position", "30", *port).returncode == 0
     deadline = time.monotonic() + 10
     position = None
     while time.monotonic() < deadline:  # the physics moves the joint, at up to 684 °/s
-        got = run("motor", "get", "1", "present_position", *port, "--json")
+        got = run_here("motor", "get", "1", "present_position", *port, "--json")
         assert got.returncode == 0, got.stderr
         position = json.loads(got.stdout)["present_position"]
         if abs(position - 30) < 2:
@@ -100,7 +107,7 @@ def test_robot_goto_sim_mujoco() -> None:
 
 
 def test_sim_with_an_unknown_engine_is_a_usage_error() -> None:
-    result = run("robot", "status", "--sim=bullet", "--profile", "ergo-jr")
+    result = run_here("robot", "status", "--sim=bullet", "--profile", "ergo-jr")
     assert result.returncode == 2
     assert "--sim mujoco" in result.stderr
 
@@ -115,7 +122,7 @@ def test_view_without_display_says_why_and_serves() -> None:
 
 
 def test_sim_without_profile_is_a_usage_error() -> None:
-    result = run("sim")
+    result = run_here("sim")
     assert result.returncode == 2
     assert "--profile" in result.stderr
 
