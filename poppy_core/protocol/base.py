@@ -75,7 +75,7 @@ class DxlProtocol(ABC):
     Attributes (sizes and layout):
         version: 1 or 2 (the number users write in configs).
         header: the bytes every packet starts with.
-        word_size: bytes of an address or length field in instruction parameters.
+        word_size / max_word: bytes and largest value of an address or length field.
         instruction_overhead / status_overhead: packet bytes besides the parameters.
         ping_params: parameter bytes of a ping's status packet.
         max_motor_id: the largest ID a motor may take.
@@ -100,6 +100,7 @@ class DxlProtocol(ABC):
     version: ClassVar[int]
     header: ClassVar[bytes]
     word_size: ClassVar[int]
+    max_word: ClassVar[int]
     instruction_overhead: ClassVar[int]
     status_overhead: ClassVar[int]
     ping_params: ClassVar[int]
@@ -136,7 +137,7 @@ class DxlProtocol(ABC):
 
     def word(self, value: int, what: str) -> bytes:
         """An address or length field (little-endian, ``word_size`` bytes)."""
-        limit = (1 << (8 * self.word_size)) - 1
+        limit = self.max_word
         if not 0 <= value <= limit:
             raise ProtocolError(f"{what} {value} is not in 0..{limit} for protocol {self.version}")
         return value.to_bytes(self.word_size, "little")

@@ -38,8 +38,8 @@ from poppy_core.protocol.constants import (
     USB2AX_ID,
     Instruction,
 )
-from poppy_core.protocol.encoding import check_protocol
 from poppy_core.protocol.packets import InstructionPacket, StatusPacket
+from poppy_core.protocol.v2 import PROTOCOL_2
 from poppy_core.protocol.versions import protocol_for
 
 
@@ -63,15 +63,6 @@ def _check_motor_ids(ids: Iterable[int]) -> list[int]:
 Proto = int | DxlProtocol
 
 
-def _word(protocol: Proto, value: int, what: str) -> bytes:
-    """Address or length as one byte (protocol 1) or two little-endian bytes (protocol 2)."""
-    return protocol_for(protocol).word(value, what)
-
-
-def _length(protocol: Proto, length: int) -> bytes:
-    return protocol_for(protocol).length_field(length)
-
-
 # ---------------------------------------------------------------- builders
 
 
@@ -83,9 +74,9 @@ def ping(id: int) -> InstructionPacket:
 
 def read(protocol: Proto, id: int, address: int, length: int) -> InstructionPacket:
     """READ ``length`` bytes from ``address`` of motor ``id``."""
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     _check_target(id)
-    params = _word(protocol, address, "address") + _length(protocol, length)
+    params = proto.word(address, "address") + proto.length_field(length)
     return InstructionPacket(id, Instruction.READ, params)
 
 
@@ -102,11 +93,11 @@ def reg_write(protocol: Proto, id: int, address: int, data: bytes) -> Instructio
 def _write(
     protocol: Proto, instruction: Instruction, id: int, address: int, data: bytes
 ) -> InstructionPacket:
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     _check_target(id)
     if not data:
         raise ProtocolError("a write needs at least one data byte")
-    return InstructionPacket(id, instruction, _word(protocol, address, "address") + bytes(data))
+    return InstructionPacket(id, instruction, proto.word(address, "address") + bytes(data))
 
 
 def action(id: int = BROADCAST_ID) -> InstructionPacket:
@@ -145,7 +136,7 @@ def sync_read(protocol: Proto, address: int, length: int, ids: Iterable[int]) ->
 def fast_sync_read(address: int, length: int, ids: Iterable[int]) -> InstructionPacket:
     """FAST_SYNC_READ (protocol 2, 0x8A): one combined reply (see ``parse_fast_sync_status``)."""
     id_list = _check_motor_ids(ids)
-    params = _word(2, address, "address") + _length(2, length) + bytes(id_list)
+    params = PROTOCOL_2.word(address, "address") + PROTOCOL_2.length_field(length) + bytes(id_list)
     return InstructionPacket(BROADCAST_ID, Instruction.FAST_SYNC_READ, params)
 
 
@@ -153,9 +144,9 @@ def sync_write(
     protocol: Proto, address: int, length: int, data: Mapping[int, bytes]
 ) -> InstructionPacket:
     """SYNC_WRITE ``length`` bytes at ``address`` of several motors: ``data`` maps ID -> bytes."""
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     _check_motor_ids(data)
-    parts = [_word(protocol, address, "address"), _length(protocol, length)]
+    parts = [proto.word(address, "address"), proto.length_field(length)]
     for motor_id, chunk in data.items():
         if len(chunk) != length:
             raise ProtocolError(
@@ -178,7 +169,11 @@ def bulk_write(requests: Sequence[tuple[int, int, bytes]]) -> InstructionPacket:
     _check_motor_ids(r[0] for r in requests)
     parts = []
     for motor_id, address, data in requests:
-        parts.append(bytes((motor_id,)) + _word(2, address, "address") + _length(2, len(data)))
+        parts.append(
+            bytes((motor_id,))
+            + PROTOCOL_2.word(address, "address")
+            + PROTOCOL_2.length_field(len(data))
+        )
         parts.append(bytes(data))
     return InstructionPacket(BROADCAST_ID, Instruction.BULK_WRITE, b"".join(parts))
 

@@ -87,7 +87,8 @@ class Protocol1(DxlProtocol):
     version = 1
     header = V1_HEADER
     word_size = 1
-    instruction_overhead = 6
+    max_word = 0xFF
+    instruction_overhead = 6  # FF FF ID LEN INS/ERR ... CHK
     status_overhead = 6
     ping_params = 0
     max_motor_id = MAX_ID

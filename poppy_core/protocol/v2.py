@@ -139,8 +139,9 @@ class Protocol2(DxlProtocol):
     version = 2
     header = V2_HEADER
     word_size = 2
-    instruction_overhead = 10
-    status_overhead = 11
+    max_word = 0xFFFF
+    instruction_overhead = 10  # FF FF FD 00 ID LEN_L LEN_H INS ... CRC_L CRC_H
+    status_overhead = 11  # a status adds 0x55 then ERR
     ping_params = 3
     max_motor_id = V2_MAX_MOTOR_ID
     error_codes = V2_CODES

@@ -9,8 +9,12 @@ from poppy_core.protocol.base import DxlProtocol
 from poppy_core.protocol.v1 import PROTOCOL_1
 from poppy_core.protocol.v2 import PROTOCOL_2
 
+_ALL: tuple[DxlProtocol, ...] = (PROTOCOL_1, PROTOCOL_2)
 #: Every protocol object by its version number.
-PROTOCOLS_BY_VERSION = MappingProxyType({p.version: p for p in (PROTOCOL_1, PROTOCOL_2)})
+PROTOCOLS_BY_VERSION = MappingProxyType({proto.version: proto for proto in _ALL})
+# Version numbers and the objects themselves, so one dict lookup answers either.
+_LOOKUP: dict[object, DxlProtocol] = {proto.version: proto for proto in _ALL}
+_LOOKUP.update({proto: proto for proto in _ALL})
 
 
 def protocol_for(protocol: int | DxlProtocol) -> DxlProtocol:
@@ -19,9 +23,7 @@ def protocol_for(protocol: int | DxlProtocol) -> DxlProtocol:
     Raises:
         ProtocolError: unknown protocol.
     """
-    if isinstance(protocol, DxlProtocol):
-        return protocol
     try:
-        return PROTOCOLS_BY_VERSION[protocol]
+        return _LOOKUP[protocol]
     except (KeyError, TypeError):
         raise ProtocolError(f"unknown Dynamixel protocol {protocol!r} (expected 1 or 2)") from None
