@@ -158,6 +158,7 @@ def build_config(found: list[FoundMotor], prefix: str) -> dict[str, Any]:
     """A config mapping for the motors found: one controller per port and protocol."""
     from poppy_core.bus import DxlBus
     from poppy_core.models import model_by_name
+    from poppy_core.protocol import protocol_for
 
     controllers: dict[str, Any] = {}
     motors: dict[str, Any] = {}
@@ -170,7 +171,7 @@ def build_config(found: list[FoundMotor], prefix: str) -> dict[str, Any]:
             "port": device,
             "protocol": protocol,
             "baudrate": baudrate,
-            "sync_read": protocol == 2,
+            "sync_read": protocol_for(protocol).has_sync_read,
             "attached_motors": names,
         }
         with DxlBus(device, baudrate, protocol) as bus:

@@ -31,38 +31,26 @@ from poppy_core.bus.timing import (
     Deadline,
     LinkTiming,
     default_latency_s,
-    status_size,
 )
 from poppy_core.bus.transport import Transport
 from poppy_core.errors import BusTimeout, CorruptPacketError, MotorError, PortError, ProtocolError
 from poppy_core.protocol import (
     BROADCAST_ID,
+    DxlProtocol,
     Instruction,
     InstructionPacket,
     StatusPacket,
-    decode_errors,
-    encode_instruction,
+    protocol_for,
 )
 
 logger = logging.getLogger(__name__)
 
-# e-manual (Protocol 1.0 status packet): bit 0 input voltage, bit 2 overheating, bit 5 overload.
-V1_ALARM_MASK = 0x01 | 0x04 | 0x20
-# e-manual (Protocol 2.0 status packet): bit 7 is the hardware alert flag, bits 0-6 the error.
-V2_ALERT_BIT = 0x80
-V2_ERROR_NUMBER_MASK = 0x7F
-
-
-def is_alarm_only(protocol: int, error: int) -> bool:
+def is_alarm_only(protocol: int | DxlProtocol, error: int) -> bool:
     """True when ``error`` carries only alarm bits (the instruction was still executed)."""
-    if error == 0:
-        return False
-    if protocol == 1:
-        return error & ~V1_ALARM_MASK & 0xFF == 0
-    return error & V2_ERROR_NUMBER_MASK == 0
+    return protocol_for(protocol).is_alarm_only(error)
 
 
-def reply_fits(protocol: int, status: StatusPacket, n_params: int) -> bool:
+def reply_fits(protocol: int | DxlProtocol, status: StatusPacket, n_params: int) -> bool:
     """A reply to keep: ``n_params`` bytes of data, or a refusal (which carries none and is
     checked later).
 
@@ -135,6 +123,7 @@ class BusCore:
         if protocol not in (1, 2):
             raise ProtocolError(f"protocol must be 1 or 2, not {protocol}")
         self._protocol = protocol
+        self._proto = protocol_for(protocol)
         self._owns_transport = transport is None
         if transport is None:
             transport = Transport(port, baudrate, protocol)
@@ -177,6 +166,11 @@ class BusCore:
     def protocol(self) -> int:
         """Dynamixel protocol (1 or 2)."""
         return self._protocol
+
+    @property
+    def proto(self) -> DxlProtocol:
+        """The protocol object: sizes, codec and capabilities (``poppy_core.protocol``)."""
+        return self._proto
 
     @property
     def baudrate(self) -> int:
@@ -254,15 +248,15 @@ class BusCore:
             self._observe(stray, drained_at)
             self._strays.append(stray)
         corrupt_before, skipped_before = transport.corrupt_packets, transport.skipped_bytes
-        data = encode_instruction(self._protocol, packet)
+        data = self._proto.encode_instruction(packet)
         transport.write(data)
         if packet.id != BROADCAST_ID:
             self._replies.sent(packet.id, time.monotonic(), len(data))
-        elif self._protocol == 2 and packet.instruction == Instruction.PING:
+        elif self._proto.has_broadcast_ping and packet.instruction == Instruction.PING:
             self._replies.sent_to_all(time.monotonic(), len(data))
         if not expected:
             return {}
-        sizes = [status_size(self._protocol, n) for _, n in expected]
+        sizes = [self._proto.status_size(n) for _, n in expected]
         first = timeout_s if timeout_s is not None else self.timeout_s
         if first is None:
             first = self._timing.reply_timeout_s(len(data), sizes[0])
@@ -298,7 +292,7 @@ class BusCore:
             else:
                 logger.debug("%s: stray status from ID %d kept aside", self._port, status.id)
                 self._strays.append(status)
-                stray_bytes += status_size(self._protocol, len(status.params))
+                stray_bytes += self._proto.status_size(len(status.params))
         corrupt = transport.corrupt_packets - corrupt_before
         if len(got) < len(wanted) and not corrupt and transport.skipped_bytes > skipped_before:
             corrupt = 1  # bytes came back but no packet could be found in them: garbage
@@ -348,7 +342,7 @@ class BusCore:
                 expected = [(motor_id, n_params)]
                 status = self.exchange(packet, expected, min_timeout_s=min_timeout_s).get(motor_id)
                 if status is not None:
-                    if status.error and not is_alarm_only(self._protocol, status.error):
+                    if status.error and not self._proto.is_alarm_only(status.error):
                         return status
                     if len(status.params) == n_params:
                         return status
@@ -373,11 +367,11 @@ class BusCore:
 
     def check_status(self, status: StatusPacket, *, register: str | None = None) -> None:
         """Raise ``MotorError`` for refusal bits; log and record alarm bits (see module doc)."""
-        if status.error == 0 or is_alarm_only(self._protocol, status.error):
+        if status.error == 0 or self._proto.is_alarm_only(status.error):
             self.record_alarms(status)
             return
         self.stats.motor_errors += 1
-        names = decode_errors(self._protocol, status.error)
+        names = self._proto.decode_errors(status.error)
         where = f" ({register})" if register else ""
         raise MotorError(
             f"motor {status.id} on {self._port}{where} reported: {', '.join(names)}",
@@ -389,7 +383,7 @@ class BusCore:
 
     def record_alarms(self, status: StatusPacket) -> None:
         """Keep the alarm bits of ``status`` in ``alarms`` and log when they change."""
-        names = decode_errors(self._protocol, status.error) if status.error else []
+        names = self._proto.decode_errors(status.error) if status.error else []
         if names != self.alarms.get(status.id, []):
             if names:
                 logger.warning(

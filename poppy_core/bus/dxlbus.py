@@ -25,8 +25,6 @@ logger = logging.getLogger(__name__)
 # Version at 2 (1 byte). Protocol 1 ping carries neither, so they are read after it.
 V1_MODEL_NUMBER_ADDRESS = 0
 V1_MODEL_INFO_LENGTH = 3
-# e-manual (Protocol 2.0, Ping): the status carries model number (2 bytes) and firmware (1).
-V2_PING_PARAMS = 3
 
 
 class DxlBus(BusCore):
@@ -57,16 +55,17 @@ class DxlBus(BusCore):
         Raises:
             CorruptPacketError: only garbage came back on every attempt.
         """
-        n_params = 0 if self._protocol == 1 else V2_PING_PARAMS
+        proto = self._proto
         with self._lock:
             try:
-                status = self._transact(ins.ping(id), id, n_params, retries=retries)
+                status = self._transact(ins.ping(id), id, proto.ping_params, retries=retries)
             except BusTimeout:
                 return None
             self.record_alarms(status)
-            if self._protocol == 2:
-                number = int.from_bytes(status.params[:2], "little")
-                return PingResult(id, number, status.params[2], model_by_number(number))
+            identity = proto.ping_identity(status.params)
+            if identity is not None:
+                number, firmware = identity
+                return PingResult(id, number, firmware, model_by_number(number))
             if not identify:
                 return PingResult(id, None, None, None)
             try:
@@ -129,12 +128,12 @@ class DxlBus(BusCore):
 
     def reboot(self, id: int) -> None:
         """Reboot motor ``id`` (protocol 2); returns once the motor acknowledged."""
-        self._need_v2("reboot")
+        self._need(self._proto.has_reboot, "reboot")
         self._write(ins.reboot(id), id, True)
 
     def clear(self, id: int) -> None:
         """Clear the multi-turn revolution count of motor ``id`` (protocol 2)."""
-        self._need_v2("clear")
+        self._need(self._proto.has_clear, "clear")
         self._write(ins.clear(id), id, True)
 
     def factory_reset(self, id: int, option: int | None = None) -> None:
@@ -152,10 +151,12 @@ class DxlBus(BusCore):
         )
         self._write(packet, id, True)
 
-    def _need_v2(self, what: str) -> None:
-        if self._protocol != 2:
+    def _need(self, capability: bool, what: str) -> None:
+        """Refuse ``what`` on a protocol without it (only protocol 1 lacks any of them)."""
+        if not capability:
             raise ProtocolError(
-                f"{what} exists only in protocol 2 (bus {self._port} is protocol 1)"
+                f"{what} exists only in protocol 2 (bus {self._port} is protocol "
+                f"{self._protocol})"
             )
 
     # -- registers in SI units -----------------------------------------------------------------
@@ -202,7 +203,7 @@ class DxlBus(BusCore):
         self, address: int, length: int, ids: Sequence[int]
     ) -> dict[int, bytes | None]:
         """Protocol 2 FAST_SYNC_READ: one combined reply for every motor."""
-        self._need_v2("fast sync read")
+        self._need(self._proto.has_fast_sync_read, "fast sync read")
         return groupread.fast_sync_read(self, address, length, list(ids))
 
     def bulk_read(self, requests: Sequence[tuple[int, int, int]]) -> dict[int, bytes | None]:
@@ -222,11 +223,11 @@ class DxlBus(BusCore):
 
     def bulk_write(self, requests: Sequence[tuple[int, int, bytes]]) -> None:
         """Write ``(id, address, data)`` to several motors in one instruction (protocol 2)."""
-        self._need_v2("bulk write")
+        self._need(self._proto.has_bulk_write, "bulk write")
         if requests:
             self._send(ins.bulk_write(requests))
 
     def broadcast_ping(self) -> list[PingResult]:
         """Ping every motor at once (protocol 2); collects replies until the line is quiet."""
-        self._need_v2("broadcast ping")
+        self._need(self._proto.has_broadcast_ping, "broadcast ping")
         return groupread.broadcast_ping(self)

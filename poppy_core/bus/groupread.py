@@ -192,7 +192,7 @@ def sync_read(bus: DxlBus, address: int, length: int, ids: list[int]) -> dict[in
         return {}
     requests = [(i, address, length) for i in ids]
     with bus.lock:
-        if bus.protocol == 2:
+        if bus.proto.has_sync_read:
             if bus.sync_read_enabled is False:
                 bus.sync_read_mode = "bulk"
                 return _checked(bus, _bulk(bus, requests), ids)

@@ -125,7 +125,7 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int
     candidates: dict[int, PingResult] = {}
     wanted = set(state.ids)
     trusted = False
-    if bus.protocol == 2 and broadcast:
+    if bus.proto.has_broadcast_ping and broadcast:
         transport = bus.transport
         corrupt, skipped = transport.corrupt_packets, transport.skipped_bytes
         answered: list[set[int]] = []

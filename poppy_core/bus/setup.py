@@ -20,6 +20,7 @@ from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.results import PingResult, SetupResult
 from poppy_core.errors import CommunicationError, SetupError
 from poppy_core.models import ServoModel, SIValue, standard_baudrates
+from poppy_core.protocol import protocol_for
 
 logger = logging.getLogger(__name__)
 
@@ -71,7 +72,7 @@ def wait_for_answer(bus: DxlBus, motor_id: int, timeout_s: float = ANSWER_TIMEOU
 
 
 def unlock_eeprom(bus: DxlBus, motor_id: int, model: ServoModel) -> None:
-    if model.protocol == 2:
+    if protocol_for(model.protocol).torque_locks_eeprom:
         bus.write_register(motor_id, model, "torque_enable", False)
 
 
@@ -260,7 +261,7 @@ def reboot(
     Raises:
         SetupError: protocol 1 (no reboot instruction), or no answer after ``timeout_s``.
     """
-    if bus.protocol != 2:
+    if not bus.proto.has_reboot:
         raise SetupError("reboot exists only in protocol 2: power-cycle the motor instead")
     identify(bus, motor_id)
     say(progress, f"motor {motor_id}: rebooting")

@@ -68,7 +68,7 @@ def factory_reset(
     _, model = identify(bus, motor_id)
     factory_id, factory_bps = _factory_settings(model)
     old_bps = bus.baudrate
-    if bus.protocol == 2:
+    if bus.proto.has_factory_reset_options:
         option = (
             RESET_KEEP_ID_BAUDRATE
             if keep_id and keep_baudrate

@@ -30,6 +30,7 @@ import time
 from dataclasses import dataclass
 
 from poppy_core.bus.ports import read_ftdi_latency_ms
+from poppy_core.protocol import DxlProtocol, protocol_for
 
 # A UART frame is 1 start bit, 8 data bits, 1 stop bit (e-manual "Protocol 1.0"/"Protocol 2.0":
 # asynchronous serial, 8 bit, 1 stop bit, no parity).
@@ -55,10 +56,6 @@ SETTLE_MIN_S = 0.01
 # on protocol 1 models, 9 on X series).
 DEFAULT_RETURN_DELAY_S = 0.0005
 
-# Packet overheads (e-manual): protocol 1 is FF FF ID LEN INS/ERR ... CHK; protocol 2 is
-# FF FF FD 00 ID LEN_L LEN_H INS ... CRC_L CRC_H, and its status adds 0x55 then ERR.
-_INSTRUCTION_OVERHEAD = {1: 6, 2: 10}
-_STATUS_OVERHEAD = {1: 6, 2: 11}
 
 
 def byte_time_s(baudrate: int) -> float:
@@ -66,14 +63,14 @@ def byte_time_s(baudrate: int) -> float:
     return BITS_PER_BYTE / baudrate
 
 
-def instruction_size(protocol: int, n_params: int) -> int:
+def instruction_size(protocol: int | DxlProtocol, n_params: int) -> int:
     """Bytes of an instruction packet carrying ``n_params`` parameter bytes (before stuffing)."""
-    return _INSTRUCTION_OVERHEAD[protocol] + n_params
+    return protocol_for(protocol).instruction_size(n_params)
 
 
-def status_size(protocol: int, n_params: int) -> int:
+def status_size(protocol: int | DxlProtocol, n_params: int) -> int:
     """Bytes of a status packet carrying ``n_params`` parameter bytes (before stuffing)."""
-    return _STATUS_OVERHEAD[protocol] + n_params
+    return protocol_for(protocol).status_size(n_params)
 
 
 def settle_s(latency_s: float) -> float:

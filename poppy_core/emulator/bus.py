@@ -17,7 +17,7 @@ from poppy_core.emulator.plant import IdealPlant, Plant
 from poppy_core.emulator.sniff import CorruptSniffer
 from poppy_core.emulator.timing import LineClock, transfer_time_s
 from poppy_core.errors import ConfigError
-from poppy_core.protocol import InstructionPacket, PacketDecoder
+from poppy_core.protocol import InstructionPacket, PacketDecoder, protocol_for
 
 logger = logging.getLogger(__name__)
 
@@ -88,6 +88,7 @@ class VirtualBus:
                     value=protocol,
                 )
         self.protocol = protocol
+        self.proto = protocol_for(protocol)
         self.baudrate = baudrate
         self.wire_timing = wire_timing
         self.latency_s = latency_s
@@ -101,8 +102,8 @@ class VirtualBus:
         self.plant: Plant = plant if plant is not None else IdealPlant()
         self.plant.attach(self._motors)
         self._last_step = clock()
-        self._decoder = PacketDecoder(protocol, "instruction")
-        self._sniffer = CorruptSniffer(protocol)
+        self._decoder = PacketDecoder(self.proto, "instruction")
+        self._sniffer = CorruptSniffer(self.proto)
         self._line = LineClock()
         self.packets_received = 0
 

@@ -69,11 +69,11 @@ def _listener(bus: VirtualBus, motor_id: int, line: int) -> VirtualMotor | None:
 def supports(motor: VirtualMotor, instruction: int) -> bool:
     """Whether the motor's firmware knows ``instruction`` among the multi-motor ones.
 
-    e-manual: protocol 1 Bulk Read exists on MX (and later) firmware, not on AX; protocol 2
-    Fast Sync Read exists on X-series (firmware 45+), not on XL-320.
+    e-manual: protocol 1 Bulk Read exists on MX (and later) firmware, not on AX (which speaks
+    only protocol 1); protocol 2 Fast Sync Read exists on X-series (firmware 45+), not on XL-320.
     """
     name = motor.model.name.upper()
-    if instruction == Instruction.BULK_READ and motor.protocol == 1:
+    if instruction == Instruction.BULK_READ:
         return not name.startswith("AX")
     if instruction == Instruction.FAST_SYNC_READ:
         return not name.startswith("XL-320")
@@ -84,7 +84,7 @@ def dispatch(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Fram
     """Execute ``packet`` on every motor that hears it; return the replies in line order."""
     ins = packet.instruction
     try:
-        if ins == Instruction.SYNC_READ_USB2AX and bus.protocol == 1:
+        if ins == Instruction.SYNC_READ_USB2AX and bus.proto.usb2ax_sync_read:
             return _usb2ax_sync_read(bus, packet, line)
         if packet.id == BROADCAST_ID and ins in (
             Instruction.SYNC_READ,
@@ -99,7 +99,7 @@ def dispatch(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Fram
         return []
     if (
         bus.adapter == "usb2ax"
-        and bus.protocol == 1
+        and bus.proto.usb2ax_sync_read
         and packet.id == USB2AX_ID
         and ins == Instruction.PING
     ):
@@ -120,16 +120,16 @@ def dispatch(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Fram
 
 
 def _group(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Frame]:
-    protocol, ins, params = bus.protocol, packet.instruction, packet.params
+    proto, ins, params = bus.proto, packet.instruction, packet.params
     if ins == Instruction.SYNC_WRITE:
-        address, _, data = parse_sync_write(protocol, params)
+        address, _, data = parse_sync_write(proto, params)
         for motor_id, chunk in data.items():
             motor = _listener(bus, motor_id, line)
             if motor is not None:
                 motor.write_block(address, chunk)
         return []
     if ins == Instruction.BULK_WRITE:
-        if protocol != 2:
+        if not proto.has_bulk_write:
             return []
         for motor_id, address, chunk in parse_bulk_write(params):
             motor = _listener(bus, motor_id, line)
@@ -137,9 +137,9 @@ def _group(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Frame]
                 motor.write_block(address, chunk)
         return []
     if ins == Instruction.BULK_READ:
-        requests = parse_bulk_read(protocol, params)
-    elif protocol == 2:
-        address, length, ids = parse_sync_read(protocol, params)
+        requests = parse_bulk_read(proto, params)
+    elif proto.has_sync_read:
+        address, length, ids = parse_sync_read(proto, params)
         requests = [(motor_id, address, length) for motor_id in ids]
     else:
         return []

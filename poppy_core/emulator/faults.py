@@ -7,6 +7,7 @@ import threading
 from collections.abc import Iterable
 
 from poppy_core.models import ServoModel
+from poppy_core.protocol import protocol_for
 
 
 class FaultInjector:
@@ -107,16 +108,6 @@ class FaultInjector:
             return bytes(out)
 
 
-# e-manual (Protocol 1.0, Status Packet): error bits a protocol 1 motor reports.
-_V1_ERROR_BITS = {
-    "input voltage": 0x01,
-    "angle limit": 0x02,
-    "overheating": 0x04,
-    "range": 0x08,
-    "checksum": 0x10,
-    "overload": 0x20,
-    "instruction": 0x40,
-}
 # e-manual (X-series, Hardware Error Status (70)).
 _X_HARDWARE_BITS = {
     "input voltage": 0x01,
@@ -140,12 +131,12 @@ def fault_bits(model: ServoModel, errors: Iterable[str]) -> int:
     Raises:
         ValueError: a name the model does not report.
     """
-    if model.protocol == 1:
-        table = _V1_ERROR_BITS
-    elif model.name.upper().startswith("XL-320"):
-        table = _XL320_HARDWARE_BITS
-    else:
-        table = _X_HARDWARE_BITS
+    # Protocol 1 names the faults in the status error byte (``status_fault_bits``); protocol 2
+    # keeps them in the model's Hardware Error Status register.
+    table = protocol_for(model.protocol).status_fault_bits
+    if table is None:
+        xl320 = model.name.upper().startswith("XL-320")
+        table = _XL320_HARDWARE_BITS if xl320 else _X_HARDWARE_BITS
     bits = 0
     for name in errors:
         key = name.strip().lower().replace("_", " ")

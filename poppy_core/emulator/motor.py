@@ -7,7 +7,7 @@ import threading
 from collections.abc import Callable, Iterable
 
 from poppy_core.emulator.faults import fault_bits, shutdown_register_names
-from poppy_core.emulator.table import V2_ALERT, ControlTable
+from poppy_core.emulator.table import ControlTable
 from poppy_core.errors import ProtocolError
 from poppy_core.models import ServoModel
 from poppy_core.protocol import (
@@ -16,9 +16,9 @@ from poppy_core.protocol import (
     InstructionPacket,
     StatusPacket,
     parse_clear,
-    parse_factory_reset,
     parse_read,
     parse_write,
+    protocol_for,
 )
 
 logger = logging.getLogger(__name__)
@@ -57,6 +57,7 @@ class VirtualMotor:
     Attributes:
         model: the servo model.
         protocol: 1 or 2 (from the model).
+        proto: the protocol object (``poppy_core.protocol``).
         table: the control table (raw bytes plus write checks).
         lock: guards the table; the bus replaces it with its own lock.
         hand_mover: hook a plant sets to take over :meth:`move_by_hand` (e.g. a physics engine).
@@ -65,6 +66,7 @@ class VirtualMotor:
     def __init__(self, model: ServoModel, motor_id: int, baudrate_bps: int | None = None) -> None:
         self.model = model
         self.protocol = model.protocol
+        self.proto = protocol_for(model.protocol)
         self.table = ControlTable(model)
         self.lock: threading.RLock = threading.RLock()
         self.hand_mover: HandMover | None = None
@@ -205,16 +207,14 @@ class VirtualMotor:
 
     def error_byte(self, code: int = 0) -> int:
         """Status error byte for an instruction result ``code`` plus the hardware errors."""
-        if self.protocol == 1:
-            return code | self._fault_bits
-        return code | (V2_ALERT if self._fault_bits else 0)
+        return self.proto.error_byte(code, self._fault_bits)
 
     # ------------------------------------------------------------------ instruction handling
 
     def answers(self, instruction: int, broadcast: bool) -> bool:
         """Whether a status packet is returned for ``instruction`` (status return level)."""
         if instruction == Instruction.PING:
-            return not broadcast or self.protocol == 2
+            return not broadcast or self.proto.has_broadcast_ping
         if broadcast:
             return False
         level = self.status_return_level
@@ -262,15 +262,13 @@ class VirtualMotor:
         """Run one instruction; returns (result code, reply params), code -1 for silence."""
         ins, params, codes = packet.instruction, packet.params, self.table.codes
         if ins == Instruction.PING:
-            if self.protocol == 1:
-                return 0, b""
-            model_number = self.table.get("model_number").to_bytes(2, "little")
-            return 0, model_number + bytes((self.table.get("firmware"),))
+            firmware = self.table.get("firmware")
+            return 0, self.proto.ping_reply(self.table.get("model_number"), firmware)
         if ins == Instruction.READ:
-            address, length = parse_read(self.protocol, params)
+            address, length = parse_read(self.proto, params)
             return self.read_block(address, length)
         if ins in (Instruction.WRITE, Instruction.REG_WRITE):
-            address, data = parse_write(self.protocol, params)
+            address, data = parse_write(self.proto, params)
             code = self.check_write(address, data)
             if code == 0 and ins == Instruction.WRITE:
                 self.apply_write(address, data)
@@ -287,11 +285,11 @@ class VirtualMotor:
             self.apply_write(address, data)
             return 0, b""
         if ins == Instruction.FACTORY_RESET:
-            return self._factory_reset(parse_factory_reset(self.protocol, params), broadcast)
-        if self.protocol == 2 and ins == Instruction.REBOOT:
+            return self._factory_reset(self.proto.parse_factory_reset(params), broadcast)
+        if self.proto.has_reboot and ins == Instruction.REBOOT:
             self._reboot()
             return 0, b""
-        if self.protocol == 2 and ins == Instruction.CLEAR:
+        if self.proto.has_clear and ins == Instruction.CLEAR:
             parse_clear(params)
             return self._clear_multi_turn(), b""
         return codes.instruction, b""
@@ -350,7 +348,7 @@ class VirtualMotor:
 
     def _factory_reset(self, option: int, broadcast: bool) -> tuple[int, bytes]:
         # e-manual (X-series, Factory Reset): a broadcast "reset all" is not executed.
-        if self.protocol == 2 and broadcast and option == _RESET_ALL:
+        if self.proto.refuses_broadcast_reset_all and broadcast and option == _RESET_ALL:
             return -1, b""
         keep_id = option in (_RESET_KEEP_ID, _RESET_KEEP_ID_BAUD)
         keep_baud = option == _RESET_KEEP_ID_BAUD

@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-from poppy_core.protocol import checksum, crc16
+from poppy_core.protocol import DxlProtocol, protocol_for
 
-_V1_HEADER = b"\xff\xff"
-_V2_HEADER = b"\xff\xff\xfd\x00"
 # Enough history to hold any instruction a test or a robot sends in one go.
 _WINDOW = 4096
 
@@ -19,11 +17,11 @@ class CorruptSniffer:
     decoder saw to recover ``(id, instruction)`` of those frames.
 
     Args:
-        protocol: 1 or 2.
+        protocol: 1 or 2 (or its protocol object).
     """
 
-    def __init__(self, protocol: int) -> None:
-        self.protocol = protocol
+    def __init__(self, protocol: int | DxlProtocol) -> None:
+        self.proto = protocol_for(protocol)
         self._buf = bytearray()
         self._base = 0  # stream offset of _buf[0]
         self._reported: set[int] = set()
@@ -50,7 +48,7 @@ class CorruptSniffer:
             ``(id, instruction)`` per frame.
         """
         found: list[tuple[int, int, int]] = []
-        header = _V1_HEADER if self.protocol == 1 else _V2_HEADER
+        header = self.proto.header
         buf = self._buf
         start = buf.find(header)
         while start >= 0:
@@ -65,22 +63,4 @@ class CorruptSniffer:
 
     def _check(self, start: int) -> tuple[int, int] | None:
         """``(id, instruction)`` when a complete frame at ``start`` fails its check."""
-        buf = self._buf
-        if self.protocol == 1:
-            if len(buf) < start + 5 or buf[start + 2] == 0xFF:
-                return None
-            end = start + 4 + buf[start + 3]
-            if buf[start + 3] < 2 or len(buf) < end:
-                return None
-            if checksum(buf[start + 2 : end - 1]) == buf[end - 1]:
-                return None
-            return buf[start + 2], buf[start + 4]
-        if len(buf) < start + 8:
-            return None
-        length = buf[start + 5] | (buf[start + 6] << 8)
-        end = start + 7 + length
-        if length < 3 or len(buf) < end or buf[start + 4] == 0xFF:
-            return None
-        if crc16(buf[start : end - 2]) == buf[end - 2] | (buf[end - 1] << 8):
-            return None
-        return buf[start + 4], buf[start + 7]
+        return self.proto.corrupt_frame_at(self._buf, start)

@@ -3,56 +3,14 @@
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
 
 from poppy_core.errors import RegisterError
 from poppy_core.models import Register, ServoModel
+from poppy_core.protocol import ErrorCodes, protocol_for
 
 logger = logging.getLogger(__name__)
 
-# e-manual (Protocol 1.0, Status Packet): error bits.
-V1_INPUT_VOLTAGE = 0x01
-V1_ANGLE_LIMIT = 0x02
-V1_OVERHEATING = 0x04
-V1_RANGE = 0x08
-V1_CHECKSUM = 0x10
-V1_OVERLOAD = 0x20
-V1_INSTRUCTION = 0x40
-
-# e-manual (Protocol 2.0, Status Packet): error numbers (bits 0-6) and the alert flag (bit 7).
-V2_RESULT_FAIL = 0x01
-V2_INSTRUCTION = 0x02
-V2_CRC = 0x03
-V2_DATA_RANGE = 0x04
-V2_DATA_LENGTH = 0x05
-V2_DATA_LIMIT = 0x06
-V2_ACCESS = 0x07
-V2_ALERT = 0x80
-
-
-@dataclass(frozen=True)
-class ErrorCodes:
-    """The status error byte a protocol uses for each kind of refused instruction."""
-
-    instruction: int
-    checksum: int
-    range: int
-    length: int
-    limit: int
-    access: int
-    eeprom_locked: int
-
-
-# Protocol 1 has no access/length error: a write to a read-only address or past the table is
-# "out of the defined range" (Range Error); a goal position outside the CW/CCW limits sets the
-# Angle Limit Error bit (e-manual, Protocol 1.0 Status Packet).
-V1_CODES = ErrorCodes(V1_INSTRUCTION, V1_CHECKSUM, V1_RANGE, V1_RANGE, V1_ANGLE_LIMIT, V1_RANGE, 0)
-# Protocol 2: "Access Error: writing to a read-only or undefined address, or to EEPROM while
-# Torque Enable is 1"; "Data Length Error: data shorter than the item"; "Data Limit Error:
-# outside the limit value" (e-manual, Protocol 2.0 Status Packet).
-V2_CODES = ErrorCodes(
-    V2_INSTRUCTION, V2_CRC, V2_DATA_RANGE, V2_DATA_LENGTH, V2_DATA_LIMIT, V2_ACCESS, V2_ACCESS
-)
+# The status error byte of each kind of refusal is the protocol's (``DxlProtocol.error_codes``).
 
 
 class ControlTable:
@@ -64,7 +22,8 @@ class ControlTable:
 
     def __init__(self, model: ServoModel) -> None:
         self.model = model
-        self.codes = V1_CODES if model.protocol == 1 else V2_CODES
+        self.proto = protocol_for(model.protocol)
+        self.codes: ErrorCodes = self.proto.error_codes
         self.data = model.default_table()
         self._by_address: dict[int, Register] = {}
         for register in model.registers.values():
@@ -172,7 +131,7 @@ class ControlTable:
         if any(not register.writable for register in touched):
             return codes.access
         if (
-            self.model.protocol == 2
+            self.proto.torque_locks_eeprom
             and torque_on
             and any(register.memory == "EEPROM" for register in touched)
         ):
@@ -181,7 +140,7 @@ class ControlTable:
         for register in touched:
             start, stop = register.address, register.address + register.size
             if start < address or stop > end:
-                if self.model.protocol == 2:
+                if self.proto.whole_registers_only:
                     return codes.length
                 continue
             raw = register.decode(bytes(data[start - address : stop - address]))

@@ -1,8 +1,11 @@
 """Bytes of Dynamixel protocols 1.0 and 2.0: packets, checksum/CRC, stuffing, instructions, decoder.
 
-Pure functions and one streaming decoder; no I/O, no threads.
+One object per protocol (``PROTOCOL_1``, ``PROTOCOL_2``; ``protocol_for(1 | 2)``) holds its sizes,
+error layout, codec and capabilities; the functions taking a protocol number delegate to it.
+Pure: no I/O, no threads.
 """
 
+from poppy_core.protocol.base import DxlProtocol, ErrorCodes
 from poppy_core.protocol.constants import (
     BROADCAST_ID,
     MAX_ID,
@@ -42,14 +45,20 @@ from poppy_core.protocol.parsers import (
     parse_write,
 )
 from poppy_core.protocol.status import decode_errors
-from poppy_core.protocol.v1 import checksum
-from poppy_core.protocol.v2 import crc16, stuff, unstuff
+from poppy_core.protocol.v1 import PROTOCOL_1, checksum
+from poppy_core.protocol.v2 import PROTOCOL_2, crc16, stuff, unstuff
+from poppy_core.protocol.versions import PROTOCOLS_BY_VERSION, protocol_for
 
 __all__ = [
     "BROADCAST_ID",
     "MAX_ID",
+    "PROTOCOLS_BY_VERSION",
+    "PROTOCOL_1",
+    "PROTOCOL_2",
     "USB2AX_ID",
     "V2_MAX_LENGTH",
+    "DxlProtocol",
+    "ErrorCodes",
     "Instruction",
     "InstructionPacket",
     "PacketDecoder",
@@ -77,6 +86,7 @@ __all__ = [
     "parse_usb2ax_sync_status",
     "parse_write",
     "ping",
+    "protocol_for",
     "read",
     "reboot",
     "reg_write",

@@ -1,31 +1,26 @@
-"""Turn packets into bytes for protocol 1 or 2 (``encode_instruction``, ``encode_status``)."""
+"""Turn packets into bytes for protocol 1 or 2 (``encode_instruction``, ``encode_status``).
+
+Thin functions over the protocol objects (``protocol_for(n).encode_instruction``) for callers
+that hold a version number.
+"""
 
 from __future__ import annotations
 
-from poppy_core.errors import ProtocolError
-from poppy_core.protocol import v1, v2
-from poppy_core.protocol.constants import BROADCAST_ID, MAX_ID, PROTOCOLS, Instruction
+from poppy_core.protocol.base import DxlProtocol
 from poppy_core.protocol.packets import InstructionPacket, StatusPacket
+from poppy_core.protocol.versions import protocol_for
 
 
-def check_protocol(protocol: int) -> None:
+def check_protocol(protocol: int | DxlProtocol) -> None:
     """Raise ``ProtocolError`` unless ``protocol`` is 1 or 2."""
-    if protocol not in PROTOCOLS:
-        raise ProtocolError(f"unknown Dynamixel protocol {protocol!r} (expected 1 or 2)")
+    protocol_for(protocol)
 
 
-def _check_id(packet_id: int) -> None:
-    if not (0 <= packet_id <= MAX_ID or packet_id == BROADCAST_ID):
-        raise ProtocolError(
-            f"ID {packet_id} cannot be encoded (0..{MAX_ID} or broadcast {BROADCAST_ID})"
-        )
-
-
-def encode_instruction(protocol: int, packet: InstructionPacket) -> bytes:
+def encode_instruction(protocol: int | DxlProtocol, packet: InstructionPacket) -> bytes:
     """Encode an instruction packet.
 
     Args:
-        protocol: 1 or 2.
+        protocol: 1 or 2 (or its protocol object).
         packet: the packet; its params are raw (stuffing is applied here for protocol 2).
 
     Returns:
@@ -34,16 +29,10 @@ def encode_instruction(protocol: int, packet: InstructionPacket) -> bytes:
     Raises:
         ProtocolError: bad protocol, ID, instruction byte or too many parameters.
     """
-    check_protocol(protocol)
-    _check_id(packet.id)
-    if not 0 <= packet.instruction <= 0xFF:
-        raise ProtocolError(f"instruction {packet.instruction} is not a byte")
-    if protocol == 1:
-        return v1.encode_frame(packet.id, packet.instruction, packet.params)
-    return v2.encode_frame(packet.id, bytes((packet.instruction,)) + packet.params)
+    return protocol_for(protocol).encode_instruction(packet)
 
 
-def encode_status(protocol: int, packet: StatusPacket) -> bytes:
+def encode_status(protocol: int | DxlProtocol, packet: StatusPacket) -> bytes:
     """Encode a status packet.
 
     Protocol 2 status packets carry ``INS=0x55`` then the error byte. A status from the broadcast
@@ -51,7 +40,7 @@ def encode_status(protocol: int, packet: StatusPacket) -> bytes:
     without byte stuffing (and ``PacketDecoder`` does not unstuff it), like the Robotis SDK.
 
     Args:
-        protocol: 1 or 2.
+        protocol: 1 or 2 (or its protocol object).
         packet: the packet; its params are raw.
 
     Returns:
@@ -60,11 +49,4 @@ def encode_status(protocol: int, packet: StatusPacket) -> bytes:
     Raises:
         ProtocolError: bad protocol, ID, error byte or too many parameters.
     """
-    check_protocol(protocol)
-    _check_id(packet.id)
-    if not 0 <= packet.error <= 0xFF:
-        raise ProtocolError(f"error byte {packet.error} is not a byte")
-    if protocol == 1:
-        return v1.encode_frame(packet.id, packet.error, packet.params)
-    body = bytes((Instruction.STATUS, packet.error)) + packet.params
-    return v2.encode_frame(packet.id, body, stuffing=packet.id != BROADCAST_ID)
+    return protocol_for(protocol).encode_status(packet)

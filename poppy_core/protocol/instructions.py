@@ -28,18 +28,19 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 
 from poppy_core.errors import ProtocolError
+from poppy_core.protocol.base import DxlProtocol
 from poppy_core.protocol.constants import (
     BROADCAST_ID,
     CLEAR_KEY,
     CLEAR_MULTI_TURN,
     FACTORY_RESET_ALL,
-    FACTORY_RESET_OPTIONS,
     MAX_ID,
     USB2AX_ID,
     Instruction,
 )
-from poppy_core.protocol.encoding import check_protocol
 from poppy_core.protocol.packets import InstructionPacket, StatusPacket
+from poppy_core.protocol.v2 import PROTOCOL_2
+from poppy_core.protocol.versions import protocol_for
 
 
 def _check_target(packet_id: int) -> None:
@@ -59,24 +60,7 @@ def _check_motor_ids(ids: Iterable[int]) -> list[int]:
     return id_list
 
 
-def _word(protocol: int, value: int, what: str) -> bytes:
-    """Address or length as one byte (protocol 1) or two little-endian bytes (protocol 2)."""
-    limit = 0xFF if protocol == 1 else 0xFFFF
-    if not 0 <= value <= limit:
-        raise ProtocolError(f"{what} {value} is not in 0..{limit} for protocol {protocol}")
-    return bytes((value,)) if protocol == 1 else value.to_bytes(2, "little")
-
-
-def _length(protocol: int, length: int) -> bytes:
-    if length < 1:
-        raise ProtocolError(f"data length {length} must be at least 1")
-    return _word(protocol, length, "data length")
-
-
-def _need_v2(protocol: int, name: str) -> None:
-    check_protocol(protocol)
-    if protocol != 2:
-        raise ProtocolError(f"{name} exists only in protocol 2")
+Proto = int | DxlProtocol
 
 
 # ---------------------------------------------------------------- builders
@@ -88,32 +72,32 @@ def ping(id: int) -> InstructionPacket:
     return InstructionPacket(id, Instruction.PING)
 
 
-def read(protocol: int, id: int, address: int, length: int) -> InstructionPacket:
+def read(protocol: Proto, id: int, address: int, length: int) -> InstructionPacket:
     """READ ``length`` bytes from ``address`` of motor ``id``."""
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     _check_target(id)
-    params = _word(protocol, address, "address") + _length(protocol, length)
+    params = proto.word(address, "address") + proto.length_field(length)
     return InstructionPacket(id, Instruction.READ, params)
 
 
-def write(protocol: int, id: int, address: int, data: bytes) -> InstructionPacket:
+def write(protocol: Proto, id: int, address: int, data: bytes) -> InstructionPacket:
     """WRITE ``data`` at ``address`` of motor ``id``."""
     return _write(protocol, Instruction.WRITE, id, address, data)
 
 
-def reg_write(protocol: int, id: int, address: int, data: bytes) -> InstructionPacket:
+def reg_write(protocol: Proto, id: int, address: int, data: bytes) -> InstructionPacket:
     """REG_WRITE ``data`` at ``address``: held by the motor until ACTION."""
     return _write(protocol, Instruction.REG_WRITE, id, address, data)
 
 
 def _write(
-    protocol: int, instruction: Instruction, id: int, address: int, data: bytes
+    protocol: Proto, instruction: Instruction, id: int, address: int, data: bytes
 ) -> InstructionPacket:
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     _check_target(id)
     if not data:
         raise ProtocolError("a write needs at least one data byte")
-    return InstructionPacket(id, instruction, _word(protocol, address, "address") + bytes(data))
+    return InstructionPacket(id, instruction, proto.word(address, "address") + bytes(data))
 
 
 def action(id: int = BROADCAST_ID) -> InstructionPacket:
@@ -122,17 +106,11 @@ def action(id: int = BROADCAST_ID) -> InstructionPacket:
     return InstructionPacket(id, Instruction.ACTION)
 
 
-def factory_reset(protocol: int, id: int, option: int = FACTORY_RESET_ALL) -> InstructionPacket:
+def factory_reset(protocol: Proto, id: int, option: int = FACTORY_RESET_ALL) -> InstructionPacket:
     """FACTORY_RESET motor ``id``; protocol 2 sends ``option`` (0xFF, 0x01 or 0x02)."""
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     _check_target(id)
-    if protocol == 1:
-        if option != FACTORY_RESET_ALL:
-            raise ProtocolError("protocol 1 factory reset has no option (it resets everything)")
-        return InstructionPacket(id, Instruction.FACTORY_RESET)
-    if option not in FACTORY_RESET_OPTIONS:
-        raise ProtocolError(f"factory reset option {option:#04x} is not 0xFF, 0x01 or 0x02")
-    return InstructionPacket(id, Instruction.FACTORY_RESET, bytes((option,)))
+    return InstructionPacket(id, Instruction.FACTORY_RESET, proto.factory_reset_params(option))
 
 
 def reboot(id: int) -> InstructionPacket:
@@ -147,29 +125,28 @@ def clear(id: int) -> InstructionPacket:
     return InstructionPacket(id, Instruction.CLEAR, bytes((CLEAR_MULTI_TURN,)) + CLEAR_KEY)
 
 
-def sync_read(protocol: int, address: int, length: int, ids: Iterable[int]) -> InstructionPacket:
+def sync_read(protocol: Proto, address: int, length: int, ids: Iterable[int]) -> InstructionPacket:
     """SYNC_READ (protocol 2, 0x82) or the USB2AX sync read (protocol 1, 0x84)."""
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     id_list = _check_motor_ids(ids)
-    params = _word(protocol, address, "address") + _length(protocol, length) + bytes(id_list)
-    code = Instruction.SYNC_READ if protocol == 2 else Instruction.SYNC_READ_USB2AX
-    return InstructionPacket(BROADCAST_ID, code, params)
+    params = proto.word(address, "address") + proto.length_field(length) + bytes(id_list)
+    return InstructionPacket(BROADCAST_ID, proto.sync_read_instruction, params)
 
 
 def fast_sync_read(address: int, length: int, ids: Iterable[int]) -> InstructionPacket:
     """FAST_SYNC_READ (protocol 2, 0x8A): one combined reply (see ``parse_fast_sync_status``)."""
     id_list = _check_motor_ids(ids)
-    params = _word(2, address, "address") + _length(2, length) + bytes(id_list)
+    params = PROTOCOL_2.word(address, "address") + PROTOCOL_2.length_field(length) + bytes(id_list)
     return InstructionPacket(BROADCAST_ID, Instruction.FAST_SYNC_READ, params)
 
 
 def sync_write(
-    protocol: int, address: int, length: int, data: Mapping[int, bytes]
+    protocol: Proto, address: int, length: int, data: Mapping[int, bytes]
 ) -> InstructionPacket:
     """SYNC_WRITE ``length`` bytes at ``address`` of several motors: ``data`` maps ID -> bytes."""
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     _check_motor_ids(data)
-    parts = [_word(protocol, address, "address"), _length(protocol, length)]
+    parts = [proto.word(address, "address"), proto.length_field(length)]
     for motor_id, chunk in data.items():
         if len(chunk) != length:
             raise ProtocolError(
@@ -180,18 +157,11 @@ def sync_write(
     return InstructionPacket(BROADCAST_ID, Instruction.SYNC_WRITE, b"".join(parts))
 
 
-def bulk_read(protocol: int, requests: Sequence[tuple[int, int, int]]) -> InstructionPacket:
+def bulk_read(protocol: Proto, requests: Sequence[tuple[int, int, int]]) -> InstructionPacket:
     """BULK_READ: ``requests`` is a sequence of ``(id, address, length)``."""
-    check_protocol(protocol)
+    proto = protocol_for(protocol)
     _check_motor_ids(r[0] for r in requests)
-    parts = [b"\x00"] if protocol == 1 else []
-    for motor_id, address, length in requests:
-        addr, size = _word(protocol, address, "address"), _length(protocol, length)
-        if protocol == 1:
-            parts.append(size + bytes((motor_id,)) + addr)
-        else:
-            parts.append(bytes((motor_id,)) + addr + size)
-    return InstructionPacket(BROADCAST_ID, Instruction.BULK_READ, b"".join(parts))
+    return InstructionPacket(BROADCAST_ID, Instruction.BULK_READ, proto.bulk_read_params(requests))
 
 
 def bulk_write(requests: Sequence[tuple[int, int, bytes]]) -> InstructionPacket:
@@ -199,7 +169,11 @@ def bulk_write(requests: Sequence[tuple[int, int, bytes]]) -> InstructionPacket:
     _check_motor_ids(r[0] for r in requests)
     parts = []
     for motor_id, address, data in requests:
-        parts.append(bytes((motor_id,)) + _word(2, address, "address") + _length(2, len(data)))
+        parts.append(
+            bytes((motor_id,))
+            + PROTOCOL_2.word(address, "address")
+            + PROTOCOL_2.length_field(len(data))
+        )
         parts.append(bytes(data))
     return InstructionPacket(BROADCAST_ID, Instruction.BULK_WRITE, b"".join(parts))
 

@@ -3,37 +3,26 @@
 from __future__ import annotations
 
 from poppy_core.errors import ProtocolError
-from poppy_core.protocol.constants import (
-    CLEAR_KEY,
-    CLEAR_MULTI_TURN,
-    FACTORY_RESET_ALL,
-    FACTORY_RESET_OPTIONS,
-    MAX_ID,
-)
-from poppy_core.protocol.encoding import check_protocol
+from poppy_core.protocol.base import DxlProtocol, check_ids
+from poppy_core.protocol.constants import CLEAR_KEY, CLEAR_MULTI_TURN
+from poppy_core.protocol.versions import protocol_for
+
+Proto = int | DxlProtocol
 
 
-def _size(protocol: int) -> int:
+def _size(protocol: Proto) -> int:
     """Width of an address or length field: 1 byte (protocol 1) or 2 (protocol 2)."""
-    check_protocol(protocol)
-    return protocol
+    return protocol_for(protocol).word_size
 
 
 def _value(params: bytes, offset: int, size: int) -> int:
     return params[offset] if size == 1 else params[offset] | (params[offset + 1] << 8)
 
 
-def _ids(raw: bytes, what: str) -> list[int]:
-    ids = list(raw)
-    for motor_id in ids:
-        if motor_id > MAX_ID:
-            raise ProtocolError(f"{what}: motor ID {motor_id} is not in 0..{MAX_ID}")
-    if len(set(ids)) != len(ids):
-        raise ProtocolError(f"{what}: duplicate motor IDs in {ids}")
-    return ids
+_ids = check_ids
 
 
-def parse_read(protocol: int, params: bytes) -> tuple[int, int]:
+def parse_read(protocol: Proto, params: bytes) -> tuple[int, int]:
     """``(address, length)`` of a READ."""
     size = _size(protocol)
     if len(params) != 2 * size:
@@ -41,7 +30,7 @@ def parse_read(protocol: int, params: bytes) -> tuple[int, int]:
     return _value(params, 0, size), _value(params, size, size)
 
 
-def parse_write(protocol: int, params: bytes) -> tuple[int, bytes]:
+def parse_write(protocol: Proto, params: bytes) -> tuple[int, bytes]:
     """``(address, data)`` of a WRITE or REG_WRITE."""
     size = _size(protocol)
     if len(params) <= size:
@@ -49,7 +38,7 @@ def parse_write(protocol: int, params: bytes) -> tuple[int, bytes]:
     return _value(params, 0, size), bytes(params[size:])
 
 
-def parse_sync_read(protocol: int, params: bytes) -> tuple[int, int, list[int]]:
+def parse_sync_read(protocol: Proto, params: bytes) -> tuple[int, int, list[int]]:
     """``(address, length, ids)`` of a SYNC_READ, FAST_SYNC_READ or USB2AX 0x84 sync read."""
     size = _size(protocol)
     if len(params) <= 2 * size:
@@ -62,7 +51,7 @@ def parse_sync_read(protocol: int, params: bytes) -> tuple[int, int, list[int]]:
     return _value(params, 0, size), length, _ids(params[2 * size :], "SYNC_READ")
 
 
-def parse_sync_write(protocol: int, params: bytes) -> tuple[int, int, dict[int, bytes]]:
+def parse_sync_write(protocol: Proto, params: bytes) -> tuple[int, int, dict[int, bytes]]:
     """``(address, length, {id: data})`` of a SYNC_WRITE."""
     size = _size(protocol)
     if len(params) <= 2 * size:
@@ -81,26 +70,13 @@ def parse_sync_write(protocol: int, params: bytes) -> tuple[int, int, dict[int, 
     return address, length, data
 
 
-def parse_bulk_read(protocol: int, params: bytes) -> list[tuple[int, int, int]]:
+def parse_bulk_read(protocol: Proto, params: bytes) -> list[tuple[int, int, int]]:
     """``[(id, address, length)]`` of a BULK_READ.
 
     Protocol 1 (e-manual, MX Bulk Read): ``00`` then ``(LEN ID ADDR)`` blocks; protocol 2:
     ``(ID ADDR_L ADDR_H LEN_L LEN_H)`` blocks.
     """
-    check_protocol(protocol)
-    if protocol == 1:
-        if not params or params[0] != 0x00 or len(params) < 4 or (len(params) - 1) % 3:
-            raise ProtocolError(
-                f"protocol 1 BULK_READ needs 00 then (LEN ID ADDR) blocks, got {params.hex(' ')}"
-            )
-        blocks = [(params[i + 1], params[i + 2], params[i]) for i in range(1, len(params), 3)]
-    else:
-        if not params or len(params) % 5:
-            raise ProtocolError(f"protocol 2 BULK_READ needs 5-byte blocks, got {len(params)}")
-        blocks = [
-            (params[i], _value(params, i + 1, 2), _value(params, i + 3, 2))
-            for i in range(0, len(params), 5)
-        ]
+    blocks = protocol_for(protocol).parse_bulk_read(params)
     _ids(bytes(b[0] for b in blocks), "BULK_READ")
     if any(length < 1 for _, _, length in blocks):
         raise ProtocolError("BULK_READ data length must be at least 1")
@@ -126,16 +102,9 @@ def parse_bulk_write(params: bytes) -> list[tuple[int, int, bytes]]:
     return blocks
 
 
-def parse_factory_reset(protocol: int, params: bytes) -> int:
+def parse_factory_reset(protocol: Proto, params: bytes) -> int:
     """Option of a FACTORY_RESET (protocol 1 has none: 0xFF, reset everything)."""
-    check_protocol(protocol)
-    if protocol == 1:
-        if params:
-            raise ProtocolError("protocol 1 FACTORY_RESET takes no parameter")
-        return FACTORY_RESET_ALL
-    if len(params) != 1 or params[0] not in FACTORY_RESET_OPTIONS:
-        raise ProtocolError(f"FACTORY_RESET option {params.hex(' ')!r} is not FF, 01 or 02")
-    return params[0]
+    return protocol_for(protocol).parse_factory_reset(params)
 
 
 def parse_clear(params: bytes) -> int:

@@ -12,16 +12,13 @@ from pydantic import BaseModel
 
 from poppy_core.errors import ConfigError, UnknownModelError
 from poppy_core.models import model_by_name
+from poppy_core.protocol import MAX_ID, protocol_for
 from poppy_core.robot.config_format import config_error
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import RobotConfig
 
 logger = logging.getLogger(__name__)
-
-# e-manual: Protocol 2.0, Packet / ID: usable IDs are 0-252 (0x00-0xFC); 0xFD is reserved
-# (it is part of the header), 0xFE is broadcast. Protocol 1.0 allows 0-253.
-MAX_PROTOCOL2_ID = 252
 
 
 def expand(
@@ -194,9 +191,11 @@ def _check_controllers(view: CheckView, source: str, problems: list[ConfigError]
 
 def _check_id(source: str, motor: str, motor_id: int, cname: str, protocol: int | None,
               ids: dict[int, str], problems: list[ConfigError]) -> None:
-    if protocol == 2 and motor_id > MAX_PROTOCOL2_ID:
+    # IDs past MAX_ID are the motor's own check; a protocol may reserve some below it.
+    top = MAX_ID if protocol is None else protocol_for(protocol).max_motor_id
+    if top < MAX_ID and motor_id > top:
         problems.append(config_error(source, f"motors.{motor}.id", motor_id,
-                                     f"protocol 2 IDs are 0-{MAX_PROTOCOL2_ID} (controller "
+                                     f"protocol {protocol} IDs are 0-{top} (controller "
                                      f"{cname!r})"))
     if motor_id in ids:
         problems.append(config_error(source, f"motors.{motor}.id", motor_id,

@@ -15,6 +15,7 @@ from poppy_core.emulator import (
 )
 from poppy_core.errors import ConfigError
 from poppy_core.models import model_by_name
+from poppy_core.protocol import protocol_for
 from poppy_core.robot.config import RobotConfig
 from poppy_core.robot.profiles import list_profiles, load_profile, profile_dirs
 
@@ -89,7 +90,7 @@ def virtual_buses(
             if set_up:
                 virtual.table.set("return_delay_time", 0)
             motors.append(virtual)
-        usb2ax = controller.protocol == 1 and controller.sync_read
+        usb2ax = protocol_for(controller.protocol).usb2ax_sync_read and controller.sync_read
         plant = None if simulation is None else _mujoco_plant(config, name, simulation)
         buses[name] = VirtualBus(
             motors,
