@@ -92,7 +92,10 @@ def main() -> None:
     except click.exceptions.ClickException as exc:  # e.g. a file Click could not open
         error_line(" ".join(exc.format_message().split()))
         sys.exit(exc.exit_code)
-    except typer.Abort:  # Ctrl-C or end of input at a prompt
+    except typer.Abort as exc:  # Ctrl-C or end of input at a prompt
+        if isinstance(exc.__context__, KeyboardInterrupt):  # Click keeps what it replaced
+            error_line("interrupted")
+            sys.exit(EXIT_INTERRUPTED)
         error_line("aborted")
         sys.exit(EXIT_FAILURE)
     except PoppyError as exc:

@@ -27,9 +27,8 @@ SLOW_MODULES = {
     "robot/test_config_hypothesis.py",
 }
 # Tests that render with OpenGL in the test process. `make test` runs them in a pytest process
-# of their own (`-m gl`): in one long run, Mesa's EGL was seen to hang in `mjr_makeContext` at
-# 0 % CPU after hundreds of other tests (never when these run on their own); see
-# docs/simulation.md.
+# of their own (`-m gl`): a render stuck in the driver would otherwise take the whole run with it
+# (it happened when mujoco was imported before MUJOCO_GL was set; see docs/simulation.md).
 GL_MODULES = {
     "sim/test_sim_camera.py",
     "sim/test_sim_plant.py",

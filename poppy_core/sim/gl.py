@@ -58,6 +58,15 @@ def _known(backend: str, timeout_s: float) -> str | None:
         return _verdict[backend]
 
 
+def _backend_mujoco_chose() -> str | None:
+    """The backend mujoco chose when it was imported (glfw when unset), None if not yet."""
+    module = sys.modules.get("mujoco.rendering.classic.gl_context") or sys.modules.get(
+        "mujoco.gl_context"
+    )
+    chosen = getattr(module, "_MUJOCO_GL", None)
+    return (chosen or "glfw") if isinstance(chosen, str) else None
+
+
 def check_offscreen_gl(timeout_s: float = PROBE_TIMEOUT_S) -> None:
     """Return when MuJoCo can render offscreen with this process's ``MUJOCO_GL``.
 
@@ -69,6 +78,13 @@ def check_offscreen_gl(timeout_s: float = PROBE_TIMEOUT_S) -> None:
         ConfigError: rendering fails or hangs here; the message says what to install or set.
     """
     backend = os.environ.get("MUJOCO_GL", "glfw").lower()
+    chosen = _backend_mujoco_chose()
+    if chosen is not None and chosen != backend:
+        raise ConfigError(
+            f"mujoco was imported with MUJOCO_GL={chosen} and MUJOCO_GL is now "
+            f"{backend}: import poppy_core (or set MUJOCO_GL) before importing mujoco",
+            field="MUJOCO_GL",
+        )  # the backend this process would use is not the one the probe tries
     reason = _known(backend, timeout_s)
     if reason is None:
         return

@@ -4,14 +4,10 @@ from __future__ import annotations
 
 import logging
 import math
-import os
 import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any
-
-if "MUJOCO_GL" not in os.environ and not os.environ.get("DISPLAY"):
-    os.environ["MUJOCO_GL"] = "egl"  # headless rendering; osmesa also works when installed
 
 import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
 import numpy as np

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import pytest
 
 pytest.importorskip("mujoco")
@@ -18,6 +22,7 @@ def fresh_verdicts(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_a_backend_that_does_not_exist_is_named_with_what_to_do(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
+    monkeypatch.setattr(gl, "_backend_mujoco_chose", lambda: None)  # mujoco not imported yet
     monkeypatch.setenv("MUJOCO_GL", "nosuchgl")
     with pytest.raises(ConfigError) as caught:
         gl.check_offscreen_gl(timeout_s=60)
@@ -41,3 +46,28 @@ def test_the_verdict_is_kept(monkeypatch: pytest.MonkeyPatch) -> None:
     gl.check_offscreen_gl()
     gl.check_offscreen_gl()
     assert calls == ["egl"]
+
+
+def test_mujoco_imported_with_another_backend_is_an_error_not_a_hang(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(gl, "_backend_mujoco_chose", lambda: "glfw")
+    monkeypatch.setenv("MUJOCO_GL", "egl")
+    with pytest.raises(ConfigError, match="before importing mujoco") as caught:
+        gl.check_offscreen_gl()
+    assert "\n" not in str(caught.value)
+
+
+def test_importing_poppy_core_first_sets_the_headless_backend() -> None:
+    """A script without a display that imports poppy_core, then mujoco, renders with EGL."""
+    code = (
+        "import poppy_core, mujoco, os\n"
+        "from mujoco.rendering.classic import gl_context\n"
+        "print(os.environ['MUJOCO_GL'], gl_context._MUJOCO_GL)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY")}
+    done = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["egl", "egl"]
