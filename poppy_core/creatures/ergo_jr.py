@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, ClassVar
 from poppy_core.creatures.postures import ERGO_JR_IDLE, clamp_to_limits
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import LoopPrimitive, Primitive
-from poppy_core.trajectory import CONTROLS
+from poppy_core.trajectory import control_name
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
@@ -57,15 +57,6 @@ JUMP_DOWN_SPEED_DPS = 250.0
 JUMP_PID: tuple[float, float, float] = (10.0, 0.0, 0.0)  # jump.py: stiff P gain while jumping
 
 SAFE_POWER_UP_S = 3.0  # postures.py SafePowerUp: IdlePosture(robot, 3.0)
-
-
-def _check_control(value: str) -> str:
-    if value not in CONTROLS:
-        raise ArgumentError(
-            f"control must be one of {', '.join(CONTROLS)}, not {value!r}",
-            field="control", value=value,
-        )  # fmt: skip
-    return value
 
 
 def _finite(name: str, value: float, low: float = 0.0) -> float:
@@ -115,7 +106,7 @@ class Dance(LoopPrimitive):
 
     @control.setter
     def control(self, value: str) -> None:
-        self._control = _check_control(value)
+        self._control = control_name(value)
 
     @property
     def amplitude_scale(self) -> float:
@@ -307,7 +298,7 @@ class SafePowerUp(Primitive):
 
     @control.setter
     def control(self, value: str) -> None:
-        self._control = _check_control(value)
+        self._control = control_name(value)
 
     @property
     def torque_limit(self) -> float:
