@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import faulthandler
 import os
+import signal
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -41,6 +42,12 @@ HANG_LIMIT_S = 600
 # Property tests run Hypothesis's default number of examples; `HYPOTHESIS_PROFILE=thorough`
 # runs ten times as many (before a release, or when a codec or parser changed). Tests whose
 # examples are costly (a whole HTTP API fuzzed) scale from ``settings.default.max_examples``.
+# A run started in the background by a non-interactive shell (`.ci/run &`, nohup) inherits SIGINT
+# ignored, and so would every `poppy` the tests start (Python then installs no KeyboardInterrupt):
+# the Ctrl-C tests would see a command that cannot be interrupted. A handler here is reset to
+# the default in each child at exec, where Python installs its own again.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 settings.register_profile("thorough", max_examples=1000)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 

@@ -83,8 +83,8 @@ def test_an_interrupted_calibration_leaves_the_previous_one(poppy: Any, user_dir
     proc.stdin.flush()
     time.sleep(0.5)
     proc.send_signal(signal.SIGINT)
-    proc.communicate(timeout=20)
-    assert proc.returncode == 130
+    _, err = proc.communicate(timeout=20)
+    assert proc.returncode == 130, err
     assert path.read_text() == before
     assert sorted(p.name for p in path.parent.iterdir()) == ["profile.yaml"]
 
