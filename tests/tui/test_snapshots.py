@@ -62,7 +62,9 @@ async def still(pilot: Any) -> None:
 
 async def scanned(pilot: Any) -> None:
     screen = pilot.app.main
-    await wait_for(pilot, lambda: screen.last_scan is not None, what="scan")
+    # A scan of every ID over TCP; late in the whole suite (one long process, a loaded machine)
+    # it was seen to take over 10 s. What is compared is the screen after it, not its speed.
+    await wait_for(pilot, lambda: screen.last_scan is not None, timeout_s=60.0, what="scan")
     await still(pilot)
 
 
