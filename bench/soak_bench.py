@@ -240,13 +240,15 @@ def torque_toggles(ctx: BenchContext) -> dict[str, Any]:
             if not port:
                 out[label] = {"error": "no port printed"}
                 continue
+            client = [str(ctx.peers_python), str(BENCH_DIR / "peers" / "pypot_torque.py"),
+                      "--port", port, "--cycles", str(TORQUE_CYCLES)]  # fmt: skip
             load_before = os.getloadavg()[0]
-            run = run_client(
-                [str(ctx.peers_python), str(BENCH_DIR / "peers" / "pypot_torque.py"),
-                 "--port", port, "--cycles", str(TORQUE_CYCLES)]
-            )  # fmt: skip
-            run.record["load_1min"] = [round(load_before, 2), round(os.getloadavg()[0], 2)]
-            out[label] = run.record
+            record = run_client(client).record
+            record["load_1min"] = [round(load_before, 2), round(os.getloadavg()[0], 2)]
+            # The control: the same client without its output flush, so that what the kernel
+            # discards at that flush is told apart from what the emulator loses.
+            record["control"] = run_client([*client, "--keep-output"]).record
+            out[label] = record
         finally:
             proc.send_signal(2)
             try:

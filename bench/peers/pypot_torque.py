@@ -10,6 +10,10 @@ each write. A write is *lost* when a motor reads back the previous state. pypot'
 write still in the port's output queue when the next packet starts is discarded unless the
 other end has already read it. Prints one JSON line: ``writes``, ``lost``, ``reads_failed``,
 ``elapsed_s``.
+
+``--keep-output`` is the control: the same client with only the output flush skipped (the input
+flush stays), so that what the emulator itself loses is counted apart from what the kernel
+discards at the client's flush.
 """
 
 from __future__ import annotations
@@ -36,6 +40,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     writes = lost = reads_failed = 0
     start = time.perf_counter()
     with io_class(args.port, baudrate=args.baud) as io:
+        if args.keep_output:
+            io._serial.flushOutput = lambda: None  # the control: flush input only
         for _ in range(args.cycles):
             for enable in (True, False):
                 if enable:
@@ -69,6 +75,7 @@ def main() -> int:
     parser.add_argument("--protocol", type=int, choices=(1, 2), default=2)
     parser.add_argument("--ids", type=parse_ids, default=parse_ids("1-6"))
     parser.add_argument("--cycles", type=int, default=150)
+    parser.add_argument("--keep-output", action="store_true", help="skip the output flush")
     args = parser.parse_args()
     try:
         record = run(args)
