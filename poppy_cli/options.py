@@ -66,9 +66,6 @@ BAUD_LIMITS = {"min": MIN_BAUD, "max": MAX_BAUD}
 out of range is a usage error (exit 2)."""
 
 
-MAX_DURATION_S = 86_400.0
-"""A day: the longest goto or move core accepts (``poppy_core.trajectory`` and
-``poppy_core.motion.move``); longer is a typing mistake that would never end."""
 
 
 def finite(value: float | None) -> float | None:

@@ -31,7 +31,7 @@ def control_name(control: str) -> str:
     return name
 
 MAX_DURATION_S = 24 * 3600.0
-"""The longest goto (a day): longer ones are typing mistakes that would never end."""
+"""The longest goto or move (a day): longer is a typing mistake that would never end."""
 
 
 def check_goto(duration_s: float, control: str) -> None:

@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.options import (
-    MAX_DURATION_S,
     ConfigOpt,
     JsonOpt,
     PortOpt,
@@ -20,6 +19,7 @@ from poppy_cli.options import (
 )
 from poppy_cli.output import EXIT_FAILURE, console, error_line, print_json
 from poppy_cli.robots import build_robot
+from poppy_core.trajectory import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from rich.table import Table

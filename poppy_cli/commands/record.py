@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.options import (
-    MAX_DURATION_S,
     ConfigOpt,
     JsonSummaryOpt,
     PortOpt,
@@ -22,6 +21,7 @@ from poppy_cli.options import (
 )
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, print_json
 from poppy_cli.robots import robot_config, start_robot
+from poppy_core.trajectory import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from rich.table import Table

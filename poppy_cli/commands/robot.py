@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.options import (
-    MAX_DURATION_S,
     ConfigOpt,
     JsonOpt,
     PortOpt,
@@ -21,6 +20,7 @@ from poppy_cli.options import (
 from poppy_cli.output import console, fmt_value, print_json, styled
 from poppy_cli.robots import build_robot, open_remote, robot_config, start_robot
 from poppy_cli.targets import TargetSyntaxError, parse_targets
+from poppy_core.trajectory import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from rich.table import Table

@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 from poppy_core.errors import ArgumentError, UnknownMotorError
+from poppy_core.trajectory import MAX_DURATION_S
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -17,8 +18,6 @@ FloatArray = npt.NDArray[np.float64]
 # move (a pypot JSON with framerate 1e6 resampled to 1.6 GB, a 1e-300 Hz move that never ends).
 MIN_FRAMERATE_HZ = 0.1
 MAX_FRAMERATE_HZ = 1000.0
-MAX_DURATION_S = 24 * 3600.0
-"""A day: longer moves are mistakes that would never end playing."""
 MAX_MOTORS = 1024
 MAX_VALUES = 5_000_000
 """Frames x motors (40 MB of float64 per array): 66 min of a 25-motor Humanoid at 50 Hz."""
