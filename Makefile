@@ -20,17 +20,22 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/activate
 run: $(VENV)/.installed
 	$(BIN)/poppy demo
 
-# The whole suite; the OpenGL tests run in a pytest process of their own (see tests/conftest.py).
+# Parallel pytest workers. Most tests wait (wire timing, servers, threads, a browser) more than
+# they compute, so more workers than cores pays; TEST_WORKERS=0 runs in one process.
+TEST_WORKERS ?= 4
+
+# The whole suite in parallel workers, a test module per worker (see tests/conftest.py); the
+# OpenGL tests run in a pytest process of their own.
 test: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
 	$(BIN)/mypy
-	$(BIN)/pytest -m "not gl"
+	$(BIN)/pytest -m "not gl" -n $(TEST_WORKERS) --dist loadgroup
 	$(BIN)/pytest -m gl
 
 # The inner loop (under 90 s on a quiet machine): lint, then every test not marked `slow`.
 test-fast: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
-	$(BIN)/pytest -q -m "not slow"
+	$(BIN)/pytest -q -m "not slow" -n $(TEST_WORKERS) --dist loadgroup
 
 lint: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench

@@ -9,10 +9,13 @@ here, so that a test added to them is marked too; a single slow test elsewhere t
 
 from __future__ import annotations
 
+import atexit
 import faulthandler
 import os
+import shutil
 import signal
 import sys
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -35,6 +38,15 @@ GL_MODULES = {
     "sim/test_sim_plant.py",
     "sim/test_sim_tracking.py",
 }
+# `make test` runs the suite in parallel worker processes (pytest-xdist, `--dist loadgroup`).
+# A module's tests stay in one worker: they share module-scoped servers, robots and MuJoCo
+# models, and some of them a fixed loopback port (tests/tui/test_snapshots.py). The modules that
+# drive Debian's chromium share one worker, so two browsers never compete for the CPU.
+BROWSER_MODULES = {
+    "server/test_browser.py",
+    "server/test_snap_browser.py",
+    "server/test_web_page.py",
+}
 # pytest-timeout (120 s, by signal) stops a test that waits in Python. A thread stuck inside a
 # C library (an OpenGL driver, a serial ioctl) never sees the signal; this watchdog then prints
 # every thread's stack and exits, so CI reports where it hung instead of running out its budget.
@@ -48,11 +60,19 @@ HANG_LIMIT_S = 600
 # the default in each child at exec, where Python installs its own again.
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+# Each test process (each xdist worker too) has user folders of its own: no test reads or
+# writes the user's ~/.config/poppy, and parallel workers never share one.
+_USER_DIRS = tempfile.mkdtemp(prefix="poppy-tests-user-")
+atexit.register(shutil.rmtree, _USER_DIRS, ignore_errors=True)
+for _var in ("XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_CACHE_HOME", "XDG_STATE_HOME"):
+    os.environ[_var] = os.path.join(_USER_DIRS, _var.lower())
 settings.register_profile("thorough", max_examples=1000)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    grouped = config.pluginmanager.hasplugin("xdist")
     for item in items:
         try:
             relative = Path(str(item.path)).resolve().relative_to(TESTS)
@@ -62,6 +82,10 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(pytest.mark.slow)
         if relative.as_posix() in GL_MODULES:
             item.add_marker(pytest.mark.gl)
+        if grouped:
+            module = relative.as_posix()
+            group = "browser" if module in BROWSER_MODULES else module
+            item.add_marker(pytest.mark.xdist_group(group))
 
 
 @pytest.hookimpl(hookwrapper=True)

@@ -93,7 +93,9 @@ def show(
     if yaml_output:
         console.print(config_to_text(config, "yaml"), markup=False, end="")
         return
-    table = Table(title=f"{profile}: {_counts(config)}")
+    # A line of its own (not the table's title): a long path is never wrapped to the table's width.
+    console.print(styled("[bold]{}[/]: {}", profile, _counts(config)), soft_wrap=True)
+    table = Table()
     for column in ("motor", "id", "model", "orientation", "offset", "limits", "controller"):
         table.add_column(column, justify="right" if column in ("id", "offset") else "left")
     for name, motor in config.motors.items():

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
 
 import pytest
@@ -10,6 +9,7 @@ import pytest
 from poppy_core.bus import Dxl320IO, DxlIO
 from poppy_core.emulator import build_bus_from_spec, ergo_jr_bus, serve_pty
 from poppy_core.errors import ArgumentError
+from tests.helpers.waiting import eventually
 
 BAUD = 1_000_000
 
@@ -24,15 +24,6 @@ def mx_port() -> Iterator[str]:
         server.stop()
 
 
-def _eventually(check: object, timeout_s: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if check():  # type: ignore[operator]
-            return True
-        time.sleep(0.05)
-    return bool(check())  # type: ignore[operator]
-
-
 def test_the_documentation_script(mx_port: str) -> None:
     # "Low-level API" example: read, enable torque, go to 90°, disable torque.
     my_id = 11
@@ -42,7 +33,7 @@ def test_the_documentation_script(mx_port: str) -> None:
     dxl_io.enable_torque([my_id])
     assert dxl_io.is_torque_enabled([my_id]) == (True,)
     dxl_io.set_goal_position({my_id: 90})
-    assert _eventually(lambda: abs(dxl_io.get_present_position([my_id])[0] - 90) < 1.0)
+    assert eventually(lambda: abs(dxl_io.get_present_position([my_id])[0] - 90) < 1.0)
     dxl_io.disable_torque([my_id])
     assert dxl_io.is_torque_enabled([my_id]) == (False,)
     dxl_io.close()
@@ -55,7 +46,7 @@ def test_scan_and_group_calls(mx_port: str) -> None:
         assert dxl_io.get_model([4, 11]) == ("MX-28", "AX-12A")
         dxl_io.enable_torque([4, 5, 6])
         dxl_io.set_goal_position({4: 0, 5: 10, 6: -25})
-        assert _eventually(lambda: all(
+        assert eventually(lambda: all(
             abs(a - b) < 1.0
             for a, b in zip(dxl_io.get_present_position([4, 5, 6]), (0, 10, -25), strict=True)
         ))  # fmt: skip

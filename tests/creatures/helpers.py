@@ -2,22 +2,13 @@
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable
 from typing import Any
 
 from poppy_core.emulator import VirtualMotor
 from poppy_core.robot import Robot
+from tests.helpers.waiting import eventually as wait_until
 
-
-def wait_until(predicate: Callable[[], bool], timeout_s: float = 5.0, step_s: float = 0.02) -> bool:
-    """Poll ``predicate`` until it holds or ``timeout_s`` passed; its last value."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(step_s)
-    return predicate()
+__all__ = ["virtual", "wait_until"]
 
 
 def virtual(robot: Robot, name: str) -> VirtualMotor:

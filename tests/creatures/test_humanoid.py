@@ -84,8 +84,12 @@ def test_arms_copy_motion_mirrors_the_left_arm_on_the_right(humanoid: Robot) -> 
     copy.start()
     try:
         left = [virtual(humanoid, m.name) for m in humanoid.l_arm]
-        assert wait_until(lambda: not any(v.torque_enabled for v in left), 2.0)
-        assert all(m.compliant for m in humanoid.l_arm)
+        # The primitive sets the left arm compliant from its own thread: wait for both ends.
+        assert wait_until(
+            lambda: all(m.compliant for m in humanoid.l_arm)
+            and not any(v.torque_enabled for v in left),
+            2.0,
+        )
         assert not any(m.compliant for m in humanoid.r_arm)
         moved = {"l_shoulder_x": 30.0, "l_elbow_y": -60.0, "l_shoulder_y": -20.0}
         for name, user_deg in moved.items():

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from types import SimpleNamespace
 from typing import Any
 
@@ -15,17 +15,9 @@ from poppy_core.creatures import MarkerFollow, TrackingFeedback, from_profile
 from poppy_core.errors import SensorError
 from poppy_core.sensors.camera import CameraCalibration
 from poppy_core.sensors.markers import Marker
+from tests.helpers.waiting import eventually
 
 WIDTH, HEIGHT = 640, 480
-
-
-def eventually(check: Callable[[], bool], timeout_s: float = 20.0) -> bool:
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if check():
-            return True
-        time.sleep(0.05)
-    return check()
 
 
 class FakeCamera:

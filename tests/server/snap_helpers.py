@@ -2,18 +2,9 @@
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable
+from tests.helpers.waiting import eventually as wait_until
 
-
-def wait_until(check: Callable[[], bool], timeout_s: float = 15.0) -> bool:
-    """Poll ``check`` until true or ``timeout_s`` (generous: the machine may be loaded)."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if check():
-            return True
-        time.sleep(0.02)
-    return check()
+__all__ = ["near", "wait_until"]
 
 
 def near(value: float, target: float, tolerance: float = 2.0) -> bool:

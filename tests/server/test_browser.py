@@ -9,8 +9,11 @@ the image does. The page reports what it saw to the server that served it.
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import threading
@@ -92,7 +95,9 @@ class PageServer:
     def visit(self, url: str, timeout_s: float = 90.0) -> dict[str, Any]:
         """Open ``url`` in headless Chromium and return what the page reported."""
         self.results.clear()
-        with tempfile.TemporaryDirectory() as profile:
+        # Chromium's helper processes may still write the profile as it goes: a leftover file
+        # there must not fail the test.
+        with tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as profile:
             browser = subprocess.Popen(
                 [
                     str(CHROMIUM),
@@ -105,6 +110,7 @@ class PageServer:
                 ],
                 stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL,
+                start_new_session=True,  # its helper processes too are killed at the end
             )
             try:
                 deadline = time.monotonic() + timeout_s
@@ -113,7 +119,8 @@ class PageServer:
                     assert browser.poll() is None, "chromium exited"
                     time.sleep(0.1)
             finally:
-                browser.kill()
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(browser.pid, signal.SIGKILL)
                 browser.wait()
         return self.results[0]
 

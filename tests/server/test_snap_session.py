@@ -160,6 +160,7 @@ def test_values_read_as_pypot_writes_them(snap: tuple[Robot, SnapServer, httpx.C
     assert http.get("/primitive/dance/methodes").text == "start/stop/pause/resume"
     assert http.get("/primitive/dance/set/tempo_scale/0.5").text == ""
     assert http.get("/primitive/dance/get/tempo_scale").text == "0.5"
+    assert http.get("/motor/m3/set/compliant/false").text == "Done!"  # a compliant one stays
     assert http.get("/motors/set/positions/5;6;7;").text == "Done!"
     assert wait_until(lambda: near(robot.m3.present_position, 7))
     assert http.get("/ip/").text == "127.0.0.1"

@@ -20,7 +20,9 @@ from poppy_core.emulator import EmulatorServer, build_bus_from_spec, serve_tcp
 from poppy_core.errors import PortError
 from tests.helpers.tui import wait_for
 
-TCP_PORT = 47311
+# Fixed, as the scan screen shows it; below Linux's ephemeral range (32768-60999), so that no
+# connection of a parallel test can hold it by chance.
+TCP_PORT = 29311
 URL = f"socket://127.0.0.1:{TCP_PORT}"
 SIZE = (80, 24)
 
