@@ -45,6 +45,9 @@ def where(bus: DxlBus) -> str:
     return f"{bus.port} at {bus.baudrate} bps, protocol {bus.protocol}"
 
 
+STARTUP_PING_RETRIES = 3
+
+
 def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> list[str]:
     """Ping every motor; return one readable problem per missing motor or wrong model.
 
@@ -54,7 +57,9 @@ def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> lis
     wrong: list[str] = []
     for motor in motors:
         try:
-            found = bus.ping(motor.id)
+            # A robot is refused when one motor is missing: a reply late once (a busy machine
+            # serving an emulator) must not decide it; a motor really absent costs a few ms more.
+            found = bus.ping(motor.id, retries=max(STARTUP_PING_RETRIES, bus.retries))
         except BusError:
             found = None
         if found is None:

@@ -9,6 +9,7 @@ from collections.abc import Callable, Coroutine
 from typing import Any
 
 from poppy_core.bus import PortInfo
+from tests.helpers.waiting import MIN_TIMEOUT_S
 
 
 def no_ports() -> list[PortInfo]:
@@ -19,8 +20,9 @@ def no_ports() -> list[PortInfo]:
 async def wait_for(
     pilot: object, check: Callable[[], bool], timeout_s: float = 10.0, what: str = ""
 ) -> None:
-    """Let the app run until ``check()`` holds (fails the test after ``timeout_s``)."""
-    end = time.monotonic() + timeout_s
+    """Let the app run until ``check()`` holds (fails the test after ``timeout_s``, at least
+    ``MIN_TIMEOUT_S``: a wait is not a speed check)."""
+    end = time.monotonic() + max(timeout_s, MIN_TIMEOUT_S)
     while not check():
         if time.monotonic() > end:
             raise AssertionError(f"timed out waiting for {what or check}")

@@ -157,8 +157,9 @@ async def test_record_then_play_a_move(moves_dir: Path) -> None:
         await wait_for(
             pilot, lambda: abs(m1.present_position - held) < 2, what="m1 follows the move"
         )
+        # the app hears of the end through a message: let it handle it
+        await wait_for(pilot, lambda: "wave: played" in notes(app), what="the note")
         assert moves.query_one("#play-progress", ProgressBar).progress == pytest.approx(1.0)
-        assert "wave: played" in notes(app)
 
 
 @run_async
