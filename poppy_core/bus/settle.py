@@ -21,13 +21,13 @@ def ping_found(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
         return None
 
 
-def settle(bus: DxlBus) -> set[int]:
-    """Listen for replies still on their way; return the IDs that answered late.
+def settle(bus: DxlBus, min_s: float = 0.0) -> set[int]:
+    """Listen for replies still on their way (``min_s`` at least); return who answered late.
 
     Whatever came is dropped, so that the next rate starts on a clean line; an adaptive bus
     has learned from it how slow the adapter really is.
     """
-    return {status.id for status in bus.listen(settle_s(bus.latency_s))}
+    return {status.id for status in bus.listen(max(settle_s(bus.latency_s), min_s))}
 
 
 def answers(bus: DxlBus, motor_id: int) -> bool:

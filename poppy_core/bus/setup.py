@@ -135,6 +135,13 @@ def change_id(
     return result
 
 
+# How long ``locate`` listens at each rate for a reply still on its way. It runs where a motor
+# was just lost (a baud rate change, a reset), so it can afford to wait for the slowest adapters
+# (an FTDI latency timer at 16 ms or more, USB hubs) rather than the scan's short settle, which
+# caught a 30 ms adapter's reply only with a millisecond to spare.
+LOCATE_SETTLE_S = 0.05
+
+
 def locate(bus: DxlBus, motor_id: int, rates: list[int] | None = None) -> int | None:
     """Search the standard baud rates for ``motor_id``; leave the bus at the rate found.
 
@@ -155,12 +162,12 @@ def locate(bus: DxlBus, motor_id: int, rates: list[int] | None = None) -> int | 
             # Heard now or late (settle), then confirmed on a settled line (see bus.scan); heard
             # but not confirmed: a late reply from the rate before, looked at again.
             heard = answers(bus, motor_id)
-            if motor_id in settle(bus) or heard:
+            if motor_id in settle(bus, LOCATE_SETTLE_S) or heard:
                 if answers(bus, motor_id):
                     return rate
                 if previous is not None:
                     bus.baudrate = previous
-                    settle(bus)
+                    settle(bus, LOCATE_SETTLE_S)
                     if answers(bus, motor_id):
                         return previous
             previous = rate
