@@ -259,13 +259,18 @@ def _torque_lost(record: Any) -> str:
     return f"{record['lost']} of {record['writes']}"
 
 
+def _control_clean(control: Any) -> bool:
+    """The control run (no output flush) lost no write and failed no read."""
+    return (
+        isinstance(control, dict) and not control.get("error")
+        and control["lost"] == 0 and control["reads_failed"] == 0
+    )  # fmt: skip
+
+
 def torque_met(torque: dict[str, Any]) -> bool:
     """The emulator loses no write (the control run, without the client's output flush)."""
     controls = [r.get("control") for r in torque.values() if isinstance(r, dict)]
-    return bool(controls) and all(
-        isinstance(c, dict) and not c.get("error") and c["lost"] == 0 and c["reads_failed"] == 0
-        for c in controls
-    )
+    return bool(controls) and all(_control_clean(c) for c in controls)
 
 
 def _torque_table(torque: dict[str, Any]) -> Table:
@@ -276,12 +281,11 @@ def _torque_table(torque: dict[str, Any]) -> Table:
             continue
         load = record.get("load_1min", ["?", "?"])
         control = record.get("control")
-        met = isinstance(control, dict) and not control.get("error") and control["lost"] == 0
         rows.append([
             target, f"{_torque_lost(record)} (reads failed: {record['reads_failed']})",
             _torque_lost(control) if control is not None else "-",
             f"{record['elapsed_s']:.1f} s", f"{load[0]} → {load[1]}", "0",
-            "yes" if met else "**no**",
+            "yes" if _control_clean(control) else "**no**",
         ])  # fmt: skip
     headers = ["Emulator", "Writes lost, pypot as is", "Writes lost, output flush skipped",
                "Time (as is)", "Load (1 min avg)", "Goal (the emulator's losses)", "Met"]

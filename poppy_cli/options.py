@@ -66,8 +66,6 @@ BAUD_LIMITS = {"min": MIN_BAUD, "max": MAX_BAUD}
 out of range is a usage error (exit 2)."""
 
 
-
-
 def finite(value: float | None) -> float | None:
     """An option callback: NaN and infinities are usage errors (a range check lets NaN by)."""
     if value is not None and not math.isfinite(value):

@@ -10,6 +10,8 @@ from poppy_core.bus import DxlBus, find_port, locate, scan
 from poppy_core.emulator import FaultInjector, VirtualBus, VirtualMotor, serve_pty
 from poppy_core.errors import PortError
 from poppy_core.models import model_by_name
+from poppy_core.robot import Motor
+from poppy_core.robot.startup import check_presence
 
 if TYPE_CHECKING:
     from tests.helpers.bus import Emulate
@@ -76,3 +78,26 @@ def test_find_port_on_a_port_that_cannot_open_is_a_port_error(tmp_path: object) 
         find_port([3], ["/dev/ttyUSB_poppy_missing_3"])
     with pytest.raises(PortError, match="no port could be opened"):
         find_port([3], ["/dev/ttyUSB_poppy_missing_4", "/dev/ttyUSB_poppy_missing_5"])
+
+
+class DropFirst(FaultInjector):
+    """Loses the first ``count`` replies, as replies late on a busy machine."""
+
+    def __init__(self, count: int) -> None:
+        super().__init__()
+        self.left = count
+
+    def filter_reply(self, data: bytes) -> bytes | None:
+        self.left -= 1
+        return None if self.left >= 0 else data
+
+
+def test_a_robot_is_not_refused_for_a_motor_late_twice_at_startup() -> None:
+    # Two lost replies in a row exceed the bus's single retry; the startup check retries more.
+    motor = VirtualMotor(model_by_name("MX-28"), 7, 1_000_000)
+    with serve_pty(VirtualBus([motor], 1, faults=DropFirst(2))) as server, \
+            DxlBus(server.url, 1_000_000, 1) as bus:  # fmt: skip
+        assert bus.retries < 2
+        robot_motor = Motor("m7", model_by_name("MX-28"), 7)
+        assert check_presence(bus, "c", [robot_motor]) == []
+        assert robot_motor.online
