@@ -6,9 +6,10 @@ from typing import Any
 
 from poppy_core.emulator import VirtualMotor
 from poppy_core.robot import Robot
+from tests.helpers.robots import reached
 from tests.helpers.waiting import eventually as wait_until
 
-__all__ = ["virtual", "wait_until"]
+__all__ = ["reached", "virtual", "wait_until"]
 
 
 def virtual(robot: Robot, name: str) -> VirtualMotor:
@@ -25,13 +26,6 @@ def stop_all(robot: Robot) -> None:
     for name, primitive in zip(robot.primitive_names, robot.primitives, strict=True):
         if name != "temperature_monitoring":
             primitive.stop()
-
-
-def reached(robot: Robot, targets: dict[str, float], tolerance_deg: float = 3.0) -> bool:
-    """True when every motor of ``targets`` is within ``tolerance_deg`` of its target."""
-    return all(
-        abs(robot.motor(n).present_position - v) <= tolerance_deg for n, v in targets.items()
-    )
 
 
 def positions(robot: Robot, names: Any = None) -> dict[str, float]:

@@ -8,3 +8,10 @@ from poppy_core.robot import Robot, from_profile
 def sim_ergo_jr() -> Robot:
     """A simulated Ergo Jr (ideal servos, in-process link) without its camera."""
     return from_profile("ergo-jr", sim=True, sensors=False)
+
+
+def reached(robot: Robot, targets: dict[str, float], tolerance_deg: float = 3.0) -> bool:
+    """True when every motor of ``targets`` is within ``tolerance_deg`` of its target."""
+    return all(
+        abs(robot.motor(n).present_position - v) <= tolerance_deg for n, v in targets.items()
+    )

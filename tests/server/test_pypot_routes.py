@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import time
-
 import httpx
 import pytest
 
 from poppy_core.robot.motor_link import link_of
+from tests.helpers.robots import reached
 from tests.helpers.server import Served
+from tests.helpers.waiting import eventually
 
 MOTORS = ["m1", "m2", "m3", "m4", "m5", "m6"]
 
@@ -113,9 +113,7 @@ def test_motor_goto_and_motors_goto(client: httpx.Client, served: Served) -> Non
     )
     assert answer.status_code == 202
     assert answer.json() == {"motors": {"m1": -10.0, "m2": 15.0}, "duration": 0.3, "waiting": True}
-    time.sleep(0.1)
-    assert served.robot.m1.present_position == pytest.approx(-10, abs=2)
-    assert served.robot.m2.present_position == pytest.approx(15, abs=2)
+    assert eventually(lambda: reached(served.robot, {"m1": -10, "m2": 15}, 2.0))
     served.robot.compliant = True
 
 

@@ -5,9 +5,10 @@ from __future__ import annotations
 import time
 
 import httpx
-import pytest
 
+from tests.helpers.robots import reached
 from tests.helpers.server import Served
+from tests.helpers.waiting import eventually
 
 
 def test_openapi_documents_v1(client: httpx.Client) -> None:
@@ -75,9 +76,7 @@ def test_goto_matches_the_robot(client: httpx.Client, served: Served) -> None:
         "waited": True,
         "done": True,
     }
-    time.sleep(0.1)
-    assert served.robot.m1.present_position == pytest.approx(15, abs=2)
-    assert served.robot.m3.present_position == pytest.approx(-20, abs=2)
+    assert eventually(lambda: reached(served.robot, {"m1": 15, "m3": -20}, 2.0))
     served.robot.compliant = True
     assert client.post("/api/v1/gotos", json={"positions": {}, "duration_s": 1}).status_code == 422
 

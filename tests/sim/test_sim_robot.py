@@ -8,6 +8,7 @@ import pytest
 
 from poppy_core.errors import ConfigError
 from poppy_core.robot.factory import from_profile
+from tests.helpers.waiting import eventually
 
 
 def test_ergo_jr_goto_ends_near_the_goal_in_the_physics() -> None:
@@ -17,12 +18,16 @@ def test_ergo_jr_goto_ends_near_the_goal_in_the_physics() -> None:
         robot.compliant = False
         goal = {"m1": 20.0, "m2": -30.0, "m3": 25.0, "m4": -15.0, "m5": 30.0, "m6": -20.0}
         robot.goto_position(goal, 1.0, wait=True)
-        time.sleep(0.5)
-        for name, value in goal.items():
-            motor = robot.motor(name)
+
+        def arrived() -> bool:
             # the joint takes the motor's own angle: m2, m3, m5 and m6 are indirect
-            assert simulation.joint_deg(name) == pytest.approx(motor.to_motor(value), abs=2.0)
-            assert motor.present_position == pytest.approx(value, abs=2.0), name
+            return all(
+                abs(simulation.joint_deg(name) - robot.motor(name).to_motor(value)) <= 2.0
+                and abs(robot.motor(name).present_position - value) <= 2.0
+                for name, value in goal.items()
+            )
+
+        assert eventually(arrived), {m.name: m.present_position for m in robot.motors}
     assert not simulation.running  # close() stopped the physics thread
 
 
@@ -32,8 +37,7 @@ def test_compliant_robot_can_be_moved_by_hand() -> None:
         time.sleep(0.2)
         bus = next(iter(robot.emulators.values())).bus
         bus.motor(1).move_by_hand(50.0)  # m1: direct, no offset
-        time.sleep(0.3)
-        assert robot.m1.present_position == pytest.approx(50.0, abs=2.0)
+        assert eventually(lambda: abs(robot.m1.present_position - 50.0) <= 2.0)
 
 
 def test_ideal_simulation_has_no_handle() -> None:
@@ -51,6 +55,5 @@ def test_humanoid_runs_with_two_buses_on_one_world() -> None:
         assert len(robot.emulators) == 2
         robot.compliant = False
         robot.goto_position({"head_z": 30.0, "l_knee_y": 20.0}, 0.5, wait=True)
-        time.sleep(0.5)
-        assert robot.simulation.joint_deg("head_z") == pytest.approx(30.0, abs=3.0)
-        assert robot.head_z.present_position == pytest.approx(30.0, abs=3.0)
+        assert eventually(lambda: abs(robot.simulation.joint_deg("head_z") - 30.0) <= 3.0)
+        assert eventually(lambda: abs(robot.head_z.present_position - 30.0) <= 3.0)
