@@ -1,10 +1,11 @@
 """``MoveRecorder``: samples motor positions in a thread and checkpoints the move to disk.
 
-Samples are taken at ``freq`` from the positions the sync loops last read, time-stamped, and
-resampled onto the regular frame grid when the move is built, so a late tick does not shift
-the frames. With a ``checkpoint_path`` the move so far is written atomically every
-``checkpoint_period_s``: a recording cut short by a signal or a crash keeps everything up to
-the last checkpoint, and ``stop()`` writes the final move.
+Samples are taken at ``freq`` from the positions the sync loops last read (the first by
+``start()`` itself, the last when ``stop()`` is called, so a busy machine neither delays nor
+cuts the take), time-stamped, and resampled onto the regular frame grid when the move is built,
+so a late tick does not shift the frames. With a ``checkpoint_path`` the move so far is
+written atomically every ``checkpoint_period_s``: a recording cut short by a signal or a crash
+keeps everything up to the last checkpoint, and ``stop()`` writes the final move.
 
 Nothing recorded is lost to a bad destination: ``start()`` checks that the folder takes files
 and locks the file against a second recorder; a checkpoint that fails (full disk, folder gone)
@@ -151,6 +152,7 @@ class MoveRecorder:
         self._metadata.setdefault("created", datetime.now(UTC).isoformat(timespec="seconds"))
         self._stop.clear()
         self._t0 = self._clock()
+        self._sample(self._t0)  # the take starts now, not when the thread first gets the CPU
         self._thread = threading.Thread(target=self._run, name="move recorder", daemon=True)
         self._thread.start()
         return self
@@ -319,16 +321,18 @@ class MoveRecorder:
             self.checkpoint_error = None
 
     def _run(self) -> None:
-        schedule = Periodic(1.0 / self.freq, self._t0)
+        schedule = Periodic(1.0 / self.freq, self._t0)  # start() took the sample at t0
         next_checkpoint = self._t0 + self.checkpoint_period_s
-        while not self._stop.is_set():
+        while True:
+            schedule.advance(self._clock())
+            if self._stop.wait(max(0.0, schedule.next_deadline - self._clock())):
+                break
             now = self._clock()
             self._sample(now)
             if now >= next_checkpoint:
                 self._checkpoint()
                 next_checkpoint = now + self.checkpoint_period_s
-            schedule.advance(self._clock())
-            self._stop.wait(max(0.0, schedule.next_deadline - self._clock()))
+        self._sample(self._clock())  # the take ends at stop(), not at the last tick before it
 
     # -- context manager -----------------------------------------------------------------------
 
