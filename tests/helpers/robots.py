@@ -1,4 +1,4 @@
-"""Robot test helpers: simulated robots built the one way (``poppy_core.robot``)."""
+"""Robot test helpers: simulated robots built the one way, and whether they reached a pose."""
 
 from __future__ import annotations
 
