@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from poppy_core import checks
 from poppy_core.errors import ArgumentError
 
 CONTROLS: tuple[str, ...] = ("minjerk", "dummy")
@@ -30,7 +31,7 @@ def control_name(control: str) -> str:
         )  # fmt: skip
     return name
 
-MAX_DURATION_S = 24 * 3600.0
+MAX_DURATION_S = checks.MAX_DURATION_S
 """The longest goto or move (a day): longer is a typing mistake that would never end."""
 
 

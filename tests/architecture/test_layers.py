@@ -12,8 +12,8 @@ ROOT = Path(__file__).resolve().parents[2]
 # room -> rooms of ours it may import (ARCHITECTURE.md); `errors`, `files` (safe writes),
 # `documents` (bounded JSON/YAML reads), `line` (the byte-line contract and its URL schemes) and
 # `trajectory` (the pure maths of a goto, shared by Motor.goto_position and the primitives'
-# sandbox) are leaves every room may use.
-LEAVES = {"errors", "files", "documents", "line", "trajectory"}
+# sandbox) and `checks` (the one rule of each kind of call argument) are leaves every room may use.
+LEAVES = {"errors", "files", "documents", "line", "trajectory", "checks"}
 ALLOWED: dict[str, set[str]] = {
     "protocol": set(),
     "models": {"protocol"},
@@ -98,11 +98,16 @@ def test_kinematics_is_numpy_only() -> None:
     assert not loaded & {"mujoco", "scipy", "typer", "rich", "pydantic", "serial"}
 
 
-def test_leaves_import_only_errors() -> None:
+def test_leaves_import_only_errors_and_checks() -> None:
     for leaf in sorted(LEAVES):
         names = _imports(ROOT / "poppy_core" / f"{leaf}.py")
         ours = {n for n in names if n.split(".")[0] in ("poppy_core", "poppy_cli")}
-        assert ours <= {"poppy_core.errors"}, (leaf, ours)
+        below = {"poppy_core.errors"} if leaf == "checks" else {"poppy_core.errors", "poppy_core"}
+        # `from poppy_core import checks` is recorded as its package
+        assert ours <= below, (leaf, ours)
+        if "poppy_core" in ours:
+            source = (ROOT / "poppy_core" / f"{leaf}.py").read_text(encoding="utf-8")
+            assert "from poppy_core import checks" in source, leaf
 
 
 def _loaded_after(code: str) -> set[str]:
@@ -151,4 +156,4 @@ def test_trajectory_is_a_leaf_still_reachable_from_motion() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, cwd=ROOT).stdout.split()  # fmt: skip
     ours = {name for name in out if name.startswith("poppy_core.")}
-    assert ours <= {"poppy_core.trajectory", "poppy_core.errors"}, ours
+    assert ours <= {"poppy_core.trajectory", "poppy_core.errors", "poppy_core.checks"}, ours

@@ -1,0 +1,114 @@
+"""Checks of call arguments (finite, positive, a duration, a rate): one rule each, ArgumentError."""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+
+from poppy_core.errors import ArgumentError
+
+# A loop never runs faster than this, whatever it is asked: a period under a millisecond would
+# spin a core (the sync loops of a real bus run at 50-100 Hz, a servo cannot follow faster).
+MAX_RATE_HZ = 1000.0
+# A loop asked to run slower than once a day is a mistake, not a schedule.
+MIN_RATE_HZ = 1.0 / (24 * 3600.0)
+# The longest duration any motion, recording or wait takes (a day).
+MAX_DURATION_S = 24 * 3600.0
+# The largest magnitude a physical value (degrees, metres, %, a speed factor) may have: far
+# beyond any robot's, small enough that every arithmetic on it stays finite.
+MAX_MAGNITUDE = 1e9
+
+
+def _describe(field: str) -> str:
+    return field or "value"
+
+
+def number(value: object, field: str = "") -> float:
+    """``value`` as a finite float; refuses NaN, infinities, huge values, booleans and text."""
+    if isinstance(value, bool) or not isinstance(value, Real):
+        raise ArgumentError(
+            f"{_describe(field)} must be a number, got {value!r}", field=field, value=value
+        )
+    try:
+        result = float(value)
+    except (OverflowError, ValueError) as exc:
+        raise ArgumentError(
+            f"{_describe(field)} must be a finite number, got a number too large",
+            field=field,
+            value=value,
+        ) from exc
+    if not math.isfinite(result):
+        raise ArgumentError(
+            f"{_describe(field)} must be a finite number, got {result}", field=field, value=value
+        )
+    if abs(result) > MAX_MAGNITUDE:
+        raise ArgumentError(
+            f"{_describe(field)} must be within ±{MAX_MAGNITUDE:g}, got {result:g}",
+            field=field,
+            value=value,
+        )
+    return result
+
+
+def positive(value: object, field: str = "") -> float:
+    """A finite number > 0."""
+    result = number(value, field)
+    if result <= 0:
+        raise ArgumentError(
+            f"{_describe(field)} must be greater than 0, got {result:g}", field=field, value=value
+        )
+    return result
+
+
+def non_negative(value: object, field: str = "") -> float:
+    """A finite number ≥ 0."""
+    result = number(value, field)
+    if result < 0:
+        raise ArgumentError(
+            f"{_describe(field)} must be 0 or more, got {result:g}", field=field, value=value
+        )
+    return result
+
+
+def in_range(value: object, low: float, high: float, field: str = "", unit: str = "") -> float:
+    """A finite number within [low, high]."""
+    result = number(value, field)
+    if not low <= result <= high:
+        suffix = f" {unit}" if unit else ""
+        raise ArgumentError(
+            f"{_describe(field)} must be {low:g}-{high:g}{suffix}, got {result:g}{suffix}",
+            field=field,
+            value=value,
+        )
+    return result
+
+
+def duration(value: object, field: str = "duration", *, allow_zero: bool = True) -> float:
+    """Seconds, 0 (or > 0 without ``allow_zero``) up to a day."""
+    result = in_range(value, 0.0, MAX_DURATION_S, field, "s")
+    if not allow_zero and result <= 0:
+        raise ArgumentError(f"{field} must be greater than 0 s, got {result:g} s", field=field)
+    return result
+
+
+def rate(value: object, field: str = "rate") -> float:
+    """A loop frequency in Hz: once a day up to ``MAX_RATE_HZ``."""
+    return in_range(value, MIN_RATE_HZ, MAX_RATE_HZ, field, "Hz")
+
+
+def period(value: object, field: str = "period") -> float:
+    """A loop period in seconds: ``1 / MAX_RATE_HZ`` up to a day."""
+    return in_range(value, 1.0 / MAX_RATE_HZ, 1.0 / MIN_RATE_HZ, field, "s")
+
+
+def count(value: object, low: int, high: int, field: str = "") -> int:
+    """An integer within [low, high], checked before anything is allocated from it."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ArgumentError(
+            f"{_describe(field)} must be a whole number, got {value!r}", field=field, value=value
+        )
+    if not low <= value <= high:
+        raise ArgumentError(
+            f"{_describe(field)} must be {low}-{high}, got {value}", field=field, value=value
+        )
+    return value

@@ -1,0 +1,69 @@
+"""The argument checks leaf: one rule per kind of argument, one ArgumentError each."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
+
+BAD_NUMBERS = [math.nan, math.inf, -math.inf, 10**400, 1e300, "12", None, True, [1]]
+
+
+@pytest.mark.parametrize("value", BAD_NUMBERS, ids=repr)
+def test_number_refuses_what_is_not_a_finite_physical_number(value: object) -> None:
+    with pytest.raises(ArgumentError, match="speed"):
+        checks.number(value, "speed")
+
+
+def test_number_takes_numpy_and_ints() -> None:
+    assert checks.number(np.float32(1.5)) == 1.5
+    assert checks.number(3) == 3.0
+
+
+@pytest.mark.parametrize(
+    ("check", "value"),
+    [
+        (checks.positive, 0),
+        (checks.positive, -1),
+        (checks.non_negative, -1e-9),
+        (checks.duration, -1),
+        (checks.duration, 1e6),
+        (checks.rate, 1e-300),
+        (checks.rate, 0),
+        (checks.rate, 1e308),
+        (checks.period, 1e-300),
+    ],
+)
+def test_range_checks_refuse_with_the_field_named(check, value) -> None:  # type: ignore[no-untyped-def]
+    with pytest.raises(ArgumentError, match=r"^f must") as info:
+        check(value, "f")
+    assert info.value.field == "f"
+
+
+def test_duration_without_zero() -> None:
+    assert checks.duration(0) == 0
+    with pytest.raises(ArgumentError):
+        checks.duration(0, allow_zero=False)
+
+
+def test_count_checks_before_anything_is_made() -> None:
+    assert checks.count(5, 0, 253) == 5
+    for bad in (10**20, -1, 2.0, True):
+        with pytest.raises(ArgumentError):
+            checks.count(bad, 0, 253, "id")
+
+
+@given(st.floats(allow_nan=True, allow_infinity=True))
+def test_number_is_finite_or_refused(value: float) -> None:
+    try:
+        result = checks.number(value)
+    except ArgumentError:
+        assert not math.isfinite(value) or abs(value) > checks.MAX_MAGNITUDE
+    else:
+        assert math.isfinite(result) and result == value
