@@ -16,6 +16,7 @@ from poppy_core.errors import KinematicsError
 from poppy_core.server import values
 from poppy_core.server.chains import find_chain
 from poppy_core.server.errors import ApiError
+from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.sensors import SensorService
 from poppy_core.server.service import RobotService, check_duration
 from poppy_core.server.snap.text import (
@@ -85,7 +86,8 @@ class SnapRobot:
 
     def write(self, motor: str, register: str, value: str) -> str:
         """``/motor/<m>/set/<register>/<value>``."""
-        self.service.write_many({motor: {register: parse_value(value)}})
+        written = pypot_value(motor, register, parse_value(value))
+        self.service.write_many({motor: {register: written}})
         return DONE
 
     def write_many(self, settings: str) -> str:
@@ -98,7 +100,8 @@ class SnapRobot:
             if len(parts) != 3:
                 raise ApiError("invalid", f"{item!r} is not motor:register:value, e.g. m1:led:red")
             motor, register, value = (p.strip() for p in parts)
-            commands.setdefault(motor, {})[register] = parse_value(value)
+            written = pypot_value(motor, register, parse_value(value))
+            commands.setdefault(motor, {})[register] = written
         if not commands:
             raise ApiError("invalid", "no motor:register:value given, e.g. m1:compliant:False")
         self.service.write_many(commands)
