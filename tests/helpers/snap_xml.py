@@ -18,11 +18,8 @@ from typing import Any
 
 SPEC_SLOT = re.compile(r"%'([^']*)'")
 CALL_SLOT = re.compile(r"%[^\s]+")
-
-
-ROBOT_URL = "$robot robot URL"
-URL_SPECS = ("$robot URL du robot",)
-"""The blocks answering the robot's ``host:port`` (English, French)."""
+URL_SPECS = ("$robot robot URL", "$robot URL du robot")
+"""The blocks answering the robot's ``host:port`` (English, French): evaluated, never a name."""
 
 
 class Unbound(LookupError):
@@ -148,7 +145,7 @@ class Project:
             return items.index(item) + 1
         if spec in env:  # a reporter the caller answers ("$robot all motors")
             return env[spec]
-        if self.symbolic and spec != ROBOT_URL and spec not in URL_SPECS:
+        if self.symbolic and spec not in URL_SPECS:
             return "{" + spec + "}"
         definition = self.definitions.get(shape(spec))
         script = definition.find("script") if definition is not None else None

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import httpx
@@ -21,6 +22,7 @@ from poppy_core.creatures import from_profile
 from poppy_core.motion import list_moves, load_move
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, start_snap_server
+from tests.helpers import pypot_files
 from tests.helpers.pypot_files import snap_project_files
 from tests.helpers.snap_xml import Project, UrlBlock
 from tests.server.snap_helpers import near, wait_until
@@ -381,3 +383,19 @@ def replay_block(replay: Replay, project: Project, block: UrlBlock, url: Any, ca
             raise AssertionError(f"{where}: {answer.text[:200]!r}: {exc}") from exc
         sent += 1
     return sent
+
+
+@pytest.mark.parametrize("ci", ["true", ""])
+def test_without_pypots_files_ci_fails_and_a_desk_skips(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, ci: str
+) -> None:
+    def offline(target: Path) -> None:
+        raise RuntimeError("`pip download --no-deps pypot==5.0.2` failed: no network")
+
+    monkeypatch.setattr(pypot_files, "_in_peers", lambda: None)
+    monkeypatch.setattr(pypot_files, "_download", offline)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv("CI", ci)
+    outcome = pytest.fail.Exception if ci else pytest.skip.Exception
+    with pytest.raises(outcome, match=r"pypot 5\.0\.2's Snap! files are needed .* no network"):
+        pypot_files.snap_project_files()
