@@ -12,6 +12,7 @@ import pytest
 from starlette.routing import Match
 
 from poppy_core.creatures import from_profile
+from poppy_core.motion import Move, save_move
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, robot_facts, start_snap_server
 from poppy_core.server.snap.catalog import BLOCKS, Block
@@ -171,11 +172,13 @@ def record_motion(served: Served, move: str, motor: str, target: float) -> None:
 
 @pytest.fixture(scope="module")
 def two_moves(snap: Served) -> Served:
-    """``first`` (m1: 0° to 30°) and ``second`` (m2: 0° to -30°) in the move library."""
+    """``first`` (m1: 0° to 30°) and ``second`` (m2: 0° to -30°) in the move library, and
+    ``torso`` driving a motor the Ergo Jr lacks."""
     for motor in snap[0].motors:
         motor.compliant = False
     record_motion(snap, "first", "m1", 30.0)
     record_motion(snap, "second", "m2", -30.0)
+    save_move(Move(10.0, ["head_z"], [[0.0], [10.0]]), "torso")
     return snap
 
 
@@ -232,6 +235,8 @@ def test_moves_play_together_and_in_sequence(two_moves: Served) -> None:
         ("/moves/concurrently/first/nan", 400, "speed must be a number"),
         ("/moves/concurrently/;/1", 400, "no move given"),
         ("/moves/sequentially/a.b/1", 400, "not a move name"),
+        ("/moves/concurrently/first;torso/1", 400, "drives motors this robot lacks: head_z"),
+        ("/moves/sequentially/first;torso/1", 400, "drives motors this robot lacks: head_z"),
     ],
 )
 def test_playing_several_moves_refuses_before_starting_any(

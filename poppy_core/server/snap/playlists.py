@@ -42,12 +42,30 @@ class Playlists:
             raise ApiError("invalid", "no move given, e.g. wave;hello")
         if len(names) > MAX_MOVES:
             raise ApiError("invalid", f"{len(names)} moves: at most {MAX_MOVES} in one call")
-        return sum(self.moves.load(name).duration_s for name in names)
+        known = {motor.name for motor in self.moves.robot.motors}
+        total = 0.0
+        for name in names:
+            move = self.moves.load(name)
+            missing = [motor for motor in move.motors if motor not in known]
+            if missing:
+                raise ApiError(
+                    "invalid", f"the move {name!r} drives motors this robot lacks: "
+                    f"{', '.join(missing)}"
+                )  # fmt: skip
+            total += move.duration_s
+        return total
 
     def together(self, names: Sequence[str], speed: float) -> float:
         """Start every move now; the longest one's duration (s) at ``speed``."""
         self._check(names)
-        players = [self.moves.play(name, speed) for name in names]
+        players: list[MovePlayer] = []
+        try:
+            for name in names:
+                players.append(self.moves.play(name, speed))
+        except (ApiError, PoppyError):
+            for player in players:  # all or none
+                player.stop()
+            raise
         return max(player.duration_s for player in players)
 
     def in_sequence(self, names: Sequence[str], speed: float) -> float:
