@@ -15,8 +15,10 @@ from typing import Any
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from poppy_core.errors import ArgumentError
 from poppy_core.server.errors import ApiError
 from poppy_core.server.jsonio import parse_json
+from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.service import RobotService
 
 REGISTER_VALUE = re.compile(r"^/motors/([A-Za-z0-9_]+)/registers/([A-Za-z0-9_]+)/value\.json$")
@@ -57,8 +59,9 @@ class RegisterFastPath:
             await self.app(scope, _replay(message, receive), send)
             return
         try:
-            written = self.service.write(motor, register, parse_json(body))
-        except ApiError:
+            value = pypot_value(motor, register, parse_json(body))
+            written = self.service.write(motor, register, value)
+        except (ApiError, ArgumentError):
             await self.app(scope, _replay(message, receive), send)
             return
         await _answer(send, 202, {register: written})

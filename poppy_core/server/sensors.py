@@ -18,6 +18,9 @@ from poppy_core.sensors.opencv import encode_image
 from poppy_core.server.errors import ApiError
 
 SENSOR_TIP = "the sensors are listed by /sensors/list.json"
+CARD_SPELLINGS = {"rabbit": "lapin"}
+"""pypot's other names of a card (pypot 5.0.2's snap.py and rest.py list ``rabbit`` with
+``lapin``'s id; its demo project's card menu offers ``rabbit``)."""
 IMAGE_TYPES = {"png": "image/png", "jpg": "image/jpeg"}
 
 
@@ -113,6 +116,8 @@ class SensorService:
     def sees(self, card: str) -> bool:
         """Whether card (or marker id) ``card`` is in view (``ApiError`` for unknown cards)."""
         detector = self.detector()
+        if card not in detector.card_ids and CARD_SPELLINGS.get(card) in detector.card_ids:
+            card = CARD_SPELLINGS[card]
         try:
             return detector.sees(card)
         except SensorError as exc:

@@ -67,18 +67,48 @@ def test_register_write_answers_202_with_the_value(client: httpx.Client, served:
 
 
 @pytest.mark.parametrize(
+    ("register", "body", "value"),
+    [
+        ("compliant", "0", False),
+        ("compliant", "1", True),
+        ("compliant", '"False"', False),
+        ("compliant", '"true"', True),
+        ("goal_position", '"12"', 12),
+        ("goal_position", '" -7.5 "', -7.5),
+    ],
+)
+def test_register_values_as_pypot_clients_wrote_them(
+    client: httpx.Client, served: Served, register: str, body: str, value: object
+) -> None:
+    motor = served.robot.m4
+    motor.compliant = False
+    answer = client.post(f"/motors/m4/registers/{register}/value.json", content=body)
+    assert answer.status_code == 202, answer.text
+    assert answer.json() == {register: value}
+    if register == "compliant":
+        assert motor.compliant is value
+    else:
+        assert motor.goal_position == pytest.approx(float(str(value)), abs=0.5)
+    motor.compliant = True
+
+
+@pytest.mark.parametrize(
     ("register", "body", "status"),
     [
         ("goal_position", "not json", 400),
         ("goal_position", "NaN", 400),
         ("goal_position", "Infinity", 400),
-        ("goal_position", '"12"', 400),
+        ("goal_position", '"12x"', 400),
+        ("goal_position", '"nan"', 400),
+        ("goal_position", "1e309", 400),
+        ("goal_position", "9" * 400, 400),
         ("goal_position", "1000", 400),
         ("goal_position", "true", 400),
         ("present_position", "3", 400),
         ("moving_speed", "-5", 400),
         ("torque_limit", "150", 400),
         ("compliant", "3", 400),
+        ("compliant", '"yes"', 400),
         ("led", "[1, 2]", 400),
         ("led", '"purple-ish"', 400),
         ("pid", "[1, 2]", 400),

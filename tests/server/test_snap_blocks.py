@@ -12,11 +12,13 @@ import pytest
 from starlette.routing import Match
 
 from poppy_core.creatures import from_profile
+from poppy_core.motion import Move, save_move
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, robot_facts, start_snap_server
 from poppy_core.server.snap.catalog import BLOCKS, Block
 from poppy_core.server.snap.examples import project_names
 from poppy_core.server.snap.routing import TextRouter
+from tests.server.snap_helpers import near, wait_until
 
 Served = tuple[Robot, SnapServer, httpx.Client]
 
@@ -146,3 +148,118 @@ def test_blocks_follow_the_robot_served(moves_folder: str) -> None:
         d for d in root.iter("block-definition") if d.get("s", "").startswith("tip position")
     )
     assert tip.findtext("./inputs/input") == "l_arm_chain"
+
+
+def test_connection_test_and_motor_index(snap: Served) -> None:
+    robot, _, http = snap
+    assert http.get("/connected").text == "True"  # the block "robot connected?" reads True
+    order = http.get("/motors/motors").text.split("/")
+    for number, name in enumerate(order, start=1):
+        assert http.get(f"/motor/{name}/index").text == str(number)
+        assert robot.motors[number - 1].name == name  # the order of 'positions of all motors'
+    missing = http.get("/motor/m9/index")
+    assert missing.status_code == 404 and missing.text.startswith("Error: no motor 'm9'")
+
+
+def record_motion(served: Served, move: str, motor: str, target: float) -> None:
+    """Record ``move`` on ``motor`` going from 0° to ``target``, through the Snap! routes."""
+    robot, _, http = served
+    robot.goto_position({motor: 0.0}, 0.3, wait=True)
+    assert http.get(f"/primitive/MoveRecorder/{move}/start/{motor}").text == "Done!"
+    robot.goto_position({motor: target}, 0.6, wait=True)
+    assert http.get(f"/primitive/MoveRecorder/{move}/stop").text == "Done!"
+
+
+@pytest.fixture(scope="module")
+def two_moves(snap: Served) -> Served:
+    """``first`` (m1: 0° to 30°) and ``second`` (m2: 0° to -30°) in the move library, and
+    ``torso`` driving a motor the Ergo Jr lacks."""
+    for motor in snap[0].motors:
+        motor.compliant = False
+    record_motion(snap, "first", "m1", 30.0)
+    record_motion(snap, "second", "m2", -30.0)
+    save_move(Move(10.0, ["head_z"], [[0.0], [10.0]]), "torso")
+    return snap
+
+
+def test_moves_play_together_and_in_sequence(two_moves: Served) -> None:
+    robot, server, http = two_moves
+    moves = server.service.moves
+    router = server.thread.server.config.app.app
+    assert isinstance(router, TextRouter)
+    playlists = router.snap.playlists
+    first, second = (moves.load(name).duration_s for name in ("first", "second"))
+
+    def home() -> None:
+        robot.goto_position({"m1": 0.0, "m2": 0.0}, 0.3, wait=True)
+
+    # together: both start at once (played slowly, so both are seen playing), both end there
+    home()
+    answer = http.get("/moves/concurrently/first;second/0.25")
+    assert float(answer.text) == pytest.approx(max(first, second) / 0.25, abs=0.01)
+    assert wait_until(lambda: {"first", "second"} <= set(moves.playing()))
+    assert wait_until(lambda: not moves.playing(), timeout_s=30)
+    assert near(robot.m1.present_position, 30.0, 3) and near(robot.m2.present_position, -30.0, 3)
+
+    # in sequence: the second starts when the first has ended
+    home()
+    answer = http.get("/moves/sequentially/first;second/0.5")
+    assert float(answer.text) == pytest.approx((first + second) / 0.5, abs=0.01)
+    seen: list[tuple[str, ...]] = []
+
+    def second_playing() -> bool:
+        seen.append(tuple(moves.playing()))
+        return "second" in seen[-1]
+
+    assert wait_until(second_playing, timeout_s=30)
+    assert ("first",) in seen and ("first", "second") not in seen  # one after the other
+    assert near(robot.m1.present_position, 30.0, 3)  # the first had reached its end
+    assert wait_until(lambda: not moves.playing() and not playlists.sequences(), timeout_s=30)
+    assert near(robot.m2.present_position, -30.0, 3)
+
+    # "stop move" on a move of a sequence ends the sequence
+    home()
+    http.get("/moves/sequentially/first;second/0.25")
+    assert playlists.sequences() == [["first", "second"]]
+    assert http.get("/primitive/MovePlayer/first/stop").text == "Done!"
+    assert wait_until(lambda: not playlists.sequences())
+    assert moves.playing() == []
+
+
+@pytest.mark.parametrize(
+    ("path", "status", "says"),
+    [
+        ("/moves/concurrently/first;nope/1", 404, "no move 'nope'"),
+        ("/moves/sequentially/nope;first/1", 404, "no move 'nope'"),
+        ("/moves/sequentially/first/0", 400, "speed must be above 0"),
+        ("/moves/concurrently/first/nan", 400, "speed must be a number"),
+        ("/moves/concurrently/;/1", 400, "no move given"),
+        ("/moves/sequentially/a.b/1", 400, "not a move name"),
+        ("/moves/concurrently/first;torso/1", 400, "drives motors this robot lacks: head_z"),
+        ("/moves/sequentially/first;torso/1", 400, "drives motors this robot lacks: head_z"),
+    ],
+)
+def test_playing_several_moves_refuses_before_starting_any(
+    two_moves: Served, path: str, status: int, says: str
+) -> None:
+    _, server, http = two_moves
+    assert wait_until(lambda: not server.service.moves.playing())
+    answer = http.get(path)
+    assert answer.status_code == status and says in answer.text, answer.text
+    assert server.service.moves.playing() == []
+
+
+def test_the_library_has_the_blocks_the_poppy_documentation_lists(snap: Served) -> None:
+    """A connection test, a motor's index, moves played together and in sequence (issue 23)."""
+    http = snap[2]
+    for document, labels in (
+        ("/snap-blocks.xml", ("robot connected?", "index of motor %'motor'",
+                              "play moves %'moves' together at speed × %'speed'",
+                              "play moves %'moves' one after the other at speed × %'speed'")),
+        ("/snap/poppy-blocks-fr", ("robot connecté ?", "numéro du moteur %'motor'",
+                                   "jouer les mouvements %'moves' ensemble à la vitesse × "
+                                   "%'speed'")),
+    ):  # fmt: skip
+        root = ET.fromstring(http.get(document).content)
+        defined = {d.get("s") for d in root.iter("block-definition")}
+        assert set(labels) <= defined, document

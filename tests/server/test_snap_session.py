@@ -138,6 +138,15 @@ def check_state(robot: Robot, server: SnapServer, path: str, answer: httpx.Respo
         ("/motors/m1;m9/get/led", 404, "no motor 'm9'"),
         ("/motor/m1/get/nothing", 404, "no register 'nothing'"),
         ("/motor/m1/set/goal_position/abc", 400, "expected a number"),
+        ("/motor/m1/set/goal_position/nan", 400, "must be a finite number"),
+        ("/motor/m1/set/goal_position/inf", 400, "must be a finite number"),
+        ("/motor/m1/set/goal_position/-Infinity", 400, "must be a finite number"),
+        ("/motor/m1/set/goal_position/1e309", 400, "must be a finite number"),
+        ("/motors/set/registers/m1:moving_speed:NaN", 400, "must be a finite number"),
+        ("/motor/m1/set/goal_position/" + "9" * 400, 400, "must be a finite number"),
+        ("/motor/m1/set/compliant/2", 400, "must be true or false (or 1 or 0)"),
+        ("/motor/m1/set/compliant/yes", 400, "must be true or false (or 1 or 0)"),
+        ("/motor/m1/set/compliant/__import__('os')", 400, "must be true or false"),
         ("/motor/m1/goto/500/1", 400, "outside the angle limits"),
         ("/motor/m1/goto/10/-1", 400, "duration"),
         ("/motors/set/goto/m1:10", 400, "motor:position:duration"),
@@ -179,6 +188,33 @@ def test_values_read_as_pypot_writes_them(snap: tuple[Robot, SnapServer, httpx.C
     frame = http.get("/frame.png")  # the Ergo Jr's camera (blank when simulated without MuJoCo)
     assert frame.status_code == 200 and frame.content.startswith(b"\x89PNG")
     assert http.get("/detect/caribou").text == "False"  # no card in view
+
+
+@pytest.mark.parametrize(
+    ("path", "compliant"),
+    [
+        # pypot's own block "set motor(s) ... compliant/stiff" sends 1 and 0 (issue 23)
+        ("/motors/set/registers/m5:compliant:0;m6:compliant:0", False),
+        ("/motors/set/registers/m5:compliant:1;m6:compliant:1", True),
+        ("/motor/m5/set/compliant/0", False),
+        ("/motor/m5/set/compliant/1", True),
+        ("/motor/m5/set/compliant/False", False),
+        ("/motor/m5/set/compliant/True", True),
+        ("/motor/m5/set/compliant/false", False),
+        ("/motor/m5/set/compliant/true", True),
+    ],
+)
+def test_booleans_as_pypot_blocks_write_them(
+    snap: tuple[Robot, SnapServer, httpx.Client], path: str, compliant: bool
+) -> None:
+    robot, _, http = snap
+    for motor in (robot.m5, robot.m6):
+        motor.compliant = not compliant
+    answer = http.get(path)
+    assert (answer.status_code, answer.text) == (200, "Done!")
+    assert robot.m5.compliant is compliant
+    if "m6" in path:
+        assert robot.m6.compliant is compliant
 
 
 def test_snap_berkeley_edu_is_allowed_and_other_pages_are_not(

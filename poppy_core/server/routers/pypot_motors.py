@@ -10,6 +10,7 @@ from fastapi.responses import HTMLResponse, JSONResponse  # noqa: TID253
 
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
+from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.routers.common import json_body, truthy, wait_goto
 
 router = APIRouter(tags=["pypot"])
@@ -116,7 +117,7 @@ async def set_register(
 ) -> JSONResponse:
     """202 ``{register: value}``; 404 unknown motor/register; 400 bad or read-only value."""
     data = await json_body(request, tip="the body is the new value as JSON, e.g. 90 or true")
-    value = service.write(motor, register, data)
+    value = service.write(motor, register, pypot_value(motor, register, data))
     return JSONResponse({register: value}, status_code=202)
 
 

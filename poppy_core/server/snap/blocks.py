@@ -98,6 +98,7 @@ class RobotFacts:
             "@chain": chain,
             "@card": self.cards[0] if self.cards else "caribou",
             "@move": "my-move",
+            "@moves": "my-move",
             "@gotos": ";".join(f"{m}:0:1" for m in self.motors[:3]),
             "@x": f"{tip[0]:.3f}",
             "@y": f"{tip[1]:.3f}",

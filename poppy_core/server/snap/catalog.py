@@ -25,7 +25,7 @@ class Input:
     slot: str = "%s"
     default: str = ""
     """A literal, or ``@motor``, ``@motors``, ``@group``, ``@primitive``, ``@chain``, ``@move``,
-    ``@card``, ``@x``/``@y``/``@z`` filled from the served robot."""
+    ``@moves``, ``@card``, ``@x``/``@y``/``@z`` filled from the served robot."""
 
 
 @dataclass(frozen=True)
@@ -48,10 +48,16 @@ M = Input("motors", "%s", "@motors")
 ONE = Input("motor", "%s", "@motor")
 
 BLOCKS: tuple[Block, ...] = (
+    Block("connected", "predicate", "sensing", "robot connected?", "robot connecté ?", (),
+          "/connected", "bool",
+          help_en="True when the robot's server answers at host:port ('set robot host to')."),
     Block("motors", "reporter", "sensing", "all motors", "tous les moteurs", (),
           "/motors/motors", "names", help_en="The robot's motors (a list)."),
     Block("group", "reporter", "sensing", "motors of group %'group'", "moteurs du groupe %'group'",
           (Input("group", "%s", "@group"),), "/motors/{group}", "names"),
+    Block("index", "reporter", "sensing", "index of motor %'motor'", "numéro du moteur %'motor'",
+          (ONE,), "/motor/{motor}/index", "number",
+          help_en="Its place in 'all motors' and 'positions of all motors' (from 1)."),
     Block("groups", "reporter", "sensing", "all motor groups", "tous les groupes de moteurs", (),
           "/motors/alias", "names"),
     Block("positions", "reporter", "sensing", "positions of all motors",
@@ -115,6 +121,18 @@ BLOCKS: tuple[Block, ...] = (
           "jouer le mouvement %'move' à l'envers à la vitesse × %'speed'",
           (Input("move", "%s", "@move"), Input("speed", "%n", "1")),
           "/primitive/MovePlayer/{move}/start/{speed}/backwards", "number"),
+    Block("play_together", "reporter", "control",
+          "play moves %'moves' together at speed × %'speed'",
+          "jouer les mouvements %'moves' ensemble à la vitesse × %'speed'",
+          (Input("moves", "%s", "@moves"), Input("speed", "%n", "1")),
+          "/moves/concurrently/{moves}/{speed}", "number",
+          help_en="Starts every move (m1;m2) at once; reports the longest duration (s)."),
+    Block("play_sequence", "reporter", "control",
+          "play moves %'moves' one after the other at speed × %'speed'",
+          "jouer les mouvements %'moves' l'un après l'autre à la vitesse × %'speed'",
+          (Input("moves", "%s", "@moves"), Input("speed", "%n", "1")),
+          "/moves/sequentially/{moves}/{speed}", "number",
+          help_en="Plays the moves (m1;m2) in turn; reports the total duration (s)."),
     Block("stop_move", "command", "control", "stop move %'move'", "arrêter le mouvement %'move'",
           (Input("move", "%s", "@move"),), "/primitive/MovePlayer/{move}/stop"),
     Block("remove", "command", "control", "delete move %'move'", "effacer le mouvement %'move'",

@@ -16,8 +16,10 @@ from poppy_core.errors import KinematicsError
 from poppy_core.server import values
 from poppy_core.server.chains import find_chain
 from poppy_core.server.errors import ApiError
+from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.sensors import SensorService
 from poppy_core.server.service import RobotService, check_duration
+from poppy_core.server.snap.playlists import Playlists
 from poppy_core.server.snap.text import (
     DONE,
     names_text,
@@ -43,6 +45,14 @@ def number(text: str, what: str) -> float:
     return result
 
 
+def _speed(text: str) -> float:
+    """A play speed factor from a URL segment: a finite number above 0."""
+    factor = number(text, "speed")
+    if factor <= 0:
+        raise ApiError("invalid", f"speed must be above 0, got {text[:40]!r}")
+    return factor
+
+
 class SnapRobot:
     """The robot as Snap!'s blocks see it.
 
@@ -57,6 +67,16 @@ class SnapRobot:
         self._lock = threading.Lock()
         self._attached: dict[str, list[str]] = {}
         """Move name -> the motors a recorder was attached to (pypot's ``attach``)."""
+        self.playlists = Playlists(service.moves)
+
+    def connected(self) -> str:
+        """``/connected``: ``True`` (the Snap! block "robot connected?" sees any other answer)."""
+        return "True"
+
+    def motor_index(self, motor: str) -> str:
+        """``/motor/<m>/index``: its place in ``/motors/motors``, from 1 as Snap!'s lists count."""
+        found = self.service.motor(motor)
+        return str(self.robot.motors.index(found) + 1)
 
     # -- motors --------------------------------------------------------------------------------
 
@@ -85,7 +105,8 @@ class SnapRobot:
 
     def write(self, motor: str, register: str, value: str) -> str:
         """``/motor/<m>/set/<register>/<value>``."""
-        self.service.write_many({motor: {register: parse_value(value)}})
+        written = pypot_value(motor, register, parse_value(value))
+        self.service.write_many({motor: {register: written}})
         return DONE
 
     def write_many(self, settings: str) -> str:
@@ -98,7 +119,8 @@ class SnapRobot:
             if len(parts) != 3:
                 raise ApiError("invalid", f"{item!r} is not motor:register:value, e.g. m1:led:red")
             motor, register, value = (p.strip() for p in parts)
-            commands.setdefault(motor, {})[register] = parse_value(value)
+            written = pypot_value(motor, register, parse_value(value))
+            commands.setdefault(motor, {})[register] = written
         if not commands:
             raise ApiError("invalid", "no motor:register:value given, e.g. m1:compliant:False")
         self.service.write_many(commands)
@@ -246,14 +268,23 @@ class SnapRobot:
 
     def play(self, move: str, speed: str = "1", backwards: bool = False) -> str:
         """``/primitive/MovePlayer/<move>/start[/<speed>[/backwards]]``: its duration (s)."""
-        factor = number(speed, "speed")
-        if factor <= 0:
-            raise ApiError("invalid", f"speed must be above 0, got {speed[:40]!r}")
-        player = self.service.moves.play(move, factor, backwards)
+        player = self.service.moves.play(move, _speed(speed), backwards)
         return number_text(player.duration_s)
 
+    def play_together(self, moves: str, speed: str = "1") -> str:
+        """``/moves/concurrently/<m1;m2>/<speed>``: start them all; the longest duration (s)."""
+        return number_text(self.playlists.together(split_names(moves), _speed(speed)))
+
+    def play_in_sequence(self, moves: str, speed: str = "1") -> str:
+        """``/moves/sequentially/<m1;m2>/<speed>``: one after the other; the total duration (s)."""
+        return number_text(self.playlists.in_sequence(split_names(moves), _speed(speed)))
+
     def stop_playing(self, move: str) -> str:
-        """``/primitive/MovePlayer/<move>/stop`` (a move that is not playing: nothing to do)."""
+        """``/primitive/MovePlayer/<move>/stop`` (a move that is not playing: nothing to do).
+
+        A sequence holding the move ends there.
+        """
+        self.playlists.stop(move)
         if move in self.service.moves.playing():
             self.service.moves.stop(move)
         return DONE

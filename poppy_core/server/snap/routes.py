@@ -65,6 +65,16 @@ def _routes() -> list[TextRoute]:
             blocking=True,
         ),
         r("/primitive/MovePlayer/{move}/stop", lambda s, p: s.stop_playing(p["move"])),
+        r(
+            "/moves/concurrently/{moves}/{speed}",
+            lambda s, p: s.play_together(p["moves"], p["speed"]),
+            blocking=True,
+        ),
+        r(
+            "/moves/sequentially/{moves}/{speed}",
+            lambda s, p: s.play_in_sequence(p["moves"], p["speed"]),
+            blocking=True,
+        ),
         # primitives
         r("/primitives", lambda s, p: s.primitives()),
         r("/primitives/running", lambda s, p: s.running()),
@@ -92,7 +102,9 @@ def _routes() -> list[TextRoute]:
             lambda s, p: s.call(p["primitive"], p["method"], p["args"]),
             blocking=True,
         ),
-        # sensors, simulation, kinematics, address
+        # the connection test, sensors, simulation, kinematics, address
+        r("/connected", lambda s, p: s.connected()),
+        r("/motor/{motor}/index", lambda s, p: s.motor_index(p["motor"])),
         r("/detect/{marker}", lambda s, p: s.detect(p["marker"]), blocking=True),
         r("/reset-simulation", lambda s, p: s.reset_simulation(), blocking=True),
         r("/ik/{chain}/endeffector", lambda s, p: s.tip(p["chain"])),
