@@ -166,3 +166,25 @@ def guarded_protocol(base: Any, header_timeout_s: float, max_connections: int) -
     GuardedProtocol.__name__ = f"Guarded{base.__name__}"
     GuardedProtocol.__qualname__ = GuardedProtocol.__name__
     return GuardedProtocol
+
+
+def quiet_denials(base: Any) -> Any:
+    """A subclass of uvicorn's WebSocket protocol class ``base`` where a handshake refused with an
+    HTTP answer (the guard's 400/401/403, ASGI's denial response) ends the handshake.
+
+    uvicorn's protocol counts only an accept or a close as one, and logs "ASGI callable returned
+    without completing handshake" at ERROR for every refused handshake: a page trying the port
+    would fill the terminal with false errors.
+    """
+
+    class QuietDenials(base):  # type: ignore[misc]
+        async def send(self, message: Any) -> None:
+            await super().send(message)
+            if message["type"] == "websocket.http.response.body" and not message.get(
+                "more_body", False
+            ):
+                self.handshake_complete = True  # answered: nothing is left to complete
+
+    QuietDenials.__name__ = f"QuietDenials{base.__name__}"
+    QuietDenials.__qualname__ = QuietDenials.__name__
+    return QuietDenials

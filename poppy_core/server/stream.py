@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from starlette.applications import Starlette
 from starlette.routing import WebSocketRoute
-from starlette.websockets import WebSocket, WebSocketDisconnect
+from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketDisconnected
 
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, PoppyError
@@ -78,8 +78,8 @@ async def stream(websocket: WebSocket, service: RobotService, rate_hz: float | s
     channel = TeleopChannel(service.robot, service.teleop, notify)
     try:
         await _receive_commands(websocket, send, service, channel)
-    except WebSocketDisconnect:
-        pass
+    except (WebSocketDisconnect, WebSocketDisconnected):
+        pass  # the client left, maybe while an answer was on its way (after teleop.stop)
     except Exception:  # a bug: logged here, the client gets a close frame with a reason
         logger.exception("WebSocket stream failed")
         with contextlib.suppress(Exception):
