@@ -64,9 +64,11 @@ def test_a_refused_websocket_handshake_is_answered_and_logs_no_error(
     with_token: ServerThread, errors: Recorder
 ) -> None:
     for headers, status in (({}, 401), ({"Origin": "http://evil.example"}, 403)):
-        with pytest.raises(InvalidStatus) as refused:
-            with connect(_ws(with_token), additional_headers=headers, open_timeout=10):
-                pass
+        with (
+            pytest.raises(InvalidStatus) as refused,
+            connect(_ws(with_token), additional_headers=headers, open_timeout=10),
+        ):
+            pass
         assert refused.value.response.status_code == status
         assert b'"error"' in refused.value.response.body
     # the error would be logged as the app returns, just after the answer: give it the time
@@ -79,7 +81,7 @@ def test_a_refused_websocket_handshake_is_answered_and_logs_no_error(
 def test_a_client_leaving_right_after_teleop_stop_logs_no_error(
     with_token: ServerThread, errors: Recorder
 ) -> None:
-    url = _ws(with_token, "?rate_hz=1&" + httpx.QueryParams({"token": TOKEN}).__str__())
+    url = _ws(with_token, "?rate_hz=1&" + str(httpx.QueryParams({"token": TOKEN})))
     for _ in range(5):
         with connect(url, open_timeout=10) as ws:
             ws.send(json.dumps({"type": "teleop.start", "motors": ["m1"]}))
