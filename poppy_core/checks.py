@@ -14,6 +14,9 @@ MAX_RATE_HZ = 1000.0
 MIN_RATE_HZ = 1.0 / (24 * 3600.0)
 # The longest duration any motion, recording or wait takes (a day).
 MAX_DURATION_S = 24 * 3600.0
+# The shortest non-zero duration: below it a trajectory's polynomial divides by an underflowed
+# zero (1e-300 ** 3), and no loop ticks that fast anyway (``1 / MAX_RATE_HZ``).
+MIN_DURATION_S = 1.0 / MAX_RATE_HZ
 # The largest magnitude a physical value (degrees, metres, %, a speed factor) may have: far
 # beyond any robot's, small enough that every arithmetic on it stays finite.
 MAX_MAGNITUDE = 1e9
@@ -50,6 +53,25 @@ def number(value: object, field: str = "") -> float:
     return result
 
 
+def number_from(value: object, field: str = "") -> float:
+    """Like ``number``, also taking text (a URL segment, a command-line or JSON string).
+
+    Text is read as a decimal number (``"0.5"``, ``"-3"``, ``"1e3"``), never evaluated; an
+    integer too large for a float is refused like any other huge value.
+    """
+    if isinstance(value, str):
+        text = value.strip()
+        try:
+            parsed: float = float(text)
+        except ValueError:
+            shown = text if len(text) <= 40 else text[:40] + "..."
+            raise ArgumentError(
+                f"{_describe(field)} must be a number, got {shown!r}", field=field, value=value
+            ) from None
+        return number(parsed, field)
+    return number(value, field)
+
+
 def positive(value: object, field: str = "") -> float:
     """A finite number > 0."""
     result = number(value, field)
@@ -84,10 +106,16 @@ def in_range(value: object, low: float, high: float, field: str = "", unit: str 
 
 
 def duration(value: object, field: str = "duration", *, allow_zero: bool = True) -> float:
-    """Seconds, 0 (or > 0 without ``allow_zero``) up to a day."""
+    """Seconds: 0 (at once; refused without ``allow_zero``) or ``MIN_DURATION_S`` up to a day."""
     result = in_range(value, 0.0, MAX_DURATION_S, field, "s")
     if not allow_zero and result <= 0:
         raise ArgumentError(f"{field} must be greater than 0 s, got {result:g} s", field=field)
+    if 0 < result < MIN_DURATION_S:
+        raise ArgumentError(
+            f"{field} must be 0 (at once) or at least {MIN_DURATION_S:g} s, got {result:g} s",
+            field=field,
+            value=value,
+        )
     return result
 
 

@@ -39,15 +39,11 @@ def check_goto(duration_s: float, control: str) -> None:
     """Refuse a goto's duration or control before anything moves.
 
     Raises:
-        ArgumentError: unknown ``control``, or a duration that is negative, not finite or longer
-            than ``MAX_DURATION_S``.
+        ArgumentError: unknown ``control``, or a duration that is negative, not finite, longer
+            than ``MAX_DURATION_S`` or too short to divide by (``checks.duration``).
     """
     control_name(control)
-    if not 0 <= duration_s <= MAX_DURATION_S:  # also refuses NaN
-        raise ArgumentError(
-            f"duration must be 0-{MAX_DURATION_S:g} s, got {duration_s} s",
-            field="duration", value=duration_s,
-        )  # fmt: skip
+    checks.duration(duration_s)
 
 
 @dataclass(frozen=True)

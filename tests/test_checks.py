@@ -67,3 +67,18 @@ def test_number_is_finite_or_refused(value: float) -> None:
         assert not math.isfinite(value) or abs(value) > checks.MAX_MAGNITUDE
     else:
         assert math.isfinite(result) and result == value
+
+
+def test_number_from_reads_text_and_refuses_what_is_not_a_finite_number() -> None:
+    assert checks.number_from(" 0.5 ", "x") == 0.5
+    assert checks.number_from(-3, "x") == -3.0
+    for text in ("abc", "nan", "inf", "1e309", "9" * 400, "", "0x10"):
+        with pytest.raises(ArgumentError, match="speed"):
+            checks.number_from(text, "speed")
+
+
+def test_a_duration_is_zero_or_long_enough_to_divide_by() -> None:
+    assert checks.duration(checks.MIN_DURATION_S) == checks.MIN_DURATION_S
+    for tiny in (1e-300, 5e-324, 1e-7):
+        with pytest.raises(ArgumentError, match="at least"):
+            checks.duration(tiny)

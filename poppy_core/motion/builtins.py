@@ -13,6 +13,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias
 
+from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.files import write_file
 from poppy_core.motion.manager import attach_primitive
@@ -90,12 +91,7 @@ class Sinus(LoopPrimitive):
 
     @frequency.setter
     def frequency(self, value: float) -> None:
-        if not math.isfinite(value) or value < 0:
-            raise ArgumentError(
-                f"frequency must be a finite number >= 0 Hz, got {value}",
-                field="frequency", value=value,
-            )  # fmt: skip
-        self._signal_hz = float(value)
+        self._signal_hz = checks.non_negative(value, "frequency")
 
     def setup(self) -> None:
         """Check the motor names."""
@@ -305,12 +301,7 @@ class SimplePosture(Primitive):
 
     @duration.setter
     def duration(self, value: float) -> None:
-        if not math.isfinite(value) or value < 0:
-            raise ArgumentError(
-                f"duration must be a finite number >= 0 s, got {value}",
-                field="duration", value=value,
-            )  # fmt: skip
-        self._duration = float(value)
+        self._duration = checks.duration(value)
 
     def setup(self) -> None:
         """Check the posture and stiffen its motors."""

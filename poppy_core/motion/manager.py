@@ -17,7 +17,8 @@ import time
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
-from poppy_core.errors import ConfigError, RobotClosedError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError
 from poppy_core.motion.sandbox import NUMERIC_REGISTERS
 from poppy_core.robot.schedule import Periodic, RateMeter
 
@@ -61,10 +62,11 @@ class PrimitiveManager:
     def __init__(
         self, robot: Robot, freq: float = DEFAULT_FREQ_HZ, filter: str | Filter = "mean"
     ) -> None:
-        if not math.isfinite(freq) or freq <= 0:
-            raise ConfigError(f"manager frequency must be positive, got {freq}", field="freq")
+        try:
+            self.freq = checks.rate(freq, "freq")
+        except ArgumentError as exc:
+            raise ConfigError(f"manager frequency: {exc}", field="freq") from None
         self._robot = robot
-        self.freq = float(freq)
         self._filter = _resolve_filter(filter)
         self._lock = threading.RLock()
         self._primitives: list[Primitive] = []

@@ -9,7 +9,6 @@ primitives. A primitive whose code raises is stopped, its traceback logged and k
 from __future__ import annotations
 
 import logging
-import math
 import threading
 import time
 import traceback
@@ -18,7 +17,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
-from poppy_core.errors import ArgumentError, ConfigError
+from poppy_core import checks
+from poppy_core.errors import ConfigError
 from poppy_core.motion.primitive_values import convert_value
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
 from poppy_core.robot.schedule import Periodic, RateMeter
@@ -368,12 +368,8 @@ class LoopPrimitive(Primitive):
 
     @update_freq.setter
     def update_freq(self, value: float) -> None:
-        if not math.isfinite(value) or value <= 0:
-            raise ArgumentError(
-                f"update frequency must be a positive number of Hz, got {value}",
-                field="update_freq", value=value,
-            )  # fmt: skip
-        self._freq = float(value)
+        # a floor on the period (no spinning) and a ceiling (no wait too long for a timer)
+        self._freq = checks.rate(value, "update_freq")
 
     @property
     def period_s(self) -> float:

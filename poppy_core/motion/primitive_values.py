@@ -6,7 +6,8 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from poppy_core.errors import ConfigError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, ConfigError
 
 _TRUE = ("1", "true", "yes", "on")
 _FALSE = ("0", "false", "no", "off")
@@ -39,8 +40,10 @@ def convert_value(name: str, current: Any, value: Any) -> Any:
         except (TypeError, ValueError):
             kind = "a number" if isinstance(current, float) else "an integer"
             raise bad(f"{value!r} is not {kind}") from None
-        if isinstance(number, float) and not math.isfinite(number):
-            raise bad("the value must be finite")
+        try:
+            checks.number(number, name)  # finite, and small enough for any arithmetic
+        except ArgumentError as exc:
+            raise bad(str(exc)) from None
         return number
     if isinstance(current, str):
         return str(value)

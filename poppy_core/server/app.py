@@ -16,6 +16,7 @@ from poppy_core.server.legacy_paths import LegacyPaths
 from poppy_core.server.middleware import MAX_BODY_BYTES, BodyLimitMiddleware, TokenMiddleware
 from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.service import RobotService
+from poppy_core.server.state_routes import changes_state_as_routed
 from poppy_core.server.web import add_web_page, is_public
 
 if TYPE_CHECKING:
@@ -117,7 +118,9 @@ def create_app(
     app.add_middleware(BodyLimitMiddleware, max_bytes=max_body_bytes)
     if token:
         app.add_middleware(TokenMiddleware, token=token, public=is_public)
-    app.add_middleware(OriginGuard, policy=policy)  # outermost: before the token and the fast path
+    # outermost: before the token and the fast path; which GETs change the robot is decided on
+    # the route each spelling reaches (LegacyPaths rewrites them later)
+    app.add_middleware(OriginGuard, policy=policy, changes_state=changes_state_as_routed(app))
     return app
 
 

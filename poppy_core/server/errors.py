@@ -8,7 +8,8 @@ status codes) and ``{"detail"}`` on the v1 API (404 unknown, 409 conflict, 422 i
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING, Literal
+import math
+from typing import TYPE_CHECKING, Any, Literal
 
 from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
@@ -115,6 +116,26 @@ async def _poppy_error(request: Request, exc: Exception) -> Response:
     return error_response(request, from_poppy_error(exc))
 
 
+def encodable(value: Any) -> Any:
+    """``value`` with every non-finite float as text (``"nan"``, ``"inf"``): JSON has none."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    if isinstance(value, dict):
+        return {str(k): encodable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [encodable(v) for v in value]
+    return value
+
+
+async def _invalid_request(request: Request, exc: Exception) -> Response:
+    # FastAPI's own handler echoes the input: NaN or 1e309 in a body made it fail (a 500).
+    from fastapi.encoders import jsonable_encoder
+    from fastapi.exceptions import RequestValidationError
+
+    assert isinstance(exc, RequestValidationError)
+    return JSONResponse({"detail": encodable(jsonable_encoder(exc.errors()))}, status_code=422)
+
+
 async def _bug(request: Request, exc: Exception) -> Response:
     # uvicorn logs the traceback server-side; the client gets one line without paths.
     message = f"internal error ({type(exc).__name__}): the server's log has the details"
@@ -126,6 +147,9 @@ async def _bug(request: Request, exc: Exception) -> Response:
 
 def install_error_handlers(app: FastAPI) -> None:
     """Map ``ApiError`` and ``PoppyError`` to JSON answers on ``app``, and bugs to a bare 500."""
+    from fastapi.exceptions import RequestValidationError
+
+    app.add_exception_handler(RequestValidationError, _invalid_request)
     app.add_exception_handler(ApiError, _api_error)
     app.add_exception_handler(PoppyError, _poppy_error)
     app.add_exception_handler(Exception, _bug)

@@ -42,24 +42,34 @@ def token_protocol(scope: Scope) -> str | None:
     return None
 
 
-def request_token(scope: Scope) -> str | None:
-    """The token a request carries: ``Authorization: Bearer …``, ``?token=…``, or (WebSocket)
-    a ``poppy-token.<hex>`` subprotocol."""
+def request_token_bytes(scope: Scope) -> bytes | None:
+    """The token a request carries, as the bytes it carries them: ``Authorization: Bearer …``,
+    ``?token=…`` (percent-decoded), or (WebSocket) a ``poppy-token.<hex>`` subprotocol.
+
+    Bytes, never text decoded one way and encoded another: a header is read as Latin-1 by
+    ASGI servers, so a non-ASCII token sent in UTF-8 never matched once re-encoded.
+    """
     if scope["type"] == "websocket":
         token = protocol_token(scope)
         if token is not None:
-            return token
+            return token.encode()
     for key, value in scope.get("headers", []):
         if key == b"authorization":
-            scheme, _, token = bytes(value).decode("latin-1").partition(" ")
-            if scheme.lower() == "bearer":
-                return str(token).strip()
-    query = scope.get("query_string", b"").decode("latin-1")
+            scheme, _, raw = bytes(value).partition(b" ")
+            if scheme.lower() == b"bearer":
+                return raw.strip()
+    query = bytes(scope.get("query_string", b"")).decode("latin-1")  # one char per byte
     if "token=" in query:
-        tokens: list[str] = parse_qs(query).get("token", [])
+        tokens: list[str] = parse_qs(query, encoding="latin-1").get("token", [])
         if tokens:
-            return str(tokens[0])
+            return tokens[0].encode("latin-1")
     return None
+
+
+def request_token(scope: Scope) -> str | None:
+    """The token a request carries as text (UTF-8), to be written in the documents it gets."""
+    raw = request_token_bytes(scope)
+    return None if raw is None else raw.decode("utf-8", errors="replace")
 
 
 class TokenMiddleware:
@@ -81,8 +91,8 @@ class TokenMiddleware:
 
     def allowed(self, scope: Scope) -> bool:
         """True when ``scope`` carries the token."""
-        given = request_token(scope)
-        return given is not None and hmac.compare_digest(given.encode(), self.token)
+        given = request_token_bytes(scope)
+        return given is not None and hmac.compare_digest(given, self.token)
 
     def _public(self, scope: Scope) -> bool:
         return (

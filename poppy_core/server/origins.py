@@ -46,8 +46,6 @@ MAX_CACHED = 256
 
 SAFE_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
 PORT = re.compile(r"[0-9]{1,5}")
-PYPOT_CONTROL_GET = re.compile(r"^/primitives/[^/]+/(start|stop|pause|resume)\.json$")
-"""pypot's GET routes that change the robot (they start and stop primitives)."""
 
 ALLOW_HEADERS = b"Origin, Accept, Content-Type, X-Requested-With, X-CSRF-Token, Authorization"
 ALLOW_METHODS = b"GET, POST, PUT, PATCH, DELETE, OPTIONS"
@@ -325,10 +323,12 @@ class OriginPolicy:
 
 
 def default_changes_state(scope: Scope) -> bool:
-    """True for what may change the robot: not GET/HEAD/OPTIONS, or pypot's GET controls."""
-    if scope["type"] == "websocket":
-        return True
-    return scope["method"] not in SAFE_METHODS or bool(PYPOT_CONTROL_GET.match(scope["path"]))
+    """True for what may change the robot: a WebSocket, any method but GET/HEAD/OPTIONS.
+
+    An app with GET routes that change the robot passes its own rule, decided on the route a
+    request reaches (the REST app: ``state_routes.changes_state_as_routed``).
+    """
+    return scope["type"] == "websocket" or scope["method"] not in SAFE_METHODS
 
 
 class OriginGuard:
@@ -342,7 +342,7 @@ class OriginGuard:
         app: the wrapped app.
         policy: the rules (shared by the servers of one ``poppy serve``).
         changes_state: which requests may change the robot (cross-site ones without ``Origin``
-            are refused); every WebSocket, non-GET request and pypot's primitive GETs by default.
+            are refused); every WebSocket and non-GET request by default.
     """
 
     def __init__(

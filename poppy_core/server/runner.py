@@ -14,7 +14,12 @@ import time
 from typing import Any
 
 from poppy_core.server.errors import ListenError
-from poppy_core.server.limits import HEADER_TIMEOUT_S, MAX_CONNECTIONS, guarded_protocol
+from poppy_core.server.limits import (
+    HEADER_TIMEOUT_S,
+    MAX_CONNECTIONS,
+    guarded_protocol,
+    quiet_denials,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -44,12 +49,14 @@ def uvicorn_server(
     """
     import uvicorn
     from uvicorn.protocols.http.auto import AutoHTTPProtocol
+    from uvicorn.protocols.websockets.auto import AutoWebSocketsProtocol
 
     config = uvicorn.Config(
         app,
         host=host,
         port=port,
         http=guarded_protocol(AutoHTTPProtocol, header_timeout_s, max_connections),
+        ws=quiet_denials(AutoWebSocketsProtocol) if AutoWebSocketsProtocol else "auto",
         log_level="warning",
         access_log=False,
         lifespan="on",

@@ -13,6 +13,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from poppy_core import checks
 from poppy_core.motion import Primitive, attach_builtins, attached_primitives
 from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
@@ -280,15 +281,10 @@ class RobotService:
 
 
 def check_duration(value: Any) -> float:
-    """A goto duration: a finite number of seconds in [MIN_GOTO_S, MAX_GOTO_S]."""
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ApiError("invalid", "duration must be a number of seconds")
-    try:
-        duration = float(value)
-    except OverflowError:
-        duration = math.inf
-    if not (math.isfinite(duration) and MIN_GOTO_S <= duration <= MAX_GOTO_S):
-        raise ApiError(
-            "invalid", f"duration must be between {MIN_GOTO_S:g} and {MAX_GOTO_S:g} seconds"
-        )
-    return duration
+    """A goto duration: a finite number of seconds (or its text) in [MIN_GOTO_S, MAX_GOTO_S].
+
+    Raises:
+        ArgumentError: anything else (NaN, 1e309, a 400-digit integer, ``"abc"``).
+    """
+    return checks.in_range(checks.number_from(value, "duration"), MIN_GOTO_S, MAX_GOTO_S,
+                           "duration", "s")  # fmt: skip

@@ -18,9 +18,10 @@ from typing import TYPE_CHECKING, Any
 
 from starlette.applications import Starlette
 from starlette.routing import WebSocketRoute
-from starlette.websockets import WebSocket, WebSocketDisconnect
+from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketDisconnected
 
-from poppy_core.errors import PoppyError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, PoppyError
 from poppy_core.server.errors import ApiError
 from poppy_core.server.jsonio import parse_json
 from poppy_core.server.middleware import TokenMiddleware, token_protocol
@@ -40,21 +41,33 @@ STREAM_PATH = "/api/v1/ws"
 
 
 def clamp_rate(rate_hz: float) -> float:
-    """A stream rate kept within [MIN_RATE_HZ, MAX_RATE_HZ]."""
-    return min(max(rate_hz, MIN_RATE_HZ), MAX_RATE_HZ)
+    """A stream rate kept within [MIN_RATE_HZ, MAX_RATE_HZ] (NaN is refused, not clamped)."""
+    return min(max(checks.number(rate_hz, "rate_hz"), MIN_RATE_HZ), MAX_RATE_HZ)
 
 
-async def stream(websocket: WebSocket, service: RobotService, rate_hz: float) -> None:
-    """Serve one WebSocket client until it leaves."""
+def check_rate(value: object) -> float:
+    """A stream rate asked by a client: a number (or its text) within the stream's range."""
+    return checks.in_range(checks.number_from(value, "rate_hz"), MIN_RATE_HZ, MAX_RATE_HZ,
+                           "rate_hz", "Hz")  # fmt: skip
+
+
+async def stream(websocket: WebSocket, service: RobotService, rate_hz: float | str) -> None:
+    """Serve one WebSocket client until it leaves (``rate_hz`` as the client asked it)."""
     # a client that gave its token as a subprotocol must get it back (browsers require it)
     await websocket.accept(subprotocol=token_protocol(websocket.scope))
+    try:
+        rate_hz = check_rate(rate_hz)
+    except ArgumentError as exc:  # an error frame, then a policy-violation close
+        await websocket.send_text(json.dumps({"error": one_line(str(exc))}))
+        await websocket.close(1008, "bad rate_hz")
+        return
     send_lock = asyncio.Lock()
 
     async def send(data: Any) -> None:
         async with send_lock:
             await websocket.send_text(json.dumps(data))
 
-    sender = asyncio.create_task(_send_states(send, service, clamp_rate(rate_hz)))
+    sender = asyncio.create_task(_send_states(send, service, rate_hz))
     loop = asyncio.get_running_loop()
 
     def notify(data: dict[str, Any]) -> None:  # from the teleop worker thread
@@ -65,8 +78,8 @@ async def stream(websocket: WebSocket, service: RobotService, rate_hz: float) ->
     channel = TeleopChannel(service.robot, service.teleop, notify)
     try:
         await _receive_commands(websocket, send, service, channel)
-    except WebSocketDisconnect:
-        pass
+    except (WebSocketDisconnect, WebSocketDisconnected):
+        pass  # the client left, maybe while an answer was on its way (after teleop.stop)
     except Exception:  # a bug: logged here, the client gets a close frame with a reason
         logger.exception("WebSocket stream failed")
         with contextlib.suppress(Exception):
@@ -130,12 +143,9 @@ async def _teleop(channel: TeleopChannel, data: dict[str, Any]) -> dict[str, Any
     return await asyncio.to_thread(channel.handle, data)
 
 
-def _rate_from(websocket: WebSocket, default_hz: float) -> float:
+def _rate_from(websocket: WebSocket, default_hz: float) -> float | str:
     text = websocket.query_params.get("rate_hz")
-    try:
-        return float(text) if text is not None else default_hz
-    except ValueError:
-        return default_hz
+    return text if text is not None else clamp_rate(default_hz)
 
 
 def add_stream_routes(app: FastAPI) -> None:

@@ -23,11 +23,11 @@ client reconnecting with the same ``client`` id takes its motors over from its o
 from __future__ import annotations
 
 import logging
-import math
 import threading
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from poppy_core import checks
 from poppy_core.motion.follow import FollowChange, FollowSession
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
@@ -192,12 +192,7 @@ class TeleopChannel:
             if name not in followed:
                 raise ApiError("not_found", f"{name!r} is not teleoperated (motors: "
                                f"{', '.join(session.motor_names)})")  # fmt: skip
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise ApiError("invalid", f"{name}: expected a number of degrees")
-            number = float(value)
-            if not math.isfinite(number):
-                raise ApiError("invalid", f"{name}: expected a finite number of degrees")
-            goals[name] = number
+            goals[name] = checks.number(value, name)  # ArgumentError: an error frame
         with self._lock:
             self._newest = goals if self._newest is None else {**self._newest, **goals}
         self._wake.set()
@@ -246,9 +241,4 @@ def _number(message: Mapping[str, Any], key: str, default: float, low: float, hi
     value = message.get(key, default)
     if value is None:
         value = default
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ApiError("invalid", f"{key} must be a number of seconds", tip=TIP)
-    number = float(value)
-    if not (math.isfinite(number) and low <= number <= high):
-        raise ApiError("invalid", f"{key} must be between {low:g} and {high:g} s", tip=TIP)
-    return number
+    return checks.in_range(value, low, high, key, "s")

@@ -15,6 +15,7 @@ import threading
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
+from poppy_core import checks
 from poppy_core.errors import PoppyError
 from poppy_core.server.errors import ApiError, ListenError
 from poppy_core.server.service import RobotService, check_duration
@@ -167,7 +168,7 @@ class ZmqRequests:
     def start_move_player(
         self, move_name: str, speed: float = 1.0, backwards: bool = False
     ) -> float:
-        player = self.service.moves.play(move_name, float(speed), bool(backwards))
+        player = self.service.moves.play(move_name, checks.number(speed, "speed"), bool(backwards))
         return player.duration_s
 
 

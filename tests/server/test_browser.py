@@ -22,6 +22,7 @@ from collections.abc import Iterator
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Any
 
+import httpx
 import pytest
 
 from poppy_core.server import OriginPolicy
@@ -173,3 +174,73 @@ def test_a_page_of_an_allowed_origin_drives_the_robot(
     assert not robot.sinus.is_alive()  # an <img> sends no Origin: cross-site GETs stay refused
     robot.compliant = True
     robot.m2.led = "off"
+
+
+# -- every spelling of every GET that changes the robot (issue 23, item 8) ---------------------
+
+SPELLINGS_PAGE = """<!doctype html><title>images</title><script>
+const base = "http://127.0.0.1:%(robot)d";
+async function main() {
+  const out = {};
+  for (const path of %(paths)s) {
+    out[path] = await new Promise(resolve => {
+      const img = new Image();
+      img.onload = () => resolve("loaded"); img.onerror = () => resolve("error");
+      img.src = base + path;
+    });
+  }
+  await fetch("/result", {method: "POST", body: JSON.stringify(out)});
+}
+main();
+</script>"""
+
+TARGETS = {"start": "sinus", "stop": "cosinus", "pause": "cosinus", "resume": "square"}
+"""The primitive each action is tried on: sinus idle, cosinus running, square paused."""
+
+
+def _spellings(app: Any) -> dict[str, list[str]]:
+    """Action -> every path reaching its route, derived from the routes the guard marks."""
+    from poppy_core.server.legacy_paths import current_path
+    from poppy_core.server.state_routes import marked_routes
+
+    found: dict[str, list[str]] = {}
+    for template, _ in marked_routes(app):
+        action = template.rsplit("/", 1)[1].split(".")[0]
+        path = template.replace("{primitive}", TARGETS[action])
+        legacy = path.replace("/primitives/", "/primitive/", 1)
+        assert current_path(legacy) == path  # pypot's old spelling of this route
+        encoded = legacy.replace("/primitive/", "/primitive%2F", 1)  # the server decodes it
+        found[action] = [path, path + "/", legacy, encoded]
+    return found
+
+
+def test_no_spelling_of_a_state_changing_get_works_from_another_site(
+    pages: PageServer, robot_for_localhost: Served
+) -> None:
+    robot = robot_for_localhost.robot
+    spellings = _spellings(robot_for_localhost.app)
+    assert set(spellings) == {"start", "stop", "pause", "resume"}
+    for name in ("sinus", "cosinus", "square"):
+        getattr(robot, name).stop()
+    robot.cosinus.start()
+    robot.square.start()
+    robot.square.pause()
+    try:
+        robot_port = int(robot_for_localhost.url.rsplit(":", 1)[1])
+        paths = [p for action in ("start", "stop", "pause", "resume") for p in spellings[action]]
+        pages.page = SPELLINGS_PAGE % {"robot": robot_port, "paths": json.dumps(paths)}
+        seen = pages.visit(f"http://127.0.0.1:{pages.port}/")
+        assert set(seen) == set(paths)  # the page tried them all
+        assert not robot.sinus.is_alive()  # not started
+        assert robot.cosinus.state == "running"  # neither stopped nor paused
+        assert robot.square.state == "paused"  # not resumed
+    finally:
+        for name in ("sinus", "cosinus", "square"):
+            getattr(robot, name).stop()
+    # each spelling does reach its route: a script (no Sec-Fetch-Site) drives sinus through it
+    with httpx.Client(base_url=robot_for_localhost.url, follow_redirects=True) as http:
+        for i in range(len(spellings["start"])):
+            for action in ("start", "pause", "resume", "stop"):
+                path = spellings[action][i].replace(f"/{TARGETS[action]}", "/sinus")
+                answer = http.get(path)
+                assert answer.status_code == 202, (path, answer.text)

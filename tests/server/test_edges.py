@@ -92,7 +92,7 @@ def test_vanishing_goto_durations_are_refused(
     assert client.post("/api/v1/gotos", content=v1, headers=headers).status_code == 422
     pypot = f'{{"position": 10, "duration": {duration}}}'
     error = _one_line_4xx(client.post("/motors/m1/goto.json", content=pypot))
-    assert "duration must be between 0.001 and 600 seconds" in error["error"]
+    assert "duration must be 0.001-600 s" in error["error"]
     several = f'{{"motors": ["m1"], "positions": [10], "duration": {duration}}}'
     _one_line_4xx(client.post("/motors/goto.json", content=several))
 

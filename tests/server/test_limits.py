@@ -126,3 +126,32 @@ def test_a_flood_of_idle_sockets_does_not_exhaust_file_descriptors(moves_folder:
     finally:
         server.stop()
         robot.close()
+
+
+def _refused_head(port: int, head: bytes) -> bytes:
+    """Send ``head`` (in pieces, stopping when the server closes) and read the answer."""
+    with socket.create_connection(("127.0.0.1", port)) as sock:
+        try:
+            for start in range(0, len(head), 16384):
+                sock.sendall(head[start : start + 16384])
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # closed once the limit was passed: the answer is already on its way
+        try:
+            return _closed_within(sock, WAIT_S)
+        except ConnectionResetError:
+            raise AssertionError("the connection was reset without an answer") from None
+
+
+def test_request_headers_have_a_size_and_a_count_limit(strict: ServerThread) -> None:
+    start = b"GET /robot.json HTTP/1.1\r\nHost: 127.0.0.1\r\n"
+    huge = start + b"X-Big: " + b"a" * (4 * 1024 * 1024) + b"\r\n\r\n"  # 4 MiB in one header
+    answer = _refused_head(strict.port, huge)
+    assert answer.startswith(b"HTTP/1.1 431"), answer[:80]
+    assert b"at most 64 KiB and 100 lines" in answer
+    many = start + b"".join(b"X-%d: 1\r\n" % i for i in range(200)) + b"\r\n"
+    assert _refused_head(strict.port, many).startswith(b"HTTP/1.1 431")
+    # what browsers and scripts send passes: 95 headers (54 KiB) on a kept-alive connection
+    with httpx.Client(base_url=strict.url) as http:
+        headers = {f"X-{i}": "b" * 600 for i in range(90)}  # and httpx's 5
+        for _ in range(2):
+            assert http.get("/robot.json", headers=headers).status_code == 200

@@ -3,6 +3,8 @@ a blank camera and a marker detector)."""
 
 from __future__ import annotations
 
+import time
+
 import httpx
 import numpy as np
 import pytest
@@ -88,3 +90,29 @@ def test_the_mjpeg_stream_sends_jpeg_parts(served: Served) -> None:
 
 def test_a_stream_of_no_camera_is_404(client: httpx.Client) -> None:
     assert client.get("/api/v1/sensors/marker_detector/stream.mjpg").status_code == 404
+
+
+def test_the_mjpeg_stream_waits_between_tries_of_a_camera_failed_for_good(
+    served: Served, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from poppy_core.errors import SensorError
+    from tests.helpers.waiting import eventually
+
+    camera = next(s for s in served.robot.sensors if s.name == "camera")
+    tries: list[int] = []
+
+    def failed_for_good(after: int = 0, timeout_s: float = 0.0) -> object:
+        tries.append(after)
+        raise SensorError("camera 'camera': unplugged for good", sensor="camera")
+
+    monkeypatch.setattr(camera, "next_frame", failed_for_good)
+    with httpx.Client(base_url=served.url, timeout=10.0) as http, http.stream(
+        "GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 30}
+    ) as answer:
+        assert answer.status_code == 200
+        assert eventually(lambda: len(tries) >= 2, 10.0)
+        first = len(tries)
+        time.sleep(1.0)  # a second with the stream open
+        # a floor of 0.5 s between tries: 2 or 3 in that second (load can only make it fewer);
+        # without one, thousands
+        assert len(tries) - first <= 5

@@ -147,8 +147,8 @@ def test_websocket_messages_are_checked(served: Served) -> None:
         assert "m2 already teleoperated" in taken["error"]
         for bad, words in [
             ({"m3": 1.0}, "'m3' is not teleoperated"),
-            ({"m1": "up"}, "expected a number"),
-            ({"m1": True}, "expected a number"),
+            ({"m1": "up"}, "m1 must be a number"),
+            ({"m1": True}, "m1 must be a number"),
             ([1, 2], "positions must be an object"),
         ]:
             answer = _ask(ws, {"type": "teleop.goals", "positions": bad})

@@ -15,6 +15,11 @@ WAIT_MARGIN_S = 2.0
 
 MISSING = object()
 
+CHANGES_STATE: dict[str, Any] = {"x-changes-state": True}
+"""``openapi_extra`` of a GET route that changes the robot (pypot's primitive controls): a page
+of another site may not reach it through a link or an image, whatever spelling of the path it
+uses (``poppy_core.server.state_routes``)."""
+
 
 async def json_body(request: Request, *, default: Any = MISSING, tip: str = "") -> Any:
     """The request body parsed as JSON (``default`` for an empty body, if given).

@@ -7,14 +7,14 @@ are comma-separated strings rounded to 4 decimals; ``goto.json`` takes ``duratio
 answers 400 for a missing parameter and 403 when IK fails; an unreachable target is one here.
 """
 
-import math
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
 from fastapi.responses import JSONResponse  # noqa: TID253
 from starlette.concurrency import run_in_threadpool
 
-from poppy_core.errors import KinematicsError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, KinematicsError
 from poppy_core.motion.cartesian import RobotChain
 from poppy_core.server.chains import find_chain
 from poppy_core.server.deps import Service
@@ -46,13 +46,12 @@ def _numbers(data: dict[str, Any], key: str) -> list[float] | None:
         return None
     raw = data[key]
     parts = raw.split(",") if isinstance(raw, str) else raw
-    try:
-        values = [float(v) for v in parts]
-    except (TypeError, ValueError):
-        values = []
-    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+    if not isinstance(parts, list) or len(parts) != 3:
         raise ApiError("invalid", f'{key} must be three numbers, e.g. "0.1,0,0.2"', tip=GOTO_TIP)
-    return values
+    try:
+        return [checks.number_from(v, key) for v in parts]
+    except ArgumentError as exc:
+        raise ApiError("invalid", str(exc), tip=GOTO_TIP) from None
 
 
 @router.get("/ik/{chain}/value.json", summary="Position and x axis of a chain's tip (pypot)")
@@ -69,9 +68,9 @@ async def ik_goto(chain: str, request: Request, service: Service) -> JSONRespons
     if not isinstance(data, dict) or "duration" not in data:
         raise ApiError("invalid", "A 'KeyError' occured. A parameter must be missing", tip=GOTO_TIP)
     try:
-        duration = check_duration(float(data["duration"]))
-    except (TypeError, ValueError):
-        raise ApiError("invalid", "duration must be a number of seconds", tip=GOTO_TIP) from None
+        duration = check_duration(data["duration"])
+    except ArgumentError as exc:
+        raise ApiError("invalid", str(exc), tip=GOTO_TIP) from None
     xyz, rot, rpy = _numbers(data, "xyz"), _numbers(data, "rot"), _numbers(data, "rpy")
     if xyz is None and rot is None and rpy is None:
         raise ApiError("invalid", "give xyz, rot or rpy", tip=GOTO_TIP)
@@ -102,9 +101,7 @@ async def ik_rpy(chain: str, request: Request, service: Service) -> JSONResponse
         data = {}
     values = {**dict(request.query_params), **data}
     try:
-        r, p, y = (float(values[k]) for k in ("r", "p", "y"))
-    except (KeyError, TypeError, ValueError):
-        raise ApiError("invalid", "r, p and y must be numbers", tip=RPY_TIP) from None
-    if not all(math.isfinite(v) for v in (r, p, y)):
-        raise ApiError("invalid", "r, p and y must be finite numbers", tip=RPY_TIP)
+        r, p, y = (checks.number_from(values[k], k) for k in ("r", "p", "y"))
+    except (KeyError, ArgumentError):
+        raise ApiError("invalid", "r, p and y must be finite numbers", tip=RPY_TIP) from None
     return JSONResponse({"rpy": found.rpy_to_rotation_matrix(r, p, y).tolist()})

@@ -1,16 +1,17 @@
 """pypot's routes for recorded moves (``/records``) and primitives (``/primitives``)."""
 
-import math
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
 from fastapi.responses import JSONResponse, Response  # noqa: TID253
 from starlette.concurrency import run_in_threadpool
 
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import pypot_positions
-from poppy_core.server.routers.common import json_body
+from poppy_core.server.routers.common import CHANGES_STATE, json_body
 
 router = APIRouter(tags=["pypot"])
 
@@ -67,10 +68,10 @@ async def play(move: str, request: Request, service: Service) -> JSONResponse:
     if not isinstance(data, dict) or "speed" not in data:
         raise ApiError("invalid", "speed field is missing.", tip=SPEED_TIP)
     try:
-        speed = float(data["speed"])
-    except (TypeError, ValueError, OverflowError):
-        raise ApiError("invalid", "the speed is not a number", tip=SPEED_TIP) from None
-    if not math.isfinite(speed) or speed == 0:
+        speed = checks.number_from(data["speed"], "speed")
+    except ArgumentError as exc:
+        raise ApiError("invalid", str(exc), tip=SPEED_TIP) from None
+    if speed == 0:
         raise ApiError("invalid", "the speed must be a finite, non-zero number", tip=SPEED_TIP)
     await run_in_threadpool(service.moves.play, move, abs(speed), speed < 0)
     return JSONResponse({move: "started replay"}, status_code=202)
@@ -113,25 +114,45 @@ def _control(primitive: str, action: str, service: Any) -> JSONResponse:
     return JSONResponse({primitive: PAST[action]}, status_code=202)
 
 
-@router.get("/primitives/{primitive}/start.json", status_code=202, summary="Start a primitive")
+@router.get(
+    "/primitives/{primitive}/start.json",
+    status_code=202,
+    summary="Start a primitive",
+    openapi_extra=CHANGES_STATE,
+)
 def start_primitive(primitive: str, service: Service) -> JSONResponse:
     """202 ``{primitive: "started"}``."""
     return _control(primitive, "start", service)
 
 
-@router.get("/primitives/{primitive}/stop.json", status_code=202, summary="Stop a primitive")
+@router.get(
+    "/primitives/{primitive}/stop.json",
+    status_code=202,
+    summary="Stop a primitive",
+    openapi_extra=CHANGES_STATE,
+)
 def stop_primitive(primitive: str, service: Service) -> JSONResponse:
     """202 ``{primitive: "stopped"}``."""
     return _control(primitive, "stop", service)
 
 
-@router.get("/primitives/{primitive}/pause.json", status_code=202, summary="Pause a primitive")
+@router.get(
+    "/primitives/{primitive}/pause.json",
+    status_code=202,
+    summary="Pause a primitive",
+    openapi_extra=CHANGES_STATE,
+)
 def pause_primitive(primitive: str, service: Service) -> JSONResponse:
     """202 ``{primitive: "paused"}``."""
     return _control(primitive, "pause", service)
 
 
-@router.get("/primitives/{primitive}/resume.json", status_code=202, summary="Resume a primitive")
+@router.get(
+    "/primitives/{primitive}/resume.json",
+    status_code=202,
+    summary="Resume a primitive",
+    openapi_extra=CHANGES_STATE,
+)
 def resume_primitive(primitive: str, service: Service) -> JSONResponse:
     """202 ``{primitive: "resumed"}``."""
     return _control(primitive, "resume", service)

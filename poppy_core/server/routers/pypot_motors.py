@@ -1,13 +1,14 @@
 """pypot's routes for the robot, motors, registers and gotos (same paths and shapes)."""
 
 import html
-import math
 import socket
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
 from fastapi.responses import HTMLResponse, JSONResponse  # noqa: TID253
 
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
 from poppy_core.server.pypot_values import pypot_value
@@ -123,12 +124,9 @@ async def set_register(
 
 def _float(value: Any, what: str, tip: str) -> float:
     try:
-        result = float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise ApiError("invalid", f"{what} must be a number", tip=tip) from None
-    if not math.isfinite(result):
-        raise ApiError("invalid", f"{what} must be a finite number", tip=tip)
-    return result
+        return checks.number_from(value, what)
+    except ArgumentError as exc:
+        raise ApiError("invalid", str(exc), tip=tip) from None
 
 
 @router.post("/motors/{motor}/goto.json", status_code=202, summary="Move one motor")

@@ -8,6 +8,7 @@ from fastapi import APIRouter, Query, Request  # noqa: TID253 (the server room i
 from fastapi.responses import Response, StreamingResponse  # noqa: TID253
 from starlette.concurrency import run_in_threadpool
 
+from poppy_core import checks
 from poppy_core.errors import SensorError
 from poppy_core.sensors import Camera
 from poppy_core.sensors.opencv import encode_image
@@ -20,6 +21,9 @@ router = APIRouter(tags=["sensors"], responses={404: {"model": Problem}, 503: {"
 BOUNDARY = "frame"
 MJPEG_QUALITY = 80
 FRAME_WAIT_S = 5.0
+LOST_CAMERA_RETRY_S = 0.5
+"""The stream's pause before asking a failed camera again (it may fail at once every time)."""
+MIN_FPS, MAX_FPS = 0.1, 60.0
 
 
 @router.get("/sensors", summary="Every sensor: type, registers, health")
@@ -67,7 +71,10 @@ async def mjpeg(camera: Camera, request: Request, fps: float) -> AsyncIterator[b
         try:
             latest = await run_in_threadpool(camera.next_frame, number, FRAME_WAIT_S)
         except SensorError:
-            continue  # a lost camera: keep the connection, frames come back with it
+            # a lost camera: keep the connection, frames come back with it; a camera that
+            # failed for good answers at once, so wait before asking again (no spinning)
+            await asyncio.sleep(max(period, LOST_CAMERA_RETRY_S))
+            continue
         number = latest.number
         jpeg = await run_in_threadpool(encode_image, latest.image, ".jpg", MJPEG_QUALITY)
         yield (
@@ -85,9 +92,10 @@ async def mjpeg(camera: Camera, request: Request, fps: float) -> AsyncIterator[b
 async def stream(
     sensor: str,
     request: Request,
-    fps: float = Query(15.0, gt=0, le=60, description="Frames per second at most."),
+    fps: float = Query(15.0, description=f"Frames per second at most ({MIN_FPS:g}-{MAX_FPS:g})."),
 ) -> StreamingResponse:
     """Every new frame as a JPEG part, at most ``fps`` per second, until the client leaves."""
+    fps = checks.in_range(fps, MIN_FPS, MAX_FPS, "fps", "Hz")  # NaN, 0, 1e-300: a 422
     camera = sensors_of(request).camera(sensor)
     await run_in_threadpool(camera.latest)  # the first frame (or a 503 now, not mid-stream)
     return StreamingResponse(

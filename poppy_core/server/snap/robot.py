@@ -7,12 +7,12 @@ move library of ``poppy record``. Refusals are ``ApiError``s: the app answers th
 
 from __future__ import annotations
 
-import math
 import threading
 from collections.abc import Sequence
 from typing import Any
 
-from poppy_core.errors import KinematicsError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, KinematicsError
 from poppy_core.server import values
 from poppy_core.server.chains import find_chain
 from poppy_core.server.errors import ApiError
@@ -37,12 +37,9 @@ NO_DETECTOR = "Error: marker detector is not activated"
 def number(text: str, what: str) -> float:
     """A finite number from a URL segment, else ``ApiError("invalid")``."""
     try:
-        result = float(text)
-    except ValueError:
-        result = math.nan
-    if not math.isfinite(result):
-        raise ApiError("invalid", f"{what} must be a number, got {text[:40]!r}")
-    return result
+        return checks.number_from(text, what)
+    except ArgumentError as exc:
+        raise ApiError("invalid", str(exc)) from None
 
 
 def _speed(text: str) -> float:
