@@ -9,7 +9,6 @@ passed them) and inside the body-size limit, which hands it the whole body in on
 
 from __future__ import annotations
 
-import json
 import re
 from typing import Any
 
@@ -17,6 +16,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from poppy_core.server.errors import ApiError
 from poppy_core.server.jsonio import parse_json
+from poppy_core.server.pypot_json import html_safe, pypot_bytes, pypot_raw_headers
 from poppy_core.server.service import RobotService
 
 REGISTER_VALUE = re.compile(r"^/motors/([A-Za-z0-9_]+)/registers/([A-Za-z0-9_]+)/value\.json$")
@@ -36,7 +36,7 @@ class RegisterFastPath:
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] == "http" and scope["path"] == "/robot.json" and scope["method"] == "GET":
-            await _send(send, 200, self.service.description_json())
+            await _send(send, 200, html_safe(self.service.description_json()))
             return
         match = REGISTER_VALUE.match(scope["path"]) if scope["type"] == "http" else None
         if match is None or scope["method"] not in ("GET", "POST"):
@@ -65,11 +65,11 @@ class RegisterFastPath:
 
 
 async def _answer(send: Send, status: int, data: dict[str, Any]) -> None:
-    await _send(send, status, json.dumps(data).encode())
+    await _send(send, status, pypot_bytes(data))
 
 
 async def _send(send: Send, status: int, body: bytes) -> None:
-    headers = [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())]
+    headers = pypot_raw_headers(len(body))  # pypot's type and headers, as the routes answer
     await send({"type": "http.response.start", "status": status, "headers": headers})
     await send({"type": "http.response.body", "body": body})
 

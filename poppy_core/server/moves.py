@@ -130,9 +130,14 @@ class MoveService:
         return recorder
 
     def recording(self) -> list[str]:
-        """Names being recorded."""
+        """Names being recorded (and takes kept after a failed save)."""
         with self._lock:
             return sorted(self._recorders)
+
+    def recording_live(self) -> list[str]:
+        """Names whose recorder still samples (not the takes kept after a failed save)."""
+        with self._lock:
+            return sorted(n for n, r in self._recorders.items() if r.recording)
 
     def save(self, name: str) -> Move:
         """Stop recording ``name`` and save it to the library (stopping a playback of it).

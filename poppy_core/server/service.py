@@ -196,6 +196,18 @@ class RobotService:
         """Names of the primitives running (or paused)."""
         return [name for name, p in self.primitives().items() if p.is_alive()]
 
+    def pypot_running_primitives(self) -> list[str]:
+        """``running_primitives()`` and the moves recorded or played, under pypot's names.
+
+        pypot attached the recorder and the player of a move as primitives named
+        ``_<move>_recorder`` and ``_<move>_player`` (pypot 5.0.2, ``pypot/server/rest.py``), so
+        its running list held them; puppet-master's move recorder polls it for ``_<move>_player``
+        to know when a move has ended.
+        """
+        recording = [f"_{name}_recorder" for name in self.moves.recording_live()]
+        playing = [f"_{name}_player" for name in self.moves.playing()]
+        return [*self.running_primitives(), *recording, *playing]
+
     def control_primitive(self, name: str, action: str) -> Primitive:
         """``start``, ``stop``, ``pause`` or ``resume`` a primitive (``stop`` joins its thread)."""
         primitive = self.primitive(name)

@@ -11,7 +11,6 @@ import math
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
-from fastapi.responses import JSONResponse  # noqa: TID253
 from starlette.concurrency import run_in_threadpool
 
 from poppy_core.errors import KinematicsError
@@ -19,6 +18,7 @@ from poppy_core.motion.cartesian import RobotChain
 from poppy_core.server.chains import find_chain
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
+from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.routers.common import json_body, truthy, wait_goto
 from poppy_core.server.service import check_duration
 
@@ -56,13 +56,13 @@ def _numbers(data: dict[str, Any], key: str) -> list[float] | None:
 
 
 @router.get("/ik/{chain}/value.json", summary="Position and x axis of a chain's tip (pypot)")
-def ik_value(chain: str, service: Service) -> JSONResponse:
+def ik_value(chain: str, service: Service) -> PypotJSON:
     """``{"xyz": "x,y,z", "rot": "Rx.x,Rx.y,Rx.z"}``."""
-    return JSONResponse(_value(find_chain(service.robot, chain)))
+    return PypotJSON(_value(find_chain(service.robot, chain)))
 
 
 @router.post("/ik/{chain}/goto.json", summary="Move a chain's tip (pypot)")
-async def ik_goto(chain: str, request: Request, service: Service) -> JSONResponse:
+async def ik_goto(chain: str, request: Request, service: Service) -> PypotJSON:
     """Moves every active motor in one goto; answers the tip's pose (after it, with ``wait``)."""
     found = find_chain(service.robot, chain)
     data = await json_body(request, tip=GOTO_TIP)
@@ -90,11 +90,11 @@ async def ik_goto(chain: str, request: Request, service: Service) -> JSONRespons
         ) from None
     if wait:
         await wait_goto(handle)
-    return JSONResponse(_value(found))
+    return PypotJSON(_value(found))
 
 
 @router.get("/ik/{chain}/rpy.json", summary="Rotation matrix of roll, pitch, yaw (pypot)")
-async def ik_rpy(chain: str, request: Request, service: Service) -> JSONResponse:
+async def ik_rpy(chain: str, request: Request, service: Service) -> PypotJSON:
     """``{"rpy": 3x3}`` of ``r``, ``p``, ``y`` in radians (URDF convention, as ikpy's)."""
     found = find_chain(service.robot, chain)
     data = await json_body(request, default={}, tip=RPY_TIP)
@@ -107,4 +107,4 @@ async def ik_rpy(chain: str, request: Request, service: Service) -> JSONResponse
         raise ApiError("invalid", "r, p and y must be numbers", tip=RPY_TIP) from None
     if not all(math.isfinite(v) for v in (r, p, y)):
         raise ApiError("invalid", "r, p and y must be finite numbers", tip=RPY_TIP)
-    return JSONResponse({"rpy": found.rpy_to_rotation_matrix(r, p, y).tolist()})
+    return PypotJSON({"rpy": found.rpy_to_rotation_matrix(r, p, y).tolist()})

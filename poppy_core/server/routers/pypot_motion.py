@@ -4,12 +4,13 @@ import math
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
-from fastapi.responses import JSONResponse, Response  # noqa: TID253
+from fastapi.responses import Response  # noqa: TID253
 from starlette.concurrency import run_in_threadpool
 
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import pypot_positions
+from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.routers.common import json_body
 
 router = APIRouter(tags=["pypot"])
@@ -25,14 +26,14 @@ SPEED_TIP = 'the speed is a number, negative to play backwards, e.g. {"speed": "
 
 
 @router.get("/records/list.json", summary="The moves of the library")
-async def records_list(service: Service) -> JSONResponse:
+async def records_list(service: Service) -> PypotJSON:
     """``{"moves": [names]}``."""
     names = await run_in_threadpool(service.moves.names)
-    return JSONResponse({"moves": names})
+    return PypotJSON({"moves": names})
 
 
 @router.post("/records/{move}/record.json", status_code=202, summary="Start recording a move")
-async def record(move: str, request: Request, service: Service) -> JSONResponse:
+async def record(move: str, request: Request, service: Service) -> PypotJSON:
     """202 ``{move: "recording"}``; the optional body names the motors."""
     data = await json_body(request, default={}, tip=MOTORS_TIP)
     motors: Any = data.get("motors") if isinstance(data, dict) else None
@@ -43,25 +44,25 @@ async def record(move: str, request: Request, service: Service) -> JSONResponse:
     ):
         raise ApiError("invalid", "cannot read the motors given", tip=MOTORS_TIP)
     await run_in_threadpool(service.moves.record, move, motors or None)
-    return JSONResponse({move: "recording"}, status_code=202)
+    return PypotJSON({move: "recording"}, status_code=202)
 
 
 @router.post("/records/{move}/save.json", status_code=202, summary="Stop recording and save")
-def save(move: str, service: Service) -> JSONResponse:
+def save(move: str, service: Service) -> PypotJSON:
     """202 ``{move: "saved"}``; 404 when it is not being recorded."""
     service.moves.save(move)
-    return JSONResponse({move: "saved"}, status_code=202)
+    return PypotJSON({move: "saved"}, status_code=202)
 
 
 @router.get("/records/{move}/value.json", summary="The frames of a move")
-def move_value(move: str, service: Service) -> JSONResponse:
+def move_value(move: str, service: Service) -> PypotJSON:
     """``{move: {time: {motor: [position, speed]}}, "length": frames}``."""
     recorded = service.moves.value(move)
-    return JSONResponse({move: pypot_positions(recorded), "length": len(recorded)})
+    return PypotJSON({move: pypot_positions(recorded), "length": len(recorded)})
 
 
 @router.post("/records/{move}/play.json", status_code=202, summary="Play a move")
-async def play(move: str, request: Request, service: Service) -> JSONResponse:
+async def play(move: str, request: Request, service: Service) -> PypotJSON:
     """202 ``{move: "started replay"}``; a negative speed plays it backwards."""
     data = await json_body(request, tip=SPEED_TIP)
     if not isinstance(data, dict) or "speed" not in data:
@@ -73,82 +74,82 @@ async def play(move: str, request: Request, service: Service) -> JSONResponse:
     if not math.isfinite(speed) or speed == 0:
         raise ApiError("invalid", "the speed must be a finite, non-zero number", tip=SPEED_TIP)
     await run_in_threadpool(service.moves.play, move, abs(speed), speed < 0)
-    return JSONResponse({move: "started replay"}, status_code=202)
+    return PypotJSON({move: "started replay"}, status_code=202)
 
 
 @router.post("/records/{move}/stop.json", status_code=202, summary="Stop playing a move")
-def stop(move: str, service: Service) -> JSONResponse:
+def stop(move: str, service: Service) -> PypotJSON:
     """202 ``{move: "stopped"}``; 400 when it was never played."""
     service.moves.stop(move)
-    return JSONResponse({move: "stopped"}, status_code=202)
+    return PypotJSON({move: "stopped"}, status_code=202)
 
 
 @router.post("/records/{move}/delete.json", status_code=202, summary="Delete a move")
-def delete(move: str, service: Service) -> JSONResponse:
+def delete(move: str, service: Service) -> PypotJSON:
     """202 ``{move: "deleted"}``; 404 when there is no such move."""
     service.moves.delete(move)
-    return JSONResponse({move: "deleted"}, status_code=202)
+    return PypotJSON({move: "deleted"}, status_code=202)
 
 
 # -- primitives ------------------------------------------------------------------------------
 
 
 @router.get("/primitives/list.json", summary="The attached primitives")
-async def primitives_list(service: Service) -> JSONResponse:
+async def primitives_list(service: Service) -> PypotJSON:
     """``{"primitives": [names]}``."""
-    return JSONResponse({"primitives": list(service.primitives())})
+    return PypotJSON({"primitives": list(service.primitives())})
 
 
 @router.get("/primitives/running/list.json", summary="The running primitives")
-async def running_list(service: Service) -> JSONResponse:
-    """``{"running_primitives": [names]}``."""
-    return JSONResponse({"running_primitives": service.running_primitives()})
+async def running_list(service: Service) -> PypotJSON:
+    """``{"running_primitives": [names]}``, with pypot's ``_<move>_recorder``/``_<move>_player``."""
+    return PypotJSON({"running_primitives": service.pypot_running_primitives()})
 
 
 PAST = {"start": "started", "stop": "stopped", "pause": "paused", "resume": "resumed"}
 
 
-def _control(primitive: str, action: str, service: Any) -> JSONResponse:
+def _control(primitive: str, action: str, service: Any) -> PypotJSON:
     service.control_primitive(primitive, action)
-    return JSONResponse({primitive: PAST[action]}, status_code=202)
+    return PypotJSON({primitive: PAST[action]}, status_code=202)
 
 
 @router.get("/primitives/{primitive}/start.json", status_code=202, summary="Start a primitive")
-def start_primitive(primitive: str, service: Service) -> JSONResponse:
+def start_primitive(primitive: str, service: Service) -> PypotJSON:
     """202 ``{primitive: "started"}``."""
     return _control(primitive, "start", service)
 
 
 @router.get("/primitives/{primitive}/stop.json", status_code=202, summary="Stop a primitive")
-def stop_primitive(primitive: str, service: Service) -> JSONResponse:
+def stop_primitive(primitive: str, service: Service) -> PypotJSON:
     """202 ``{primitive: "stopped"}``."""
     return _control(primitive, "stop", service)
 
 
 @router.get("/primitives/{primitive}/pause.json", status_code=202, summary="Pause a primitive")
-def pause_primitive(primitive: str, service: Service) -> JSONResponse:
+def pause_primitive(primitive: str, service: Service) -> PypotJSON:
     """202 ``{primitive: "paused"}``."""
     return _control(primitive, "pause", service)
 
 
 @router.get("/primitives/{primitive}/resume.json", status_code=202, summary="Resume a primitive")
-def resume_primitive(primitive: str, service: Service) -> JSONResponse:
+def resume_primitive(primitive: str, service: Service) -> PypotJSON:
     """202 ``{primitive: "resumed"}``."""
     return _control(primitive, "resume", service)
 
 
 @router.get("/primitives/{primitive}/properties/list.json", summary="A primitive's properties")
-async def properties_list(primitive: str, service: Service) -> JSONResponse:
+async def properties_list(primitive: str, service: Service) -> PypotJSON:
     """``{"property": [names]}`` (pypot's key)."""
-    return JSONResponse({"property": service.property_names(primitive)})
+    return PypotJSON({"property": service.property_names(primitive)})
 
 
 @router.get(
     "/primitives/{primitive}/properties/{prop}/value.json", summary="Read a primitive property"
 )
-async def get_property(primitive: str, prop: str, service: Service) -> JSONResponse:
+async def get_property(primitive: str, prop: str, service: Service) -> PypotJSON:
     """``{"primitive.prop": value}``."""
-    return JSONResponse({f"{primitive}.{prop}": service.get_property(primitive, prop)})
+    return PypotJSON({f"{primitive}.{prop}": service.get_property(primitive, prop)})
 
 
 @router.post(
@@ -164,21 +165,19 @@ async def set_property(primitive: str, prop: str, request: Request, service: Ser
 
 
 @router.get("/primitives/{primitive}/methods/list.json", summary="A primitive's methods")
-async def methods_list(primitive: str, service: Service) -> JSONResponse:
+async def methods_list(primitive: str, service: Service) -> PypotJSON:
     """``{"methods": [names]}``."""
-    return JSONResponse({"methods": service.method_names(primitive)})
+    return PypotJSON({"methods": service.method_names(primitive)})
 
 
 @router.post(
     "/primitives/{primitive}/methods/{method}/args.json", summary="Call a primitive method"
 )
-async def call_method(
-    primitive: str, method: str, request: Request, service: Service
-) -> JSONResponse:
+async def call_method(primitive: str, method: str, request: Request, service: Service) -> PypotJSON:
     """``{"primitive:method": result}``; the body holds the keyword arguments (or a list)."""
     data = await json_body(request, default={}, tip="the body is an object of keyword arguments")
     args, kwargs = (data, {}) if isinstance(data, list) else ([], data)
     if not isinstance(kwargs, dict):
         args, kwargs = [data], {}
     result = await run_in_threadpool(service.call_method, primitive, method, args, kwargs)
-    return JSONResponse({f"{primitive}:{method}": result})
+    return PypotJSON({f"{primitive}:{method}": result})
