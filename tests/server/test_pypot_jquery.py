@@ -115,16 +115,15 @@ def test_a_move_is_recorded_listed_played_and_stopped(page: Any, robot_server: S
     page.evaluate("() => startRecording('jq_wave', ['m1', 'm2'])")
     assert eventually(lambda: moves.recording() == ["jq_wave"], WAIT_S)
     robot.goto_position({"m1": 20.0}, 1.0, wait=True)
-    page.evaluate("() => saveRecording('jq_wave')")
+    page.evaluate("() => saveRecording('jq_wave')")  # and asks for the list at once
     assert eventually(lambda: moves.recording() == [] and "jq_wave" in moves.names(), WAIT_S)
-
-    page.evaluate("() => loadMoves()")
-    assert eventually(lambda: "jq_wave" in texts(page, "#moves option"), WAIT_S)
+    assert eventually(lambda: page.evaluate("() => window.listsLoaded") == 1, WAIT_S)
+    assert "jq_wave" in texts(page, "#moves option")  # the list answered after the save
 
     page.evaluate("() => play('jq_wave', 0.1)")  # 10 times slower: still playing when stopped
     assert eventually(lambda: page.evaluate("() => window.sawPlayer"), WAIT_S)
     assert moves.playing() == ["jq_wave"]
-    assert page.inner_text("#state") == "playing"
+    assert page.inner_text("#state") == "playing"  # the first poll already saw the player
     assert eventually(lambda: robot.m1.goal_position < 15.0, WAIT_S)  # on its way back to -20
     page.evaluate("() => stop('jq_wave')")
     assert eventually(lambda: page.inner_text("#state") == "ended", WAIT_S)

@@ -20,6 +20,10 @@ MOTORS_TIP = (
     '{"motors": "m1,m2"}'
 )
 SPEED_TIP = 'the speed is a number, negative to play backwards, e.g. {"speed": "-1.0"}'
+# IN ORDER: pypot handled requests one after the other on its event loop, and pages written for
+# it count on that: puppet-master's move recorder asks for the move list right after posting a
+# save, and for the running list right after posting a play. Saving and starting a playback are
+# therefore done on the event loop (no thread-pool hop), so a request arriving next sees them.
 
 
 # -- records ---------------------------------------------------------------------------------
@@ -48,8 +52,11 @@ async def record(move: str, request: Request, service: Service) -> PypotJSON:
 
 
 @router.post("/records/{move}/save.json", status_code=202, summary="Stop recording and save")
-def save(move: str, service: Service) -> PypotJSON:
-    """202 ``{move: "saved"}``; 404 when it is not being recorded."""
+async def save(move: str, service: Service) -> PypotJSON:
+    """202 ``{move: "saved"}``; 404 when it is not being recorded.
+
+    Saved on the event loop (see IN ORDER above): the list asked for next holds the move.
+    """
     service.moves.save(move)
     return PypotJSON({move: "saved"}, status_code=202)
 
@@ -73,7 +80,7 @@ async def play(move: str, request: Request, service: Service) -> PypotJSON:
         raise ApiError("invalid", "the speed is not a number", tip=SPEED_TIP) from None
     if not math.isfinite(speed) or speed == 0:
         raise ApiError("invalid", "the speed must be a finite, non-zero number", tip=SPEED_TIP)
-    await run_in_threadpool(service.moves.play, move, abs(speed), speed < 0)
+    service.moves.play(move, abs(speed), speed < 0)  # on the event loop: see IN ORDER above
     return PypotJSON({move: "started replay"}, status_code=202)
 
 
