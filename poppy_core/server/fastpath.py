@@ -16,7 +16,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from poppy_core.server.errors import ApiError
 from poppy_core.server.jsonio import parse_json
-from poppy_core.server.pypot_json import html_safe, pypot_bytes, pypot_raw_headers
+from poppy_core.server.pypot_json import pypot_bytes, pypot_raw_headers
 from poppy_core.server.service import RobotService
 
 REGISTER_VALUE = re.compile(r"^/motors/([A-Za-z0-9_]+)/registers/([A-Za-z0-9_]+)/value\.json$")
@@ -36,7 +36,7 @@ class RegisterFastPath:
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] == "http" and scope["path"] == "/robot.json" and scope["method"] == "GET":
-            await _send(send, 200, html_safe(self.service.description_json()))
+            await _send(send, 200, self.service.description_json())
             return
         match = REGISTER_VALUE.match(scope["path"]) if scope["type"] == "http" else None
         if match is None or scope["method"] not in ("GET", "POST"):

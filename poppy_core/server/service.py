@@ -18,6 +18,7 @@ from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
+from poppy_core.server.pypot_json import html_safe
 from poppy_core.server.teleop import TeleopRegistry
 
 DESCRIPTION_TTL_S = 0.01
@@ -156,14 +157,15 @@ class RobotService:
         return attached_primitives(self.robot)
 
     def description_json(self) -> bytes:
-        """``description()`` encoded, rebuilt at most every ``DESCRIPTION_TTL_S``.
+        """``description()`` encoded as pypot's routes answer it (``pypot_json.html_safe``),
+        rebuilt at most every ``DESCRIPTION_TTL_S``.
 
         The motors' values come from caches the sync loops refresh at 50 Hz, so a description
         up to 10 ms old says the same; pollers asking many times a second share one encoding.
         """
         now = time.monotonic()
         if self._description is None or now - self._description[0] > DESCRIPTION_TTL_S:
-            self._description = (now, json.dumps(self.description()).encode())
+            self._description = (now, html_safe(json.dumps(self.description()).encode()))
         return self._description[1]
 
     def description(self) -> dict[str, Any]:
