@@ -30,6 +30,10 @@ PYPOT_HEADERS: dict[str, str] = {
 ``Cache-control: no-store`` is added to every answer by ``origins.OriginGuard``."""
 
 
+ENCODER = json.JSONEncoder(ensure_ascii=False, allow_nan=False, separators=(",", ":"))
+"""Starlette's JSON encoding (one encoder: ``json.dumps`` with options builds one per call)."""
+
+
 def html_safe(body: bytes) -> bytes:
     """JSON ``body`` with ``<``, ``>`` and ``&`` escaped (same JSON, no markup)."""
     return body.replace(b"<", b"\\u003c").replace(b">", b"\\u003e").replace(b"&", b"\\u0026")
@@ -41,8 +45,7 @@ def pypot_bytes(content: Any) -> bytes:
     Raises:
         ValueError: ``content`` holds a non-finite number (not JSON).
     """
-    encoded = json.dumps(content, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
-    return html_safe(encoded.encode("utf-8"))
+    return html_safe(ENCODER.encode(content).encode("utf-8"))
 
 
 def pypot_raw_headers(length: int) -> list[tuple[bytes, bytes]]:
