@@ -220,10 +220,8 @@ def _save_elsewhere(recorder: MoveRecorder, failure: FileError, name: str) -> Pa
     Raises:
         FileError: nothing could be written anywhere.
     """
-    import tempfile
-    from datetime import datetime
-
     from poppy_core.errors import FileError
+    from poppy_core.motion import fallback_path
 
     error_line(f"the take could not be saved: {failure}")
     while _interactive():
@@ -237,8 +235,7 @@ def _save_elsewhere(recorder: MoveRecorder, failure: FileError, name: str) -> Pa
             return recorder.save(Path(answer).expanduser())
         except FileError as exc:
             error_line(str(exc))
-    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
-    fallback = Path(tempfile.gettempdir()) / f"poppy-take-{name.replace('/', '_')}-{stamp}.move"
+    fallback = fallback_path(name)
     try:
         written = recorder.save(fallback)
     except FileError as exc:

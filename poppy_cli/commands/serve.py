@@ -18,6 +18,7 @@ from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
     from poppy_core.server import ServerThread
+    from poppy_core.server.moves import SavedTake
     from poppy_core.server.zmqserver import ZmqRobotServer
 
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
@@ -171,7 +172,27 @@ def serve(
                 zmq_server.stop()
             for server in reversed(servers):
                 server.stop()
+            app.state.service.close()  # done already by the HTTP app's lifespan, if it ran
+            _say_where_takes_went(app.state.service.moves.saved_on_close)
     print("stopped", file=sys.stderr, flush=True)
+
+
+def _say_where_takes_went(saved: list[SavedTake]) -> None:
+    """One line per take saved on stopping (a recording in progress, a take kept after a 507)."""
+    for take in saved:
+        if take.in_library:
+            err_console.print(
+                f"the take {take.name!r} ({take.frames} frames) was not saved yet: saved it "
+                f"to the move library, {take.path}",
+                soft_wrap=True, highlight=False, markup=False,
+            )  # fmt: skip
+        else:
+            err_console.print(
+                f"the take {take.name!r} ({take.frames} frames) was not saved yet and the "
+                f"library could not have it: saved it to {take.path}; `poppy moves import "
+                f"{take.path}` puts it in the library",
+                soft_wrap=True, highlight=False, markup=False,
+            )  # fmt: skip
 
 
 def _report(line: str) -> None:

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import os
 import re
+import tempfile
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 
 import platformdirs
@@ -180,6 +182,17 @@ def delete_move(ref: str | os.PathLike[str]) -> Path:
     path = move_path(ref)
     path.unlink()
     return path
+
+
+def fallback_path(name: str) -> Path:
+    """Where a take goes when its destination failed: ``<temp dir>/poppy-take-<name>-<time>.move``.
+
+    ``poppy record`` and a server stopping with takes not saved write there when the library
+    cannot have them; ``poppy moves import`` brings such a file into the library.
+    """
+    stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+    safe = name.replace("/", "_").replace(os.sep, "_")
+    return Path(tempfile.gettempdir()) / f"poppy-take-{safe}-{stamp}{MOVE_SUFFIX}"
 
 
 def import_move(

@@ -2,7 +2,8 @@
 
 Routes raise ``ApiError`` (or let a ``PoppyError`` through); the handlers installed by
 ``install_error_handlers`` answer ``{"error", "tip", "details"}`` on pypot's routes (with pypot's
-status codes) and ``{"detail"}`` on the v1 API (404 unknown, 409 conflict, 422 invalid value).
+status codes and content type) and ``{"detail"}`` on the v1 API (404 unknown, 409 conflict, 422
+invalid value).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from poppy_core.errors import (
     RobotClosedError,
     SensorError,
 )
+from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.refusals import one_line
 
 if TYPE_CHECKING:
@@ -87,7 +89,7 @@ def error_response(request: Request, error: ApiError) -> JSONResponse:
     if request.url.path.startswith(V1_PREFIX):
         return JSONResponse({"detail": message}, status_code=V1_STATUS[error.kind])
     status = error.pypot_status or PYPOT_STATUS[error.kind]
-    return JSONResponse(pypot_body(message, one_line(error.tip), message), status_code=status)
+    return PypotJSON(pypot_body(message, one_line(error.tip), message), status_code=status)
 
 
 def from_poppy_error(exc: PoppyError) -> ApiError:
@@ -142,7 +144,7 @@ async def _bug(request: Request, exc: Exception) -> Response:
     if request.url.path.startswith(V1_PREFIX):
         return JSONResponse({"detail": message}, status_code=500)
     tip = "this is a bug in poppy: please report it with the server's log"
-    return JSONResponse(pypot_body(message, tip), status_code=500)
+    return PypotJSON(pypot_body(message, tip), status_code=500)
 
 
 def install_error_handlers(app: FastAPI) -> None:

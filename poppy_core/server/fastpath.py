@@ -9,7 +9,6 @@ passed them) and inside the body-size limit, which hands it the whole body in on
 
 from __future__ import annotations
 
-import json
 import re
 from typing import Any
 
@@ -18,6 +17,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from poppy_core.errors import ArgumentError
 from poppy_core.server.errors import ApiError
 from poppy_core.server.jsonio import parse_json
+from poppy_core.server.pypot_json import pypot_bytes, pypot_raw_headers
 from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.service import RobotService
 
@@ -68,11 +68,11 @@ class RegisterFastPath:
 
 
 async def _answer(send: Send, status: int, data: dict[str, Any]) -> None:
-    await _send(send, status, json.dumps(data).encode())
+    await _send(send, status, pypot_bytes(data))
 
 
 async def _send(send: Send, status: int, body: bytes) -> None:
-    headers = [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())]
+    headers = pypot_raw_headers(len(body))  # pypot's type and headers, as the routes answer
     await send({"type": "http.response.start", "status": status, "headers": headers})
     await send({"type": "http.response.body", "body": body})
 

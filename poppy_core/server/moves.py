@@ -2,7 +2,9 @@
 
 Recordings live in memory until saved; saved moves go to the library (``moves_dir()``), never to
 the working directory. Names are restricted to letters, digits, ``_`` and ``-`` so a URL can never
-reach a path outside the library.
+reach a path outside the library. A server stopping saves the takes not yet saved (recordings in
+progress, takes kept after a failed save): to the library when the name is free there, else to
+``fallback_path()``, as ``poppy record`` does.
 """
 
 from __future__ import annotations
@@ -12,6 +14,8 @@ import logging
 import re
 import threading
 from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from poppy_core.errors import ConfigError, FileError
@@ -21,9 +25,11 @@ from poppy_core.motion import (
     MoveRecorder,
     delete_move,
     encode_pypot,
+    fallback_path,
     list_moves,
     load_move,
     save_move,
+    write_move,
 )
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
@@ -35,6 +41,17 @@ MAX_RECORDINGS = 8
 """Recordings running at once (each is a thread)."""
 RECORD_TIP = "start by recording a move with /records/<move_name>/record.json"
 PLAY_TIP = "start by playing a move with /records/<move_name>/play.json"
+
+
+@dataclass(frozen=True)
+class SavedTake:
+    """A take a stopping server saved: its name, where it went, how long it is."""
+
+    name: str
+    path: Path
+    frames: int
+    in_library: bool
+    """False when the library could not have it (name taken, full disk): a temporary file."""
 
 
 def check_move_name(name: str) -> str:
@@ -60,6 +77,9 @@ class MoveService:
         self._lock = threading.Lock()
         self._recorders: dict[str, MoveRecorder] = {}
         self._players: dict[str, MovePlayer] = {}
+        self._closing = threading.Lock()
+        self.saved_on_close: list[SavedTake] = []
+        """The takes ``close()`` saved (a server says where on stopping)."""
 
     # -- library -------------------------------------------------------------------------------
 
@@ -130,9 +150,14 @@ class MoveService:
         return recorder
 
     def recording(self) -> list[str]:
-        """Names being recorded."""
+        """Names being recorded (and takes kept after a failed save)."""
         with self._lock:
             return sorted(self._recorders)
+
+    def recording_live(self) -> list[str]:
+        """Names whose recorder still samples (not the takes kept after a failed save)."""
+        with self._lock:
+            return sorted(n for n, r in self._recorders.items() if r.recording)
 
     def save(self, name: str) -> Move:
         """Stop recording ``name`` and save it to the library (stopping a playback of it).
@@ -204,17 +229,53 @@ class MoveService:
             )
         player.stop()
 
-    def close(self) -> None:
-        """Stop every recording (unsaved ones are lost) and playback."""
-        with self._lock:
-            recorders = list(self._recorders.values())
-            players = list(self._players.values())
-            self._recorders.clear()
-            self._players.clear()
-        for recorder in recorders:
-            recorder.stop()
-        for player in players:
-            player.stop()
+    def close(self) -> list[SavedTake]:
+        """Stop every playback and recording, and save the takes not saved yet.
+
+        A recording in progress and a take kept after a failed save go to the library under
+        their name when it is free there (a saved move is never replaced), else to
+        ``fallback_path()``; a take nothing could hold is logged as lost. A second call (the
+        app's lifespan and ``poppy serve`` both close) waits for the first and saves nothing new.
+
+        Returns:
+            The takes saved by this call (all of them are in ``saved_on_close``).
+        """
+        with self._closing:
+            with self._lock:
+                recorders = dict(self._recorders)
+                players = list(self._players.values())
+                self._recorders.clear()
+                self._players.clear()
+            for player in players:
+                player.stop()
+            saved = []
+            for name, recorder in sorted(recorders.items()):
+                take = self._save_on_close(name, recorder)
+                if take is not None:
+                    saved.append(take)
+            self.saved_on_close.extend(saved)
+            return saved
+
+    def _save_on_close(self, name: str, recorder: MoveRecorder) -> SavedTake | None:
+        try:
+            move = recorder.stop()
+        except FileError:  # a checkpoint file failed: the take is still held
+            move = recorder.move
+        if len(move) == 0:
+            return None
+        try:
+            path = save_move(move, name, replace=False)
+            in_library = True
+        except FileError as exc:
+            logger.info("the library cannot have the take %s (%s): saving it elsewhere", name, exc)
+            try:
+                path = write_move(move, fallback_path(name), replace=False)
+            except FileError as again:
+                logger.error("the take %s (%d frames) is lost: %s", name, len(move), again)
+                return None
+            in_library = False
+        logger.info("saved the take %s (%d frames) to %s on closing", name, len(move), path)
+        return SavedTake(name, path, len(move), in_library)
 
 
 def pypot_positions(move: Move) -> dict[str, Any]:

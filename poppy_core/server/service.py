@@ -19,6 +19,7 @@ from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
+from poppy_core.server.pypot_json import html_safe
 from poppy_core.server.teleop import TeleopRegistry
 
 DESCRIPTION_TTL_S = 0.01
@@ -157,14 +158,15 @@ class RobotService:
         return attached_primitives(self.robot)
 
     def description_json(self) -> bytes:
-        """``description()`` encoded, rebuilt at most every ``DESCRIPTION_TTL_S``.
+        """``description()`` encoded as pypot's routes answer it (``pypot_json.html_safe``),
+        rebuilt at most every ``DESCRIPTION_TTL_S``.
 
         The motors' values come from caches the sync loops refresh at 50 Hz, so a description
         up to 10 ms old says the same; pollers asking many times a second share one encoding.
         """
         now = time.monotonic()
         if self._description is None or now - self._description[0] > DESCRIPTION_TTL_S:
-            self._description = (now, json.dumps(self.description()).encode())
+            self._description = (now, html_safe(json.dumps(self.description()).encode()))
         return self._description[1]
 
     def description(self) -> dict[str, Any]:
@@ -196,6 +198,18 @@ class RobotService:
     def running_primitives(self) -> list[str]:
         """Names of the primitives running (or paused)."""
         return [name for name, p in self.primitives().items() if p.is_alive()]
+
+    def pypot_running_primitives(self) -> list[str]:
+        """``running_primitives()`` and the moves recorded or played, under pypot's names.
+
+        pypot attached the recorder and the player of a move as primitives named
+        ``_<move>_recorder`` and ``_<move>_player`` (pypot 5.0.2, ``pypot/server/rest.py``), so
+        its running list held them; puppet-master's move recorder polls it for ``_<move>_player``
+        to know when a move has ended.
+        """
+        recording = [f"_{name}_recorder" for name in self.moves.recording_live()]
+        playing = [f"_{name}_player" for name in self.moves.playing()]
+        return [*self.running_primitives(), *recording, *playing]
 
     def control_primitive(self, name: str, action: str) -> Primitive:
         """``start``, ``stop``, ``pause`` or ``resume`` a primitive (``stop`` joins its thread)."""

@@ -59,7 +59,7 @@ class ZmqRequests:
             "set_goto_position_for_motor": self.set_goto_position_for_motor,
             "set_goto_positions_for_motors": self.set_goto_positions_for_motors,
             "get_primitives_list": lambda: list(service.primitives()),
-            "get_running_primitives_list": service.running_primitives,
+            "get_running_primitives_list": service.pypot_running_primitives,
             "start_primitive": lambda primitive: self._control(primitive, "start"),
             "stop_primitive": lambda primitive: self._control(primitive, "stop"),
             "pause_primitive": lambda primitive: self._control(primitive, "pause"),

@@ -10,7 +10,6 @@ answers 400 for a missing parameter and 403 when IK fails; an unreachable target
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
-from fastapi.responses import JSONResponse  # noqa: TID253
 from starlette.concurrency import run_in_threadpool
 
 from poppy_core import checks
@@ -19,6 +18,7 @@ from poppy_core.motion.cartesian import RobotChain
 from poppy_core.server.chains import find_chain
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
+from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.routers.common import json_body, truthy, wait_goto
 from poppy_core.server.service import check_duration
 
@@ -55,13 +55,13 @@ def _numbers(data: dict[str, Any], key: str) -> list[float] | None:
 
 
 @router.get("/ik/{chain}/value.json", summary="Position and x axis of a chain's tip (pypot)")
-def ik_value(chain: str, service: Service) -> JSONResponse:
+def ik_value(chain: str, service: Service) -> PypotJSON:
     """``{"xyz": "x,y,z", "rot": "Rx.x,Rx.y,Rx.z"}``."""
-    return JSONResponse(_value(find_chain(service.robot, chain)))
+    return PypotJSON(_value(find_chain(service.robot, chain)))
 
 
 @router.post("/ik/{chain}/goto.json", summary="Move a chain's tip (pypot)")
-async def ik_goto(chain: str, request: Request, service: Service) -> JSONResponse:
+async def ik_goto(chain: str, request: Request, service: Service) -> PypotJSON:
     """Moves every active motor in one goto; answers the tip's pose (after it, with ``wait``)."""
     found = find_chain(service.robot, chain)
     data = await json_body(request, tip=GOTO_TIP)
@@ -89,11 +89,11 @@ async def ik_goto(chain: str, request: Request, service: Service) -> JSONRespons
         ) from None
     if wait:
         await wait_goto(handle)
-    return JSONResponse(_value(found))
+    return PypotJSON(_value(found))
 
 
 @router.get("/ik/{chain}/rpy.json", summary="Rotation matrix of roll, pitch, yaw (pypot)")
-async def ik_rpy(chain: str, request: Request, service: Service) -> JSONResponse:
+async def ik_rpy(chain: str, request: Request, service: Service) -> PypotJSON:
     """``{"rpy": 3x3}`` of ``r``, ``p``, ``y`` in radians (URDF convention, as ikpy's)."""
     found = find_chain(service.robot, chain)
     data = await json_body(request, default={}, tip=RPY_TIP)
@@ -104,4 +104,4 @@ async def ik_rpy(chain: str, request: Request, service: Service) -> JSONResponse
         r, p, y = (checks.number_from(values[k], k) for k in ("r", "p", "y"))
     except (KeyError, ArgumentError):
         raise ApiError("invalid", "r, p and y must be finite numbers", tip=RPY_TIP) from None
-    return JSONResponse({"rpy": found.rpy_to_rotation_matrix(r, p, y).tolist()})
+    return PypotJSON({"rpy": found.rpy_to_rotation_matrix(r, p, y).tolist()})

@@ -3,7 +3,7 @@
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
-from fastapi.responses import JSONResponse, Response  # noqa: TID253
+from fastapi.responses import Response  # noqa: TID253
 from starlette.concurrency import run_in_threadpool
 
 from poppy_core import checks
@@ -11,6 +11,7 @@ from poppy_core.errors import ArgumentError
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import pypot_positions
+from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.routers.common import CHANGES_STATE, json_body
 
 router = APIRouter(tags=["pypot"])
@@ -20,20 +21,24 @@ MOTORS_TIP = (
     '{"motors": "m1,m2"}'
 )
 SPEED_TIP = 'the speed is a number, negative to play backwards, e.g. {"speed": "-1.0"}'
+# IN ORDER: pypot handled requests one after the other on its event loop, and pages written for
+# it count on that: puppet-master's move recorder asks for the move list right after posting a
+# save, and for the running list right after posting a play. Saving and starting a playback are
+# therefore done on the event loop (no thread-pool hop), so a request arriving next sees them.
 
 
 # -- records ---------------------------------------------------------------------------------
 
 
 @router.get("/records/list.json", summary="The moves of the library")
-async def records_list(service: Service) -> JSONResponse:
+async def records_list(service: Service) -> PypotJSON:
     """``{"moves": [names]}``."""
     names = await run_in_threadpool(service.moves.names)
-    return JSONResponse({"moves": names})
+    return PypotJSON({"moves": names})
 
 
 @router.post("/records/{move}/record.json", status_code=202, summary="Start recording a move")
-async def record(move: str, request: Request, service: Service) -> JSONResponse:
+async def record(move: str, request: Request, service: Service) -> PypotJSON:
     """202 ``{move: "recording"}``; the optional body names the motors."""
     data = await json_body(request, default={}, tip=MOTORS_TIP)
     motors: Any = data.get("motors") if isinstance(data, dict) else None
@@ -44,25 +49,28 @@ async def record(move: str, request: Request, service: Service) -> JSONResponse:
     ):
         raise ApiError("invalid", "cannot read the motors given", tip=MOTORS_TIP)
     await run_in_threadpool(service.moves.record, move, motors or None)
-    return JSONResponse({move: "recording"}, status_code=202)
+    return PypotJSON({move: "recording"}, status_code=202)
 
 
 @router.post("/records/{move}/save.json", status_code=202, summary="Stop recording and save")
-def save(move: str, service: Service) -> JSONResponse:
-    """202 ``{move: "saved"}``; 404 when it is not being recorded."""
+async def save(move: str, service: Service) -> PypotJSON:
+    """202 ``{move: "saved"}``; 404 when it is not being recorded.
+
+    Saved on the event loop (see IN ORDER above): the list asked for next holds the move.
+    """
     service.moves.save(move)
-    return JSONResponse({move: "saved"}, status_code=202)
+    return PypotJSON({move: "saved"}, status_code=202)
 
 
 @router.get("/records/{move}/value.json", summary="The frames of a move")
-def move_value(move: str, service: Service) -> JSONResponse:
+def move_value(move: str, service: Service) -> PypotJSON:
     """``{move: {time: {motor: [position, speed]}}, "length": frames}``."""
     recorded = service.moves.value(move)
-    return JSONResponse({move: pypot_positions(recorded), "length": len(recorded)})
+    return PypotJSON({move: pypot_positions(recorded), "length": len(recorded)})
 
 
 @router.post("/records/{move}/play.json", status_code=202, summary="Play a move")
-async def play(move: str, request: Request, service: Service) -> JSONResponse:
+async def play(move: str, request: Request, service: Service) -> PypotJSON:
     """202 ``{move: "started replay"}``; a negative speed plays it backwards."""
     data = await json_body(request, tip=SPEED_TIP)
     if not isinstance(data, dict) or "speed" not in data:
@@ -73,45 +81,45 @@ async def play(move: str, request: Request, service: Service) -> JSONResponse:
         raise ApiError("invalid", str(exc), tip=SPEED_TIP) from None
     if speed == 0:
         raise ApiError("invalid", "the speed must be a finite, non-zero number", tip=SPEED_TIP)
-    await run_in_threadpool(service.moves.play, move, abs(speed), speed < 0)
-    return JSONResponse({move: "started replay"}, status_code=202)
+    service.moves.play(move, abs(speed), speed < 0)  # on the event loop: see IN ORDER above
+    return PypotJSON({move: "started replay"}, status_code=202)
 
 
 @router.post("/records/{move}/stop.json", status_code=202, summary="Stop playing a move")
-def stop(move: str, service: Service) -> JSONResponse:
+def stop(move: str, service: Service) -> PypotJSON:
     """202 ``{move: "stopped"}``; 400 when it was never played."""
     service.moves.stop(move)
-    return JSONResponse({move: "stopped"}, status_code=202)
+    return PypotJSON({move: "stopped"}, status_code=202)
 
 
 @router.post("/records/{move}/delete.json", status_code=202, summary="Delete a move")
-def delete(move: str, service: Service) -> JSONResponse:
+def delete(move: str, service: Service) -> PypotJSON:
     """202 ``{move: "deleted"}``; 404 when there is no such move."""
     service.moves.delete(move)
-    return JSONResponse({move: "deleted"}, status_code=202)
+    return PypotJSON({move: "deleted"}, status_code=202)
 
 
 # -- primitives ------------------------------------------------------------------------------
 
 
 @router.get("/primitives/list.json", summary="The attached primitives")
-async def primitives_list(service: Service) -> JSONResponse:
+async def primitives_list(service: Service) -> PypotJSON:
     """``{"primitives": [names]}``."""
-    return JSONResponse({"primitives": list(service.primitives())})
+    return PypotJSON({"primitives": list(service.primitives())})
 
 
 @router.get("/primitives/running/list.json", summary="The running primitives")
-async def running_list(service: Service) -> JSONResponse:
-    """``{"running_primitives": [names]}``."""
-    return JSONResponse({"running_primitives": service.running_primitives()})
+async def running_list(service: Service) -> PypotJSON:
+    """``{"running_primitives": [names]}``, with pypot's ``_<move>_recorder``/``_<move>_player``."""
+    return PypotJSON({"running_primitives": service.pypot_running_primitives()})
 
 
 PAST = {"start": "started", "stop": "stopped", "pause": "paused", "resume": "resumed"}
 
 
-def _control(primitive: str, action: str, service: Any) -> JSONResponse:
+def _control(primitive: str, action: str, service: Any) -> PypotJSON:
     service.control_primitive(primitive, action)
-    return JSONResponse({primitive: PAST[action]}, status_code=202)
+    return PypotJSON({primitive: PAST[action]}, status_code=202)
 
 
 @router.get(
@@ -120,7 +128,7 @@ def _control(primitive: str, action: str, service: Any) -> JSONResponse:
     summary="Start a primitive",
     openapi_extra=CHANGES_STATE,
 )
-def start_primitive(primitive: str, service: Service) -> JSONResponse:
+def start_primitive(primitive: str, service: Service) -> PypotJSON:
     """202 ``{primitive: "started"}``."""
     return _control(primitive, "start", service)
 
@@ -131,7 +139,7 @@ def start_primitive(primitive: str, service: Service) -> JSONResponse:
     summary="Stop a primitive",
     openapi_extra=CHANGES_STATE,
 )
-def stop_primitive(primitive: str, service: Service) -> JSONResponse:
+def stop_primitive(primitive: str, service: Service) -> PypotJSON:
     """202 ``{primitive: "stopped"}``."""
     return _control(primitive, "stop", service)
 
@@ -142,7 +150,7 @@ def stop_primitive(primitive: str, service: Service) -> JSONResponse:
     summary="Pause a primitive",
     openapi_extra=CHANGES_STATE,
 )
-def pause_primitive(primitive: str, service: Service) -> JSONResponse:
+def pause_primitive(primitive: str, service: Service) -> PypotJSON:
     """202 ``{primitive: "paused"}``."""
     return _control(primitive, "pause", service)
 
@@ -153,23 +161,23 @@ def pause_primitive(primitive: str, service: Service) -> JSONResponse:
     summary="Resume a primitive",
     openapi_extra=CHANGES_STATE,
 )
-def resume_primitive(primitive: str, service: Service) -> JSONResponse:
+def resume_primitive(primitive: str, service: Service) -> PypotJSON:
     """202 ``{primitive: "resumed"}``."""
     return _control(primitive, "resume", service)
 
 
 @router.get("/primitives/{primitive}/properties/list.json", summary="A primitive's properties")
-async def properties_list(primitive: str, service: Service) -> JSONResponse:
+async def properties_list(primitive: str, service: Service) -> PypotJSON:
     """``{"property": [names]}`` (pypot's key)."""
-    return JSONResponse({"property": service.property_names(primitive)})
+    return PypotJSON({"property": service.property_names(primitive)})
 
 
 @router.get(
     "/primitives/{primitive}/properties/{prop}/value.json", summary="Read a primitive property"
 )
-async def get_property(primitive: str, prop: str, service: Service) -> JSONResponse:
+async def get_property(primitive: str, prop: str, service: Service) -> PypotJSON:
     """``{"primitive.prop": value}``."""
-    return JSONResponse({f"{primitive}.{prop}": service.get_property(primitive, prop)})
+    return PypotJSON({f"{primitive}.{prop}": service.get_property(primitive, prop)})
 
 
 @router.post(
@@ -185,21 +193,19 @@ async def set_property(primitive: str, prop: str, request: Request, service: Ser
 
 
 @router.get("/primitives/{primitive}/methods/list.json", summary="A primitive's methods")
-async def methods_list(primitive: str, service: Service) -> JSONResponse:
+async def methods_list(primitive: str, service: Service) -> PypotJSON:
     """``{"methods": [names]}``."""
-    return JSONResponse({"methods": service.method_names(primitive)})
+    return PypotJSON({"methods": service.method_names(primitive)})
 
 
 @router.post(
     "/primitives/{primitive}/methods/{method}/args.json", summary="Call a primitive method"
 )
-async def call_method(
-    primitive: str, method: str, request: Request, service: Service
-) -> JSONResponse:
+async def call_method(primitive: str, method: str, request: Request, service: Service) -> PypotJSON:
     """``{"primitive:method": result}``; the body holds the keyword arguments (or a list)."""
     data = await json_body(request, default={}, tip="the body is an object of keyword arguments")
     args, kwargs = (data, {}) if isinstance(data, list) else ([], data)
     if not isinstance(kwargs, dict):
         args, kwargs = [data], {}
     result = await run_in_threadpool(service.call_method, primitive, method, args, kwargs)
-    return JSONResponse({f"{primitive}:{method}": result})
+    return PypotJSON({f"{primitive}:{method}": result})

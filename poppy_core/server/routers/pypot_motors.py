@@ -5,12 +5,13 @@ import socket
 from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
-from fastapi.responses import HTMLResponse, JSONResponse  # noqa: TID253
+from fastapi.responses import HTMLResponse  # noqa: TID253
 
 from poppy_core import checks
 from poppy_core.errors import ArgumentError
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
+from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.routers.common import json_body, truthy, wait_goto
 
@@ -39,9 +40,9 @@ async def index(request: Request) -> HTMLResponse:
 
 
 @router.get("/robot.json", summary="Every motor's registers and every primitive")
-async def robot_json(service: Service) -> JSONResponse:
+async def robot_json(service: Service) -> PypotJSON:
     """pypot's robot description (also answered by the fast path)."""
-    return JSONResponse(service.description())
+    return PypotJSON(service.description())
 
 
 # TEST-NET-1 (RFC 5737): connecting a UDP socket there only picks the outgoing interface, no
@@ -60,52 +61,52 @@ def local_ip() -> str | None:
 
 
 @router.get("/ip.json", summary="The robot's IP address")
-def ip_json() -> JSONResponse:
+def ip_json() -> PypotJSON:
     """``{"ip": address}`` as pypot; 404 with an error and a tip when there is no network."""
     ip = local_ip()
     if ip is None:
-        return JSONResponse(
+        return PypotJSON(
             {"error": "Cannot find ip of your Poppy Robot",
              "tip": "this machine has no network route: check its connection (ip addr)"},
             status_code=404,
         )  # fmt: skip
-    return JSONResponse({"ip": ip})
+    return PypotJSON({"ip": ip})
 
 
 @router.get("/motors/list.json", summary="The motor names")
-async def motors_list(service: Service) -> JSONResponse:
+async def motors_list(service: Service) -> PypotJSON:
     """``{"motors": [names]}``."""
-    return JSONResponse({"motors": service.motor_names()})
+    return PypotJSON({"motors": service.motor_names()})
 
 
 @router.get("/motors/aliases/list.json", summary="The group names")
-async def aliases_list(service: Service) -> JSONResponse:
+async def aliases_list(service: Service) -> PypotJSON:
     """``{"aliases": [group names]}``."""
-    return JSONResponse({"aliases": list(service.groups())})
+    return PypotJSON({"aliases": list(service.groups())})
 
 
 @router.get("/motors/registers/{register}/list.json", summary="One register of every motor")
-async def register_values(register: str, service: Service) -> JSONResponse:
+async def register_values(register: str, service: Service) -> PypotJSON:
     """``{register: {motor: value}}``."""
-    return JSONResponse({register: service.register_values(register)})
+    return PypotJSON({register: service.register_values(register)})
 
 
 @router.get("/motors/{alias}/list.json", summary="The motors of a group")
-async def alias_list(alias: str, service: Service) -> JSONResponse:
+async def alias_list(alias: str, service: Service) -> PypotJSON:
     """``{alias: [names]}``."""
-    return JSONResponse({alias: service.group(alias)})
+    return PypotJSON({alias: service.group(alias)})
 
 
 @router.get("/motors/{motor}/registers/list.json", summary="The registers of a motor")
-async def registers_list(motor: str, service: Service) -> JSONResponse:
+async def registers_list(motor: str, service: Service) -> PypotJSON:
     """``{"registers": [names]}``."""
-    return JSONResponse({"registers": list(service.motor(motor).registers)})
+    return PypotJSON({"registers": list(service.motor(motor).registers)})
 
 
 @router.get("/motors/{motor}/registers/{register}/value.json", summary="Read a register")
-async def get_register(motor: str, register: str, service: Service) -> JSONResponse:
+async def get_register(motor: str, register: str, service: Service) -> PypotJSON:
     """``{register: value}``."""
-    return JSONResponse({register: service.read(motor, register)})
+    return PypotJSON({register: service.read(motor, register)})
 
 
 @router.post(
@@ -113,13 +114,11 @@ async def get_register(motor: str, register: str, service: Service) -> JSONRespo
     status_code=202,
     summary="Write a register (the body is the raw JSON value)",
 )
-async def set_register(
-    motor: str, register: str, request: Request, service: Service
-) -> JSONResponse:
+async def set_register(motor: str, register: str, request: Request, service: Service) -> PypotJSON:
     """202 ``{register: value}``; 404 unknown motor/register; 400 bad or read-only value."""
     data = await json_body(request, tip="the body is the new value as JSON, e.g. 90 or true")
     value = service.write(motor, register, pypot_value(motor, register, data))
-    return JSONResponse({register: value}, status_code=202)
+    return PypotJSON({register: value}, status_code=202)
 
 
 def _float(value: Any, what: str, tip: str) -> float:
@@ -130,7 +129,7 @@ def _float(value: Any, what: str, tip: str) -> float:
 
 
 @router.post("/motors/{motor}/goto.json", status_code=202, summary="Move one motor")
-async def motor_goto(motor: str, request: Request, service: Service) -> JSONResponse:
+async def motor_goto(motor: str, request: Request, service: Service) -> PypotJSON:
     """202 ``{"motors": {motor: position}, "duration", "waiting"}`` (after the move if waiting)."""
     data = await json_body(request, tip=GOTO_TIP)
     if not isinstance(data, dict) or "position" not in data or "duration" not in data:
@@ -141,13 +140,13 @@ async def motor_goto(motor: str, request: Request, service: Service) -> JSONResp
     handle = service.goto({motor: position}, duration)
     if wait:
         await wait_goto(handle)
-    return JSONResponse(
+    return PypotJSON(
         {"motors": {motor: position}, "duration": duration, "waiting": wait}, status_code=202
     )
 
 
 @router.post("/motors/goto.json", status_code=202, summary="Move several motors together")
-async def motors_goto(request: Request, service: Service) -> JSONResponse:
+async def motors_goto(request: Request, service: Service) -> PypotJSON:
     """202 ``{"motors": {motor: position}, "duration", "waiting"}``."""
     data = await json_body(request, tip=GOTOS_TIP)
     if not isinstance(data, dict) or not {"motors", "positions", "duration"} <= set(data):
@@ -166,4 +165,4 @@ async def motors_goto(request: Request, service: Service) -> JSONResponse:
     handle = service.goto(targets, duration)
     if wait:
         await wait_goto(handle)
-    return JSONResponse({"motors": targets, "duration": duration, "waiting": wait}, status_code=202)
+    return PypotJSON({"motors": targets, "duration": duration, "waiting": wait}, status_code=202)
