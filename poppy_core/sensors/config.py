@@ -133,8 +133,8 @@ CameraMaker = Callable[[str, Mapping[str, Any]], Camera]
 def opencv_camera(name: str, spec: Mapping[str, Any]) -> Camera:
     """The camera an entry describes on real hardware (``OpenCVCamera`` opens its device).
 
-    Raises:
-        SensorError: the device cannot be opened.
+    A camera is an accessory: one that cannot be opened now (unplugged, busy in another
+    program) starts lost and is opened with backoff when it can be (``retry_open``).
     """
     resolution = spec.get("resolution")
     fps = float(spec.get("fps", DEFAULT_FPS))
@@ -150,6 +150,7 @@ def opencv_camera(name: str, spec: Mapping[str, Any]) -> Camera:
         fps,
         tuple(resolution) if resolution is not None else None,
         calibration=cal,
+        retry_open=True,
     )
 
 
