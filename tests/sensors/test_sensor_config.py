@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from poppy_core.errors import ConfigError, SensorError
+from poppy_core.errors import ConfigError
 from poppy_core.robot import RobotConfig, from_profile, load_profile
 from poppy_core.sensors import DummyCamera, MarkerDetector
 
