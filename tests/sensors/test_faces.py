@@ -18,8 +18,8 @@ from poppy_core.sensors import (
     SensorProblem,
     build_sensors,
     check_section,
-    opencv_camera,
 )
+from poppy_core.sensors.config import opencv_camera  # the package's name is the submodule too
 
 cv2 = pytest.importorskip("cv2")
 skimage_data = pytest.importorskip("skimage.data")
