@@ -3,7 +3,7 @@
 poppy-ergo-jr's behaviour of that name (attached when the robot has a face detector): the base
 (m1) and the head follow the face. Here it aims the camera like ``marker_follow`` (through the
 arm's kinematic chain, on the real robot and in MuJoCo), following the face nearest the one it
-followed last, so two people in view do not make it hesitate.
+followed last, so two people in view do not make it hesitate (at start: the surest face).
 """
 
 from __future__ import annotations
@@ -49,11 +49,11 @@ class FaceTracking(FollowInView):
         self._followed = None
 
     def pick(self, found: list[Any]) -> Any | None:
-        """The face nearest the one followed last (the biggest at first)."""
+        """The face nearest the one followed last (at first the surest, then the biggest)."""
         if not found:
             return None
         if self._followed is None:
-            face = max(found, key=lambda f: f.rect[2])
+            face = max(found, key=lambda f: (f.hits, f.size))
         else:
             x, y = self._followed
             face = min(found, key=lambda f: (f.position[0] - x) ** 2 + (f.position[1] - y) ** 2)
