@@ -20,6 +20,8 @@ from poppy_core.sensors import (
     check_section,
 )
 from poppy_core.sensors.config import opencv_camera  # the package's name is the submodule too
+from poppy_core.sensors.opencv_camera import OpenCVCamera
+from tests.helpers.waiting import eventually
 
 cv2 = pytest.importorskip("cv2")
 skimage_data = pytest.importorskip("skimage.data")
@@ -110,12 +112,16 @@ def test_the_face_detector_sees_the_face_through_its_camera() -> None:
         assert health.ok and health.running and health.kind == "FaceDetector"
 
 
-def test_a_face_detector_on_a_video_file_from_a_config(tmp_path: Path) -> None:
-    path = tmp_path / "astronaut.avi"
+def write_video(path: Path) -> None:
     writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 20.0, (512, 512))
     for _ in range(5):
         writer.write(astronaut_bgr())
     writer.release()
+
+
+def test_a_face_detector_on_a_video_file_from_a_config(tmp_path: Path) -> None:
+    path = tmp_path / "astronaut.avi"
+    write_video(path)
     section: dict[str, Any] = {
         "camera": {"type": "OpenCVCamera", "index": str(path), "fps": 20.0},
         "face_detector": {
@@ -154,3 +160,20 @@ def test_bad_face_detector_entries_name_their_field(spec: dict[str, Any], field:
     with pytest.raises(SensorProblem) as caught:
         check_section({"camera": {"type": "DummyCamera"}, "face_detector": entry})
     assert caught.value.field == field
+
+
+def test_a_face_detector_on_a_camera_plugged_in_later(tmp_path: Path) -> None:
+    device = tmp_path / "video0.avi"
+    camera = OpenCVCamera("camera", str(device), fps=20.0, retry_open=True)
+    with camera, FaceDetector("face_detector", [camera], freq=5.0) as detector:
+        assert not camera.health().connected
+        with pytest.raises(SensorError) as caught:
+            detector.wait_first(1.0)  # no frame: one line saying why (as reading faces)
+        assert "\n" not in str(caught.value)
+        part = tmp_path / "writing.avi"
+        write_video(part)
+        part.rename(device)  # plugged in
+        assert eventually(lambda: bool(detector.detect()), timeout_s=20)
+        assert eventually(lambda: len(detector.faces) == 1)
+        assert inside(detector.faces[0].center, FACE_BOX)
+        assert camera.health().connected and detector.health().ok
