@@ -60,7 +60,7 @@ def serve(
     ),
     zmq_port: int = typer.Option(6768, "--zmq-port", min=0, max=65535, help="ZMQ port."),
     no_sensors: bool = typer.Option(
-        False, "--no-sensors", help="Leave the config's cameras closed (e.g. no camera plugged)."
+        False, "--no-sensors", help="Leave the config's cameras closed."
     ),
     snap: bool = typer.Option(
         False, "--snap", help="Serve pypot's Snap! routes and the Poppy blocks (see docs/snap.md)."

@@ -2,6 +2,7 @@
 
 from poppy_core.creatures.body import DanceBeatMotion, HeadIdleMotion, UpperBodyIdleMotion
 from poppy_core.creatures.ergo_jr import Dance, Jump, SafePowerUp
+from poppy_core.creatures.face_tracking import FaceTracking
 from poppy_core.creatures.factory import from_config, from_profile
 from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.creatures.interaction import ArmsCopyMotion, ArmsTurnCompliant
@@ -21,7 +22,7 @@ from poppy_core.creatures.registry import (
     normalize_kind,
 )
 from poppy_core.creatures.safety import LimitTorque, TemperatureMonitor
-from poppy_core.creatures.tracking import MarkerFollow, TrackingFeedback
+from poppy_core.creatures.tracking import FollowInView, MarkerFollow, TrackingFeedback
 
 __all__ = [
     "CREATURES",
@@ -33,6 +34,8 @@ __all__ = [
     "CreatureSpec",
     "Dance",
     "DanceBeatMotion",
+    "FaceTracking",
+    "FollowInView",
     "HeadFollow",
     "HeadIdleMotion",
     "Jump",

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from poppy_core.creatures import body, ergo_jr, interaction, postures, safety
+from poppy_core.creatures.face_tracking import FaceTracking
 from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.creatures.tracking import MarkerFollow, TrackingFeedback
 from poppy_core.errors import ConfigError, RegisterError
@@ -198,8 +199,9 @@ def attach_creature(robot: Robot, kind: str, *, start_defaults: bool = True) -> 
     those started by default (``temperature_monitoring``). Attaching again returns the
     primitives already there. The creature's kinematic chains (``robot.chain``,
     ``robot.l_arm_chain``...) come from the config's ``kinematics`` section, or the creature's
-    profile; a simulated Ergo Jr (MuJoCo) also gets ``head_follow``, and an Ergo Jr with a marker
-    detector ``tracking_feedback`` and ``marker_follow``.
+    profile; a simulated Ergo Jr (MuJoCo) also gets ``head_follow``, an Ergo Jr with a marker
+    detector ``tracking_feedback`` and ``marker_follow``, one with a face detector
+    ``face_tracking``.
 
     Args:
         robot: the robot.
@@ -239,6 +241,10 @@ def attach_creature(robot: Robot, kind: str, *, start_defaults: bool = True) -> 
         if "chain" in chains:
             attached["marker_follow"] = MarkerFollow(robot, "chain")
             robot.attach_primitive(attached["marker_follow"], "marker_follow")
+    faces = [s for s in robot.sensors if "faces" in s.registers]  # a FaceDetector
+    if known == "ergo-jr" and faces and "chain" in chains:
+        attached["face_tracking"] = FaceTracking(robot, "chain", faces[0])
+        robot.attach_primitive(attached["face_tracking"], "face_tracking")
     creature = Creature(known, spec.goto_control, attached)
     robot.attach("creature", creature)
     if start_defaults and not robot.closed:

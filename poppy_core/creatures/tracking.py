@@ -1,5 +1,6 @@
 """Ergo Jr and markers: ``tracking_feedback`` (LEDs say one is seen), ``marker_follow`` (the head
-turns to keep one in the middle of its camera's view).
+turns to keep one in the middle of its camera's view); ``FollowInView``, what ``marker_follow``
+and ``face_tracking`` share.
 
 ``tracking_feedback`` is poppy-ergo-jr's behaviour of that name: the tip motors' LEDs are green
 while a marker was seen in any of the last six updates, off otherwise. ``marker_follow`` is the
@@ -122,27 +123,26 @@ class TrackingFeedback(LoopPrimitive):
             self.get_mockup_motor(name).led = "off"
 
 
-class MarkerFollow(LoopPrimitive):
-    """Turn the chain so that its camera keeps a marker in the middle of the view.
+class FollowInView(LoopPrimitive):
+    """Turn the chain so that its camera keeps something its detector sees in the middle of the
+    view (``marker_follow``, ``face_tracking``); subclasses choose what (``pick``).
 
     Args:
-        robot: a robot with the chain, a camera at the chain's tip and a marker detector.
+        robot: a robot with the chain, a camera at the chain's tip and a detector.
         chain: the chain carrying the camera (looking along the tip's -z).
-        detector: the detector, or its sensor name.
-        marker: the marker to follow: an id or a card name; None follows the largest one seen.
+        detector: the detector (its ``cameras`` and ``detect(camera)``), or its sensor name.
         freq: updates per second (each acts on a frame taken after the last move ended).
         gain: the share of the seen error corrected per update (0..1].
         motors: the chain's joints that move.
     """
 
-    properties: ClassVar[Sequence[str]] = ("marker", "gain", "update_freq")
+    properties: ClassVar[Sequence[str]] = ("gain", "update_freq")
 
     def __init__(
         self,
         robot: Robot,
         chain: str = "chain",
         detector: Any = "marker_detector",
-        marker: str | int | None = None,
         freq: float = FOLLOW_HZ,
         gain: float = 0.7,
         motors: Sequence[str] = FOLLOWING_MOTORS,
@@ -150,22 +150,16 @@ class MarkerFollow(LoopPrimitive):
         super().__init__(robot, freq)
         self.chain_name = chain
         self.detector = _detector(robot, detector)
-        self.marker = marker
         self.gain = gain
         self.moving = list(motors)
         self._last_sighting: tuple[Any, ...] | None = None
         self._still_from = 0.0
         self._axes: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
-    @property
-    def marker(self) -> str | int | None:
-        """The marker followed (an id or a card name; None: the largest seen)."""
-        return self._marker
-
-    @marker.setter
-    def marker(self, value: str | int | None) -> None:
-        self._wanted = _wanted_ids(self.detector, value)
-        self._marker = value
+    def pick(self, found: list[Any]) -> Any | None:
+        """The one of ``found`` (things seen in one frame, each with ``center`` in pixels and
+        ``camera``) to follow, or None."""
+        raise NotImplementedError
 
     @property
     def gain(self) -> float:
@@ -206,7 +200,8 @@ class MarkerFollow(LoopPrimitive):
         unknown = [name for name in self.moving if name not in chain.model.names]
         if unknown:
             raise PoppyError(
-                f"marker_follow: {', '.join(unknown)} not in chain {self.chain_name!r} "
+                f"{self.name}: {', '.join(unknown)} not in chain "
+                f"{self.chain_name!r} "
                 f"(its joints: {', '.join(chain.model.names)})"
             )
         self.robot.compliant = False
@@ -214,24 +209,15 @@ class MarkerFollow(LoopPrimitive):
         self._still_from = 0.0
 
     def _sighting(self) -> Any | None:
-        """The marker followed in the newest frame taken after the last move ended, if any."""
+        """What is followed in the newest frame taken after the last move ended, if any."""
         camera = self.detector.cameras[0]
         if camera.latest().time_s < self._still_from:
             return None  # taken while the head was still turning: it would overshoot
-        found = self.detector.detect(camera)
-        markers = [m for m in found if self._wanted is None or m.id in self._wanted]
-        if not markers:
-            return None
+        return self.pick(list(self.detector.detect(camera)))
 
-        def area(m: Any) -> float:
-            xs, ys = zip(*m.corners, strict=True)
-            return float((max(xs) - min(xs)) * (max(ys) - min(ys)))
-
-        return max(markers, key=area)
-
-    def _pixel_ray(self, marker: Any) -> np.ndarray:
-        """The marker's direction in the camera's (right, down, look) axes."""
-        camera = next((c for c in self.detector.cameras if c.name == marker.camera), None)
+    def _pixel_ray(self, seen: Any) -> np.ndarray:
+        """The direction of what is seen in the camera's (right, down, look) axes."""
+        camera = next((c for c in self.detector.cameras if c.name == seen.camera), None)
         camera = camera or self.detector.cameras[0]
         calibration = getattr(camera, "calibration", None)
         if calibration is not None:
@@ -241,7 +227,7 @@ class MarkerFollow(LoopPrimitive):
             width, height = camera.resolution
             fy = fx = (height / 2.0) / math.tan(math.radians(ERGO_JR_FOVY_DEG) / 2.0)
             cx, cy = width / 2.0, height / 2.0
-        u, v = marker.center
+        u, v = seen.center
         ray = np.array([(u - cx) / fx, (v - cy) / fy, 1.0])
         unit: np.ndarray = ray / np.linalg.norm(ray)
         return unit
@@ -278,17 +264,17 @@ class MarkerFollow(LoopPrimitive):
 
     def update(self) -> None:
         try:
-            marker = self._sighting()
+            seen = self._sighting()
         except SensorError as exc:
-            logger.debug("marker_follow: %s", exc)
+            logger.debug("%s: %s", self.name, exc)
             return
-        if marker is None:
+        if seen is None:
             return
-        key = (marker.id, marker.camera, *marker.center)
+        key = (seen.camera, *seen.center)
         if key == self._last_sighting:  # no new frame since the last step
             return
         self._last_sighting = key
-        ray = self._pixel_ray(marker)
+        ray = self._pixel_ray(seen)
         if math.degrees(math.acos(min(1.0, float(ray[2])))) < DEAD_ZONE_DEG:
             return
         chain = self._chain()
@@ -298,3 +284,53 @@ class MarkerFollow(LoopPrimitive):
         self.robot.goto_position(goals, duration_s, control="minjerk")
         camera = self.detector.cameras[0]
         self._still_from = camera.clock_s() + duration_s + SETTLE_S
+
+
+class MarkerFollow(FollowInView):
+    """Turn the chain so that its camera keeps a marker in the middle of the view.
+
+    Args:
+        robot: a robot with the chain, a camera at the chain's tip and a marker detector.
+        chain: the chain carrying the camera (looking along the tip's -z).
+        detector: the detector, or its sensor name.
+        marker: the marker to follow: an id or a card name; None follows the largest one seen.
+        freq: updates per second (each acts on a frame taken after the last move ended).
+        gain: the share of the seen error corrected per update (0..1].
+        motors: the chain's joints that move.
+    """
+
+    properties: ClassVar[Sequence[str]] = ("marker", "gain", "update_freq")
+
+    def __init__(
+        self,
+        robot: Robot,
+        chain: str = "chain",
+        detector: Any = "marker_detector",
+        marker: str | int | None = None,
+        freq: float = FOLLOW_HZ,
+        gain: float = 0.7,
+        motors: Sequence[str] = FOLLOWING_MOTORS,
+    ) -> None:
+        super().__init__(robot, chain, detector, freq, gain, motors)
+        self.marker = marker
+
+    @property
+    def marker(self) -> str | int | None:
+        """The marker followed (an id or a card name; None: the largest seen)."""
+        return self._marker
+
+    @marker.setter
+    def marker(self, value: str | int | None) -> None:
+        self._wanted = _wanted_ids(self.detector, value)
+        self._marker = value
+
+    def pick(self, found: list[Any]) -> Any | None:
+        markers = [m for m in found if self._wanted is None or m.id in self._wanted]
+        if not markers:
+            return None
+
+        def area(m: Any) -> float:
+            xs, ys = zip(*m.corners, strict=True)
+            return float((max(xs) - min(xs)) * (max(ys) - min(ys)))
+
+        return max(markers, key=area)

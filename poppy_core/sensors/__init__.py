@@ -1,4 +1,4 @@
-"""Sensors: cameras (OpenCV devices, blank, simulated in ``poppy_core.sim``), marker detection.
+"""Sensors: cameras (OpenCV devices, blank, simulated in ``poppy_core.sim``), markers and faces.
 
 Imports nothing of ours but ``errors``; OpenCV is imported on first use. The robot factory
 builds them from a config's ``sensors`` section (``build_sensors``).
@@ -15,7 +15,8 @@ from poppy_core.sensors.config import (
     dummy_camera,
     opencv_camera,
 )
-from poppy_core.sensors.detector import MarkerDetector
+from poppy_core.sensors.detector import FrameDetector, MarkerDetector
+from poppy_core.sensors.faces import Face, FaceDetector, FaceFinder
 from poppy_core.sensors.markers import Marker, MarkerFinder, MarkerPose, marker_image
 
 __all__ = [
@@ -24,7 +25,11 @@ __all__ = [
     "Camera",
     "CameraCalibration",
     "DummyCamera",
+    "Face",
+    "FaceDetector",
+    "FaceFinder",
     "Frame",
+    "FrameDetector",
     "Marker",
     "MarkerDetector",
     "MarkerFinder",

@@ -5,6 +5,11 @@ first value, later reads return the latest one at once. ``update()`` runs in the
 thread at ``rate_hz``. A device that goes away (``SensorLost``) is logged at WARNING once,
 shown in ``health()``, reopened with backoff (``reconnect()``) and resumes; one WARNING says
 it is back. Other failures of ``update()`` are counted like a motor's failed reads.
+
+A device already away when the sensor is made (a camera unplugged or busy: an accessory) is
+the same story from the start (``begin_lost``): the robot starts, one WARNING says so, health
+shows it lost, and a background thread reopens it with backoff; once open, that thread stops
+until the sensor's first use, so a camera nobody reads still grabs nothing.
 """
 
 from __future__ import annotations
@@ -135,6 +140,8 @@ class Sensor:
         self._warned = False
         self._last_good: float | None = None
         self._fatal = ""
+        self._watching = False
+        """The thread only reopens a device that was away at start (nobody read the sensor)."""
 
     # -- what subclasses implement -----------------------------------------------------------
 
@@ -208,13 +215,28 @@ class Sensor:
         with self._lock:
             if self._closed:
                 raise SensorError(f"sensor {self._name!r} is closed", sensor=self._name)
+            self._watching = False
             if self._thread is not None:
                 return
-            self._stop.clear()
-            self._thread = threading.Thread(
-                target=self._run, name=f"sensor {self._name}", daemon=True
-            )
-            self._thread.start()
+            self._start_thread()
+
+    def _start_thread(self) -> None:
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._run, name=f"sensor {self._name}", daemon=True)
+        self._thread.start()
+
+    def begin_lost(self, reason: str) -> None:
+        """The device is away from the start: warn once, show it lost, reopen it with backoff.
+
+        For accessories (a camera unplugged or busy in another program): the robot starts
+        without them and they resume when they can be opened, as after a loss.
+        """
+        self._lost(reason, at_start=True)
+        with self._lock:
+            if self._closed or self._thread is not None:
+                return
+            self._watching = True
+            self._start_thread()
 
     def close(self) -> None:
         """Stop the thread and free the device (idempotent)."""
@@ -306,6 +328,8 @@ class Sensor:
                 self._step()
             else:
                 self._retry()
+                if self._park():
+                    return
                 continue
             deadline += period
             now = self._clock()
@@ -332,13 +356,26 @@ class Sensor:
         self._warned = False
         self._first.set()
 
-    def _lost(self, reason: str) -> None:
+    def _park(self) -> bool:
+        """After a device away at start was reopened: end the thread until first use."""
+        with self._lock:
+            if not self._watching or not self._connected or self._closed:
+                return False
+            self._watching = False
+            self._thread = None
+            return True
+
+    def _lost(self, reason: str, at_start: bool = False) -> None:
         self._connected = False
         self._down_since = self._clock()
         self._losses += 1
         self._errors += 1
         self._last_error = reason
-        logger.warning("%s %s lost: %s; retrying", self.kind, self._name, reason)
+        if at_start:
+            logger.warning("%s %s is not available: %s; starting without it, retrying",
+                           self.kind, self._name, reason)  # fmt: skip
+        else:
+            logger.warning("%s %s lost: %s; retrying", self.kind, self._name, reason)
 
     def _retry(self) -> None:
         backoff = BACKOFF_START_S

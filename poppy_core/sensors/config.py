@@ -4,7 +4,8 @@ pypot's form: ``{"camera": {"type": "OpenCVCamera", "index": -1, "fps": 20.0, "r
 [640, 480]}, "marker_detector": {"type": "MarkerDetector", "cameras": ["camera"], "freq": 1.0,
 "need_robot": true}}`` (poppy_ergo_jr.json). Keys poppy adds: ``calibration`` (camera),
 ``cards``, ``dictionary``, ``marker_size``, ``families`` (marker detector), ``sim_camera`` (the
-MuJoCo camera a simulated robot renders for it; default: the sensor's name).
+MuJoCo camera a simulated robot renders for it; default: the sensor's name). A ``FaceDetector``
+(pypot's: ``cameras``, ``freq``) takes ``min_size`` (pixels) and ``cascade`` (an LBP cascade XML).
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from poppy_core.errors import SensorError
+from poppy_core.checks import count
+from poppy_core.errors import ArgumentError, SensorError
 from poppy_core.sensors.base import Sensor
 from poppy_core.sensors.camera import (
     DEFAULT_FPS,
@@ -24,10 +26,18 @@ from poppy_core.sensors.camera import (
     check_resolution,
 )
 from poppy_core.sensors.detector import DEFAULT_FREQ_HZ, MarkerDetector
+from poppy_core.sensors.faces import (
+    DEFAULT_FACE_FREQ_HZ,
+    DEFAULT_MIN_SIZE_PX,
+    MAX_FACE_PX,
+    MIN_FACE_PX,
+    FaceDetector,
+)
 from poppy_core.sensors.markers import DEFAULT_DICTIONARY, DEFAULT_MARKER_SIZE_M, FAMILIES
 
 CAMERA_TYPES = ("OpenCVCamera", "DummyCamera")
-SUPPORTED_TYPES = (*CAMERA_TYPES, "MarkerDetector")
+DETECTOR_TYPES = ("MarkerDetector", "FaceDetector")
+SUPPORTED_TYPES = (*CAMERA_TYPES, *DETECTOR_TYPES)
 NOT_YET: dict[str, str] = {
     # pypot 5.0.2's pypot.sensor classes and the sensors the Poppy documentation names
     "KinectSensor": "Kinect",
@@ -41,7 +51,6 @@ NOT_YET: dict[str, str] = {
     "SonarSensor": "sonar",
     "ArduinoSensor": "Arduino",
     "BlobDetector": "blob detector",
-    "FaceDetector": "face detector",
 }
 
 
@@ -119,11 +128,26 @@ def check_section(section: Mapping[str, Any]) -> None:
             target = section.get(camera)
             if not isinstance(target, Mapping) or target.get("type") not in CAMERA_TYPES:
                 raise SensorProblem(f"{name}.cameras", cameras, f"{camera!r} is not a camera here")
+        if kind == "FaceDetector":
+            _face_options(name, spec)
+            continue
         _cards(name, spec.get("cards", {}))
         _number(spec, "marker_size", DEFAULT_MARKER_SIZE_M, name)
         families = spec.get("families", list(FAMILIES))
         if not isinstance(families, list) or not families or set(families) - set(FAMILIES):
             raise SensorProblem(f"{name}.families", families, f"a list of {', '.join(FAMILIES)}")
+
+
+def _face_options(name: str, spec: Mapping[str, Any]) -> tuple[int, str | None]:
+    size = spec.get("min_size", DEFAULT_MIN_SIZE_PX)
+    try:
+        size = count(size, MIN_FACE_PX, MAX_FACE_PX, "min_size")
+    except ArgumentError as exc:
+        raise SensorProblem(f"{name}.min_size", size, str(exc)) from None
+    cascade = spec.get("cascade")
+    if cascade is not None and (not isinstance(cascade, str) or not cascade):
+        raise SensorProblem(f"{name}.cascade", cascade, "must be the path of an LBP cascade XML")
+    return size, cascade
 
 
 CameraMaker = Callable[[str, Mapping[str, Any]], Camera]
@@ -133,8 +157,8 @@ CameraMaker = Callable[[str, Mapping[str, Any]], Camera]
 def opencv_camera(name: str, spec: Mapping[str, Any]) -> Camera:
     """The camera an entry describes on real hardware (``OpenCVCamera`` opens its device).
 
-    Raises:
-        SensorError: the device cannot be opened.
+    A camera is an accessory: one that cannot be opened now (unplugged, busy in another
+    program) starts lost and is opened with backoff when it can be (``retry_open``).
     """
     resolution = spec.get("resolution")
     fps = float(spec.get("fps", DEFAULT_FPS))
@@ -150,6 +174,7 @@ def opencv_camera(name: str, spec: Mapping[str, Any]) -> Camera:
         fps,
         tuple(resolution) if resolution is not None else None,
         calibration=cal,
+        retry_open=True,
     )
 
 
@@ -166,7 +191,8 @@ def build_sensors(
     """The sensors of a checked section, cameras first; none started yet.
 
     Raises:
-        SensorError: a camera cannot be opened (the ones opened so far are closed).
+        SensorError: a sensor cannot be made: a bad camera index, face detection without
+            scikit-image (the ones made so far are closed).
     """
     sensors: dict[str, Sensor] = {}
     try:
@@ -184,6 +210,15 @@ def build_sensors(
                     dictionary=str(spec.get("dictionary", DEFAULT_DICTIONARY)),
                     marker_size=float(spec.get("marker_size", DEFAULT_MARKER_SIZE_M)),
                     families=tuple(spec.get("families", FAMILIES)),
+                )
+            elif spec.get("type") == "FaceDetector":
+                min_size, cascade = _face_options(name, spec)
+                sensors[name] = FaceDetector(
+                    name,
+                    [c for c in (sensors[c] for c in spec["cameras"]) if isinstance(c, Camera)],
+                    float(spec.get("freq", DEFAULT_FACE_FREQ_HZ)),
+                    min_size=min_size,
+                    cascade=cascade,
                 )
     except BaseException:
         for sensor in sensors.values():

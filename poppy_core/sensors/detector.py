@@ -1,5 +1,7 @@
 """``MarkerDetector``: markers in the frames of one or more cameras, in the background.
 
+``FrameDetector`` is what every detector on camera frames shares (``FaceDetector`` too).
+
 pypot's ``MarkerDetector`` (``cameras``, ``freq``; register ``markers``) with ArUco and Hamming
 markers, poses when a camera's calibration is known, and named cards: ``sees("caribou")`` is
 the library call behind Snap!'s ``/detect/<card>`` block.
@@ -8,7 +10,9 @@ the library call behind Snap!'s ``/detect/<card>`` block.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import ClassVar
+from typing import ClassVar, Generic, TypeVar
+
+import numpy as np
 
 from poppy_core.errors import SensorError
 from poppy_core.sensors.base import FIRST_VALUE_TIMEOUT_S, Sensor
@@ -23,10 +27,68 @@ from poppy_core.sensors.markers import (
 
 DEFAULT_FREQ_HZ = 5.0
 STALE_FRAME_S = 2.0
-"""Frames older than this (a lost camera) show no markers."""
+"""Frames older than this (a lost camera) show nothing."""
+
+T = TypeVar("T")
 
 
-class MarkerDetector(Sensor):
+class FrameDetector(Sensor, Generic[T]):
+    """What a detector of things in camera frames shares: its cameras, looking at each new frame
+    once, stale frames ignored. Subclasses implement ``find``.
+
+    Args:
+        name: the sensor's name.
+        cameras: the cameras to look through.
+        freq: detections per second.
+    """
+
+    what: ClassVar[str] = "things"
+    """What it detects, for messages."""
+
+    def __init__(self, name: str, cameras: Sequence[Camera], freq: float) -> None:
+        super().__init__(name, freq)
+        if not cameras:
+            raise SensorError(f"sensor {name!r}: a {self.kind} needs a camera", sensor=name)
+        self.cameras = list(cameras)
+        self._found: list[T] = []
+        self._seen: dict[str, tuple[int, list[T]]] = {}
+
+    def find(self, image: np.ndarray, camera: Camera) -> list[T]:
+        """What is in one frame of ``camera`` (called in the detector's thread or by ``detect``)."""
+        raise NotImplementedError
+
+    def _in(self, camera: Camera) -> list[T]:
+        frame = camera.latest()
+        number, found = self._seen.get(camera.name, (0, []))
+        if number != frame.number:  # a new frame: look again
+            found = self.find(frame.image, camera)
+            self._seen[camera.name] = (frame.number, found)
+        return found
+
+    def update(self) -> None:
+        found: list[T] = []
+        for camera in self.cameras:
+            if camera.clock_s() - camera.latest().time_s > STALE_FRAME_S:
+                continue
+            found.extend(self._in(camera))
+        self._found = found
+
+    def found(self) -> list[T]:
+        """What the latest frames hold (the first call starts the detector and waits).
+
+        Raises:
+            SensorError: no detection ran in time (a camera gives no frame).
+        """
+        self.wait_first(FIRST_VALUE_TIMEOUT_S * 2)
+        return list(self._found)
+
+    def detect(self, camera: Camera | None = None) -> list[T]:
+        """What ``camera``'s latest frame holds (the first camera by default): detected now, in
+        this thread, unless the background detection already looked at that frame."""
+        return list(self._in(camera or self.cameras[0]))
+
+
+class MarkerDetector(FrameDetector[Marker]):
     """Detects markers in the latest frames of ``cameras`` at ``freq`` Hz.
 
     Args:
@@ -40,6 +102,7 @@ class MarkerDetector(Sensor):
     """
 
     registers: ClassVar[tuple[str, ...]] = ("markers", "cards")
+    what: ClassVar[str] = "markers"
 
     def __init__(
         self,
@@ -52,27 +115,12 @@ class MarkerDetector(Sensor):
         marker_size: float = DEFAULT_MARKER_SIZE_M,
         families: Sequence[str] = FAMILIES,
     ) -> None:
-        super().__init__(name, freq)
-        if not cameras:
-            raise SensorError(f"sensor {name!r}: a marker detector needs a camera", sensor=name)
-        self.cameras = list(cameras)
+        super().__init__(name, cameras, freq)
         self.finder = MarkerFinder(dictionary, marker_size, tuple(families))
         self.card_ids: dict[str, list[int]] = {k: list(v) for k, v in (cards or {}).items()}
-        self._markers: list[Marker] = []
-        self._seen: dict[str, tuple[int, list[Marker]]] = {}
 
-    def update(self) -> None:
-        markers: list[Marker] = []
-        for camera in self.cameras:
-            frame = camera.latest()
-            if camera.clock_s() - frame.time_s > STALE_FRAME_S:
-                continue
-            number, found = self._seen.get(camera.name, (0, []))
-            if number != frame.number:  # a new frame: look again
-                found = self.finder.find(frame.image, camera.calibration, camera.name)
-                self._seen[camera.name] = (frame.number, found)
-            markers.extend(found)
-        self._markers = markers
+    def find(self, image: np.ndarray, camera: Camera) -> list[Marker]:
+        return self.finder.find(image, camera.calibration, camera.name)
 
     # -- registers -------------------------------------------------------------------------------
 
@@ -83,8 +131,7 @@ class MarkerDetector(Sensor):
         Raises:
             SensorError: no detection ran in time (a camera gives no frame).
         """
-        self.wait_first(FIRST_VALUE_TIMEOUT_S * 2)
-        return list(self._markers)
+        return self.found()
 
     @property
     def cards(self) -> list[str]:
@@ -112,14 +159,3 @@ class MarkerDetector(Sensor):
                 f"no card {card_or_id!r} (cards: {known}; or give a marker id)", sensor=self.name
             )
         return any(m.id in wanted for m in self.markers)
-
-    def detect(self, camera: Camera | None = None) -> list[Marker]:
-        """The markers in ``camera``'s latest frame (the first camera by default): detected now,
-        in this thread, unless the background detection already looked at that frame."""
-        chosen = camera or self.cameras[0]
-        frame = chosen.latest()
-        number, found = self._seen.get(chosen.name, (0, []))
-        if number != frame.number:
-            found = self.finder.find(frame.image, chosen.calibration, chosen.name)
-            self._seen[chosen.name] = (frame.number, found)
-        return list(found)

@@ -1,8 +1,10 @@
 """``OpenCVCamera``: a V4L2 device (index or path) or a video file, grabbed in the background.
 
-The device is opened when the camera is made, so a missing or busy one is a one-line
-``SensorError`` before anything runs. A video file stands in for a device (tests, demos): it
-loops at its end. A device that stops giving frames is lost: reopened with backoff, it resumes.
+The device is opened when the camera is made: a missing or busy one is a one-line
+``SensorError`` (``poppy camera``), or, with ``retry_open`` (a robot's camera: an accessory),
+the camera starts lost and is opened with backoff once it can be. A video file stands in for a
+device (tests, demos): it loops at its end. A device that stops giving frames is lost: reopened
+with backoff, it resumes.
 """
 
 from __future__ import annotations
@@ -87,9 +89,12 @@ class OpenCVCamera(Camera):
         resolution: ``(width, height)`` asked of the device (None: its default).
         calibration: intrinsics for marker poses.
         opener: makes the capture (tests give a wrapper around ``cv2.VideoCapture``).
+        retry_open: a device that cannot be opened now is no error: the camera starts lost
+            (one WARNING, ``health()``) and is opened with backoff when it appears or is freed.
 
     Raises:
-        SensorError: the device cannot be opened (missing, busy, no permission), one line.
+        SensorError: the device cannot be opened (missing, busy, no permission), one line
+            (not with ``retry_open``).
     """
 
     registers: ClassVar[tuple[str, ...]] = (*Camera.registers, "index")
@@ -103,13 +108,20 @@ class OpenCVCamera(Camera):
         *,
         calibration: CameraCalibration | None = None,
         opener: Opener | None = None,
+        retry_open: bool = False,
     ) -> None:
         super().__init__(name, resolution or (640, 480), fps, calibration=calibration)
         self._source = parse_source(index, name)
         self._asked = resolution
         self._opener = opener or _default_opener
         self._is_file = isinstance(self._source, str) and not self._source.startswith("/dev/")
-        self._capture = self._open()
+        self._capture: Any = None
+        try:
+            self._capture = self._open()
+        except SensorError as exc:
+            if not retry_open:
+                raise
+            self.begin_lost(self._reason(exc))
 
     @property
     def index(self) -> Source:
@@ -151,14 +163,23 @@ class OpenCVCamera(Camera):
         return np.ascontiguousarray(image)
 
     def reconnect(self) -> None:
+        capture, self._capture = self._capture, None
+        if capture is not None:
+            try:
+                capture.release()
+            except Exception:
+                logger.debug("releasing %s", self.device, exc_info=True)
         try:
-            self._capture.release()
-        except Exception:
-            logger.debug("releasing %s", self.device, exc_info=True)
-        self._capture = self._open()
+            self._capture = self._open()
+        except SensorError as exc:  # health's last_error: the reason, not the sensor's name
+            raise SensorError(self._reason(exc), sensor=self.name, device=self.device) from None
+
+    def _reason(self, exc: SensorError) -> str:
+        return str(exc).removeprefix(f"camera {self.name!r}: ")
 
     def release(self) -> None:
-        self._capture.release()
+        if self._capture is not None:
+            self._capture.release()
 
 
 def list_devices(root: str = "/sys/class/video4linux") -> list[dict[str, Any]]:

@@ -12,6 +12,7 @@ from typing import Any
 import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
 import numpy as np
 
+from poppy_core.checks import positive
 from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.errors import ConfigError
 from poppy_core.sim.drive import Drive, Joint
@@ -308,10 +309,40 @@ class Simulation:
         image = np.repeat(grey[:, :, None], 3, axis=2)
         dark = np.nonzero(grey.min(axis=0) < 128)[0]  # columns of the black square
         card_half = size / 2 * grey.shape[1] / float(dark[-1] - dark[0] + 1)
+        self.add_picture(name, image, position, 2 * card_half, facing=facing)
+
+    def add_picture(
+        self,
+        name: str,
+        image: np.ndarray,
+        position: tuple[float, float, float],
+        size: float = 0.1,
+        *,
+        facing: tuple[float, float, float] | None = None,
+    ) -> None:
+        """Add a square card showing ``image`` (RGB, ``(h, w, 3)`` uint8; a face, a photo), held
+        in place (it does not fall).
+
+        Args:
+            name: the card's body name.
+            image: the picture; it is stretched to the square card.
+            position: the card's centre (m, world).
+            size: side of the card (m).
+            facing: direction the picture faces; None: toward the robot's camera (``camera``).
+
+        Raises:
+            ConfigError: the name is used, no direction to face, a bad image.
+            ArgumentError: a size that is not a positive length.
+        """
+        pixels = np.asarray(image)
+        if pixels.ndim != 3 or pixels.shape[2] < 3 or pixels.dtype != np.uint8:
+            raise ConfigError("a picture is an (height, width, 3) uint8 RGB image",
+                              field="image", value=getattr(pixels, "shape", None))  # fmt: skip
+        side = positive(size, "size")
         if facing is None:
             facing = self._toward_camera(position)
         spec = ObjectSpec("card", name, tuple(float(v) for v in position),  # type: ignore[arg-type]
-                          (card_half,), 0.01, facing_quat(facing), True, image)  # fmt: skip
+                          (side / 2,), 0.01, facing_quat(facing), True, pixels)  # fmt: skip
         self._add(spec)
 
     def _toward_camera(self, position: tuple[float, float, float]) -> tuple[float, float, float]:

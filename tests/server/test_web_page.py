@@ -6,6 +6,7 @@ Each test opens the page of a virtual Ergo Jr served on 127.0.0.1, uses it as a 
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 import time
 from collections.abc import Callable, Iterator
@@ -194,6 +195,20 @@ def test_a_refused_goal_is_shown(page: Any, served: Served) -> None:
         assert motor.goal_position <= 10.0
     finally:
         motor.angle_limit = old
+
+
+def test_the_sensors_are_shown_and_a_lost_camera_says_why(
+    page: Any, served: Served, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    eventually(lambda: "camera" in page.inner_text("#sensors"), "the sensors listed")
+    assert page.get_attribute("#sensors li:first-child", "class") == "ok"
+    camera = served.robot.sensor("camera")
+    why = "/dev/video0 does not exist: plug the camera in"
+    lost = dataclasses.replace(camera.health(), connected=False, last_error=why)
+    monkeypatch.setattr(camera, "health", lambda: lost)  # as an unplugged camera's
+    eventually(lambda: "lost · /dev/video0 does not exist" in page.inner_text("#sensors"),
+               "the lost camera shown (the page refreshes every 5 s)")  # fmt: skip
+    assert page.get_attribute("#sensors li:first-child", "class") == "bad"
 
 
 def test_the_phone_layout_fits_the_screen(browser: Any, served: Served) -> None:

@@ -53,7 +53,7 @@ def simulated(robot: Robot) -> bool:
 
 
 def about(robot: Robot, request: Request) -> dict[str, Any]:
-    """The page's header: name, creature, buses and their health, uptime, links."""
+    """The page's header: name, creature, buses and sensors with their health, uptime, links."""
     profile = robot.config.profile if robot.config is not None else None
     state = request.app.state
     health = {name: h.as_dict() for name, h in robot.health().items()}
@@ -65,6 +65,7 @@ def about(robot: Robot, request: Request) -> dict[str, Any]:
         "uptime_s": round(time.monotonic() - state.web_started, 1),
         "buses": jsonable(health),
         "cameras": [s.name for s in robot.sensors if isinstance(s, Camera)],
+        "sensors": {name: h.as_dict() for name, h in robot.sensor_health().items()},
         "chains": _chain_names(robot),
         "links": dict(state.web_links),
     }

@@ -30,6 +30,13 @@ function showAbout(about) {
     return el("li", { className: bus.ok ? "ok" : "bad" },
       el("strong", { textContent: name }), ` ${bus.port}: ${text}`);
   }));
+  const sensors = Object.entries(about.sensors ?? {});
+  document.getElementById("sensors").replaceChildren(...sensors.map(([name, sensor]) => {
+    const text = sensor.ok ? (sensor.running ? `ok · ${sensor.rate_hz.toFixed(0)} Hz` : "ok · idle")
+      : `lost · ${sensor.last_error}`;
+    return el("li", { className: sensor.ok ? "ok" : "bad" },
+      el("strong", { textContent: name }), ` ${sensor.kind}: ${text}`);
+  }));
   const links = document.getElementById("links");
   links.replaceChildren(...Object.entries(about.links).map(([name, url]) =>
     el("a", { href: url, textContent: name, target: name === "routes" ? "" : "_blank", rel: "noopener" })));
