@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.results import PingResult, SetupResult
@@ -74,6 +75,24 @@ def wait_for_answer(bus: DxlBus, motor_id: int, timeout_s: float = ANSWER_TIMEOU
 def unlock_eeprom(bus: DxlBus, motor_id: int, model: ServoModel) -> None:
     if protocol_for(model.protocol).torque_locks_eeprom:
         bus.write_register(motor_id, model, "torque_enable", False)
+
+
+@contextmanager
+def eeprom_unlocked(bus: DxlBus, motor_id: int, model: ServoModel) -> Iterator[None]:
+    """EEPROM writes allowed in the block: a stiff motor whose protocol locks its EEPROM while
+    the torque is on is made compliant for the block and stiff again after it (it holds its
+    goal again), so a running robot is left as it was found."""
+    if not protocol_for(model.protocol).torque_locks_eeprom:
+        yield
+        return
+    stiff = bool(bus.read_register(motor_id, model, "torque_enable"))
+    if stiff:
+        bus.write_register(motor_id, model, "torque_enable", False)
+    try:
+        yield
+    finally:
+        if stiff:
+            bus.write_register(motor_id, model, "torque_enable", True)
 
 
 def _write_verified(
@@ -289,6 +308,7 @@ __all__ = [
     "ANSWER_TIMEOUT_S",
     "change_baudrate",
     "change_id",
+    "eeprom_unlocked",
     "factory_reset",
     "identify",
     "locate",

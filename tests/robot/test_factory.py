@@ -128,6 +128,30 @@ def test_return_delay_reported_then_fixed_with_consent(served: list[EmulatorServ
     assert all(m.table.get("return_delay_time") == 0 for m in bus.motors)
 
 
+def test_return_delay_fixed_on_stiff_motors_which_stay_stiff(
+    served: list[EmulatorServer],
+) -> None:
+    bus = ergo_line([1, 2, 3, 4, 5, 6], delay_zero=False)
+    for motor in bus.motors[:3]:  # the XL-320 locks its EEPROM while its torque is on
+        motor.table.set("torque_enable", 1)
+    url = serve(served, bus)
+    with from_profile("ergo-jr", port=url, sensors=False, fix_return_delay=True) as robot:
+        assert [m.compliant for m in robot.motors] == [False] * 3 + [True] * 3
+    assert [m.table.get("return_delay_time") for m in bus.motors] == [0] * 6
+    assert [m.table.get("torque_enable") for m in bus.motors] == [1] * 3 + [0] * 3
+
+
+def test_return_delay_advice_names_the_python_argument(
+    served: list[EmulatorServer], caplog: pytest.LogCaptureFixture
+) -> None:
+    url = serve(served, ergo_line([1, 2, 3, 4, 5, 6], delay_zero=False))
+    with caplog.at_level("WARNING"), from_profile("ergo-jr", port=url, sensors=False):
+        pass
+    advice = [r.getMessage() for r in caplog.records if "return delay" in r.getMessage()]
+    assert len(advice) == 1 and "fix_return_delay=True" in advice[0]
+    assert "poppy motor" not in advice[0]  # a shell command is no advice in a Python program
+
+
 def test_auto_port_finds_the_bus(served: list[EmulatorServer]) -> None:
     empty = serve(served, VirtualBus([], 2))
     url = serve(served, ergo_line([1, 2, 3, 4, 5, 6]))
