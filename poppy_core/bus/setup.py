@@ -98,13 +98,16 @@ def eeprom_unlocked(bus: DxlBus, motor_id: int, model: ServoModel) -> Iterator[N
 def _write_verified(
     bus: DxlBus, motor_id: int, model: ServoModel, name: str, value: SIValue
 ) -> tuple[SIValue, SIValue]:
-    """Write register ``name``, read it back, and return (old, new) SI values."""
+    """Write register ``name``, read it back, and return (old, new) SI values (a stiff motor
+    whose EEPROM locks is compliant for an EEPROM write and stiff again after it)."""
     register = model.register(name)
     wanted = register.from_si(value)
     old = bus.read_register(motor_id, model, name)
     if register.memory == "EEPROM":
-        unlock_eeprom(bus, motor_id, model)
-    bus.write_register(motor_id, model, name, value)
+        with eeprom_unlocked(bus, motor_id, model):
+            bus.write_register(motor_id, model, name, value)
+    else:
+        bus.write_register(motor_id, model, name, value)
     raw = register.decode(bus.read(motor_id, register.address, register.size))
     if raw != wanted:
         raise SetupError(

@@ -6,6 +6,10 @@ own firmware enforces them too. A config's ``angle_limit`` is in the motor frame
 (``pypot.robot.config`` writes it to the EEPROM as it is), so the same values land in the
 EEPROM as with pypot; the ``Motor`` shows them in the user frame. ``write_angle_limits=False``
 leaves the EEPROM alone; goals are clamped in software either way.
+
+EEPROM writes (return delay, angle limits) on a motor whose protocol locks the EEPROM while its
+torque is on (protocol 2: XL-320, X series) make a stiff motor compliant for the write and stiff
+again after it.
 """
 
 from __future__ import annotations
@@ -165,11 +169,12 @@ def write_angle_limits(bus: DxlBus, motors: Sequence[Motor]) -> None:
         if all(abs(w - p) <= step for w, p in zip(wanted, present, strict=True)):
             continue
         try:
-            for name, value in zip(names, wanted, strict=True):
-                bus.write_register(motor.id, model, name, value)
+            with eeprom_unlocked(bus, motor.id, model):  # a stiff motor stays stiff after
+                for name, value in zip(names, wanted, strict=True):
+                    bus.write_register(motor.id, model, name, value)
         except (BusError, MotorError) as exc:
             logger.warning(
-                "%s: could not write its angle limits %s (torque on?): %s",
+                "%s: could not write its angle limits %s: %s",
                 motor.name,
                 wanted,
                 exc,
