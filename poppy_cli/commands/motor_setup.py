@@ -105,7 +105,7 @@ def _run_each(
         print_json([setup_record(result) for result in results])
 
 
-@app.command("set-return-delay")
+@app.command("set-return-delay", cls=NumbersCommand)
 def set_return_delay(
     ids: str = typer.Argument(..., help="Motor ID(s): 3, or 1-6, or 1,3,5."),
     delay_us: float = typer.Argument(..., help="Return delay in µs (0 for a fast bus)."),
@@ -127,7 +127,7 @@ def set_return_delay(
 
 @app.command("angle-limits", cls=NumbersCommand)
 def angle_limits(
-    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    ids: str = typer.Argument(..., help="Motor ID(s): 3, or 1-6, or 1,3,5."),
     min_deg: float | None = typer.Argument(None, help="Lower limit in degrees."),
     max_deg: float | None = typer.Argument(None, help="Upper limit in degrees."),
     port: str | None = BusPortOpt,
@@ -135,7 +135,10 @@ def angle_limits(
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
 ) -> None:
-    """Show the angle limits, or set them: `poppy motor angle-limits 3 -90 90`."""
+    """Show the angle limits, or set them: `poppy motor angle-limits 3 -90 90`.
+
+    `--json`: a list of {id, min, max} (or of setup results), whatever the number of IDs.
+    """
     from poppy_cli.connect import ping_model
     from poppy_cli.output import fmt_value, print_json
     from poppy_core.bus.setup import set_angle_limits
@@ -143,23 +146,30 @@ def angle_limits(
     if (min_deg is None) != (max_deg is None):
         error_line("give both limits (MIN MAX), or none to read them")
         raise typer.Exit(EXIT_USAGE)
-    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
-        if min_deg is None or max_deg is None:
+    if min_deg is not None and max_deg is not None:
+        low, high = min_deg, max_deg
+        _run_each(port, ids, baud, protocol, json_output,
+                  lambda bus, motor_id, say: set_angle_limits(bus, motor_id, low, high,
+                                                              progress=say))  # fmt: skip
+        return
+    id_list = parse_ids(ids)
+    rows = []
+    with open_bus(require_port(port), id_list, baud, protocol) as bus:
+        for motor_id in id_list:
             model = ping_model(bus, motor_id).model
             assert model is not None
-            low = bus.read_register(motor_id, model, "min_position_limit")
-            high = bus.read_register(motor_id, model, "max_position_limit")
-            if json_output:
-                print_json({"id": motor_id, "min": low, "max": high})
-            else:
-                console.print(
-                    f"motor {motor_id}: {fmt_value(low, 'deg')} .. {fmt_value(high, 'deg')}"
-                )
-            return
-        result = set_angle_limits(
-            bus, motor_id, min_deg, max_deg, progress=None if json_output else _say
+            rows.append({
+                "id": motor_id,
+                "min": bus.read_register(motor_id, model, "min_position_limit"),
+                "max": bus.read_register(motor_id, model, "max_position_limit"),
+            })  # fmt: skip
+    if json_output:
+        print_json(rows)
+        return
+    for row in rows:
+        console.print(
+            f"motor {row['id']}: {fmt_value(row['min'], 'deg')} .. {fmt_value(row['max'], 'deg')}"
         )
-    print_setup(result, json_output)
 
 
 @app.command("reboot")

@@ -5,8 +5,6 @@ from __future__ import annotations
 import time
 from typing import Any
 
-import pytest
-
 P1 = ("--baud", "1000000", "--protocol", "1")
 P2 = ("--baud", "1000000", "--protocol", "2")
 
@@ -125,7 +123,7 @@ def test_return_delay_and_angle_limits(poppy: Any, mx_bus: Any) -> None:
     assert poppy("motor", "set-return-delay", "11", "0", *port).code == 0
     assert poppy("motor", "get", "11", "return_delay_time", *port).stdout.strip() == "0 µs"
     assert poppy("motor", "angle-limits", "11", *port, "--", "-90", "90").code == 0
-    limits = poppy("motor", "angle-limits", "11", "--json", *port).json()
+    [limits] = poppy("motor", "angle-limits", "11", "--json", *port).json()
     assert abs(limits["min"] + 90) < 0.1 and abs(limits["max"] - 90) < 0.1
 
 
@@ -229,11 +227,11 @@ def test_a_goal_to_a_compliant_motor_says_why_it_does_not_move(poppy: Any, ergo_
 
 def test_negative_values_need_no_double_dash(poppy: Any, ergo_jr: Any) -> None:
     port = ("--port", ergo_jr.url, *P2)
-    limits = poppy("motor", "angle-limits", "4", "-90.5", "1e2", *port)
+    limits = poppy("motor", "angle-limits", "4-5", "-90.5", "1e2", *port)  # an ID list too
     assert limits.code == 0, limits.stderr
-    assert poppy("motor", "angle-limits", "4", "--json", *port).json()["min"] == pytest.approx(
-        -90.5, abs=0.3
-    )
+    read = poppy("motor", "angle-limits", "4,5", "--json", *port).json()
+    assert [r["id"] for r in read] == [4, 5]
+    assert all(abs(r["min"] + 90.5) < 0.3 and abs(r["max"] - 100) < 0.3 for r in read), read
     unknown = poppy("motor", "set", "4", "goal_position", "-6", "--jsn", *port)
     assert unknown.code == 2 and "No such option: --jsn" in unknown.stderr
 
