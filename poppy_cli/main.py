@@ -86,7 +86,6 @@ def _root(
     if quiet and (debug or verbose):
         raise typer.BadParameter("it cannot go with --verbose or --debug", param_hint="--quiet")
     state.debug = debug
-    state.quiet = quiet
     err_console.quiet = quiet  # error_line still prints (see poppy_cli.output)
     if quiet:
         import warnings

@@ -144,4 +144,4 @@ def _as_a_process(
         sys.stdin, sys.stdout, sys.stderr = saved_streams
         for signum, handler in handlers.items():
             signal.signal(signum, handler)
-        state.debug = state.quiet = False
+        state.debug = False
