@@ -22,7 +22,13 @@ from poppy_cli.commands import snap as snap_cmd
 from poppy_cli.commands import teleop as teleop_cmd
 from poppy_cli.commands import tui as tui_cmd
 from poppy_cli.options import SimArgsGroup
-from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_INTERRUPTED,
+    EXIT_USAGE,
+    err_console,
+    error_line,
+)
 
 app = typer.Typer(
     name="poppy",
@@ -34,12 +40,58 @@ app = typer.Typer(
 )
 
 
+def version_text() -> str:
+    """``poppy X.Y.Z`` and, on a second line, what it runs on (from package metadata: nothing
+    is imported)."""
+    import platform
+    from importlib import metadata
+
+    def version_of(package: str) -> str:
+        try:
+            return metadata.version(package)
+        except metadata.PackageNotFoundError:
+            return "not installed"
+
+    libraries = ", ".join(
+        f"{name} {version_of(name)}" for name in ("typer", "rich", "textual", "numpy", "mujoco")
+    )
+    return (
+        f"poppy {version_of('poppy')}\n"
+        f"Python {platform.python_version()} on {platform.system() or 'unknown'}; {libraries}"
+    )
+
+
+def _show_version(shown: bool) -> None:
+    if shown:
+        sys.stdout.write(version_text() + "\n")
+        raise typer.Exit(0)
+
+
 @app.callback()
 def _root(
     debug: bool = typer.Option(False, "--debug", help="Show tracebacks and debug logs."),
     verbose: bool = typer.Option(False, "--verbose", "-v", help="Show info logs."),
+    quiet: bool = typer.Option(
+        False, "--quiet", "-q", help="Only errors on stderr: no warnings, notes or progress."
+    ),
+    _version: bool = typer.Option(
+        False,
+        "--version",
+        "-V",
+        is_eager=True,
+        callback=_show_version,
+        help="Show poppy's version (and Python's, and its main libraries') and exit.",
+    ),
 ) -> None:
+    if quiet and (debug or verbose):
+        raise typer.BadParameter("it cannot go with --verbose or --debug", param_hint="--quiet")
     state.debug = debug
+    err_console.quiet = quiet  # error_line still prints (see poppy_cli.output)
+    if quiet:
+        import warnings
+
+        logging.getLogger().setLevel(logging.ERROR)
+        warnings.simplefilter("ignore")
     if debug or verbose:
         logging.basicConfig(
             level=logging.DEBUG if debug else logging.INFO,

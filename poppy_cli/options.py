@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from typing import TYPE_CHECKING, Any
 
 import typer
-from typer.core import TyperGroup
+from typer.core import TyperCommand, TyperGroup
 
 if TYPE_CHECKING:
     from typer import _click
@@ -40,6 +41,20 @@ def parse_ids(text: str) -> list[int]:
     if not ids:
         raise typer.BadParameter("no ID given; use e.g. 0-253 or 1,2,3")
     return sorted(ids)
+
+
+def format_ids(ids: list[int]) -> str:
+    """IDs as ``parse_ids`` reads them, runs shortened: [1, 2, 3, 5] -> "1-3,5"."""
+    runs: list[list[int]] = []
+    for motor_id in sorted(set(ids)):
+        if runs and motor_id == runs[-1][-1] + 1:
+            runs[-1].append(motor_id)
+        else:
+            runs.append([motor_id])
+    return ",".join(
+        str(run[0]) if len(run) == 1 else f"{run[0]}{'-' if len(run) > 2 else ','}{run[-1]}"
+        for run in runs
+    )
 
 
 def parse_protocols(text: str) -> list[int]:
@@ -195,3 +210,49 @@ class SimArgsGroup(TyperGroup):
         if "--sim" in args and _sim_takes_value(_leaf_command(self, ctx, args)):
             args = normalise_sim_args(args)
         return super().parse_args(ctx, args)
+
+
+# -- negative numbers as values: `poppy motor set 2 goal_position -60` ------------------------
+
+_NEGATIVE_NUMBER = re.compile(r"-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def values_last(params: list[Any], args: list[str]) -> list[str]:
+    """``args`` with the options first and the values (arguments) after a ``--``, in their
+    order, when a value is a negative number (Click would read ``-60`` as an option ``-6``).
+
+    ``params`` are the command's; an option's own value stays with it (``--baud 1000000``).
+    """
+    takes_value = {
+        name: param.nargs
+        for param in params
+        if getattr(param, "param_type_name", "") == "option" and not param.is_flag
+        and not param.count
+        for name in (*param.opts, *param.secondary_opts)
+    }  # fmt: skip
+    options: list[str] = []
+    values: list[str] = []
+    index = 0
+    while index < len(args):
+        token = args[index]
+        if token == "--":
+            values += args[index + 1 :]
+            break
+        if _NEGATIVE_NUMBER.fullmatch(token) or not token.startswith("-") or token == "-":
+            values.append(token)
+        else:
+            options.append(token)
+            count = takes_value.get(token, 0)  # `--port=X`, `-pX`: the value is in the token
+            options += args[index + 1 : index + 1 + count]
+            index += count
+        index += 1
+    if not any(_NEGATIVE_NUMBER.fullmatch(value) for value in values):
+        return args
+    return [*options, "--", *values]
+
+
+class NumbersCommand(TyperCommand):
+    """A command whose arguments may be negative numbers, with no ``--`` before them."""
+
+    def parse_args(self, ctx: _click.Context, args: list[str]) -> list[str]:
+        return super().parse_args(ctx, values_last(self.params, args))

@@ -80,14 +80,25 @@ def print_json(data: Any) -> None:
 
 
 def error_line(message: str) -> None:
-    """Print one clear error line on stderr (``message`` literally, on one line)."""
+    """Print one clear error line on stderr (``message`` literally, on one line), even with
+    `--quiet` (which quiets ``err_console`` for everything else)."""
     one_line = message.replace("\r", "\\r").replace("\n", "\\n")
-    err_console.print(styled("[bold red]error:[/] {}", one_line), soft_wrap=True)
+    quiet, err_console.quiet = err_console.quiet, False
+    try:
+        err_console.print(styled("[bold red]error:[/] {}", one_line), soft_wrap=True)
+    finally:
+        err_console.quiet = quiet
 
 
 def warn_line(message: str) -> None:
-    """Print one warning line on stderr (``message`` literally)."""
+    """Print one warning line on stderr (``message`` literally; not with `--quiet`)."""
     err_console.print(styled("[yellow]warning:[/] {}", message), soft_wrap=True)
+
+
+def note_line(message: str) -> None:
+    """Print one note on stderr (``message`` literally; not with `--quiet`): something the
+    user may not expect, and what to do about it."""
+    err_console.print(styled("[cyan]note:[/] {}", message), soft_wrap=True)
 
 
 def fmt_value(value: Any, unit: str = "") -> str:

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.output import EXIT_USAGE, error_line
+from poppy_cli.output import EXIT_USAGE, error_line, warn_line
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -82,15 +82,34 @@ def open_remote(url: str) -> RemoteRobot:
 
 
 def ask_return_delay(issues: list[ReturnDelayIssue]) -> bool:
-    """Ask (only on an interactive terminal) whether slow return delays may be set to 0 µs."""
-    import sys
+    """Ask (only when stdin is a terminal) whether slow return delays may be set to 0 µs; when
+    not asked, or declined, say which command sets them."""
+    from poppy_cli.prompts import confirm
 
     listed = ", ".join(str(issue) for issue in issues)
-    if not sys.stdin.isatty():
-        return False
-    return typer.confirm(
+    agreed = confirm(
         f"These motors wait before answering, which slows the bus: {listed}. "
         "Set their return delay to 0 µs (EEPROM)?",
         default=True,
-        err=True,
     )
+    if not agreed:
+        warn_line(return_delay_advice(issues))
+    return bool(agreed)
+
+
+def return_delay_advice(issues: list[ReturnDelayIssue]) -> str:
+    """The warning naming the command that sets the return delays of ``issues`` to 0 µs."""
+    import shlex
+
+    from poppy_cli.options import format_ids
+
+    by_port: dict[str, list[int]] = {}
+    for issue in issues:
+        by_port.setdefault(issue.port, []).append(issue.id)
+    commands = " and ".join(
+        f"`poppy motor set-return-delay {format_ids(ids)} 0"
+        + (f" --port {shlex.quote(port)}`" if port else "`")
+        for port, ids in by_port.items()
+    )
+    listed = ", ".join(str(issue) for issue in issues)
+    return f"return delay above 0 slows every transaction: {listed}; {commands} sets it to 0"

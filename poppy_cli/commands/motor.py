@@ -7,7 +7,16 @@ from typing import TYPE_CHECKING
 import typer
 
 from poppy_cli.connect import open_bus, ping_model
-from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, ProtoOpt, default_port, parse_ids
+from poppy_cli.options import (
+    BaudOpt,
+    BusPortOpt,
+    JsonOpt,
+    NumbersCommand,
+    ProtoOpt,
+    default_port,
+    format_ids,
+    parse_ids,
+)
 from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_json, styled
 
 if TYPE_CHECKING:
@@ -35,20 +44,23 @@ def parse_value(register: Register, text: str) -> SIValue:
     return register.parse(text)
 
 
+def setup_record(result: SetupResult) -> dict[str, object]:
+    """A setup result as JSON."""
+    return {
+        "operation": result.operation,
+        "port": result.port,
+        "id": result.motor_id,
+        "baud": result.baudrate,
+        "protocol": result.protocol,
+        "changes": {k: list(v) for k, v in result.changes.items()},
+        "verified": result.verified,
+        "notes": result.notes,
+    }
+
+
 def print_setup(result: SetupResult, json_output: bool) -> None:
     if json_output:
-        print_json(
-            {
-                "operation": result.operation,
-                "port": result.port,
-                "id": result.motor_id,
-                "baud": result.baudrate,
-                "protocol": result.protocol,
-                "changes": {k: list(v) for k, v in result.changes.items()},
-                "verified": result.verified,
-                "notes": result.notes,
-            }
-        )
+        print_json(setup_record(result))
         return
     for name, (old, new) in result.changes.items():
         console.print(styled("{}: {} → [bold]{}[/]", name, fmt_value(old), fmt_value(new)))
@@ -159,7 +171,7 @@ def get(
     console.print(table)
 
 
-@app.command("set")
+@app.command("set", cls=NumbersCommand)
 def set_register(
     ids: str = typer.Argument(..., help="Motor ID(s): 11, or 1-6, or 1,3,5."),
     register: str = typer.Argument(..., help="Register name, e.g. goal_position."),
@@ -169,7 +181,11 @@ def set_register(
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
 ) -> None:
-    """Write one register in SI units, e.g. `poppy motor set 11 goal_position 30`."""
+    """Write one register in SI units, e.g. `poppy motor set 11 goal_position -30`.
+
+    A compliant motor (torque off) does not move to a goal: `poppy motor torque ID on` first
+    (a note says so when a goal is written to one).
+    """
     from poppy_core.errors import RegisterError
 
     id_list = parse_ids(ids)
@@ -181,6 +197,7 @@ def set_register(
             register=register,
         )
     results: dict[str, dict[str, object]] = {}
+    compliant: list[int] = []
     with open_bus(require_port(port), id_list, baud, protocol) as bus:
         for motor_id in id_list:
             model = ping_model(bus, motor_id).model
@@ -195,8 +212,29 @@ def set_register(
             results[str(motor_id)] = {reg.name: written}
             if not json_output:
                 console.print(f"motor {motor_id}: {reg.name} = {fmt_value(written, reg.unit)}")
+            if reg.name.startswith("goal_") and not bus.read_register(
+                motor_id, model, "torque_enable"
+            ):
+                compliant.append(motor_id)
     if json_output:
         print_json(results)
+    elif compliant:
+        _say_compliant(compliant, port)
+
+
+def _say_compliant(ids: list[int], port: str | None) -> None:
+    """A note: these motors were given a goal but are compliant, so they do not move."""
+    import shlex
+
+    from poppy_cli.output import note_line
+
+    which = f"motor {ids[0]} is" if len(ids) == 1 else f"motors {format_ids(ids)} are"
+    where = f" --port {shlex.quote(port)}" if port else ""
+    them = "it" if len(ids) == 1 else "them"
+    note_line(
+        f"{which} compliant (torque off), so the goal moves nothing: "
+        f"`poppy motor torque {format_ids(ids)} on{where}` makes {them} stiff"
+    )
 
 
 def _toggle(

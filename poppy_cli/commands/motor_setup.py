@@ -7,8 +7,8 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.commands.motor import app, print_setup, require_port
-from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, ProtoOpt
+from poppy_cli.commands.motor import app, print_setup, require_port, setup_record
+from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, NumbersCommand, ProtoOpt, parse_ids
 
 if TYPE_CHECKING:
     from poppy_core.bus.dxlbus import DxlBus
@@ -81,31 +81,53 @@ def set_baudrate(
     )
 
 
-@app.command("set-return-delay")
+def _run_each(
+    port: str | None,
+    ids: str,
+    baud: int | None,
+    protocol: int | None,
+    json_output: bool,
+    operation: Callable[[DxlBus, int, Callable[[str], None] | None], SetupResult],
+) -> None:
+    """Open the bus where the ``ids`` answer and run one setup operation on each, in order;
+    print each result (``--json``: a list of them, whatever the number of IDs)."""
+    from poppy_cli.output import print_json
+
+    id_list = parse_ids(ids)
+    results = []
+    with open_bus(require_port(port), id_list, baud, protocol) as bus:
+        for motor_id in id_list:
+            result = operation(bus, motor_id, None if json_output else _say)
+            results.append(result)
+            if not json_output:
+                print_setup(result, json_output=False)
+    if json_output:
+        print_json([setup_record(result) for result in results])
+
+
+@app.command("set-return-delay", cls=NumbersCommand)
 def set_return_delay(
-    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    ids: str = typer.Argument(..., help="Motor ID(s): 3, or 1-6, or 1,3,5."),
     delay_us: float = typer.Argument(..., help="Return delay in µs (0 for a fast bus)."),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
 ) -> None:
-    """Set the return delay time (µs); Poppy robots use 0."""
+    """Set the return delay time (µs); Poppy robots use 0: `poppy motor set-return-delay 1-6 0`.
+
+    The return delay is in the EEPROM, which protocol 2 motors (XL-320, X series) lock while
+    their torque is on: a stiff motor is made compliant for the write and stiff again after.
+    """
     from poppy_core.bus.setup import set_return_delay as run
 
-    _run_setup(
-        port,
-        motor_id,
-        baud,
-        protocol,
-        json_output,
-        lambda bus, say: run(bus, motor_id, delay_us, progress=say),
-    )
+    _run_each(port, ids, baud, protocol, json_output,
+              lambda bus, motor_id, say: run(bus, motor_id, delay_us, progress=say))  # fmt: skip
 
 
-@app.command("angle-limits")
+@app.command("angle-limits", cls=NumbersCommand)
 def angle_limits(
-    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    ids: str = typer.Argument(..., help="Motor ID(s): 3, or 1-6, or 1,3,5."),
     min_deg: float | None = typer.Argument(None, help="Lower limit in degrees."),
     max_deg: float | None = typer.Argument(None, help="Upper limit in degrees."),
     port: str | None = BusPortOpt,
@@ -113,7 +135,10 @@ def angle_limits(
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
 ) -> None:
-    """Show the angle limits, or set them: `poppy motor angle-limits 3 -- -90 90`."""
+    """Show the angle limits, or set them: `poppy motor angle-limits 3 -90 90`.
+
+    `--json`: a list of {id, min, max} (or of setup results), whatever the number of IDs.
+    """
     from poppy_cli.connect import ping_model
     from poppy_cli.output import fmt_value, print_json
     from poppy_core.bus.setup import set_angle_limits
@@ -121,44 +146,45 @@ def angle_limits(
     if (min_deg is None) != (max_deg is None):
         error_line("give both limits (MIN MAX), or none to read them")
         raise typer.Exit(EXIT_USAGE)
-    with open_bus(require_port(port), [motor_id], baud, protocol) as bus:
-        if min_deg is None or max_deg is None:
+    if min_deg is not None and max_deg is not None:
+        low, high = min_deg, max_deg
+        _run_each(port, ids, baud, protocol, json_output,
+                  lambda bus, motor_id, say: set_angle_limits(bus, motor_id, low, high,
+                                                              progress=say))  # fmt: skip
+        return
+    id_list = parse_ids(ids)
+    rows = []
+    with open_bus(require_port(port), id_list, baud, protocol) as bus:
+        for motor_id in id_list:
             model = ping_model(bus, motor_id).model
             assert model is not None
-            low = bus.read_register(motor_id, model, "min_position_limit")
-            high = bus.read_register(motor_id, model, "max_position_limit")
-            if json_output:
-                print_json({"id": motor_id, "min": low, "max": high})
-            else:
-                console.print(
-                    f"motor {motor_id}: {fmt_value(low, 'deg')} .. {fmt_value(high, 'deg')}"
-                )
-            return
-        result = set_angle_limits(
-            bus, motor_id, min_deg, max_deg, progress=None if json_output else _say
+            rows.append({
+                "id": motor_id,
+                "min": bus.read_register(motor_id, model, "min_position_limit"),
+                "max": bus.read_register(motor_id, model, "max_position_limit"),
+            })  # fmt: skip
+    if json_output:
+        print_json(rows)
+        return
+    for row in rows:
+        console.print(
+            f"motor {row['id']}: {fmt_value(row['min'], 'deg')} .. {fmt_value(row['max'], 'deg')}"
         )
-    print_setup(result, json_output)
 
 
 @app.command("reboot")
 def reboot(
-    motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
+    ids: str = typer.Argument(..., help="Motor ID(s): 3, or 1-6, or 1,3,5."),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
     json_output: bool = JsonOpt,
 ) -> None:
-    """Reboot a motor (clears a hardware alarm) and wait until it answers again."""
+    """Reboot motors (clears a hardware alarm) and wait until each answers again."""
     from poppy_core.bus.setup import reboot as run
 
-    _run_setup(
-        port,
-        motor_id,
-        baud,
-        protocol,
-        json_output,
-        lambda bus, say: run(bus, motor_id, progress=say),
-    )
+    _run_each(port, ids, baud, protocol, json_output,
+              lambda bus, motor_id, say: run(bus, motor_id, progress=say))  # fmt: skip
 
 
 @app.command("factory-reset")
@@ -179,11 +205,11 @@ def factory_reset(
     """Restore the factory control table (keeps ID and baud rate unless told otherwise)."""
     from poppy_core.bus.setup import factory_reset as run
 
-    if not yes and not typer.confirm(
-        f"Reset motor {motor_id} to its factory settings?", default=False
-    ):
-        error_line("factory reset cancelled")
-        raise typer.Exit(EXIT_USAGE)
+    if not yes:
+        from poppy_cli.prompts import require_yes
+
+        require_yes(f"Reset motor {motor_id} to its factory settings?",
+                    declined="factory reset cancelled")  # fmt: skip
     _run_setup(
         port,
         motor_id,

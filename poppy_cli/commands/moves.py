@@ -182,9 +182,10 @@ def rm(
     from poppy_core.motion import delete_move, move_path
 
     path = move_path(name)
-    if not yes and not typer.confirm(f"delete {path}?", default=False):
-        error_line("not deleted")
-        raise typer.Exit(EXIT_USAGE)
+    if not yes:
+        from poppy_cli.prompts import require_yes
+
+        require_yes(f"delete {path}?", declined="not deleted")
     delete_move(path)
     if json_output:
         print_json({"deleted": str(path)})

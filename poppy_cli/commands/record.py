@@ -20,6 +20,7 @@ from poppy_cli.options import (
     finite,
 )
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, print_json
+from poppy_cli.prompts import ask
 from poppy_cli.robots import robot_config, start_robot
 from poppy_core.trajectory import MAX_DURATION_S
 
@@ -158,9 +159,11 @@ def record(
     groups = {g: config.resolve_group(g) for g in config.motorgroups}
     names = _motor_names(motors, list(config.motors), groups)
     stop = threading.Event()
-    watcher = _install_stop(stop)
     save_failure: FileError | None = None  # the take is still held by the recorder
+    # Built before Ctrl-C and Enter stop a recording: a question asked at start-up (return
+    # delays) is answered, or Ctrl-C there ends the command with nothing recorded.
     with start_robot(config, sim) as robot:
+        watcher = _install_stop(stop)
         recorder = MoveRecorder(robot, freq, names, checkpoint_path=path, replace=force,
                                 make_folder=in_library)  # fmt: skip
         recorder.start()  # refused here when another `poppy record` writes the same file
@@ -221,20 +224,28 @@ def _save_elsewhere(recorder: MoveRecorder, failure: FileError, name: str) -> Pa
         FileError: nothing could be written anywhere.
     """
     from poppy_core.errors import FileError
-    from poppy_core.motion import fallback_path
 
     error_line(f"the take could not be saved: {failure}")
-    while _interactive():
-        answer = typer.prompt(
-            "Save it where? (a file or a folder; empty: a temporary file)",
-            default="", show_default=False, err=True,
-        ).strip()  # fmt: skip
-        if not answer:
-            break
-        try:
-            return recorder.save(Path(answer).expanduser())
-        except FileError as exc:
-            error_line(str(exc))
+    try:
+        while _interactive():
+            answer = ask("Save it where? (a file or a folder; empty: a temporary file)")
+            if not answer or not answer.strip():
+                break
+            try:
+                return recorder.save(Path(answer.strip()).expanduser())
+            except FileError as exc:
+                error_line(str(exc))
+    except (typer.Abort, SystemExit):  # Ctrl-C, end of input, SIGTERM: the take is the user's
+        _save_to_temp(recorder, name)
+        raise
+    return _save_to_temp(recorder, name)
+
+
+def _save_to_temp(recorder: MoveRecorder, name: str) -> Path:
+    """Save the take to a temporary file, and say where."""
+    from poppy_core.errors import FileError
+    from poppy_core.motion import fallback_path
+
     fallback = fallback_path(name)
     try:
         written = recorder.save(fallback)

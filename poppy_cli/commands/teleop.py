@@ -154,12 +154,14 @@ def teleop(
         else:
             follower_motors = list((follower_config or leader_config).motors)
         _check_map(mapping, list(leader_config.motors), follower_motors, follower == SELF)
-        stop = threading.Event()
-        _install_stop(stop)
         lead = stack.enter_context(_build(leader_config, None))
         if follow is None:
             follow = (lead if follower_config is None
                       else stack.enter_context(_build(follower_config, follower_sim)))  # fmt: skip
+        # Only now do Ctrl-C and Enter stop a teleoperation: before, a question asked at
+        # start-up (return delays) is answered, or Ctrl-C there ends the command.
+        stop = threading.Event()
+        _install_stop(stop)
         teleop_run = _start(lead, follow, mapping, rate, ramp, duration, path, leader_config,
                             follower)  # fmt: skip
         _watch(teleop_run, stop, show=not json_output)

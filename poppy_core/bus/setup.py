@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.results import PingResult, SetupResult
@@ -76,16 +77,37 @@ def unlock_eeprom(bus: DxlBus, motor_id: int, model: ServoModel) -> None:
         bus.write_register(motor_id, model, "torque_enable", False)
 
 
+@contextmanager
+def eeprom_unlocked(bus: DxlBus, motor_id: int, model: ServoModel) -> Iterator[None]:
+    """EEPROM writes allowed in the block: a stiff motor whose protocol locks its EEPROM while
+    the torque is on is made compliant for the block and stiff again after it (it holds its
+    goal again), so a running robot is left as it was found."""
+    if not protocol_for(model.protocol).torque_locks_eeprom:
+        yield
+        return
+    stiff = bool(bus.read_register(motor_id, model, "torque_enable"))
+    if stiff:
+        bus.write_register(motor_id, model, "torque_enable", False)
+    try:
+        yield
+    finally:
+        if stiff:
+            bus.write_register(motor_id, model, "torque_enable", True)
+
+
 def _write_verified(
     bus: DxlBus, motor_id: int, model: ServoModel, name: str, value: SIValue
 ) -> tuple[SIValue, SIValue]:
-    """Write register ``name``, read it back, and return (old, new) SI values."""
+    """Write register ``name``, read it back, and return (old, new) SI values (a stiff motor
+    whose EEPROM locks is compliant for an EEPROM write and stiff again after it)."""
     register = model.register(name)
     wanted = register.from_si(value)
     old = bus.read_register(motor_id, model, name)
     if register.memory == "EEPROM":
-        unlock_eeprom(bus, motor_id, model)
-    bus.write_register(motor_id, model, name, value)
+        with eeprom_unlocked(bus, motor_id, model):
+            bus.write_register(motor_id, model, name, value)
+    else:
+        bus.write_register(motor_id, model, name, value)
     raw = register.decode(bus.read(motor_id, register.address, register.size))
     if raw != wanted:
         raise SetupError(
@@ -289,6 +311,7 @@ __all__ = [
     "ANSWER_TIMEOUT_S",
     "change_baudrate",
     "change_id",
+    "eeprom_unlocked",
     "factory_reset",
     "identify",
     "locate",

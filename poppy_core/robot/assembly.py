@@ -160,7 +160,7 @@ class Assembly:
             motors = self.motors[name]
             startup.load_state(bus, motors)
             targets = _return_delays(self.config, (m.name for m in motors))
-            issues = startup.return_delay_issues(motors, targets)
+            issues = startup.return_delay_issues(motors, targets, bus.port)
             startup.fix_return_delays(bus, motors, issues, fix_return_delay)
             if write_angle_limits:
                 startup.write_angle_limits(bus, motors)

@@ -6,6 +6,10 @@ own firmware enforces them too. A config's ``angle_limit`` is in the motor frame
 (``pypot.robot.config`` writes it to the EEPROM as it is), so the same values land in the
 EEPROM as with pypot; the ``Motor`` shows them in the user frame. ``write_angle_limits=False``
 leaves the EEPROM alone; goals are clamped in software either way.
+
+EEPROM writes (return delay, angle limits) on a motor whose protocol locks the EEPROM while its
+torque is on (protocol 2: XL-320, X series) make a stiff motor compliant for the write and stiff
+again after it.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from poppy_core.bus import DxlBus
+from poppy_core.bus.setup import eeprom_unlocked
 from poppy_core.errors import BusError, MotorError, RegisterError
 from poppy_core.robot import registers as regs
 from poppy_core.robot.motor import Motor
@@ -31,13 +36,16 @@ class ReturnDelayIssue:
     id: int
     delay_us: float
     target_us: float
+    port: str = ""
+    """The port of the motor's bus (for advice naming the command that fixes it)."""
 
     def __str__(self) -> str:
         return f"{self.motor} (id {self.id}): {self.delay_us:g} µs"
 
 
 ReturnDelayConsent = bool | Callable[[list[ReturnDelayIssue]], bool]
-"""True/False, or a function shown the issues that returns whether to fix them."""
+"""True/False, or a function shown the issues that returns whether to fix them (a function
+that declines says what to do itself: only False logs the advice, a warning)."""
 
 
 def where(bus: DxlBus) -> str:
@@ -90,9 +98,10 @@ def load_state(bus: DxlBus, motors: Sequence[Motor]) -> None:
 
 
 def return_delay_issues(
-    motors: Sequence[Motor], targets_us: dict[str, float]
+    motors: Sequence[Motor], targets_us: dict[str, float], port: str = ""
 ) -> list[ReturnDelayIssue]:
-    """Motors whose return delay (read by ``load_state``) is above its target."""
+    """Motors (on the bus at ``port``) whose return delay (read by ``load_state``) is above its
+    target."""
     issues = []
     for motor in motors:
         if not motor.online:
@@ -100,7 +109,7 @@ def return_delay_issues(
         delay = link_of(motor).number("return_delay_time")
         target = targets_us.get(motor.name, 0.0)
         if delay > target:
-            issues.append(ReturnDelayIssue(motor.name, motor.id, delay, target))
+            issues.append(ReturnDelayIssue(motor.name, motor.id, delay, target, port))
     return issues
 
 
@@ -112,6 +121,9 @@ def fix_return_delays(
 ) -> list[ReturnDelayIssue]:
     """Report return delays above target and, with consent, write the targets.
 
+    The return delay is in the EEPROM, which protocol 2 servos lock while their torque is on:
+    a stiff motor is made compliant for the write and stiff again after it.
+
     Returns:
         The issues left unfixed.
     """
@@ -119,9 +131,11 @@ def fix_return_delays(
         return []
     agreed = consent(issues) if callable(consent) else consent
     if not agreed:
-        logger.warning(
+        # a consent function was shown the issues and told its user what to do
+        log = logger.info if callable(consent) else logger.warning
+        log(
             "return delay above 0 slows every transaction on %s: %s "
-            "(set it to 0 with fix_return_delay=True, or `poppy motor set-return-delay ID 0`)",
+            "(fix_return_delay=True sets it to 0 at start-up)",
             bus.port,
             ", ".join(map(str, issues)),
         )
@@ -131,7 +145,8 @@ def fix_return_delays(
     for issue in issues:
         motor = by_name[issue.motor]
         try:
-            bus.write_register(motor.id, motor.model, "return_delay_time", issue.target_us)
+            with eeprom_unlocked(bus, motor.id, motor.model):
+                bus.write_register(motor.id, motor.model, "return_delay_time", issue.target_us)
         except (BusError, MotorError, RegisterError) as exc:
             logger.warning("%s: could not set the return delay: %s", issue.motor, exc)
             left.append(issue)
@@ -154,11 +169,12 @@ def write_angle_limits(bus: DxlBus, motors: Sequence[Motor]) -> None:
         if all(abs(w - p) <= step for w, p in zip(wanted, present, strict=True)):
             continue
         try:
-            for name, value in zip(names, wanted, strict=True):
-                bus.write_register(motor.id, model, name, value)
+            with eeprom_unlocked(bus, motor.id, model):  # a stiff motor stays stiff after
+                for name, value in zip(names, wanted, strict=True):
+                    bus.write_register(motor.id, model, name, value)
         except (BusError, MotorError) as exc:
             logger.warning(
-                "%s: could not write its angle limits %s (torque on?): %s",
+                "%s: could not write its angle limits %s: %s",
                 motor.name,
                 wanted,
                 exc,

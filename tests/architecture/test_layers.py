@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 
 # room -> rooms of ours it may import (ARCHITECTURE.md); `errors`, `files` (safe writes),
@@ -136,13 +138,14 @@ def test_cli_start_up_is_lazy() -> None:
     assert "poppy_core" not in loaded or not {"numpy"} & loaded
 
 
-def test_help_does_not_import_heavy_libraries() -> None:
+@pytest.mark.parametrize("flag", ["--help", "--version"])
+def test_help_does_not_import_heavy_libraries(flag: str) -> None:
     code = (
         "import sys\nfrom poppy_cli.main import app\n"
-        "try:\n    app(['--help'])\nexcept SystemExit:\n    pass\n"
+        f"try:\n    app([{flag!r}])\nexcept SystemExit:\n    pass\n"
     )
     loaded = _loaded_after(code)
-    assert not loaded & {"textual", "fastapi", "uvicorn", "mujoco", "matplotlib", "cv2"}
+    assert not loaded & {"textual", "fastapi", "uvicorn", "mujoco", "matplotlib", "cv2", "numpy"}
 
 
 def test_trajectory_is_a_leaf_still_reachable_from_motion() -> None:

@@ -123,7 +123,7 @@ def test_return_delay_and_angle_limits(poppy: Any, mx_bus: Any) -> None:
     assert poppy("motor", "set-return-delay", "11", "0", *port).code == 0
     assert poppy("motor", "get", "11", "return_delay_time", *port).stdout.strip() == "0 µs"
     assert poppy("motor", "angle-limits", "11", *port, "--", "-90", "90").code == 0
-    limits = poppy("motor", "angle-limits", "11", "--json", *port).json()
+    [limits] = poppy("motor", "angle-limits", "11", "--json", *port).json()
     assert abs(limits["min"] + 90) < 0.1 and abs(limits["max"] - 90) < 0.1
 
 
@@ -200,3 +200,50 @@ def test_every_command_has_help(poppy: Any) -> None:
         result = poppy(*args, "--help")
         assert result.code == 0, (args, result.stderr)
         assert "Usage" in result.stdout
+
+
+def test_a_goal_to_a_compliant_motor_says_why_it_does_not_move(poppy: Any, ergo_jr: Any) -> None:
+    port = ("--port", ergo_jr.url, *P2)
+    written = poppy("motor", "set", "2", "goal_position", "-60", *port)  # no `--` needed
+    assert written.code == 0, written.stderr
+    assert written.stdout.strip() == "motor 2: goal_position = -60.06 deg"
+    note = written.stderr.strip()
+    assert note.startswith("note: motor 2 is compliant") and "\n" not in note
+    stiffen = note.split("`")[1]
+    assert stiffen == f"poppy motor torque 2 on --port {ergo_jr.url}"
+    assert poppy(*stiffen.split()[1:]).code == 0
+    again = poppy("motor", "set", "2", "goal_position", "-60", *port)
+    assert again.code == 0 and again.stderr == ""
+    position = -999.0
+    deadline = time.monotonic() + 10
+    while abs(position + 60) > 0.5 and time.monotonic() < deadline:
+        position = poppy("motor", "get", "2", "present_position", "--json", *port).json()[
+            "present_position"
+        ]
+    assert abs(position + 60) < 0.5
+    quiet = poppy("motor", "set", "3", "goal_position", "10", "--json", *port)
+    assert quiet.code == 0 and quiet.stderr == ""  # --json: data only
+
+
+def test_negative_values_need_no_double_dash(poppy: Any, ergo_jr: Any) -> None:
+    port = ("--port", ergo_jr.url, *P2)
+    limits = poppy("motor", "angle-limits", "4-5", "-90.5", "1e2", *port)  # an ID list too
+    assert limits.code == 0, limits.stderr
+    read = poppy("motor", "angle-limits", "4,5", "--json", *port).json()
+    assert [r["id"] for r in read] == [4, 5]
+    assert all(abs(r["min"] + 90.5) < 0.3 and abs(r["max"] - 100) < 0.3 for r in read), read
+    unknown = poppy("motor", "set", "4", "goal_position", "-6", "--jsn", *port)
+    assert unknown.code == 2 and "No such option: --jsn" in unknown.stderr
+
+
+def test_set_return_delay_and_reboot_take_id_lists(poppy: Any, ergo_jr: Any) -> None:
+    port = ("--port", ergo_jr.url, *P2)
+    assert poppy("motor", "torque", "1,3", "on", *port).code == 0  # their EEPROM is locked
+    result = poppy("motor", "set-return-delay", "1-3,5", "0", "--json", *port)
+    assert result.code == 0, result.stderr
+    assert [r["id"] for r in result.json()] == [1, 2, 3, 5]
+    rows = poppy("motor", "get", "1-6", "return_delay_time", "torque_enable", "--json", *port)
+    assert [r["return_delay_time"] for r in rows.json().values()] == [0, 0, 0, 500, 0, 500]
+    assert [r["torque_enable"] for r in rows.json().values()] == [1, 0, 1, 0, 0, 0]
+    rebooted = poppy("motor", "reboot", "5-6", *port)
+    assert rebooted.code == 0 and rebooted.stdout.count("verified") == 2

@@ -15,6 +15,7 @@ from typer.testing import CliRunner
 from poppy_cli.main import app
 from poppy_core.errors import ConfigError
 from poppy_core.motion import Move, read_move, save_move
+from tests.helpers.cli import run_poppy
 
 
 @dataclass
@@ -99,11 +100,11 @@ def test_export_both_formats_and_import_back(poppy: Any, tmp_path: Path) -> None
 
 def test_rm_asks_first(poppy: Any, library: Path) -> None:
     save_move(wave(), "wave")
-    refused = poppy("moves", "rm", "wave", input="n\n")
+    refused = run_poppy("moves", "rm", "wave", input="y\n")  # stdin is no terminal: not asked
     assert refused.code == 2 and (library / "wave.move").exists()
-    done = poppy("moves", "rm", "wave", input="y\n")
-    assert done.code == 0 and not (library / "wave.move").exists()
-    save_move(wave(), "wave")
+    assert refused.stderr.strip() == (
+        "error: not deleted: stdin is not a terminal to ask on; pass --yes"
+    )
     assert poppy("moves", "rm", "wave", "--yes", "--json").json()["deleted"].endswith("wave.move")
     missing = poppy("moves", "rm", "wave", "--yes")
     assert isinstance(missing.error, ConfigError) and "no move 'wave'" in str(missing.error)

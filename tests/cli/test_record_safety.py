@@ -16,6 +16,7 @@ import pytest
 
 from poppy_core.motion import read_move
 from tests.helpers.cli import POPPY
+from tests.helpers.terminal import CTRL_C, Terminal
 
 SIM = ("--sim", "--profile", "ergo-jr")
 
@@ -147,3 +148,19 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
                 proc.kill()
             os.close(parent)
     assert len(read_move(tmp_path / "wave.move")) > 250
+
+
+def test_ctrl_c_where_to_save_keeps_the_take_in_a_temporary_file(tmp_path: Path) -> None:
+    with tmpfs(tmp_path / "full", "32k") as library:
+        (library / "filler").write_bytes(b"\0" * 28_000)
+        terminal = Terminal("record", "wave", *SIM, "--duration", "6",
+                            env={"POPPY_MOVES_DIR": str(library)})  # fmt: skip
+        try:
+            assert "Save it where?" in terminal.read_until("Save it where?")
+            terminal.type(CTRL_C)
+            assert terminal.wait(timeout_s=30) == 130, terminal.text[-2000:]
+        finally:
+            terminal.close()
+    [kept] = list((tmp_path / "tmp").glob("poppy-take-wave-*.move"))
+    assert f"the take was saved to {kept}" in terminal.text
+    assert len(read_move(kept)) > 250 and "Traceback" not in terminal.text

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 from typing import Any
 
@@ -141,3 +142,17 @@ def test_slow_return_delay_is_reported_without_a_terminal(poppy: Any, ergo_jr: A
         "2",
     )
     assert delays.stdout.strip() == "500 µs"
+
+
+def test_return_delay_advice_is_a_command_that_works(poppy: Any, ergo_jr: Any) -> None:
+    robot = ("robot", "status", "--profile", "ergo-jr", "--port", ergo_jr.url, "--json")
+    warned = poppy(*robot)
+    assert warned.code == 0, warned.stderr
+    advice = [line for line in warned.stderr.splitlines() if "return delay" in line]
+    assert len(advice) == 1 and "fix_return_delay" not in advice[0]  # a Python argument
+    command = advice[0].split("`")[1]
+    assert command == f"poppy motor set-return-delay 1-6 0 --port {ergo_jr.url}"
+    fixed = poppy(*shlex.split(command)[1:])  # an ID list, as `motor get 1-6` takes
+    assert fixed.code == 0, fixed.stderr
+    again = poppy(*robot)
+    assert again.code == 0 and again.stderr == ""

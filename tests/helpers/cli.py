@@ -116,7 +116,7 @@ def _as_a_process(
     root = logging.getLogger()
     saved_logging = root.handlers[:], root.level
     handlers = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
-    consoles = [(c, c._width, c._color_system) for c in (console, err_console)]
+    consoles = [(c, c._width, c._color_system, c.quiet) for c in (console, err_console)]
     saved_tempdir = tempfile.tempdir
     tempfile.tempdir = None  # found again from TMPDIR, as a new process does
     sys.stdin = io.StringIO(input or "")
@@ -124,15 +124,15 @@ def _as_a_process(
     sys.argv = ["poppy", *args]
     os.environ.update(env)
     root.handlers = []  # `--debug` / `-v` configure logging as in a new process
-    for c, _, _ in consoles:
+    for c, _, _, _ in consoles:
         c.width = WIDTH
         c._color_system = None
     try:
         yield
     finally:
         tempfile.tempdir = saved_tempdir
-        for c, width, colors in consoles:
-            c._width, c._color_system = width, colors
+        for c, width, colors, quiet in consoles:
+            c._width, c._color_system, c.quiet = width, colors, quiet
         root.handlers, _ = saved_logging
         root.setLevel(saved_logging[1])
         for name, value in saved_env.items():

@@ -128,6 +128,38 @@ def test_return_delay_reported_then_fixed_with_consent(served: list[EmulatorServ
     assert all(m.table.get("return_delay_time") == 0 for m in bus.motors)
 
 
+def test_eeprom_written_at_start_up_on_stiff_motors_which_stay_stiff(
+    served: list[EmulatorServer], caplog: pytest.LogCaptureFixture
+) -> None:
+    bus = ergo_line([1, 2, 3, 4, 5, 6], delay_zero=False)
+    for motor in bus.motors[:3]:  # the XL-320 locks its EEPROM while its torque is on
+        motor.table.set("torque_enable", 1)
+    url = serve(served, bus)
+    config = load_profile("ergo-jr")
+    with caplog.at_level("WARNING"), from_profile(
+        "ergo-jr", port=url, sensors=False, fix_return_delay=True
+    ) as robot:
+        assert [m.compliant for m in robot.motors] == [False] * 3 + [True] * 3
+    assert [r.getMessage() for r in caplog.records if r.levelname == "WARNING"] == []
+    assert [m.table.get("return_delay_time") for m in bus.motors] == [0] * 6
+    assert [m.table.get("torque_enable") for m in bus.motors] == [1] * 3 + [0] * 3
+    limits = [tuple(config.motors[f"m{m.id}"].angle_limit) for m in bus.motors]
+    read = [tuple(round(XL320.register(n).to_si(m.table.get(n)), 0) for n in
+                  ("min_position_limit", "max_position_limit")) for m in bus.motors]  # fmt: skip
+    assert read == [tuple(round(v, 0) for v in pair) for pair in limits]
+
+
+def test_return_delay_advice_names_the_python_argument(
+    served: list[EmulatorServer], caplog: pytest.LogCaptureFixture
+) -> None:
+    url = serve(served, ergo_line([1, 2, 3, 4, 5, 6], delay_zero=False))
+    with caplog.at_level("WARNING"), from_profile("ergo-jr", port=url, sensors=False):
+        pass
+    advice = [r.getMessage() for r in caplog.records if "return delay" in r.getMessage()]
+    assert len(advice) == 1 and "fix_return_delay=True" in advice[0]
+    assert "poppy motor" not in advice[0]  # a shell command is no advice in a Python program
+
+
 def test_auto_port_finds_the_bus(served: list[EmulatorServer]) -> None:
     empty = serve(served, VirtualBus([], 2))
     url = serve(served, ergo_line([1, 2, 3, 4, 5, 6]))
