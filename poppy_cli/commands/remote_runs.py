@@ -7,7 +7,7 @@ from typing import Any
 
 import typer
 
-from poppy_cli.output import EXIT_FAILURE, console, error_line, print_json
+from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, console, error_line, print_json
 
 REFRESH_S = 0.1
 
@@ -120,3 +120,5 @@ def play_remote(
     else:
         state = "stopped" if interrupted else "played"
         console.print(f"{name}: {state} on {url} in {elapsed:.1f} s")
+    if interrupted:
+        raise typer.Exit(EXIT_INTERRUPTED)
