@@ -22,7 +22,13 @@ from poppy_cli.commands import snap as snap_cmd
 from poppy_cli.commands import teleop as teleop_cmd
 from poppy_cli.commands import tui as tui_cmd
 from poppy_cli.options import SimArgsGroup
-from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_USAGE, error_line
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_INTERRUPTED,
+    EXIT_USAGE,
+    error_line,
+    log_to_stderr,
+)
 
 app = typer.Typer(
     name="poppy",
@@ -41,10 +47,12 @@ def _root(
 ) -> None:
     state.debug = debug
     if debug or verbose:
-        logging.basicConfig(
-            level=logging.DEBUG if debug else logging.INFO,
-            format="%(asctime)s %(name)s %(levelname)s: %(message)s",
+        log_to_stderr(
+            logging.DEBUG if debug else logging.INFO,
+            "%(asctime)s %(name)s %(levelname)s: %(message)s",
         )
+    else:
+        log_to_stderr()  # warnings, escaped (a motor name may hold terminal escapes)
 
 
 app.command("ports")(ports.ports)
