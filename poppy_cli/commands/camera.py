@@ -11,6 +11,8 @@ import typer
 
 from poppy_cli.options import ConfigOpt, JsonOpt, ProfileOpt, SimOpt
 from poppy_cli.output import EXIT_USAGE, console, error_line, print_json, styled
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -33,15 +35,21 @@ CardOpt = typer.Option(
     None, "--card", help="With --sim mujoco: hold a Poppy card (caribou, tetris, lapin) in view."
 )
 SNAPSHOT_TYPES = (".png", ".jpg", ".jpeg")
+MAX_SIDE = 8192
+"""The widest image side asked of a camera (8K)."""
 
 
 def _resolution(text: str | None) -> tuple[int, int] | None:
     if text is None:
         return None
     width, _, height = text.lower().partition("x")
-    if not (width.isdigit() and height.isdigit()) or not int(width) or not int(height):
+    if not (width.isdigit() and height.isdigit()):
         raise typer.BadParameter(f"{text!r}: give WIDTHxHEIGHT, e.g. 640x480")
-    return int(width), int(height)
+    try:  # checked before a camera or a renderer is asked for that many pixels
+        return (checks.count(int(width), 1, MAX_SIDE, "the width"),
+                checks.count(int(height), 1, MAX_SIDE, "the height"))  # fmt: skip
+    except (ArgumentError, ValueError) as exc:
+        raise typer.BadParameter(f"{text!r}: {exc}") from None
 
 
 def _usage(message: str) -> None:

@@ -10,12 +10,20 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.options import MAX_BAUD, MIN_BAUD, profile_option
+from poppy_cli.options import MAX_BAUD, MIN_BAUD, checked, finite, profile_option
 from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
 
 if TYPE_CHECKING:
     from poppy_core.emulator import VirtualBus
     from poppy_core.emulator.control import EmulatorControl
+
+
+def _delay_ms(value: float) -> float:
+    """A reply delay or latency in ms, as the emulator's control accepts (0-10000)."""
+    from poppy_core import checks
+    from poppy_core.emulator.control import MAX_REPLY_DELAY_MS
+
+    return checks.in_range(value, 0.0, MAX_REPLY_DELAY_MS, unit="ms")
 
 
 def parse_hostport(text: str) -> tuple[str, int]:
@@ -49,7 +57,11 @@ def emulate(
         False, "--wire-timing", help="Delay replies as a real wire does (10 bits/byte)."
     ),
     latency_ms: float = typer.Option(
-        0.0, "--latency-ms", min=0.0, help="Adapter (USB) latency added to replies, in ms."
+        0.0,
+        "--latency-ms",
+        min=0.0,
+        callback=checked(_delay_ms),
+        help="Adapter (USB) latency added to replies, in ms.",
     ),
     usb2ax: bool = typer.Option(
         False, "--usb2ax", help="Act as a USB2AX adapter (answers protocol 1 SYNC_READ 0x84)."
@@ -60,13 +72,27 @@ def emulate(
         help="Keep this symlink pointing at the pty (one per bus, in order); it survives `lose`.",
     ),
     corrupt: float = typer.Option(
-        0.0, "--corrupt", min=0.0, max=1.0, help="Fault: probability that a reply byte is flipped."
+        0.0,
+        "--corrupt",
+        min=0.0,
+        max=1.0,
+        callback=finite,
+        help="Fault: probability that a reply byte is flipped.",
     ),
     drop: float = typer.Option(
-        0.0, "--drop", min=0.0, max=1.0, help="Fault: probability that a reply is lost."
+        0.0,
+        "--drop",
+        min=0.0,
+        max=1.0,
+        callback=finite,
+        help="Fault: probability that a reply is lost.",
     ),
     delay_ms: float = typer.Option(
-        0.0, "--delay-ms", min=0.0, help="Fault: extra delay added to every reply, in ms."
+        0.0,
+        "--delay-ms",
+        min=0.0,
+        callback=checked(_delay_ms),
+        help="Fault: extra delay added to every reply, in ms.",
     ),
     unplug: list[str] | None = typer.Option(
         None,

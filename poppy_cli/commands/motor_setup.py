@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from poppy_cli.commands.motor import app, print_setup, require_port
-from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, ProtoOpt
+from poppy_cli.options import MAX_BAUD, MIN_BAUD, BaudOpt, BusPortOpt, JsonOpt, ProtoOpt, finite
 
 if TYPE_CHECKING:
     from poppy_core.bus.dxlbus import DxlBus
@@ -62,7 +62,9 @@ def set_id(
 @app.command("set-baudrate")
 def set_baudrate(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
-    rate: int = typer.Argument(..., help="New baud rate in bps, e.g. 1000000."),
+    rate: int = typer.Argument(
+        ..., help="New baud rate in bps, e.g. 1000000.", min=MIN_BAUD, max=MAX_BAUD
+    ),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
@@ -84,7 +86,13 @@ def set_baudrate(
 @app.command("set-return-delay")
 def set_return_delay(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
-    delay_us: float = typer.Argument(..., help="Return delay in µs (0 for a fast bus)."),
+    delay_us: float = typer.Argument(
+        ...,
+        help="Return delay in µs (0 for a fast bus; at most 508).",
+        min=0.0,
+        max=508.0,
+        callback=finite,
+    ),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
@@ -106,8 +114,12 @@ def set_return_delay(
 @app.command("angle-limits")
 def angle_limits(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
-    min_deg: float | None = typer.Argument(None, help="Lower limit in degrees."),
-    max_deg: float | None = typer.Argument(None, help="Upper limit in degrees."),
+    min_deg: float | None = typer.Argument(
+        None, help="Lower limit in degrees.", min=-360.0, max=360.0, callback=finite
+    ),
+    max_deg: float | None = typer.Argument(
+        None, help="Upper limit in degrees.", min=-360.0, max=360.0, callback=finite
+    ),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
@@ -198,12 +210,20 @@ def factory_reset(
 
 @app.command("reset")
 def reset(
-    motor_id: int = typer.Argument(..., help="Current motor ID (a new motor is ID 1)."),
+    motor_id: int = typer.Argument(
+        ..., help="Current motor ID (a new motor is ID 1).", min=0, max=253
+    ),
     target_id: int = typer.Argument(..., help="The ID the motor must have.", min=0, max=253),
     model: str | None = typer.Option(
         None, "--model", help="Expected model (e.g. MX-28); refused if the motor differs."
     ),
-    rate: int = typer.Option(1_000_000, "--rate", help="Baud rate to set (Poppy: 1000000)."),
+    rate: int = typer.Option(
+        1_000_000,
+        "--rate",
+        help="Baud rate to set (Poppy: 1000000).",
+        min=MIN_BAUD,
+        max=MAX_BAUD,
+    ),
     limits: str | None = typer.Option(
         None, "--angle-limits", help="Angle limits MIN,MAX in degrees, e.g. -150,150."
     ),
