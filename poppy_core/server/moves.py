@@ -1,15 +1,15 @@
 """``MoveService``: record, save, play, stop and delete moves of poppy's move library by name.
 
 Recordings live in memory until saved; saved moves go to the library (``moves_dir()``), never to
-the working directory. Names are restricted to letters, digits, ``_`` and ``-`` so a URL can never
-reach a path outside the library.
+the working directory. Names follow the library's one rule (``check_name``: letters, digits,
+``. _ -`` and spaces, starting with a letter or a digit, no ``/``), so a URL can never reach a
+path outside the library, and a move the CLI recorded is one every client can play.
 """
 
 from __future__ import annotations
 
 import json
 import logging
-import re
 import threading
 from collections.abc import Sequence
 from typing import Any
@@ -19,6 +19,7 @@ from poppy_core.motion import (
     Move,
     MovePlayer,
     MoveRecorder,
+    check_name,
     delete_move,
     encode_pypot,
     list_moves,
@@ -30,7 +31,6 @@ from poppy_core.server.errors import ApiError
 
 logger = logging.getLogger(__name__)
 
-NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,63}$")
 MAX_RECORDINGS = 8
 """Recordings running at once (each is a thread)."""
 RECORD_TIP = "start by recording a move with /records/<move_name>/record.json"
@@ -38,14 +38,12 @@ PLAY_TIP = "start by playing a move with /records/<move_name>/play.json"
 
 
 def check_move_name(name: str) -> str:
-    """``name`` if it can name a library move, else ``ApiError("invalid")``."""
-    if not NAME.match(name):
-        raise ApiError(
-            "invalid",
-            f"{name!r} is not a move name: 1-64 letters, digits, '_' or '-'",
-            pypot_status=400,
-        )
-    return name
+    """``name`` if it can name a library move (the library's ``check_name``), else
+    ``ApiError("invalid")``."""
+    try:
+        return check_name(name)
+    except ConfigError as exc:
+        raise ApiError("invalid", str(exc), pypot_status=400) from None
 
 
 class MoveService:
