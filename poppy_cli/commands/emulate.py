@@ -12,6 +12,8 @@ import typer
 
 from poppy_cli.options import MAX_BAUD, MIN_BAUD, checked, finite, profile_option
 from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
     from poppy_core.emulator import VirtualBus
@@ -20,7 +22,6 @@ if TYPE_CHECKING:
 
 def _delay_ms(value: float) -> float:
     """A reply delay or latency in ms, as the emulator's control accepts (0-10000)."""
-    from poppy_core import checks
     from poppy_core.emulator.control import MAX_REPLY_DELAY_MS
 
     return checks.in_range(value, 0.0, MAX_REPLY_DELAY_MS, unit="ms")
@@ -29,11 +30,15 @@ def _delay_ms(value: float) -> float:
 def parse_hostport(text: str) -> tuple[str, int]:
     """Parse HOST:PORT (PORT 0 picks a free port)."""
     host, sep, port_text = text.rpartition(":")
-    if not sep or not port_text.isdigit() or int(port_text) > 65535:
+    try:
+        if not sep or not port_text.isdigit():
+            raise ValueError(port_text)
+        port = checks.count(int(port_text), 0, 65535, "port")  # int() refuses 5000 digits
+    except (ValueError, ArgumentError):
         raise typer.BadParameter(
             f"{text!r} is not HOST:PORT with a port in 0-65535, e.g. 127.0.0.1:4000"
-        )
-    return host or "127.0.0.1", int(port_text)
+        ) from None
+    return host or "127.0.0.1", port
 
 
 def emulate(

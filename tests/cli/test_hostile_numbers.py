@@ -52,10 +52,12 @@ TABLE: list[tuple[tuple[str, ...], str]] = [
     (("emulate", "--motors", "XL-320:1", "--latency-ms", "1e309"), "--latency-ms"),
     (("emulate", "--motors", "XL-320:1", "--corrupt", "nan"), "--corrupt"),
     (("emulate", "--motors", "XL-320:1", "--drop", "nan"), "--drop"),
+    (("emulate", "--motors", "XL-320:1", "--tcp", "127.0.0.1:" + "9" * 5000), "is not HOST:PORT"),
+    (("emulate", "--motors", "XL-320:1", "--tcp", "127.0.0.1:65536"), "is not HOST:PORT"),
 ]
 
 
-@pytest.mark.parametrize(("args", "words"), TABLE, ids=[" ".join(a) for a, _ in TABLE])
+@pytest.mark.parametrize(("args", "words"), TABLE, ids=[" ".join(a)[:90] for a, _ in TABLE])
 def test_a_hostile_number_is_one_usage_line(args: tuple[str, ...], words: str) -> None:
     # A process of its own: before the fix some of these served forever (emulate, serve) or
     # crashed; the timeout turns a command that runs into a failure.
