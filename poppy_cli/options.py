@@ -87,8 +87,9 @@ def finite(value: float | None) -> float | None:
     """An option callback: NaN, infinities and numbers past ``checks.MAX_MAGNITUDE`` are usage
     errors (Click's range check lets NaN by, and an option without a maximum lets 1e309 by).
 
-    Every float option of the CLI has it, with a ``min`` and a ``max``
-    (tests/cli/test_hostile_numbers.py holds them to it).
+    Every float option of the CLI has it, with a ``min`` and a ``max`` unless the library
+    checks the range itself against the motor's model (a return delay, angle limits);
+    tests/cli/test_hostile_numbers.py holds them to it.
     """
     if value is None:
         return None

@@ -87,11 +87,7 @@ def set_baudrate(
 def set_return_delay(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
     delay_us: float = typer.Argument(
-        ...,
-        help="Return delay in µs (0 for a fast bus; at most 508).",
-        min=0.0,
-        max=508.0,
-        callback=finite,
+        ..., help="Return delay in µs (0 for a fast bus).", callback=finite
     ),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
@@ -114,12 +110,8 @@ def set_return_delay(
 @app.command("angle-limits")
 def angle_limits(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
-    min_deg: float | None = typer.Argument(
-        None, help="Lower limit in degrees.", min=-360.0, max=360.0, callback=finite
-    ),
-    max_deg: float | None = typer.Argument(
-        None, help="Upper limit in degrees.", min=-360.0, max=360.0, callback=finite
-    ),
+    min_deg: float | None = typer.Argument(None, help="Lower limit in degrees.", callback=finite),
+    max_deg: float | None = typer.Argument(None, help="Upper limit in degrees.", callback=finite),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
