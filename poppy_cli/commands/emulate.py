@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from poppy_cli.options import MAX_BAUD, MIN_BAUD, checked, finite, profile_option
-from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
+from poppy_cli.output import EXIT_USAGE, err_console, error_line, printable, styled
 from poppy_core import checks
 from poppy_core.errors import ArgumentError
 
@@ -183,7 +183,7 @@ def emulate(
             error_line(f"--unplug: {exc}")
             raise typer.Exit(EXIT_USAGE) from None
         for index, server in enumerate(servers):
-            sys.stdout.write(f"{links[index] if links else server.url}\n")
+            sys.stdout.write(f"{printable(str(links[index]) if links else server.url)}\n")
         sys.stdout.flush()
         for (name, bus), server in zip(buses, servers, strict=True):
             ids = ", ".join(str(m.id) for m in bus.motors)

@@ -187,3 +187,16 @@ def test_the_servers_suggestion_never_writes_a_clients_control_characters() -> N
     assert "--allow-host ev\\x9bil.com" in err, err
     assert "--cors http://a\\x9d31m.example" in err, err
     assert "\x9b" not in err and "\x9d" not in err
+
+
+def test_the_path_record_prints_for_scripts_is_escaped(
+    poppy: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
+    target = tmp_path / f"take{ESCAPE}.move"
+    result = poppy("record", "w", "--sim", "--profile", "ergo-jr", "--motors", "m1",
+                   "--duration", "0.2", "--output", str(target))  # fmt: skip
+    assert result.code == 0, result.stderr
+    assert target.is_file()
+    assert result.stdout.strip().splitlines()[-1] == f"{tmp_path}/take\\x1b[2J.move"
+    assert ESCAPE not in result.stdout
