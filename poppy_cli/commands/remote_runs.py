@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import time
 from typing import Any
 
@@ -92,6 +93,7 @@ def play_remote(
 
     robot = open_remote(url)
     interrupted = False
+    signal.signal(signal.SIGTERM, signal.default_int_handler)  # stops it as Ctrl-C does
     try:
         info = robot.moves.get(name)
         started = time.monotonic()
