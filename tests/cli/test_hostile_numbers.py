@@ -40,6 +40,8 @@ TABLE: list[tuple[tuple[str, ...], str]] = [
     (("robot", "goto", *ROBOT, "m1=1e300"), "finite number of degrees"),
     (("robot", "reach", *ROBOT, "--duration", "1e309", "0.1", "0", "0.1"), "--duration"),
     (("robot", "reach", *ROBOT, "--duration", "nan", "0.1", "0", "0.1"), "--duration"),
+    (("robot", "reach", *ROBOT, "1e300", "0", "0.1"), "X Y Z takes 3 finite numbers within"),
+    (("robot", "reach", *ROBOT, "0.1", "0", "0.1", "--rpy", "1e20,0,0"), "--rpy takes 3"),
     (("calibrate", *ROBOT, "--check", "--tolerance", "inf"), "--tolerance"),
     (("calibrate", *ROBOT, "--check", "--tolerance", "nan"), "--tolerance"),
     (("teleop", "--rate", "nan"), "--rate"),
