@@ -101,9 +101,7 @@ def check_name(name: str) -> str:
 
 def is_move_name(name: str) -> bool:
     """True when ``check_name`` accepts ``name``."""
-    return len(name) <= MAX_NAME_CHARS and bool(_NAME.match(name)) and not name.endswith(
-        (".", " ")
-    )
+    return len(name) <= MAX_NAME_CHARS and bool(_NAME.match(name)) and not name.endswith((".", " "))
 
 
 def list_moves(folder: Path | None = None) -> list[MoveEntry]:
