@@ -28,6 +28,7 @@ from poppy_cli.output import (
     EXIT_USAGE,
     err_console,
     error_line,
+    log_to_stderr,
 )
 
 app = typer.Typer(
@@ -93,10 +94,12 @@ def _root(
         logging.getLogger().setLevel(logging.ERROR)
         warnings.simplefilter("ignore")
     if debug or verbose:
-        logging.basicConfig(
-            level=logging.DEBUG if debug else logging.INFO,
-            format="%(asctime)s %(name)s %(levelname)s: %(message)s",
+        log_to_stderr(
+            logging.DEBUG if debug else logging.INFO,
+            "%(asctime)s %(name)s %(levelname)s: %(message)s",
         )
+    else:
+        log_to_stderr()  # warnings, escaped (a motor name may hold terminal escapes)
 
 
 app.command("ports")(ports.ports)

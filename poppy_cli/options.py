@@ -2,20 +2,40 @@
 
 from __future__ import annotations
 
-import math
 import os
 import re
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import typer
 from typer.core import TyperCommand, TyperGroup
 
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
+
 if TYPE_CHECKING:
     from typer import _click
 
 
+MAX_ID = 253
+"""The largest Dynamixel ID (254 is the broadcast ID)."""
+
+
+def _checked_id(value: int) -> int:
+    try:
+        return checks.count(value, 0, MAX_ID, "ID")
+    except ArgumentError:
+        raise typer.BadParameter(
+            f"ID {value} is out of range; Dynamixel IDs are 0-{MAX_ID}"
+        ) from None
+
+
 def parse_ids(text: str) -> list[int]:
-    """Parse "0-253", "1,2,5-7" into a sorted list of IDs in 0..253."""
+    """Parse "0-253", "1,2,5-7" into a sorted list of IDs in 0..253.
+
+    Both ends of a range are checked before it is expanded: ``0-99999999999999999999`` is one
+    line at once (expanding it first took gigabytes).
+    """
     ids: set[int] = set()
     for part in text.replace(" ", "").split(","):
         if not part:
@@ -28,16 +48,13 @@ def parse_ids(text: str) -> list[int]:
                     raise typer.BadParameter(
                         f"range {part!r} goes backwards; write it as {hi}-{lo}"
                     )
-                ids.update(range(lo, hi + 1))
+                ids.update(range(_checked_id(lo), _checked_id(hi) + 1))
             else:
-                ids.add(int(part))
+                ids.add(_checked_id(int(part)))
         except ValueError:
             raise typer.BadParameter(
                 f"{part!r} is not an ID or a range; use e.g. 1-6 or 1,3,11-15"
             ) from None
-    bad = sorted(i for i in ids if not 0 <= i <= 253)
-    if bad:
-        raise typer.BadParameter(f"ID {bad[0]} is out of range; Dynamixel IDs are 0-253")
     if not ids:
         raise typer.BadParameter("no ID given; use e.g. 0-253 or 1,2,3")
     return sorted(ids)
@@ -82,10 +99,34 @@ out of range is a usage error (exit 2)."""
 
 
 def finite(value: float | None) -> float | None:
-    """An option callback: NaN and infinities are usage errors (a range check lets NaN by)."""
-    if value is not None and not math.isfinite(value):
-        raise typer.BadParameter(f"{value} is not a finite number")
-    return value
+    """An option callback: NaN, infinities and numbers past ``checks.MAX_MAGNITUDE`` are usage
+    errors (Click's range check lets NaN by, and an option without a maximum lets 1e309 by).
+
+    Every float option of the CLI has it, with a ``min`` and a ``max`` unless the library
+    checks the range itself against the motor's model (a return delay, angle limits);
+    tests/cli/test_hostile_numbers.py holds them to it.
+    """
+    if value is None:
+        return None
+    try:
+        return checks.number(value)
+    except ArgumentError:
+        raise typer.BadParameter(f"{value} is not a finite number of a sensible size") from None
+
+
+def checked(rule: Callable[[float], float]) -> Callable[[float | None], float | None]:
+    """An option callback applying ``rule`` (a ``poppy_core.checks`` rule) to the value: its
+    ``ArgumentError`` becomes a usage error (exit 2) saying what is accepted."""
+
+    def callback(value: float | None) -> float | None:
+        if value is None:
+            return None
+        try:
+            return rule(value)
+        except ArgumentError as exc:
+            raise typer.BadParameter(str(exc).removeprefix("value ")) from None
+
+    return callback
 
 
 PORT_HELP = (

@@ -4,18 +4,23 @@ Text is printed literally: the consoles read no Rich markup and no ``:emoji:`` c
 port, motor or move name is shown as it is (``/etc/passwd``'s ``root:x:0:0`` stays text, a motor
 named ``[red]x`` restyles nothing), and control characters (terminal escapes, bidi overrides)
 are shown as ``\x1b``-style escapes instead of acting on the terminal. Our own styling goes
-through ``styled``, which escapes the values it is given.
+through ``styled``, which escapes the values it is given. The two ways text reaches the terminal
+each escape once, whatever the caller built: the consoles every piece of text they render
+(a string, a ``Text``, a table cell), and the log handler (``log_to_stderr``) every record.
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import sys
 import unicodedata
+from collections.abc import Iterable
 from typing import Any
 
-from rich.console import Console
+from rich.console import Console, ConsoleOptions, RenderableType
 from rich.markup import escape
+from rich.segment import Segment
 from rich.text import Text
 
 EXIT_OK = 0
@@ -50,6 +55,19 @@ class LiteralConsole(Console):
         """Every string printed, in a table cell, a title or a status, passes here."""
         options.update(markup=False, emoji=False)
         return super().render_str(printable(text), **options)
+
+    def render(
+        self, renderable: RenderableType, options: ConsoleOptions | None = None
+    ) -> Iterable[Segment]:
+        """Every piece of text rendered passes here, a ``Text`` built by the caller included
+        (``Text.assemble(..., line)`` skips ``render_str``): its control characters are
+        escaped; the console's own control segments (cursor moves of a live display) are kept.
+        """
+        for segment in super().render(renderable, options):
+            if segment.control is None and not segment.text.isprintable():
+                yield Segment(printable(segment.text), segment.style)
+            else:
+                yield segment
 
 
 console = LiteralConsole()
@@ -99,6 +117,44 @@ def note_line(message: str) -> None:
     """Print one note on stderr (``message`` literally; not with `--quiet`): something the
     user may not expect, and what to do about it."""
     err_console.print(styled("[cyan]note:[/] {}", message), soft_wrap=True)
+
+
+class LiteralFormatter(logging.Formatter):
+    """A log formatter that escapes control characters (see ``printable``): a log line quotes
+    what users and clients sent (a motor name of a config, an ``Origin`` header)."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        """The record as the base formatter writes it, control characters escaped."""
+        return printable(super().format(record))
+
+
+class _StderrHandler(logging.StreamHandler):  # type: ignore[type-arg]
+    """Writes to whatever ``sys.stderr`` is when a record comes (as Python's last resort)."""
+
+    @property
+    def stream(self) -> Any:
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value: Any) -> None:
+        del value
+
+
+def log_to_stderr(level: int = logging.WARNING, fmt: str = "%(message)s") -> None:
+    """Send the records of ``level`` and above to stderr through ``LiteralFormatter``.
+
+    The CLI calls it once at start: WARNING and above by default (what Python's last-resort
+    handler showed, now escaped), INFO with ``-v``, DEBUG with ``--debug``.
+    """
+    root = logging.getLogger()
+    for old in [h for h in root.handlers if isinstance(h, _StderrHandler)]:
+        root.removeHandler(old)
+    handler = _StderrHandler()
+    handler.setFormatter(LiteralFormatter(fmt))
+    handler.setLevel(level)
+    root.addHandler(handler)
+    if root.level > level or root.level == logging.NOTSET:
+        root.setLevel(level)
 
 
 def fmt_value(value: Any, unit: str = "") -> str:

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping, Sequence
 
+from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 
 
@@ -43,10 +43,13 @@ def parse_targets(
             raise TargetSyntaxError(
                 f"{word!r}: {text!r} is not a number of degrees", field=name, value=text
             ) from None
-        if not math.isfinite(value):
+        try:
+            checks.number(value, name)
+        except ArgumentError:
             raise TargetSyntaxError(
-                f"{word!r}: the angle must be a finite number", field=name, value=value
-            )
+                f"{word!r}: the angle must be a finite number of degrees within "
+                f"±{checks.MAX_MAGNITUDE:g}", field=name, value=value,
+            ) from None  # fmt: skip
         bounds = (limits or {}).get(name)
         if bounds is not None and not bounds[0] <= value <= bounds[1]:
             raise ArgumentError(

@@ -256,6 +256,20 @@ def _sync_folder(folder: Path) -> None:
             os.close(fd)
 
 
+_LOCK_ATTEMPTS = 100
+"""How often ``FileLock.acquire`` starts again on a lock file replaced under it."""
+
+
+def _same_file(fd: int, path: Path) -> bool:
+    """True when the open file ``fd`` is the file at ``path`` (not a removed or replaced one)."""
+    try:
+        at_path = os.stat(path, follow_symlinks=False)
+    except OSError:
+        return False
+    held = os.fstat(fd)
+    return (held.st_dev, held.st_ino) == (at_path.st_dev, at_path.st_ino)
+
+
 class FileLock:
     """An exclusive lock on a file about to be written, held in ``.<name>.lock`` beside it.
 
@@ -276,32 +290,49 @@ class FileLock:
     def acquire(self) -> FileLock:
         """Take the lock (without waiting).
 
+        The lock file is removed by its last holder (``release``), so the file a process opened
+        may be gone by the time it gets the lock, and a third process may have made and locked a
+        new one: the lock counts only when the file locked is still the one at ``path`` (the
+        same inode), else it is taken again on the new file. (Locking a removed file and keeping
+        it let two writers hold the lock at once.)
+
         Raises:
             FileError: another process holds it (its pid is named), or it cannot be created.
         """
         import fcntl
 
-        try:
-            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, NEW_FILE_MODE)
-        except OSError as exc:
-            raise file_error(exc, self.path, "create the lock") from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.read(fd, 32).decode(errors="replace").strip() or "?"
-            os.close(fd)
-            raise FileError(
-                f"another poppy process (pid {holder}) is writing {self.target}: wait for it, "
-                "or pick another name",
-                path=str(self.target), errno=errno.EBUSY,
-            ) from None  # fmt: skip
-        os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()}\n".encode())
-        self._fd = fd
-        return self
+        for _ in range(_LOCK_ATTEMPTS):
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, NEW_FILE_MODE)
+            except OSError as exc:
+                raise file_error(exc, self.path, "create the lock") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 32).decode(errors="replace").strip() or "?"
+                os.close(fd)
+                raise FileError(
+                    f"another poppy process (pid {holder}) is writing {self.target}: wait for "
+                    "it, or pick another name",
+                    path=str(self.target), errno=errno.EBUSY,
+                ) from None  # fmt: skip
+            if _same_file(fd, self.path):
+                os.ftruncate(fd, 0)
+                os.write(fd, f"{os.getpid()}\n".encode())
+                self._fd = fd
+                return self
+            os.close(fd)  # its holder removed it meanwhile: lock the file now at the path
+        raise FileError(
+            f"cannot lock {self.target}: its lock file {self.path} keeps being replaced",
+            path=str(self.target), errno=errno.EBUSY,
+        )  # fmt: skip
 
     def release(self) -> None:
-        """Drop the lock and its file (again: nothing)."""
+        """Drop the lock and its file (again: nothing).
+
+        The file is removed while still locked: a process that opened it meanwhile finds, once
+        it gets the lock, that it is no longer the file at the path, and starts again.
+        """
         fd, self._fd = self._fd, None
         if fd is None:
             return

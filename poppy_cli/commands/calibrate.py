@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, json_option
+from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, finite, json_option
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
@@ -157,7 +157,12 @@ def calibrate(
         False, "--check", help="Compare the robot to its calibration and report drift."
     ),
     tolerance: float = typer.Option(
-        3.0, "--tolerance", min=0.0, help="--check: drift allowed, in degrees."
+        3.0,
+        "--tolerance",
+        min=0.0,
+        max=360.0,
+        callback=finite,
+        help="--check: drift allowed, in degrees.",
     ),
     yes: bool = typer.Option(False, "--yes", "-y", help="Write the profile without asking."),
     json_output: bool = json_option("Print the result as JSON."),

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -12,7 +10,9 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.options import ConfigOpt, JsonOpt, ProfileOpt, SimOpt
-from poppy_cli.output import EXIT_USAGE, console, error_line, print_json
+from poppy_cli.output import EXIT_USAGE, console, error_line, print_json, styled
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -35,15 +35,21 @@ CardOpt = typer.Option(
     None, "--card", help="With --sim mujoco: hold a Poppy card (caribou, tetris, lapin) in view."
 )
 SNAPSHOT_TYPES = (".png", ".jpg", ".jpeg")
+MAX_SIDE = 8192
+"""The widest image side asked of a camera (8K)."""
 
 
 def _resolution(text: str | None) -> tuple[int, int] | None:
     if text is None:
         return None
     width, _, height = text.lower().partition("x")
-    if not (width.isdigit() and height.isdigit()) or not int(width) or not int(height):
+    if not (width.isdigit() and height.isdigit()):
         raise typer.BadParameter(f"{text!r}: give WIDTHxHEIGHT, e.g. 640x480")
-    return int(width), int(height)
+    try:  # checked before a camera or a renderer is asked for that many pixels
+        return (checks.count(int(width), 1, MAX_SIDE, "the width"),
+                checks.count(int(height), 1, MAX_SIDE, "the height"))  # fmt: skip
+    except (ArgumentError, ValueError) as exc:
+        raise typer.BadParameter(f"{text!r}: {exc}") from None
 
 
 def _usage(message: str) -> None:
@@ -148,20 +154,10 @@ def list_cameras(json_output: bool = JsonOpt) -> None:
     console.print(table)
 
 
-def _write_atomically(path: Path, data: bytes) -> None:
-    folder = path.parent if str(path.parent) else Path(".")
-    handle, temp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".part")
-    try:
-        with os.fdopen(handle, "wb") as out:
-            out.write(data)
-        os.replace(temp, path)
-    except BaseException:
-        Path(temp).unlink(missing_ok=True)
-        raise
-
-
 def snapshot(
-    output: Path = typer.Option(..., "--output", "-o", help="Image file (.png or .jpg)."),
+    output: Path = typer.Option(
+        ..., "--output", "-o", help="Image file (.png or .jpg), or a folder (snapshot.png)."
+    ),
     device: str | None = DeviceOpt,
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
@@ -169,22 +165,26 @@ def snapshot(
     resolution: str | None = SizeOpt,
     marker: int | None = MarkerOpt,
     card: str | None = CardOpt,
+    force: bool = typer.Option(False, "--force", "-f", help="Replace an existing file."),
 ) -> None:
-    """Save one frame: of a device (default /dev/video0), or of a simulated robot's camera."""
+    """Save one frame: of a device (default /dev/video0), or of a simulated robot's camera.
+
+    An existing file is replaced only with --force; a folder, a link, a FIFO or a device never.
+    """
+    from poppy_core.files import output_path, write_file
     from poppy_core.sensors.opencv import encode_image
 
-    if output.suffix.lower() not in SNAPSHOT_TYPES:
-        _usage(f"{output}: the image type comes from its name: use .png or .jpg")
-    if not output.parent.is_dir():
-        _usage(f"{output.parent} is not a folder: create it first")
+    target = output_path(output, default_name="snapshot.png", replace=force)  # before the camera
+    if target.suffix.lower() not in SNAPSHOT_TYPES:
+        _usage(f"{target}: the image type comes from its name: use .png or .jpg")
     size = _resolution(resolution)
     with _source(device, profile, config_file, sim, size, marker, card) as (camera, _):
         first = camera.next_frame(-1, timeout_s=30)
         frame = camera.next_frame(first.number, timeout_s=30)  # rendered after the cards were put
-        data = encode_image(frame.image, output.suffix.lower())
-    _write_atomically(output, data)
+        data = encode_image(frame.image, target.suffix.lower())
+    written = write_file(target, data, replace=force)
     height, width = frame.image.shape[:2]
-    console.print(f"saved {output} ({width}x{height})")
+    console.print(styled("saved {} ({}x{})", written, width, height))
 
 
 def detect(

@@ -10,22 +10,35 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.options import MAX_BAUD, MIN_BAUD, profile_option
-from poppy_cli.output import EXIT_USAGE, err_console, error_line, styled
+from poppy_cli.options import MAX_BAUD, MIN_BAUD, checked, finite, profile_option
+from poppy_cli.output import EXIT_USAGE, err_console, error_line, printable, styled
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
     from poppy_core.emulator import VirtualBus
     from poppy_core.emulator.control import EmulatorControl
 
 
+def _delay_ms(value: float) -> float:
+    """A reply delay or latency in ms, as the emulator's control accepts (0-10000)."""
+    from poppy_core.emulator.control import MAX_REPLY_DELAY_MS
+
+    return checks.in_range(value, 0.0, MAX_REPLY_DELAY_MS, unit="ms")
+
+
 def parse_hostport(text: str) -> tuple[str, int]:
     """Parse HOST:PORT (PORT 0 picks a free port)."""
     host, sep, port_text = text.rpartition(":")
-    if not sep or not port_text.isdigit() or int(port_text) > 65535:
+    try:
+        if not sep or not port_text.isdigit():
+            raise ValueError(port_text)
+        port = checks.count(int(port_text), 0, 65535, "port")  # int() refuses 5000 digits
+    except (ValueError, ArgumentError):
         raise typer.BadParameter(
             f"{text!r} is not HOST:PORT with a port in 0-65535, e.g. 127.0.0.1:4000"
-        )
-    return host or "127.0.0.1", int(port_text)
+        ) from None
+    return host or "127.0.0.1", port
 
 
 def emulate(
@@ -49,7 +62,11 @@ def emulate(
         False, "--wire-timing", help="Delay replies as a real wire does (10 bits/byte)."
     ),
     latency_ms: float = typer.Option(
-        0.0, "--latency-ms", min=0.0, help="Adapter (USB) latency added to replies, in ms."
+        0.0,
+        "--latency-ms",
+        min=0.0,
+        callback=checked(_delay_ms),
+        help="Adapter (USB) latency added to replies, in ms.",
     ),
     usb2ax: bool = typer.Option(
         False, "--usb2ax", help="Act as a USB2AX adapter (answers protocol 1 SYNC_READ 0x84)."
@@ -60,13 +77,27 @@ def emulate(
         help="Keep this symlink pointing at the pty (one per bus, in order); it survives `lose`.",
     ),
     corrupt: float = typer.Option(
-        0.0, "--corrupt", min=0.0, max=1.0, help="Fault: probability that a reply byte is flipped."
+        0.0,
+        "--corrupt",
+        min=0.0,
+        max=1.0,
+        callback=finite,
+        help="Fault: probability that a reply byte is flipped.",
     ),
     drop: float = typer.Option(
-        0.0, "--drop", min=0.0, max=1.0, help="Fault: probability that a reply is lost."
+        0.0,
+        "--drop",
+        min=0.0,
+        max=1.0,
+        callback=finite,
+        help="Fault: probability that a reply is lost.",
     ),
     delay_ms: float = typer.Option(
-        0.0, "--delay-ms", min=0.0, help="Fault: extra delay added to every reply, in ms."
+        0.0,
+        "--delay-ms",
+        min=0.0,
+        callback=checked(_delay_ms),
+        help="Fault: extra delay added to every reply, in ms.",
     ),
     unplug: list[str] | None = typer.Option(
         None,
@@ -152,7 +183,7 @@ def emulate(
             error_line(f"--unplug: {exc}")
             raise typer.Exit(EXIT_USAGE) from None
         for index, server in enumerate(servers):
-            sys.stdout.write(f"{links[index] if links else server.url}\n")
+            sys.stdout.write(f"{printable(str(links[index]) if links else server.url)}\n")
         sys.stdout.flush()
         for (name, bus), server in zip(buses, servers, strict=True):
             ids = ", ".join(str(m.id) for m in bus.motors)

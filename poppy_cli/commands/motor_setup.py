@@ -8,7 +8,17 @@ from typing import TYPE_CHECKING
 import typer
 
 from poppy_cli.commands.motor import app, print_setup, require_port, setup_record
-from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, NumbersCommand, ProtoOpt, parse_ids
+from poppy_cli.options import (
+    MAX_BAUD,
+    MIN_BAUD,
+    BaudOpt,
+    BusPortOpt,
+    JsonOpt,
+    NumbersCommand,
+    ProtoOpt,
+    finite,
+    parse_ids,
+)
 
 if TYPE_CHECKING:
     from poppy_core.bus.dxlbus import DxlBus
@@ -62,7 +72,9 @@ def set_id(
 @app.command("set-baudrate")
 def set_baudrate(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
-    rate: int = typer.Argument(..., help="New baud rate in bps, e.g. 1000000."),
+    rate: int = typer.Argument(
+        ..., help="New baud rate in bps, e.g. 1000000.", min=MIN_BAUD, max=MAX_BAUD
+    ),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
@@ -108,7 +120,9 @@ def _run_each(
 @app.command("set-return-delay", cls=NumbersCommand)
 def set_return_delay(
     ids: str = typer.Argument(..., help="Motor ID(s): 3, or 1-6, or 1,3,5."),
-    delay_us: float = typer.Argument(..., help="Return delay in µs (0 for a fast bus)."),
+    delay_us: float = typer.Argument(
+        ..., help="Return delay in µs (0 for a fast bus).", callback=finite
+    ),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
@@ -128,8 +142,8 @@ def set_return_delay(
 @app.command("angle-limits", cls=NumbersCommand)
 def angle_limits(
     ids: str = typer.Argument(..., help="Motor ID(s): 3, or 1-6, or 1,3,5."),
-    min_deg: float | None = typer.Argument(None, help="Lower limit in degrees."),
-    max_deg: float | None = typer.Argument(None, help="Upper limit in degrees."),
+    min_deg: float | None = typer.Argument(None, help="Lower limit in degrees.", callback=finite),
+    max_deg: float | None = typer.Argument(None, help="Upper limit in degrees.", callback=finite),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
@@ -224,12 +238,20 @@ def factory_reset(
 
 @app.command("reset")
 def reset(
-    motor_id: int = typer.Argument(..., help="Current motor ID (a new motor is ID 1)."),
+    motor_id: int = typer.Argument(
+        ..., help="Current motor ID (a new motor is ID 1).", min=0, max=253
+    ),
     target_id: int = typer.Argument(..., help="The ID the motor must have.", min=0, max=253),
     model: str | None = typer.Option(
         None, "--model", help="Expected model (e.g. MX-28); refused if the motor differs."
     ),
-    rate: int = typer.Option(1_000_000, "--rate", help="Baud rate to set (Poppy: 1000000)."),
+    rate: int = typer.Option(
+        1_000_000,
+        "--rate",
+        help="Baud rate to set (Poppy: 1000000).",
+        min=MIN_BAUD,
+        max=MAX_BAUD,
+    ),
     limits: str | None = typer.Option(
         None, "--angle-limits", help="Angle limits MIN,MAX in degrees, e.g. -150,150."
     ),

@@ -18,7 +18,14 @@ from poppy_cli.options import (
     SimOpt,
     finite,
 )
-from poppy_cli.output import console, err_console, print_json, warn_line
+from poppy_cli.output import (
+    EXIT_INTERRUPTED,
+    console,
+    err_console,
+    print_json,
+    styled,
+    warn_line,
+)
 from poppy_cli.robots import robot_config, start_robot
 
 if TYPE_CHECKING:
@@ -41,8 +48,8 @@ def play(
 ) -> None:
     """Play a move: a gentle ramp to its first frame, then the frames at the chosen speed.
 
-    The motors of the move turn stiff. Ctrl-C stops where the motors are. With --remote, NAME
-    is a move of the server's library.
+    The motors of the move turn stiff. Ctrl-C or SIGTERM stops where the motors are (exit 130,
+    after the summary). With --remote, NAME is a move of the server's library.
     """
     if remote:
         from poppy_cli.commands.remote_runs import play_remote
@@ -73,6 +80,7 @@ def play(
         stop = threading.Event()
         for signum in (signal.SIGINT, signal.SIGTERM):
             signal.signal(signum, lambda *_: stop.set())
+        err_console.print(styled("playing {}: Ctrl-C stops it", path.name), soft_wrap=True)
         _run(player, stop, show=not json_output)
     summary = {
         "path": str(path),
@@ -86,9 +94,11 @@ def play(
     }
     if json_output:
         print_json(summary)
-        return
-    state = "played" if not player.stopped else "stopped after"
-    console.print(f"{state} {player.played_s:.2f} s of {path.name} ({', '.join(move.motors)})")
+    else:
+        state = "played" if not player.stopped else "stopped after"
+        console.print(f"{state} {player.played_s:.2f} s of {path.name} ({', '.join(move.motors)})")
+    if stop.is_set():  # a signal ended it: an interruption, as everywhere in the CLI
+        raise typer.Exit(EXIT_INTERRUPTED)
 
 
 def fmt_limits(limits: tuple[float, float]) -> str:

@@ -13,9 +13,12 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.commands.robot import SETTLE_S, app
-from poppy_cli.options import ConfigOpt, JsonOpt, PortOpt, ProfileOpt, SimOpt
+from poppy_cli.options import ConfigOpt, JsonOpt, PortOpt, ProfileOpt, SimOpt, finite
 from poppy_cli.output import console, print_json
 from poppy_cli.robots import build_robot
+from poppy_core import checks
+from poppy_core.checks import MAX_DURATION_S
+from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
     from poppy_core.motion.cartesian import RobotChain
@@ -35,8 +38,14 @@ def _numbers(text: str, what: str, count: int = 3) -> list[float]:
         raise typer.BadParameter(
             f"{what} takes {count} numbers, e.g. 0.1,0,0.2; got {text!r}"
         ) from None
-    if len(values) != count or not all(math.isfinite(v) for v in values):
-        raise typer.BadParameter(f"{what} takes {count} finite numbers, got {text!r}")
+    try:
+        if len(values) != count:
+            raise ArgumentError(what)
+        values = [checks.number(v, what) for v in values]  # 1e300 overflowed the solver
+    except ArgumentError:
+        raise typer.BadParameter(
+            f"{what} takes {count} finite numbers within ±{checks.MAX_MAGNITUDE:g}, got {text!r}"
+        ) from None
     return values
 
 
@@ -120,7 +129,15 @@ def reach(
     rpy: str | None = typer.Option(
         None, "--rpy", help="The tip's whole orientation as roll,pitch,yaw in degrees."
     ),
-    duration: float = typer.Option(2.0, "--duration", "-d", min=0.0, help="Seconds to move."),
+    duration: float = typer.Option(
+        2.0,
+        "--duration",
+        "-d",
+        min=0.0,
+        max=MAX_DURATION_S,
+        callback=finite,
+        help="Seconds to move.",
+    ),
     linear: bool = typer.Option(False, "--linear", help="Move the tip along a straight line."),
     wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),
     profile: str | None = ProfileOpt,

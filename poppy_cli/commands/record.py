@@ -19,7 +19,14 @@ from poppy_cli.options import (
     SimOpt,
     finite,
 )
-from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, print_json
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_USAGE,
+    err_console,
+    error_line,
+    print_json,
+    printable,
+)
 from poppy_cli.prompts import ask
 from poppy_cli.robots import robot_config, start_robot
 from poppy_core.trajectory import MAX_DURATION_S
@@ -198,7 +205,7 @@ def record(
         err_console.print(
             f"recorded {len(move)} frames ({move.duration_s:.2f} s) of {len(move.motors)} motors"
         )
-        sys.stdout.write(f"{path}\n")
+        sys.stdout.write(f"{printable(str(path))}\n")  # a path may hold terminal escapes
         sys.stdout.flush()
     if save_failure is not None and not _interactive():
         raise typer.Exit(EXIT_FAILURE)

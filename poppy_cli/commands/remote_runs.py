@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import signal
 import time
 from typing import Any
 
 import typer
 
-from poppy_cli.output import EXIT_FAILURE, console, error_line, print_json
+from poppy_cli.output import EXIT_FAILURE, EXIT_INTERRUPTED, console, error_line, print_json
 
 REFRESH_S = 0.1
 
@@ -92,6 +93,7 @@ def play_remote(
 
     robot = open_remote(url)
     interrupted = False
+    signal.signal(signal.SIGTERM, signal.default_int_handler)  # stops it as Ctrl-C does
     try:
         info = robot.moves.get(name)
         started = time.monotonic()
@@ -120,3 +122,5 @@ def play_remote(
     else:
         state = "stopped" if interrupted else "played"
         console.print(f"{name}: {state} on {url} in {elapsed:.1f} s")
+    if interrupted:
+        raise typer.Exit(EXIT_INTERRUPTED)

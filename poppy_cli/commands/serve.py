@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 import typer
 
 from poppy_cli.commands.serve_snap import announce_snap, check_snap_options, snap_server_for
-from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt
+from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, finite
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, warn_line
 from poppy_cli.robots import build_robot
 
@@ -35,7 +35,12 @@ def serve(
     ws: bool = typer.Option(False, "--ws", help="Also stream the motors' state on a WebSocket."),
     ws_port: int = typer.Option(9009, "--ws-port", min=0, max=65535, help="WebSocket port."),
     ws_rate: float = typer.Option(
-        30.0, "--ws-rate", min=0.1, max=200.0, help="State frames per second on the WebSocket."
+        30.0,
+        "--ws-rate",
+        min=0.1,
+        max=200.0,
+        callback=finite,
+        help="State frames per second on the WebSocket.",
     ),
     token: str | None = typer.Option(
         None,

@@ -15,8 +15,9 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.options import SIM_ENGINES, JsonSummaryOpt
+from poppy_cli.options import SIM_ENGINES, JsonSummaryOpt, finite
 from poppy_cli.output import EXIT_USAGE, console, err_console, error_line, print_json, styled
+from poppy_core.checks import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -87,12 +88,25 @@ def teleop(
         help="Joint map FOLLOWER=[-][SCALE*]LEADER[+OFFSET],... (default: same motor names).",
     ),
     map_file: Path | None = typer.Option(None, "--map-file", help="Joint map file (YAML)."),
-    rate: float = typer.Option(100.0, "--rate", min=1.0, max=1000.0, help="Ticks per second."),
+    rate: float = typer.Option(
+        100.0, "--rate", min=1.0, max=1000.0, callback=finite, help="Ticks per second."
+    ),
     ramp: float | None = typer.Option(
-        None, "--ramp", min=0.0, max=30.0, help="Start/resume ramp in s (default: by distance)."
+        None,
+        "--ramp",
+        min=0.0,
+        max=30.0,
+        callback=finite,
+        help="Start/resume ramp in s (default: by distance).",
     ),
     duration: float | None = typer.Option(
-        None, "--duration", "-d", min=0.1, help="Stop after this many seconds."
+        None,
+        "--duration",
+        "-d",
+        min=0.1,
+        max=MAX_DURATION_S,
+        callback=finite,
+        help="Stop after this many seconds.",
     ),
     record: str | None = typer.Option(
         None, "--record", help="Save the follower's trajectory as a move of this name (or path)."

@@ -27,7 +27,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
 
+from poppy_core import checks
 from poppy_core.emulator.server import Endpoint
+from poppy_core.errors import ArgumentError
 
 logger = logging.getLogger(__name__)
 
@@ -72,11 +74,18 @@ class ScheduledUnplug:
         return cls(motor_id, at_s, duration_s)
 
 
-def _seconds(text: str) -> float:
-    value = float(text)
-    if not math.isfinite(value) or value < 0:
-        raise ValueError(text)
-    return value
+SECONDS = f"0-{checks.MAX_DURATION_S:g}"
+"""What a duration of a fault command may be (a day at most)."""
+MAX_REPLY_DELAY_MS = 10_000.0
+"""The longest delay (or adapter latency) added to a reply: far past every timeout of a bus."""
+
+
+def _seconds(text: str, high: float = checks.MAX_DURATION_S) -> float:
+    """Seconds 0 up to ``high`` (a day); ValueError for anything else (1e309, nan, -1)."""
+    try:
+        return checks.in_range(float(text), 0.0, high)
+    except ArgumentError:
+        raise ValueError(text) from None
 
 
 def _probability(text: str, what: str) -> float:
@@ -173,7 +182,7 @@ class EmulatorControl:
             try:
                 duration = _seconds(args[1])
             except ValueError:
-                raise ControlError(f"usage: {usage} (seconds >= 0)") from None
+                raise ControlError(f"usage: {usage} (seconds {SECONDS})") from None
         server.bus.unplug(motor_id)
         if duration is None:
             return f"motor {motor_id} unplugged"
@@ -206,9 +215,11 @@ class EmulatorControl:
     def _delay(self, args: list[str]) -> str:
         def milliseconds(text: str) -> float:
             try:
-                return _seconds(text) / 1000.0
+                return _seconds(text, MAX_REPLY_DELAY_MS) / 1000.0
             except ValueError:
-                raise ControlError(f"delay takes milliseconds >= 0, not {text!r}") from None
+                raise ControlError(
+                    f"delay takes milliseconds 0-{MAX_REPLY_DELAY_MS:g}, not {text!r}"
+                ) from None
 
         buses = self._set_fault(args, "extra_delay_s", milliseconds)
         return f"delay {args[0]} ms on {', '.join(buses)}"
@@ -220,7 +231,7 @@ class EmulatorControl:
             try:
                 duration = _seconds(args[0])
             except ValueError:
-                raise ControlError(f"usage: {usage} (seconds >= 0)") from None
+                raise ControlError(f"usage: {usage} (seconds {SECONDS})") from None
             args = args[1:]
         buses = self._buses(args, usage)
         for bus in buses:

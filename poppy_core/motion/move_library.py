@@ -79,6 +79,11 @@ def is_path(ref: str | os.PathLike[str]) -> bool:
 def check_name(name: str) -> str:
     """A valid library name (letters, digits, ``. _ -`` and spaces; no folder part).
 
+    The one rule of move names: the CLI, the Python API and every server (REST, Snap!, ZMQ)
+    check names with it, and the library lists only the files it accepts, so a move listed
+    anywhere can be played, shown and deleted everywhere. A name starts with a letter or a
+    digit and has no ``/``: it never names a hidden file or a path outside the library.
+
     Raises:
         ConfigError: a name that cannot be a file stem.
     """
@@ -87,7 +92,7 @@ def check_name(name: str) -> str:
             f"a move name has at most {MAX_NAME_CHARS} characters ({len(name)} given)",
             field="name", value=name,
         )  # fmt: skip
-    if not _NAME.match(name) or name.endswith((".", " ")):
+    if not is_move_name(name):
         raise ConfigError(
             f"{name!r} is not a move name: use letters, digits, '.', '_', '-' or spaces",
             field="name",
@@ -96,14 +101,23 @@ def check_name(name: str) -> str:
     return name
 
 
+def is_move_name(name: str) -> bool:
+    """True when ``check_name`` accepts ``name``."""
+    return len(name) <= MAX_NAME_CHARS and bool(_NAME.match(name)) and not name.endswith((".", " "))
+
+
 def list_moves(folder: Path | None = None) -> list[MoveEntry]:
-    """The moves in the library, sorted by name (``.move`` first when both exist)."""
+    """The moves in the library, sorted by name (``.move`` first when both exist).
+
+    A file whose stem is not a move name (``check_name``: ``wave (copy).move``) is left out:
+    no command could name it (``poppy moves import FILE`` adds it under a name).
+    """
     root = folder if folder is not None else library()
     if not root.is_dir():
         return []
     entries = []
     for path in root.iterdir():
-        if path.suffix.lower() in SUFFIXES and path.is_file() and not path.name.startswith("."):
+        if path.suffix.lower() in SUFFIXES and is_move_name(path.stem) and path.is_file():
             entries.append(MoveEntry(path.stem, path, format_for_path(path), path.stat().st_size))
     return sorted(entries, key=lambda e: (e.name, SUFFIXES.index(e.path.suffix.lower())))
 

@@ -15,8 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
+from poppy_core.documents import Limits, parse_yaml, read_limited
 from poppy_core.errors import ConfigError
 
 _NAME = r"[A-Za-z_][A-Za-z0-9_]*"
@@ -25,6 +24,8 @@ _ENTRY = re.compile(
     rf"^\s*(?P<follower>{_NAME})\s*=\s*(?P<sign>-)?\s*(?:(?P<scale>{_NUMBER})\s*\*\s*)?"
     rf"(?P<leader>{_NAME})\s*(?:(?P<op>[+-])\s*(?P<offset>{_NUMBER}))?\s*$"
 )
+MAP_LIMITS = Limits(max_bytes=256 << 10, max_nodes=20_000, max_depth=8)
+"""A joint map file: the Humanoid's is a few hundred values, two levels deep."""
 SYNTAX = "FOLLOWER=[-][SCALE*]LEADER[+OFFSET], e.g. r_elbow_y=-m3 or r_arm_z=0.5*m4+10"
 
 
@@ -198,12 +199,6 @@ class JointMap:
             ConfigError: the file cannot be read or is not a joint map.
         """
         file = Path(path)
-        try:
-            data = yaml.safe_load(file.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError) as exc:
-            reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-            raise ConfigError(f"{file}: cannot read: {reason}", file=str(file)) from None
-        except yaml.YAMLError as exc:
-            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise ConfigError(f"{file}: not valid YAML: {first}", file=str(file)) from None
+        data = parse_yaml(read_limited(file, MAP_LIMITS.max_bytes, "joint map"), str(file),
+                          MAP_LIMITS)  # fmt: skip
         return cls.from_data(data, str(file))

@@ -18,7 +18,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from poppy_core.errors import SensorError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, SensorError
 from poppy_core.sensors.base import SensorLost
 from poppy_core.sensors.camera import DEFAULT_FPS, Camera, CameraCalibration
 from poppy_core.sensors.opencv import cv
@@ -26,6 +27,8 @@ from poppy_core.sensors.opencv import cv
 logger = logging.getLogger(__name__)
 
 Source = int | str
+MAX_DEVICE_INDEX = 255
+"""The largest V4L2 video device number (``/dev/video255``); ``-1`` means the first found."""
 Opener = Callable[[Source], Any]
 """Makes a ``cv2.VideoCapture``-like object (``isOpened``, ``read``, ``set``, ``release``)."""
 
@@ -55,6 +58,11 @@ def why_not_open(source: Source) -> str:
 
 def _default_opener(source: Source) -> Any:
     cv2 = cv()
+    if isinstance(source, int) and source < 0:  # OpenCV's own search for -1 may crash: ours
+        found = list_devices()
+        if not found:
+            return cv2.VideoCapture()  # not opened: "no camera found"
+        source = int(found[0]["index"])
     device = (isinstance(source, int) and source >= 0) or str(source).startswith("/dev/")
     if device and sys.platform.startswith("linux"):
         return cv2.VideoCapture(source, cv2.CAP_V4L2)  # not GStreamer: it opens slowly
@@ -73,9 +81,16 @@ def parse_source(value: Any, sensor: str) -> Source:
             f"a video file), got {value!r}",
             sensor=sensor,
         )
-    if isinstance(value, str) and value.strip().lstrip("-").isdigit():
-        return int(value)
-    return value
+    source: Source = value
+    if isinstance(source, str) and source.strip().lstrip("-").isdigit():
+        source = int(source)
+    if isinstance(source, int) and source != -1:  # checked before OpenCV sees it (-5 crashed it)
+        try:
+            checks.count(source, 0, MAX_DEVICE_INDEX, "the device index")
+        except ArgumentError as exc:
+            raise SensorError(f"sensor {sensor!r}: {exc} (-1: the first camera found)",
+                              sensor=sensor) from None  # fmt: skip
+    return source
 
 
 class OpenCVCamera(Camera):

@@ -1,17 +1,18 @@
 """``MoveService``: record, save, play, stop and delete moves of poppy's move library by name.
 
 Recordings live in memory until saved; saved moves go to the library (``moves_dir()``), never to
-the working directory. Names are restricted to letters, digits, ``_`` and ``-`` so a URL can never
-reach a path outside the library. A server stopping saves the takes not yet saved (recordings in
-progress, takes kept after a failed save): to the library when the name is free there, else to
-``fallback_path()``, as ``poppy record`` does.
+the working directory. Names follow the library's one rule (``check_name``: letters, digits,
+``. _ -`` and spaces, starting with a letter or a digit, no ``/``), so a URL can never reach a
+path outside the library, and a move the CLI recorded is one every client can play. A server
+stopping saves the takes not yet saved (recordings in progress, takes kept after a failed save):
+to the library when the name is free there, else to ``fallback_path()``, as ``poppy record``
+does.
 """
 
 from __future__ import annotations
 
 import json
 import logging
-import re
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -23,6 +24,7 @@ from poppy_core.motion import (
     Move,
     MovePlayer,
     MoveRecorder,
+    check_name,
     delete_move,
     encode_pypot,
     fallback_path,
@@ -36,7 +38,6 @@ from poppy_core.server.errors import ApiError
 
 logger = logging.getLogger(__name__)
 
-NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,63}$")
 MAX_RECORDINGS = 8
 """Recordings running at once (each is a thread)."""
 RECORD_TIP = "start by recording a move with /records/<move_name>/record.json"
@@ -55,14 +56,12 @@ class SavedTake:
 
 
 def check_move_name(name: str) -> str:
-    """``name`` if it can name a library move, else ``ApiError("invalid")``."""
-    if not NAME.match(name):
-        raise ApiError(
-            "invalid",
-            f"{name!r} is not a move name: 1-64 letters, digits, '_' or '-'",
-            pypot_status=400,
-        )
-    return name
+    """``name`` if it can name a library move (the library's ``check_name``), else
+    ``ApiError("invalid")``."""
+    try:
+        return check_name(name)
+    except ConfigError as exc:
+        raise ApiError("invalid", str(exc), pypot_status=400) from None
 
 
 class MoveService:

@@ -285,7 +285,7 @@ class OriginPolicy:
         """The one-line message for a refused origin (reported once per origin)."""
         text = origin[:200]
         try:
-            hint = self.origin_hint.format(origin=normalize_origin(text))
+            hint = self.origin_hint.format(origin=_quoted(normalize_origin(text)))
         except ValueError:
             hint = "it is not a valid origin"
         message = f"refused a request from the web page origin {text!r}: to allow it, {hint}"
@@ -309,7 +309,7 @@ class OriginPolicy:
         message = (
             f"refused a request for host {name!r}, a name this server was not started for "
             f"(a DNS-rebinding page uses such names): if you reach the robot by that name, "
-            f"{self.host_hint.format(host=name)}"
+            f"{self.host_hint.format(host=_quoted(name))}"
         )
         self._report(f"host {name}", message)
         return message
@@ -320,6 +320,12 @@ class OriginPolicy:
             return
         self._reported.add(key)
         self.report(message)
+
+
+def _quoted(value: str) -> str:
+    """``value`` for a suggested command line: as Python quotes it, without the quotes, so a
+    control character a client sent (``\x9b``) is shown escaped, never written raw."""
+    return repr(value)[1:-1]
 
 
 def default_changes_state(scope: Scope) -> bool:

@@ -106,3 +106,97 @@ def test_hostile_motor_names_in_show_and_errors(poppy: Any, tmp_path: Path) -> N
     missing = poppy("config", "validate", str(tmp_path / f"no{ESCAPE}[red]file.json"))
     assert "no\\x1b[2J[red]file.json" in missing.stderr
     assert ESCAPE not in missing.stderr
+
+
+OSC_TITLE = "m\x1b]0;pwned\x07\x1b[41mX"  # sets the terminal's title, then paints it red
+
+
+def test_a_warning_logged_with_a_motor_name_is_escaped(poppy: Any, tmp_path: Path) -> None:
+    data = _config([OSC_TITLE, "m2"])
+    data["controllers"]["bus"]["attached_motors"] = ["m2"]  # OSC_TITLE: "attached to none"
+    path = tmp_path / "robot.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    result = poppy("config", "validate", str(path))
+    assert result.code == 0, result.stderr
+    assert "motors.m\\x1b]0;pwned\\x07\\x1b[41mX is attached to no controller" in result.stderr
+    assert "\x1b" not in result.stderr and "\x07" not in result.stderr
+
+
+def test_the_log_formatter_escapes_records() -> None:
+    import logging
+
+    from poppy_cli.output import LiteralFormatter
+
+    record = logging.LogRecord("x", logging.WARNING, __file__, 1, "host %s", ("a\x9bb",), None)
+    assert LiteralFormatter("%(message)s").format(record) == "host a\\x9bb"
+
+
+def test_text_built_by_the_caller_is_escaped_by_the_console(
+    captured: tuple[io.StringIO, io.StringIO],
+) -> None:
+    from rich.table import Table
+    from rich.text import Text
+
+    _, err = captured
+    err_console.print(Text.assemble(("warning:", "yellow"), " ", "a\x9b31mb \x1b[2J"))
+    table = Table("name")
+    table.add_row(Text("c\x9d0;t\x07"))
+    err_console.print(table)
+    shown = err.getvalue()
+    assert "a\\x9b31mb \\x1b[2J" in shown
+    assert "c\\x9" in shown  # the cell was measured on the raw text: its escape may be cut
+    assert not any(char in shown for char in "\x9b\x9d\x1b\x07")
+
+
+def test_the_servers_suggestion_never_writes_a_clients_control_characters() -> None:
+    """C1 controls in a Host or Origin header reach `poppy serve`'s --allow-host/--cors hint."""
+    import signal
+    import socket
+    import subprocess
+
+    from tests.helpers.cli import ENV, POPPY
+
+    proc = subprocess.Popen(
+        [*POPPY, "serve", "--http", "--sim", "--profile", "ergo-jr", "--http-port", "0"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=dict(__import__("os").environ, **ENV),
+    )  # fmt: skip
+    try:
+        assert proc.stdout is not None and proc.stderr is not None
+        url = proc.stdout.readline().strip()
+        port = int(url.rsplit(":", 1)[1])
+        requests = [
+            b"GET /motors/list.json HTTP/1.1\r\nHost: ev\x9bil.com\r\nConnection: close\r\n\r\n",
+            b"POST /api/v1/robot/compliant HTTP/1.1\r\nHost: 127.0.0.1\r\n"
+            b"Origin: http://a\x9d31m.example\r\nContent-Length: 0\r\nConnection: close\r\n\r\n",
+        ]
+        for request in requests:
+            with socket.create_connection(("127.0.0.1", port), timeout=10) as sock:
+                sock.sendall(request)
+                assert sock.recv(100).startswith(b"HTTP/1.1 4")
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=30) == 0
+        err = proc.stderr.read()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        for stream in (proc.stdout, proc.stderr):
+            if stream is not None:
+                stream.close()
+    assert "--allow-host ev\\x9bil.com" in err, err
+    assert "--cors http://a\\x9d31m.example" in err, err
+    assert "\x9b" not in err and "\x9d" not in err
+
+
+def test_the_path_record_prints_for_scripts_is_escaped(
+    poppy: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
+    target = tmp_path / f"take{ESCAPE}.move"
+    result = poppy("record", "w", "--sim", "--profile", "ergo-jr", "--motors", "m1",
+                   "--duration", "0.2", "--output", str(target))  # fmt: skip
+    assert result.code == 0, result.stderr
+    assert target.is_file()
+    assert result.stdout.strip().splitlines()[-1] == f"{tmp_path}/take\\x1b[2J.move"
+    assert ESCAPE not in result.stdout

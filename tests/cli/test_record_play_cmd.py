@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -137,3 +138,22 @@ def test_play_refuses_missing_motors_naming_them(poppy: Any) -> None:
 def test_play_unknown_move(poppy: Any) -> None:
     result = poppy("play", "nothing", "--sim", "--profile", "ergo-jr")
     assert result.code == 1 and "no move 'nothing'" in result.stderr
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_during_play_exits_130_after_the_summary(signum: int) -> None:
+    save_move(ramp(["m1"], [30.0], seconds=60.0), "long")
+    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    proc = subprocess.Popen(
+        [*POPPY, "play", "long", "--sim", "--profile", "ergo-jr", "--json"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True,
+        env=env,
+    )  # fmt: skip
+    assert proc.stderr is not None
+    line = proc.stderr.readline()
+    assert line.startswith("playing long"), line + proc.stderr.read()
+    proc.send_signal(signum)
+    stdout, stderr = proc.communicate(timeout=20)
+    assert proc.returncode == 130, stderr
+    summary = json.loads(stdout)
+    assert summary["completed"] is False and summary["played_s"] < 60

@@ -9,12 +9,13 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from poppy_cli.targets import TargetSyntaxError, parse_targets
+from poppy_core.checks import MAX_MAGNITUDE
 from poppy_core.errors import ArgumentError, ConfigError
 
 KNOWN = ["m1", "m2", "m3"]
 
 
-@given(st.dictionaries(st.sampled_from(KNOWN), st.floats(allow_nan=False, allow_infinity=False),
+@given(st.dictionaries(st.sampled_from(KNOWN), st.floats(-MAX_MAGNITUDE, MAX_MAGNITUDE),
                        min_size=1))  # fmt: skip
 def test_written_targets_read_back(targets: dict[str, float]) -> None:
     words = [f"{name}={value!r}" for name, value in targets.items()]

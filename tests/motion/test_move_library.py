@@ -14,6 +14,7 @@ from poppy_core.motion import (
     delete_move,
     export_move,
     import_move,
+    is_move_name,
     list_moves,
     load_move,
     move_path,
@@ -129,3 +130,11 @@ def _junk(folder: Path) -> Path:
     path = folder / "junk.move"
     path.write_bytes(b"\x00\x01 not a move")
     return path
+
+
+def test_the_library_lists_only_the_moves_a_name_can_reach(library: Path) -> None:
+    save_move(two_motor_move(), "my wave.v2")
+    (library / "wave (copy).move").write_bytes((library / "my wave.v2.move").read_bytes())
+    assert [e.name for e in list_moves()] == ["my wave.v2"]
+    assert is_move_name("my wave.v2") and not is_move_name("wave (copy)")
+    assert not is_move_name(".hidden") and not is_move_name("a/b") and not is_move_name("x.")

@@ -153,3 +153,34 @@ def test_probe_a_read_only_folder(tmp_path: Path) -> None:
             probe_folder(folder)
     finally:
         folder.chmod(0o700)
+
+
+def test_a_lock_file_removed_under_a_waiting_writer_does_not_let_two_in(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The known race: B opens the lock file, A releases it (and removes it), B locks the removed
+    file, C makes a new one and locks it too. B must notice and lock the new file instead."""
+    from poppy_core.files import FileLock
+
+    target = tmp_path / "take.move"
+    first = FileLock(target).acquire()
+    real_open = os.open
+    opened: list[int] = []
+
+    def open_then_holder_releases(path: object, flags: int, mode: int = 0o777) -> int:
+        fd = real_open(path, flags, mode)  # type: ignore[arg-type]
+        opened.append(fd)
+        if len(opened) == 1:
+            first.release()  # in B's window between open() and flock()
+        return fd
+
+    monkeypatch.setattr(os, "open", open_then_holder_releases)
+    second = FileLock(target).acquire()
+    monkeypatch.setattr(os, "open", real_open)
+    with pytest.raises(FileError, match="is writing"):
+        FileLock(target).acquire()
+    assert second.held
+    second.release()
+    third = FileLock(target).acquire()  # free again once B is done
+    third.release()
+    assert not (tmp_path / ".take.move.lock").exists()

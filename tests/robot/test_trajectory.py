@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import MinimumJerk, dummy_speed
-from poppy_core.trajectory import plan_goto
+from poppy_core.trajectory import GotoPlan, plan_goto
 
 angles = st.floats(-300, 300, allow_nan=False)
 rates = st.floats(-200, 200, allow_nan=False)
@@ -81,3 +81,11 @@ def test_goto_plan() -> None:
         plan_goto(0.0, 1.0, 1.0, "teleport", None)
     with pytest.raises(ArgumentError, match="duration"):
         plan_goto(0.0, 1.0, -1.0, "dummy", None)
+
+
+@pytest.mark.parametrize("control", ["minjerk", "dummy"])
+@pytest.mark.parametrize("duration", [1e-300, 5e-324, 1e-4])
+def test_a_goto_shorter_than_a_write_period_is_a_jump(control: str, duration: float) -> None:
+    """`robot goto --duration 1e-300` was a ZeroDivisionError (t**3 is 0.0)."""
+    plan = plan_goto(0.0, 30.0, duration, control, (-90.0, 90.0))
+    assert plan == GotoPlan(30.0, None, 0.0)

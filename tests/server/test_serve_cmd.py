@@ -282,3 +282,29 @@ def test_both_websockets_apply_the_origin_rules_and_say_how_to_allow_one() -> No
         for stream in (proc.stdout, proc.stderr):
             if stream is not None:
                 stream.close()
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_stops_a_remote_play_with_exit_130(served: Any, signum: int) -> None:
+    from poppy_core.motion import Move, save_move
+    from tests.helpers.waiting import eventually
+
+    frames = [{"m1": 10.0 * i / 2999} for i in range(3000)]  # a minute at 50 Hz
+    save_move(Move.from_frames(50.0, frames), "remote_long")
+    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    proc = subprocess.Popen(
+        [*POPPY, "play", "remote_long", "--remote", served.url, "--json"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+    )  # fmt: skip
+    try:
+        moves = served.app.state.service.moves
+        assert eventually(lambda: "remote_long" in moves.playing(), timeout_s=60), proc.stderr
+        proc.send_signal(signum)
+        stdout, stderr = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, stderr
+    assert json.loads(stdout)["interrupted"] is True
+    assert eventually(lambda: "remote_long" not in moves.playing(), timeout_s=10)

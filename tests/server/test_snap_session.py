@@ -154,7 +154,8 @@ def check_state(robot: Robot, server: SnapServer, path: str, answer: httpx.Respo
         ("/primitive/nope/start", 404, "no primitive 'nope'"),
         ("/primitive/dance/get/nothing", 404, "no property 'nothing'"),
         ("/primitive/MovePlayer/nope/start", 404, "no move 'nope'"),
-        ("/primitive/MovePlayer/a.b/start", 400, "not a move name"),
+        ("/primitive/MovePlayer/a.b/start", 404, "no move 'a.b'"),  # a name, as in the CLI
+        ("/primitive/MovePlayer/.b/start", 400, "not a move name"),
         ("/primitive/MoveRecorder/r1/start/m1;zz", 404, "no motor 'zz'"),
         ("/ik/nochain/endeffector", 404, "does not exist"),
         ("/ik/chain/goto/5/5/5/1", 400, "cannot reach"),

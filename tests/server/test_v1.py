@@ -109,3 +109,23 @@ def test_moves(client: httpx.Client) -> None:
     assert client.post("/api/v1/moves/ghost/stop").status_code == 409
     assert client.delete("/api/v1/moves/v1move").status_code == 204
     assert client.delete("/api/v1/moves/v1move").status_code == 404
+
+
+def test_one_rule_for_move_names_everywhere(client: httpx.Client, moves_folder: str) -> None:
+    """A name the CLI and the library accept ("my wave.v2") is one REST plays (it was 422);
+    a file no name can reach is not listed."""
+    from pathlib import Path
+
+    from poppy_core.motion import Move, save_move
+
+    save_move(Move(10, ["m1"], [[0.0], [1.0]]), "my wave.v2")
+    (Path(moves_folder) / "wave (copy).move").write_bytes(b"{}")
+    listed = [m["name"] for m in client.get("/api/v1/moves").json()]
+    assert "my wave.v2" in listed and "wave (copy)" not in listed
+    assert client.get("/api/v1/moves/my wave.v2").status_code == 200
+    assert client.post("/api/v1/moves/my wave.v2/play", json={"speed": 4}).status_code == 202
+    assert client.post("/api/v1/moves/my wave.v2/stop").status_code == 200
+    assert "my wave.v2" in client.get("/records/list.json").json()["moves"]
+    refused = client.get("/api/v1/moves/.hidden")
+    assert refused.status_code == 422 and "not a move name" in refused.text
+    assert client.delete("/api/v1/moves/my wave.v2").status_code == 204

@@ -68,13 +68,30 @@ def test_yaml_file(tmp_path: Path) -> None:
         ("a: {leader: m1, gain: 2}", "unknown key 'gain'"),
         ("a: {leader: m1, scale: two}", "scale must be a number"),
         ("a: {scale: 2}", "give a leader joint name"),
-        ("a: [", "not valid YAML"),
+        ("a: [", "YAML syntax error"),
     ]:
         file.write_text(text)
         with pytest.raises(ConfigError, match=message):
             JointMap.load(file)
     with pytest.raises(ConfigError, match="cannot read"):
         JointMap.load(tmp_path / "missing.yaml")
+
+
+def test_a_map_file_is_read_through_the_bounded_loaders(tmp_path: Path) -> None:
+    file = tmp_path / "map.yaml"
+    file.write_text("m1: m2\n" + "# padding\n" * 40_000)  # 400 kB
+    with pytest.raises(ConfigError, match="bytes"):
+        JointMap.load(file)
+    file.write_text("a: " + "[" * 5000 + "]" * 5000)
+    with pytest.raises(ConfigError, match="nested more than"):
+        JointMap.load(file)
+    laughs = ["l0: &l0 [x, x, x, x, x, x, x, x, x]"]
+    laughs += [f"l{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 9)}]" for i in range(1, 6)]
+    file.write_text("\n".join(laughs))
+    with pytest.raises(ConfigError, match="aliases"):
+        JointMap.load(file)
+    with pytest.raises(ConfigError, match="a folder"):
+        JointMap.load(tmp_path)
 
 
 def test_the_shipped_example_map_loads() -> None:
