@@ -33,7 +33,6 @@ def control_name(control: str) -> str:
 
 MAX_DURATION_S = checks.MAX_DURATION_S
 """The longest goto or move (a day): longer is a typing mistake that would never end."""
-INSTANT_S = 1.0 / checks.MAX_RATE_HZ
 """A goto shorter than this (one period of the fastest loop) is a jump: the goal is sent at once
 at full speed, as for 0 (no loop could sample it, and a minimum-jerk curve of 1e-300 s divides
 by zero)."""
@@ -181,7 +180,8 @@ def plan_goto(
     Args:
         start: where the motion starts (degrees).
         target: where it should end (degrees).
-        duration_s: its length; 0 (or under ``INSTANT_S``) sends the goal at once at full speed.
+        duration_s: its length; 0 sends the goal at once at full speed (between 0 and 1 ms is
+            refused by ``check_goto``: too short to sample, and surely a typing mistake).
         control: ``"minjerk"`` (``"minijerk"``) or ``"dummy"``.
         limits: the angle limits the goal is clamped to; None for a wheel (no limits).
         min_speed: the smallest speed the servo can be given (one register step): a ``dummy``
@@ -193,8 +193,6 @@ def plan_goto(
     name = control_name(control)
     check_goto(duration_s, name)
     goal = target if limits is None else min(max(target, limits[0]), limits[1])
-    if duration_s < INSTANT_S:
-        duration_s = 0.0
     if name == "dummy" or duration_s == 0:
         speed = dummy_speed(start, goal, duration_s)
         return GotoPlan(goal, None, max(speed, min_speed) if speed else 0.0)
