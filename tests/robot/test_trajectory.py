@@ -88,6 +88,6 @@ def test_goto_plan() -> None:
 def test_a_goto_shorter_than_a_millisecond_is_refused(control: str, duration: float) -> None:
     """`robot goto --duration 1e-300` was a ZeroDivisionError (t**3 is 0.0): 0 is a jump, and
     anything between 0 and 1 ms is refused by the core's one rule (poppy_core.checks)."""
-    with pytest.raises(ArgumentError, match="at least 0.001 s"):
+    with pytest.raises(ArgumentError, match=r"at least 0\.001 s"):
         plan_goto(0.0, 30.0, duration, control, (-90.0, 90.0))
     assert plan_goto(0.0, 30.0, 0.0, control, (-90.0, 90.0)) == GotoPlan(30.0, None, 0.0)
