@@ -23,8 +23,9 @@ def set_cmd(
     key: str = typer.Argument(..., help=KEY_HELP, metavar="KEY"),
     value: str = typer.Argument(..., help="Its value: a profile name, a port.", metavar="VALUE"),
 ) -> None:
-    """Store a default in the user settings file: `poppy config set profile ergo-jr`,
-    `poppy config set port /dev/ttyUSB0`. POPPY_PROFILE/POPPY_PORT and the options still win.
+    """Store a default (profile or port) in the user settings file.
+
+    POPPY_PROFILE/POPPY_PORT and the options still win over it.
 
     Examples:
         poppy config set profile ergo-jr
@@ -92,8 +93,9 @@ def path_cmd(
     ),
     json_output: bool = json_option("Print a JSON object of the paths."),
 ) -> None:
-    """Where the user settings and profiles live; with PROFILE, the file that name resolves to
-    (a user profile hides an installed one of the same name).
+    """Print where the user settings and profiles live, or the file PROFILE resolves to.
+
+    A user profile hides an installed one of the same name.
 
     Examples:
         poppy config path
