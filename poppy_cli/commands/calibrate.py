@@ -65,14 +65,14 @@ class RichAnswers:
     def move(self, motors: Sequence[str], watch: RangeWatch) -> bool:
         """Show the joints' ranges live until Enter."""
         which = motors[0] if len(motors) == 1 else "each joint"
-        err_console.print(styled(
-            "Move [bold]{}[/] slowly from one end of its range to the other, back to the "
-            "posture, then press Enter (q to cancel)", which
-        ))  # fmt: skip
-        sys.stderr.flush()
         answer: list[bool] = []
         done = threading.Event()
-        with single_keys() as keys:
+        with single_keys() as keys:  # before the prompt: a key typed at once is not lost
+            err_console.print(styled(
+                "Move [bold]{}[/] slowly from one end of its range to the other, back to the "
+                "posture, then press Enter (q to cancel)", which
+            ))  # fmt: skip
+            sys.stderr.flush()
 
             def read_answer() -> None:
                 answer.append(_go_on(keys))
@@ -117,7 +117,7 @@ def single_keys() -> Iterator[int | None]:
     import tty
 
     saved = termios.tcgetattr(fd)
-    tty.setcbreak(fd)
+    tty.setcbreak(fd, termios.TCSANOW)  # keys typed already are kept (TCSAFLUSH drops them)
     try:
         yield fd
     finally:
@@ -154,9 +154,9 @@ def _read_line() -> str:
 
 
 def _enter(prompt: str) -> bool:
-    err_console.print(prompt)
-    sys.stderr.flush()
-    with single_keys() as keys:
+    with single_keys() as keys:  # before the prompt: a key typed at once is not lost
+        err_console.print(prompt)
+        sys.stderr.flush()
         return _go_on(keys)
 
 
