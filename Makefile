@@ -6,14 +6,17 @@ BIN := $(VENV)/bin
 .PHONY: run test test-fast lint completions bench clean sim-deps
 
 $(BIN)/activate:
+	@echo "creating the virtualenv $(VENV)…"
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 
 $(VENV)/.installed: pyproject.toml | $(BIN)/activate
+	@echo "installing poppy and its dependencies into $(VENV) (about a minute)…"
 	$(BIN)/pip install --quiet -e .
 	touch $@
 
 $(VENV)/.installed-test: pyproject.toml | $(BIN)/activate
+	@echo "installing poppy, its dependencies and the test tools into $(VENV) (a minute or two)…"
 	$(BIN)/pip install --quiet -e '.[test]'
 	touch $(VENV)/.installed $@
 

@@ -85,8 +85,10 @@ def parse_protocols(text: str) -> list[int]:
 
 
 def default_port(port: str | None) -> str | None:
-    """The port given, or POPPY_PORT from the environment."""
-    return port or os.environ.get("POPPY_PORT") or None
+    """The port given, or POPPY_PORT from the environment, or the user settings' ``port``."""
+    from poppy_cli.settings import PORT_ENV, load_settings
+
+    return port or os.environ.get(PORT_ENV) or load_settings().port
 
 
 # Dynamixel rates run from 9,600 bps (the slowest code of AX/MX/X) to 10.5 Mbps (X-series); the

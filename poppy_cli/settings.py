@@ -74,3 +74,50 @@ def resolve(profile: str | None = None, port: str | None = None) -> Settings:
         chosen_profile = chosen_profile or stored.profile
         chosen_port = chosen_port or stored.port
     return Settings(profile=chosen_profile, port=chosen_port)
+
+
+def check_key(key: str) -> str:
+    """``key`` if it is a setting.
+
+    Raises:
+        ConfigError: an unknown key (the settings listed).
+    """
+    from poppy_core.errors import ConfigError
+
+    if key not in SETTINGS_KEYS:
+        raise ConfigError(f"unknown setting {key!r} (settings: {', '.join(SETTINGS_KEYS)})",
+                          field=key)  # fmt: skip
+    return key
+
+
+def check_setting(key: str, value: str) -> str:
+    """``value`` checked for ``key``: the profile must exist (its name as listed), the port be
+    non-blank text.
+
+    Raises:
+        ConfigError: an unknown key, an unknown profile (known names listed), a blank value.
+    """
+    from poppy_core.errors import ConfigError
+
+    check_key(key)
+    text = value.strip()
+    if not text:
+        raise ConfigError(f"{key}: give a value (`poppy config unset {key}` removes it)",
+                          field=key)  # fmt: skip
+    if key == "profile":
+        from poppy_core.robot.profiles import find_profile
+
+        return find_profile(text).name
+    return text
+
+
+def save_settings(settings: Settings, path: Path | None = None) -> Path:
+    """Write the user settings file atomically (``poppy_core.files``), unset keys left out."""
+    import yaml
+
+    from poppy_core.files import write_file
+
+    file = path if path is not None else settings_file()
+    values = {key: getattr(settings, key) for key in SETTINGS_KEYS if getattr(settings, key)}
+    text = yaml.safe_dump(values, sort_keys=False) if values else ""
+    return write_file(file, text, replace=True, make_folder=True)

@@ -6,9 +6,11 @@ questions with Rich (``RichAnswers``) and writes the result with ``save_user_pro
 
 from __future__ import annotations
 
+import os
 import sys
 import threading
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -44,7 +46,8 @@ CANCEL_WORDS = ("q", "quit", "c", "cancel")
 
 
 class RichAnswers:
-    """The session's questions on the terminal: Enter goes on, ``q`` + Enter cancels."""
+    """The session's questions on the terminal: Enter goes on, ``q`` cancels (a single key on a
+    terminal; ``q`` then Enter when stdin is a pipe or a file)."""
 
     def posture(self, posture: ReferencePosture, motors: Sequence[str]) -> bool:
         """Show the posture, wait for Enter."""
@@ -62,30 +65,31 @@ class RichAnswers:
     def move(self, motors: Sequence[str], watch: RangeWatch) -> bool:
         """Show the joints' ranges live until Enter."""
         which = motors[0] if len(motors) == 1 else "each joint"
-        err_console.print(styled(
-            "Move [bold]{}[/] slowly from one end of its range to the other, back to the "
-            "posture, then press Enter (q to cancel)", which
-        ))  # fmt: skip
-        sys.stderr.flush()
-        answer: list[str] = []
+        answer: list[bool] = []
         done = threading.Event()
+        with single_keys() as keys:  # before the prompt: a key typed at once is not lost
+            err_console.print(styled(
+                "Move [bold]{}[/] slowly from one end of its range to the other, back to the "
+                "posture, then press Enter (q to cancel)", which
+            ))  # fmt: skip
+            sys.stderr.flush()
 
-        def read_line() -> None:
-            answer.append(_read_line())
-            done.set()
+            def read_answer() -> None:
+                answer.append(_go_on(keys))
+                done.set()
 
-        threading.Thread(target=read_line, name="calibrate enter", daemon=True).start()
-        if err_console.is_terminal:
-            from rich.live import Live
+            threading.Thread(target=read_answer, name="calibrate enter", daemon=True).start()
+            if err_console.is_terminal:
+                from rich.live import Live
 
-            with Live(_range_table(watch), console=err_console, transient=True) as live:
-                while not done.wait(REFRESH_S):
-                    live.update(_range_table(watch))
-        else:
-            done.wait()
+                with Live(_range_table(watch), console=err_console, transient=True) as live:
+                    while not done.wait(REFRESH_S):
+                        live.update(_range_table(watch))
+            else:
+                done.wait()
         for reading in watch.readings():
             err_console.print(f"  {reading.motor}: {reading.low:.1f}° … {reading.high:.1f}°")
-        return answer[0].strip().lower() not in CANCEL_WORDS
+        return answer[0]
 
     def confirm(self, question: str) -> bool:
         """A yes/no question (Enter: yes)."""
@@ -98,6 +102,49 @@ class RichAnswers:
             return False
 
 
+@contextmanager
+def single_keys() -> Iterator[int | None]:
+    """On a terminal stdin, its descriptor in cbreak mode (a key is read without Enter, not
+    echoed; Ctrl-C still interrupts), the terminal restored on the way out; else None."""
+    try:
+        fd = sys.stdin.fileno()
+    except (AttributeError, OSError, ValueError):  # replaced by a StringIO (tests), closed
+        fd = -1
+    if fd < 0 or not os.isatty(fd):
+        yield None
+        return
+    import termios
+    import tty
+
+    saved = termios.tcgetattr(fd)
+    tty.setcbreak(fd, termios.TCSANOW)  # keys typed already are kept (TCSAFLUSH drops them)
+    try:
+        yield fd
+    finally:
+        termios.tcsetattr(fd, termios.TCSADRAIN, saved)
+
+
+def _read_key(fd: int) -> bool:
+    """Wait for Enter (True) or q, Esc, Ctrl-D (False) on a terminal in cbreak mode; other keys
+    are ignored."""
+    while True:
+        try:
+            key = os.read(fd, 1)
+        except OSError:
+            return False
+        if key in (b"\r", b"\n"):
+            return True
+        if not key or key.lower() in (b"q", b"c") or key in (b"\x1b", b"\x04"):
+            return False
+
+
+def _go_on(keys: int | None) -> bool:
+    """The answer to "press Enter (q to cancel)": a key on a terminal, else a line."""
+    if keys is not None:
+        return _read_key(keys)
+    return _read_line().strip().lower() not in CANCEL_WORDS
+
+
 def _read_line() -> str:
     try:
         line = sys.stdin.readline()
@@ -107,9 +154,10 @@ def _read_line() -> str:
 
 
 def _enter(prompt: str) -> bool:
-    err_console.print(prompt)
-    sys.stderr.flush()
-    return _read_line().strip().lower() not in CANCEL_WORDS
+    with single_keys() as keys:  # before the prompt: a key typed at once is not lost
+        err_console.print(prompt)
+        sys.stderr.flush()
+        return _go_on(keys)
 
 
 def _range_table(watch: RangeWatch) -> Table:

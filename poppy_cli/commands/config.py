@@ -228,3 +228,12 @@ def generate(
     config = RobotConfig.from_dict(build_config(found, name), source="generate")
     written = dump_config(config, output, replace=force)
     console.print(f"wrote {written}: {_counts(config)}")
+
+
+def _register_settings() -> None:
+    from poppy_cli.commands import config_settings
+
+    config_settings.register(app)
+
+
+_register_settings()

@@ -8,7 +8,7 @@ import subprocess
 import sys
 import threading
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import typer
 
@@ -19,16 +19,10 @@ from poppy_cli.output import (
     console,
     err_console,
     error_line,
-    plain,
     styled,
 )
 
-if TYPE_CHECKING:
-    from poppy_core.robot import RobotConfig
-
 RENDER_PACKAGES = "libegl1 libgl1 (EGL) or libosmesa6 (OSMesa)"
-GIF_FPS = 15.0
-SETTLE_S = 0.5  # physics time before the first frame: the robot takes its pose
 
 app = typer.Typer(
     help="Simulate a robot with MuJoCo: serve its buses (like `poppy emulate`) or render it.",
@@ -200,40 +194,23 @@ def _no_gl(detail: str) -> typer.Exit:
     return typer.Exit(EXIT_FAILURE)
 
 
-def _motor_map(config: RobotConfig, servers: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
-    """Motor name -> (virtual motor, its config entry)."""
-    out: dict[str, tuple[Any, Any]] = {}
-    for controller, server in servers.items():
-        for name in config.motors_of_controller(controller):
-            entry = config.motors[name]
-            out[name] = (server.bus.motor(entry.id), entry)
-    return out
-
-
-def _command(motors: dict[str, tuple[Any, Any]], goals: dict[str, float]) -> None:
-    """Torque on and goal positions (poppy's frame) written into the virtual motors' tables."""
-    from poppy_core.robot.frames import to_motor
-
-    for name, (motor, entry) in motors.items():
-        with motor.lock:
-            motor.table.set("torque_enable", 1)
-            if name in goals:
-                goal = to_motor(goals[name], entry.orientation, entry.offset)
-                motor.table.set_si("goal_position", goal)
-
-
-def render_frames(
-    profile: str, move_ref: str | None, camera: str | None, width: int, height: int
+def _render_with_progress(
+    profile: str, move_ref: str | None, camera: str | None, width: int, height: int, backend: str
 ) -> list[Any]:
-    """RGB frames of the profile's robot: one still (servos on) or the move at ``GIF_FPS``.
+    """Render through ``poppy_core.motion.render``, a bar of frames and time left on a terminal."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
-    The physics is advanced by hand (no thread, faster than real time); goals go through the
-    virtual servos' control tables, so their speed and torque limits apply as on a robot.
-    """
     from poppy_core.errors import ConfigError
     from poppy_core.motion import load_move
+    from poppy_core.motion.render import RenderProgress, frame_count, render_frames
     from poppy_core.robot import load_profile
-    from poppy_core.robot.factory import start_emulators, start_simulation
 
     config = load_profile(profile)
     move = load_move(move_ref) if move_ref is not None else None
@@ -242,25 +219,18 @@ def render_frames(
         if unknown:
             raise ConfigError(f"move {move_ref!r} drives motors {profile} has not: "
                               f"{', '.join(unknown)}", field="move")  # fmt: skip
-    simulation = start_simulation(config)
-    servers = start_emulators(config, simulation)
-    try:
-        motors = _motor_map(config, servers)
-        first = move.position_at(0.0) if move is not None else {}
-        _command(motors, first)
-        simulation.advance(SETTLE_S)
-        frames = [simulation.render(camera, width, height)]
-        if move is not None:
-            step = 1.0 / GIF_FPS
-            for index in range(1, int(move.duration_s * GIF_FPS) + 2):
-                _command(motors, move.position_at(min(index * step, move.duration_s)))
-                simulation.advance(step)
-                frames.append(simulation.render(camera, width, height))
-        return frames
-    finally:
-        for server in servers.values():
-            server.stop()
-        simulation.close()
+    columns = (
+        TextColumn("{task.description}", markup=False), BarColumn(),
+        MofNCompleteColumn(), TextColumn("frames ·"), TimeElapsedColumn(),
+        TextColumn("·"), TimeRemainingColumn(), TextColumn("left"),
+    )  # fmt: skip
+    with Progress(*columns, console=err_console, transient=True) as bar:
+        task = bar.add_task(f"rendering {profile} ({backend})", total=frame_count(move))
+
+        def on_progress(event: RenderProgress) -> None:
+            bar.update(task, completed=event.done, total=event.total)
+
+        return render_frames(config, move, camera, width, height, progress=on_progress)
 
 
 def save_frames(frames: list[Any], output: Path, *, replace: bool = False) -> Path:
@@ -274,6 +244,7 @@ def save_frames(frames: list[Any], output: Path, *, replace: bool = False) -> Pa
     from PIL import Image
 
     from poppy_core.files import write_file
+    from poppy_core.motion.render import GIF_FPS
 
     images = [Image.fromarray(frame) for frame in frames]
     suffix = output.suffix.lower()
@@ -318,8 +289,7 @@ def render(
         raise _no_gl("no working OpenGL backend: EGL and OSMesa failed")
     chosen = None if camera in (None, "free") else camera
     try:
-        with console.status(plain(f"rendering {profile} with MuJoCo ({backend})…")):
-            frames = render_frames(profile, move, chosen, width, height)
+        frames = _render_with_progress(profile, move, chosen, width, height, backend)
     except ConfigError as exc:
         if exc.field == "MUJOCO_GL":
             raise _no_gl(str(exc)) from None

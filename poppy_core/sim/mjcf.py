@@ -52,14 +52,20 @@ class Style:
     radius_m: float
     rgba: str
     mount: str  # "table", "support" or "floor"
-    camera: tuple[Vec3, Vec3]  # position, point looked at
+    view: Vec3  # direction from the robot to the `front` camera (its distance is computed)
 
 
 STYLES: dict[str, Style] = {
-    "ergo-jr": Style(0.012, "0.95 0.95 0.95 1", "table", ((0.3, -0.3, 0.3), (0, 0, 0.15))),
-    "torso": Style(0.022, "0.92 0.92 0.9 1", "support", ((0.7, -0.7, 1.25), (0, 0, 0.95))),
-    "humanoid": Style(0.025, "0.92 0.92 0.9 1", "floor", ((1.0, -1.0, 0.8), (0, 0, 0.45))),
+    "ergo-jr": Style(0.012, "0.95 0.95 0.95 1", "table", (1.0, -1.0, 0.75)),
+    "torso": Style(0.022, "0.92 0.92 0.9 1", "support", (1.0, -1.0, 0.3)),
+    "humanoid": Style(0.025, "0.92 0.92 0.9 1", "floor", (1.0, -1.0, 0.25)),
 }
+# The `front` camera frames the whole robot and everything its limbs can reach (a ball around
+# the root as wide as the longest chain, cut by the table or the floor), in a 4:3 image with its
+# vertical field of view, leaving a margin at the edges.
+FRONT_FOVY_DEG = 45.0
+FRONT_ASPECT = 4 / 3
+FRONT_MARGIN = 0.9  # the framed points stay within 90% of the half-width and half-height
 # link -> (geom type, size) drawn at the link's centre of mass, so the robot looks like itself.
 BLOBS: dict[str, dict[str, tuple[str, Vec3]]] = {
     "ergo-jr": {"tip": ("sphere", (0.018, 0.0, 0.0))},
@@ -122,6 +128,86 @@ def _clean(v: Vec3) -> Vec3:
 
 def _cross(a: Vec3, b: Vec3) -> Vec3:
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _sub(a: Vec3, b: Vec3) -> Vec3:
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _dot(a: Vec3, b: Vec3) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _unit(v: Vec3) -> Vec3:
+    n = _norm(v)
+    return (v[0] / n, v[1] / n, v[2] / n)
+
+
+def reach_points(centre: Vec3, radius: float, floor_z: float) -> list[Vec3]:
+    """Points on the ball of ``radius`` around ``centre``, those below ``floor_z`` lifted to it."""
+    points: list[Vec3] = []
+    for i in range(13):  # latitude, pole to pole
+        polar = math.pi * i / 12
+        for j in range(24):
+            azimuth = 2 * math.pi * j / 24
+            x = centre[0] + radius * math.sin(polar) * math.cos(azimuth)
+            y = centre[1] + radius * math.sin(polar) * math.sin(azimuth)
+            z = max(floor_z, centre[2] + radius * math.cos(polar))
+            points.append((x, y, z))
+    return points
+
+
+def frame_points(
+    points: list[Vec3],
+    view: Vec3,
+    fovy_deg: float = FRONT_FOVY_DEG,
+    aspect: float = FRONT_ASPECT,
+    margin: float = FRONT_MARGIN,
+) -> tuple[Vec3, Vec3]:
+    """A camera position and the point it looks at, seeing every point of ``points`` from the
+    direction ``view`` within ``margin`` of a ``fovy_deg`` × ``aspect`` frame."""
+    lows = [min(p[k] for p in points) for k in range(3)]
+    highs = [max(p[k] for p in points) for k in range(3)]
+    target: Vec3 = tuple((lo + hi) / 2 for lo, hi in zip(lows, highs, strict=True))  # type: ignore[assignment]
+    back = _unit(view)
+    forward = (-back[0], -back[1], -back[2])
+    right = _unit(_cross(forward, (0.0, 0.0, 1.0)))
+    up = _cross(right, forward)
+    tan_v = math.tan(math.radians(fovy_deg) / 2) * margin
+    tan_h = tan_v * aspect
+
+    def fits(distance: float) -> bool:
+        eye = tuple(t + distance * b for t, b in zip(target, back, strict=True))
+        for point in points:
+            rel = _sub(point, eye)  # type: ignore[arg-type]
+            depth = _dot(rel, forward)
+            if depth <= 0.01:
+                return False
+            if abs(_dot(rel, right)) > tan_h * depth or abs(_dot(rel, up)) > tan_v * depth:
+                return False
+        return True
+
+    near, far = 0.01, 1.0
+    while not fits(far):
+        far *= 2
+    for _ in range(40):
+        middle = (near + far) / 2
+        near, far = (near, middle) if fits(middle) else (middle, far)
+    eye: Vec3 = tuple(t + far * b for t, b in zip(target, back, strict=True))  # type: ignore[assignment]
+    return _clean(eye), _clean(target)
+
+
+def camera_axes(eye: Vec3, target: Vec3) -> tuple[Vec3, Vec3]:
+    """MuJoCo ``xyaxes`` of a camera at ``eye`` looking at ``target`` (world +z up)."""
+    forward = _unit(_sub(target, eye))
+    right = _unit(_cross(forward, (0.0, 0.0, 1.0)))
+    return _clean(right), _clean(_cross(right, forward))
+
+
+def _along(offset: Vec3, axis: Vec3) -> bool:
+    """Whether ``offset`` lies on the line of ``axis`` (a point a hinge does not move)."""
+    length = _norm(offset)
+    return length < 1e-6 or _norm(_cross(offset, axis)) < 1e-6 * max(1.0, length) + 1e-9
 
 
 def load_profile_data(profiles_dir: Path, robot: str) -> dict[str, Any]:
@@ -191,6 +277,62 @@ class _Writer:
                 poses[joint.child] = (child_pos, quat_mul(quat, self.joint_quat(joint)))
                 pending.append(joint.child)
         return poses
+
+    def reach(self) -> tuple[Vec3, float]:
+        """A ball holding every part of the robot whatever its pose: its centre (root frame, at
+        the zero pose) and radius.
+
+        The centre is the last pivot of the trunk that no joint moves (each joint's next offset
+        along its own axis, as the Ergo Jr's m1 then m2); the radius, the longest chain of joint
+        offsets from there plus the farthest point of the last link's shapes.
+        """
+        poses = self.world_frames()
+        centre_link = self.urdf.root
+        while True:
+            kids = self.urdf.children(centre_link)
+            if len(kids) != 1:
+                break
+            joint = kids[0]
+            after = self.urdf.children(joint.child)
+            centre_link = joint.child
+            if len(after) != 1 or not _along(after[0].xyz, self.axis(joint)):
+                break
+        centre = poses[centre_link][0]
+        radius = 0.0
+        for link in poses:
+            extent = self.style.radius_m
+            inertial = self.urdf.links.get(link)
+            if inertial is not None:
+                extent += 2 * _norm(inertial.com)  # a capsule to twice the centre of mass
+                blob = BLOBS.get(self.robot, {}).get(link)
+                if blob is not None:
+                    extent = max(extent, _norm(inertial.com) + _norm(blob[1]))
+            radius = max(radius, self._path(link, centre_link) + extent)
+        return centre, radius
+
+    def _path(self, link: str, ancestor: str) -> float:
+        """Length of the joint offsets from ``ancestor`` down to ``link`` (either way up)."""
+        parents = {j.child: j for j in self.urdf.joints}
+        length, current = 0.0, link
+        while current != ancestor and current in parents:
+            length += _norm(parents[current].xyz)
+            current = parents[current].parent
+        if current == ancestor:
+            return length
+        return self._path(ancestor, link)  # ``link`` is above the centre, on the trunk
+
+    def front_camera(self, root_pos: Vec3, floor_z: float) -> str:
+        """The `front` camera: the whole robot and its reach in view (see ``frame_points``)."""
+        centre, radius = self.reach()
+        world = (root_pos[0] + centre[0], root_pos[1] + centre[1], root_pos[2] + centre[2])
+        points = reach_points(world, radius, floor_z)
+        eye, target = frame_points(points, self.style.view)
+        right, up = camera_axes(eye, target)
+        mode = "trackcom" if self.style.mount == "floor" else "fixed"
+        return (
+            f'    <camera name="front" mode="{mode}" pos="{_v(eye)}" '
+            f'xyaxes="{_v(right)} {_v(up)}" fovy="{_f(FRONT_FOVY_DEG)}"/>'
+        )
 
     def geoms(self, link: str, indent: str, world_quat: Quat) -> None:
         radius = self.style.radius_m
@@ -302,7 +444,6 @@ class _Writer:
         style = self.style
         poses = self.world_frames()
         root = self.urdf.root
-        cam_pos, _ = style.camera
         out = self.lines
         out += [
             f'<mujoco model="poppy-{self.robot}">',
@@ -326,7 +467,6 @@ class _Writer:
             '    <light name="sun" pos="0 0 3" dir="0 0 -1" directional="true"/>',
             '    <light name="key" pos="1 -1 2" dir="-1 1 -1.5"/>',
             '    <geom name="floor" class="world" type="plane" size="3 3 0.05" material="grid"/>',
-            f'    <camera name="front" mode="targetbody" target="{root}" pos="{_v(cam_pos)}"/>',
         ]
         if style.mount == "table":
             top = TABLE_TOP_M
@@ -335,6 +475,7 @@ class _Writer:
                 f'pos="0 0 {_f(top / 2)}" rgba="0.55 0.4 0.3 1"/>'
             )
             root_pos: Vec3 = (0.0, 0.0, top + 0.068)
+            floor_z = top
         elif style.mount == "support":
             top = SUPPORT_TOP_M
             out.append(
@@ -342,8 +483,11 @@ class _Writer:
                 f'pos="0 0 {_f(top / 2)}" rgba="0.3 0.3 0.3 1"/>'
             )
             root_pos = (0.0, 0.0, top)
+            floor_z = 0.0
         else:
             root_pos = (0.0, 0.0, -self.lowest_point(poses) + 0.002)
+            floor_z = 0.0
+        out.append(self.front_camera(root_pos, floor_z))
         out.append(f'    <body name="{root}" pos="{_v(root_pos)}">')
         if style.mount == "floor":
             out.append('      <freejoint name="root"/>')

@@ -1,0 +1,25 @@
+"""`make run` and `make test` say what they install before the minute pip takes."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("target", ["run", "test"])
+def test_make_says_it_is_installing_before_pip_runs(target: str, tmp_path: Path) -> None:
+    if shutil.which("make") is None:
+        pytest.skip("no make here")
+    done = subprocess.run(["make", "-n", "-B", target, f"VENV={tmp_path / '.venv'}"], cwd=ROOT,
+                          capture_output=True, text=True, timeout=60, check=False)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    install = next(i for i, line in enumerate(lines) if "pip install --quiet -e" in line)
+    said = [line for line in lines[:install] if line.startswith("echo ")]
+    assert said, lines
+    assert "installing poppy" in said[-1] and "minute" in said[-1]
