@@ -1,7 +1,7 @@
 """Drawings with matplotlib, as pypot's ``Move.plot(ax)`` and ``chain.plot(joints, ax)`` made them.
 
-matplotlib is imported only when a drawing is asked for; without an axis one is made on the Agg
-backend (no display needed) and returned.
+matplotlib is imported only when a drawing is asked for; without an axis one is made on a figure
+of its own (no display, no pyplot: ``fig.savefig`` writes it) and returned.
 """
 
 from __future__ import annotations
@@ -19,9 +19,7 @@ if TYPE_CHECKING:
 
 
 def _new_axes(three_d: bool) -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
+    """An axis on a figure of its own, made without pyplot: the caller's backend is untouched."""
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(8, 4.5) if not three_d else (6, 6))
