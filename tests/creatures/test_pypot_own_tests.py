@@ -32,6 +32,7 @@ RUN_TIMEOUT_S = 90.0  # under pytest-timeout's 120 s: a hang is reported as one
 
 
 def _cache_dir() -> Path:
+    # Not $XDG_CACHE_HOME: tests/conftest.py points it at a temporary folder per worker.
     configured = os.environ.get("POPPY_TEST_CACHE")
     base = Path(configured) if configured else Path.home() / ".cache" / "poppy-tests"
     return base / f"pypot-{PYPOT_TAG}"
