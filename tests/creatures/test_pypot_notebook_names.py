@@ -140,3 +140,26 @@ def test_snap_run_returns_when_the_server_already_serves() -> None:
             runner.start()
             assert returned.wait(10.0), f"{server!r}.run() blocked"
             assert "m1" in httpx.get(f"{server.url}{route}", timeout=10).text  # still serving
+
+
+def test_moving_speed_beyond_the_top_is_capped_in_python_and_over_rest() -> None:
+    # `m.moving_speed = 10000`: pypot accepted it and capped it to the servo's top speed, in
+    # Python and over its REST API; NaN and non-numbers stay refused (the lead's decision).
+    with PoppyErgoJr(simulator="dummy", use_http=True, http_port=0) as robot:
+        top = 1023 * 0.111 * 6  # XL-320: the register's 1023 steps of 0.111 rpm
+        robot.m1.moving_speed = 10000
+        assert robot.m1.moving_speed == pytest.approx(top)
+        with pytest.raises(ArgumentError, match=r"m1\.moving_speed must be a finite number"):
+            robot.m1.moving_speed = float("nan")
+        robot.m2.moving_speed = 50
+        url = f"{robot.http.url}/motor/m2/register/moving_speed/value.json"
+        answer = httpx.post(url, json=10000, timeout=10)
+        assert answer.status_code < 300, answer.text
+        assert robot.m2.moving_speed == pytest.approx(top)
+        refused = httpx.post(url, content=b"NaN", timeout=10,
+                             headers={"content-type": "application/json"})  # fmt: skip
+        assert refused.status_code == 400 and robot.m2.moving_speed == pytest.approx(top)
+        pid = httpx.post(f"{robot.http.url}/motor/m3/register/pid/value.json",
+                         json=[100, 2, 0], timeout=10)  # fmt: skip
+        assert pid.status_code < 300, pid.text
+        assert robot.m3.pid[0] == pytest.approx(254 / 8)  # the P gain register's top
