@@ -92,7 +92,8 @@ def test_bad_calls_are_one_line(mx_port: str) -> None:
 
 # The documented calls of pypot's DxlIO (reference lines 4119-4440) on the emulated MX-28 and
 # AX-12A bus above. Expected values: RECORDED from pypot 5.0.2's own DxlIO, run with the peers
-# venv's python against `poppy emulate --motors MX-28:4-6,AX-12A:11` on a pty (2026-11-27).
+# venv's python against `poppy emulate --motors MX-28:4-6,AX-12A:11` on a pty (2026-11-27), by
+# bench/peers/pypot_dxlio_calls.py.
 # pypot's degree scale divides by 4095 and 1023 where poppy's divides by the resolution (4096,
 # 1024): pypot's angles are off by up to 0.3° (0.04° at the centre, 0.29° at an AX-12A's end).
 PYPOT_ANSWERS = {
