@@ -17,7 +17,7 @@ from typing import Any
 
 from poppy_core.bus import setup, setup_reset
 from poppy_core.bus.dxlbus import DxlBus
-from poppy_core.bus.dxlio_pypot import GROUPS, RENAMED, PypotCalls, _ids, _mapping
+from poppy_core.bus.dxlio_pypot import GROUPS, RENAMED, PypotCalls, _ids, _mapping, capped
 from poppy_core.bus.ports import list_ports
 from poppy_core.errors import ArgumentError, CommunicationError, RegisterError
 from poppy_core.models import ServoModel
@@ -141,7 +141,8 @@ class DxlIO(PypotCalls):
     def set(self, register: str, value_for_id: Mapping[int, Any]) -> None:
         """Write ``register`` of each motor (``{id: value}``, SI units)."""
         for motor_id, value in _mapping(value_for_id).items():
-            self.bus.write_register(motor_id, self._model(motor_id), register, value)
+            model = self._model(motor_id)
+            self.bus.write_register(motor_id, model, register, capped(model, register, value))
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_"):

@@ -9,6 +9,7 @@ units: the register facts come from the Robotis e-manuals, the names from pypot'
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
@@ -28,6 +29,9 @@ GROUPS: dict[str, tuple[str, ...]] = {
     "goal_position_speed_load": ("goal_position", "moving_speed", "torque_limit"),
     "present_position_speed_load": ("present_position", "present_speed", "present_load"),
 }
+# Registers pypot's DxlIO capped to their range when written (its speed, position and gain
+# conversions): poppy's DxlIO caps them too; a value beyond any other register is refused.
+CAPPED = frozenset({"goal_position", "moving_speed", "p_gain", "i_gain", "d_gain"})
 # pypot's names of single registers.
 RENAMED = {
     "highest_temperature_limit": "temperature_limit",
@@ -254,3 +258,16 @@ def _mapping(values: Mapping[int, Any]) -> dict[int, Any]:
     if not isinstance(values, Mapping):
         raise ArgumentError(f"give {{id: value}}, not {values!r} (e.g. {{4: 0}})", field="values")
     return {int(k): v for k, v in values.items()}
+
+
+def capped(model: ServoModel, register: str, value: Any) -> Any:
+    """``value`` clamped to the register's range when pypot capped that register (a finite
+    number only: anything else goes on to the register's own check, which refuses it)."""
+    if register not in CAPPED or not model.has_register(register):
+        return value
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        return value
+    low, high = model.register(register).si_range()
+    if register == "moving_speed":  # signed in wheel mode: the magnitude is capped
+        return math.copysign(min(abs(value), high), value)
+    return min(max(float(value), low), high)

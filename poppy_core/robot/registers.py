@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from numbers import Real
 
 from poppy_core import checks
-from poppy_core.models import DirectionBit, Register, ServoModel
+from poppy_core.models import Register, ServoModel
 
 # e-manual (MX-28/64/106 protocol 1, XL-320): P/I/D gains at addresses 26-29 (order differs).
 MX_PID = ("p_gain", "i_gain", "d_gain")
@@ -102,10 +102,7 @@ def decode_table(model: ServoModel, data: bytes, names: Sequence[str] = STATE) -
 
 def si_range(register: Register) -> tuple[float, float]:
     """The (lowest, highest) SI value ``register`` holds; a speed or load its magnitude's."""
-    if isinstance(register.conversion, DirectionBit):
-        return 0.0, float(register.to_si(0x3FF))
-    ends = float(register.to_si(register.min_raw)), float(register.to_si(register.max_raw))
-    return min(ends), max(ends)
+    return register.si_range()
 
 
 def finite(value: object, field: str) -> float:

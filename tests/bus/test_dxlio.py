@@ -8,7 +8,7 @@ import pytest
 
 from poppy_core.bus import Dxl320IO, DxlIO
 from poppy_core.emulator import build_bus_from_spec, ergo_jr_bus, serve_pty
-from poppy_core.errors import ArgumentError
+from poppy_core.errors import ArgumentError, RegisterError
 from tests.helpers.waiting import eventually
 
 BAUD = 1_000_000
@@ -111,6 +111,8 @@ PYPOT_ANSWERS = {
     "get_highest_temperature_limit([4, 11])": (80.0, 70.0),
     "get_drive_mode([4])": (("normal", "master"),),
     "get_status_return_level([4, 11])": ("always", "always"),
+    # pypot capped the speed to the register's top (1023 steps of 0.114 rpm on an MX-28).
+    "get_moving_speed([4]) after set_moving_speed({4: 10000})": (699.732,),
     "get_control_table([4]) keys": (
         "model",
         "firmware",
@@ -221,3 +223,23 @@ def test_control_table_as_pypot(mx_port: str) -> None:
     # The AX-12A has margins and slopes where the MX-28 has gains.
     assert ax["model"] == "AX-12A" and "pid gain" not in ax
     assert ax["compliance margin"] == (1, 1) and ax["compliance slope"] == (32, 32)
+
+
+def test_speeds_positions_and_gains_beyond_their_range_are_capped_as_pypot(mx_port: str) -> None:
+    with DxlIO(mx_port, baudrate=BAUD) as dxl_io:
+        dxl_io.set_moving_speed({4: 10000})
+        (speed,) = dxl_io.get_moving_speed([4])
+        recorded = PYPOT_ANSWERS["get_moving_speed([4]) after set_moving_speed({4: 10000})"]
+        assert speed == pytest.approx(recorded[0])
+        dxl_io.set_wheel_mode([5])
+        dxl_io.set_moving_speed({5: -10000})
+        assert dxl_io.get_moving_speed([5]) == (pytest.approx(-speed),)
+        dxl_io.set_goal_position({11: 400})
+        assert dxl_io.get_goal_position([11]) == (pytest.approx(149.7, abs=0.1),)
+        dxl_io.set_pid_gain({4: (100, 2, 1)})
+        assert dxl_io.get_pid_gain([4])[0][0] == pytest.approx(254 / 8)
+        for bad in (float("nan"), float("inf"), "fast"):
+            with pytest.raises(RegisterError):
+                dxl_io.set_moving_speed({4: bad})
+        with pytest.raises(RegisterError):
+            dxl_io.set_return_delay_time({4: 10000})  # never capped by pypot: refused
