@@ -163,3 +163,26 @@ def test_moving_speed_beyond_the_top_is_capped_in_python_and_over_rest() -> None
                          json=[100, 2, 0], timeout=10)  # fmt: skip
         assert pid.status_code < 300, pid.text
         assert robot.m3.pid[0] == pytest.approx(254 / 8)  # the P gain register's top
+
+
+def test_a_bound_only_server_serves_in_run_until_close() -> None:
+    # start_background_services=False: the script serves with run(), which blocks until close.
+    robot = PoppyErgoJr(simulator="dummy", use_snap=True, snap_port=0,
+                        start_background_services=False)  # fmt: skip
+    try:
+        runner = threading.Thread(target=robot.snap.run, daemon=True)
+        runner.start()
+        url = f"{robot.snap.url}/motors/motors"
+        assert wait_until(lambda: _answers(url), 10.0)
+        assert runner.is_alive()  # still serving in run()
+    finally:
+        robot.close()
+    runner.join(10.0)
+    assert not runner.is_alive()
+
+
+def _answers(url: str) -> bool:
+    try:
+        return "m1" in httpx.get(url, timeout=2).text
+    except httpx.TransportError:
+        return False
