@@ -26,6 +26,7 @@ The tree (catch the bases, raise the leaves)::
     │                             ``motor`` and ``known``
     ├── KinematicsError           a target out of a chain's reach; carries ``nearest``
     ├── SensorError               a camera or other sensor cannot be opened or read; ``sensor``
+    ├── PrimitiveError            a primitive's thread died; carries ``primitive`` and ``failure``
     └── CalibrationCancelled      the user cancelled a calibration (nothing was written)
 
 This module imports nothing of ours, so every layer (protocol included) may use it.
@@ -226,6 +227,15 @@ class SensorError(PoppyError):
         super().__init__(message)
         self.sensor = sensor
         self.device = device
+
+
+class PrimitiveError(PoppyError):
+    """A primitive's thread died: raised to whoever waits on it, from the original exception."""
+
+    def __init__(self, message: str, *, primitive: str, failure: str) -> None:
+        super().__init__(message)
+        self.primitive = primitive
+        self.failure = failure
 
 
 class CalibrationCancelled(PoppyError):

@@ -138,7 +138,7 @@ def _wait(primitive: Primitive, duration: float | None, on_tick: Any) -> None:
         if deadline is not None and time.monotonic() >= deadline:
             break
         on_tick()
-        primitive.wait_to_stop(REFRESH_S)
+        time.sleep(REFRESH_S)  # not wait_to_stop: a failure is reported below, from .error
 
 
 @app.command("run")
@@ -193,11 +193,11 @@ def run(
 
                 with Live(console=console, refresh_per_second=10) as live:
                     _wait(primitive, duration, lambda: live.update(_status(key, primitive)))
-                    primitive.stop()
+                    primitive.halt()
                     live.update(_status(key, primitive))
         except KeyboardInterrupt:
             interrupted = True
-        primitive.stop()
+        primitive.halt()  # its failure, if any, is reported below
         report = {"name": key, "interrupted": interrupted, **primitive.describe()}
     if json_output:
         print_json(report)

@@ -29,6 +29,7 @@ from poppy_core.bus.setup import (
 from poppy_core.bus.setup_reset import factory_reset, reset_motor
 from poppy_core.bus.timing import Deadline, LinkTiming, default_latency_s, is_virtual_port
 from poppy_core.bus.transport import Transport, port_error
+from poppy_core.models.xl320 import XL320LEDColors  # pypot.dynamixel.conversion's name
 
 __all__ = [
     "KNOWN_ADAPTERS",
@@ -47,6 +48,7 @@ __all__ = [
     "SerialLine",
     "SetupResult",
     "Transport",
+    "XL320LEDColors",
     "change_baudrate",
     "change_id",
     "default_latency_s",

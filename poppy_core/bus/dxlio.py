@@ -17,6 +17,7 @@ from typing import Any
 
 from poppy_core.bus import setup, setup_reset
 from poppy_core.bus.dxlbus import DxlBus
+from poppy_core.bus.dxlio_pypot import GROUPS, RENAMED, PypotCalls, _ids, _mapping, capped
 from poppy_core.bus.ports import list_ports
 from poppy_core.errors import ArgumentError, CommunicationError, RegisterError
 from poppy_core.models import ServoModel
@@ -35,7 +36,7 @@ def get_available_ports(only_free: bool = False) -> list[str]:
     return ports
 
 
-class DxlIO:
+class DxlIO(PypotCalls):
     """A protocol 1 bus (AX, MX...) spoken as pypot's ``DxlIO``.
 
     Args:
@@ -140,7 +141,8 @@ class DxlIO:
     def set(self, register: str, value_for_id: Mapping[int, Any]) -> None:
         """Write ``register`` of each motor (``{id: value}``, SI units)."""
         for motor_id, value in _mapping(value_for_id).items():
-            self.bus.write_register(motor_id, self._model(motor_id), register, value)
+            model = self._model(motor_id)
+            self.bus.write_register(motor_id, model, register, capped(model, register, value))
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_"):
@@ -148,10 +150,16 @@ class DxlIO:
         if name in FLAGS:
             register = FLAGS[name]
             return lambda ids: tuple(v not in (False, 0, "off") for v in self.get(register, ids))
+        register = name[4:]
+        pypot_name = register in GROUPS or register in RENAMED
         if name.startswith("get_"):
-            return lambda ids: self.get(name[4:], ids)
+            if pypot_name:
+                return lambda ids: self.get_grouped(register, ids)
+            return lambda ids: self.get(register, ids)
         if name.startswith("set_"):
-            return lambda value_for_id: self.set(name[4:], value_for_id)
+            if pypot_name:
+                return lambda value_for_id: self.set_grouped(register, value_for_id)
+            return lambda value_for_id: self.set(register, value_for_id)
         raise AttributeError(f"{type(self).__name__} has no {name!r}")
 
     def enable_torque(self, ids: Iterable[int]) -> None:
@@ -222,15 +230,3 @@ class Dxl320IO(DxlIO):
     """A protocol 2 bus (XL-320, X series) spoken as pypot's ``Dxl320IO``."""
 
     protocol = 2
-
-
-def _ids(ids: Iterable[int]) -> list[int]:
-    if isinstance(ids, int | Mapping):
-        raise ArgumentError(f"give a list of IDs, not {ids!r} (e.g. [{ids}])", field="ids")
-    return [int(i) for i in ids]
-
-
-def _mapping(values: Mapping[int, Any]) -> dict[int, Any]:
-    if not isinstance(values, Mapping):
-        raise ArgumentError(f"give {{id: value}}, not {values!r} (e.g. {{4: 0}})", field="values")
-    return {int(k): v for k, v in values.items()}

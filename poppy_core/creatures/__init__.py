@@ -1,5 +1,8 @@
 """Creatures: what is specific to Poppy Ergo Jr, Torso and Humanoid (setup and primitives)."""
 
+from types import MappingProxyType
+
+from poppy_core import __version__
 from poppy_core.creatures.body import DanceBeatMotion, HeadIdleMotion, UpperBodyIdleMotion
 from poppy_core.creatures.ergo_jr import Dance, Jump, SafePowerUp
 from poppy_core.creatures.face_tracking import FaceTracking
@@ -23,6 +26,12 @@ from poppy_core.creatures.registry import (
 )
 from poppy_core.creatures.safety import LimitTorque, TemperatureMonitor
 from poppy_core.creatures.tracking import FollowInView, MarkerFollow, TrackingFeedback
+
+installed_poppy_creatures = MappingProxyType(
+    {"poppy-humanoid": PoppyHumanoid, "poppy-torso": PoppyTorso, "poppy-ergo-jr": PoppyErgoJr}
+)
+"""pypot's ``pypot.creatures.installed_poppy_creatures``: package name -> creature class (all three
+are part of poppy)."""
 
 __all__ = [
     "CREATURES",
@@ -48,9 +57,11 @@ __all__ = [
     "TemperatureMonitor",
     "TrackingFeedback",
     "UpperBodyIdleMotion",
+    "__version__",
     "attach_creature",
     "detect_kind",
     "from_config",
     "from_profile",
+    "installed_poppy_creatures",
     "normalize_kind",
 ]

@@ -1,4 +1,5 @@
-"""Posture primitives of the creatures: Ergo Jr base/rest/curious, Humanoid stand/sit.
+"""Posture primitives of the creatures: Ergo Jr base/rest/curious/tetris, Torso's init position,
+Humanoid stand/sit.
 
 Each one is a ``SimplePosture`` that moves with its creature's default goto control, keeps the
 targets inside the motors' angle limits and, on Ergo Jr, colours the LEDs as pypot's postures do.
@@ -33,6 +34,14 @@ ERGO_JR_REST: dict[str, float] = {
 ERGO_JR_CURIOUS: dict[str, float] = {
     "m1": 0.0, "m2": -15.0, "m3": 40.0, "m4": 0.0, "m5": -35.0, "m6": -60.0,
 }  # fmt: skip
+# poppy_ergo_jr/primitives/postures.py (TetrisPosture, yellow LEDs), degrees.
+ERGO_JR_TETRIS: dict[str, float] = {
+    "m1": 0.0, "m2": -90.0, "m3": 90.0, "m4": 0.0, "m5": -90.0, "m6": -90.0,
+}  # fmt: skip
+# poppy_torso/primitives/posture.py (InitPosition): every motor to 0° in 3 s, then the bust
+# leans 4° (bust_y) in 1 s.
+TORSO_INIT_S = 3.0
+TORSO_INIT_LEAN: tuple[str, float, float] = ("bust_y", 4.0, 1.0)
 # poppy_ergo_jr/primitives/postures.py (IdlePosture), degrees; SafePowerUp goes there (m2's
 # user range is [-125, 90]: the profile's [-90, 125] is in the motor frame and m2 is indirect).
 ERGO_JR_IDLE: dict[str, float] = {
@@ -130,3 +139,22 @@ class CreaturePosture(SimplePosture):
         if self.led is not None:
             for name in self.target_position:
                 self.robot.motor(name).led = "off"
+
+
+class InitPosition(CreaturePosture):
+    """The Torso's ``init_position``: stiff, every motor to 0°, then the bust leans forward."""
+
+    def __init__(self, robot: Robot, control: str = "minjerk") -> None:
+        zeros = {m.name: 0.0 for m in robot.motors}
+        super().__init__(robot, zeros, TORSO_INIT_S, control)
+
+    def run(self) -> None:
+        """Reach 0° everywhere, then lean ``bust_y`` (when the robot has it)."""
+        super().run()
+        name, angle, duration = TORSO_INIT_LEAN
+        if self.should_stop() or name not in self.target_position:
+            return
+        lean = clamp_to_limits(self.real_robot, {name: angle})
+        start = time.monotonic()
+        self.robot.goto_position(lean, duration, self.control)
+        self.sleep(duration - (time.monotonic() - start))

@@ -11,7 +11,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from poppy_core.creatures import body, ergo_jr, interaction, postures, safety
+from poppy_core.creatures import body, ergo_demos, ergo_jr, interaction, postures, safety
 from poppy_core.creatures.face_tracking import FaceTracking
 from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.creatures.tracking import MarkerFollow, TrackingFeedback
@@ -86,14 +86,22 @@ def _ergo_jr_primitives() -> dict[str, Factory]:
         "base_posture": lambda r, s: postures.CreaturePosture(
             r, postures.ERGO_JR_BASE, ms, s.goto_control
         ),
-        # postures.py: RestPosture lights the LEDs blue, CuriousPosture pink.
+        # postures.py: RestPosture lights the LEDs blue, CuriousPosture pink, TetrisPosture yellow.
         "rest_posture": lambda r, s: postures.CreaturePosture(
             r, postures.ERGO_JR_REST, ms, s.goto_control, led="blue"
         ),
         "curious_posture": lambda r, s: postures.CreaturePosture(
             r, postures.ERGO_JR_CURIOUS, ms, s.goto_control, led="pink"
         ),
+        "tetris_posture": lambda r, s: postures.CreaturePosture(
+            r, postures.ERGO_JR_TETRIS, ms, s.goto_control, led="yellow"
+        ),
         "jump": lambda r, s: ergo_jr.Jump(r),
+        # poppy_ergo_jr.py attaches its four demos under these names (Puzzel spelt so).
+        "tinsel_demo": lambda r, s: ergo_demos.TinselDemo(r),
+        "stubborn_demo": lambda r, s: ergo_demos.StubbornDemo(r),
+        "chicken_demo": lambda r, s: ergo_demos.ChickenDemo(r),
+        "puzzel_demo": lambda r, s: ergo_demos.PuzzleDemo(r),
     }
 
 
@@ -140,7 +148,10 @@ CREATURES: dict[str, CreatureSpec] = {
         goto_control="minjerk",
         safe_groups=("torso",),
         manager_filter="sum",
-        primitives=_upper_body_primitives(),
+        primitives={
+            **_upper_body_primitives(),
+            "init_position": lambda r, s: postures.InitPosition(r, s.goto_control),
+        },
         started=("temperature_monitoring",),
         motors=TORSO_MOTORS,
     ),

@@ -21,7 +21,7 @@ from poppy_core.models.register import (
     Register,
     SIValue,
 )
-from poppy_core.models.xl320 import XL_320
+from poppy_core.models.xl320 import XL_320, XL320LEDColors
 from poppy_core.models.xseries import XL330_M288, XL430_W250, XM430_W350
 
 __all__ = [
@@ -48,6 +48,7 @@ __all__ = [
     "Register",
     "SIValue",
     "ServoModel",
+    "XL320LEDColors",
     "model_by_name",
     "model_by_number",
     "standard_baudrates",

@@ -366,6 +366,13 @@ class Register:
             return self.conversion.on if on else self.conversion.to_si(0)
         raise RegisterError(f"{self.name} is not an on/off register", register=self.name)
 
+    def si_range(self) -> tuple[float, float]:
+        """(lowest, highest) SI value it holds; a speed's or load's magnitude (bit 10: sign)."""
+        if isinstance(self.conversion, DirectionBit):
+            return 0.0, float(self.conversion.to_si(min(self.max_raw, 0x3FF)))
+        ends = float(self.to_si(self.min_raw)), float(self.to_si(self.max_raw))
+        return min(ends), max(ends)
+
     def decode_si(self, data: bytes, start: int | None = None) -> SIValue:
         """The SI value of this register in ``data``, bytes read from address ``start`` (None:
         ``data`` starts at this register).

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from enum import Enum
+
 from poppy_core.models.model import ServoModel, aliases_for
 from poppy_core.models.register import (
     BOOL,
@@ -39,6 +41,22 @@ XL320_LED = Choice(
     mask=0x07,
     on="white",  # "on" lights all three LEDs
 )
+
+
+
+class XL320LEDColors(Enum):
+    """pypot's enum of the LED colours (``pypot.dynamixel.conversion``): each is its register
+    code + 1 (``XL320LEDColors(code + 1).name``, ``XL320LEDColors.red.value - 1``)."""
+
+    off = 1
+    red = 2
+    green = 3
+    yellow = 4
+    blue = 5
+    pink = 6
+    cyan = 7
+    white = 8
+
 
 _POSITION = position(300.0, 1024)
 # e-manual: Moving Speed / Present Speed unit about 0.111 rpm (joint mode), bit 10 = CW.

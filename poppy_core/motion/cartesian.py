@@ -31,6 +31,7 @@ from poppy_core.kinematics import (
 )
 from poppy_core.kinematics.chain import Orientation
 from poppy_core.kinematics.transforms import Matrix, Vector, axis_angle_matrix, rotation_log
+from poppy_core.motion.plots import plot_chain
 
 if TYPE_CHECKING:
     from poppy_core.robot import GotoHandle, Motor, Robot
@@ -160,6 +161,42 @@ class RobotChain:
     def rpy_to_rotation_matrix(roll: float, pitch: float, yaw: float) -> Matrix:
         """The 3x3 rotation of roll, pitch, yaw (radians), as pypot's REST ``rpy.json``."""
         return rpy_matrix(roll, pitch, yaw)
+
+    def convert_to_ik_angles(self, joints: Sequence[float]) -> list[float]:
+        """pypot's IK representation: 0, each joint's model angle (radians), 0 (pypot's ends)."""
+        count = len(self.model.names)
+        if len(joints) != count:
+            raise KinematicsError(f"chain {self.name!r} has {count} joints, got {len(joints)} "
+                                  "angles", chain=self.name)  # fmt: skip
+        theta = self.model.to_model(np.asarray(joints, dtype=float))
+        return [0.0, *(float(v) for v in theta), 0.0]
+
+    def convert_from_ik_angles(self, joints: Sequence[float]) -> list[float]:
+        """Degrees (user frame) from pypot's IK representation (``convert_to_ik_angles``)."""
+        count = len(self.model.names)
+        if len(joints) != count + 2:
+            raise KinematicsError(f"chain {self.name!r}: pypot's IK angles are {count + 2} "
+                                  f"values, got {len(joints)}", chain=self.name)  # fmt: skip
+        return [float(v) for v in self.model.from_model(np.asarray(joints[1:-1], dtype=float))]
+
+    def plot(self, joints: Sequence[float] | None = None, ax: Any = None, target: Any = None,
+             show: bool = False) -> Any:  # fmt: skip
+        """Draw the chain in 3D on a matplotlib axis (pypot's ``chain.plot(joints, ax)``).
+
+        Args:
+            joints: degrees, one per joint, or pypot's IK angles (``convert_to_ik_angles``);
+                None: the present positions.
+            ax: a 3D axis (``projection='3d'``), or None for a new one (Agg).
+            target: an ``[x, y, z]`` to mark.
+            show: accepted for pypot's calls; the drawing is shown by the caller's matplotlib.
+
+        Returns:
+            The axis drawn on.
+        """
+        values = self.joints_position if joints is None else list(joints)
+        if len(values) == len(self.model.names) + 2:
+            values = self.convert_from_ik_angles(values)
+        return plot_chain(self.model, values, ax, target)
 
     def forward(self, joints: Mapping[str, float] | Sequence[float] | None = None) -> Matrix:
         """The tip pose (4x4) for ``joints`` (degrees; the motors not given where they are)."""

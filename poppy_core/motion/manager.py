@@ -204,7 +204,7 @@ class PrimitiveManager:
     def close(self) -> None:
         """Stop every primitive, then the thread (the robot's ``close`` calls it)."""
         for primitive in self.primitives:
-            primitive.stop(wait=True)
+            primitive.halt(wait=True)
         with self._lock:
             self._closed = True
             self._primitives.clear()

@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 from poppy_core.errors import ArgumentError, UnknownMotorError
+from poppy_core.motion.plots import plot_move
 from poppy_core.trajectory import MAX_DURATION_S
 
 FloatArray = npt.NDArray[np.float64]
@@ -260,6 +261,11 @@ class Move:
     def duration_s(self) -> float:
         """Time from the first frame to the last (0 for fewer than two frames)."""
         return max(len(self) - 1, 0) / self.framerate
+
+    def plot(self, ax: Any = None) -> Any:
+        """Draw each motor's position over time on a matplotlib axis (pypot's ``move.plot(ax)``);
+        without one, on a new Agg axis. Returns the axis."""
+        return plot_move(self, ax)
 
     def times(self) -> FloatArray:
         """The time of each frame in seconds."""

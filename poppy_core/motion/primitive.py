@@ -2,8 +2,9 @@
 
 A primitive acts on a sandboxed view of the robot (``self.robot``, see ``sandbox``): its writes
 are requests that the robot's ``PrimitiveManager`` combines with those of the other running
-primitives. A primitive whose code raises is stopped, its traceback logged and kept in
-``error``; ``state`` then reads ``"failed"``.
+primitives. A primitive whose code raises is stopped, its traceback logged once at WARNING and
+kept in ``error``; ``state`` then reads ``"failed"``, and whoever waits on it (``wait_to_stop``,
+``stop``) gets a ``PrimitiveError`` raised from the original exception.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 from poppy_core import checks
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ConfigError, PrimitiveError
 from poppy_core.motion.primitive_values import convert_value
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
 from poppy_core.robot.schedule import Periodic, RateMeter
@@ -90,6 +91,7 @@ class Primitive:
         self._lifecycle = threading.Lock()
         self._state: State = "idle"
         self.error: PrimitiveFailure | None = None
+        self._exception: BaseException | None = None
         self._t0: float | None = None
         self._paused_at: float | None = None
         self._paused_s = 0.0
@@ -128,6 +130,7 @@ class Primitive:
             self._stop_event.clear()
             self._resume_event.set()
             self.error = None
+            self._exception = None
             self._t0 = time.monotonic()
             self._paused_s = 0.0
             self._paused_at = None
@@ -141,9 +144,36 @@ class Primitive:
         logger.info("%s started", type(self).__name__)
 
     def stop(self, wait: bool = True) -> None:
-        """Ask the primitive to stop; with ``wait``, return once its thread ended."""
+        """Ask the primitive to stop; with ``wait``, return once its thread ended.
+
+        Raises:
+            PrimitiveError: with ``wait``, the primitive's thread died (from its exception).
+        """
+        self.halt(wait)
+        if wait:
+            self.raise_failure()
+
+    def halt(self, wait: bool = True) -> None:
+        """Stop it as ``stop`` does, without raising its failure (supervisors read ``error``)."""
         with self._lifecycle:
             self._stop_locked(wait)
+
+    def raise_failure(self) -> None:
+        """Raise a ``PrimitiveError`` if the last run died (nothing when it ended well).
+
+        Raises:
+            PrimitiveError: naming the primitive and its exception, raised from that exception.
+        """
+        failure, exception = self.error, self._exception
+        if failure is None:
+            return
+        error = PrimitiveError(
+            f"primitive {self.name} died: {failure.one_line} (its traceback is in the log and in "
+            "its .error)",
+            primitive=self.name,
+            failure=failure.one_line,
+        )
+        raise error from exception
 
     def _stop_locked(self, wait: bool) -> None:
         self._stop_event.set()
@@ -202,9 +232,10 @@ class Primitive:
     def _fail(self, exc: BaseException) -> None:
         text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
         self.error = PrimitiveFailure(type(exc).__name__, str(exc), text)
+        self._exception = exc
         self._state = "failed"
         self._stop_event.set()
-        logger.error("primitive %s failed:\n%s", type(self).__name__, text.rstrip())
+        logger.warning("primitive %s died:\n%s", self.name, text.rstrip())
 
     # -- state -------------------------------------------------------------------------------
 
@@ -258,12 +289,19 @@ class Primitive:
         return self._resume_event.wait(timeout_s)
 
     def wait_to_stop(self, timeout_s: float | None = None) -> bool:
-        """Block until the thread ended; False when ``timeout_s`` ran out first."""
+        """Block until the thread ended; False when ``timeout_s`` ran out first.
+
+        Raises:
+            PrimitiveError: the primitive's thread died (raised from its exception).
+        """
         thread = self._thread
         if thread is None or thread is threading.current_thread():
             return not self.is_alive()
         thread.join(timeout_s)
-        return not thread.is_alive()
+        if thread.is_alive():
+            return False
+        self.raise_failure()
+        return True
 
     def sleep(self, seconds: float) -> bool:
         """Wait ``seconds`` unless stopped first; True when the primitive should stop."""
@@ -283,6 +321,18 @@ class Primitive:
     def get_mockup_motor(self, motor: Motor | MockupMotor | str) -> MockupMotor:
         """The sandboxed version of a motor (or motor name) for this primitive."""
         return self.robot.mockup(motor)
+
+    def affect_once(self, motor: Motor | MockupMotor | str, register: str, value: Any) -> None:
+        """Write ``register`` of the real motor once, outside the manager (pypot's).
+
+        A request (``self.robot.m1.led = 'red'``) is applied again at every manager tick; a value
+        affected once stays only until something else writes it (the user, another primitive).
+
+        Raises:
+            UnknownMotorError: no such motor.
+            RegisterError, ArgumentError: the motor refuses the value.
+        """
+        setattr(self.robot.mockup(motor).real_motor, register, value)
 
     # -- remote access -----------------------------------------------------------------------
 

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Literal
 from poppy_core.errors import RegisterError
 from poppy_core.models import ServoModel
 from poppy_core.robot import frames
+from poppy_core.robot import registers as regs
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.motor_link import MotorLink
 from poppy_core.robot.motor_pypot import CompliantBehaviorSetting, PypotMotorMixin
@@ -215,8 +216,9 @@ class Motor(PypotMotorMixin):
 
     @goal_position.setter
     def goal_position(self, value: float) -> None:
+        target = regs.finite(value, f"{self.name}.goal_position")
         self._link.runner.cancel(self)
-        self._set_goal(value)
+        self._set_goal(target)
 
     def _set_goal(self, user_deg: float) -> None:
         """Set the goal position without cancelling a running goto (the goto runner's way, through
@@ -230,17 +232,23 @@ class Motor(PypotMotorMixin):
 
     @property
     def moving_speed(self) -> float:
-        """Speed limit toward the goal in deg/s (0 = the servo's full speed)."""
+        """Speed limit toward the goal in deg/s (0 = the servo's full speed).
+
+        A speed beyond the register's top is capped to it, as pypot and the servo do; NaN, an
+        infinity or a non-number is refused (``ArgumentError``), a negative one too.
+        """
         return abs(self._link.number("moving_speed"))
 
     @moving_speed.setter
     def moving_speed(self, value: float) -> None:
-        if value < 0:
+        speed = regs.finite(value, f"{self.name}.moving_speed")
+        if speed < 0:
             raise RegisterError(
                 f"{self.name}: moving_speed is a magnitude (>= 0), got {value}",
                 register="moving_speed", motor=self.name,
             )
-        self._link.store("moving_speed", float(value))
+        register = self.model.register("moving_speed")
+        self._link.store("moving_speed", regs.capped(register, speed, "moving_speed"))
 
     @property
     def goal_speed(self) -> float:
@@ -254,8 +262,8 @@ class Motor(PypotMotorMixin):
 
     @goal_speed.setter
     def goal_speed(self, value: float) -> None:
+        speed = regs.finite(value, f"{self.name}.goal_speed")
         self._link.runner.cancel(self)
-        speed = float(value)
         register = self.model.register("moving_speed")
         smallest = abs(float(register.to_si(1)))  # 0 means full speed: never send it
         if abs(speed) < smallest / 2:
@@ -282,7 +290,7 @@ class Motor(PypotMotorMixin):
                 f"{self.name}: {self.model.name} has no torque limit register",
                 register="torque_limit", motor=self.name,
             )
-        self._link.store("torque_limit", float(value))
+        self._link.store("torque_limit", regs.finite(value, f"{self.name}.torque_limit"))
 
     # -- compliance --------------------------------------------------------------------------
 

@@ -62,7 +62,8 @@ class PypotMotorMixin:
     @pid.setter
     def pid(self, gains: tuple[float, float, float]) -> None:
         for name, value in zip(self._pid_names(), gains, strict=True):
-            self._link.store(name, float(value))
+            gain = regs.capped(self.model.register(name), value, f"{self.name}.pid")
+            self._link.store(name, gain)  # pypot capped the gains to the registers' range too
 
     def _pid_names(self) -> tuple[str, str, str]:
         names = regs.pid_names(self.model)

@@ -7,9 +7,12 @@ Names here are the common names of ``poppy_core.models`` (aliases resolve per mo
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from numbers import Real
 
+from poppy_core import checks
 from poppy_core.models import Register, ServoModel
 
 # e-manual (MX-28/64/106 protocol 1, XL-320): P/I/D gains at addresses 26-29 (order differs).
@@ -95,3 +98,33 @@ def read_blocks(model: ServoModel, names: Sequence[str]) -> list[Block]:
 def decode_table(model: ServoModel, data: bytes, names: Sequence[str] = STATE) -> dict[str, object]:
     """SI values of ``names`` found in a control-table dump starting at address 0."""
     return dict(model.decode_table(data, names))
+
+
+def si_range(register: Register) -> tuple[float, float]:
+    """The (lowest, highest) SI value ``register`` holds; a speed or load its magnitude's."""
+    return register.si_range()
+
+
+def finite(value: object, field: str) -> float:
+    """``value`` as a finite float (a huge integer is cut to ±2**40 before it meets ``float()``).
+
+    Raises:
+        ArgumentError: not a number, NaN or infinite.
+    """
+    if isinstance(value, Real) and not isinstance(value, bool):
+        if isinstance(value, int):
+            value = max(min(value, 1 << 40), -(1 << 40))
+        number = float(value)
+        if math.isfinite(number):
+            return number
+    return checks.number(value, field)  # raises: NaN, an infinity, not a number
+
+
+def capped(register: Register, value: object, field: str) -> float:
+    """``value`` as a number clamped to what ``register`` holds, as pypot capped it.
+
+    Raises:
+        ArgumentError: not a number, NaN or infinite (never clamped).
+    """
+    low, high = si_range(register)
+    return min(max(finite(value, field), low), high)

@@ -59,7 +59,10 @@ class BackgroundServer:
         return self
 
     def run(self, timeout_s: float | None = None) -> None:
-        """Serve (if not yet) and block until ``stop()`` (pypot's ``server.run()``)."""
+        """Serve and block until ``stop()`` (pypot's ``server.run()``); when it already serves in
+        the background (the robot's constructor started it), return at once, as pypot did."""
+        if self._thread.running:
+            return
         self.start()
         self._stopped.wait(timeout_s)
 

@@ -217,7 +217,7 @@ class RobotService:
         if action == "start":
             primitive.start()
         elif action == "stop":
-            primitive.stop(wait=True)
+            primitive.halt(wait=True)
         elif action == "pause":
             primitive.pause()
         elif action == "resume":

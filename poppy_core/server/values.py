@@ -155,8 +155,8 @@ def _moving_speed(motor: Motor, name: str, value: Any) -> float:
     speed = number(motor, name, value)
     if speed < 0:
         raise _bad(motor, name, "a speed limit is a magnitude (>= 0)")
-    _fits(motor, "moving_speed", speed, name)
-    return speed
+    # Beyond the register's top: capped to it, as pypot's REST and the Motor do.
+    return min(speed, regs.si_range(motor.model.register("moving_speed"))[1])
 
 
 def _torque(motor: Motor, name: str, value: Any) -> float:
@@ -198,9 +198,10 @@ def _triple(motor: Motor, name: str, value: Any) -> tuple[float, float, float]:
         raise _bad(motor, name, f"{motor.model.name} has no PID gains")
     if not isinstance(value, list | tuple) or len(value) != 3:
         raise _bad(motor, name, "expected [P, I, D]")
-    gains = tuple(number(motor, name, v) for v in value)
-    for register, gain in zip(names, gains, strict=True):
-        _fits(motor, register, gain, name)
+    gains = tuple(
+        regs.capped(motor.model.register(register), number(motor, name, v), name)
+        for register, v in zip(names, value, strict=True)
+    )  # beyond a gain register's range: capped, as pypot's REST and the Motor do
     return gains[0], gains[1], gains[2]
 
 

@@ -232,7 +232,10 @@ class ZmqRobotServer:
         return self
 
     def run(self, timeout_s: float | None = None) -> None:
-        """Serve (if not yet) and block until ``stop()`` (pypot's ``server.run()``)."""
+        """Serve and block until ``stop()`` (pypot's ``server.run()``); when it already serves in
+        the background (``use_zmq=True`` started it), return at once, as pypot did."""
+        if self._thread.is_alive():
+            return
         self.start()
         self._stop.wait(timeout_s)
 

@@ -84,10 +84,11 @@ def test_a_plain_robot_gets_no_behaviour_and_a_named_one_can_be_attached() -> No
 
 def test_every_creature_declares_its_primitives() -> None:
     assert set(CREATURES) == {"ergo-jr", "torso", "humanoid"}
-    assert {"base_posture", "rest_posture", "curious_posture", "safe_power_up", "dance",
-            "jump"} == set(CREATURES["ergo-jr"].primitives)  # fmt: skip
+    assert {"base_posture", "rest_posture", "curious_posture", "tetris_posture", "safe_power_up",
+            "dance", "jump", "tinsel_demo", "stubborn_demo", "chicken_demo",
+            "puzzel_demo"} == set(CREATURES["ergo-jr"].primitives)  # fmt: skip
     upper = {"limit_torque", "temperature_monitoring", "dance_beat_motion",
              "upper_body_idle_motion", "head_idle_motion", "arms_turn_compliant",
              "arms_copy_motion"}  # fmt: skip
-    assert set(CREATURES["torso"].primitives) == upper
+    assert set(CREATURES["torso"].primitives) == upper | {"init_position"}
     assert set(CREATURES["humanoid"].primitives) == upper | {"stand_position", "sit_position"}

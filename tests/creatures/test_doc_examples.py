@@ -306,10 +306,10 @@ def test_humanoid_behaviours_and_setup(simulator: str, capsys: pytest.CaptureFix
 
 
 def test_torso_behaviours(torso: Robot) -> None:
-    # the documentation's list (line 1969)
+    # the documentation's list (line 1969), and init_position, which poppy_torso.py attaches too
     assert torso.primitive_names == [
         "limit_torque", "temperature_monitoring", "dance_beat_motion", "upper_body_idle_motion",
-        "head_idle_motion", "arms_turn_compliant", "arms_copy_motion",
+        "head_idle_motion", "arms_turn_compliant", "arms_copy_motion", "init_position",
     ]  # fmt: skip
     assert torso.temperature_monitoring.running
     stop_all(torso)

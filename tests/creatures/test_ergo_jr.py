@@ -16,7 +16,8 @@ from poppy_core.robot import Robot
 from tests.creatures.helpers import positions, reached, virtual, wait_until
 
 ERGO_JR_PRIMITIVES = [
-    "safe_power_up", "dance", "base_posture", "rest_posture", "curious_posture", "jump",
+    "safe_power_up", "dance", "base_posture", "rest_posture", "curious_posture",
+    "tetris_posture", "jump", "tinsel_demo", "stubborn_demo", "chicken_demo", "puzzel_demo",
     "tracking_feedback", "marker_follow",
 ]  # fmt: skip
 

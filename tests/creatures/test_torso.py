@@ -22,7 +22,7 @@ def test_behaviours_are_attached(torso: Robot) -> None:
     assert torso.creature.kind == "torso" and torso.creature.goto_control == "minjerk"
     assert torso.primitive_names == [
         "limit_torque", "temperature_monitoring", "dance_beat_motion", "upper_body_idle_motion",
-        "head_idle_motion", "arms_turn_compliant", "arms_copy_motion",
+        "head_idle_motion", "arms_turn_compliant", "arms_copy_motion", "init_position",
     ]  # fmt: skip
     assert "stand_position" not in torso.extensions  # no legs
     assert torso.active_primitives == [torso.temperature_monitoring]

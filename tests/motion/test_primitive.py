@@ -9,7 +9,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from poppy_core.errors import ConfigError, RobotClosedError
+from poppy_core.errors import ConfigError, PrimitiveError, RobotClosedError
 from poppy_core.motion import (
     LoopPrimitive,
     Primitive,
@@ -177,9 +177,12 @@ def test_crash_is_reported_and_the_manager_survives(
     steady = Sinus(ergo, 50, ["m2"], amp=0.0, offset=15.0)
     steady.start()
     crasher = Crasher(ergo)
-    with caplog.at_level(logging.ERROR, logger="poppy_core.motion.primitive"):
+    with caplog.at_level(logging.WARNING, logger="poppy_core.motion.primitive"):
         crasher.start()
-        assert crasher.wait_to_stop(3.0)
+        assert eventually(lambda: not crasher.is_alive())
+        with pytest.raises(PrimitiveError, match="boom at update 3") as raised:
+            crasher.wait_to_stop(3.0)
+    assert isinstance(raised.value.__cause__, ValueError)
     assert state(crasher) == "failed"
     assert not crasher.is_alive()
     assert crasher.error is not None
@@ -201,7 +204,8 @@ def test_crash_is_reported_and_the_manager_survives(
     steady.stop()
     first_error = crasher.error
     crasher.start()  # a failed primitive can be started again (its error is reset)
-    assert crasher.wait_to_stop(3.0)
+    assert eventually(lambda: not crasher.is_alive())
+    crasher.halt()  # a supervisor stops it without raising
     assert state(crasher) == "failed" and crasher.updates == 3
     assert crasher.error is not None and crasher.error is not first_error
 
@@ -219,7 +223,8 @@ class _BadSetup(Primitive):
 def test_failing_setup_never_runs(ergo: Robot) -> None:
     primitive = _BadSetup(ergo)
     primitive.start()
-    assert primitive.wait_to_stop(3.0)
+    with pytest.raises(PrimitiveError, match="UnknownMotorError"):
+        primitive.wait_to_stop(3.0)
     assert state(primitive) == "failed"
     assert not primitive.ran
     assert primitive.error is not None and primitive.error.type == "UnknownMotorError"
@@ -320,3 +325,62 @@ def test_primitive_cannot_restart_itself(ergo: Robot) -> None:
     assert selfish.wait_to_stop(2.0)
     assert len(errors) == 1 and state(selfish) == "stopped"
     assert threading.active_count() >= 1
+
+
+class DiesInRun(Primitive):
+    """Dies on a name it lacks, as pypot's Switcher did on poppy before affect_once."""
+
+    def run(self) -> None:
+        self.sleep(0.05)
+        self.no_such_method()  # type: ignore[attr-defined]
+
+
+def test_a_dead_primitive_says_so_to_whoever_waits(
+    ergo: Robot, caplog: pytest.LogCaptureFixture
+) -> None:
+    primitive = DiesInRun(ergo)
+    with caplog.at_level(logging.WARNING, logger="poppy_core.motion.primitive"):
+        primitive.start()
+        with pytest.raises(PrimitiveError, match="no_such_method") as waited:
+            primitive.wait_to_stop()  # no timeout: it must not block for good
+        with pytest.raises(PrimitiveError, match="dies_in_run died: AttributeError"):
+            primitive.stop()
+    assert isinstance(waited.value.__cause__, AttributeError)
+    assert waited.value.primitive == "dies_in_run"
+    deaths = [r for r in caplog.records if "died" in r.getMessage()]
+    assert len(deaths) == 1 and deaths[0].levelno == logging.WARNING
+    primitive.halt()  # supervisors (close, the servers) stop it without raising
+    ergo.close()  # and closing the robot does not raise either
+
+
+class _Switcher(LoopPrimitive):
+    """pypot's tests/test_primitive.py::test_set_once, in poppy's words."""
+
+    def setup(self) -> None:
+        self.state_on = False
+        self.old_state = False
+        self.switched = threading.Event()
+
+    def update(self) -> None:
+        if self.state_on != self.old_state:
+            for m in self.robot.motors:
+                self.affect_once(m, "led", "red" if self.state_on else "off")
+            self.old_state = self.state_on
+            self.switched.set()
+
+
+def test_affect_once_writes_the_real_motor_once(ergo: Robot) -> None:
+    switcher = _Switcher(ergo, 10)
+    switcher.start()
+    assert eventually(lambda: hasattr(switcher, "switched"))
+    for m in ergo.motors:
+        m.led = "off"
+    switcher.state_on = True
+    assert switcher.switched.wait(10.0)
+    assert [m.led for m in ergo.motors] == ["red"] * 6
+    ergo.m3.led = "blue"  # written once: the user's write stays
+    time.sleep(0.3)  # three updates of the switcher
+    assert [m.led for m in ergo.motors] == ["red", "red", "blue", "red", "red", "red"]
+    switcher.stop()
+    with pytest.raises(ConfigError):
+        switcher.affect_once("m9", "led", "red")

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from poppy_core.errors import RegisterError
+from poppy_core.errors import ArgumentError, RegisterError
 from poppy_core.models import model_by_name
 from poppy_core.robot import Motor
 from poppy_core.robot.config import MotorConfig
@@ -215,3 +215,39 @@ def test_the_sync_loop_side_is_not_on_the_users_motor() -> None:
     assert public.isdisjoint(sync_side), public & sync_side
     assert {"goal_position", "present_position", "compliant", "online"} <= public
     assert link_of(motor).take_pending(["goal_position"]) == {}
+
+
+@pytest.mark.parametrize("model", [AX, MX, XL, XM], ids=lambda m: m.name)
+def test_speeds_beyond_the_register_are_capped_as_pypot(model: object) -> None:
+    # pypot accepted `m.moving_speed = 10000` and capped it to the servo's top speed (its
+    # speed_to_dxl); the lead's decision for poppy: clamp what is beyond a register's range.
+    motor = stiff(Motor("m", model, 1))  # type: ignore[arg-type]
+    register = motor.model.register("moving_speed")
+    top = max(abs(float(register.to_si(0x3FF))), float(register.to_si(register.max_raw)))
+    for huge in (10000, top * 10, 1e12, 10**400):
+        motor.moving_speed = huge
+        assert motor.moving_speed == pytest.approx(min(huge, top))
+    raw = link_of(motor).take_pending(["moving_speed"])["moving_speed"]
+    assert register.to_si(raw) == pytest.approx(top)
+    motor.moving_speed = 100  # within the range: kept as given
+    assert motor.moving_speed == pytest.approx(100, abs=1.0)
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf"), "fast", None, True])
+@pytest.mark.parametrize(
+    "register", ["moving_speed", "goal_position", "goal_speed", "torque_limit", "pid"]
+)
+def test_non_finite_and_wrong_types_are_refused(register: str, bad: object) -> None:
+    motor = stiff(Motor("m4", MX, 4))
+    link_of(motor).take_pending(MX.registers)
+    value = (bad, 0.0, 0.0) if register == "pid" else bad
+    with pytest.raises(ArgumentError, match=rf"m4\.{register} must be a"):
+        setattr(motor, register, value)
+    assert not link_of(motor).has_pending()  # nothing was queued for the servo
+
+
+def test_pid_gains_are_capped_to_their_registers() -> None:
+    motor = stiff(Motor("m", MX, 1))
+    motor.pid = (100.0, -3.0, 1e9)  # pypot truncated each gain to its register's 0-254
+    p, i, d = motor.pid
+    assert p == pytest.approx(254 / 8) and i == 0.0 and d == pytest.approx(254 * 4 / 1000)

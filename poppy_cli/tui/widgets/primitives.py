@@ -146,7 +146,7 @@ class PrimitivesPanel(Vertical):
                     robot.compliant = False  # primitives request goals: the torque must be on
                 primitive.start()
             else:
-                primitive.stop()
+                primitive.halt()  # a failure shows in the table (state failed)
         except (PoppyError, RuntimeError) as exc:
             verb = "start" if start else "stop"
             self.post_message(BusFailed(f"cannot {verb} primitive {name}: {exc}"))

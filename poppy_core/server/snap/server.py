@@ -132,9 +132,11 @@ class SnapServer:
         return self
 
     def run(self, timeout_s: float | None = None) -> None:
-        """Serve (if not yet) and block until ``stop()`` (pypot's ``server.run()``)."""
-        if not self.thread.running:
-            self.start()
+        """Serve and block until ``stop()`` (pypot's ``server.run()``); when it already serves in
+        the background (``use_snap=True`` started it), return at once, as pypot did."""
+        if self.thread.running:
+            return
+        self.start()
         self._stopped.wait(timeout_s)
 
     def stop(self) -> None:

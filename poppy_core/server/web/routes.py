@@ -108,7 +108,7 @@ def stop_everything(service: RobotService, then: str) -> StopResult:
     robot = service.robot
     stopped = service.running_primitives()
     for name in stopped:
-        service.primitive(name).stop(wait=True)
+        service.primitive(name).halt(wait=True)
     moves = service.moves.playing()
     for name in moves:
         service.moves.stop(name)
