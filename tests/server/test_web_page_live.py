@@ -148,3 +148,37 @@ def test_one_update_a_second_is_said_in_the_singular(
     finally:
         context.close()
         server.stop()
+
+
+def test_a_stream_gone_silent_counts_as_lost(
+    browser: Any,  # noqa: F811 (the fixture imported above)
+    robot: Robot,
+) -> None:
+    """A server that stops sending without closing (a network down): greyed out, then back."""
+    server = ServerThread(create_app(robot)).start()
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    tab = context.new_page()
+    tab.set_default_timeout(WAIT_S * 1000)
+    silent = [False]
+    sockets: list[Any] = []
+
+    def relay(socket: Any) -> None:
+        sockets.append(socket)
+        upstream = socket.connect_to_server()
+        upstream.on_message(lambda message: None if silent[0] else socket.send(message))
+
+    try:
+        tab.route_web_socket(re.compile(r".*/api/v1/ws.*"), relay)
+        tab.goto(server.url + "/")
+        tab.wait_for_function(LIVE)
+        eventually(lambda: tab.is_enabled("#stop-all"), "the page live")
+        silent[0] = True  # frames stop, the socket stays open
+        eventually(lambda: offline_look(tab)["offline"], "the silent stream counted as lost")
+        assert not tab.is_enabled("#motor-m2 input[type=checkbox]")
+        silent[0] = False
+        eventually(lambda: not offline_look(tab)["offline"], "the stream back")
+        assert len(sockets) >= 2, "the page did not open a new stream"
+        eventually(lambda: tab.is_enabled("#motor-m2 input[type=checkbox]"), "controls back")
+    finally:
+        context.close()
+        server.stop()
