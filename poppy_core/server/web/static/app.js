@@ -108,7 +108,10 @@ function setLive(up) {
   if (!up) {
     document.getElementById("stop-dialog").close();
     document.getElementById("rate").textContent = "not live: no connection";
-  } else if (wasDown && window.poppy.ready) {
+  } else if (wasDown) {
+    document.getElementById("rate").textContent = "live";
+  }
+  if (up && wasDown && window.poppy.ready) {
     refresh(); refreshPrimitives(); refreshMoves();
     get("/api/v1/web/about").then(showAbout, () => { /* the badge says */ });
   }
