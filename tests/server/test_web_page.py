@@ -161,6 +161,13 @@ def test_a_move_recorded_from_the_page_replays(page: Any, served: Served) -> Non
     robot.compliant = True
 
 
+def overlap(a: dict[str, float], b: dict[str, float]) -> bool:
+    """True when two bounding boxes share some area."""
+    apart_x = a["x"] + a["width"] <= b["x"] or b["x"] + b["width"] <= a["x"]
+    apart_y = a["y"] + a["height"] <= b["y"] or b["y"] + b["height"] <= a["y"]
+    return not (apart_x or apart_y)
+
+
 def test_one_click_on_stop_stops_and_holds_then_offers_compliant(page: Any, served: Served) -> None:
     robot = served.robot
     robot.compliant = True
@@ -173,6 +180,12 @@ def test_one_click_on_stop_stops_and_holds_then_offers_compliant(page: Any, serv
     eventually(lambda: page.is_visible("#stop-dialog"), "the choice after Stop")
     assert not page.evaluate("() => document.getElementById('stop-dialog').matches(':modal')")
     assert "1 primitive and 0 moves stopped" in page.inner_text("#stop-dialog")
+    for width in (390, 1280):  # the choice covers no part of Stop, on a phone either
+        page.set_viewport_size({"width": width, "height": 900})
+        stop = page.locator("#stop-all").bounding_box()
+        choice = page.locator("#stop-dialog").bounding_box()
+        assert stop and choice
+        assert not overlap(stop, choice), f"the choice covers Stop at {width} px: {choice}, {stop}"
     page.click("button[aria-label='start cosinus']")
     eventually(robot.cosinus.is_alive, "cosinus started with the choice still open")
     # keyboard: Escape alone stops
