@@ -3,8 +3,9 @@
 Measures page load to the first live values, the state stream's update rate as the page sees it
 with 25 motors, and the server process's CPU with one page open (against none). The server runs
 in its own process (``poppy serve --http --sim --profile humanoid``) so its CPU is its own.
-``python -m bench.web_bench --screenshots`` writes docs/img/web-desktop.png and web-phone.png
-with the same browser. Duration of the rate and CPU windows: ``POPPY_BENCH_WEB_S`` (default 10).
+``python -m bench.web_bench --screenshots`` writes docs/img/web-desktop.png, web-phone.png and
+web-offline.png with the same browser. Duration of the rate and CPU windows:
+``POPPY_BENCH_WEB_S`` (default 10).
 """
 
 from __future__ import annotations
@@ -187,35 +188,46 @@ def web_benchmark(ctx: BenchContext) -> BenchResult:
 
 
 def screenshots(folder: str) -> list[str]:
-    """The page of a served Ergo Jr, busy, at desktop and phone widths (PNG files written)."""
+    """The page of a served Ergo Jr, busy, at desktop and phone widths, then with its server
+    gone (PNG files written)."""
     import httpx
 
     written = []
-    with served("ergo-jr") as (url, _pid), browser() as chrome, httpx.Client(base_url=url) as http:
-        http.put("/api/v1/robot/compliant", json={"compliant": False})
-        http.post("/api/v1/moves/wave/record", json={"motors": ["m1", "m2", "m3"]})
-        for angles in ([30, -20, 20], [-30, 10, -20], [0, 0, 0]):
-            http.post("/api/v1/gotos", json={"positions": dict(zip(["m1", "m2", "m3"], angles,
-                      strict=True)), "duration_s": 0.8, "wait": True})  # fmt: skip
-        http.post("/api/v1/moves/wave/save")
-        http.put("/api/v1/primitives/sinus/properties/amplitude", json={"value": 25})
-        http.post("/api/v1/primitives/sinus/start")
-        for name, size, mobile in (("desktop", (1280, 900), False), ("phone", (390, 844), True)):
-            context = chrome.new_context(viewport={"width": size[0], "height": size[1]},
-                                         is_mobile=mobile, device_scale_factor=1)  # fmt: skip
-            page = context.new_page()
-            page.goto(url + "/")
-            page.wait_for_function(READY, timeout=30_000)
-            page.click("button[aria-label='plot wave']")
-            page.wait_for_selector("#plot polyline")
-            page.evaluate("window.scrollTo(0, 0)")
-            time.sleep(1.5)
-            path = os.path.join(folder, f"web-{name}.png")
-            page.screenshot(path=path, full_page=name == "desktop")
-            written.append(path)
-            context.close()
-        http.post("/api/v1/web/stop", json={"then": "compliant"})
-        http.delete("/api/v1/moves/wave")
+    with browser() as chrome:
+        with served("ergo-jr") as (url, _pid), httpx.Client(base_url=url) as http:
+            http.put("/api/v1/robot/compliant", json={"compliant": False})
+            http.post("/api/v1/moves/wave/record", json={"motors": ["m1", "m2", "m3"]})
+            for angles in ([30, -20, 20], [-30, 10, -20], [0, 0, 0]):
+                http.post("/api/v1/gotos", json={"positions": dict(zip(["m1", "m2", "m3"],
+                          angles, strict=True)), "duration_s": 0.8, "wait": True})  # fmt: skip
+            http.post("/api/v1/moves/wave/save")
+            http.put("/api/v1/primitives/sinus/properties/amplitude", json={"value": 25})
+            http.post("/api/v1/primitives/sinus/start")
+            shots = (("desktop", (1280, 900), False), ("phone", (390, 844), True),
+                     ("offline", (1280, 900), False))  # fmt: skip
+            for name, size, mobile in shots:
+                context = chrome.new_context(viewport={"width": size[0], "height": size[1]},
+                                             is_mobile=mobile, device_scale_factor=1)  # fmt: skip
+                page = context.new_page()
+                page.goto(url + "/")
+                page.wait_for_function(READY, timeout=30_000)
+                page.click("button[aria-label='plot wave']")
+                page.wait_for_selector("#plot polyline")
+                page.evaluate("window.scrollTo(0, 0)")
+                time.sleep(1.5)
+                if name == "offline":
+                    break  # shot once the server is gone
+                path = os.path.join(folder, f"web-{name}.png")
+                page.screenshot(path=path, full_page=name == "desktop")
+                written.append(path)
+                context.close()
+        # the server is gone: the page greys out, its controls off
+        page.wait_for_function("() => document.body.classList.contains('offline')")
+        time.sleep(1.0)
+        path = os.path.join(folder, "web-offline.png")
+        page.screenshot(path=path)
+        written.append(path)
+        context.close()
     return written
 
 

@@ -30,6 +30,7 @@ from poppy_core.motion import (
     fallback_path,
     list_moves,
     load_move,
+    read_move,
     save_move,
     write_move,
 )
@@ -79,6 +80,7 @@ class MoveService:
         self._closing = threading.Lock()
         self.saved_on_close: list[SavedTake] = []
         """The takes ``close()`` saved (a server says where on stopping)."""
+        self._lengths: dict[Path, tuple[tuple[int, int], float | None, int | None]] = {}
 
     # -- library -------------------------------------------------------------------------------
 
@@ -87,10 +89,39 @@ class MoveService:
         return sorted({entry.name for entry in list_moves()})
 
     def entries(self) -> list[dict[str, Any]]:
-        """The library's moves: name, format, size."""
-        return [
-            {"name": e.name, "format": e.format, "size_bytes": e.size_bytes} for e in list_moves()
-        ]
+        """The library's moves: name, format, size, duration and frames (None: unreadable)."""
+        answer = []
+        listed = list_moves()
+        with self._lock:  # forget the files gone
+            for gone in set(self._lengths) - {entry.path for entry in listed}:
+                del self._lengths[gone]
+        for entry in listed:
+            duration_s, frames = self._length(entry.path)
+            answer.append(
+                {"name": entry.name, "format": entry.format, "size_bytes": entry.size_bytes,
+                 "duration_s": duration_s, "frames": frames}
+            )  # fmt: skip
+        return answer
+
+    def _length(self, path: Path) -> tuple[float | None, int | None]:
+        """A library file's duration and frames, read once per version of the file."""
+        try:
+            stat = path.stat()
+        except OSError:
+            return None, None
+        key = (stat.st_mtime_ns, stat.st_size)
+        with self._lock:
+            known = self._lengths.get(path)
+        if known is not None and known[0] == key:
+            return known[1], known[2]
+        try:
+            move = read_move(path)
+            length: tuple[float | None, int | None] = (round(move.duration_s, 3), len(move))
+        except (ConfigError, FileError, OSError):
+            length = (None, None)
+        with self._lock:
+            self._lengths[path] = (key, *length)
+        return length
 
     def load(self, name: str) -> Move:
         """The library move ``name``, or ``ApiError("not_found")``."""

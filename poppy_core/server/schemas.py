@@ -135,6 +135,10 @@ class MoveEntry(BaseModel):
     name: str
     format: str
     size_bytes: int
+    duration_s: float | None = Field(
+        None, description="seconds from the first frame to the last (null: unreadable file)"
+    )
+    frames: int | None = Field(None, description="frames (null: unreadable file)")
 
 
 class MoveInfo(BaseModel):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 
 import httpx
+import numpy as np
 
 from tests.helpers.robots import reached
 from tests.helpers.server import Served
@@ -129,3 +130,24 @@ def test_one_rule_for_move_names_everywhere(client: httpx.Client, moves_folder: 
     refused = client.get("/api/v1/moves/.hidden")
     assert refused.status_code == 422 and "not a move name" in refused.text
     assert client.delete("/api/v1/moves/my wave.v2").status_code == 204
+
+
+def test_the_move_list_gives_each_duration(client: httpx.Client, moves_folder: str) -> None:
+    """As `poppy moves list` does: seconds and frames, null for a file that is not a move."""
+    from pathlib import Path
+
+    from poppy_core.motion import Move, save_move
+
+    save_move(Move(20, ["m1"], np.zeros((41, 1))), "two_seconds")
+    (Path(moves_folder) / "broken.move").write_bytes(b"not a move")
+    try:
+        listed = {m["name"]: m for m in client.get("/api/v1/moves").json()}
+        assert listed["two_seconds"]["duration_s"] == 2.0
+        assert listed["two_seconds"]["frames"] == 41
+        assert listed["broken"]["duration_s"] is None and listed["broken"]["frames"] is None
+        save_move(Move(20, ["m1"], np.zeros((21, 1))), "two_seconds")  # replaced: read again
+        listed = {m["name"]: m for m in client.get("/api/v1/moves").json()}
+        assert listed["two_seconds"]["duration_s"] == 1.0
+    finally:
+        for name in ("two_seconds.move", "broken.move"):
+            (Path(moves_folder) / name).unlink()

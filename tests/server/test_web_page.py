@@ -7,11 +7,13 @@ Each test opens the page of a virtual Ergo Jr served on 127.0.0.1, uses it as a 
 from __future__ import annotations
 
 import dataclasses
+import re
 import shutil
 import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
+import numpy as np
 import pytest
 
 from tests.server.conftest import Served, serve
@@ -160,25 +162,133 @@ def test_a_move_recorded_from_the_page_replays(page: Any, served: Served) -> Non
     robot.compliant = True
 
 
-def test_stop_stops_a_running_primitive(page: Any, served: Served) -> None:
+def overlap(a: dict[str, float], b: dict[str, float]) -> bool:
+    """True when two bounding boxes share some area."""
+    apart_x = a["x"] + a["width"] <= b["x"] or b["x"] + b["width"] <= a["x"]
+    apart_y = a["y"] + a["height"] <= b["y"] or b["y"] + b["height"] <= a["y"]
+    return not (apart_x or apart_y)
+
+
+def test_one_click_on_stop_stops_and_holds_then_offers_compliant(page: Any, served: Served) -> None:
     robot = served.robot
+    robot.compliant = True
     robot.sinus.start()
     eventually(robot.sinus.is_alive, "sinus running")
-    page.click("#stop-all")
-    page.check("#stop-dialog input[value=hold]")
-    page.click("#stop-confirm")
-    eventually(lambda: not robot.sinus.is_alive(), "Stop to stop sinus")
+    page.click("#stop-all")  # one click and nothing else
+    eventually(lambda: not robot.sinus.is_alive(), "one click on Stop to stop sinus")
     eventually(lambda: not any(m.compliant for m in robot.motors), "the motors held")
-    # keyboard only: Escape opens the dialog with Stop focused, Enter confirms
-    robot.cosinus.start()
+    # what follows is a choice that blocks nothing: the page works with it open
+    eventually(lambda: page.is_visible("#stop-dialog"), "the choice after Stop")
+    assert not page.evaluate("() => document.getElementById('stop-dialog').matches(':modal')")
+    assert "1 primitive and 0 moves stopped" in page.inner_text("#stop-dialog")
+    for width in (390, 1280):  # the choice covers no part of Stop, on a phone either
+        page.set_viewport_size({"width": width, "height": 900})
+        stop = page.locator("#stop-all").bounding_box()
+        choice = page.locator("#stop-dialog").bounding_box()
+        assert stop and choice
+        assert not overlap(stop, choice), f"the choice covers Stop at {width} px: {choice}, {stop}"
+    page.click("button[aria-label='start cosinus']")
+    eventually(robot.cosinus.is_alive, "cosinus started with the choice still open")
+    # keyboard: Escape alone stops
     page.keyboard.press("Escape")
-    eventually(lambda: page.is_visible("#stop-dialog"), "the Stop dialog")
-    page.check("#stop-dialog input[value=compliant]")
-    page.focus("#stop-confirm")
-    page.keyboard.press("Enter")
-    eventually(lambda: not robot.cosinus.is_alive(), "cosinus stopped")
-    eventually(lambda: robot.compliant, "the motors compliant")
+    eventually(lambda: not robot.cosinus.is_alive(), "Escape alone to stop cosinus")
+    page.click("#stop-compliant")
+    eventually(lambda: robot.compliant, "the motors compliant when asked after")
+    assert not page.is_visible("#stop-dialog")
     eventually(lambda: "Stop from the web page" in page.inner_text("#log-lines"), "the log line")
+
+
+ACTIONS = ("start", "pause", "resume", "stop")
+
+
+def test_behaviour_buttons_offer_what_its_state_allows(page: Any, served: Served) -> None:
+    def offered() -> dict[str, bool]:
+        return {a: page.is_enabled(f"button[aria-label='{a} square']") for a in ACTIONS}
+
+    def expect(enabled: set[str], state: str) -> None:
+        want = {a: a in enabled for a in ACTIONS}
+        eventually(lambda: offered() == want, f"{state}: only {sorted(enabled)} enabled")
+
+    expect({"start"}, "idle")
+    page.click("button[aria-label='start square']")
+    expect({"pause", "stop"}, "running")
+    page.click("button[aria-label='pause square']")
+    expect({"resume", "stop"}, "paused")
+    page.click("button[aria-label='resume square']")
+    expect({"pause", "stop"}, "running again")
+    page.click("button[aria-label='stop square']")
+    expect({"start"}, "stopped")
+    assert not served.robot.square.is_alive()
+    served.robot.compliant = True
+
+
+LINES = """cells => cells.map(cell => {
+  const range = document.createRange();
+  range.selectNodeContents(cell);
+  return new Set([...range.getClientRects()].map(r => Math.round(r.top))).size;
+})"""
+
+
+def move_row(page: Any, name: str) -> dict[str, str]:
+    """A row of the move list by column heading."""
+    return dict(
+        page.evaluate(
+            """name => {
+      const heads = [...document.querySelectorAll("#move-table thead th")].map(t => t.textContent);
+      const cells = [...document.getElementById(`move-${name}`).children];
+      return Object.fromEntries(heads.map((h, i) => [h, cells[i].textContent]));
+    }""",
+            name,
+        )
+    )
+
+
+@pytest.fixture
+def timed(page: Any) -> Iterator[str]:
+    """A move of 2.98 s in the library (150 frames at 50 Hz), shown in the page's list."""
+    from poppy_core.motion import Move, delete_move, save_move
+
+    times = np.arange(150) / 50.0
+    save_move(Move(50, ["m1", "m2"], np.stack([30 * np.sin(2 * times), 10 * times], 1)), "timed")
+    eventually(lambda: page.query_selector("#move-timed"), "the move in the list")
+    yield "timed"
+    delete_move("timed")
+
+
+def test_the_move_list_gives_durations(page: Any, timed: str) -> None:
+    row = move_row(page, timed)
+    assert "duration" in row, f"no duration column: {sorted(row)}"
+    assert row["duration"].replace("\xa0", " ") == "2.98 s"  # as `poppy moves list` says it
+    assert re.fullmatch(r"\d+\.\d kB", row["size"].replace("\xa0", " ")), row["size"]
+
+
+def test_no_value_of_the_move_list_wraps(page: Any, timed: str) -> None:
+    for width in (1280, 390):  # desktop, then a phone
+        page.set_viewport_size({"width": width, "height": 900})
+        heads = page.eval_on_selector_all("#move-table thead th", "ts => ts.map(t => t.innerText)")
+        cells = page.eval_on_selector_all(f"#move-{timed} > *", LINES)
+        lines = {h: n for h, n in zip(heads, cells, strict=True) if h in ("size", "duration")}
+        assert lines and set(lines.values()) == {1}, f"a value split over lines at {width}: {lines}"
+    scroller = "document.getElementById('move-table').parentElement"
+    wide, room = page.evaluate(f"() => [{scroller}.scrollWidth, {scroller}.clientWidth]")
+    assert wide <= room, f"the move list is {wide} px wide in {room} px on a phone"
+
+
+def test_the_plot_has_a_time_axis_in_seconds(page: Any, timed: str) -> None:
+    page.click(f"button[aria-label='plot {timed}']")
+    eventually(lambda: page.is_visible("#plot polyline"), "the plot")
+    assert "time (s)" in page.inner_text("#plot")
+    texts = page.eval_on_selector_all(
+        "#plot-svg text", "ts => ts.map(t => [t.textContent, Number(t.getAttribute('x'))])"
+    )
+    marks = [(float(text), x) for text, x in texts if re.fullmatch(r"[\d.]+", text)]
+    assert len(marks) >= 3 and marks[0][0] == 0, texts
+    assert [v for v, _ in marks] == sorted(v for v, _ in marks)
+    assert 1.5 <= marks[-1][0] <= 2.98, marks
+    points = page.get_attribute("#plot polyline", "points") or ""
+    start, end = (float(p.split(",")[0]) for p in (points.split()[0], points.split()[-1]))
+    for seconds, x in marks:  # each tick where that time is drawn
+        assert abs(x - (start + (end - start) * seconds / 2.98)) < 1.0, (seconds, x)
 
 
 def test_a_refused_goal_is_shown(page: Any, served: Served) -> None:

@@ -117,7 +117,7 @@ def call(primitive: str, method: str, body: MethodCall, service: Service) -> Met
 
 @router.get("/moves", tags=["moves"], summary="The moves of the library")
 def moves(service: Service) -> list[MoveEntry]:
-    """Name, format and size of each."""
+    """Name, format, size, duration and frames of each."""
     return [MoveEntry.model_validate(e) for e in service.moves.entries()]
 
 

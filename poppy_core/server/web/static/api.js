@@ -76,27 +76,47 @@ export const post = (path, body) => api("POST", path, body ?? {});
 export const put = (path, value) => api("PUT", path, { value });
 
 // The state stream: calls onFrame with {motor: {present_position, ...}} at rateHz; reconnects.
+// onStatus(true) when frames arrive, onStatus(false) when the socket closes or goes silent
+// (no frame for STALE_MS: a server gone without closing, a network down); each change once.
+const STALE_MS = 3000;
+
 export function openStream(rateHz, onFrame, onStatus) {
   let socket = null;
   let retry = 500;
+  let up = null; // unknown until the first frame or the first failure
+  let lastFrame = 0;
+  const status = (now) => { if (now !== up) { up = now; onStatus(now); } };
+  function lost(which) {
+    if (which !== socket) return; // an older socket, already handled
+    socket = null;
+    which.onopen = which.onmessage = which.onclose = null;
+    try { which.close(); } catch { /* already closed */ }
+    status(false);
+    setTimeout(async () => {
+      try { await get("/api/v1/web/about"); } catch { /* the next try says */ }
+      connect();
+    }, retry);
+    retry = Math.min(retry * 2, 5000);
+  }
   function connect() {
     const scheme = location.protocol === "https:" ? "wss" : "ws";
     const url = `${scheme}://${location.host}/api/v1/ws?rate_hz=${rateHz}`;
-    socket = token() ? new WebSocket(url, [`poppy-token.${hex(token())}`]) : new WebSocket(url);
-    socket.onopen = () => { retry = 500; onStatus(true); };
-    socket.onmessage = (event) => {
+    const opened = token() ? new WebSocket(url, [`poppy-token.${hex(token())}`]) : new WebSocket(url);
+    socket = opened;
+    opened.onopen = () => { lastFrame = performance.now(); };
+    opened.onmessage = (event) => {
       const data = JSON.parse(event.data);
-      if (!data.error && !data.type) onFrame(data);
+      if (data.error || data.type) return;
+      lastFrame = performance.now();
+      retry = 500;
+      status(true);
+      onFrame(data);
     };
-    socket.onclose = () => {
-      onStatus(false);
-      setTimeout(async () => {
-        try { await get("/api/v1/web/about"); } catch { /* the next try says */ }
-        connect();
-      }, retry);
-      retry = Math.min(retry * 2, 5000);
-    };
+    opened.onclose = () => lost(opened);
   }
+  setInterval(() => {
+    if (socket && socket.readyState === 1 && performance.now() - lastFrame > STALE_MS) lost(socket);
+  }, 1000);
   connect();
   return { send: (data) => socket && socket.readyState === 1 && socket.send(JSON.stringify(data)) };
 }

@@ -1,13 +1,14 @@
 // The robot's home page: fetches who the robot is, builds each part, keeps them live.
-import { get, openStream, post } from "./api.js";
+import { api, get, openStream, post } from "./api.js";
 import { showCameras, showChains } from "./extras.js";
 import { buildTable, onFrame, refresh, stats } from "./motors.js";
 import { refreshMoves, setupRecorder } from "./moves.js";
 import { refreshPrimitives } from "./primitives.js";
-import { el, every, say } from "./ui.js";
+import { count, el, every, say } from "./ui.js";
 
 const STREAM_HZ = 20;
 let uptimeBase = null;
+let live = false; // frames are arriving: the page shows the robot as it is
 
 function duration(seconds) {
   const s = Math.floor(seconds);
@@ -43,7 +44,7 @@ function showAbout(about) {
 }
 
 function tickUptime() {
-  if (uptimeBase) {
+  if (uptimeBase && live) {
     const now = uptimeBase.uptime + (performance.now() - uptimeBase.at) / 1000;
     document.getElementById("uptime").textContent = duration(now);
   }
@@ -64,27 +65,63 @@ async function refreshLogs() {
   if (lines.length) list.scrollTop = list.scrollHeight;
 }
 
+// One click stops: every primitive and move, motors held where they are. The dialog that
+// follows is not modal: it offers to make the motors compliant and blocks nothing.
+async function stopAll() {
+  const dialog = document.getElementById("stop-dialog");
+  try {
+    const done = await post("/api/v1/web/stop", { then: "hold" });
+    const what = `${count(done.primitives.length, "primitive")} and ${count(done.moves.length, "move")} stopped`;
+    say(`Stopped: ${what}; motors held where they are`);
+    document.getElementById("stop-what").textContent = `${what}.`;
+    if (!dialog.open) dialog.show();
+    document.getElementById("stop-keep").focus();
+  } catch (error) { say(`Stop failed: ${error.message}`, true); }
+  refresh(); refreshPrimitives(); refreshMoves();
+}
+
 function setupStop() {
   const dialog = document.getElementById("stop-dialog");
-  document.getElementById("stop-all").addEventListener("click", () => {
-    dialog.showModal();
-    document.getElementById("stop-confirm").focus();
-  });
-  dialog.addEventListener("close", async () => {
-    if (dialog.returnValue !== "stop") return;
-    const then = dialog.querySelector("input[name=then]:checked").value;
+  document.getElementById("stop-all").addEventListener("click", stopAll);
+  document.getElementById("stop-keep").addEventListener("click", () => dialog.close());
+  document.getElementById("stop-compliant").addEventListener("click", async () => {
+    dialog.close();
     try {
-      const done = await post("/api/v1/web/stop", { then });
-      say(`Stopped: ${done.primitives.length} primitive(s), ${done.moves.length} move(s); motors ${then === "hold" ? "held" : "compliant"}`);
+      await api("PUT", "/api/v1/robot/compliant", { compliant: true });
+      say("Stopped; motors compliant");
     } catch (error) { say(error.message, true); }
-    refresh(); refreshPrimitives(); refreshMoves();
+    refresh();
   });
-  // Escape anywhere opens the confirmation with Stop focused: Escape then Enter stops all
+  // Escape anywhere (but in the token dialog) stops at once, like the button
   document.addEventListener("keydown", (event) => {
-    if (event.key !== "Escape" || document.querySelector("dialog[open]")) return;
+    if (event.key !== "Escape" || document.getElementById("token-dialog").open) return;
     event.preventDefault();
     document.getElementById("stop-all").click();
   });
+}
+
+// The stream is up (frames arriving) or down: down, everything is greyed out and every control
+// is off (the values shown are the last received, not the robot's); back, all is read again.
+function setLive(up) {
+  const conn = document.getElementById("conn");
+  conn.textContent = up ? "connected" : "disconnected";
+  conn.className = `badge ${up ? "ok" : "bad"}`;
+  const wasDown = !live;
+  live = up;
+  document.body.classList.toggle("offline", !up);
+  document.getElementById("live").disabled = !up;
+  document.getElementById("stop-all").disabled = !up;
+  document.getElementById("offline").hidden = up;
+  if (!up) {
+    document.getElementById("stop-dialog").close();
+    document.getElementById("rate").textContent = "not live: no connection";
+  } else if (wasDown) {
+    document.getElementById("rate").textContent = "live";
+  }
+  if (up && wasDown && window.poppy.ready) {
+    refresh(); refreshPrimitives(); refreshMoves();
+    get("/api/v1/web/about").then(showAbout, () => { /* the badge says */ });
+  }
 }
 
 function rateMeter() {
@@ -93,19 +130,15 @@ function rateMeter() {
     const now = performance.now();
     stats.rateHz = ((stats.frames - frames) * 1000) / (now - at);
     frames = stats.frames; at = now;
-    document.getElementById("rate").textContent = `live · ${stats.rateHz.toFixed(0)} updates/s`;
+    if (live) document.getElementById("rate").textContent = `live · ${count(Math.round(stats.rateHz), "update")}/s`;
   }, 2000);
 }
 
 async function main() {
   window.poppy = { stats };
   setupStop();
-  const conn = document.getElementById("conn");
   // the stream opens at once and every first request goes out together: first values sooner
-  openStream(STREAM_HZ, onFrame, (up) => {
-    conn.textContent = up ? "connected" : "disconnected";
-    conn.className = `badge ${up ? "ok" : "bad"}`;
-  });
+  openStream(STREAM_HZ, onFrame, setLive);
   const [about, details] = await Promise.all([
     get("/api/v1/web/about"), get("/api/v1/web/motors?leds=true"),
   ]);

@@ -1,6 +1,6 @@
 // Moves: the library, record (chosen motors), stop and save, play (speed, backwards), delete, plot.
 import { api, get, post } from "./api.js";
-import { button, el, say } from "./ui.js";
+import { button, el, say, secondsText, sizeText } from "./ui.js";
 
 let recording = null;
 const COLOURS = ["#2b6cb0", "#c53030", "#2f855a", "#b7791f", "#6b46c1", "#319795", "#d53f8c", "#4a5568"];
@@ -48,38 +48,66 @@ async function remove(name) {
   refreshMoves();
 }
 
+// Plot area in the SVG's viewBox (600 × 232): time along x, degrees along y.
+const AREA = { left: 44, right: 590, top: 10, bottom: 190 };
+const SVG_NS = "http://www.w3.org/2000/svg";
+
+function svgNode(tag, attributes, text) {
+  const node = document.createElementNS(SVG_NS, tag);
+  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, value);
+  if (text !== undefined) node.textContent = text;
+  return node;
+}
+
+// Ticks for 0..span: a round step (1, 2 or 5 × a power of ten), about six of them.
+export function ticks(span, wanted = 6) {
+  if (!(span > 0)) return { step: 1, values: [0] };
+  const raw = span / wanted;
+  const power = 10 ** Math.floor(Math.log10(raw));
+  const step = [1, 2, 5, 10].map((m) => m * power).find((s) => s >= raw);
+  const values = [];
+  for (let i = 0; i * step <= span * (1 + 1e-9); i += 1) values.push(i * step);
+  return { step, values };
+}
+
+function timeAxis(svg, duration, x) {
+  const { step, values } = ticks(duration);
+  const digits = Math.max(0, -Math.floor(Math.log10(step) + 1e-9));
+  const axis = svgNode("g", { class: "x-axis" });
+  axis.append(svgNode("line", { x1: AREA.left, x2: AREA.right, y1: AREA.bottom, y2: AREA.bottom }));
+  for (const t of values) {
+    const at = x(t).toFixed(1);
+    axis.append(svgNode("line", { x1: at, x2: at, y1: AREA.bottom, y2: AREA.bottom + 4 }),
+      svgNode("text", { x: at, y: AREA.bottom + 17, class: "tick", "data-seconds": String(t) }, t.toFixed(digits)));
+  }
+  axis.append(svgNode("text", { x: (AREA.left + AREA.right) / 2, y: AREA.bottom + 36, class: "label" }, "time (s)"));
+  svg.append(axis);
+}
+
 export async function plot(name) {
   const move = await get(`/api/v1/moves/${name}?positions=true`);
   const svg = document.getElementById("plot-svg");
   const frames = move.positions || [];
   const values = frames.flat();
   const low = Math.min(...values, -1), high = Math.max(...values, 1);
-  const x = (i) => 40 + (550 * i) / Math.max(frames.length - 1, 1);
-  const y = (v) => 190 - (180 * (v - low)) / (high - low);
-  const ns = "http://www.w3.org/2000/svg";
-  svg.replaceChildren();
-  const axis = document.createElementNS(ns, "text");
-  Object.entries({ x: 2, y: 14, class: "axis" }).forEach(([k, v]) => axis.setAttribute(k, v));
-  axis.textContent = `${high.toFixed(0)}°`;
-  const bottom = axis.cloneNode();
-  bottom.setAttribute("y", 195);
-  bottom.textContent = `${low.toFixed(0)}°`;
-  svg.append(axis, bottom);
+  const duration = Math.max(move.duration_s, 0);
+  const x = (t) => AREA.left + ((AREA.right - AREA.left) * t) / (duration || 1);
+  const y = (v) => AREA.bottom - ((AREA.bottom - AREA.top) * (v - low)) / (high - low);
+  svg.replaceChildren(
+    svgNode("text", { x: 2, y: AREA.top + 4, class: "axis" }, `${high.toFixed(0)}°`),
+    svgNode("text", { x: 2, y: AREA.bottom, class: "axis" }, `${low.toFixed(0)}°`));
+  timeAxis(svg, duration, x);
   move.motors.forEach((motor, m) => {
-    const line = document.createElementNS(ns, "polyline");
-    line.setAttribute("points", frames.map((f, i) => `${x(i).toFixed(1)},${y(f[m]).toFixed(1)}`).join(" "));
-    line.setAttribute("stroke", COLOURS[m % COLOURS.length]);
-    line.setAttribute("fill", "none");
-    const title = document.createElementNS(ns, "title");
-    title.textContent = motor;
-    line.append(title);
+    const points = frames.map((f, i) => `${x(i / move.framerate).toFixed(1)},${y(f[m]).toFixed(1)}`);
+    const line = svgNode("polyline", { points: points.join(" "), stroke: COLOURS[m % COLOURS.length], fill: "none" });
+    line.append(svgNode("title", {}, motor));
     svg.append(line);
   });
   svg.setAttribute("aria-label", `positions of ${move.motors.join(", ")} over ${move.duration_s.toFixed(1)} s`);
   const legend = move.motors.map((m, i) =>
     el("span", { className: "swatch", textContent: m, style: `border-color: ${COLOURS[i % COLOURS.length]}` }));
   document.getElementById("plot-title").replaceChildren(
-    `${name} (${move.duration_s.toFixed(1)} s): `, ...legend);
+    `${name} (${secondsText(move.duration_s)}): `, ...legend);
   document.getElementById("plot").hidden = false;
 }
 
@@ -90,7 +118,8 @@ function row(entry, playing) {
   back.setAttribute("aria-label", `${entry.name} backwards`);
   const tr = el("tr", { id: `move-${entry.name}` },
     el("th", { scope: "row", textContent: entry.name + (playing ? " ▶" : "") }),
-    el("td", { className: "num", textContent: `${(entry.size_bytes / 1024).toFixed(1)} kB` }),
+    el("td", { className: "num duration", textContent: entry.duration_s == null ? "unreadable" : secondsText(entry.duration_s) }),
+    el("td", { className: "num size", textContent: sizeText(entry.size_bytes) }),
     el("td", {}, el("label", {}, "×", speed), el("label", {}, back, " backwards"),
       button("play", () => play(entry.name, Number(speed.value), back.checked), `play ${entry.name}`),
       button("stop", async () => { try { await post(`/api/v1/moves/${entry.name}/stop`); } catch (e) { say(e.message, true); } refreshMoves(); }, `stop ${entry.name}`)),

@@ -2,7 +2,13 @@
 import { get, post, put } from "./api.js";
 import { button, el, say } from "./ui.js";
 
-const cards = new Map(); // name -> {state, inputs}
+const cards = new Map(); // name -> {state, inputs, node, actions}
+const ACTIONS = ["start", "pause", "resume", "stop"];
+// What each state allows (poppy_core.motion.primitive: idle, running, paused, stopped, failed)
+const ALLOWED = {
+  idle: ["start"], stopped: ["start"], failed: ["start"],
+  running: ["pause", "stop"], paused: ["resume", "stop"],
+};
 
 function parse(text, old) {
   if (typeof old === "number") return Number(text);
@@ -47,14 +53,13 @@ function card(info) {
     inputs.set(prop, input);
     props.append(el("label", {}, el("span", { textContent: prop }), input));
   }
-  const actions = el("div", { className: "actions" },
-    ...["start", "pause", "resume", "stop"].map((a) =>
-      button(a, () => control(info.name, a), `${a} ${info.name}`)));
+  const buttons = new Map(ACTIONS.map((a) => [a, button(a, () => control(info.name, a), `${a} ${info.name}`)]));
+  const actions = el("div", { className: "actions" }, ...buttons.values());
   const node = el("article", { id: `primitive-${info.name}`, className: "card" },
     el("h3", {}, info.name, " ", state), actions,
     el("details", {}, el("summary", { textContent: "properties" }), props));
   node.dataset.primitive = info.name;
-  cards.set(info.name, { state, inputs, node });
+  cards.set(info.name, { state, inputs, node, buttons });
   return node;
 }
 
@@ -64,6 +69,13 @@ function update(info) {
   found.state.textContent = info.state + (info.error ? ` (error: ${info.error.message ?? ""})` : "");
   found.state.className = `state ${info.state}`;
   found.node.dataset.state = info.state;
+  const allowed = ALLOWED[info.state] ?? ACTIONS; // a state this page does not know: all offered
+  const focused = [...found.buttons.values()].includes(document.activeElement);
+  for (const [action, node] of found.buttons) node.disabled = !allowed.includes(action);
+  // a keyboard user keeps a focus in the card: on the action the new state allows
+  if (focused && document.activeElement?.disabled !== false) {
+    [...found.buttons.values()].find((node) => !node.disabled)?.focus();
+  }
   for (const [prop, input] of found.inputs) {
     if (document.activeElement !== input && prop in info.properties) {
       input.value = show(info.properties[prop]);

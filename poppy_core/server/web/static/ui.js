@@ -24,3 +24,21 @@ export function every(seconds, run) {
   run();
   return setInterval(run, seconds * 1000);
 }
+
+// "1 update", "2 updates": a count and its noun, plural right.
+export function count(n, noun, plural = `${noun}s`) {
+  return `${n} ${n === 1 ? noun : plural}`;
+}
+
+// A size in bytes as the CLI writes it (B, kB, MB: powers of 1000), never split over two lines.
+export function sizeText(bytes) {
+  const NBSP = "\u00a0";
+  if (bytes < 1000) return `${bytes}${NBSP}B`;
+  if (bytes < 1e6) return `${(bytes / 1000).toFixed(1)}${NBSP}kB`;
+  return `${(bytes / 1e6).toFixed(1)}${NBSP}MB`;
+}
+
+// Seconds as the CLI writes a move's duration ("2.98 s"), never split over two lines.
+export function secondsText(seconds) {
+  return `${seconds.toFixed(2)}\u00a0s`;
+}
