@@ -54,7 +54,7 @@ def test_record_save_list_play_stop_delete(
         ("POST", "/records/ghost/delete.json", None, 404),
         ("GET", "/records/ghost/value.json", None, 404),
         ("POST", "/records/ghost/record.json", {"motors": ["m9"]}, 404),
-        ("POST", "/records/bad.name/record.json", None, 400),
+        ("POST", "/records/.bad/record.json", None, 400),
     ],
 )
 def test_record_errors(

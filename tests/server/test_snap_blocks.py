@@ -234,7 +234,7 @@ def test_moves_play_together_and_in_sequence(two_moves: Served) -> None:
         ("/moves/sequentially/first/0", 400, "speed must be above 0"),
         ("/moves/concurrently/first/nan", 400, "speed must be a finite number"),
         ("/moves/concurrently/;/1", 400, "no move given"),
-        ("/moves/sequentially/a.b/1", 400, "not a move name"),
+        ("/moves/sequentially/.b/1", 400, "not a move name"),
         ("/moves/concurrently/first;torso/1", 400, "drives motors this robot lacks: head_z"),
         ("/moves/sequentially/first;torso/1", 400, "drives motors this robot lacks: head_z"),
     ],
