@@ -203,7 +203,9 @@ def reset(
     model: str | None = typer.Option(
         None, "--model", help="Expected model (e.g. MX-28); refused if the motor differs."
     ),
-    rate: int = typer.Option(1_000_000, "--rate", help="Baud rate to set (Poppy: 1000000)."),
+    rate: int = typer.Option(
+        1_000_000, "--target-baud", help="Baud rate to give the motor (Poppy: 1000000)."
+    ),
     limits: str | None = typer.Option(
         None, "--angle-limits", help="Angle limits MIN,MAX in degrees, e.g. -150,150."
     ),
