@@ -113,7 +113,11 @@ def primitives(ctx: typer.Context, incomplete: str) -> Choices:
         from poppy_core.motion.builtins import BUILTINS
 
         names = [(name, "built-in") for name in BUILTINS]
-        kind = _creature_kind(ctx.params)
+        try:
+            kind = _creature_kind(ctx.params)
+        except Exception:  # an unknown profile, a broken config: the built-ins still
+            logger.debug("no creature for completion", exc_info=True)
+            kind = None
         if kind is not None:
             from poppy_core.creatures.registry import CREATURES
 

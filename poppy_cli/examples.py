@@ -51,7 +51,7 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
     "calibrate": (
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0", "zeros and ranges into a user profile"),
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0 --check", "report the drift since"),
-        ("calibrate --profile ergo-jr --sim -m m1,m2 -y -n my-ergo", "two joints, no question"),
+        ("calibrate --profile ergo-jr --sim -m m1,m2 -y -n my-ergo", "two virtual joints"),
     ),
     "teleop": (
         (
@@ -64,15 +64,15 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
             "drive a served robot",
         ),
         (
-            "teleop --leader ergo-jr --leader-port /dev/ttyUSB0 --follower-sim mujoco"
-            " -d 30 --record take -f",
+            "teleop --leader ergo-jr --leader-port /dev/ttyUSB0 --follower ergo-jr"
+            " --follower-sim mujoco -d 30 --record take -f",
             "30 s, saving the follower's move",
         ),
     ),
     "serve": (
         ("serve --http --profile ergo-jr --sim", "the REST API and web page on port 8080"),
         ("serve --snap --open --profile ergo-jr -p /dev/ttyUSB0", "Snap! with the Poppy blocks"),
-        ("serve --http --http-port 9000 --ws --token s3cret --sim", "another port, a token"),
+        ("serve --http --http-port 9000 --ws --token s3cret --profile ergo-jr --sim", "a token"),
     ),
     "motor": (
         ("motor info 3 -p /dev/ttyUSB0", "the whole control table"),
@@ -231,7 +231,7 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
     ),
     "camera detect": (
         ("camera detect", "markers seen by /dev/video0"),
-        ("camera detect --device 1 -w --json", "keep detecting, JSON lines"),
+        ("camera detect --device 1 -w --json", "keep detecting (JSON each time)"),
         ("camera detect --profile ergo-jr --sim mujoco --marker 7", "a simulated marker"),
     ),
 }

@@ -123,19 +123,24 @@ def test_deprecated_spellings_still_work_with_a_warning(
         ("config", "generate"): ["-o", "robot.yaml"], ("camera", "snapshot"): ["-o", "x.png"],
     }.get(alias.command, [])  # fmt: skip
     old = parse([*alias.command, *needed, alias.old, value])
-    assert re.search(rf"warning: `{alias.old}` is deprecated: use `{alias.new}`", capsys.readouterr().err)
+    warning = rf"warning: `{alias.old}` is deprecated: use `{alias.new}`"
+    assert re.search(warning, capsys.readouterr().err)
     new = parse([*alias.command, *needed, alias.new, value])
     assert capsys.readouterr().err == ""
     assert old == new and str(new.params[option.name]) == value
 
 
 def test_record_freq_and_force_are_two_flags() -> None:
+    """`-f` was both `--freq` and `--force` in `record` (`-f 20`: an extra argument)."""
+    record = dict(walk())["record"]
+    assert [o.name for o in options(record) if "-f" in o.opts] == ["force"]
     parsed = parse(["record", "wave", "--freq", "20", "-f"])
     assert parsed.params["freq"] == 20 and parsed.params["force"] is True
 
 
 def test_follower_sim_is_spelled_as_sim() -> None:
-    assert parse(["teleop", "--follower", "ergo-jr", "--follower-sim"]).params["follower_sim"] == "ideal"
+    bare = parse(["teleop", "--follower", "ergo-jr", "--follower-sim"])
+    assert bare.params["follower_sim"] == "ideal"
     parsed = parse(["teleop", "--follower", "ergo-jr", "--follower-sim", "mujoco", "-d", "1"])
     assert parsed.params["follower_sim"] == "mujoco" and parsed.params["duration"] == 1
 

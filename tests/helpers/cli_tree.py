@@ -1,4 +1,4 @@
-"""The `poppy` command tree for tests: every command, and command lines parsed without running them."""
+"""The `poppy` command tree for tests: every command; command lines parsed but not run."""
 
 from __future__ import annotations
 
