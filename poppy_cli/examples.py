@@ -64,9 +64,8 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
             "drive a served robot",
         ),
         (
-            "teleop --leader ergo-jr --leader-port /dev/ttyUSB0 --follower ergo-jr"
-            " --follower-sim mujoco -d 30 --record take -f",
-            "30 s, saving the follower's move",
+            "teleop --follower ergo-jr --follower-sim mujoco -d 30 --record take -f",
+            "the leader of the user settings; 30 s saved as the move take",
         ),
     ),
     "serve": (
@@ -238,15 +237,24 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
 """Command path (words after `poppy`, "" for the root) -> its examples."""
 
 
+ALIGNED_WIDTH = 88
+"""Examples whose lines fit in this width get their purpose on the same line, aligned."""
+
+
 def examples_epilog(path: str) -> str | None:
     """The help's Examples section of command ``path`` (Rich markup), or None when it has none."""
     examples = EXAMPLES.get(path)
     if not examples:
         return None
-    width = max(len(line) for line, _ in examples) + len("$ poppy ")
+    commands = [f"$ poppy {line}" for line, _ in examples]
+    width = max(len(command) for command in commands)
+    aligned = all(width + 4 + len(purpose) <= ALIGNED_WIDTH for _, purpose in examples)
     lines = ["[bold]Examples[/bold]"]
-    for line, purpose in examples:
-        command = f"$ poppy {line}"
-        text = f"{command.ljust(width)}  # {purpose}" if purpose else command
-        lines.append(escape(text))
+    for command, (_, purpose) in zip(commands, examples, strict=True):
+        if not purpose:
+            lines.append(escape(command))
+        elif aligned:
+            lines.append(escape(f"{command.ljust(width)}  # {purpose}"))
+        else:
+            lines += [escape(f"# {purpose}"), escape(command)]
     return "\n".join(lines)
