@@ -25,6 +25,8 @@ FLAGS: dict[str, Flag] = {
     # -- the root group
     "--debug": Flag(None, None, "show tracebacks and debug logs"),
     "--verbose": Flag("-v", None, "show info logs"),
+    "--quiet": Flag("-q", None, "print only errors and the data asked for"),
+    "--version": Flag("-V", None, "print poppy's version and exit"),
     "--install-completion": Flag(None, None, "install shell completion for the current shell"),
     "--show-completion": Flag(None, None, "print the completion script of the current shell"),
     # -- the robot a command drives
