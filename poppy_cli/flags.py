@@ -196,8 +196,10 @@ def _match(token: str, aliases: dict[str, str]) -> tuple[str | None, str, str | 
 
 
 def flag_table_markdown() -> str:
-    """The table of docs/cli.md: one row per long flag, sorted by name."""
-    rows = ["| flag | short | value | meaning |", "|---|---|---|---|"]
+    """The table of docs/cli.md: the short flags, then one row per long flag, sorted by name."""
+    shorts = sorted((flag.short, name) for name, flag in FLAGS.items() if flag.short)
+    index = " · ".join(f"`{short}` `{name}`" for short, name in shorts)
+    rows = [f"Short flags: {index}.", "", "| flag | short | value | meaning |", "|---|---|---|---|"]
     for name in sorted(FLAGS):
         flag = FLAGS[name]
         value = f"`{flag.value}`".replace("|", "\\|") if flag.value else ""
