@@ -62,7 +62,7 @@ def set_id(
 @app.command("set-baudrate")
 def set_baudrate(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
-    rate: int = typer.Argument(..., help="New baud rate in bps, e.g. 1000000."),
+    rate: int = typer.Argument(..., metavar="BPS", help="New baud rate in bps, e.g. 1000000."),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
