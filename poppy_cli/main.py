@@ -21,7 +21,7 @@ from poppy_cli.commands import sim as sim_cmd
 from poppy_cli.commands import snap as snap_cmd
 from poppy_cli.commands import teleop as teleop_cmd
 from poppy_cli.commands import tui as tui_cmd
-from poppy_cli.options import SimArgsGroup
+from poppy_cli.group import PoppyGroup
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
@@ -37,7 +37,7 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     rich_markup_mode="rich",
-    cls=SimArgsGroup,  # `--sim [ideal|mujoco]`: see poppy_cli/options.py
+    cls=PoppyGroup,  # `--sim [mujoco]`, old flag spellings, help pages: see poppy_cli/group.py
 )
 
 
@@ -102,26 +102,31 @@ def _root(
         log_to_stderr()  # warnings, escaped (a motor name may hold terminal escapes)
 
 
-app.command("ports")(ports.ports)
-app.command("scan")(scan.scan)
+# `poppy --help` lists the commands in these panels, in this order.
+START, SETUP, DRIVE, MOVES, SERVE, SIMULATE = (
+    "Start here", "Set up", "Drive", "Moves", "Serve", "Simulate"
+)  # fmt: skip
+
+app.command("demo", rich_help_panel=START)(demo.demo)
+app.command("tui", rich_help_panel=START)(tui_cmd.tui)
+app.command("ports", rich_help_panel=SETUP)(ports.ports)
+app.command("scan", rich_help_panel=SETUP)(scan.scan)
 # motor_setup adds the setup commands to the `poppy motor` group defined in commands/motor.py.
-app.add_typer(motor_setup.app, name="motor")
-app.command("emulate")(emulate.emulate)
-app.command("demo")(demo.demo)
-app.add_typer(config.app, name="config")
+app.add_typer(motor_setup.app, name="motor", rich_help_panel=SETUP)
+app.add_typer(config.app, name="config", rich_help_panel=SETUP)
+app.command("calibrate", rich_help_panel=SETUP)(calibrate_cmd.calibrate)
 # reach_cmd adds `reach` and `where` to the `poppy robot` group defined in commands/robot.py.
-app.add_typer(reach_cmd.app, name="robot")
-app.command("tui")(tui_cmd.tui)
-app.add_typer(primitive_cmd.app, name="primitive")
-app.command("record")(record_cmd.record)
-app.command("play")(play_cmd.play)
-app.add_typer(moves_cmd.app, name="moves")
-app.command("calibrate")(calibrate_cmd.calibrate)
-app.command("teleop")(teleop_cmd.teleop)
-app.command("serve")(serve_cmd.serve)
-app.add_typer(sim_cmd.app, name="sim")
-app.add_typer(snap_cmd.app, name="snap")
-app.add_typer(camera.app, name="camera")
+app.add_typer(reach_cmd.app, name="robot", rich_help_panel=DRIVE)
+app.add_typer(primitive_cmd.app, name="primitive", rich_help_panel=DRIVE)
+app.command("teleop", rich_help_panel=DRIVE)(teleop_cmd.teleop)
+app.add_typer(camera.app, name="camera", rich_help_panel=DRIVE)
+app.command("record", rich_help_panel=MOVES)(record_cmd.record)
+app.command("play", rich_help_panel=MOVES)(play_cmd.play)
+app.add_typer(moves_cmd.app, name="moves", rich_help_panel=MOVES)
+app.command("serve", rich_help_panel=SERVE)(serve_cmd.serve)
+app.add_typer(snap_cmd.app, name="snap", rich_help_panel=SERVE)
+app.command("emulate", rich_help_panel=SIMULATE)(emulate.emulate)
+app.add_typer(sim_cmd.app, name="sim", rich_help_panel=SIMULATE)
 
 
 def usage_line(exc: click.exceptions.UsageError) -> str:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 from typer.core import TyperCommand, TyperGroup
 
+from poppy_cli import complete
 from poppy_core import checks
 from poppy_core.errors import ArgumentError
 
@@ -145,7 +146,7 @@ SIM_ENGINES = ("ideal", "mujoco")
 
 def port_option(help: str = PORT_HELP) -> Any:
     """``--port/-p PORT`` (None when not given; ``default_port`` adds POPPY_PORT)."""
-    return typer.Option(None, "--port", "-p", help=help)
+    return typer.Option(None, "--port", "-p", help=help, autocompletion=complete.ports)
 
 
 def json_option(help: str = "Print JSON instead of a table.") -> Any:
@@ -155,7 +156,7 @@ def json_option(help: str = "Print JSON instead of a table.") -> Any:
 
 def profile_option(help: str, default: str | None = None) -> Any:
     """``--profile NAME``: a robot profile (``poppy_core.robot.profiles``)."""
-    return typer.Option(default, "--profile", help=help)
+    return typer.Option(default, "--profile", help=help, autocompletion=complete.profiles)
 
 
 def _sim_engine(value: str | None) -> str | None:
@@ -165,9 +166,17 @@ def _sim_engine(value: str | None) -> str | None:
     return value
 
 
-def sim_option(help: str) -> Any:
-    """``--sim [mujoco]``: a bare ``--sim`` is ``ideal`` (see ``SimArgsGroup``)."""
-    return typer.Option(None, "--sim", metavar="[mujoco]", callback=_sim_engine, help=help)
+def sim_option(help: str, flag: str = "--sim") -> Any:
+    """``--sim [mujoco]``: a bare ``--sim`` is ``ideal`` (see ``SimArgsGroup``); ``flag``: another
+    name of such an option (``--follower-sim``)."""
+    return typer.Option(
+        None,
+        flag,
+        metavar="[mujoco]",
+        callback=_sim_engine,
+        help=help,
+        autocompletion=complete.engines,
+    )
 
 
 BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP, min=MIN_BAUD, max=MAX_BAUD)
@@ -211,18 +220,29 @@ def _leaf_command(group: TyperGroup, ctx: _click.Context, args: list[str]) -> An
     return None if command is group else command
 
 
-def _sim_takes_value(command: Any) -> bool:
+SIM_FLAGS = ("--sim", "--follower-sim")
+"""The options whose engine may be left out (``--sim``, ``--follower-sim``: ideal)."""
+
+
+def _sim_takes_value(command: Any, flag: str = "--sim") -> bool:
     for param in getattr(command, "params", []):
-        if "--sim" in getattr(param, "opts", []):
+        if flag in getattr(param, "opts", []):
             return not getattr(param, "is_flag", True)
     return False
 
 
-def normalise_sim_args(args: list[str], engines: tuple[str, ...] = SIM_ENGINES) -> list[str]:
+def normalise_sim_args(
+    args: list[str],
+    engines: tuple[str, ...] = SIM_ENGINES,
+    flag: str = "--sim",
+    any_word: bool = False,
+) -> list[str]:
     """``--sim`` alone -> ``--sim=ideal``; ``--sim ENGINE`` -> ``--sim=ENGINE`` (words kept).
 
     So ``--sim`` stays a bare flag in every command line (``poppy robot goto --sim m1=30``)
-    while ``--sim mujoco`` picks the physics engine.
+    while ``--sim mujoco`` picks the physics engine. ``flag`` names another such option;
+    ``any_word``: the command takes no argument, so any word after ``flag`` is its engine (a
+    wrong one is refused by name rather than as an extra argument).
     """
     out: list[str] = []
     index = 0
@@ -230,13 +250,15 @@ def normalise_sim_args(args: list[str], engines: tuple[str, ...] = SIM_ENGINES) 
         token = args[index]
         if token == "--":
             return out + args[index:]
-        if token == "--sim":
+        if token == flag:
             following = args[index + 1] if index + 1 < len(args) else None
-            if following in engines:
-                out.append(f"--sim={following}")
+            if following in engines or (
+                any_word and following is not None and not following.startswith("-")
+            ):
+                out.append(f"{flag}={following}")
                 index += 2
                 continue
-            token = "--sim=ideal"
+            token = f"{flag}=ideal"
         out.append(token)
         index += 1
     return out
@@ -250,8 +272,11 @@ class SimArgsGroup(TyperGroup):
 
     def parse_args(self, ctx: _click.Context, args: list[str]) -> list[str]:
         """Rewrite ``--sim [ENGINE]`` for the command about to run, then parse as usual."""
-        if "--sim" in args and _sim_takes_value(_leaf_command(self, ctx, args)):
-            args = normalise_sim_args(args)
+        for flag in SIM_FLAGS:
+            leaf = _leaf_command(self, ctx, args)
+            if flag in args and _sim_takes_value(leaf, flag):
+                words = not any(p.param_type_name == "argument" for p in leaf.params)
+                args = normalise_sim_args(args, flag=flag, any_word=words)
         return super().parse_args(ctx, args)
 
 

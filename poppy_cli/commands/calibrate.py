@@ -196,7 +196,7 @@ def calibrate(
         None, "--motors", "-m", help="Joints or groups to calibrate, e.g. m1,m2 or base (all)."
     ),
     name: str | None = typer.Option(
-        None, "--name", help="User profile to write (default: the robot's profile name)."
+        None, "--name", "-n", help="User profile to write (default: the robot's profile name)."
     ),
     all_at_once: bool = typer.Option(
         False, "--all-at-once", help="Move every joint through its range in one go."

@@ -25,7 +25,7 @@ app = typer.Typer(
 )
 
 DeviceOpt = typer.Option(
-    None, "--device", "-d", help="Camera index (0 is /dev/video0), device path or video file."
+    None, "--device", help="Camera index (0 is /dev/video0), device path or video file."
 )
 SizeOpt = typer.Option(None, "--resolution", help="WIDTHxHEIGHT, e.g. 640x480.")
 MarkerOpt = typer.Option(

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from poppy_cli import complete
 from poppy_cli.options import BaudOpt, BusPortOpt, JsonOpt, ProtoOpt, default_port, json_option
 from poppy_cli.output import (
     EXIT_FAILURE,
@@ -76,7 +77,11 @@ def convert(
 
 @app.command("show")
 def show(
-    profile: str = typer.Argument(..., help="Profile name (see `poppy config list`) or a file."),
+    profile: str = typer.Argument(
+        ...,
+        help="Profile name (see `poppy config list`) or a file.",
+        autocompletion=complete.profiles,
+    ),
     json_output: bool = json_option("Print the config as JSON."),
     yaml_output: bool = typer.Option(False, "--yaml", help="Print the config as YAML."),
 ) -> None:
@@ -202,7 +207,7 @@ def generate(
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
-    name: str = typer.Option("m", "--name", help="Motor name prefix: <prefix><ID>."),
+    name: str = typer.Option("m", "--prefix", help="Motor name prefix: <prefix><ID>."),
     force: bool = ForceOpt,
 ) -> None:
     """Scan a bus and write a config of the motors found (limits read from the motors)."""

@@ -46,7 +46,7 @@ def emulate(
         "Robot profile: ergo-jr (6 XL-320, ids 1-6), torso, humanoid."
     ),
     motors: str | None = typer.Option(
-        None, "--motors", help="Models and IDs, e.g. MX-28:11-15,AX-12A:36-37."
+        None, "--motors", "-m", help="Models and IDs, e.g. MX-28:11-15,AX-12A:36-37."
     ),
     protocol: int | None = typer.Option(
         None, "--protocol", min=1, max=2, help="Protocol (default: the models')."

@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from poppy_cli import complete
 from poppy_cli.connect import open_bus, ping_model
 from poppy_cli.options import (
     BaudOpt,
@@ -135,7 +136,9 @@ def info(
 @app.command("get")
 def get(
     ids: str = typer.Argument(..., help="Motor ID(s): 11, or 1-6, or 1,3,5."),
-    registers: list[str] = typer.Argument(..., help="Register name(s), e.g. present_position."),
+    registers: list[str] = typer.Argument(
+        ..., help="Register name(s), e.g. present_position.", autocompletion=complete.registers
+    ),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,
@@ -174,7 +177,9 @@ def get(
 @app.command("set", cls=NumbersCommand)
 def set_register(
     ids: str = typer.Argument(..., help="Motor ID(s): 11, or 1-6, or 1,3,5."),
-    register: str = typer.Argument(..., help="Register name, e.g. goal_position."),
+    register: str = typer.Argument(
+        ..., help="Register name, e.g. goal_position.", autocompletion=complete.writable_registers
+    ),
     value: str = typer.Argument(..., help="Value in SI units (degrees, deg/s, %, on/off...)."),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
@@ -252,7 +257,7 @@ def _toggle(
 @app.command("torque")
 def torque(
     ids: str = typer.Argument(..., help="Motor ID(s)."),
-    state: str = typer.Argument(..., help="on or off."),
+    state: str = typer.Argument(..., help="on or off.", autocompletion=complete.on_off),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
     protocol: int | None = ProtoOpt,

@@ -73,7 +73,8 @@ def set_id(
 def set_baudrate(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
     rate: int = typer.Argument(
-        ..., help="New baud rate in bps, e.g. 1000000.", min=MIN_BAUD, max=MAX_BAUD
+        ..., metavar="BPS", help="New baud rate in bps, e.g. 1000000.", min=MIN_BAUD,
+        max=MAX_BAUD,
     ),
     port: str | None = BusPortOpt,
     baud: int | None = BaudOpt,
@@ -247,8 +248,8 @@ def reset(
     ),
     rate: int = typer.Option(
         1_000_000,
-        "--rate",
-        help="Baud rate to set (Poppy: 1000000).",
+        "--target-baud",
+        help="Baud rate to give the motor (Poppy: 1000000).",
         min=MIN_BAUD,
         max=MAX_BAUD,
     ),

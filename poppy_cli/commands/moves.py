@@ -7,6 +7,7 @@ from typing import Any
 
 import typer
 
+from poppy_cli import complete
 from poppy_cli.options import JsonOpt
 from poppy_cli.output import EXIT_USAGE, console, error_line, print_json, styled
 
@@ -16,7 +17,9 @@ app = typer.Typer(
 )
 
 ForceOpt = typer.Option(False, "--force", "-f", help="Replace an existing file.")
-NameArg = typer.Argument(..., help="Library name of the move, or a file path.")
+NameArg = typer.Argument(
+    ..., help="Library name of the move, or a file path.", autocompletion=complete.moves
+)
 
 
 def _header(path: Path) -> dict[str, Any]:

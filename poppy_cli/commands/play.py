@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from poppy_cli import complete
 from poppy_cli.options import (
     ConfigOpt,
     JsonSummaryOpt,
@@ -33,12 +34,14 @@ if TYPE_CHECKING:
 
 
 def play(
-    name: str = typer.Argument(..., help="Library name of the move, or a file path."),
+    name: str = typer.Argument(
+        ..., help="Library name of the move, or a file path.", autocompletion=complete.moves
+    ),
     speed: float = typer.Option(
         1.0, "--speed", "-s", min=0.01, max=100.0, callback=finite, help="2 = twice as fast."
     ),
     reverse: bool = typer.Option(False, "--reverse", "-r", help="Play it backwards."),
-    loop: int = typer.Option(1, "--loop", "-n", min=1, max=10_000, help="Play it this many times."),
+    loop: int = typer.Option(1, "--loop", "-l", min=1, max=10_000, help="Play it this many times."),
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,

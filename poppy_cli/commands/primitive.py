@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from poppy_cli import complete
 from poppy_cli.options import (
     ConfigOpt,
     JsonOpt,
@@ -143,7 +144,9 @@ def _wait(primitive: Primitive, duration: float | None, on_tick: Any) -> None:
 
 @app.command("run")
 def run(
-    name: str = typer.Argument(..., help="Primitive name (see `poppy primitive list`)."),
+    name: str = typer.Argument(
+        ..., help="Primitive name (see `poppy primitive list`).", autocompletion=complete.primitives
+    ),
     duration: float | None = typer.Option(
         None,
         "--duration",

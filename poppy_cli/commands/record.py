@@ -113,7 +113,7 @@ def record(
         None, "--motors", "-m", help="Motors or groups to record, e.g. m1,m2 or base (all)."
     ),
     freq: float = typer.Option(
-        50.0, "--freq", "-f", min=1.0, max=1000.0, callback=finite, help="Frames per s."
+        50.0, "--freq", min=1.0, max=1000.0, callback=finite, help="Frames per s."
     ),
     duration: float | None = typer.Option(
         None,

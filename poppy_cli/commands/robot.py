@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from poppy_cli import complete
 from poppy_cli.options import (
     ConfigOpt,
     JsonOpt,
@@ -194,7 +195,7 @@ def goto(
         help="Seconds to move.",
     ),
     wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),
-    control: str = typer.Option("minjerk", "--control", help="minjerk or dummy."),
+    control: str = typer.Option("minjerk", "--trajectory", help="minjerk or dummy."),
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
@@ -210,7 +211,7 @@ def goto(
     (served by `poppy serve`) moves on its own, so the command waits only with --wait.
     """
     if control not in ("minjerk", "dummy"):
-        raise typer.BadParameter(f"control {control!r} is not minjerk or dummy")
+        raise typer.BadParameter(f"{control!r} is not minjerk or dummy", param_hint="--trajectory")
     robot: Robot | RemoteRobot
     if remote:
         robot = open_remote(remote)
@@ -243,7 +244,11 @@ def goto(
 
 @app.command("compliant")
 def compliant(
-    state: str = typer.Argument(..., help="on (free to move by hand) or off (holds position)."),
+    state: str = typer.Argument(
+        ...,
+        help="on (free to move by hand) or off (holds position).",
+        autocompletion=complete.on_off,
+    ),
     names: list[str] | None = typer.Argument(None, help="Motors or groups (default: all)."),
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,

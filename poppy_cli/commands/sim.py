@@ -12,6 +12,7 @@ from typing import Any
 
 import typer
 
+from poppy_cli import complete
 from poppy_cli.options import finite, profile_option
 from poppy_cli.output import (
     EXIT_FAILURE,
@@ -128,6 +129,7 @@ def sim(
     speed: float = typer.Option(
         1.0,
         "--speed",
+        "-s",
         min=0.01,
         max=1000.0,
         callback=finite,
@@ -264,7 +266,10 @@ def render(
     ),
     profile: str = profile_option("Robot profile to render.", default="ergo-jr"),
     move: str | None = typer.Option(
-        None, "--move", help="Play this move (library name or file) and render it (use a .gif)."
+        None,
+        "--move",
+        help="Play this move (library name or file) and render it (use a .gif).",
+        autocompletion=complete.moves,
     ),
     camera: str | None = typer.Option(
         "front", "--camera", help="Camera of the model ('front'); 'free' for the default view."

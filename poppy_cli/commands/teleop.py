@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from poppy_cli import complete
 from poppy_cli.options import SIM_ENGINES, JsonSummaryOpt, finite
 from poppy_cli.output import EXIT_USAGE, console, err_console, error_line, print_json, styled
 from poppy_core.checks import MAX_DURATION_S
@@ -65,22 +66,36 @@ def _ports_of(config: RobotConfig) -> set[str]:
 
 def teleop(
     leader: str | None = typer.Option(
-        None, "--leader", help="Leader: a profile name or a config file. [default: user settings]"
+        None,
+        "--leader",
+        help="Leader: a profile name or a config file. [default: user settings]",
+        autocompletion=complete.profiles,
     ),
     leader_port: str | None = typer.Option(
-        None, "--leader-port", help="Serial port of the leader's bus. [env: POPPY_PORT]"
+        None,
+        "--leader-port",
+        help="Serial port of the leader's bus. [env: POPPY_PORT]",
+        autocompletion=complete.ports,
     ),
     follower: str = typer.Option(
         ...,
         "--follower",
         help="Follower: a profile name, a config file, http://HOST:PORT of `poppy serve "
         "--http`, or 'self' (the leader copies its own joints, e.g. one arm to the other).",
+        autocompletion=complete.profiles,
     ),
     follower_port: str | None = typer.Option(
-        None, "--follower-port", help="Serial port of the follower's bus."
+        None,
+        "--follower-port",
+        help="Serial port of the follower's bus.",
+        autocompletion=complete.ports,
     ),
     follower_sim: str | None = typer.Option(
-        None, "--follower-sim", metavar="ideal|mujoco", help="Simulate the follower."
+        None,
+        "--follower-sim",
+        metavar="[mujoco]",
+        help="Simulate the follower: --follower-sim (ideal servos) or --follower-sim mujoco.",
+        autocompletion=complete.engines,
     ),
     joint_map: str | None = typer.Option(
         None,
@@ -111,7 +126,9 @@ def teleop(
     record: str | None = typer.Option(
         None, "--record", help="Save the follower's trajectory as a move of this name (or path)."
     ),
-    force: bool = typer.Option(False, "--force", help="Replace an existing move of that name."),
+    force: bool = typer.Option(
+        False, "--force", "-f", help="Replace an existing move of that name."
+    ),
     json_output: bool = JsonSummaryOpt,
 ) -> None:
     """Teleoperate: the leader turns compliant, move it by hand; the follower copies it.

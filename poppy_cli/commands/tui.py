@@ -51,7 +51,7 @@ def tui(
     serve: bool = typer.Option(False, "--serve", help="Serve the app to a web browser."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to serve on (with --serve)."),
     web_port: int = typer.Option(
-        8000, "--web-port", min=1, max=65535, help="TCP port to serve on (with --serve)."
+        8000, "--http-port", min=1, max=65535, help="TCP port to serve on (with --serve)."
     ),
 ) -> None:
     """Herborist's successor: find motors, edit their control table, watch them, drive a robot.

@@ -98,7 +98,7 @@ def test_list_marks_user_profiles(poppy: Any, tmp_path: Path) -> None:
 def test_generate_from_emulator_then_validate(poppy: Any, ergo_jr: Any, tmp_path: Path) -> None:
     out = tmp_path / "found.yaml"
     args = ("config", "generate", "--port", ergo_jr.url, "--baud", "1000000")
-    result = poppy(*args, "--protocol", "2", "--name", "joint", "-o", str(out))
+    result = poppy(*args, "--protocol", "2", "--prefix", "joint", "-o", str(out))
     assert result.code == 0, result.stderr
     validated = poppy("config", "validate", str(out))
     assert validated.code == 0, validated.stderr

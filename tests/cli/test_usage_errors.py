@@ -8,7 +8,7 @@ import pytest
 
 CASES = [
     (("--baud", "0"), "No such option: --baud", "poppy --help"),
-    (("robot", "goto"), "Missing argument 'targets'", "poppy robot goto --help"),
+    (("robot", "goto"), "Missing argument 'TARGETS'", "poppy robot goto --help"),
     (("scan", "--baud", "fast"), "Invalid value for '--baud'", "poppy scan --help"),
     (("moves", "nonsense"), "No such command 'nonsense'", "poppy moves --help"),
     (("robot", "goto", "m1=x", "--sim", "--profile", "ergo-jr"), "'x' is not a number",
@@ -33,7 +33,7 @@ def test_usage_error_is_one_line(
 def test_help_is_unchanged(poppy: Any) -> None:
     result = poppy("robot", "goto", "--help")
     assert result.code == 0
-    assert result.stdout.lstrip().startswith("Usage: poppy robot goto [OPTIONS] {targets}...")
+    assert result.stdout.lstrip().startswith("Usage: poppy robot goto [OPTIONS] TARGETS...")
     assert result.stderr == ""
 
 

@@ -20,7 +20,7 @@ def _free_port() -> int:
 def test_tui_serve_answers_a_browser_on_loopback() -> None:
     port = _free_port()
     proc = subprocess.Popen(
-        [sys.executable, "-m", "poppy_cli", "tui", "--serve", "--sim", "--web-port", str(port)],
+        [sys.executable, "-m", "poppy_cli", "tui", "--serve", "--sim", "--http-port", str(port)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

@@ -1,0 +1,260 @@
+"""The Examples section of every command's help: command lines that work, each with its purpose.
+
+``tests/cli/test_help_pages.py`` checks that every command has examples and that each one parses
+against the command it shows (flags and arguments as they are today).
+"""
+
+from __future__ import annotations
+
+from rich.markup import escape
+
+Example = tuple[str, str]
+"""A command line (without the leading `poppy`) and what it does."""
+
+EXAMPLES: dict[str, tuple[Example, ...]] = {
+    "": (
+        ("demo", "a virtual Ergo Jr: scan it, show it, make it dance"),
+        ("ports", "serial ports and the Dynamixel adapters among them"),
+        ("robot status --profile ergo-jr --sim", "a virtual robot's motors"),
+    ),
+    "ports": (("ports", "every serial port, adapters first"), ("ports --json", "for scripts")),
+    "scan": (
+        ("scan --port /dev/ttyUSB0", "IDs 0-253 at 1 Mbps, protocols 1 and 2"),
+        ("scan -p /dev/ttyUSB0 --all-bauds --ids 1-6", "every standard rate, IDs 1-6"),
+        ("scan -p /dev/ttyUSB0 -b 57600 -b 1000000 --protocol 1 --json", "two rates, JSON"),
+    ),
+    "emulate": (
+        ("emulate --profile ergo-jr", "six virtual XL-320; prints the pty to use as --port"),
+        ("emulate -m MX-28:11-15,AX-12A:36-37 --tcp 127.0.0.1:4000", "any motors, on TCP"),
+        ("emulate --profile ergo-jr --control", "type faults on stdin: unplug 3, drop 0.05"),
+    ),
+    "demo": (
+        ("demo", "the whole tour on a virtual Ergo Jr"),
+        ("demo --quick", "ten times faster"),
+        ("demo --sim mujoco", "the dance with MuJoCo physics"),
+    ),
+    "tui": (
+        ("tui --sim", "a virtual Ergo Jr in the terminal"),
+        ("tui -p /dev/ttyUSB0", "open and scan this bus at start"),
+        ("tui --serve --http-port 8000", "the same app in a web browser"),
+    ),
+    "record": (
+        ("record wave --profile ergo-jr -p /dev/ttyUSB0", "move the arm by hand; Enter stops"),
+        ("record wave --profile ergo-jr --sim -d 5 -f", "5 s, replacing a move named wave"),
+        ("record wave --profile ergo-jr -p /dev/ttyUSB0 -m base --freq 20", "some motors"),
+    ),
+    "play": (
+        ("play wave --profile ergo-jr --sim", "play a move of the library"),
+        ("play wave -s 2 -l 3 --profile ergo-jr -p /dev/ttyUSB0", "twice as fast, 3 times"),
+        ("play ./wave.json -r --remote http://poppy.local:8080", "backwards, on a served robot"),
+    ),
+    "calibrate": (
+        ("calibrate --profile ergo-jr -p /dev/ttyUSB0", "zeros and ranges into a user profile"),
+        ("calibrate --profile ergo-jr -p /dev/ttyUSB0 --check", "report the drift since"),
+        ("calibrate --profile ergo-jr --sim -m m1,m2 -y -n my-ergo", "two virtual joints"),
+    ),
+    "teleop": (
+        (
+            "teleop --leader ergo-jr --leader-port /dev/ttyUSB0 --follower ergo-jr --follower-sim",
+            "a virtual follower copies the real leader",
+        ),
+        (
+            "teleop --leader ergo-jr --leader-port /dev/ttyUSB0"
+            " --follower http://poppy.local:8080 --rate 50",
+            "drive a served robot",
+        ),
+        (
+            "teleop --follower ergo-jr --follower-sim mujoco -d 30 --record take -f",
+            "the leader of the user settings; 30 s saved as the move take",
+        ),
+    ),
+    "serve": (
+        ("serve --http --profile ergo-jr --sim", "the REST API and web page on port 8080"),
+        ("serve --snap --open --profile ergo-jr -p /dev/ttyUSB0", "Snap! with the Poppy blocks"),
+        ("serve --http --http-port 9000 --ws --token s3cret --profile ergo-jr --sim", "a token"),
+    ),
+    "motor": (
+        ("motor info 3 -p /dev/ttyUSB0", "the whole control table"),
+        ("motor get 1-6 present_position -p /dev/ttyUSB0", "read a register of six motors"),
+        ("motor set-id 1 11 -p /dev/ttyUSB0 -b 57600 --protocol 1", "a new ID, verified"),
+    ),
+    "motor info": (
+        ("motor info 3 -p /dev/ttyUSB0", "model, firmware and control table"),
+        ("motor info 3 -p /dev/ttyUSB0 -b 1000000 --protocol 2 --json", "no search; JSON"),
+    ),
+    "motor get": (
+        ("motor get 3 present_position -p /dev/ttyUSB0", "degrees"),
+        ("motor get 1-6 present_position present_temperature -p /dev/ttyUSB0 --json", "JSON"),
+    ),
+    "motor set": (
+        ("motor set 3 torque_enable on -p /dev/ttyUSB0", "stiff"),
+        ("motor set 3 goal_position 30 -p /dev/ttyUSB0", "move (torque must be on)"),
+        ("motor set 1,3,5 moving_speed 60 -p /dev/ttyUSB0", "60 deg/s on three motors"),
+    ),
+    "motor torque": (
+        ("motor torque 1-6 on -p /dev/ttyUSB0", "stiff"),
+        ("motor torque 3 off -p /dev/ttyUSB0", "compliant: move it by hand"),
+    ),
+    "motor led": (
+        ("motor led 1-6 on -p /dev/ttyUSB0", "lights on"),
+        ("motor led 3 green -p /dev/ttyUSB0", "a colour on an XL-320"),
+    ),
+    "motor set-id": (
+        ("motor set-id 1 11 -p /dev/ttyUSB0", "motor 1 becomes 11"),
+        ("motor set-id 1 11 -p /dev/ttyUSB0 -b 57600 --protocol 1", "no search"),
+    ),
+    "motor set-baudrate": (
+        ("motor set-baudrate 11 1000000 -p /dev/ttyUSB0", "1 Mbps, checked at the new rate"),
+    ),
+    "motor set-return-delay": (
+        ("motor set-return-delay 3 0 -p /dev/ttyUSB0", "answer at once (Poppy robots)"),
+    ),
+    "motor angle-limits": (
+        ("motor angle-limits 3 -p /dev/ttyUSB0", "show them"),
+        ("motor angle-limits 3 -p /dev/ttyUSB0 -- -90 90", "set them (`--` before -90)"),
+    ),
+    "motor reboot": (("motor reboot 3 -p /dev/ttyUSB0", "clears a hardware alarm"),),
+    "motor factory-reset": (
+        ("motor factory-reset 3 -p /dev/ttyUSB0", "asks first; keeps ID and baud rate"),
+        ("motor factory-reset 3 --reset-id --reset-baudrate -y -p /dev/ttyUSB0", "everything"),
+    ),
+    "motor reset": (
+        ("motor reset 1 42 -p /dev/ttyUSB0", "a new motor becomes 42, 1 Mbps, delay 0"),
+        ("motor reset 1 42 --model MX-28 --angle-limits -150,150 --zero -p /dev/ttyUSB0", ""),
+        ("motor reset 1 42 --target-baud 57600 -p /dev/ttyUSB0", "another baud rate"),
+    ),
+    "config": (
+        ("config list", "installed and user profiles"),
+        ("config show ergo-jr", "a profile's motors and groups"),
+        ("config generate -p /dev/ttyUSB0 -o my_robot.yaml", "a config of the motors found"),
+    ),
+    "config validate": (("config validate my_robot.yaml", "one line per problem"),),
+    "config convert": (
+        ("config convert poppy_ergo_jr.json ergo.yaml", "pypot JSON to YAML"),
+        ("config convert ergo.yaml ergo.json -f", "back, replacing the file"),
+    ),
+    "config show": (("config show ergo-jr", "a profile"), ("config show my.yaml --json", "JSON")),
+    "config list": (("config list", "profiles"), ("config list --json", "for scripts")),
+    "config generate": (
+        ("config generate -p /dev/ttyUSB0 -o my_robot.yaml", "scan and write"),
+        ("config generate -p /dev/ttyUSB0 -b 1000000 --protocol 2 --prefix joint -o .", ""),
+    ),
+    "robot": (
+        ("robot status --profile ergo-jr --sim", "every motor of a virtual Ergo Jr"),
+        ("robot goto m1=30 m2=-10 -d 2 --profile ergo-jr -p /dev/ttyUSB0", "move two motors"),
+        ("robot compliant off --profile ergo-jr -p /dev/ttyUSB0", "every motor stiff"),
+    ),
+    "robot status": (
+        ("robot status --profile ergo-jr -p /dev/ttyUSB0", "a table of every motor"),
+        ("robot status --profile ergo-jr --sim -w", "refreshed until Ctrl-C"),
+        ("robot status --remote http://poppy.local:8080 --json", "a served robot, JSON"),
+    ),
+    "robot goto": (
+        ("robot goto m1=30 m2=-10 -d 2 --profile ergo-jr -p /dev/ttyUSB0", "arrive together"),
+        ("robot goto m1=0 --trajectory dummy --wait --profile ergo-jr --sim", "a plain jump"),
+        ("robot goto m6=-20 --sim mujoco --profile ergo-jr", "with MuJoCo physics"),
+    ),
+    "robot compliant": (
+        ("robot compliant on --profile ergo-jr -p /dev/ttyUSB0", "move it by hand"),
+        ("robot compliant off m1 m2 --profile ergo-jr -p /dev/ttyUSB0", "two motors stiff"),
+    ),
+    "robot where": (
+        ("robot where --profile ergo-jr --sim", "the tip of each chain"),
+        ("robot where --profile ergo-jr -p /dev/ttyUSB0 --json", "JSON"),
+    ),
+    "robot reach": (
+        ("robot reach 0.1 -0.1 0.12 --profile ergo-jr --sim", "the tip to x, y, z (metres)"),
+        ("robot reach 0.1 0 0.15 --linear -d 2 --wait --profile ergo-jr --sim", "a line"),
+    ),
+    "primitive": (
+        ("primitive list --profile ergo-jr --sim", "what a robot can run"),
+        ("primitive run sinus -d 5 --set amplitude=20 --profile ergo-jr --sim", "a sine"),
+    ),
+    "primitive list": (
+        ("primitive list --profile ergo-jr --sim", "state, properties, last error"),
+        ("primitive list --remote http://poppy.local:8080 --json", "of a served robot"),
+    ),
+    "primitive run": (
+        ("primitive run sinus -d 5 --set amplitude=20 --profile ergo-jr --sim", "5 s of sine"),
+        ("primitive run dance --profile ergo-jr -p /dev/ttyUSB0", "the Ergo Jr's dance"),
+    ),
+    "moves": (
+        ("moves list", "the library"),
+        ("moves show wave", "header and statistics of a move"),
+        ("moves export wave -o wave.json", "in pypot's format"),
+    ),
+    "moves list": (("moves list", "name, motors, duration, size"), ("moves list --json", "")),
+    "moves show": (("moves show wave", "per-motor statistics"), ("moves show ./w.json --json", "")),
+    "moves plot": (("moves plot wave -o wave.png", "each motor against time"),),
+    "moves rm": (("moves rm wave", "asks first"), ("moves rm wave -y", "no question")),
+    "moves export": (
+        ("moves export wave -o wave.json", "pypot's JSON, for old tools"),
+        ("moves export wave -o . --format poppy -f", "poppy's format into this folder"),
+    ),
+    "moves import": (
+        ("moves import mymove.json", "named after the file"),
+        ("moves import mymove.json -n old-wave -f", "another name, replacing it"),
+    ),
+    "sim": (
+        ("sim --profile ergo-jr", "serve the simulated robot's bus (prints its pty)"),
+        ("sim --profile humanoid -s 0.5 --view", "half speed, in MuJoCo's viewer"),
+        ("sim render --profile humanoid -o humanoid.png", "a picture"),
+    ),
+    "sim render": (
+        ("sim render --profile humanoid -o humanoid.png", "a still"),
+        ("sim render --profile ergo-jr --move wave -o wave.gif -f", "a move, as a GIF"),
+        ("sim render --profile ergo-jr --camera free --width 320 --height 240 -o .", ""),
+    ),
+    "snap": (
+        ("snap blocks -o poppy-blocks.xml --profile ergo-jr", "the Poppy blocks"),
+        ("snap project first-steps -o . --profile ergo-jr", "an example project"),
+    ),
+    "snap blocks": (
+        ("snap blocks -o . --profile ergo-jr", "into this folder"),
+        ("snap blocks -o blocks.xml --lang fr --host poppy.local --snap-port 6969", "French"),
+    ),
+    "snap project": (
+        ("snap project first-steps -o . --profile ergo-jr", "a first project"),
+        ("snap project record-replay-fr -o rr.xml --profile ergo-jr -f", "in French"),
+    ),
+    "camera": (
+        ("camera list", "video devices"),
+        ("camera snapshot -o frame.png", "one frame of /dev/video0"),
+        ("camera detect --profile ergo-jr --sim mujoco --marker 7", "markers, in simulation"),
+    ),
+    "camera list": (("camera list", "V4L2 devices and names"), ("camera list --json", "")),
+    "camera snapshot": (
+        ("camera snapshot -o frame.png", "/dev/video0"),
+        ("camera snapshot -o frame.jpg --device 1 --resolution 640x480", "another camera"),
+        ("camera snapshot -o sim.png --profile ergo-jr --sim mujoco --card caribou", "in sim"),
+    ),
+    "camera detect": (
+        ("camera detect", "markers seen by /dev/video0"),
+        ("camera detect --device 1 -w --json", "keep detecting (JSON each time)"),
+        ("camera detect --profile ergo-jr --sim mujoco --marker 7", "a simulated marker"),
+    ),
+}
+"""Command path (words after `poppy`, "" for the root) -> its examples."""
+
+
+ALIGNED_WIDTH = 88
+"""Examples whose lines fit in this width get their purpose on the same line, aligned."""
+
+
+def examples_epilog(path: str) -> str | None:
+    """The help's Examples section of command ``path`` (Rich markup), or None when it has none."""
+    examples = EXAMPLES.get(path)
+    if not examples:
+        return None
+    commands = [f"$ poppy {line}" for line, _ in examples]
+    width = max(len(command) for command in commands)
+    aligned = all(width + 4 + len(purpose) <= ALIGNED_WIDTH for _, purpose in examples)
+    lines = ["[bold]Examples[/bold]"]
+    for command, (_, purpose) in zip(commands, examples, strict=True):
+        if not purpose:
+            lines.append(escape(command))
+        elif aligned:
+            lines.append(escape(f"{command.ljust(width)}  # {purpose}"))
+        else:
+            lines += [escape(f"# {purpose}"), escape(command)]
+    return "\n".join(lines)
