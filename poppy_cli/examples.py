@@ -135,6 +135,16 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
     ),
     "config show": (("config show ergo-jr", "a profile"), ("config show my.yaml --json", "JSON")),
     "config list": (("config list", "profiles"), ("config list --json", "for scripts")),
+    "config set": (
+        ("config set profile ergo-jr", "the default robot of every command"),
+        ("config set port /dev/ttyUSB0", "its default serial port"),
+    ),
+    "config get": (("config get profile", "one setting"), ("config get --json", "all of them")),
+    "config unset": (("config unset port", "back to no default port"),),
+    "config path": (
+        ("config path", "where the settings and profiles live"),
+        ("config path ergo-jr --json", "the file a profile resolves to"),
+    ),
     "config generate": (
         ("config generate -p /dev/ttyUSB0 -o my_robot.yaml", "scan and write"),
         ("config generate -p /dev/ttyUSB0 -b 1000000 --protocol 2 --prefix joint -o .", ""),
