@@ -118,7 +118,7 @@ def test_deprecated_spellings_still_work_with_a_warning(
     assert alias.old not in visible and alias.new in visible
     option = next(o for o in options(command) if alias.new in o.opts)
     # a number within the option's range (a baud rate is 1200 bps at least, a loop count 2)
-    value = ("57600" if "baud" in option.name else "2") if _kind(option) == "number" else "dummy"
+    value = ("57600" if "baud" in alias.new else "2") if _kind(option) == "number" else "dummy"
     needed = {
         ("robot", "goto"): ["m1=1"], ("play",): ["wave"], ("motor", "reset"): ["1", "2"],
         ("config", "generate"): ["-o", "robot.yaml"], ("camera", "snapshot"): ["-o", "x.png"],
