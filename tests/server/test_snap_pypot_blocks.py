@@ -31,7 +31,8 @@ HOST = "127.0.0.1"
 NOT_THIS_SERVER = {"{host}/services.php?python=restart", "{host}/reset"}
 """pypot's "reset robot" also calls the Raspberry Pi's web page (port 80), not the Snap! server."""
 
-COLOURS = ("red", "green", "blue", "off")
+# the menu of pypot's "set LED" block (pypot-snap-blocks.xml): every XL-320 colour
+COLOURS = ("off", "red", "green", "yellow", "blue", "pink", "cyan", "white")
 REGISTER_VALUES = {
     # the values pypot's blocks send: "set motor(s) compliant/stiff" sends 1/0
     "compliant": (("1", True), ("True", True), ("0", False), ("False", False), ("false", False)),
