@@ -15,6 +15,7 @@ from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, DataTable, Static
 
+from poppy_cli.tui.text import fixed, set_cell
 from poppy_core.errors import CalibrationCancelled, PoppyError
 
 if TYPE_CHECKING:
@@ -165,8 +166,8 @@ class CalibrationScreen(ModalScreen[str | None]):
 
     @staticmethod
     def _range_cells(reading: Any) -> tuple[str, ...]:
-        return (reading.motor, f"{reading.current:.1f}", f"{reading.low:.1f}",
-                f"{reading.high:.1f}", f"{reading.span:.1f}")  # fmt: skip
+        return (reading.motor, fixed(reading.current), fixed(reading.low),
+                fixed(reading.high), fixed(reading.span))  # fmt: skip
 
     def _refresh_ranges(self) -> None:
         if self._watch is None:
@@ -174,7 +175,7 @@ class CalibrationScreen(ModalScreen[str | None]):
         table = self.query_one("#calibration-ranges", DataTable)
         for reading in self._watch.readings():
             for column, text in zip(RANGE_COLUMNS, self._range_cells(reading), strict=True):
-                table.update_cell(reading.motor, column, text)
+                set_cell(table, reading.motor, column, text)
 
     def _review(self, calibration: Calibration) -> None:
         from poppy_core.robot.profile_store import user_profile_path
