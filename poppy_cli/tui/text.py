@@ -17,6 +17,12 @@ def fixed(value: float, digits: int = 1, width: int = 0) -> str:
     return text.rjust(width)
 
 
+def short(value: float) -> str:
+    """``value`` in the shortest form (``{:g}``: 30, 2.5, 0.125); -0.0 prints as 0."""
+    text = f"{value:g}"
+    return "0" if text == "-0" else text
+
+
 def set_cell(table: DataTable[str], row: str, column: str, text: str) -> None:
     """Show ``text`` in a cell, widening its column when it is longer (never cut: ``stopped``
     shown as ``stopp`` under a column sized for ``idle``); a column never shrinks back, so

@@ -14,7 +14,7 @@ from textual.widgets._tabbed_content import ContentTabs  # noqa: TID253  (a TUI 
 from poppy_cli.tui.app import PoppyApp, make_app
 from poppy_cli.tui.busio import LiveValues
 from poppy_cli.tui.messages import LiveSampled
-from poppy_cli.tui.text import fixed
+from poppy_cli.tui.text import fixed, short
 from poppy_cli.tui.widgets.control_table import ControlTable, format_value
 from poppy_cli.tui.widgets.live import LivePanel
 from poppy_cli.tui.widgets.motor_tree import MotorTree
@@ -165,6 +165,7 @@ def test_numbers_never_show_a_negative_zero() -> None:
     assert fixed(-0.0) == "0.0" and fixed(-0.04) == "0.0" and fixed(-0.0, 0) == "0"
     assert fixed(-0.06) == "-0.1" and fixed(-0.4, 0) == "0" and fixed(-0.6, 0) == "-1"
     assert format_value(-0.0, "°") == "0.0 °"
+    assert short(-0.0) == "0" and short(-2.5) == "-2.5" and short(30.0) == "30"
 
 
 @run_async

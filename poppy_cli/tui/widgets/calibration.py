@@ -15,7 +15,7 @@ from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, DataTable, Static
 
-from poppy_cli.tui.text import fixed, set_cell
+from poppy_cli.tui.text import fixed, set_cell, short
 from poppy_core.errors import CalibrationCancelled, PoppyError
 
 if TYPE_CHECKING:
@@ -51,7 +51,8 @@ class ScreenAnswers:
         if posture.image is not None:
             text += f"\n\npicture: {posture.image}"
         if posture.positions:
-            text += "\n\nangles: " + ", ".join(f"{m} {v:g}°" for m, v in posture.positions.items())
+            angles = ", ".join(f"{m} {short(v)}°" for m, v in posture.positions.items())
+            text += f"\n\nangles: {angles}"
         text += f"\n\n{', '.join(motors)} are compliant: put the robot in this posture."
         return self._ask(lambda: self.screen.show_step("Reference posture", text))
 
@@ -194,8 +195,9 @@ class CalibrationScreen(ModalScreen[str | None]):
             old_limit, new_limit = change["angle_limit"]
             table.add_row(
                 motor,
-                f"{old_offset:g} → {new_offset:g}",
-                f"{old_limit[0]:g}…{old_limit[1]:g} → {new_limit[0]:g}…{new_limit[1]:g}",
+                f"{short(old_offset)} → {short(new_offset)}",
+                f"{short(old_limit[0])}…{short(old_limit[1])} → "
+                f"{short(new_limit[0])}…{short(new_limit[1])}",
                 key=motor,
             )
         self.query_one("#calibration-title", Static).update(Text("Review", style="bold"))

@@ -64,7 +64,8 @@ class LivePanel(Vertical):
 
     def show_goal(self, goal_deg: float | None, limits: tuple[float, float], state: str) -> None:
         """Show the dial's goal, the angle limits and torque/LED state."""
-        goal = "?" if goal_deg is None else f"{goal_deg:.1f}°"
+        goal = "?" if goal_deg is None else f"{fixed(goal_deg)}°"
+        low, high = fixed(limits[0], 0), fixed(limits[1], 0)
         self.query_one("#live-goal", Static).update(
-            f"goal {goal}  ←/→ ±1° ⇧ ±10°\nlimits {limits[0]:.0f}°..{limits[1]:.0f}°\n{state}"
+            f"goal {goal}  ←/→ ±1° ⇧ ±10°\nlimits {low}°..{high}°\n{state}"
         )

@@ -14,7 +14,7 @@ from textual.widgets import Button, Checkbox, DataTable, Input, Select, TabbedCo
 
 from poppy_cli.targets import parse_targets
 from poppy_cli.tui.messages import BusFailed, RobotOpened
-from poppy_cli.tui.text import fixed, set_cell
+from poppy_cli.tui.text import fixed, set_cell, short
 from poppy_cli.tui.widgets.chains import ChainsPanel
 from poppy_cli.tui.widgets.moves import MovesPanel
 from poppy_cli.tui.widgets.primitives import PrimitivesPanel
@@ -234,7 +234,7 @@ class RobotPanel(Vertical):
         except (PoppyError, ValueError) as exc:
             self.notify(str(exc), severity="error")
             return
-        self.notify(f"goto {', '.join(f'{n}={v:g}°' for n, v in targets.items())}")
+        self.notify(f"goto {', '.join(f'{n}={short(v)}°' for n, v in targets.items())}")
 
     def toggle_compliant(self) -> None:
         """Toggle the compliance of the motor under the cursor."""
