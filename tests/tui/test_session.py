@@ -33,7 +33,9 @@ NEGATIVE_ZERO = re.compile(r"(?<![\d.])-0(\.0+)?(?![\d.])")
 
 
 def screen_lines(app: PoppyApp) -> list[str]:
-    """The screen as the terminal shows it, one string per line."""
+    """The screen as the terminal shows it, one string per line. Notifications are dismissed
+    first (a toast covers the right of the lines it floats over; the next frame is without)."""
+    app.clear_notifications()
     return [strip.text for strip in app.screen._compositor.render_strips()]
 
 
@@ -46,6 +48,13 @@ def line_with(app: PoppyApp, word: str) -> str:
 def shown(app: PoppyApp, word: str) -> str:
     """The first screen line with ``word`` ("" when none: for waits)."""
     return next((line for line in screen_lines(app) if word in line), "")
+
+
+async def see(pilot: Any, app: PoppyApp, word: str, pattern: str) -> None:
+    """Wait until the screen line with ``word`` matches ``pattern``."""
+    await wait_for(
+        pilot, lambda: re.search(pattern, shown(app, word)) is not None, what=f"{pattern!r}"
+    )
 
 
 def footer(app: PoppyApp) -> str:
@@ -146,6 +155,18 @@ async def test_control_table_shows_the_live_values(xl320_server: Endpoint) -> No
 
 
 @run_async
+async def test_control_table_columns_fit_80_columns(xl320_server: Endpoint) -> None:
+    app = bus_session(xl320_server)
+    async with app.run_test(size=SIZE) as pilot:
+        screen = app.main
+        await wait_for(pilot, lambda: screen.last_scan is not None, what="scan")
+        await open_motor(pilot, screen, 1)
+        # Memory and the read-only mark are shown whole (not "EEPRO", no mark cut off).
+        await see(pilot, app, "model_number", r"model_number +350 +EEPROM +ro\b")
+        await see(pilot, app, "torque_enable", r"torque_enable +off +RAM +│")
+
+
+@run_async
 async def test_live_plot_shows_its_scale(xl320_server: Endpoint) -> None:
     app = bus_session(xl320_server)
     async with app.run_test(size=SIZE) as pilot:
@@ -157,8 +178,8 @@ async def test_live_plot_shows_its_scale(xl320_server: Endpoint) -> None:
             panel.post_message(LiveSampled(panel.motor, LiveValues(position, 0, 0, 35, 7.4)))
         await wait_for(pilot, lambda: "10.0 °" in shown(app, "position "), what="samples")
         # The sparkline spans the lowest to the highest position plotted: both are written.
-        assert re.search(r"max +15\.0 °", line_with(app, "max ")), line_with(app, "max ")
-        assert re.search(r"min +3\.0 °", line_with(app, "min ")), line_with(app, "min ")
+        await see(pilot, app, "max ", r"max +15\.0 °")
+        await see(pilot, app, "min ", r"min +3\.0 °")
 
 
 def test_numbers_never_show_a_negative_zero() -> None:
@@ -183,7 +204,9 @@ async def test_no_negative_zero_on_the_robot_and_motor_tabs(xl320_server: Endpoi
         motor = await open_motor(pilot, app.main, 1)
         assert motor.motor is not None
         motor.post_message(LiveSampled(motor.motor, LiveValues(-0.0, -0.0, -0.04, 35, 7.4)))
-        await wait_for(pilot, lambda: "°/s" in shown(app, "speed "), what="a sample")
+        await see(pilot, app, "speed ", "°/s")
+        await see(pilot, app, "load ", " %")
+        await see(pilot, app, "position ", " °")
         for word in ("position ", "speed ", "load "):
             assert not NEGATIVE_ZERO.search(line_with(app, word)), line_with(app, word)
 
@@ -228,8 +251,8 @@ async def test_toggles_show_a_mark_not_only_a_colour(xl320_server: Endpoint) -> 
         screen = app.main
         await wait_for(pilot, lambda: screen.last_scan is not None, what="scan")
         await pilot.pause(0.1)
-        assert "▐X▌" in line_with(app, "1,000,000 bps")  # ticked (--baud 1000000)
-        assert "▐ ▌" in line_with(app, "  500,000 bps")  # not ticked
+        await see(pilot, app, "1,000,000 bps", "▐X▌")  # ticked (--baud 1000000)
+        await see(pilot, app, "  500,000 bps", "▐ ▌")  # not ticked
         await pilot.press("f3")
         await wait_for(pilot, lambda: "▐ ▌ sim" in shown(app, " sim "), what="sim unticked")
         screen.query_one("#robot-sim", Checkbox).value = True

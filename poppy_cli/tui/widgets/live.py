@@ -57,7 +57,7 @@ class LivePanel(Vertical):
         self.query_one("#live-plot", Sparkline).data = list(self.history)
         # The sparkline spans the lowest to the highest value plotted: say which they are.
         high, low = max(self.history), min(self.history)
-        self.query_one("#live-max", Static).update(f"max {fixed(high, 1, 7)} °  position")
+        self.query_one("#live-max", Static).update(f"max {fixed(high, 1, 7)} °")
         self.query_one("#live-min", Static).update(
             f"min {fixed(low, 1, 7)} °  last {len(self.history)}"
         )
@@ -67,5 +67,5 @@ class LivePanel(Vertical):
         goal = "?" if goal_deg is None else f"{fixed(goal_deg)}°"
         low, high = fixed(limits[0], 0), fixed(limits[1], 0)
         self.query_one("#live-goal", Static).update(
-            f"goal {goal}  ←/→ ±1° ⇧ ±10°\nlimits {low}°..{high}°\n{state}"
+            f"goal {goal}\n←/→ ±1°  ⇧ ±10°\nlimits {low}°..{high}°\n{state}"
         )

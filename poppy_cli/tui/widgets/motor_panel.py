@@ -218,7 +218,7 @@ class MotorPanel(Horizontal):
         low, high = self._limits()
         torque = self.value("torque_enable")
         led = self.value("led")
-        state = f"torque {format_value(torque, '')} (t)  led {format_value(led, '')} (l)"
+        state = f"torque {format_value(torque, '')} (t)\nled    {format_value(led, '')} (l)"
         self.query_one(LivePanel).show_goal(self.goal_deg, (low, high), state)
 
     def _limits(self) -> tuple[float, float]:
