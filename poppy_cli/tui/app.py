@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from textual import on
 from textual.app import App
@@ -13,13 +13,14 @@ from textual.binding import Binding, BindingType
 from textual.notifications import SeverityLevel
 
 from poppy_cli.tui.busio import BusPool
-from poppy_cli.tui.messages import BusFailed
+from poppy_cli.tui.messages import BusFailed, RobotOpened
 from poppy_cli.tui.screens.main import MainScreen
 from poppy_cli.tui.widgets.motor_tree import MotorTree
 from poppy_cli.tui.widgets.ports import PortLister, PortsPanel
 from poppy_cli.tui.widgets.robot_panel import RobotPanel
 from poppy_cli.tui.widgets.scan import ScanPanel
 from poppy_core.bus import PortInfo, list_ports
+from poppy_core.emulator.link import SCHEME as LINK_SCHEME
 
 logger = logging.getLogger(__name__)
 
@@ -57,7 +58,8 @@ class PoppyApp(App[None]):
         self.port_lister = port_lister
         self.live_period_s = live_period_s
         self.robot_source = robot_source
-        self.emulator: Any = None
+        self.scan_robot = False
+        """Scan the buses of the robot opened at start (``sim``): one robot per session."""
         self.main = MainScreen(self.pool, port_lister, live_period_s)
 
     def on_mount(self) -> None:
@@ -70,24 +72,46 @@ class PoppyApp(App[None]):
             ports.add_virtual(url, select=False)
         baudrates = [self.start_baudrate] if self.start_baudrate else None
         protocols = [self.start_protocol] if self.start_protocol else None
-        port = self.start_port
-        if self.sim:
-            from poppy_core.emulator import ergo_jr_bus, serve_link
+        robot = self.robot_source
+        if self.sim and robot is None:
+            robot = "ergo-jr"
+        if robot is not None:
+            # The Bus and Motor tabs then scan this robot's own virtual buses (``_robot_opened``):
+            # a dance started in the Robot tab is what the Motor tab shows.
+            self.scan_robot = self.start_port is None
+            self.main.query_one(RobotPanel).open(robot, self.sim)
+        if self.start_port is not None:
+            self.scan_at_start([self.start_port], baudrates, protocols)
 
-            self.emulator = serve_link(ergo_jr_bus())
-            port, baudrates, protocols = self.emulator.url, [1_000_000], [2]
-            self.main.query_one(RobotPanel).open("ergo-jr", True)
-        if self.robot_source is not None:
-            self.main.query_one(RobotPanel).open(self.robot_source, self.sim)
-        if port is None:
-            return
-        ports.add_virtual(port)
+    def scan_at_start(
+        self, ports: list[str], baudrates: list[int] | None, protocols: list[int] | None
+    ) -> None:
+        """List ``ports`` in the Bus tab, scan them and focus the motor tree."""
         panel = self.main.query_one(ScanPanel)
+        for port in ports:
+            self.main.query_one(PortsPanel).add_virtual(port)
         panel.set_choice(baudrates, protocols)
         request = panel.request()
         if not isinstance(request, str):
-            self.main.start_scan([port], request)
+            self.main.start_scan(ports, request)
         self.main.query_one(MotorTree).focus()
+
+    @on(RobotOpened)
+    def _robot_opened(self, message: RobotOpened) -> None:
+        """Scan the buses of the robot opened at start that are linked in this process (its
+        emulators): a real serial port is left to the robot, which holds it."""
+        if not self.scan_robot:
+            return
+        self.scan_robot = False
+        buses = [
+            bus for bus in message.robot.buses.values() if bus.port.startswith(f"{LINK_SCHEME}://")
+        ]
+        if buses:
+            self.scan_at_start(
+                [bus.port for bus in buses],
+                sorted({bus.baudrate for bus in buses}),
+                sorted({bus.protocol for bus in buses}),
+            )
 
     def notify(
         self,
@@ -109,8 +133,6 @@ class PoppyApp(App[None]):
     def on_unmount(self) -> None:
         self.main.abort_event.set()
         self.pool.close()
-        if self.emulator is not None:
-            self.emulator.stop()
 
 
 def make_app(
@@ -130,7 +152,8 @@ def make_app(
         port: a bus to open straight away (it is scanned at start).
         baudrate: the rate to scan ``port`` at (None: every standard rate).
         protocol: the protocol to scan ``port`` in (None: both).
-        sim: start an in-process virtual Ergo Jr (pty bus scanned at start, robot tab opened).
+        sim: open a virtual Ergo Jr in the Robot tab (``robot_source`` when given: its motors
+            served by emulators) and scan its buses in the Bus tab: one robot for every tab.
         virtual_ports: extra virtual buses listed (pty paths, ``socket://`` URLs).
         port_lister: lists the serial ports (tests pass fixed data); None uses ``list_ports``.
         live_period_s: live view period; 0 turns the live view off.

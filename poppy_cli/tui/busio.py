@@ -77,6 +77,17 @@ class LiveValues:
     temperature_c: float
     voltage_v: float
 
+    def registers(self) -> dict[str, float]:
+        """Register name (``LIVE_REGISTERS``) -> its value in this sample."""
+        values = (
+            self.position_deg,
+            self.speed_dps,
+            self.load_percent,
+            self.temperature_c,
+            self.voltage_v,
+        )
+        return dict(zip(LIVE_REGISTERS, values, strict=True))
+
 
 class BusPool:
     """One open transport per port, shared by every operation, one operation at a time.

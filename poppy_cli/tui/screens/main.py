@@ -31,14 +31,22 @@ TAB_FOCUS = {"bus": "#tree", "motor": "#control-table", "robot": "#robot-table"}
 VIRTUAL_SCAN_LATENCY_S = 0.005
 
 
+class BusView(Horizontal):
+    """The Bus tab: the motor tree, then ports and scan options (ctrl+s shown in its footer)."""
+
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("ctrl+s", "screen.scan", "Scan")]
+
+
 class MainScreen(Screen[None]):
     """Three tabs; the bus work runs in thread workers and reports with messages."""
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("f1", "tab('bus')", "Bus"),
-        Binding("f2", "tab('motor')", "Motor"),
-        Binding("f3", "tab('robot')", "Robot"),
-        Binding("ctrl+s", "scan", "Scan"),
+        # The tab labels show F1-F3 (the footer has no room for them at 80 columns).
+        Binding("f1", "tab('bus')", "Bus", show=False),
+        Binding("f2", "tab('motor')", "Motor", show=False),
+        Binding("f3", "tab('robot')", "Robot", show=False),
+        Binding("tab", "app.focus_next", "Next"),
+        Binding("ctrl+s", "scan", "Scan", show=False),  # shown by the Bus tab (BusView)
         Binding("escape", "abort", "Abort scan", show=False),
     ]
 
@@ -56,16 +64,17 @@ class MainScreen(Screen[None]):
     def compose(self) -> ComposeResult:
         yield Header()
         with TabbedContent(initial="bus", id="tabs"):
-            with TabPane("Bus", id="bus"), Horizontal():
-                with VerticalScroll(id="bus-left"):
+            # The tree first: one Tab from the tab bar reaches it (focus goes left to right).
+            with TabPane("Bus F1", id="bus"), BusView():
+                yield MotorTree(id="tree")
+                with VerticalScroll(id="bus-side"):
                     yield PortsPanel(self.lister, id="ports")
                     yield ScanPanel(id="scan-panel")
-                yield MotorTree(id="tree")
-            with TabPane("Motor", id="motor"):
+            with TabPane("Motor F2", id="motor"):
                 yield MotorPanel(self.pool, self.live_period_s, id="motor-panel")
-            with TabPane("Robot", id="robot"):
+            with TabPane("Robot F3", id="robot"):
                 yield RobotPanel(id="robot-panel")
-        yield Footer()
+        yield Footer(compact=True)
 
     def action_tab(self, tab: str) -> None:
         """Show a tab and focus its main widget (focus left in a hidden tab would pull it back)."""

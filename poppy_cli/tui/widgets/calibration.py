@@ -15,6 +15,7 @@ from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, DataTable, Static
 
+from poppy_cli.tui.text import fixed, set_cell, short
 from poppy_core.errors import CalibrationCancelled, PoppyError
 
 if TYPE_CHECKING:
@@ -50,7 +51,8 @@ class ScreenAnswers:
         if posture.image is not None:
             text += f"\n\npicture: {posture.image}"
         if posture.positions:
-            text += "\n\nangles: " + ", ".join(f"{m} {v:g}°" for m, v in posture.positions.items())
+            angles = ", ".join(f"{m} {short(v)}°" for m, v in posture.positions.items())
+            text += f"\n\nangles: {angles}"
         text += f"\n\n{', '.join(motors)} are compliant: put the robot in this posture."
         return self._ask(lambda: self.screen.show_step("Reference posture", text))
 
@@ -165,8 +167,8 @@ class CalibrationScreen(ModalScreen[str | None]):
 
     @staticmethod
     def _range_cells(reading: Any) -> tuple[str, ...]:
-        return (reading.motor, f"{reading.current:.1f}", f"{reading.low:.1f}",
-                f"{reading.high:.1f}", f"{reading.span:.1f}")  # fmt: skip
+        return (reading.motor, fixed(reading.current), fixed(reading.low),
+                fixed(reading.high), fixed(reading.span))  # fmt: skip
 
     def _refresh_ranges(self) -> None:
         if self._watch is None:
@@ -174,7 +176,7 @@ class CalibrationScreen(ModalScreen[str | None]):
         table = self.query_one("#calibration-ranges", DataTable)
         for reading in self._watch.readings():
             for column, text in zip(RANGE_COLUMNS, self._range_cells(reading), strict=True):
-                table.update_cell(reading.motor, column, text)
+                set_cell(table, reading.motor, column, text)
 
     def _review(self, calibration: Calibration) -> None:
         from poppy_core.robot.profile_store import user_profile_path
@@ -193,8 +195,9 @@ class CalibrationScreen(ModalScreen[str | None]):
             old_limit, new_limit = change["angle_limit"]
             table.add_row(
                 motor,
-                f"{old_offset:g} → {new_offset:g}",
-                f"{old_limit[0]:g}…{old_limit[1]:g} → {new_limit[0]:g}…{new_limit[1]:g}",
+                f"{short(old_offset)} → {short(new_offset)}",
+                f"{short(old_limit[0])}…{short(old_limit[1])} → "
+                f"{short(new_limit[0])}…{short(new_limit[1])}",
                 key=motor,
             )
         self.query_one("#calibration-title", Static).update(Text("Review", style="bold"))

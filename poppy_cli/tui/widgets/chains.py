@@ -12,6 +12,7 @@ from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Input, Label
 
+from poppy_cli.tui.text import fixed, set_cell
 from poppy_core.errors import PoppyError
 
 if TYPE_CHECKING:
@@ -90,8 +91,8 @@ class ChainsPanel(Vertical):
     def _cells(self, name: str) -> tuple[str, ...]:
         pose = self.chains[name].pose
         x, y, z = (1000.0 * float(v) for v in pose[:3, 3])
-        axis = ", ".join(f"{float(v):.2f}" for v in pose[:3, 0])
-        return name, f"{x:.1f}", f"{y:.1f}", f"{z:.1f}", axis
+        axis = ", ".join(fixed(float(v), 2) for v in pose[:3, 0])
+        return name, fixed(x), fixed(y), fixed(z), axis
 
     def poll(self) -> None:
         """Show where the tips are now (forward kinematics of the cached positions; no I/O)."""
@@ -100,7 +101,7 @@ class ChainsPanel(Vertical):
         table = self.query_one("#chain-table", DataTable)
         for name in self.chains:
             for column, text in zip(CHAIN_COLUMNS, self._cells(name), strict=True):
-                table.update_cell(name, column, text)
+                set_cell(table, name, column, text)
 
     def selected(self) -> str | None:
         """The chain under the cursor (the first one when the table has no cursor yet)."""

@@ -11,6 +11,7 @@ from textual.message import Message
 from textual.widgets import DataTable
 
 from poppy_cli.tui.busio import RegisterValue, SIValue
+from poppy_cli.tui.text import fixed, set_cell
 
 COLUMNS = ("addr", "register", "value", "mem", "")
 
@@ -21,7 +22,7 @@ def format_value(value: SIValue | None, unit: str) -> str:
         return "?"
     if isinstance(value, bool):
         return "on" if value else "off"
-    text = f"{value:.1f}" if isinstance(value, float) else str(value)
+    text = fixed(value) if isinstance(value, float) else str(value)
     return f"{text} {unit}".rstrip()
 
 
@@ -29,8 +30,10 @@ class ControlTable(DataTable[str]):
     """Address, name, SI value with unit, EEPROM/RAM, read-only mark. Enter edits a row."""
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("left", "dial(-1)", "Goal -1°"),
-        Binding("right", "dial(1)", "Goal +1°"),
+        Binding("enter", "select_cursor", "Edit"),
+        # The live panel shows the dial and its keys (←/→ ±1°, shift ±10°): no footer room.
+        Binding("left", "dial(-1)", "Goal -1°", show=False),
+        Binding("right", "dial(1)", "Goal +1°", show=False),
         Binding("shift+left", "dial(-10)", "-10°", show=False),
         Binding("shift+right", "dial(10)", "+10°", show=False),
     ]
@@ -55,7 +58,7 @@ class ControlTable(DataTable[str]):
         self.values = {row.register.name: row for row in rows}
         if same:
             for row in rows:
-                self.update_cell(row.register.name, "value", self._text(row))
+                set_cell(self, row.register.name, "value", self._text(row))
             return
         cursor = self.cursor_row
         self.clear()
@@ -78,7 +81,7 @@ class ControlTable(DataTable[str]):
         if row is None:
             return
         self.values[name] = RegisterValue(row.register, value)
-        self.update_cell(name, "value", self._text(self.values[name]))
+        set_cell(self, name, "value", self._text(self.values[name]))
 
     @staticmethod
     def _text(row: RegisterValue) -> str:

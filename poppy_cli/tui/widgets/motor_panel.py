@@ -46,7 +46,7 @@ class MotorPanel(Horizontal):
         Binding("l", "led", "LED"),
         Binding("r", "reread", "Re-read"),
         Binding("b", "restart('reboot')", "Reboot"),
-        Binding("f", "restart('reset')", "Factory reset"),
+        Binding("f", "restart('reset')", "Reset"),
     ]
 
     def __init__(self, pool: BusPool, live_period_s: float, *, id: str | None = None) -> None:
@@ -178,8 +178,20 @@ class MotorPanel(Horizontal):
     @on(LiveSampled)
     def _live(self, message: LiveSampled) -> None:
         message.stop()
-        if self.motor is not None and message.motor.key == self.motor.key:
-            self.query_one(LivePanel).show(message.values)
+        if self.motor is None or message.motor.key != self.motor.key:
+            return
+        self.query_one(LivePanel).show(message.values)
+        model = self.model
+        if model is None:
+            return
+        # The table shows the present values of this sample too, not those of the last full read.
+        table = self.query_one(ControlTable)
+        for name, value in message.values.registers().items():
+            row = table.values.get(model.register(name).name) if model.has_register(name) else None
+            if row is None:
+                continue
+            whole = isinstance(row.value, int) and not isinstance(row.value, bool)
+            table.set_value(row.register.name, round(value) if whole else value)
 
     @on(ValueWritten)
     def _written(self, message: ValueWritten) -> None:
@@ -206,7 +218,7 @@ class MotorPanel(Horizontal):
         low, high = self._limits()
         torque = self.value("torque_enable")
         led = self.value("led")
-        state = f"torque {format_value(torque, '')} (t)  led {format_value(led, '')} (l)"
+        state = f"torque {format_value(torque, '')} (t)\nled    {format_value(led, '')} (l)"
         self.query_one(LivePanel).show_goal(self.goal_deg, (low, high), state)
 
     def _limits(self) -> tuple[float, float]:

@@ -28,8 +28,9 @@ class MotorTree(Tree[NodeData]):
     """Found motors; Enter opens one in the motor panel, space marks several."""
 
     BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("enter", "select_cursor", "Open"),
         Binding("space", "mark", "Mark"),
-        Binding("a", "mark_all", "Mark all", show=False),
+        Binding("a", "mark_all", "Mark all"),
     ]
 
     @dataclass

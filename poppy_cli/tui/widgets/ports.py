@@ -12,6 +12,7 @@ from textual.widgets import Input, SelectionList, Static
 from textual.widgets.selection_list import Selection
 
 from poppy_cli.tui.messages import BusFailed, PortsListed
+from poppy_cli.tui.widgets.toggles import MarkedList
 from poppy_core.bus import PortInfo
 from poppy_core.errors import PoppyError
 
@@ -37,7 +38,7 @@ class PortsPanel(Vertical):
 
     def compose(self) -> ComposeResult:
         yield Static("Ports [dim](space ticks)[/]", classes="title")
-        yield SelectionList[str](id="port-list")
+        yield MarkedList[str](id="port-list")
         yield Static("", id="port-advice")
         yield Input(placeholder="virtual bus: /dev/pts/N or socket://host:port", id="virtual")
 

@@ -12,6 +12,7 @@ from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable
 
 from poppy_cli.tui.messages import BusFailed
+from poppy_cli.tui.text import set_cell
 from poppy_core.errors import PoppyError
 
 if TYPE_CHECKING:
@@ -88,8 +89,8 @@ class PrimitivesPanel(Vertical):
         table = self.query_one("#primitive-table", DataTable)
         for name, primitive in self.primitives.items():
             error = primitive.error
-            table.update_cell(name, "state", primitive.state)
-            table.update_cell(name, "error", short_error(error))
+            set_cell(table, name, "state", primitive.state)
+            set_cell(table, name, "error", short_error(error))
             if error is not None and self._reported.get(name) is not error:
                 self._reported[name] = error
                 self.notify(

@@ -14,9 +14,11 @@ from textual.widgets import Button, Checkbox, DataTable, Input, Select, TabbedCo
 
 from poppy_cli.targets import parse_targets
 from poppy_cli.tui.messages import BusFailed, RobotOpened
+from poppy_cli.tui.text import fixed, set_cell, short
 from poppy_cli.tui.widgets.chains import ChainsPanel
 from poppy_cli.tui.widgets.moves import MovesPanel
 from poppy_cli.tui.widgets.primitives import PrimitivesPanel
+from poppy_cli.tui.widgets.toggles import MarkedCheckbox
 from poppy_core.errors import PoppyError
 
 if TYPE_CHECKING:
@@ -72,7 +74,7 @@ class RobotPanel(Vertical):
     def compose(self) -> ComposeResult:
         with Horizontal(classes="row"):
             yield Input(placeholder="profile (ergo-jr) or config file", id="robot-source")
-            yield Checkbox("sim", id="robot-sim")
+            yield MarkedCheckbox("sim", id="robot-sim")
             yield Button("Open", id="robot-open")
         with TabbedContent(initial="robot-motors", id="robot-views"):
             with TabPane("Motors 1", id="robot-motors"), MotorsView():
@@ -127,7 +129,7 @@ class RobotPanel(Vertical):
 
     @on(RobotOpened)
     def _opened(self, message: RobotOpened) -> None:
-        message.stop()
+        # Not stopped: the app scans the buses of the robot it opened at start.
         self.close_robot()
         self.robot = message.robot
         self.primitives.set_robot(message.robot)
@@ -152,11 +154,11 @@ class RobotPanel(Vertical):
         return (
             name,
             str(motor.id),
-            f"{motor.present_position:.1f}",
-            f"{motor.goal_position:.1f}",
-            f"{motor.present_speed:.0f}",
-            f"{motor.present_load:.0f}",
-            f"{motor.present_temperature:.0f}",
+            fixed(motor.present_position),
+            fixed(motor.goal_position),
+            fixed(motor.present_speed, 0),
+            fixed(motor.present_load, 0),
+            fixed(motor.present_temperature, 0),
             ("yes" if motor.compliant else "no") + link,
         )
 
@@ -185,11 +187,11 @@ class RobotPanel(Vertical):
         table = self.query_one("#robot-table", DataTable)
         for motor in self.robot.motors:
             for column, text in zip(COLUMNS, self._cells(motor.name), strict=True):
-                table.update_cell(motor.name, column, text)
+                set_cell(table, motor.name, column, text)
         health = self.query_one("#health-table", DataTable)
         for controller, cells in self._health_rows().items():
             for column, text in zip(HEALTH_COLUMNS, cells, strict=True):
-                health.update_cell(controller, column, text)
+                set_cell(health, controller, column, text)
         self.primitives.refresh_states()
         self.moves.poll()
         self.chains.poll()
@@ -232,7 +234,7 @@ class RobotPanel(Vertical):
         except (PoppyError, ValueError) as exc:
             self.notify(str(exc), severity="error")
             return
-        self.notify(f"goto {', '.join(f'{n}={v:g}°' for n, v in targets.items())}")
+        self.notify(f"goto {', '.join(f'{n}={short(v)}°' for n, v in targets.items())}")
 
     def toggle_compliant(self) -> None:
         """Toggle the compliance of the motor under the cursor."""

@@ -12,6 +12,7 @@ from textual.message import Message
 from textual.widgets import Button, Input, ProgressBar, Select, SelectionList, Static
 from textual.widgets.selection_list import Selection
 
+from poppy_cli.tui.widgets.toggles import MarkedList
 from poppy_core.models import standard_baudrates
 
 ALL_RATES = sorted(set(standard_baudrates(1)) | set(standard_baudrates(2)), reverse=True)
@@ -39,7 +40,7 @@ class ScanPanel(Vertical):
     def compose(self) -> ComposeResult:
         yield Select(PROTOCOL_CHOICES, value="both", allow_blank=False, id="protocol")
         yield Static("Baud rates [dim](space ticks)[/]", classes="title")
-        yield SelectionList[int](
+        yield MarkedList[int](
             *(Selection(f"{rate:>9,} bps", rate, rate == 1_000_000) for rate in ALL_RATES),
             id="bauds",
         )
