@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.files import write_file
-from poppy_core.motion.manager import attach_primitive
+from poppy_core.motion.attached import attach_primitive
 from poppy_core.motion.primitive import LoopPrimitive, Primitive
 from poppy_core.motion.sandbox import MockupMotor
 
