@@ -236,6 +236,9 @@ class PositionWatcher(LoopPrimitive):
         if hasattr(target, "plot") and hasattr(target, "set_xlabel"):
             self._draw(target)
             return target
+        from poppy_core.extras import require
+
+        require("matplotlib", extra="plot", feature="plotting")
         import matplotlib
 
         matplotlib.use("Agg")
