@@ -15,6 +15,7 @@ import pytest
 
 from poppy_core.errors import MissingExtraError
 from poppy_core.extras import require
+from tests.helpers.bus import emulate_bus
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -58,6 +59,39 @@ def test_a_missing_extra_is_one_line_naming_it(
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1, done.stderr
     assert f"pip install 'poppy[{extra}]'" in lines[0]
+
+
+EVERY_EXTRA = (
+    "mujoco,cv2,fastapi,uvicorn,starlette,zmq,textual,textual_serve,matplotlib,skimage,PIL"
+)
+
+
+def _poppy_without_extras(argv: list[str], tmp_path: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path)}
+    return subprocess.run(
+        [sys.executable, "-c", RUN, EVERY_EXTRA, *argv],
+        capture_output=True, text=True, timeout=120, env=env, cwd=tmp_path, check=False,
+    )  # fmt: skip
+
+
+def test_the_core_scans_drives_and_reports_a_robot_without_any_extra(tmp_path: Path) -> None:
+    """What `pip install poppy` (no extra) gives a Raspberry Pi: a bus on a pty, a scan, a
+    motor read and write, the robot's status (its profile has a camera: not opened), the demo."""
+    with emulate_bus("XL-320:1-6", protocol=2, via="pty") as (_, port):
+        runs = [
+            ["scan", "--port", port, "--protocol", "2", "--baud", "1000000", "--json"],
+            ["motor", "set", "3", "goal_position", "10", "--port", port],
+            ["motor", "get", "3", "goal_position", "--port", port],
+            ["robot", "status", "--profile", "ergo-jr", "--port", port, "--json"],
+        ]
+        done = [_poppy_without_extras(argv, tmp_path) for argv in runs]
+    done.append(_poppy_without_extras(["demo", "--quick"], tmp_path))
+    for argv, result in zip([*runs, ["demo"]], done, strict=True):
+        assert result.returncode == 0, (argv, result.stderr)
+        assert "Traceback" not in result.stderr
+    assert '"id":6' in done[0].stdout.replace(" ", "")
+    assert done[2].stdout.startswith("9.96 deg")  # 10° on the XL-320's 0.29° steps
+    assert "m6" in done[3].stdout
 
 
 def test_require_names_the_extra_and_the_feature(monkeypatch: pytest.MonkeyPatch) -> None:
