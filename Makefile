@@ -12,12 +12,12 @@ $(BIN)/activate:
 
 $(VENV)/.installed: pyproject.toml | $(BIN)/activate
 	@echo "installing poppy and its dependencies into $(VENV) (about a minute)…"
-	$(BIN)/pip install --quiet -e .
+	$(BIN)/pip install --quiet -e '.[all]'
 	touch $@
 
 $(VENV)/.installed-test: pyproject.toml | $(BIN)/activate
 	@echo "installing poppy, its dependencies and the test tools into $(VENV) (a minute or two)…"
-	$(BIN)/pip install --quiet -e '.[test]'
+	$(BIN)/pip install --quiet -e '.[all,test]'
 	touch $(VENV)/.installed $@
 
 run: $(VENV)/.installed

@@ -26,6 +26,8 @@ The tree (catch the bases, raise the leaves)::
     │                             ``motor`` and ``known``
     ├── KinematicsError           a target out of a chain's reach; carries ``nearest``
     ├── SensorError               a camera or other sensor cannot be opened or read; ``sensor``
+    ├── MissingExtraError         a feature whose optional dependencies (an extra, e.g.
+    │                             ``poppy[sim]``) are not installed; carries ``extra``, ``module``
     ├── PrimitiveError            a primitive's thread died; carries ``primitive`` and ``failure``
     └── CalibrationCancelled      the user cancelled a calibration (nothing was written)
 
@@ -240,3 +242,12 @@ class PrimitiveError(PoppyError):
 
 class CalibrationCancelled(PoppyError):
     """The user cancelled a calibration or a check; nothing was written."""
+
+
+class MissingExtraError(PoppyError):
+    """A feature needs an optional dependency that is not installed (``pip install 'poppy[x]'``)."""
+
+    def __init__(self, message: str, *, extra: str, module: str) -> None:
+        super().__init__(message)
+        self.extra = extra
+        self.module = module

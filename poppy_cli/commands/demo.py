@@ -115,7 +115,7 @@ def dance(time_factor: float, sim: bool | str = True) -> None:
 
     from poppy_core.robot import from_profile
 
-    with from_profile("ergo-jr", sim=sim) as robot:
+    with from_profile("ergo-jr", sim=sim, sensors=False) as robot:  # the dance needs no camera
         robot.compliant = False
         with Live(positions_table(robot, "ready"), console=console, refresh_per_second=10) as live:
             for label, goals, duration_s in CHOREOGRAPHY:

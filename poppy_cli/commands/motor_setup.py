@@ -218,7 +218,7 @@ def factory_reset(
     json_output: bool = JsonOpt,
 ) -> None:
     """Restore the factory control table (keeps ID and baud rate unless told otherwise)."""
-    from poppy_core.bus.setup import factory_reset as run
+    from poppy_core.bus.setup_reset import factory_reset as run
 
     if not yes:
         from poppy_cli.prompts import require_yes
@@ -263,7 +263,7 @@ def reset(
     json_output: bool = JsonOpt,
 ) -> None:
     """Prepare a motor for a Poppy robot (the old poppy-reset-motor): ID, 1 Mbps, delay 0."""
-    from poppy_core.bus.setup import reset_motor
+    from poppy_core.bus.setup_reset import reset_motor
 
     angle_limits = None
     if limits is not None:

@@ -140,9 +140,11 @@ def plot(
     """Draw each motor's trajectory against time into an image (matplotlib)."""
     import io
 
+    from poppy_core.extras import require
     from poppy_core.files import output_path, write_file
     from poppy_core.motion import load_move, move_path
 
+    require("matplotlib", extra="plot", feature="poppy moves plot")
     path = move_path(name)
     target = output_path(output, default_name=f"{path.stem}.png", replace=force)
     image_format = target.suffix.lower().lstrip(".") or "png"

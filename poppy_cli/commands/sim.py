@@ -47,6 +47,9 @@ def _open_viewer(simulation: Any) -> Any:
             "window; serving without it (render images with `poppy sim render`)"
         )
         return None
+    from poppy_core.extras import require
+
+    require("mujoco", extra="sim", feature="--view")
     try:
         import mujoco.viewer
 
@@ -281,8 +284,10 @@ def render(
     """Render the simulated robot offscreen (EGL or OSMesa, no GPU needed) to a PNG, or a
     move played in the simulation to a GIF (15 frames per second)."""
     from poppy_core.errors import ConfigError
+    from poppy_core.extras import require
     from poppy_core.files import output_path
 
+    require("mujoco", "PIL", extra="sim", feature="poppy sim render")
     default = f"{profile}.gif" if move is not None else f"{profile}.png"
     output = output_path(output, default_name=default, replace=force)  # refused before rendering
     suffix = output.suffix.lower()

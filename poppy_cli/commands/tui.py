@@ -59,6 +59,9 @@ def tui(
     Keys: F1/F2/F3 switch tabs, ctrl+s scans, Enter opens a motor or edits a register,
     space marks motors for a multi-apply, t/l toggle torque/LED, arrows turn the goal dial, q quits.
     """
+    from poppy_core.extras import require
+
+    require("textual", *(["textual_serve"] if serve else []), extra="tui", feature="poppy tui")
     if serve:
         from textual_serve.server import Server
 

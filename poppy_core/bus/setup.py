@@ -4,10 +4,10 @@
   EEPROM while torque is on; e-manual "Torque Enable").
 * A write that changes the ID or the baud rate may be answered from the new ID or at the new
   rate (or not at all): its reply is not relied upon; the motor is pinged at the new setting.
-* ``factory_reset`` on protocol 1 resets everything (ID and baud rate included): the motor is
-  then looked for at the model's factory ID and rate and, as asked, its ID and baud rate are put
-  back. Before resetting, the factory ID must be free at the factory rate, else two motors would
-  end up sharing it.
+* ``factory_reset`` (in ``setup_reset``, which builds on this module) on protocol 1 resets
+  everything (ID and baud rate included): the motor is then looked for at the model's factory ID
+  and rate and, as asked, its ID and baud rate are put back. Before resetting, the factory ID
+  must be free at the factory rate, else two motors would end up sharing it.
 """
 
 from __future__ import annotations
@@ -304,19 +304,14 @@ def reboot(
     return result
 
 
-# The whole-motor operations live next door (size); they are reachable from here too.
-from poppy_core.bus.setup_reset import factory_reset, reset_motor  # noqa: E402
-
 __all__ = [
     "ANSWER_TIMEOUT_S",
     "change_baudrate",
     "change_id",
     "eeprom_unlocked",
-    "factory_reset",
     "identify",
     "locate",
     "reboot",
-    "reset_motor",
     "set_angle_limits",
     "set_return_delay",
     "wait_for_answer",

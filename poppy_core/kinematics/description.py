@@ -235,7 +235,10 @@ def parse_mjcf(path: Path) -> KinematicDescription:
     Raises:
         ConfigError: MuJoCo cannot load the file.
     """
-    import mujoco  # only for MJCF models; URDF needs no MuJoCo
+    from poppy_core.extras import require
+
+    require("mujoco", extra="sim", feature="reading an MJCF model")  # URDF needs no MuJoCo
+    import mujoco
 
     try:
         model = mujoco.MjModel.from_xml_path(str(path))

@@ -1,5 +1,6 @@
 """Motion: trajectories (minimum jerk, constant speed); primitives and moves build on them."""
 
+from poppy_core.motion.attached import active_primitives, attach_primitive, attached_primitives
 from poppy_core.motion.builtins import (
     BUILTINS,
     Cosinus,
@@ -9,14 +10,7 @@ from poppy_core.motion.builtins import (
     Square,
     attach_builtins,
 )
-from poppy_core.motion.manager import (
-    FILTERS,
-    PrimitiveManager,
-    active_primitives,
-    attach_primitive,
-    attached_primitives,
-    primitive_manager,
-)
+from poppy_core.motion.manager import FILTERS, PrimitiveManager, primitive_manager
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import (
     FORMATS,

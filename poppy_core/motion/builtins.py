@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.files import write_file
-from poppy_core.motion.manager import attach_primitive
+from poppy_core.motion.attached import attach_primitive
 from poppy_core.motion.primitive import LoopPrimitive, Primitive
 from poppy_core.motion.sandbox import MockupMotor
 
@@ -236,6 +236,9 @@ class PositionWatcher(LoopPrimitive):
         if hasattr(target, "plot") and hasattr(target, "set_xlabel"):
             self._draw(target)
             return target
+        from poppy_core.extras import require
+
+        require("matplotlib", extra="plot", feature="plotting")
         import matplotlib
 
         matplotlib.use("Agg")

@@ -214,7 +214,7 @@ class PrimitiveManager:
             thread.join(timeout=2.0)
 
 
-# -- one manager per robot, attached primitives ---------------------------------------------------
+# -- one manager per robot ------------------------------------------------------------------------
 
 
 def primitive_manager(robot: Robot) -> PrimitiveManager:
@@ -229,31 +229,3 @@ def primitive_manager(robot: Robot) -> PrimitiveManager:
     if not isinstance(chosen, PrimitiveManager):
         raise ConfigError(f"robot.extensions[{MANAGER_KEY!r}] is not a PrimitiveManager")
     return chosen
-
-
-def attach_primitive(robot: Robot, name: str, primitive: Primitive) -> None:
-    """Make ``primitive`` reachable as ``robot.<name>`` and list it in ``robot.primitives``.
-
-    Raises:
-        ConfigError: the primitive acts on another robot, or ``name`` is taken or invalid.
-    """
-    if primitive.real_robot is not robot:
-        raise ConfigError(f"primitive {name!r} was built for another robot", field=name)
-    robot.attach_primitive(primitive, name)
-
-
-def attached_primitives(robot: Robot) -> dict[str, Primitive]:
-    """Name -> every primitive attached to ``robot``."""
-    from poppy_core.motion.primitive import Primitive
-
-    return {
-        name: obj
-        for name in robot.primitive_names
-        if isinstance(obj := robot.extensions.get(name), Primitive)
-    }
-
-
-def active_primitives(robot: Robot) -> list[Primitive]:
-    """The primitives whose requests the manager combines now (attached or not)."""
-    existing = robot.extensions.get(MANAGER_KEY)
-    return existing.primitives if isinstance(existing, PrimitiveManager) else []

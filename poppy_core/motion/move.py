@@ -10,50 +10,33 @@ import numpy as np
 import numpy.typing as npt
 
 from poppy_core.errors import ArgumentError, UnknownMotorError
+from poppy_core.motion.move_bounds import (  # re-exported: the bounds of a Move
+    MAX_FRAMERATE_HZ,
+    MAX_MOTORS,
+    MAX_POSITION_DEG,
+    MAX_SPEED_DPS,
+    MAX_VALUES,
+    MIN_FRAMERATE_HZ,
+    FloatArray,
+    check_size,
+    resample,
+)
+from poppy_core.motion.move_pypot import bad_move, parse_pypot, pypot_json
 from poppy_core.motion.plots import plot_move
-from poppy_core.trajectory import MAX_DURATION_S
 
-FloatArray = npt.NDArray[np.float64]
-
-# Bounds of a move, checked before any array is allocated so that a tiny file cannot claim a huge
-# move (a pypot JSON with framerate 1e6 resampled to 1.6 GB, a 1e-300 Hz move that never ends).
-MIN_FRAMERATE_HZ = 0.1
-MAX_FRAMERATE_HZ = 1000.0
-MAX_MOTORS = 1024
-MAX_VALUES = 5_000_000
-"""Frames x motors (40 MB of float64 per array): 66 min of a 25-motor Humanoid at 50 Hz."""
-MAX_POSITION_DEG = 1000.0
-"""No servo turns further from its zero, offsets included; larger values are corrupt data."""
-MAX_SPEED_DPS = 100_000.0
-
-
-def check_size(framerate: float, frames: int, motors: int) -> None:
-    """Refuse a move too large or too long to hold, before its arrays are allocated.
-
-    Raises:
-        ArgumentError: a framerate out of ``MIN_FRAMERATE_HZ``-``MAX_FRAMERATE_HZ``, more than
-            ``MAX_MOTORS`` motors, more than ``MAX_VALUES`` values or longer than a day.
-    """
-    if not MIN_FRAMERATE_HZ <= framerate <= MAX_FRAMERATE_HZ:  # also refuses NaN
-        raise ArgumentError(
-            f"framerate must be {MIN_FRAMERATE_HZ:g}-{MAX_FRAMERATE_HZ:g} Hz, got {framerate:g}",
-            field="framerate", value=framerate,
-        )  # fmt: skip
-    if motors > MAX_MOTORS:
-        raise ArgumentError(
-            f"{motors} motors: a move holds at most {MAX_MOTORS}", field="motors", value=motors
-        )
-    if frames < 0 or frames * max(motors, 1) > MAX_VALUES:
-        raise ArgumentError(
-            f"{frames} frames of {motors} motors: a move holds at most {MAX_VALUES:,} values",
-            field="frames", value=frames,
-        )  # fmt: skip
-    if (frames - 1) / framerate > MAX_DURATION_S:
-        raise ArgumentError(
-            f"{frames} frames at {framerate:g} Hz last {(frames - 1) / framerate:.3g} s: a move "
-            f"lasts at most {MAX_DURATION_S:g} s",
-            field="frames", value=frames,
-        )  # fmt: skip
+__all__ = [
+    "MAX_FRAMERATE_HZ",
+    "MAX_MOTORS",
+    "MAX_POSITION_DEG",
+    "MAX_SPEED_DPS",
+    "MAX_VALUES",
+    "MIN_FRAMERATE_HZ",
+    "FloatArray",
+    "Move",
+    "PositionArray",
+    "check_size",
+    "resample",
+]
 
 
 class PositionArray(np.ndarray[Any, np.dtype[np.float64]]):
@@ -221,9 +204,7 @@ class Move:
 
     def save(self, file: IO[str]) -> None:
         """Write the move as pypot's move JSON to an open text file (pypot's ``save``)."""
-        from poppy_core.motion.move_format import encode_pypot
-
-        file.write(encode_pypot(self).decode())
+        file.write(pypot_json(self.framerate, self.motors, self.positions, self.speeds).decode())
 
     @classmethod
     def load(cls, file: IO[str] | IO[bytes]) -> Move:
@@ -232,16 +213,21 @@ class Move:
         Raises:
             ConfigError: not pypot move JSON (the file's name and the reason).
         """
-        from poppy_core.motion.move_format import decode_pypot
-
-        return decode_pypot(file.read(), str(getattr(file, "name", "<file>")))
+        return cls.loads(file.read(), str(getattr(file, "name", "<file>")))
 
     @classmethod
-    def loads(cls, text: str | bytes) -> Move:
-        """Read pypot's move JSON from a string (pypot's ``Move.loads``)."""
-        from poppy_core.motion.move_format import decode_pypot
+    def loads(cls, text: str | bytes, source: str = "<json>") -> Move:
+        """Read pypot's move JSON from a string (pypot's ``Move.loads``); ``source`` names it in
+        errors (keys sorted as times; irregular times are resampled).
 
-        return decode_pypot(text)
+        Raises:
+            ConfigError: not pypot move JSON (the source and the reason).
+        """
+        framerate, motors, positions, speeds = parse_pypot(text, source)
+        try:
+            return cls(framerate, motors, positions, speeds=speeds, metadata={})
+        except ValueError as exc:
+            raise bad_move(source, str(exc)) from None
 
     def __repr__(self) -> str:
         return (
@@ -364,34 +350,3 @@ class Move:
             and self.positions.shape == other.positions.shape
             and bool(np.all(np.abs(self.positions - other.positions) <= tolerance_deg))
         )
-
-
-def resample(times_s: npt.ArrayLike, positions: npt.ArrayLike, framerate: float) -> FloatArray:
-    """Positions sampled at irregular times, linearly resampled at ``framerate``.
-
-    Args:
-        times_s: increasing sample times (the first one becomes t = 0).
-        positions: shape ``(samples, motors)``.
-        framerate: frames per second of the result.
-
-    Returns:
-        Shape ``(frames, motors)``: frame ``k`` is the position at ``times_s[0] + k / framerate``,
-        up to the last sample time.
-
-    Raises:
-        ArgumentError: the result would be too large (see ``check_size``), checked before it is
-            allocated.
-    """
-    t = np.asarray(times_s, dtype=np.float64)
-    values = np.asarray(positions, dtype=np.float64)
-    if t.size == 0:
-        return values.reshape(0, values.shape[1] if values.ndim == 2 else 0)
-    span = float(t[-1] - t[0])
-    # A small slack keeps a last sample that falls a hair before its frame's time.
-    count = math.floor(span * framerate + 1e-6) + 1
-    check_size(framerate, count, values.shape[1] if values.ndim == 2 else 0)
-    grid = t[0] + np.arange(count, dtype=np.float64) / framerate
-    out = np.empty((count, values.shape[1]), dtype=np.float64)
-    for column in range(values.shape[1]):
-        out[:, column] = np.interp(grid, t, values[:, column])
-    return out

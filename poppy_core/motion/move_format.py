@@ -12,20 +12,14 @@ Loading is one read, one small JSON parse and a zero-copy ``numpy.frombuffer``, 
 25-motor 50 Hz move loads in milliseconds. float32 keeps about 1e-5° at 180°, far below a
 servo's resolution (0.088° on MX/X, 0.29° on AX/XL-320).
 
-pypot's format (``.json``, written by ``pypot.primitive.move.Move.save``)::
-
-    {"framerate": 50.0, "positions": {"0.0": {"m1": [pos, speed], ...}, "0.02": {...}, ...}}
-
-keys are times in seconds written as float strings. Recorded keys are the recorder's elapsed
-times, so they are not exactly evenly spaced: we sort them and, when they stray more than half
-a period from the regular grid, resample linearly at the framerate.
+pypot's format (``.json``, written by ``pypot.primitive.move.Move.save``) is read and written by
+``move_pypot`` (below ``Move``, whose pypot ``save``/``load``/``loads`` use it).
 """
 
 from __future__ import annotations
 
 import json
 import logging
-import math
 import os
 import struct
 from pathlib import Path
@@ -36,7 +30,9 @@ import numpy as np
 from poppy_core.documents import Limits, parse_json, read_limited
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.files import write_file
-from poppy_core.motion.move import MAX_VALUES, Move, check_size, resample
+from poppy_core.motion.move import Move
+from poppy_core.motion.move_bounds import MAX_VALUES, check_size
+from poppy_core.motion.move_pypot import bad_move, pypot_json
 
 logger = logging.getLogger(__name__)
 
@@ -54,15 +50,12 @@ _LENGTH = struct.Struct("<I")
 MAX_HEADER_BYTES = 1 << 20
 MAX_MOVE_BYTES = 2 * MAX_VALUES * 8 + MAX_HEADER_BYTES
 """The largest .move file: the largest move in float64 with speeds."""
-PYPOT_LIMITS = Limits(max_bytes=64 << 20, max_nodes=4 * MAX_VALUES, max_depth=8)
-"""A pypot move JSON: 64 MiB holds 30 min of a 25-motor Humanoid at 50 Hz."""
 
 
 _HEADER_LIMITS = Limits(max_bytes=MAX_HEADER_BYTES, max_nodes=100_000, max_depth=16)
 
 
-def _bad(source: str, reason: str) -> ConfigError:
-    return ConfigError(f"{source}: not a valid move file: {reason}", file=source, reason=reason)
+_bad = bad_move
 
 
 # -- poppy's binary format ---------------------------------------------------------------------
@@ -157,23 +150,7 @@ def decode_move(data: bytes, source: str = "<bytes>") -> Move:
 
 def encode_pypot(move: Move) -> bytes:
     """A move as pypot's move JSON (``[position, speed]`` per motor; speed 0 when unknown)."""
-    speeds = move.speeds if move.speeds is not None else np.zeros_like(move.positions)
-    timed: dict[str, dict[str, list[float]]] = {}
-    pos_rows = move.positions.tolist()
-    speed_rows = speeds.tolist()
-    for index in range(len(move)):
-        row = zip(move.motors, pos_rows[index], speed_rows[index], strict=True)
-        timed[repr(index / move.framerate)] = {name: [pos, speed] for name, pos, speed in row}
-    return json.dumps({"framerate": move.framerate, "positions": timed}).encode()
-
-
-def _value_pair(value: Any) -> tuple[float, float]:
-    if isinstance(value, int | float) and not isinstance(value, bool):
-        return float(value), 0.0
-    if isinstance(value, list | tuple) and value:
-        speed = value[1] if len(value) > 1 else 0.0
-        return float(value[0]), float(speed if speed is not None else 0.0)
-    raise ValueError(f"{value!r} is not [position, speed]")
+    return pypot_json(move.framerate, move.motors, move.positions, move.speeds)
 
 
 def decode_pypot(data: bytes | str, source: str = "<json>") -> Move:
@@ -182,69 +159,7 @@ def decode_pypot(data: bytes | str, source: str = "<json>") -> Move:
     Raises:
         ConfigError: not pypot move JSON.
     """
-    if len(data) > PYPOT_LIMITS.max_bytes:
-        raise _bad(source, f"{len(data):,} bytes of JSON (at most {PYPOT_LIMITS.max_bytes:,})")
-    try:
-        document = parse_json(data, source, PYPOT_LIMITS, check=False)
-    except ConfigError as exc:
-        raise _bad(source, str(exc.reason)) from None
-    try:
-        framerate = float(document["framerate"])
-        timed = document["positions"]
-        if not isinstance(timed, dict):
-            raise TypeError("positions is not an object")
-        items = sorted(((float(k), v) for k, v in timed.items()), key=lambda kv: kv[0])
-    except (ValueError, KeyError, TypeError, OverflowError) as exc:
-        raise _bad(source, f"not pypot move JSON ({type(exc).__name__}: {exc})") from None
-    if not math.isfinite(framerate) or framerate <= 0:
-        raise _bad(source, f"framerate {framerate!r} is not a positive number")
-    motors: dict[str, None] = {}
-    for time_s, frame in items:
-        if not isinstance(frame, dict):
-            raise _bad(source, "a frame is not an object of motor positions")
-        if not math.isfinite(time_s):
-            raise _bad(source, f"frame time {time_s!r} is not a finite number")
-        motors.update(dict.fromkeys(frame))
-    try:  # the grid the frames are resampled on, checked before any array is made
-        span = items[-1][0] - items[0][0] if items else 0.0
-        grid = int(min(span * framerate, 1e12)) + 1  # inf-safe: a huge grid is refused below
-        check_size(framerate, max(len(items), grid), len(motors))
-    except ArgumentError as exc:
-        raise _bad(source, str(exc)) from None
-    times = np.array([t for t, _ in items], dtype=np.float64)
-    positions = np.full((len(items), len(motors)), np.nan)
-    speeds = np.full((len(items), len(motors)), np.nan)
-    column = {m: i for i, m in enumerate(motors)}
-    names = list(motors)
-    try:
-        for row, (_, frame) in enumerate(items):
-            for name, value in frame.items():
-                positions[row, column[name]], speeds[row, column[name]] = _value_pair(value)
-    except (ValueError, TypeError, OverflowError) as exc:
-        raise _bad(source, str(exc)) from None
-    for array in (positions, speeds):
-        _fill_gaps(array)
-    if len(items) > 1:
-        grid = times[0] + np.arange(len(items)) / framerate
-        if float(np.max(np.abs(times - grid))) > 0.5 / framerate:
-            logger.info("%s: irregular frame times, resampling at %g Hz", source, framerate)
-            positions = resample(times, positions, framerate)
-            speeds = resample(times, speeds, framerate)
-    try:
-        return Move(framerate, names, positions, speeds=speeds, metadata={})
-    except ValueError as exc:
-        raise _bad(source, str(exc)) from None
-
-
-def _fill_gaps(array: np.ndarray[Any, np.dtype[np.float64]]) -> None:
-    """Fill a motor missing from some frames with its previous (else next) known value."""
-    for column in range(array.shape[1]):
-        values = array[:, column]
-        known = np.flatnonzero(~np.isnan(values))
-        if known.size == len(values) or known.size == 0:
-            continue
-        index = np.searchsorted(known, np.arange(len(values)), side="right") - 1
-        values[:] = values[known[np.clip(index, 0, None)]]
+    return Move.loads(data, source)
 
 
 # -- files -------------------------------------------------------------------------------------

@@ -20,12 +20,12 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 from poppy_core import checks
 from poppy_core.errors import ConfigError, PrimitiveError
+from poppy_core.motion.manager import PrimitiveManager, primitive_manager
 from poppy_core.motion.primitive_values import convert_value
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
 from poppy_core.robot.schedule import Periodic, RateMeter
 
 if TYPE_CHECKING:
-    from poppy_core.motion.manager import PrimitiveManager
     from poppy_core.robot import Motor, Robot
 
 logger = logging.getLogger(__name__)
@@ -78,8 +78,6 @@ class Primitive:
     methods: ClassVar[Sequence[str]] = ("start", "stop", "pause", "resume")
 
     def __init__(self, robot: Robot) -> None:
-        from poppy_core.motion.manager import primitive_manager
-
         self.real_robot = robot
         self._stop_event = threading.Event()
         self._resume_event = threading.Event()

@@ -17,12 +17,12 @@ from typing import Any, ClassVar
 import numpy as np
 
 from poppy_core.checks import count
-from poppy_core.errors import SensorError
+from poppy_core.errors import MissingExtraError, SensorError
+from poppy_core.extras import require
 from poppy_core.sensors.camera import Camera
 from poppy_core.sensors.detector import FrameDetector
 from poppy_core.sensors.opencv import cv
 
-FACES_EXTRA = "pip install 'poppy[faces]' (scikit-image)"
 DEFAULT_FACE_FREQ_HZ = 2.0
 DEFAULT_MIN_SIZE_PX = 24
 """Smallest face looked for, in pixels of the frame as searched (``WORK_WIDTH_PX`` wide at most)."""
@@ -64,10 +64,12 @@ class Face:
 
 def _cascade(path: str | None) -> Any:
     try:
-        from skimage import data
-        from skimage.feature import Cascade
-    except ImportError as exc:
-        raise SensorError(f"face detection needs scikit-image: {FACES_EXTRA} ({exc})") from exc
+        require("skimage", extra="faces", feature="face detection")
+    except MissingExtraError as exc:
+        raise SensorError(str(exc)) from None
+    from skimage import data
+    from skimage.feature import Cascade
+
     shipped: Any = data  # untyped
     chosen = path or str(shipped.lbp_frontal_face_cascade_filename())
     if not Path(chosen).is_file():

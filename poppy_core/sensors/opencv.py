@@ -5,9 +5,8 @@ from __future__ import annotations
 import os
 from typing import Any
 
-from poppy_core.errors import SensorError
-
-OPENCV_PACKAGE = "opencv-python-headless"
+from poppy_core.errors import MissingExtraError, SensorError
+from poppy_core.extras import require
 
 
 def cv() -> Any:
@@ -19,11 +18,11 @@ def cv() -> Any:
     # OpenCV prints its own warnings (e.g. "can't open camera by index") on stderr unless told.
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
     try:
-        import cv2
-    except ImportError as exc:
-        raise SensorError(
-            f"cameras need OpenCV: pip install {OPENCV_PACKAGE} ({exc})", sensor=None
-        ) from exc
+        require("cv2", extra="vision", feature="cameras")
+    except MissingExtraError as exc:
+        raise SensorError(str(exc), sensor=None) from None
+    import cv2
+
     return cv2
 
 

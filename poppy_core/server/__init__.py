@@ -1,8 +1,10 @@
 """The REST/WebSocket server over a ``Robot``: pypot's routes, the v1 API and a state stream.
 
-Importing this package loads FastAPI: the CLI imports it only inside ``poppy serve``.
+Importing this package loads FastAPI: the CLI imports it only inside ``poppy serve``. Without
+the ``server`` extra, importing it raises ``MissingExtraError`` naming the extra.
 """
 
+from poppy_core.server import needs  # noqa: F401  (checks the server extra, before the rest)
 from poppy_core.server.app import create_app
 from poppy_core.server.errors import ListenError
 from poppy_core.server.origins import OriginGuard, OriginPolicy

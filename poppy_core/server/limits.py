@@ -14,9 +14,14 @@ uvicorn's HTTP protocol class:
   64 MiB of headers took the server from 83 to 374 MiB);
 - **cap**: beyond ``max_connections`` open connections (HTTP and WebSocket), a new one is
   answered ``503`` with a one-line JSON body and closed, before it costs anything more.
+  uvicorn's own ``limit_concurrency`` cannot take its place: it answers ``503`` only once a
+  request's headers have arrived (``on_headers_complete``), so sockets that send nothing are all
+  accepted and each holds a file descriptor until the header deadline.
 
 It relies on the attributes uvicorn's protocols share (``connections``, ``cycle``, ``transport``,
-``loop``, ``on_response_complete``); ``tests/server/test_limits.py`` pins the behaviour.
+``loop``, ``on_response_complete``): pyproject bounds uvicorn to the minor versions tested,
+``tests/server/test_uvicorn_contract.py`` checks those attributes and
+``tests/server/test_limits.py`` pins the behaviour.
 """
 
 from __future__ import annotations

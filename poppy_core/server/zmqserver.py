@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from poppy_core import checks
 from poppy_core.errors import PoppyError
+from poppy_core.extras import require
 from poppy_core.server.errors import ApiError, ListenError
 from poppy_core.server.service import RobotService, check_duration
 
@@ -190,6 +191,7 @@ class ZmqRobotServer:
     """
 
     def __init__(self, robot: Robot, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
+        require("zmq", extra="zmq", feature="pypot's ZMQ server")
         import zmq
 
         self.host = host

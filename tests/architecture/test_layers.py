@@ -12,10 +12,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 # room -> rooms of ours it may import (ARCHITECTURE.md); `errors`, `files` (safe writes),
-# `documents` (bounded JSON/YAML reads), `line` (the byte-line contract and its URL schemes) and
+# `documents` (bounded JSON/YAML reads), `line` (the byte-line contract and its URL schemes),
 # `trajectory` (the pure maths of a goto, shared by Motor.goto_position and the primitives'
-# sandbox) and `checks` (the one rule of each kind of call argument) are leaves every room may use.
-LEAVES = {"errors", "files", "documents", "line", "trajectory", "checks"}
+# sandbox), `checks` (the one rule of each kind of call argument) and `extras` (the optional
+# dependencies, with the one-line error naming a missing extra) are leaves every room may use.
+LEAVES = {"errors", "files", "documents", "line", "trajectory", "checks", "extras"}
 ALLOWED: dict[str, set[str]] = {
     "protocol": set(),
     "models": {"protocol"},
