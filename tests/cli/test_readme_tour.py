@@ -34,7 +34,7 @@ import pytest
 import typer
 
 from poppy_cli.main import app
-from tests.helpers.cli import POPPY
+from tests.helpers.cli import POPPY, run_poppy_process
 from tests.helpers.terminal import CTRL_C, Terminal
 from tests.helpers.waiting import eventually
 
@@ -478,78 +478,97 @@ def on_a_terminal(step: Step) -> bool:
 
 @dataclass
 class Screen:
-    """What the pty tour expects of a command once started: keys to type when text shows."""
+    """What the pty tour does with a command: ``answers`` to what it asks (each time it shows),
+    then ``stop`` (keys typed once its text showed) and the exit code then."""
 
-    keys: list[tuple[str, bytes]]
+    answers: list[tuple[str, bytes]]
+    stop: tuple[str, bytes] | None
     code: int
 
 
 def _screen(step: Step) -> Screen:
     kind = _kind(step)
     if kind == "watch":
-        return Screen([("m6", CTRL_C)], 130)
+        return Screen([], ("m6", CTRL_C), 130)
     if kind == "record":
-        return Screen([("recording", b"\n")], 0)
+        return Screen([], ("recording", b"\n"), 0)
     if kind == "teleop":
-        return Screen([("stops", b"\n")], 0)
-    if kind == "calibrate":
-        return Screen([("Enter", b"\n")] * 8 + [("[y/n]", b"y\n")], 0)
+        return Screen([], ("stops", b"\n"), 0)
+    if kind == "calibrate":  # the posture, each joint (not moved), then write the profile
+        return Screen([("press Enter", b"\n"), ("[y/n]", b"y\n")], None, 0)
     if kind == "tui":
-        return Screen([("Bus", b"q")], 0)
-    return Screen([], 0)
+        return Screen([], ("Bus", b"q"), 0)
+    return Screen([], None, 0)
+
+
+RETURN_DELAY = "return delay to 0"
 
 
 def test_readme_tour_on_a_terminal(tour: Tour) -> None:
     """The tour's commands a terminal changes, in a pty: the README's return-delay question is
-    asked once (answered yes, as the README says) and never again; keys stop what they say."""
-    asked = False
+    asked once per emulated bus (answered yes, as the README says) and never again; keys stop
+    what they say."""
+    answered: set[str] = set()  # the ports whose return delay was set
     for step in tour_steps():
         if _kind(step) == "emulate":
             tour.ports["tour"] = tour.emulate(*step.argv[1:])
         elif on_a_terminal(step):
-            asked = _on_a_terminal(tour, step, asked)
+            _on_a_terminal(tour, step, answered)
     tour.close()
     assert not tour.problems, "the README tour, on a terminal:\n" + "\n".join(tour.problems)
 
 
-def _on_a_terminal(tour: Tour, step: Step, asked: bool) -> bool:
-    """Run ``step`` in a pty, answer and type what it expects; whether the question was asked."""
+def _on_a_terminal(tour: Tour, step: Step, answered: set[str]) -> None:
+    """Run ``step`` in a pty, answering and typing what ``_screen`` says."""
     screen = _screen(step)
-    keys = list(screen.keys)
+    stop = screen.stop
+    argv = tour.argv(step)
+    ports = {w for w in argv if w.startswith("/dev/")}
+    may_ask = len(ports - answered)  # once per bus not set yet
     env = {k: v for k, v in tour.env.items() if k not in ("NO_COLOR", "COLUMNS")}
-    terminal = Terminal(*tour.argv(step), env={**env, "LINES": "50"})  # 200 columns
+    terminal = Terminal(*argv, env={**env, "LINES": "50"})  # 200 columns
+    code: int | None = None
     try:
         seen = 0  # what was shown before this is answered
         deadline = time.monotonic() + RUN_S
         while time.monotonic() < deadline and terminal.proc.poll() is None:
             terminal.read_until("\x00", 0.5)
             new = terminal.text[seen:]
-            if keys and keys[0][0] in new:
-                time.sleep(0.5)  # let it record or draw a little first (not an assertion)
-                terminal.type(keys.pop(0)[1])
-                seen = len(terminal.text)
-            elif PROMPT.search(new) and "return delay" in new:
-                if asked:
+            if RETURN_DELAY in new and PROMPT.search(new):
+                if may_ask == 0:
                     tour.problem(step, f"on a terminal: asks again: {_line_with(new, PROMPT)!r}")
                     terminal.type(CTRL_C)
                     break
-                asked = True
+                may_ask -= 1
                 terminal.type(b"y\n")
-                seen = len(terminal.text)
-        if terminal.proc.poll() is None:
-            code: int | None = terminal.wait(10)
-        else:
-            code = terminal.wait(5)
+            elif answer := next((keys for text, keys in screen.answers if text in new), None):
+                terminal.type(answer)
+            elif stop is not None and stop[0] in new:
+                time.sleep(0.5)  # let it record or draw a little first (not an assertion)
+                terminal.type(stop[1])
+                stop = None
+            else:
+                continue
+            seen = len(terminal.text)
+        code = terminal.wait(10)
     except subprocess.TimeoutExpired:
         code = None
     finally:
         terminal.close()
+    answered |= ports
     if code is None:
         tour.problem(step, f"on a terminal: still running; it shows {terminal.text[-300:]!r}")
     elif code != screen.code:
         tour.problem(step, f"on a terminal: exit {code}, expected {screen.code}: "
                      f"{terminal.text.strip()[-300:]!r}")  # fmt: skip
-    if keys:
-        tour.problem(step, f"on a terminal: never showed {keys[0][0]!r}")
+    if stop is not None:
+        tour.problem(step, f"on a terminal: never showed {stop[0]!r}")
     check_output(tour, step, "", terminal.text, piped=False)
-    return asked
+
+
+def test_tui_without_a_terminal_says_so_at_once() -> None:
+    """`poppy tui` piped drew its screen into the pipe and waited there for keys, forever."""
+    result = run_poppy_process("tui", "--sim", timeout=60)
+    assert result.code == 2
+    assert "needs a terminal" in result.stderr and "poppy tui --serve" in result.stderr
+    assert result.stdout == ""
