@@ -27,9 +27,8 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
-import click
 import pytest
 import typer
 
@@ -49,6 +48,7 @@ CUT = re.compile(r"\S…\s*([│┃]|$)")  # Rich's cut cell ("posit… │"), n
 HINT = re.compile(r"`(poppy\s[^`]+)`")
 FIRST_LINE_S = 60  # a loaded machine starts Python, imports, opens a robot: waits, not bounds
 RUN_S = 120  # a command not done after this long hangs
+WATCH_S = 20  # a live table's first rows come within a second or two of the robot
 
 
 # --- the README's commands ------------------------------------------------------------------
@@ -99,7 +99,7 @@ def python_block() -> str:
 
 def test_the_tour_is_read_from_the_readme() -> None:
     steps = tour_steps()
-    assert steps[1].argv[:1] == ["emulate"] and steps[1].background
+    assert any(s.argv[0] == "emulate" and s.background for s in steps)
     assert any(s.has("--watch") for s in steps)
     assert "from_profile" in python_block()
     for step in steps:  # every hardware port has an emulated stand-in
@@ -156,6 +156,8 @@ class Running:
             cwd=cwd,
             start_new_session=True,  # a Ctrl-C of the test run is not theirs
         )
+        self.finished = False
+        self.code: int | None = None
         self.out: list[bytes] = []
         self.err: list[bytes] = []
         self._readers = [
@@ -202,6 +204,8 @@ class Running:
 
     def finish(self, timeout_s: float = RUN_S) -> int | None:
         """The exit code, or None when it hangs (then it is killed)."""
+        if self.finished:
+            return self.code
         try:
             code: int | None = self.proc.wait(timeout=timeout_s)
         except subprocess.TimeoutExpired:
@@ -212,6 +216,7 @@ class Running:
             reader.join(5)
         if self.proc.stdin is not None:
             self.proc.stdin.close()
+        self.finished, self.code = True, code
         return code
 
     def stop(self) -> None:
@@ -262,7 +267,9 @@ class Tour:
                 adapter = _adapter_for(step, word)
                 assert adapter is not None, f"no stand-in for {word} in {step.line}"
                 if adapter not in self.ports:
-                    self.ports[adapter] = self.emulate(*PORT_MAPPINGS[adapter][0])
+                    args, what = PORT_MAPPINGS[adapter]
+                    self.ports[adapter] = self.emulate(*args)
+                    print(f"{word} of `{step.command}`: {what}, {self.ports[adapter]}")
                 word = self.ports[adapter]
             words.append(word)
         return words
@@ -272,8 +279,9 @@ class Tour:
             running.stop()
         for emulator in self.emulators:
             emulator.interrupt()
-            if emulator.finish(30) is None:
-                self.problems.append(f"poppy emulate {emulator.argv[1:]}: did not stop on SIGINT")
+            code = emulator.finish(30)
+            if code != 0:  # serves until Ctrl-C, then ends normally
+                self.problems.append(f"poppy {shlex.join(emulator.argv)}: exit {code} on Ctrl-C")
 
 
 @pytest.fixture
@@ -287,10 +295,10 @@ def tour(tmp_path: Path) -> Iterator[Tour]:
 
 # --- what every command's output must be ----------------------------------------------------
 
-_commands: dict[str, click.Command] = {}
+_commands: dict[str, Any] = {}  # typer's click command of `poppy`
 
 
-def _cli() -> click.Command:
+def _cli() -> Any:
     if "" not in _commands:
         _commands[""] = typer.main.get_command(app)
     return _commands[""]
@@ -299,7 +307,7 @@ def _cli() -> click.Command:
 def hint_problem(hint: str) -> str | None:
     """What is wrong with a `poppy ...` command named in a hint (None: it exists, options too)."""
     command = _cli()
-    ctx = click.Context(command, info_name="poppy")
+    ctx = command.context_class(command, info_name="poppy")
     words = shlex.split(hint)[1:]
     options = {o for p in command.params for o in getattr(p, "opts", [])} | {"--help"}
     for word in words:
@@ -317,6 +325,13 @@ def hint_problem(hint: str) -> str | None:
             if name not in options and name not in ("--debug", "-v", "-q", "-V"):
                 return f"`{hint}`: no option {name} in `{command.name}`"
     return None
+
+
+def test_hints_are_checked_against_the_cli() -> None:
+    assert hint_problem("poppy motor set-return-delay 1-6 0 --port /dev/pts/2") is None
+    assert hint_problem("poppy -q robot goto m1=-30 --sim") is None
+    assert "no command 'set-delay'" in str(hint_problem("poppy motor set-delay 1-6 0"))
+    assert "no option --fix" in str(hint_problem("poppy robot status --fix"))
 
 
 def check_output(tour: Tour, step: Step, out: str, err: str, *, piped: bool = True) -> None:
@@ -375,20 +390,25 @@ def run_piped(tour: Tour, step: Step) -> None:
         return
     expected = 0
     if kind == "watch":  # a live table until Ctrl-C: 130, as every interrupted command
-        if not running.wait_for("\n"):
-            tour.problem(step, "printed nothing before Ctrl-C (a piped live view shows no row)")
+        if not running.wait_for("\n", WATCH_S):
+            tour.problem(step, f"piped, printed no row in {WATCH_S:g} s (only at Ctrl-C)")
         running.interrupt()
         expected = 130
     elif kind == "serve":  # serves until Ctrl-C: exit 0, `stopped` on stderr (docs/cli.md)
         if not running.wait_for("http://"):
             tour.problem(step, "printed no URL it serves")
         running.interrupt()
+        if running.finish() == 0 and "stopped" not in running.stderr:
+            tour.problem(step, "did not say `stopped` on Ctrl-C")
     elif kind == "record":  # Enter only stops it on a terminal; Ctrl-C saves and exits 0
+        move = Path(tour.env["XDG_DATA_HOME"], "poppy", "moves", f"{step.argv[1]}.move")
         if running.wait_for("recording"):
-            eventually(lambda: Path(tour.env["XDG_DATA_HOME"], "poppy/moves").is_dir(), 5)
+            eventually(move.exists, 5)  # its first checkpoint: it has recorded a second
         else:
             tour.problem(step, "never said it records")
         running.interrupt()
+        if running.finish() == 0 and running.stdout.strip().splitlines()[-1:] != [str(move)]:
+            tour.problem(step, f"the last line of stdout is not {move}: {running.stdout!r}")
     elif kind == "calibrate":  # answers from stdin: Enter for the posture, then each joint
         running.type(b"\n" * 20)
     elif kind == "teleop":  # Ctrl-C stops it: the follower holds, exit 0
