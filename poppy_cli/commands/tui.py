@@ -69,6 +69,7 @@ def tui(
         console.print(f"serving poppy tui on http://{host}:{web_port} (Ctrl-C to stop)")
         Server(command, host=host, port=web_port, title="poppy").serve()
         return
+    _need_a_terminal()
     from poppy_cli.tui.app import make_app
 
     if sim == "mujoco":
@@ -76,6 +77,25 @@ def tui(
             make_app(port, baud, protocol, False, robot_source=str(config_path)).run()
         return
     make_app(port, baud, protocol, sim is not None).run()
+
+
+def _need_a_terminal() -> None:
+    """Refuse to draw the app into a pipe or a file (it would wait there for keys forever).
+
+    textual-serve's sessions (``TEXTUAL_DRIVER``) talk to the browser through pipes: they run.
+    """
+    import os
+
+    from poppy_cli.output import EXIT_USAGE, error_line
+
+    if os.environ.get("TEXTUAL_DRIVER"):
+        return
+    if not (sys.stdin is not None and sys.stdin.isatty() and sys.stdout.isatty()):
+        error_line(
+            "poppy tui needs a terminal (its stdin and stdout are not one); "
+            "`poppy tui --serve` serves it to a browser"
+        )
+        raise typer.Exit(EXIT_USAGE)
 
 
 @contextmanager
