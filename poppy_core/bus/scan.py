@@ -14,10 +14,14 @@ How a scan stays fast:
   The second broadcast costs one round trip, a few ms at 1 Mbps.
 
 Slow adapters: the deadlines assume the adapter latency known for the port (see
-``poppy_core.bus.timing``); a reply slower than that raises it for the rest of the port's scan
-(``poppy_core.bus.latency``). Before motors found at a rate are reported, the line is left quiet
-for a few latencies and they are asked again: a reply that came late from the rate tried before
-(and was taken for an answer at this one) does not answer twice, and is dropped.
+``poppy_core.bus.timing``); replies late in a row raise it for the rest of the port's scan
+(``poppy_core.bus.latency``). The pass that pings each ID keeps the deadline it began with,
+though: a silent ID costs no more than it did, and on an adapter that answers on time a reply
+the OS made late once costs one more ping, not a longer wait at every ID still to ping; a slow
+adapter's replies, late, are caught as strays and their IDs pinged again after the pass, with
+the latency learned. Before motors found at a rate are reported, the line is left quiet for a
+few latencies and they are asked again: a reply that came late from the rate tried before (and
+was taken for an answer at this one) does not answer twice, and is dropped.
 
 A scan opens each port once and switches rates on it. On an abort (``should_abort()`` true) it
 returns what it has found so far.
@@ -149,17 +153,21 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int
     late: set[int] = set()
     if not trusted:
         late.update(s.id for s in bus.take_strays() if s.id in wanted)  # late broadcast replies
-        for motor_id in state.ids:
-            if state.abort_requested():
-                break
-            if motor_id not in candidates:
-                result = ping_found(bus, motor_id, retries=0)
-                if result is not None:
-                    candidates[motor_id] = result
-                    state.unconfirmed = len(candidates)
-                strays = bus.take_strays()
-                late.update(s.id for s in strays if s.id in wanted and s.id not in candidates)
-            state.report(port, bus, "ping", motor_id, 1)
+        bus.timeout_s = _ping_deadline_s(bus)  # kept through the pass (module docstring)
+        try:
+            for motor_id in state.ids:
+                if state.abort_requested():
+                    break
+                if motor_id not in candidates:
+                    result = ping_found(bus, motor_id, retries=0)
+                    if result is not None:
+                        candidates[motor_id] = result
+                        state.unconfirmed = len(candidates)
+                    strays = bus.take_strays()
+                    late.update(s.id for s in strays if s.id in wanted and s.id not in candidates)
+                state.report(port, bus, "ping", motor_id, 1)
+        finally:
+            bus.timeout_s = None
     # Replies still coming are late answers of this rate: wait for them before the next rate.
     late |= settle(bus) & wanted
     for motor_id in sorted(late - set(candidates)):
@@ -169,6 +177,13 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int
     unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
     found_here = {f.id for f in state.found if f.baudrate == bus.baudrate}
     return (unconfirmed | late) - found_here
+
+
+def _ping_deadline_s(bus: DxlBus) -> float:
+    """How long a ping waits at ``bus``'s rate with the latency it assumes now."""
+    proto = bus.proto
+    tx, rx = proto.instruction_size(0), proto.status_size(proto.ping_params)
+    return bus.timing.reply_timeout_s(tx, rx)
 
 
 def _scan_bus(
