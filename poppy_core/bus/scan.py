@@ -14,14 +14,15 @@ How a scan stays fast:
   The second broadcast costs one round trip, a few ms at 1 Mbps.
 
 Slow adapters: the deadlines assume the adapter latency known for the port (see
-``poppy_core.bus.timing``); replies late in a row raise it for the rest of the port's scan
-(``poppy_core.bus.latency``). The pass that pings each ID keeps the deadline it began with,
-though: a silent ID costs no more than it did, and on an adapter that answers on time a reply
-the OS made late once costs one more ping, not a longer wait at every ID still to ping; a slow
-adapter's replies, late, are caught as strays and their IDs pinged again after the pass, with
-the latency learned. Before motors found at a rate are reported, the line is left quiet for a
-few latencies and they are asked again: a reply that came late from the rate tried before (and
-was taken for an answer at this one) does not answer twice, and is dropped.
+``poppy_core.bus.timing``); a reply that came after its deadline raises it for the rest of the
+port's scan (``poppy_core.bus.latency``). The pass that pings each ID keeps the deadline it began
+with, though: a silent ID costs no more than it did, and on an adapter that answers on time a
+reply the OS made late once costs one more ping, not a longer wait at every ID still to ping; a
+slow adapter's replies, late, are caught as strays and their IDs pinged again after the pass,
+with the latency learned. Before motors found at a rate are reported, the line is left quiet for
+a few latencies and they are asked again: a reply that came late from the rate tried before (and
+was taken for an answer at this one) does not answer twice, and is dropped. At the first rate
+tried on a port there is no rate before, and nothing to ask again.
 
 A scan opens each port once and switches rates on it. On an abort (``should_abort()`` true) it
 returns what it has found so far.
@@ -120,8 +121,13 @@ class _Scan:
             self.on_found(motor)
 
 
-def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int]:
+def _scan_rate(
+    state: _Scan, port: str, bus: DxlBus, broadcast: bool, *, first: bool = False
+) -> set[int]:
     """Scan one (port, rate, protocol); motors answering are confirmed before being reported.
+
+    ``first``: nothing was sent on the port before in this scan, so no late reply from another
+    rate can be taken for a motor here: the motors found are reported without asking again.
 
     Returns:
         IDs heard at this rate that did not confirm: late replies from the rate before.
@@ -174,6 +180,11 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int
         result = ping_found(bus, motor_id, retries=1)
         if result is not None:
             candidates[motor_id] = result
+    if first:
+        for result in candidates.values():
+            state.add(_found(port, bus, result))
+        state.unconfirmed = 0
+        return late - set(candidates)
     unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
     found_here = {f.id for f in state.found if f.baudrate == bus.baudrate}
     return (unconfirmed | late) - found_here
@@ -318,6 +329,7 @@ def scan(
             logger.warning("skipping %s: %s", port, exc)
             continue
         learned = latency_s  # a slower adapter than assumed is learned once, for every rate
+        first = True  # nothing sent on this port yet: nothing can come late from elsewhere
         try:
             for protocol in protocol_list:
                 previous: int | None = None
@@ -327,7 +339,8 @@ def scan(
 
                     timing = (learned, return_delay_s)
                     bus = _scan_bus(port, rate, protocol, transport, *timing)
-                    heard_late = _scan_rate(state, port, bus, broadcast)
+                    heard_late = _scan_rate(state, port, bus, broadcast, first=first)
+                    first = False
                     learned = bus.latency_s
                     if heard_late and previous is not None:
                         earlier = _scan_bus(port, previous, protocol, transport, learned, timing[1])

@@ -107,3 +107,14 @@ def test_a_reply_within_its_deadline_teaches_no_latency() -> None:
         bus._replies.sent(4, 200.0, tx)
         bus._observe(reply, 200.0 + late)
         assert bus.latency_s > 0.001 + 0.003
+
+
+def test_the_first_rate_reports_its_motors_without_asking_again() -> None:
+    # Asking again only unmasks a late reply from the rate tried before; at the first rate on
+    # a port there is none: 10 pings and the 2 model reads, no confirmation pings.
+    motors = [VirtualMotor(model_by_name("MX-28"), i, 1_000_000) for i in (2, 5)]
+    virtual = VirtualBus(motors, 1)
+    with serve_link(virtual) as server:
+        found = scan(server.url, [1_000_000], [1], ids=range(10))
+    assert sorted(f.id for f in found) == [2, 5]
+    assert virtual.packets_received == 10 + 2
