@@ -24,10 +24,13 @@ def ping_found(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
 def settle(bus: DxlBus, min_s: float = 0.0) -> set[int]:
     """Listen for replies still on their way (``min_s`` at least); return who answered late.
 
-    Whatever came is dropped, so that the next rate starts on a clean line; an adaptive bus
-    has learned from it how slow the adapter really is.
+    The quiet time counts from the last instruction sent: a reply comes that long after its
+    instruction at the latest, and whatever came since is kept (the wait for the last reply
+    is part of it). Whatever came is dropped, so that the next rate starts on a clean line; an
+    adaptive bus has learned from it how slow the adapter really is.
     """
-    return {status.id for status in bus.listen(max(settle_s(bus.latency_s), min_s))}
+    quiet_s = max(settle_s(bus.latency_s), min_s)
+    return {status.id for status in bus.listen(max(0.0, quiet_s - bus.transport.since_written_s()))}
 
 
 def answers(bus: DxlBus, motor_id: int) -> bool:

@@ -16,7 +16,8 @@ import pytest
 
 from poppy_core.bus import DxlBus, scan
 from poppy_core.bus import core as bus_core
-from poppy_core.bus.timing import Deadline, instruction_size, status_size
+from poppy_core.bus.settle import settle
+from poppy_core.bus.timing import Deadline, instruction_size, settle_s, status_size
 from poppy_core.emulator import FaultInjector, VirtualBus, VirtualMotor, serve_link
 from poppy_core.models import model_by_name
 from poppy_core.protocol import Instruction, InstructionPacket, StatusPacket
@@ -118,3 +119,26 @@ def test_the_first_rate_reports_its_motors_without_asking_again() -> None:
         found = scan(server.url, [1_000_000], [1], ids=range(10))
     assert sorted(f.id for f in found) == [2, 5]
     assert virtual.packets_received == 10 + 2
+
+
+def test_the_quiet_time_after_a_rate_counts_from_the_last_instruction(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # A late reply comes at most settle_s after its instruction; the wait for the last ping's
+    # reply is part of that time, not added to it.
+    waits: list[float] = []
+
+    class Recorded(Deadline):
+        def __init__(self, duration_s: float | None) -> None:
+            super().__init__(duration_s)
+            waits.append(duration_s or 0.0)
+
+    monkeypatch.setattr(bus_core, "Deadline", Recorded)
+    motor = VirtualMotor(model_by_name("MX-28"), 1, 1_000_000)
+    options = {"latency_s": 0.001, "min_timeout_s": 0.0}
+    with serve_link(VirtualBus([motor], 1)) as server, \
+            DxlBus(server.url, 1_000_000, 1, **options) as bus:  # fmt: skip
+        assert bus.ping(5, retries=0) is None
+        ping_wait = waits[-1]
+        settle(bus)
+    assert waits[-1] <= settle_s(0.001) - ping_wait
