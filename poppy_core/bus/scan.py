@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_bus, find_port
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
-from poppy_core.bus.settle import answers, ping_found, settle
+from poppy_core.bus.settle import answers, doubt_learned, ping_found, settle
 from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S
 from poppy_core.bus.transport import Transport
 from poppy_core.errors import PortError
@@ -122,12 +122,20 @@ class _Scan:
 
 
 def _scan_rate(
-    state: _Scan, port: str, bus: DxlBus, broadcast: bool, *, first: bool = False
+    state: _Scan,
+    port: str,
+    bus: DxlBus,
+    broadcast: bool,
+    *,
+    first: bool = False,
+    last: bool = False,
 ) -> set[int]:
     """Scan one (port, rate, protocol); motors answering are confirmed before being reported.
 
     ``first``: nothing was sent on the port before in this scan, so no late reply from another
     rate can be taken for a motor here: the motors found are reported without asking again.
+    ``last``: no rate comes after on this port; after a trusted broadcast ping no reply is
+    still coming, and the line need not be left quiet.
 
     Returns:
         IDs heard at this rate that did not confirm: late replies from the rate before.
@@ -135,6 +143,7 @@ def _scan_rate(
     candidates: dict[int, PingResult] = {}
     wanted = set(state.ids)
     trusted = False
+    began_s = bus.latency_s
     if bus.proto.has_broadcast_ping and broadcast:
         transport = bus.transport
         corrupt, skipped = transport.corrupt_packets, transport.skipped_bytes
@@ -175,7 +184,8 @@ def _scan_rate(
         finally:
             bus.timeout_s = None
     # Replies still coming are late answers of this rate: wait for them before the next rate.
-    late |= settle(bus) & wanted
+    if not (trusted and last):
+        late |= settle(bus) & wanted
     for motor_id in sorted(late - set(candidates)):
         result = ping_found(bus, motor_id, retries=1)
         if result is not None:
@@ -184,10 +194,13 @@ def _scan_rate(
         for result in candidates.values():
             state.add(_found(port, bus, result))
         state.unconfirmed = 0
-        return late - set(candidates)
-    unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
-    found_here = {f.id for f in state.found if f.baudrate == bus.baudrate}
-    return (unconfirmed | late) - found_here
+        unconfirmed: set[int] = set()
+    else:
+        unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
+    here = [f.id for f in state.found if (f.baudrate, f.protocol) == (bus.baudrate, bus.protocol)]
+    if bus.latency_s > began_s and here:
+        doubt_learned(bus, began_s, max(here))
+    return (unconfirmed | late) - set(here)
 
 
 def _ping_deadline_s(bus: DxlBus) -> float:
@@ -339,7 +352,8 @@ def scan(
 
                     timing = (learned, return_delay_s)
                     bus = _scan_bus(port, rate, protocol, transport, *timing)
-                    heard_late = _scan_rate(state, port, bus, broadcast, first=first)
+                    last = protocol == protocol_list[-1] and rate == rates[protocol][-1]
+                    heard_late = _scan_rate(state, port, bus, broadcast, first=first, last=last)
                     first = False
                     learned = bus.latency_s
                     if heard_late and previous is not None:

@@ -17,7 +17,14 @@ import pytest
 from poppy_core.bus import DxlBus, scan
 from poppy_core.bus import core as bus_core
 from poppy_core.bus.settle import settle
-from poppy_core.bus.timing import Deadline, instruction_size, settle_s, status_size
+from poppy_core.bus.timing import (
+    DEFAULT_RETURN_DELAY_S,
+    Deadline,
+    LinkTiming,
+    instruction_size,
+    settle_s,
+    status_size,
+)
 from poppy_core.emulator import FaultInjector, VirtualBus, VirtualMotor, serve_link
 from poppy_core.models import model_by_name
 from poppy_core.protocol import Instruction, InstructionPacket, StatusPacket
@@ -39,16 +46,17 @@ class LateOnce(FaultInjector):
 
 
 @pytest.fixture
-def ping_waits(monkeypatch: pytest.MonkeyPatch) -> dict[int, list[float]]:
-    """The first-reply wait each ping got, by motor ID (every attempt, in order)."""
-    waits: dict[int, list[float]] = defaultdict(list)
-    pinging: list[int] = []
+def ping_waits(monkeypatch: pytest.MonkeyPatch) -> dict[Any, list[float]]:
+    """The first-reply wait each ping got, by motor ID and by (baud rate, ID), every attempt."""
+    waits: dict[Any, list[float]] = defaultdict(list)
+    pinging: list[tuple[int, int]] = []
     real_exchange = bus_core.BusCore.exchange
 
     class Recorded(Deadline):
         def __init__(self, duration_s: float | None) -> None:
             super().__init__(duration_s)
             if pinging and duration_s is not None:
+                waits[pinging[-1][1]].append(duration_s)
                 waits[pinging[-1]].append(duration_s)
 
     def exchange(
@@ -59,7 +67,7 @@ def ping_waits(monkeypatch: pytest.MonkeyPatch) -> dict[int, list[float]]:
     ) -> dict[int, StatusPacket]:
         ping = packet.instruction == Instruction.PING and packet.id in range(254)
         if ping:
-            pinging.append(packet.id)
+            pinging.append((self.baudrate, packet.id))
         try:
             return real_exchange(self, packet, expected, **options)
         finally:
@@ -72,7 +80,7 @@ def ping_waits(monkeypatch: pytest.MonkeyPatch) -> dict[int, list[float]]:
 
 
 def test_a_reply_late_once_does_not_lengthen_the_scans_wait(
-    ping_waits: dict[int, list[float]],
+    ping_waits: dict[Any, list[float]],
 ) -> None:
     # Motor 3's ping reply comes 15 ms late (the OS ran the emulator late once): it is caught
     # and pinged again after the pass, and every silent ID is waited for as long as ID 0 was.
@@ -87,6 +95,22 @@ def test_a_reply_late_once_does_not_lengthen_the_scans_wait(
     first = ping_waits[0][0]
     silent = [i for i in range(30) if i not in (3, 9)]
     assert {i: ping_waits[i] for i in silent} == {i: [first] for i in silent}
+
+
+def test_a_reply_late_once_does_not_lengthen_the_next_rates_wait(
+    ping_waits: dict[Any, list[float]],
+) -> None:
+    # A motor found at 1 Mbps answers on time when asked again: the latency the late reply
+    # taught is dropped, and 500 kbps is scanned with the deadline of an adapter on time.
+    motors = [VirtualMotor(model_by_name("MX-28"), i, 1_000_000) for i in (3, 9)]
+    virtual = VirtualBus(
+        motors, 1, wire_timing=True, latency_s=0.001, faults=LateOnce(1, 0.015)
+    )
+    with serve_link(virtual) as server:
+        found = scan(server.url, [1_000_000, 500_000], [1], ids=range(30), latency_s=0.001)
+    assert sorted((f.id, f.baudrate) for f in found) == [(3, 1_000_000), (9, 1_000_000)]
+    on_time = LinkTiming(500_000, DEFAULT_RETURN_DELAY_S, 0.001).reply_timeout_s(6, 6)
+    assert all(ping_waits[(500_000, i)] == [pytest.approx(on_time)] for i in range(30))
 
 
 def test_a_reply_within_its_deadline_teaches_no_latency() -> None:
