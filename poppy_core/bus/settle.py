@@ -11,8 +11,8 @@ from poppy_core.errors import CorruptPacketError
 
 logger = logging.getLogger(__name__)
 
-# Pings on time that show a latency just learned came from a busy moment (see doubt_learned).
-DOUBT_PINGS = 2
+# Pings, at most, to tell a slow adapter from a busy moment (see doubt_learned).
+DOUBT_PINGS = 3
 
 
 def ping_found(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
@@ -47,30 +47,33 @@ def answers(bus: DxlBus, motor_id: int) -> bool:
 def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> None:
     """Keep the latency learned at this rate only if a motor found at it still needs it.
 
-    A late reply may come from a slow adapter, or from the one moment the OS ran the other
-    end late (a busy machine). Learned from the latter, a longer wait would cost every silent
-    ID at every rate still to scan (a sweep of 17 rates took 35 s instead of 13 s). So
-    ``motor_id``, found at this rate, is pinged ``DOUBT_PINGS`` times with the deadline of
-    before: answering on time each time, it shows that the adapter keeps up, and the latency of
-    before is restored. A slow adapter misses the first of these deadlines; the latency learned
-    stays.
+    A late reply may come from a slow adapter, or from a moment the OS ran the other end late
+    (a busy machine). Learned from the latter, a longer wait would cost every silent ID at every
+    rate still to scan (one reply 20 ms late made a sweep of 17 rates take 84 s, not 13 s).
+    So ``motor_id``, found at this rate, is pinged with the deadline of before, up to
+    ``DOUBT_PINGS`` times: one answer on time shows that the adapter keeps up, and the latency
+    of before is restored. A slow adapter is late every time (the line is left quiet between
+    the pings, so that a late answer is not taken for the next one's); the latency learned stays.
     """
     learned = bus.latency_s
-    bus.latency_s = before_s
-    for _ in range(DOUBT_PINGS):
+    for attempt in range(DOUBT_PINGS):
+        if attempt:
+            bus.listen(settle_s(learned))  # the last ping's late answer, if it is coming
+        bus.latency_s = before_s
         try:
             on_time = bus.ping(motor_id, retries=0, identify=False) is not None
         except CorruptPacketError:
             on_time = False
-        if not on_time:
-            bus.latency_s = max(learned, bus.latency_s)
-            settle(bus)  # its late reply must not land at the next rate
+        if on_time:
+            logger.info(
+                "%s: motor %d answers on time at %.1f ms: a reply was late once, the adapter "
+                "is not slower (not waiting %.1f ms)",
+                bus.port,
+                motor_id,
+                before_s * 1000,
+                learned * 1000,
+            )
             return
-    logger.info(
-        "%s: motor %d answers on time at %.1f ms: a reply was late once, the adapter is not "
-        "slower (not waiting %.1f ms)",
-        bus.port,
-        motor_id,
-        before_s * 1000,
-        learned * 1000,
-    )
+        learned = max(learned, bus.latency_s)
+    bus.latency_s = learned
+    settle(bus)  # the last ping's late answer must not land at the next rate
