@@ -183,6 +183,8 @@ def _scan_rate(
                 state.report(port, bus, "ping", motor_id, 1)
         finally:
             bus.timeout_s = None
+    if bus.latency_s > began_s and candidates:  # before the waits that follow use it
+        doubt_learned(bus, began_s, max(candidates))
     # Replies still coming are late answers of this rate: wait for them before the next rate.
     if not (trusted and last):
         late |= settle(bus) & wanted

@@ -166,3 +166,26 @@ def test_the_quiet_time_after_a_rate_counts_from_the_last_instruction(
         ping_wait = waits[-1]
         settle(bus)
     assert waits[-1] <= settle_s(0.001) - ping_wait
+
+
+def test_a_reply_late_once_does_not_lengthen_the_quiet_time(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The latency a late reply taught is doubted before the line is left quiet: motor 9, found
+    # on time in the pass, answers on time again, so the quiet time is an on-time adapter's.
+    listened: list[float] = []
+    real_listen = bus_core.BusCore.listen
+
+    def listen(self: bus_core.BusCore, duration_s: float) -> list[StatusPacket]:
+        listened.append(duration_s)
+        return real_listen(self, duration_s)
+
+    monkeypatch.setattr(bus_core.BusCore, "listen", listen)
+    motors = [VirtualMotor(model_by_name("MX-28"), i, 1_000_000) for i in (3, 9)]
+    virtual = VirtualBus(
+        motors, 1, wire_timing=True, latency_s=0.001, faults=LateOnce(3, 0.015)
+    )  # the 3rd reply: motor 9's ping (motor 3's ping and model read came first)
+    with serve_link(virtual) as server:
+        found = scan(server.url, [1_000_000], [1], ids=range(30), latency_s=0.001)
+    assert sorted(f.id for f in found) == [3, 9]
+    assert listened and max(listened) <= settle_s(0.001)
