@@ -15,8 +15,8 @@ How a scan stays fast:
 
 Slow adapters: the deadlines assume the adapter latency known for the port (see
 ``poppy_core.bus.timing``); a reply that came after its deadline raises it for the rest of the
-port's scan (``poppy_core.bus.latency``). The pass that pings each ID keeps the deadline it began
-with, though: a silent ID costs no more than it did, and on an adapter that answers on time a
+port's scan (``poppy_core.bus.latency``). The pass that pings each ID keeps the port's deadline,
+though: a silent ID costs no more than it did, and on an adapter that answers on time a
 reply the OS made late once costs one more ping, not a longer wait at every ID still to ping; a
 slow adapter's replies, late, are caught as strays and their IDs pinged again after the pass,
 with the latency learned. Before motors found at a rate are reported, the line is left quiet for
@@ -38,7 +38,7 @@ from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_bus, find_port
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
 from poppy_core.bus.settle import answers, doubt_learned, ping_found, settle
-from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S
+from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, LinkTiming
 from poppy_core.bus.transport import Transport
 from poppy_core.errors import PortError
 from poppy_core.models import standard_baudrates
@@ -129,13 +129,15 @@ def _scan_rate(
     *,
     first: bool = False,
     last: bool = False,
+    pass_latency_s: float | None = None,
 ) -> set[int]:
     """Scan one (port, rate, protocol); motors answering are confirmed before being reported.
 
     ``first``: nothing was sent on the port before in this scan, so no late reply from another
     rate can be taken for a motor here: the motors found are reported without asking again.
     ``last``: no rate comes after on this port; after a trusted broadcast ping no reply is
-    still coming, and the line need not be left quiet.
+    still coming, and the line need not be left quiet. ``pass_latency_s``: the latency the
+    pass over every ID assumes (the port's, not one learned since; None: the bus's).
 
     Returns:
         IDs heard at this rate that did not confirm: late replies from the rate before.
@@ -168,7 +170,8 @@ def _scan_rate(
     late: set[int] = set()
     if not trusted:
         late.update(s.id for s in bus.take_strays() if s.id in wanted)  # late broadcast replies
-        bus.timeout_s = _ping_deadline_s(bus)  # kept through the pass (module docstring)
+        # The pass keeps the port's deadline, whatever is learned (module docstring).
+        bus.timeout_s = _ping_deadline_s(bus, pass_latency_s or bus.latency_s)
         try:
             for motor_id in state.ids:
                 if state.abort_requested():
@@ -205,11 +208,12 @@ def _scan_rate(
     return (unconfirmed | late) - set(here)
 
 
-def _ping_deadline_s(bus: DxlBus) -> float:
-    """How long a ping waits at ``bus``'s rate with the latency it assumes now."""
+def _ping_deadline_s(bus: DxlBus, latency_s: float) -> float:
+    """How long a ping waits at ``bus``'s rate with an adapter latency of ``latency_s``."""
     proto = bus.proto
     tx, rx = proto.instruction_size(0), proto.status_size(proto.ping_params)
-    return bus.timing.reply_timeout_s(tx, rx)
+    timing = LinkTiming(bus.baudrate, bus.timing.return_delay_s, latency_s)
+    return timing.reply_timeout_s(tx, rx)
 
 
 def _scan_bus(
@@ -345,6 +349,7 @@ def scan(
             continue
         learned = latency_s  # a slower adapter than assumed is learned once, for every rate
         first = True  # nothing sent on this port yet: nothing can come late from elsewhere
+        assumed: float | None = None  # the port's latency, before anything is learned
         try:
             for protocol in protocol_list:
                 previous: int | None = None
@@ -355,7 +360,10 @@ def scan(
                     timing = (learned, return_delay_s)
                     bus = _scan_bus(port, rate, protocol, transport, *timing)
                     last = protocol == protocol_list[-1] and rate == rates[protocol][-1]
-                    heard_late = _scan_rate(state, port, bus, broadcast, first=first, last=last)
+                    assumed = bus.latency_s if assumed is None else assumed
+                    heard_late = _scan_rate(
+                        state, port, bus, broadcast, first=first, last=last, pass_latency_s=assumed
+                    )
                     first = False
                     learned = bus.latency_s
                     if heard_late and previous is not None:

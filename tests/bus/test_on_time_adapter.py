@@ -189,3 +189,18 @@ def test_a_reply_late_once_does_not_lengthen_the_quiet_time(
         found = scan(server.url, [1_000_000], [1], ids=range(30), latency_s=0.001)
     assert sorted(f.id for f in found) == [3, 9]
     assert listened and max(listened) <= settle_s(0.001)
+
+
+def test_a_slow_adapters_silent_ids_wait_the_ports_deadline(
+    ping_waits: dict[Any, list[float]],
+) -> None:
+    # Behind an 8 ms adapter the latency learned at 1 Mbps stays (its motors are late when
+    # asked again), yet 500 kbps's silent IDs wait the port's deadline: a late reply is caught
+    # as a stray and asked again after the pass, with the latency learned.
+    motors = [VirtualMotor(model_by_name("MX-28"), i, 1_000_000) for i in (1, 2)]
+    virtual = VirtualBus(motors, 1, wire_timing=True, latency_s=0.008)
+    with serve_link(virtual) as server:
+        found = scan(server.url, [1_000_000, 500_000], [1], ids=range(6), latency_s=0.001)
+    assert sorted((f.id, f.baudrate) for f in found) == [(1, 1_000_000), (2, 1_000_000)]
+    on_time = LinkTiming(500_000, DEFAULT_RETURN_DELAY_S, 0.001).reply_timeout_s(6, 6)
+    assert all(ping_waits[(500_000, i)][0] == pytest.approx(on_time) for i in range(6))
