@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 
-.PHONY: run test test-fast lint completions bench clean sim-deps
+.PHONY: run test test-fast test-loaded lint completions bench clean sim-deps
 
 $(BIN)/activate:
 	@echo "creating the virtualenv $(VENV)…"
@@ -40,6 +40,14 @@ test: $(VENV)/.installed-test
 test-fast: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
 	$(BIN)/pytest -q -m "not slow" -n $(TEST_WORKERS) --dist loadgroup
+
+# The whole suite with LOOPS busy loops beside it (default 2, one per core), as on a shared CI
+# machine: a test that measures a timing instead of an arrival, an order or a shape fails here.
+# tests/loaded.sh stops the loops when the run ends. TARGET=test-fast for the inner loop.
+LOOPS ?= 2
+TARGET ?= test
+test-loaded: $(VENV)/.installed-test
+	LOOPS=$(LOOPS) sh tests/loaded.sh $(MAKE) $(TARGET)
 
 lint: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+from pathlib import Path
 
 from bench import (
     camera_bench,
@@ -51,6 +52,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--minutes", type=float, default=None, help="duration of the soak, per robot (default 10)"
     )
+    parser.add_argument(
+        "--baseline",
+        type=Path,
+        default=None,
+        help="another checkout of poppy (e.g. `git worktree add /tmp/old REV`) that `scan` "
+        "measures beside this one, alternately",
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="bench: %(message)s")
     if args.list:
@@ -63,7 +71,9 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"unknown benchmark(s) {', '.join(unknown)}" if unknown else "--repeat < 1")
     if args.minutes is not None and not args.minutes > 0:
         parser.error("--minutes must be > 0")
-    ctx = BenchContext(repeat=args.repeat, minutes=args.minutes)
+    if args.baseline is not None and not (args.baseline / "poppy_core").is_dir():
+        parser.error(f"--baseline {args.baseline}: no poppy_core folder there (a poppy checkout)")
+    ctx = BenchContext(repeat=args.repeat, minutes=args.minutes, baseline=args.baseline)
     if args.no_peers:
         ctx.peers_note = "run with --no-peers"
     else:

@@ -38,7 +38,13 @@ def _children_cpu_s() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def run_client(args: list[str], *, json_lines: bool = True) -> ClientRun:
+def run_client(
+    args: list[str],
+    *,
+    json_lines: bool = True,
+    cwd: Path = REPO_ROOT,
+    env: dict[str, str] | None = None,
+) -> ClientRun:
     """Run one client to completion and parse the JSON it prints.
 
     Clients run one at a time, so the growth of ``RUSAGE_CHILDREN`` is this client's CPU time.
@@ -47,6 +53,8 @@ def run_client(args: list[str], *, json_lines: bool = True) -> ClientRun:
         args: the command line.
         json_lines: the output is one JSON line (a peer script); False for a JSON document
             (``poppy scan --json``), returned as ``{"output": ...}``.
+        cwd: the folder it runs in (another checkout for a baseline client).
+        env: its environment (None: this process's).
 
     Returns:
         The parsed record, wall time and CPU time.
@@ -59,7 +67,8 @@ def run_client(args: list[str], *, json_lines: bool = True) -> ClientRun:
             capture_output=True,
             text=True,
             timeout=CLIENT_TIMEOUT_S,
-            cwd=REPO_ROOT,
+            cwd=cwd,
+            env=env,
             check=False,
         )
     except (OSError, subprocess.TimeoutExpired) as exc:

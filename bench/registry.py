@@ -23,12 +23,15 @@ class BenchContext:
         peers_python: the peers venv's interpreter, or None when the peers are unavailable.
         peers_note: why the peers are unavailable (empty when they are).
         minutes: duration of the long benchmarks (``soak``), None for their default.
+        baseline: another checkout of poppy measured beside this one, alternately, by the
+            benchmarks that support it (``scan``); None for none.
     """
 
     repeat: int = 3
     peers_python: Path | None = None
     peers_note: str = ""
     minutes: float | None = None
+    baseline: Path | None = None
 
 
 @dataclass

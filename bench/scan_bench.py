@@ -2,12 +2,15 @@
 
 Two emulators run in their own processes (``poppy emulate --wire-timing --latency-ms 1``): a
 protocol 1 bus and a protocol 2 bus, both at 1 Mbps. Every client runs as a subprocess, one at
-a time, and each measurement is repeated ``BenchContext.repeat`` times.
+a time, and each measurement is repeated ``BenchContext.repeat`` times. With ``--baseline DIR``
+the poppy of another checkout scans too, right before or after this one in every round (the
+order swaps each round), so that both see the same load (see bench/scan_baseline.py).
 """
 
 from __future__ import annotations
 
 import logging
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -21,6 +24,7 @@ from bench.registry import (
     BenchResult,
     register,
 )
+from bench.scan_baseline import BASELINE_CLIENT, baseline_label
 from bench.scan_report import build_result
 
 logger = logging.getLogger(__name__)
@@ -58,10 +62,13 @@ class Client:
     name: str
     peer: bool
     timed_by: str  # "scan": the client's own scan time; "wall": the whole process
+    baseline: bool = False  # poppy from the --baseline checkout
 
 
-def _clients(bus: BusSpec, peers: bool) -> list[Client]:
+def _clients(bus: BusSpec, peers: bool, baseline: bool) -> list[Client]:
     clients = [Client("poppy", False, "scan")]
+    if baseline:
+        clients.append(Client(BASELINE_CLIENT, False, "scan", baseline=True))
     if bus.protocol == 2:
         clients.append(Client("poppy (no broadcast)", False, "scan"))
     clients.append(Client("poppy scan CLI", False, "wall"))
@@ -94,8 +101,14 @@ def _found_ids(client: Client, run: ClientRun, bus: BusSpec) -> list[int]:
 def _measure(
     client: Client, bus: BusSpec, emu: EmulatorProcess, ctx: BenchContext
 ) -> dict[str, Any]:
+    where: dict[str, Any] = {}
+    if client.baseline and ctx.baseline is not None:  # its own poppy_core and client script
+        where = {"cwd": ctx.baseline, "env": {**os.environ, "PYTHONPATH": str(ctx.baseline)}}
+    load1 = os.getloadavg()[0]
     emu_cpu = emu.cpu_s()
-    run = run_client(_argv(client, bus, emu.port, ctx), json_lines=client.timed_by == "scan")
+    run = run_client(
+        _argv(client, bus, emu.port, ctx), json_lines=client.timed_by == "scan", **where
+    )
     emu_cpu = emu.cpu_s() - emu_cpu
     found = _found_ids(client, run, bus) if not run.record.get("error") else []
     problem = run.record.get("error")
@@ -112,6 +125,7 @@ def _measure(
         "wall_s": run.wall_s,
         "cpu_s": run.cpu_s,
         "emulator_cpu_s": emu_cpu,
+        "load1": load1,
         "found": found,
         "record": run.record,
     }
@@ -163,9 +177,12 @@ def scan_benchmark(ctx: BenchContext) -> BenchResult:
             continue
         emulators.append({"protocol": bus.protocol, "command": emu.command, "label": bus.label})
         try:
-            clients = _clients(bus, ctx.peers_python is not None)
+            clients = _clients(bus, ctx.peers_python is not None, ctx.baseline is not None)
             for rep in range(ctx.repeat):
-                for client in clients:
+                order = list(clients)
+                if ctx.baseline is not None and rep % 2:
+                    order[0], order[1] = order[1], order[0]  # neither always runs first
+                for client in order:
                     runs.append({"rep": rep, **_measure(client, bus, emu, ctx)})
             for rep in range(ctx.repeat):
                 sweeps.append({"rep": rep, **_sweep(bus, emu)})
@@ -187,4 +204,5 @@ def scan_benchmark(ctx: BenchContext) -> BenchResult:
         errors=errors,
         peers_note=ctx.peers_note,
         repeat=ctx.repeat,
+        baseline=baseline_label(ctx.baseline) if ctx.baseline is not None else None,
     )

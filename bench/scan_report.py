@@ -7,6 +7,7 @@ from collections import defaultdict
 from typing import Any
 
 from bench.registry import BenchResult, Table
+from bench.scan_baseline import BASELINE_CLIENT, baseline_table
 from bench.stats import fmt_range, fmt_ratio, fmt_s, summary
 
 GOAL_SCAN_S = 1.0
@@ -67,7 +68,7 @@ def _scan_table(aggs: dict[tuple[int, str], dict[str, Any]]) -> tuple[Table, boo
                 verdict += f" ({agg['scan']['median'] - GOAL_SCAN_S:.2f} s over)"
         if not agg["ok"]:
             verdict = f"**FAIL**: {agg['problem']}"
-            if client.startswith("poppy"):
+            if client.startswith("poppy") and client != BASELINE_CLIENT:
                 passed = False  # poppy finding the wrong motors fails the benchmark
         timed = agg["ok"]
         rows.append(
@@ -244,7 +245,7 @@ def _notes(
 ) -> list[str]:
     notes = [f"Could not run: {e}." for e in errors]
     for (protocol, client), agg in aggs.items():
-        if client.startswith("poppy") and not agg["ok"]:
+        if client.startswith("poppy") and client != BASELINE_CLIENT and not agg["ok"]:
             notes.append(
                 f"**Correctness failure**: `{client}` on the protocol {protocol} bus, "
                 f"{agg['problem']}. A scan that misses motors is a bug, not noise; it fails this "
@@ -310,6 +311,7 @@ def build_result(
     errors: list[str],
     peers_note: str,
     repeat: int,
+    baseline: str | None = None,
 ) -> BenchResult:
     """Assemble the scan benchmark's result from its raw runs.
 
@@ -321,6 +323,7 @@ def build_result(
         errors: emulators that could not start.
         peers_note: why the peers were not measured (empty when they were).
         repeat: runs per measurement.
+        baseline: the label of the checkout measured beside this one (None: none).
 
     Returns:
         The benchmark result (tables, notes, pass/fail, raw data).
@@ -328,6 +331,11 @@ def build_result(
     aggs = {key: _aggregate(group) for key, group in _group(runs).items()}
     scan_table, scan_ok = _scan_table(aggs)
     totals, rates, sweep_ok, analysis = _sweep_tables(sweeps)
+    side: list[Table] = []
+    side_notes: list[str] = []
+    if baseline is not None:
+        table, side_notes = baseline_table(runs, baseline)
+        side = [table]
     raw = {
         "buses": buses,
         "emulators": emulators,
@@ -338,13 +346,14 @@ def build_result(
         "runs": runs,
         "sweeps": sweeps,
         "errors": errors,
+        "baseline": baseline,
     }
     return BenchResult(
         name="scan",
         title="Bus scan",
         intro=INTRO + f" Each measurement is repeated {repeat} times; the median is reported.",
-        tables=[scan_table, _ratio_table(aggs), totals, rates],
-        notes=_notes(aggs, analysis, peers_note, errors),
+        tables=[scan_table, *side, _ratio_table(aggs), totals, rates],
+        notes=side_notes + _notes(aggs, analysis, peers_note, errors),
         passed=scan_ok and sweep_ok and not errors,
         raw=raw,
     )

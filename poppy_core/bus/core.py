@@ -23,7 +23,7 @@ from collections import deque
 from collections.abc import Sequence
 from types import TracebackType
 
-from poppy_core.bus.latency import ReplyClock, learned_latency_s
+from poppy_core.bus.latency import ReplyClock
 from poppy_core.bus.results import BusStats
 from poppy_core.bus.timing import (
     DEFAULT_RETURN_DELAY_S,
@@ -195,17 +195,21 @@ class BusCore:
             self._timing = LinkTiming(self.baudrate, self._timing.return_delay_s, latency_s)
 
     def _observe(self, status: StatusPacket, at_s: float) -> None:
-        """Time a reply against its instruction; learn a slower adapter (``adaptive_latency``)."""
+        """Time a reply against its instruction; a late one teaches a slower adapter.
+
+        Only on an ``adaptive_latency`` bus, and only from a reply that came after its deadline
+        (see ``poppy_core.bus.latency``).
+        """
         if not self.adaptive_latency:
             return
-        shown = self._replies.latency_of(status, at_s, self._timing, self._protocol)
-        if shown is not None and shown > self._latency_s:
-            self.latency_s = learned_latency_s(shown)
+        learned = self._replies.learn(status, at_s, self._timing, self._protocol)
+        if learned is not None:
+            self.latency_s = learned
             logger.info(
-                "%s: a reply took %.1f ms more than the wire needs: waiting %.1f ms from now on",
+                "%s: a reply came late, the adapter is slower than assumed: waiting %.1f ms "
+                "from now on",
                 self._port,
-                shown * 1000,
-                self._latency_s * 1000,
+                learned * 1000,
             )
 
     @property

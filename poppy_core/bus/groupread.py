@@ -289,9 +289,11 @@ def fast_sync_read(
 def broadcast_ping(bus: DxlBus) -> list[PingResult]:
     """``DxlBus.broadcast_ping``: collect every reply until the line has been quiet long enough.
 
-    The first reply is awaited for one physical round trip; each reply then extends the wait by
-    the time one more reply needs (return delay + its bytes + latency + margin): motors answer
-    one after the other, so a silence that long means the last one has spoken.
+    The first reply is awaited for one physical round trip, and at least the bus's
+    ``min_timeout_s`` as every other transaction (a scan's bus has none); each reply then
+    extends the wait by the time one more reply needs (return delay + its bytes + latency +
+    margin): motors answer one after the other, so a silence that long means the last one has
+    spoken.
     """
     timing = bus.timing
     size = status_size(2, 3)
@@ -300,9 +302,8 @@ def broadcast_ping(bus: DxlBus) -> list[PingResult]:
         bus.stats.transactions += 1
         transport = bus.transport
         bus.exchange(ins.ping(BROADCAST_ID), [])
-        deadline = Deadline(
-            timing.reply_timeout_s(len(encode_instruction(2, ins.ping(BROADCAST_ID))), size)
-        )
+        first = timing.reply_timeout_s(len(encode_instruction(2, ins.ping(BROADCAST_ID))), size)
+        deadline = Deadline(max(first, bus.min_timeout_s))
         while True:
             status = transport.read_packet(deadline, grace_s=timing.grace_s(size))
             if status is None:

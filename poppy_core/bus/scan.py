@@ -14,10 +14,15 @@ How a scan stays fast:
   The second broadcast costs one round trip, a few ms at 1 Mbps.
 
 Slow adapters: the deadlines assume the adapter latency known for the port (see
-``poppy_core.bus.timing``); a reply slower than that raises it for the rest of the port's scan
-(``poppy_core.bus.latency``). Before motors found at a rate are reported, the line is left quiet
-for a few latencies and they are asked again: a reply that came late from the rate tried before
-(and was taken for an answer at this one) does not answer twice, and is dropped.
+``poppy_core.bus.timing``); a reply that came after its deadline raises it for the rest of the
+port's scan (``poppy_core.bus.latency``). The pass that pings each ID keeps the port's deadline,
+though: a silent ID costs no more than it did, and on an adapter that answers on time a
+reply the OS made late once costs one more ping, not a longer wait at every ID still to ping; a
+slow adapter's replies, late, are caught as strays and their IDs pinged again after the pass,
+with the latency learned. Before motors found at a rate are reported, the line is left quiet for
+a few latencies and they are asked again: a reply that came late from the rate tried before (and
+was taken for an answer at this one) does not answer twice, and is dropped. At the first rate
+tried on a port there is no rate before, and nothing to ask again.
 
 A scan opens each port once and switches rates on it. On an abort (``should_abort()`` true) it
 returns what it has found so far.
@@ -32,8 +37,8 @@ from dataclasses import dataclass, field
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_bus, find_port
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
-from poppy_core.bus.settle import answers, ping_found, settle
-from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S
+from poppy_core.bus.settle import answers, doubt_learned, ping_found, settle
+from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, LinkTiming
 from poppy_core.bus.transport import Transport
 from poppy_core.errors import PortError
 from poppy_core.models import standard_baudrates
@@ -116,8 +121,23 @@ class _Scan:
             self.on_found(motor)
 
 
-def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int]:
+def _scan_rate(
+    state: _Scan,
+    port: str,
+    bus: DxlBus,
+    broadcast: bool,
+    *,
+    first: bool = False,
+    last: bool = False,
+    pass_latency_s: float | None = None,
+) -> set[int]:
     """Scan one (port, rate, protocol); motors answering are confirmed before being reported.
+
+    ``first``: nothing was sent on the port before in this scan, so no late reply from another
+    rate can be taken for a motor here: the motors found are reported without asking again.
+    ``last``: no rate comes after on this port; after a trusted broadcast ping no reply is
+    still coming, and the line need not be left quiet. ``pass_latency_s``: the latency the
+    pass over every ID assumes (the port's, not one learned since; None: the bus's).
 
     Returns:
         IDs heard at this rate that did not confirm: late replies from the rate before.
@@ -125,6 +145,7 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int
     candidates: dict[int, PingResult] = {}
     wanted = set(state.ids)
     trusted = False
+    began_s = bus.latency_s
     if bus.proto.has_broadcast_ping and broadcast:
         transport = bus.transport
         corrupt, skipped = transport.corrupt_packets, transport.skipped_bytes
@@ -149,26 +170,50 @@ def _scan_rate(state: _Scan, port: str, bus: DxlBus, broadcast: bool) -> set[int
     late: set[int] = set()
     if not trusted:
         late.update(s.id for s in bus.take_strays() if s.id in wanted)  # late broadcast replies
-        for motor_id in state.ids:
-            if state.abort_requested():
-                break
-            if motor_id not in candidates:
-                result = ping_found(bus, motor_id, retries=0)
-                if result is not None:
-                    candidates[motor_id] = result
-                    state.unconfirmed = len(candidates)
-                strays = bus.take_strays()
-                late.update(s.id for s in strays if s.id in wanted and s.id not in candidates)
-            state.report(port, bus, "ping", motor_id, 1)
+        # The pass keeps the port's deadline, whatever is learned (module docstring).
+        bus.timeout_s = _ping_deadline_s(bus, pass_latency_s or bus.latency_s)
+        try:
+            for motor_id in state.ids:
+                if state.abort_requested():
+                    break
+                if motor_id not in candidates:
+                    result = ping_found(bus, motor_id, retries=0)
+                    if result is not None:
+                        candidates[motor_id] = result
+                        state.unconfirmed = len(candidates)
+                    strays = bus.take_strays()
+                    late.update(s.id for s in strays if s.id in wanted and s.id not in candidates)
+                state.report(port, bus, "ping", motor_id, 1)
+        finally:
+            bus.timeout_s = None
+    if bus.latency_s > began_s and candidates:  # before the waits that follow use it
+        doubt_learned(bus, began_s, max(candidates))
     # Replies still coming are late answers of this rate: wait for them before the next rate.
-    late |= settle(bus) & wanted
+    if not (trusted and last):
+        late |= settle(bus) & wanted
     for motor_id in sorted(late - set(candidates)):
         result = ping_found(bus, motor_id, retries=1)
         if result is not None:
             candidates[motor_id] = result
-    unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
-    found_here = {f.id for f in state.found if f.baudrate == bus.baudrate}
-    return (unconfirmed | late) - found_here
+    if first:
+        for result in candidates.values():
+            state.add(_found(port, bus, result))
+        state.unconfirmed = 0
+        unconfirmed: set[int] = set()
+    else:
+        unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
+    here = [f.id for f in state.found if (f.baudrate, f.protocol) == (bus.baudrate, bus.protocol)]
+    if bus.latency_s > began_s and here:
+        doubt_learned(bus, began_s, max(here))
+    return (unconfirmed | late) - set(here)
+
+
+def _ping_deadline_s(bus: DxlBus, latency_s: float) -> float:
+    """How long a ping waits at ``bus``'s rate with an adapter latency of ``latency_s``."""
+    proto = bus.proto
+    tx, rx = proto.instruction_size(0), proto.status_size(proto.ping_params)
+    timing = LinkTiming(bus.baudrate, bus.timing.return_delay_s, latency_s)
+    return timing.reply_timeout_s(tx, rx)
 
 
 def _scan_bus(
@@ -303,6 +348,8 @@ def scan(
             logger.warning("skipping %s: %s", port, exc)
             continue
         learned = latency_s  # a slower adapter than assumed is learned once, for every rate
+        first = True  # nothing sent on this port yet: nothing can come late from elsewhere
+        assumed: float | None = None  # the port's latency, before anything is learned
         try:
             for protocol in protocol_list:
                 previous: int | None = None
@@ -312,7 +359,12 @@ def scan(
 
                     timing = (learned, return_delay_s)
                     bus = _scan_bus(port, rate, protocol, transport, *timing)
-                    heard_late = _scan_rate(state, port, bus, broadcast)
+                    last = protocol == protocol_list[-1] and rate == rates[protocol][-1]
+                    assumed = bus.latency_s if assumed is None else assumed
+                    heard_late = _scan_rate(
+                        state, port, bus, broadcast, first=first, last=last, pass_latency_s=assumed
+                    )
+                    first = False
                     learned = bus.latency_s
                     if heard_late and previous is not None:
                         earlier = _scan_bus(port, previous, protocol, transport, learned, timing[1])

@@ -11,6 +11,9 @@ from poppy_core.errors import CorruptPacketError
 
 logger = logging.getLogger(__name__)
 
+# Pings, at most, to tell a slow adapter from a busy moment (see doubt_learned).
+DOUBT_PINGS = 3
+
 
 def ping_found(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
     """Ping ``motor_id`` as a search does: garbage in reply counts as no reply."""
@@ -24,10 +27,13 @@ def ping_found(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
 def settle(bus: DxlBus, min_s: float = 0.0) -> set[int]:
     """Listen for replies still on their way (``min_s`` at least); return who answered late.
 
-    Whatever came is dropped, so that the next rate starts on a clean line; an adaptive bus
-    has learned from it how slow the adapter really is.
+    The quiet time counts from the last instruction sent: a reply comes that long after its
+    instruction at the latest, and whatever came since is kept (the wait for the last reply
+    is part of it). Whatever came is dropped, so that the next rate starts on a clean line; an
+    adaptive bus has learned from it how slow the adapter really is.
     """
-    return {status.id for status in bus.listen(max(settle_s(bus.latency_s), min_s))}
+    quiet_s = max(settle_s(bus.latency_s), min_s)
+    return {status.id for status in bus.listen(max(0.0, quiet_s - bus.transport.since_written_s()))}
 
 
 def answers(bus: DxlBus, motor_id: int) -> bool:
@@ -36,3 +42,38 @@ def answers(bus: DxlBus, motor_id: int) -> bool:
         return bus.ping(motor_id, retries=1, identify=False) is not None
     except CorruptPacketError:
         return False
+
+
+def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> None:
+    """Keep the latency learned at this rate only if a motor found at it still needs it.
+
+    A late reply may come from a slow adapter, or from a moment the OS ran the other end late
+    (a busy machine). Learned from the latter, a longer wait would cost every silent ID at every
+    rate still to scan (one reply 20 ms late made a sweep of 17 rates take 84 s, not 13 s).
+    So ``motor_id``, found at this rate, is pinged with the deadline of before, up to
+    ``DOUBT_PINGS`` times: one answer on time shows that the adapter keeps up, and the latency
+    of before is restored. A slow adapter is late every time (the line is left quiet between
+    the pings, so that a late answer is not taken for the next one's); the latency learned stays.
+    """
+    learned = bus.latency_s
+    for attempt in range(DOUBT_PINGS):
+        if attempt:
+            bus.listen(settle_s(learned))  # the last ping's late answer, if it is coming
+        bus.latency_s = before_s
+        try:
+            on_time = bus.ping(motor_id, retries=0, identify=False) is not None
+        except CorruptPacketError:
+            on_time = False
+        if on_time:
+            logger.info(
+                "%s: motor %d answers on time at %.1f ms: a reply was late once, the adapter "
+                "is not slower (not waiting %.1f ms)",
+                bus.port,
+                motor_id,
+                before_s * 1000,
+                learned * 1000,
+            )
+            return
+        learned = max(learned, bus.latency_s)
+    bus.latency_s = learned
+    settle(bus)  # the last ping's late answer must not land at the next rate

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from collections import deque
 from collections.abc import Callable
 
@@ -50,6 +51,8 @@ class Transport:
         self._packets: deque[StatusPacket] = deque()
         self.bytes_received = 0
         """Bytes read from the line since the port was opened."""
+        self.written_at = float("-inf")
+        """``time.monotonic()`` when bytes were last written (-inf: never)."""
         self._line = line if line is not None else open_line(port, baudrate, exclusive=exclusive)
 
     # -- configuration ------------------------------------------------------------------------
@@ -108,6 +111,11 @@ class Transport:
             PortError: the port went away (adapter unplugged, server closed).
         """
         self._line.write(data)
+        self.written_at = time.monotonic()
+
+    def since_written_s(self) -> float:
+        """Seconds since bytes were last written (infinite before the first write)."""
+        return time.monotonic() - self.written_at
 
     def _read_available(self, wait_s: float | None) -> bytes:
         """Wait up to ``wait_s`` (None: forever) for bytes and return what is there."""

@@ -259,3 +259,11 @@ def test_fixed_timeout_overrides_the_physical_estimate(emulate: Emulate) -> None
         virtual.extra_delay_s = 0.05  # far beyond the physical estimate, within 0.2 s
         assert bus.ping(4) is not None
         assert bus.stats.timeouts == 0
+
+
+def test_broadcast_ping_waits_at_least_the_buses_floor(emulate: Emulate) -> None:
+    # Replies 4 ms behind the latency assumed (the OS ran the emulator late, under load) come
+    # within the 10 ms floor every transaction of a bus gets (a scan's bus has no floor).
+    slow = emulate("XL430-W250:1-2", protocol=2, wire_timing=True, latency_s=0.004)
+    with slow as (_, url), DxlBus(url, protocol=2, latency_s=0.001) as bus:
+        assert [p.id for p in bus.broadcast_ping()] == [1, 2]

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import importlib
-import time
 from typing import TYPE_CHECKING
 
 import pytest
@@ -85,13 +84,11 @@ def test_scan_abort_and_on_found(emulate: Emulate) -> None:
     assert len(calls) == 10
 
 
-def test_scan_at_1mbps_is_fast_with_wire_timing(emulate: Emulate) -> None:
+def test_scan_at_1mbps_with_wire_timing_finds_every_motor(emulate: Emulate) -> None:
+    # How fast: `python -m bench scan` (docs/performance.md), not a bound a busy machine breaks.
     with emulate("MX-28:1-6", wire_timing=True, latency_s=0.001) as (_, url):
-        start = time.perf_counter()
         found = scan(url, [1_000_000], [1])
-        elapsed = time.perf_counter() - start
     assert [f.id for f in found] == [1, 2, 3, 4, 5, 6]
-    assert elapsed < 3.0  # goal: < 1 s; generous margin against loaded CI machines
 
 
 def test_scan_over_tcp(emulate: Emulate) -> None:

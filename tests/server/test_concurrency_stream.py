@@ -54,11 +54,8 @@ def test_v1_waiting_goto_does_not_block_either(client: httpx.Client, served: Ser
         body = {"positions": {"m2": 20}, "duration_s": 3.0, "wait": True}
         future = pool.submit(lambda: httpx.post(f"{served.url}/api/v1/gotos", json=body))
         time.sleep(0.2)
-        t0 = time.monotonic()
         assert client.get("/api/v1/robot/state").status_code == 200
-        # answered while the goto still waits (a blocked server would answer 2.8 s later)
-        assert time.monotonic() - t0 < 1.5
-        assert not future.done()
+        assert not future.done()  # answered while the 3 s goto still waits, not after it
         answer = future.result(timeout=5)
     assert answer.status_code == 200
     assert answer.json()["done"] is True

@@ -115,7 +115,7 @@ def test_record_saves_the_followers_trajectory(
                              record=path, record_metadata={"robot": "ergo-jr"}).run()  # fmt: skip
     move = read_move(path)
     assert move.motors == ("m1",) and move.framerate == 50
-    assert move.duration_s == pytest.approx(1.5, abs=0.2)
+    assert 1.45 <= move.duration_s < 2.5  # the 1.5 s on the 50 Hz grid; its end may come late
     assert report.recorded_frames == len(move) and move.metadata["robot"] == "ergo-jr"
     assert max(move.positions[:, 0]) - min(move.positions[:, 0]) > 5.0  # it moved
 

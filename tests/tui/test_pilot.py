@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import pytest
 
 from poppy_cli.tui.app import make_app
@@ -184,10 +182,8 @@ async def test_abort_stops_a_scan(xl320_server: Endpoint) -> None:
         screen = app.main
         await pilot.pause(0.3)
         assert screen.scanning
-        start = time.monotonic()
         await pilot.press("escape")
+        # every rate of both protocols takes far longer than the 5 s this waits for the end
         await wait_for(pilot, lambda: screen.last_scan is not None, timeout_s=5, what="abort")
-        elapsed = time.monotonic() - start
         assert screen.last_scan is not None and screen.last_scan.aborted
-        assert elapsed < 2.0
         assert not [w for w in screen.workers if w.group == "scan" and w.is_running]
