@@ -35,7 +35,7 @@ from poppy_core.robot.health import BusHealth, LoopStats, SyncStats
 from poppy_core.robot.loops import BASE_LOOPS, LIGHT_LOOPS, LoopSpec, loops_for
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.motor_link import link_of
-from poppy_core.robot.schedule import Periodic, RateMeter
+from poppy_core.schedule import Backoff, Periodic, RateMeter
 
 logger = logging.getLogger(__name__)
 
@@ -113,7 +113,7 @@ class BusSync:
         self.connected = True
         self.losses = 0
         self._down_since = 0.0
-        self._backoff_s = RECONNECT_FIRST_S
+        self._backoff = Backoff(RECONNECT_FIRST_S, RECONNECT_MAX_S)
         self._next_reopen = 0.0
 
     @property
@@ -286,8 +286,7 @@ class BusSync:
         self.connected = False
         self.losses += 1
         self._down_since = self._clock()
-        self._backoff_s = RECONNECT_FIRST_S
-        self._next_reopen = self._down_since + self._backoff_s
+        self._next_reopen = self._down_since + self._backoff.reset()
         for motor in self.motors:
             link_of(motor).mark_offline()
         logger.warning(
@@ -304,8 +303,7 @@ class BusSync:
         try:
             self.bus.reopen()
         except PortError as exc:
-            self._backoff_s = min(2 * self._backoff_s, RECONNECT_MAX_S)
-            self._next_reopen = self._clock() + self._backoff_s
+            self._next_reopen = self._clock() + self._backoff.failed()
             logger.debug("%s: %s still away (%s)", self.controller, self.bus.port, exc)
             return
         now = self._clock()

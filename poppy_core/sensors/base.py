@@ -15,15 +15,15 @@ until the sensor's first use, so a camera nobody reads still grabs nothing.
 from __future__ import annotations
 
 import logging
-import math
 import threading
 import time
-from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from poppy_core.errors import SensorError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, SensorError
+from poppy_core.schedule import Backoff, Periodic, RateMeter
 
 logger = logging.getLogger(__name__)
 
@@ -85,22 +85,6 @@ class SensorHealth:
         return data
 
 
-class _Rate:
-    """Updates per second over the last few updates (0 once they are stale)."""
-
-    def __init__(self, window: int = 30) -> None:
-        self._times: deque[float] = deque(maxlen=window)
-
-    def tick(self, now_s: float) -> None:
-        self._times.append(now_s)
-
-    def at(self, now_s: float, stale_s: float) -> float:
-        if len(self._times) < 2 or now_s - self._times[-1] > stale_s:
-            return 0.0
-        span = self._times[-1] - self._times[0]
-        return (len(self._times) - 1) / span if span > 0 else 0.0
-
-
 class Sensor:
     """Base of every sensor: subclasses give ``registers`` and implement ``update``.
 
@@ -118,11 +102,10 @@ class Sensor:
     def __init__(
         self, name: str, rate_hz: float, *, clock: Callable[[], float] = time.monotonic
     ) -> None:
-        if not rate_hz > 0 or not math.isfinite(rate_hz):
-            raise SensorError(
-                f"sensor {name!r}: its rate must be a positive number of Hz, got {rate_hz}",
-                sensor=name,
-            )
+        try:
+            checks.rate(rate_hz, "its rate")
+        except ArgumentError as exc:
+            raise SensorError(f"sensor {name!r}: {exc}", sensor=name) from None
         self._name = name
         self._rate_hz = float(rate_hz)
         self._clock = clock
@@ -131,7 +114,7 @@ class Sensor:
         self._first = threading.Event()
         self._thread: threading.Thread | None = None
         self._closed = False
-        self._rate = _Rate()
+        self._rate = RateMeter(window=30)
         self._connected = True
         self._down_since = 0.0
         self._losses = 0
@@ -299,7 +282,7 @@ class Sensor:
             running=self.running,
             down_s=0.0 if self._connected else now - self._down_since,
             losses=self._losses,
-            rate_hz=self._rate.at(now, max(1.0, 3.0 / self._rate_hz)),
+            rate_hz=self._rate.rate_at(now, max(1.0, 3.0 / self._rate_hz)),
             target_hz=self._rate_hz,
             errors=self._errors,
             last_error=self._last_error,
@@ -321,8 +304,7 @@ class Sensor:
                 logger.exception("sensor %s: cleaning up its thread", self._name)
 
     def _loop(self) -> None:
-        period = 1.0 / self._rate_hz
-        deadline = self._clock()
+        schedule = Periodic(1.0 / self._rate_hz, self._clock(), catch_up=1)
         while not self._stop.is_set():
             if self._connected:
                 self._step()
@@ -331,11 +313,9 @@ class Sensor:
                 if self._park():
                     return
                 continue
-            deadline += period
             now = self._clock()
-            if now > deadline:  # late: skip the missed periods, no burst to catch up
-                deadline = now
-            self._stop.wait(max(0.0, deadline - now))
+            schedule.advance(now)  # late: one run at once, the periods missed before it skipped
+            self._stop.wait(max(0.0, schedule.next_deadline - now))
 
     def _step(self) -> None:
         try:
@@ -378,13 +358,13 @@ class Sensor:
             logger.warning("%s %s lost: %s; retrying", self.kind, self._name, reason)
 
     def _retry(self) -> None:
-        backoff = BACKOFF_START_S
-        while not self._stop.wait(backoff):
+        backoff = Backoff(BACKOFF_START_S, BACKOFF_MAX_S)
+        while not self._stop.wait(backoff.delay_s):
             try:
                 self.reconnect()
             except Exception as exc:
                 self._last_error = str(exc)
-                backoff = min(backoff * 2, BACKOFF_MAX_S)
+                backoff.failed()
                 continue
             self._connected = True
             down_s = self._clock() - self._down_since
