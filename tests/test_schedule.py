@@ -1,4 +1,4 @@
-"""The schedule leaf: deadlines on a fake clock, the rate meter, the backoff, the worker's errors."""
+"""The schedule leaf: deadlines on a fake clock, rate meter, backoff, the worker's errors."""
 
 from __future__ import annotations
 
@@ -92,8 +92,3 @@ def test_worker_error_is_logged_once_kept_and_raised_to_the_joiner(
     warnings = [r for r in caplog.records if "test breaker failed" in r.getMessage()]
     assert len(warnings) == 1 and warnings[0].levelno == logging.WARNING
 
-
-def test_robot_schedule_re_exports_the_leaf() -> None:
-    from poppy_core.robot import schedule
-
-    assert schedule.Periodic is Periodic and schedule.Backoff is Backoff

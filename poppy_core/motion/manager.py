@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError
 from poppy_core.motion.sandbox import NUMERIC_REGISTERS
-from poppy_core.robot.schedule import Periodic, RateMeter
+from poppy_core.schedule import Periodic, RateMeter
 
 if TYPE_CHECKING:
     from poppy_core.motion.primitive import Primitive

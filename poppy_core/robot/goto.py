@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from poppy_core.errors import RobotClosedError
 from poppy_core.robot.motor_link import link_of
-from poppy_core.robot.schedule import Periodic
+from poppy_core.schedule import Periodic
 from poppy_core.trajectory import MinimumJerk, check_goto, control_name, plan_goto
 
 if TYPE_CHECKING:
