@@ -18,7 +18,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from poppy_core.errors import KinematicsError, PortError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, KinematicsError, PortError
 from poppy_core.kinematics import (
     Chain,
     KinematicDescription,
@@ -32,6 +33,8 @@ from poppy_core.kinematics import (
 from poppy_core.kinematics.chain import Orientation
 from poppy_core.kinematics.transforms import Matrix, Vector, axis_angle_matrix, rotation_log
 from poppy_core.motion.plots import plot_chain
+from poppy_core.schedule import Periodic
+from poppy_core.trajectory import minimum_jerk_weight
 
 if TYPE_CHECKING:
     from poppy_core.robot import GotoHandle, Motor, Robot
@@ -259,10 +262,13 @@ class RobotChain:
             KinematicsError: a point of the line is out of reach, or following the line needs
                 a jump of the joints (nothing moves).
         """
-        if not (math.isfinite(duration) and duration > 0 and rate_hz > 0):
+        try:  # with both in range, a waypoint's period is within checks.period too
+            checks.duration(duration, allow_zero=False)
+            checks.rate(rate_hz, "rate_hz")
+        except ArgumentError as exc:
             raise KinematicsError(
-                "a straight move needs a positive duration and rate", chain=self.name
-            )
+                f"a straight move needs a positive duration and rate: {exc}", chain=self.name
+            ) from None
         waypoints = plan_line(self, position, orientation, max(2, math.ceil(duration * rate_hz)))
         move = LinearMove(self.robot, waypoints, duration / len(waypoints), self.name)
         if wait:
@@ -297,7 +303,7 @@ def plan_line(
         turn = axis / (np.linalg.norm(axis) or 1.0) * angle
     for k in range(1, count):
         tau = k / (count - 1)
-        s = tau**3 * (10 - 15 * tau + 6 * tau * tau)
+        s = minimum_jerk_weight(tau)
         point = begin + s * (target.position - begin)
         goal: Matrix | None = None
         if turn is not None:
@@ -368,15 +374,17 @@ class LinearMove:
         self._cancel.set()
 
     def _run(self) -> None:
-        t0 = time.monotonic()
+        # a late waypoint goes at once and the next keep their times (no deadline is skipped)
+        schedule = Periodic(self._period_s, time.monotonic(), catch_up=len(self._waypoints))
         try:
-            for k, angles in enumerate(self._waypoints):
+            for angles in self._waypoints:
                 if self._cancel.is_set():
                     break
                 # dummy control: each motor gets the next waypoint and the speed to reach it in
                 # one period, so the servos move continuously between waypoints
                 self._robot.goto_position(angles, self._period_s, control="dummy")
-                delay = t0 + (k + 1) * self._period_s - time.monotonic()
+                schedule.advance(time.monotonic())
+                delay = schedule.next_deadline - time.monotonic()
                 if delay > 0 and self._cancel.wait(delay):
                     break
         except PortError:
