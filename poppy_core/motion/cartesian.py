@@ -33,7 +33,7 @@ from poppy_core.kinematics import (
 from poppy_core.kinematics.chain import Orientation
 from poppy_core.kinematics.transforms import Matrix, Vector, axis_angle_matrix, rotation_log
 from poppy_core.motion.plots import plot_chain
-from poppy_core.schedule import Periodic
+from poppy_core.schedule import Periodic, Worker
 from poppy_core.trajectory import minimum_jerk_weight
 
 if TYPE_CHECKING:
@@ -345,7 +345,10 @@ def plan_line(
 
 
 class LinearMove:
-    """Streams the waypoints of a straight move, one short goto per period, in its own thread."""
+    """Streams the waypoints of a straight move, one short goto per period, in its own thread.
+
+    A failure ends the move: logged once, kept in ``error`` and raised by ``wait``.
+    """
 
     def __init__(
         self, robot: Robot, waypoints: list[dict[str, float]], period_s: float, name: str
@@ -354,43 +357,44 @@ class LinearMove:
         self._waypoints = waypoints
         self._period_s = period_s
         self.duration_s = period_s * len(waypoints)
-        self._cancel = threading.Event()
-        self._done = threading.Event()
-        self.error: BaseException | None = None
-        self._thread = threading.Thread(target=self._run, name=f"goto_linear {name}", daemon=True)
-        self._thread.start()
+        self._worker = Worker(f"goto_linear {name}", self._run)
+        self._worker.start()
+
+    @property
+    def error(self) -> BaseException | None:
+        """What ended the move early (None: it ran to its end, was cancelled, the robot closed)."""
+        return self._worker.error
 
     @property
     def done(self) -> bool:
         """True once the move ended (or was cancelled)."""
-        return self._done.is_set()
+        return not self._worker.running
 
     def wait(self, timeout_s: float | None = None) -> bool:
-        """Block until the move ends; False when ``timeout_s`` ran out first."""
-        return self._done.wait(timeout_s)
+        """Block until the move ends; False when ``timeout_s`` ran out first.
+
+        Raises:
+            Exception: what ended the move early (``error``).
+        """
+        return self._worker.join(timeout_s)
 
     def cancel(self) -> None:
         """Stop streaming waypoints (motors finish their current short goto)."""
-        self._cancel.set()
+        self._worker.request_stop()
 
-    def _run(self) -> None:
+    def _run(self, cancel: threading.Event) -> None:
         # a late waypoint goes at once and the next keep their times (no deadline is skipped)
         schedule = Periodic(self._period_s, time.monotonic(), catch_up=len(self._waypoints))
         try:
             for angles in self._waypoints:
-                if self._cancel.is_set():
+                if cancel.is_set():
                     break
                 # dummy control: each motor gets the next waypoint and the speed to reach it in
                 # one period, so the servos move continuously between waypoints
                 self._robot.goto_position(angles, self._period_s, control="dummy")
                 schedule.advance(time.monotonic())
                 delay = schedule.next_deadline - time.monotonic()
-                if delay > 0 and self._cancel.wait(delay):
+                if delay > 0 and cancel.wait(delay):
                     break
         except PortError:
             pass  # the robot closed under the move
-        except Exception as exc:  # report, never kill the program from a thread
-            self.error = exc
-            logger.exception("straight move failed")
-        finally:
-            self._done.set()
