@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, SensorError
-from poppy_core.schedule import Backoff, Periodic, RateMeter
+from poppy_core.schedule import Backoff, Periodic, RateMeter, Worker
 
 logger = logging.getLogger(__name__)
 
@@ -112,7 +112,7 @@ class Sensor:
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._first = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._thread: Worker | None = None
         self._closed = False
         self._rate = RateMeter(window=30)
         self._connected = True
@@ -182,7 +182,7 @@ class Sensor:
     def running(self) -> bool:
         """True while the background thread is alive."""
         thread = self._thread
-        return thread is not None and thread.is_alive()
+        return thread is not None and thread.running
 
     @property
     def closed(self) -> bool:
@@ -205,7 +205,9 @@ class Sensor:
 
     def _start_thread(self) -> None:
         self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name=f"sensor {self._name}", daemon=True)
+        # one Worker per run of the thread: a parked thread may still be ending when a read
+        # starts the next; the loop waits on the sensor's own stop event (``fail`` sets it too)
+        self._thread = Worker(f"sensor {self._name}", self._run, on_exit=self.thread_ended)
         self._thread.start()
 
     def begin_lost(self, reason: str) -> None:
@@ -229,8 +231,13 @@ class Sensor:
             self._closed = True
             thread, self._thread = self._thread, None
         self._stop.set()
-        if thread is not None and thread is not threading.current_thread():
-            thread.join(timeout=2.0)
+        if thread is not None:
+            try:
+                thread.join(2.0)
+            except BaseException as exc:
+                if exc is not thread.error:
+                    raise
+                # the loop died: logged once by its worker, shown in health; close goes on
         try:
             self.release()
         except Exception:
@@ -294,14 +301,13 @@ class Sensor:
 
     # -- the loop ----------------------------------------------------------------------------
 
-    def _run(self) -> None:
+    def _run(self, stopping: threading.Event) -> None:
         try:
             self._loop()
-        finally:
-            try:
-                self.thread_ended()
-            except Exception:
-                logger.exception("sensor %s: cleaning up its thread", self._name)
+        except BaseException as exc:  # the worker logs it once and keeps it; health shows it
+            self._errors += 1
+            self._last_error = str(exc) or type(exc).__name__
+            raise
 
     def _loop(self) -> None:
         schedule = Periodic(1.0 / self._rate_hz, self._clock(), catch_up=1)
