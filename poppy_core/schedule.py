@@ -187,6 +187,17 @@ class Worker:
         self.request_stop()
         return self.join(timeout_s)
 
+    def close(self, timeout_s: float | None = 2.0) -> bool:
+        """``stop`` for an owner's close: the body's exception is not raised again (it was
+        logged and stays in ``error``), so the close goes on freeing what it owns."""
+        self.request_stop()
+        try:
+            return self.join(timeout_s)
+        except BaseException as exc:
+            if exc is not self.error:
+                raise
+            return True
+
     def _run(self) -> None:
         try:
             self._body(self.stopping)

@@ -232,12 +232,7 @@ class Sensor:
             thread, self._thread = self._thread, None
         self._stop.set()
         if thread is not None:
-            try:
-                thread.join(2.0)
-            except BaseException as exc:
-                if exc is not thread.error:
-                    raise
-                # the loop died: logged once by its worker, shown in health; close goes on
+            thread.close(2.0)  # a loop that died was logged once and is shown in health
         try:
             self.release()
         except Exception:
