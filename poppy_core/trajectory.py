@@ -49,6 +49,16 @@ def check_goto(duration_s: float, control: str) -> None:
     checks.duration(duration_s)
 
 
+def minimum_jerk_weight(fraction: float) -> float:
+    """The minimum-jerk blend 10τ³ − 15τ⁴ + 6τ⁵ of ``fraction`` τ (clamped to 0..1).
+
+    The share of the way a rest-to-rest ``MinimumJerk`` has gone at ``fraction`` of its time:
+    ramps and straight moves blend with it instead of building the polynomial.
+    """
+    tau = min(max(fraction, 0.0), 1.0)
+    return min(1.0, tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau)))
+
+
 @dataclass(frozen=True)
 class MinimumJerk:
     """A quintic polynomial from ``start`` to ``goal`` in ``duration_s`` seconds.

@@ -18,7 +18,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from poppy_core.errors import KinematicsError, PortError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, KinematicsError, PortError
 from poppy_core.kinematics import (
     Chain,
     KinematicDescription,
@@ -32,6 +33,8 @@ from poppy_core.kinematics import (
 from poppy_core.kinematics.chain import Orientation
 from poppy_core.kinematics.transforms import Matrix, Vector, axis_angle_matrix, rotation_log
 from poppy_core.motion.plots import plot_chain
+from poppy_core.schedule import Periodic, Worker
+from poppy_core.trajectory import minimum_jerk_weight
 
 if TYPE_CHECKING:
     from poppy_core.robot import GotoHandle, Motor, Robot
@@ -259,10 +262,13 @@ class RobotChain:
             KinematicsError: a point of the line is out of reach, or following the line needs
                 a jump of the joints (nothing moves).
         """
-        if not (math.isfinite(duration) and duration > 0 and rate_hz > 0):
+        try:  # with both in range, a waypoint's period is within checks.period too
+            checks.duration(duration, allow_zero=False)
+            checks.rate(rate_hz, "rate_hz")
+        except ArgumentError as exc:
             raise KinematicsError(
-                "a straight move needs a positive duration and rate", chain=self.name
-            )
+                f"a straight move needs a positive duration and rate: {exc}", chain=self.name
+            ) from None
         waypoints = plan_line(self, position, orientation, max(2, math.ceil(duration * rate_hz)))
         move = LinearMove(self.robot, waypoints, duration / len(waypoints), self.name)
         if wait:
@@ -297,7 +303,7 @@ def plan_line(
         turn = axis / (np.linalg.norm(axis) or 1.0) * angle
     for k in range(1, count):
         tau = k / (count - 1)
-        s = tau**3 * (10 - 15 * tau + 6 * tau * tau)
+        s = minimum_jerk_weight(tau)
         point = begin + s * (target.position - begin)
         goal: Matrix | None = None
         if turn is not None:
@@ -339,7 +345,10 @@ def plan_line(
 
 
 class LinearMove:
-    """Streams the waypoints of a straight move, one short goto per period, in its own thread."""
+    """Streams the waypoints of a straight move, one short goto per period, in its own thread.
+
+    A failure ends the move: logged once, kept in ``error`` and raised by ``wait``.
+    """
 
     def __init__(
         self, robot: Robot, waypoints: list[dict[str, float]], period_s: float, name: str
@@ -348,41 +357,44 @@ class LinearMove:
         self._waypoints = waypoints
         self._period_s = period_s
         self.duration_s = period_s * len(waypoints)
-        self._cancel = threading.Event()
-        self._done = threading.Event()
-        self.error: BaseException | None = None
-        self._thread = threading.Thread(target=self._run, name=f"goto_linear {name}", daemon=True)
-        self._thread.start()
+        self._worker = Worker(f"goto_linear {name}", self._run)
+        self._worker.start()
+
+    @property
+    def error(self) -> BaseException | None:
+        """What ended the move early (None: it ran to its end, was cancelled, the robot closed)."""
+        return self._worker.error
 
     @property
     def done(self) -> bool:
         """True once the move ended (or was cancelled)."""
-        return self._done.is_set()
+        return not self._worker.running
 
     def wait(self, timeout_s: float | None = None) -> bool:
-        """Block until the move ends; False when ``timeout_s`` ran out first."""
-        return self._done.wait(timeout_s)
+        """Block until the move ends; False when ``timeout_s`` ran out first.
+
+        Raises:
+            Exception: what ended the move early (``error``).
+        """
+        return self._worker.join(timeout_s)
 
     def cancel(self) -> None:
         """Stop streaming waypoints (motors finish their current short goto)."""
-        self._cancel.set()
+        self._worker.request_stop()
 
-    def _run(self) -> None:
-        t0 = time.monotonic()
+    def _run(self, cancel: threading.Event) -> None:
+        # a late waypoint goes at once and the next keep their times (no deadline is skipped)
+        schedule = Periodic(self._period_s, time.monotonic(), catch_up=len(self._waypoints))
         try:
-            for k, angles in enumerate(self._waypoints):
-                if self._cancel.is_set():
+            for angles in self._waypoints:
+                if cancel.is_set():
                     break
                 # dummy control: each motor gets the next waypoint and the speed to reach it in
                 # one period, so the servos move continuously between waypoints
                 self._robot.goto_position(angles, self._period_s, control="dummy")
-                delay = t0 + (k + 1) * self._period_s - time.monotonic()
-                if delay > 0 and self._cancel.wait(delay):
+                schedule.advance(time.monotonic())
+                delay = schedule.next_deadline - time.monotonic()
+                if delay > 0 and cancel.wait(delay):
                     break
         except PortError:
             pass  # the robot closed under the move
-        except Exception as exc:  # report, never kill the program from a thread
-            self.error = exc
-            logger.exception("straight move failed")
-        finally:
-            self._done.set()

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
 from poppy_core.errors import ConfigError, PoppyError
+from poppy_core.trajectory import minimum_jerk_weight
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -35,12 +36,6 @@ DEFAULT_RAMP_SPEED_DPS = 60.0
 MIN_RAMP_S = 0.3
 RAMP_SKIP_DEG = 0.5
 """No ramp when every motor is already this close to its target."""
-
-
-def minimum_jerk_weight(fraction: float) -> float:
-    """The minimum-jerk blend 10τ³ − 15τ⁴ + 6τ⁵ of ``fraction`` τ (clamped to 0..1)."""
-    tau = min(max(fraction, 0.0), 1.0)
-    return min(1.0, tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau)))
 
 
 @dataclass(frozen=True)

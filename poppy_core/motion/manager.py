@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError
 from poppy_core.motion.sandbox import NUMERIC_REGISTERS
-from poppy_core.robot.schedule import Periodic, RateMeter
+from poppy_core.schedule import Periodic, RateMeter, Worker
 
 if TYPE_CHECKING:
     from poppy_core.motion.primitive import Primitive
@@ -70,7 +70,7 @@ class PrimitiveManager:
         self._filter = _resolve_filter(filter)
         self._lock = threading.RLock()
         self._primitives: list[Primitive] = []
-        self._thread: threading.Thread | None = None
+        self._thread: Worker | None = None  # one per run: it ends when no primitive is left
         self._wake = threading.Event()
         self._closed = False
         self._applied: dict[tuple[str, str], Any] = {}
@@ -100,7 +100,7 @@ class PrimitiveManager:
     def running(self) -> bool:
         """True while the manager's thread runs."""
         thread = self._thread
-        return thread is not None and thread.is_alive()
+        return thread is not None and thread.running
 
     @property
     def rate_hz(self) -> float:
@@ -122,9 +122,7 @@ class PrimitiveManager:
                 self._primitives.append(primitive)
             if self._thread is None:
                 self._wake.clear()
-                self._thread = threading.Thread(
-                    target=self._loop, name="primitive manager", daemon=True
-                )
+                self._thread = Worker("primitive manager", self._loop)
                 self._thread.start()
 
     def remove(self, primitive: Primitive) -> None:
@@ -186,7 +184,7 @@ class PrimitiveManager:
         self.errors += 1
         self.last_error = message
 
-    def _loop(self) -> None:
+    def _loop(self, stopping: threading.Event) -> None:  # ends itself; close sets _wake
         schedule = Periodic(1.0 / self.freq, time.monotonic())
         while True:
             with self._lock:
@@ -210,8 +208,8 @@ class PrimitiveManager:
             self._primitives.clear()
             thread = self._thread
             self._wake.set()
-        if thread is not None and thread is not threading.current_thread():
-            thread.join(timeout=2.0)
+        if thread is not None:
+            thread.close(2.0)
 
 
 # -- one manager per robot ------------------------------------------------------------------------

@@ -22,7 +22,7 @@ import numpy as np
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import read_move
-from poppy_core.robot.schedule import Periodic
+from poppy_core.schedule import Periodic
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot

@@ -23,7 +23,7 @@ from poppy_core.errors import ConfigError, PrimitiveError
 from poppy_core.motion.manager import PrimitiveManager, primitive_manager
 from poppy_core.motion.primitive_values import convert_value
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
-from poppy_core.robot.schedule import Periodic, RateMeter
+from poppy_core.schedule import Periodic, RateMeter
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot

@@ -30,7 +30,7 @@ from poppy_core.errors import ArgumentError, FileError
 from poppy_core.files import FileLock, output_path, probe_folder
 from poppy_core.motion.move import MAX_FRAMERATE_HZ, MIN_FRAMERATE_HZ, Move, resample
 from poppy_core.motion.move_format import MOVE_SUFFIX, write_move
-from poppy_core.robot.schedule import Periodic
+from poppy_core.schedule import Periodic
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot

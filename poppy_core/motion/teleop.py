@@ -31,7 +31,7 @@ from poppy_core.motion.teleop_follower import Follower, LocalFollower
 from poppy_core.motion.teleop_map import JointMap
 from poppy_core.motion.teleop_record import TrajectoryRecorder
 from poppy_core.motion.teleop_stats import TeleopReport, TeleopStatus
-from poppy_core.robot.schedule import Periodic
+from poppy_core.schedule import Backoff, Periodic
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -265,7 +265,7 @@ class Teleoperation:
         period = 1.0 / self.rate_hz
         schedule = Periodic(period, self._t0)
         retry_at = self._t0
-        backoff = RETRY_FIRST_S
+        backoff = Backoff(RETRY_FIRST_S, RETRY_MAX_S)
         while not self._stop.is_set():
             tick = self._clock()
             if self.duration_s is not None and tick - self._t0 >= self.duration_s:
@@ -275,10 +275,10 @@ class Teleoperation:
                     positions = self._read_leader()
                 except _LeaderLost as exc:
                     self._leader_lost(str(exc))
-                    retry_at = tick + backoff
-                    backoff = min(2 * backoff, RETRY_MAX_S)
+                    retry_at = tick + backoff.delay_s
+                    backoff.failed()
                 else:
-                    backoff = RETRY_FIRST_S
+                    backoff.reset()
                     self._follow(tick, positions)
             follower_positions = self.follower.positions()
             if self.recorder is not None:

@@ -24,6 +24,7 @@ from urllib.parse import urlencode, urlsplit
 
 from poppy_core.errors import CommunicationError, ConfigError
 from poppy_core.remote.client import HttpClient, path_of
+from poppy_core.schedule import Backoff
 
 logger = logging.getLogger(__name__)
 
@@ -313,14 +314,14 @@ class RemoteFollower:
         threading.Thread(target=self._reconnect, name="teleop reconnect", daemon=True).start()
 
     def _reconnect(self) -> None:
-        delay = RECONNECT_FIRST_S
+        backoff = Backoff(RECONNECT_FIRST_S, RECONNECT_MAX_S)
         try:
-            while not self._stopping.wait(delay):
+            while not self._stopping.wait(backoff.delay_s):
                 try:
                     self._connect()
                 except (CommunicationError, ConfigError) as exc:
                     logger.debug("reconnecting to %s: %s", self.url, exc)
-                    delay = min(2 * delay, RECONNECT_MAX_S)
+                    backoff.failed()
                     continue
                 self.reconnects += 1
                 logger.warning("link to %s back: the follower resumes with a ramp", self.url)

@@ -17,6 +17,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
+from poppy_core import checks
 from poppy_core.errors import CalibrationCancelled, ConfigError
 from poppy_core.robot.calibration import (
     Calibration,
@@ -25,6 +26,7 @@ from poppy_core.robot.calibration import (
     reference_posture,
 )
 from poppy_core.robot.motor_link import link_of
+from poppy_core.schedule import Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot.motor import Motor
@@ -106,26 +108,24 @@ class RangeWatch:
     def __init__(self, motors: Sequence[Motor], offsets: dict[str, float], period_s: float) -> None:
         self._motors = list(motors)
         self._offsets = offsets
-        self._period_s = period_s
+        self._period_s = checks.period(period_s, "sample_period_s")
         self._lock = threading.Lock()
         first = {m.name: _motor_frame_position(m) for m in self._motors}
         self._low = dict(first)
         self._high = dict(first)
         self._current = dict(first)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, name="calibration range", daemon=True)
+        self._worker = Worker("calibration range", self._run)
 
     def __enter__(self) -> RangeWatch:
-        self._thread.start()
+        self._worker.start()
         return self
 
     def __exit__(self, *_: object) -> None:
-        self._stop.set()
-        self._thread.join(2.0)
+        self._worker.stop(2.0)  # a sampler that failed says so here
         self._sample()
 
-    def _run(self) -> None:
-        while not self._stop.wait(self._period_s):
+    def _run(self, stopping: threading.Event) -> None:
+        while not stopping.wait(self._period_s):
             self._sample()
 
     def _sample(self) -> None:

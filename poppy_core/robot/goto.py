@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from poppy_core.errors import RobotClosedError
 from poppy_core.robot.motor_link import link_of
-from poppy_core.robot.schedule import Periodic
+from poppy_core.schedule import Periodic, Worker
 from poppy_core.trajectory import MinimumJerk, check_goto, control_name, plan_goto
 
 if TYPE_CHECKING:
@@ -78,7 +78,7 @@ class GotoRunner:
         self._clock = clock
         self._lock = threading.Lock()
         self._moves: dict[int, _Move] = {}
-        self._thread: threading.Thread | None = None
+        self._thread: Worker | None = None  # one per run: it ends when no goto is left
         self._wake = threading.Event()
         self._closed = False
 
@@ -124,7 +124,7 @@ class GotoRunner:
                 )
             if self._moves and self._thread is None:
                 self._wake.clear()
-                self._thread = threading.Thread(target=self._run, name=self.name, daemon=True)
+                self._thread = Worker(self.name, self._run)
                 self._thread.start()
         return handle
 
@@ -147,8 +147,8 @@ class GotoRunner:
             self._moves.clear()
             thread = self._thread
             self._wake.set()
-        if thread is not None and thread is not threading.current_thread():
-            thread.join(timeout=2.0)
+        if thread is not None:
+            thread.close(2.0)
 
     def _step(self, now: float) -> bool:
         """Advance every move; False when none is left (the thread then ends)."""
@@ -172,7 +172,7 @@ class GotoRunner:
                 return False
             return True
 
-    def _run(self) -> None:
+    def _run(self, stopping: threading.Event) -> None:  # ends itself; close sets _wake
         schedule = Periodic(self.period_s, self._clock())
         while True:
             now = self._clock()

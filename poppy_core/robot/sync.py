@@ -35,7 +35,7 @@ from poppy_core.robot.health import BusHealth, LoopStats, SyncStats
 from poppy_core.robot.loops import BASE_LOOPS, LIGHT_LOOPS, LoopSpec, loops_for
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.motor_link import link_of
-from poppy_core.robot.schedule import Periodic, RateMeter
+from poppy_core.schedule import Backoff, Periodic, RateMeter, Worker
 
 logger = logging.getLogger(__name__)
 
@@ -105,21 +105,21 @@ class BusSync:
         self._clock = clock
         self._specs = [*loops, LoopSpec(RETRY, (), False, 1.0 / retry_period_s)]
         self._loops: list[_Loop] = []
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._worker = Worker(f"sync {controller}", self._run)
+        self._stop = self._worker.stopping
         self._blocks: dict[tuple[str, ServoModel], list[regs.Block]] = {}
         self._driven: set[str] = set()
         self._retry_turn = 0
         self.connected = True
         self.losses = 0
         self._down_since = 0.0
-        self._backoff_s = RECONNECT_FIRST_S
+        self._backoff = Backoff(RECONNECT_FIRST_S, RECONNECT_MAX_S)
         self._next_reopen = 0.0
 
     @property
     def running(self) -> bool:
         """True while the loop thread is alive."""
-        return self._thread is not None and self._thread.is_alive()
+        return self._worker.running
 
     def start(self) -> None:
         """Start the thread (no-op when running)."""
@@ -127,22 +127,15 @@ class BusSync:
             return
         now = self._clock()
         self._loops = [_Loop(spec, now) for spec in self._specs]
-        self._stop.clear()
-        self._thread = threading.Thread(
-            target=self._run, name=f"sync {self.controller}", daemon=True
-        )
-        self._thread.start()
+        self._worker.start()
 
     def stop(self, timeout_s: float = 2.0) -> None:
         """Stop and join the thread, then send the writes still pending (idempotent)."""
-        self._stop.set()
-        thread = self._thread
-        if thread is not None and thread is not threading.current_thread():
-            thread.join(timeout_s)
-            if thread.is_alive():
+        try:
+            if not self._worker.stop(timeout_s):
                 logger.warning("sync loop of %s did not stop in %.1f s", self.controller, timeout_s)
-        self._thread = None
-        self.flush()
+        finally:
+            self.flush()
 
     def flush(self) -> None:
         """Send every pending write now, from the calling thread.
@@ -241,8 +234,8 @@ class BusSync:
 
     # -- the thread ------------------------------------------------------------------------------
 
-    def _run(self) -> None:
-        while not self._stop.is_set():
+    def _run(self, stopping: threading.Event) -> None:
+        while not stopping.is_set():
             try:
                 if self.connected:
                     self._run_due_loops()
@@ -286,8 +279,7 @@ class BusSync:
         self.connected = False
         self.losses += 1
         self._down_since = self._clock()
-        self._backoff_s = RECONNECT_FIRST_S
-        self._next_reopen = self._down_since + self._backoff_s
+        self._next_reopen = self._down_since + self._backoff.reset()
         for motor in self.motors:
             link_of(motor).mark_offline()
         logger.warning(
@@ -304,8 +296,7 @@ class BusSync:
         try:
             self.bus.reopen()
         except PortError as exc:
-            self._backoff_s = min(2 * self._backoff_s, RECONNECT_MAX_S)
-            self._next_reopen = self._clock() + self._backoff_s
+            self._next_reopen = self._clock() + self._backoff.failed()
             logger.debug("%s: %s still away (%s)", self.controller, self.bus.port, exc)
             return
         now = self._clock()

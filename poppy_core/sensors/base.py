@@ -15,15 +15,15 @@ until the sensor's first use, so a camera nobody reads still grabs nothing.
 from __future__ import annotations
 
 import logging
-import math
 import threading
 import time
-from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from poppy_core.errors import SensorError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, SensorError
+from poppy_core.schedule import Backoff, Periodic, RateMeter, Worker
 
 logger = logging.getLogger(__name__)
 
@@ -85,22 +85,6 @@ class SensorHealth:
         return data
 
 
-class _Rate:
-    """Updates per second over the last few updates (0 once they are stale)."""
-
-    def __init__(self, window: int = 30) -> None:
-        self._times: deque[float] = deque(maxlen=window)
-
-    def tick(self, now_s: float) -> None:
-        self._times.append(now_s)
-
-    def at(self, now_s: float, stale_s: float) -> float:
-        if len(self._times) < 2 or now_s - self._times[-1] > stale_s:
-            return 0.0
-        span = self._times[-1] - self._times[0]
-        return (len(self._times) - 1) / span if span > 0 else 0.0
-
-
 class Sensor:
     """Base of every sensor: subclasses give ``registers`` and implement ``update``.
 
@@ -118,20 +102,19 @@ class Sensor:
     def __init__(
         self, name: str, rate_hz: float, *, clock: Callable[[], float] = time.monotonic
     ) -> None:
-        if not rate_hz > 0 or not math.isfinite(rate_hz):
-            raise SensorError(
-                f"sensor {name!r}: its rate must be a positive number of Hz, got {rate_hz}",
-                sensor=name,
-            )
+        try:
+            checks.rate(rate_hz, "its rate")
+        except ArgumentError as exc:
+            raise SensorError(f"sensor {name!r}: {exc}", sensor=name) from None
         self._name = name
         self._rate_hz = float(rate_hz)
         self._clock = clock
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._first = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._thread: Worker | None = None
         self._closed = False
-        self._rate = _Rate()
+        self._rate = RateMeter(window=30)
         self._connected = True
         self._down_since = 0.0
         self._losses = 0
@@ -199,7 +182,7 @@ class Sensor:
     def running(self) -> bool:
         """True while the background thread is alive."""
         thread = self._thread
-        return thread is not None and thread.is_alive()
+        return thread is not None and thread.running
 
     @property
     def closed(self) -> bool:
@@ -222,7 +205,9 @@ class Sensor:
 
     def _start_thread(self) -> None:
         self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name=f"sensor {self._name}", daemon=True)
+        # one Worker per run of the thread: a parked thread may still be ending when a read
+        # starts the next; the loop waits on the sensor's own stop event (``fail`` sets it too)
+        self._thread = Worker(f"sensor {self._name}", self._run, on_exit=self.thread_ended)
         self._thread.start()
 
     def begin_lost(self, reason: str) -> None:
@@ -246,8 +231,8 @@ class Sensor:
             self._closed = True
             thread, self._thread = self._thread, None
         self._stop.set()
-        if thread is not None and thread is not threading.current_thread():
-            thread.join(timeout=2.0)
+        if thread is not None:
+            thread.close(2.0)  # a loop that died was logged once and is shown in health
         try:
             self.release()
         except Exception:
@@ -299,7 +284,7 @@ class Sensor:
             running=self.running,
             down_s=0.0 if self._connected else now - self._down_since,
             losses=self._losses,
-            rate_hz=self._rate.at(now, max(1.0, 3.0 / self._rate_hz)),
+            rate_hz=self._rate.rate_at(now, max(1.0, 3.0 / self._rate_hz)),
             target_hz=self._rate_hz,
             errors=self._errors,
             last_error=self._last_error,
@@ -311,18 +296,16 @@ class Sensor:
 
     # -- the loop ----------------------------------------------------------------------------
 
-    def _run(self) -> None:
+    def _run(self, stopping: threading.Event) -> None:
         try:
             self._loop()
-        finally:
-            try:
-                self.thread_ended()
-            except Exception:
-                logger.exception("sensor %s: cleaning up its thread", self._name)
+        except BaseException as exc:  # the worker logs it once and keeps it; health shows it
+            self._errors += 1
+            self._last_error = str(exc) or type(exc).__name__
+            raise
 
     def _loop(self) -> None:
-        period = 1.0 / self._rate_hz
-        deadline = self._clock()
+        schedule = Periodic(1.0 / self._rate_hz, self._clock(), catch_up=1)
         while not self._stop.is_set():
             if self._connected:
                 self._step()
@@ -331,11 +314,9 @@ class Sensor:
                 if self._park():
                     return
                 continue
-            deadline += period
             now = self._clock()
-            if now > deadline:  # late: skip the missed periods, no burst to catch up
-                deadline = now
-            self._stop.wait(max(0.0, deadline - now))
+            schedule.advance(now)  # late: one run at once, the periods missed before it skipped
+            self._stop.wait(max(0.0, schedule.next_deadline - now))
 
     def _step(self) -> None:
         try:
@@ -378,13 +359,13 @@ class Sensor:
             logger.warning("%s %s lost: %s; retrying", self.kind, self._name, reason)
 
     def _retry(self) -> None:
-        backoff = BACKOFF_START_S
-        while not self._stop.wait(backoff):
+        backoff = Backoff(BACKOFF_START_S, BACKOFF_MAX_S)
+        while not self._stop.wait(backoff.delay_s):
             try:
                 self.reconnect()
             except Exception as exc:
                 self._last_error = str(exc)
-                backoff = min(backoff * 2, BACKOFF_MAX_S)
+                backoff.failed()
                 continue
             self._connected = True
             down_s = self._clock() - self._down_since

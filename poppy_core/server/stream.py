@@ -22,6 +22,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketDiscon
 
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, PoppyError
+from poppy_core.schedule import Periodic
 from poppy_core.server.errors import ApiError
 from poppy_core.server.jsonio import parse_json
 from poppy_core.server.middleware import TokenMiddleware, token_protocol
@@ -98,16 +99,12 @@ async def _send_quietly(send: Any, data: Any) -> None:
 
 async def _send_states(send: Any, service: RobotService, rate_hz: float) -> None:
     loop = asyncio.get_running_loop()
-    period = 1.0 / rate_hz
-    deadline = loop.time()
+    # fell behind (slow client): one state at once, the periods missed before it skipped
+    schedule = Periodic(1.0 / rate_hz, loop.time(), catch_up=1)
     while True:
         await send(service.state())
-        deadline += period
-        delay = deadline - loop.time()
-        if delay < -period:  # fell behind (slow client): start again from now
-            deadline = loop.time()
-            delay = 0.0
-        await asyncio.sleep(max(0.0, delay))
+        schedule.advance(loop.time())
+        await asyncio.sleep(max(0.0, schedule.next_deadline - loop.time()))
 
 
 async def _receive_commands(

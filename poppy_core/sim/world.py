@@ -15,6 +15,7 @@ import numpy as np
 from poppy_core.checks import positive
 from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.errors import ConfigError
+from poppy_core.schedule import Worker
 from poppy_core.sim.drive import Drive, Joint
 from poppy_core.sim.exchange import MotorPort
 from poppy_core.sim.gl import check_offscreen_gl
@@ -65,8 +66,7 @@ class Simulation:
         self._state_age_s = math.inf  # simulated time since the state was last written
         self._objects = _Objects()
         self._renderers: dict[tuple[int, int], Any] = {}
-        self._thread: threading.Thread | None = None
-        self._stop = threading.Event()
+        self._worker = Worker("mujoco physics", self._run)
 
     # ------------------------------------------------------------------ motors
 
@@ -170,15 +170,11 @@ class Simulation:
 
     def start(self) -> None:
         """Run the physics in real time (times ``speed``) in a background thread."""
-        if self._thread is not None:
-            return
-        self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name="mujoco physics", daemon=True)
-        self._thread.start()
+        self._worker.start()
 
-    def _run(self) -> None:
+    def _run(self, stopping: threading.Event) -> None:
         last = time.monotonic()
-        while not self._stop.wait(SYNC_PERIOD_S):
+        while not stopping.wait(SYNC_PERIOD_S):
             now = time.monotonic()
             elapsed = min(now - last, 0.1)  # never try to catch up more than 100 ms
             last = now
@@ -189,15 +185,12 @@ class Simulation:
 
     def stop(self) -> None:
         """Stop the physics thread (idempotent)."""
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout=2.0)
-            self._thread = None
+        self._worker.stop(2.0)
 
     @property
     def running(self) -> bool:
         """True while the physics thread runs."""
-        return self._thread is not None
+        return self._worker.running
 
     def close(self) -> None:
         """Stop the thread and free the renderers."""

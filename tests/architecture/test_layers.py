@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[2]
 # `trajectory` (the pure maths of a goto, shared by Motor.goto_position and the primitives'
 # sandbox), `checks` (the one rule of each kind of call argument) and `extras` (the optional
 # dependencies, with the one-line error naming a missing extra) are leaves every room may use.
-LEAVES = {"errors", "files", "documents", "line", "trajectory", "checks", "extras"}
+LEAVES = {"errors", "files", "documents", "line", "trajectory", "checks", "extras", "schedule"}
 ALLOWED: dict[str, set[str]] = {
     "protocol": set(),
     "models": {"protocol"},

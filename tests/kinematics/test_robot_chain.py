@@ -125,3 +125,17 @@ def test_arm_chains_of_the_torso_move_only_the_arm() -> None:
         pose.update({"r_shoulder_y": -40.0, "r_elbow_y": 60.0})
         angles = chain.solve(chain.forward(pose)[:3, 3])
         assert set(angles) == {m.name for m in torso.r_arm}
+
+
+class _BrokenRobot:
+    def goto_position(self, *args: object, **kwargs: object) -> None:
+        raise RuntimeError("the goto broke")
+
+
+def test_a_straight_move_that_fails_says_so_to_its_waiter() -> None:
+    from poppy_core.motion.cartesian import LinearMove
+
+    move = LinearMove(_BrokenRobot(), [{"m1": 0.0}, {"m1": 1.0}], 0.01, "arm")  # type: ignore[arg-type]
+    with pytest.raises(RuntimeError, match="the goto broke"):
+        move.wait(timeout_s=5.0)
+    assert move.done and isinstance(move.error, RuntimeError)

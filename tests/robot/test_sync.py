@@ -10,7 +10,7 @@ from poppy_core.bus import DxlBus
 from poppy_core.emulator import VirtualBus, VirtualMotor, serve_link
 from poppy_core.models import model_by_name
 from poppy_core.robot import BASE_LOOPS, BusSync, Motor, loops_for
-from poppy_core.robot.schedule import Periodic, RateMeter
+from poppy_core.schedule import Periodic, RateMeter
 
 
 def test_periodic_is_drift_free_and_counts_skips() -> None:

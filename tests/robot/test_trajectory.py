@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import MinimumJerk, dummy_speed
-from poppy_core.trajectory import GotoPlan, plan_goto
+from poppy_core.trajectory import GotoPlan, minimum_jerk_weight, plan_goto
 
 angles = st.floats(-300, 300, allow_nan=False)
 rates = st.floats(-200, 200, allow_nan=False)
@@ -91,3 +91,11 @@ def test_a_goto_shorter_than_a_millisecond_is_refused(control: str, duration: fl
     with pytest.raises(ArgumentError, match=r"at least 0\.001 s"):
         plan_goto(0.0, 30.0, duration, control, (-90.0, 90.0))
     assert plan_goto(0.0, 30.0, 0.0, control, (-90.0, 90.0)) == GotoPlan(30.0, None, 0.0)
+
+
+@given(angles, angles, durations, st.floats(0, 1))
+def test_the_weight_is_the_rest_to_rest_curve(p0: float, p1: float, t: float, f: float) -> None:
+    """Ramps and straight moves blend with the weight: it is the same curve as a goto's."""
+    traj = MinimumJerk(p0, p1, t)
+    blended = p0 + minimum_jerk_weight(f) * (p1 - p0)
+    assert blended == pytest.approx(traj.position(f * t), abs=1e-9)

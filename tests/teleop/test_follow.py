@@ -9,8 +9,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from poppy_core.errors import ConfigError
-from poppy_core.motion.follow import FollowSession, minimum_jerk_weight
+from poppy_core.motion.follow import FollowSession
 from poppy_core.robot import Robot
+from poppy_core.trajectory import minimum_jerk_weight
 from tests.teleop.hands import READ_S, Hand, wait_for
 
 

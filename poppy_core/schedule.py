@@ -1,0 +1,207 @@
+"""Loop machinery: drift-free deadlines, a rate meter, a doubling backoff and a worker thread."""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from collections import deque
+from collections.abc import Callable
+
+from poppy_core import checks
+from poppy_core.errors import ArgumentError
+
+logger = logging.getLogger(__name__)
+
+
+class Periodic:
+    """Deadlines at ``start + k * period``: late runs skip the periods they missed, no drift.
+
+    With ``catch_up=1`` a run that ended late keeps the one deadline it overran (the next run
+    starts at once): a loop whose runs take about its period on average, a few longer, keeps
+    its rate; only periods missed by more than that are skipped.
+
+    Attributes:
+        period_s: time between deadlines.
+        next_deadline: when the next run is due (same clock as the times passed in).
+        missed: periods skipped because a run came too late.
+    """
+
+    def __init__(self, period_s: float, start_s: float, catch_up: int = 0) -> None:
+        """Create a schedule whose first deadline is ``start_s``.
+
+        Raises:
+            ArgumentError: a period outside ``checks.period`` (a ``ValueError`` too).
+        """
+        self.period_s = checks.period(period_s)
+        self.next_deadline = start_s
+        self.missed = 0
+        self.catch_up = catch_up
+
+    def due(self, now_s: float) -> bool:
+        """True when the deadline has come."""
+        return now_s >= self.next_deadline
+
+    def advance(self, now_s: float) -> int:
+        """Move to the next deadline after a run that started at ``now_s``.
+
+        Returns:
+            How many whole periods were skipped (also added to ``missed``).
+        """
+        self.next_deadline += self.period_s
+        skipped = 0
+        kept = self.catch_up * self.period_s  # overdue deadlines still run
+        if now_s >= self.next_deadline + kept:
+            skipped = math.floor((now_s - self.next_deadline - kept) / self.period_s) + 1
+            self.next_deadline += skipped * self.period_s
+        self.missed += skipped
+        return skipped
+
+
+class RateMeter:
+    """Measures how often something runs, over its last ``window`` runs."""
+
+    def __init__(self, window: int = 50) -> None:
+        self._times: deque[float] = deque(maxlen=max(2, window))
+        self.count = 0
+
+    def tick(self, now_s: float) -> None:
+        """Record one run at ``now_s``."""
+        self._times.append(now_s)
+        self.count += 1
+
+    def rate_at(self, now_s: float, stale_after_s: float) -> float:
+        """``rate_hz``, or 0 when the last run is more than ``stale_after_s`` before ``now_s``."""
+        if not self._times or now_s - self._times[-1] > stale_after_s:
+            return 0.0
+        return self.rate_hz
+
+    @property
+    def rate_hz(self) -> float:
+        """Runs per second over the window (0 until two runs were seen)."""
+        if len(self._times) < 2:
+            return 0.0
+        span = self._times[-1] - self._times[0]
+        return (len(self._times) - 1) / span if span > 0 else 0.0
+
+
+class Backoff:
+    """Delays between attempts: ``first_s``, then twice as long each failure, up to ``max_s``.
+
+    ``delay_s`` is the wait before the next attempt; ``failed()`` doubles it (and returns the new
+    one), ``reset()`` (after a success) starts again from ``first_s``.
+    """
+
+    def __init__(self, first_s: float, max_s: float) -> None:
+        """Raises ArgumentError: a delay outside ``checks.period``, or ``max_s < first_s``."""
+        self.first_s = checks.period(first_s, "first delay")
+        self.max_s = checks.period(max_s, "longest delay")
+        if self.max_s < self.first_s:
+            raise ArgumentError(
+                f"longest delay ({self.max_s:g} s) must not be shorter than the first "
+                f"({self.first_s:g} s)",
+                field="longest delay",
+                value=max_s,
+            )
+        self.delay_s = self.first_s
+
+    def failed(self) -> float:
+        """One more failed attempt: the delay doubles (up to ``max_s``); returns it."""
+        self.delay_s = min(2 * self.delay_s, self.max_s)
+        return self.delay_s
+
+    def reset(self) -> float:
+        """A success: the next delay is ``first_s`` again; returns it."""
+        self.delay_s = self.first_s
+        return self.delay_s
+
+
+class Worker:
+    """One background thread running ``body(stopping)`` until it returns or is asked to stop.
+
+    The error story, the same for every loop built on it: an exception that escapes ``body``
+    ends the thread, is logged once at WARNING (with its traceback), kept in ``error`` for the
+    owner's health, and raised again by ``join``/``stop`` to whoever waits for the thread.
+    ``body`` should return soon after ``stopping`` is set (wait on it rather than sleep).
+
+    Args:
+        name: the thread's name (also names the worker in the log).
+        body: the loop; it receives the event that asks it to stop.
+        on_exit: called in the thread after ``body`` ended, whatever the way (cleanup); its
+            own exception is logged, never raised.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        body: Callable[[threading.Event], None],
+        on_exit: Callable[[], None] | None = None,
+    ) -> None:
+        self.name = name
+        self._body = body
+        self._on_exit = on_exit
+        self.stopping = threading.Event()
+        self.error: BaseException | None = None
+        self._thread: threading.Thread | None = None
+
+    @property
+    def running(self) -> bool:
+        """True while the thread is alive."""
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self) -> None:
+        """Start the thread (no-op while running); a new start forgets the previous error."""
+        if self.running:
+            return
+        self.stopping.clear()
+        self.error = None
+        self._thread = threading.Thread(target=self._run, name=self.name, daemon=True)
+        self._thread.start()
+
+    def request_stop(self) -> None:
+        """Ask the body to stop, without waiting."""
+        self.stopping.set()
+
+    def join(self, timeout_s: float | None = None) -> bool:
+        """Wait for the thread to end; False when it is still running after ``timeout_s``.
+
+        Raises:
+            BaseException: the exception that ended the body (kept in ``error``).
+        """
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout_s)
+            if thread.is_alive():
+                return False
+        if self.error is not None:
+            raise self.error
+        return True
+
+    def stop(self, timeout_s: float | None = 2.0) -> bool:
+        """Ask the body to stop and ``join`` it (from its own thread: only asks)."""
+        self.request_stop()
+        return self.join(timeout_s)
+
+    def close(self, timeout_s: float | None = 2.0) -> bool:
+        """``stop`` for an owner's close: the body's exception is not raised again (it was
+        logged and stays in ``error``), so the close goes on freeing what it owns."""
+        self.request_stop()
+        try:
+            return self.join(timeout_s)
+        except BaseException as exc:
+            if exc is not self.error:
+                raise
+            return True
+
+    def _run(self) -> None:
+        try:
+            self._body(self.stopping)
+        except BaseException as exc:  # kept for join() and health, logged once
+            self.error = exc
+            logger.warning("%s failed: %s", self.name, exc, exc_info=exc)
+        finally:
+            if self._on_exit is not None:
+                try:
+                    self._on_exit()
+                except Exception:
+                    logger.exception("%s: cleaning up its thread", self.name)
