@@ -18,15 +18,21 @@ import unicodedata
 from collections.abc import Iterable
 from typing import Any
 
-from rich.console import Console, ConsoleOptions, RenderableType
+from rich.cells import cell_len
+from rich.console import Console, ConsoleDimensions, ConsoleOptions, RenderableType
 from rich.markup import escape
 from rich.segment import Segment
+from rich.table import Table
 from rich.text import Text
 
 EXIT_OK = 0
 EXIT_FAILURE = 1
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
+
+PIPED_WIDTH = 100_000
+"""The width of a console whose output is not a terminal: a table takes the width of its data
+and a line is never wrapped, so what a pipe or a file gets is whole lines, never cut."""
 
 _KEPT = frozenset("\n\t")
 _BIDI = frozenset("\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
@@ -46,10 +52,43 @@ def printable(text: str) -> str:
 
 class LiteralConsole(Console):
     """A Rich console that prints every string as it is: no markup, no emoji, no highlighting,
-    no terminal control (see ``printable``); styled output is built with ``styled``."""
+    no terminal control (see ``printable``); styled output is built with ``styled``.
+
+    Piped (its file is not a terminal), it is as wide as the data (``PIPED_WIDTH``): tables are
+    never cut to 80 columns nor a value wrapped over two lines, whatever ``COLUMNS`` says, and
+    a live display ends its last frame with a newline.
+    """
 
     def __init__(self, **options: Any) -> None:
         super().__init__(markup=False, emoji=False, highlight=False, **options)
+
+    @property
+    def size(self) -> ConsoleDimensions:
+        """The terminal's size; ``PIPED_WIDTH`` wide when the output is not a terminal."""
+        size = Console.size.fget(self)  # type: ignore[attr-defined]
+        assert isinstance(size, ConsoleDimensions)
+        if self.is_terminal:
+            return size
+        return ConsoleDimensions(PIPED_WIDTH, size.height)
+
+    @size.setter
+    def size(self, new_size: tuple[int, int]) -> None:
+        Console.size.fset(self, new_size)  # type: ignore[attr-defined]
+
+    def pop_render_hook(self) -> None:
+        """Rich ends a live display with a newline on a terminal only: piped, its last frame
+        (which it does print) ran into the next line (``└──┘replayed 135 frames``)."""
+        from rich.live import Live
+
+        hook = self._render_hooks[-1] if self._render_hooks else None
+        super().pop_render_hook()
+        if (
+            isinstance(hook, Live)
+            and not hook.transient
+            and not self.is_terminal
+            and hook._live_render.last_render_height
+        ):
+            self.line()
 
     def render_str(self, text: str, **options: Any) -> Text:
         """Every string printed, in a table cell, a title or a status, passes here."""
@@ -62,7 +101,12 @@ class LiteralConsole(Console):
         """Every piece of text rendered passes here, a ``Text`` built by the caller included
         (``Text.assemble(..., line)`` skips ``render_str``): its control characters are
         escaped; the console's own control segments (cursor moves of a live display) are kept.
+        Piped, a table is made as wide as its title, which would wrap otherwise.
         """
+        if isinstance(renderable, Table) and not self.is_terminal and renderable.title:
+            title = renderable.title
+            wide = title.cell_len if isinstance(title, Text) else cell_len(str(title))
+            renderable.min_width = max(renderable.min_width or 0, wide)
         for segment in super().render(renderable, options):
             if segment.control is None and not segment.text.isprintable():
                 yield Segment(printable(segment.text), segment.style)
