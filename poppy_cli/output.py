@@ -201,6 +201,11 @@ def log_to_stderr(level: int = logging.WARNING, fmt: str = "%(message)s") -> Non
         root.setLevel(level)
 
 
+def counted(count: int, noun: str) -> str:
+    """``1 controller``, ``2 controllers``, ``0 controllers``: ``noun`` is a regular noun."""
+    return f"{count} {noun}" if count == 1 else f"{count} {noun}s"
+
+
 def fmt_value(value: Any, unit: str = "") -> str:
     """Format an SI register value with its unit for humans."""
     if isinstance(value, bool):

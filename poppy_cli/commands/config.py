@@ -12,6 +12,7 @@ from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
     console,
+    counted,
     error_line,
     fmt_value,
     plain,
@@ -30,9 +31,13 @@ app = typer.Typer(
 
 
 def _counts(config: RobotConfig) -> str:
-    return (
-        f"{len(config.motors)} motors, {len(config.controllers)} controllers, "
-        f"{len(config.motorgroups)} groups"
+    return ", ".join(
+        counted(len(things), word)
+        for things, word in (
+            (config.motors, "motor"),
+            (config.controllers, "controller"),
+            (config.motorgroups, "group"),
+        )
     )
 
 

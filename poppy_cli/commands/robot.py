@@ -17,7 +17,7 @@ from poppy_cli.options import (
     SimOpt,
     finite,
 )
-from poppy_cli.output import console, fmt_value, print_json, styled
+from poppy_cli.output import EXIT_INTERRUPTED, console, fmt_value, print_json, styled
 from poppy_cli.robots import build_robot, open_remote, robot_config, start_robot
 from poppy_cli.targets import TargetSyntaxError, parse_targets
 from poppy_core.trajectory import MAX_DURATION_S
@@ -165,8 +165,8 @@ def status(
                 while True:
                     time.sleep(0.1)
                     live.update(view("robot status (Ctrl-C to stop)"))
-        except KeyboardInterrupt:
-            return
+        except KeyboardInterrupt:  # the way to stop watching, yet an interruption (130)
+            raise typer.Exit(EXIT_INTERRUPTED) from None
 
 
 def _goals(

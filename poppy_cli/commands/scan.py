@@ -24,6 +24,7 @@ from poppy_cli.output import (
     printable,
     styled,
 )
+from poppy_cli.port_choice import choose_ports
 
 if TYPE_CHECKING:
     from poppy_core.bus.results import FoundMotor
@@ -88,10 +89,7 @@ def scan(
         raise typer.BadParameter("give either --baud or --all-bauds, not both")
     baudrates = None if all_bauds else (baud or [1_000_000])
     chosen = default_port(port)
-    ports = [chosen] if chosen else [p.device for p in list_ports()]
-    if not ports:
-        error_line("no serial port found: plug the adapter in (see `poppy ports`) or give --port")
-        raise typer.Exit(EXIT_FAILURE)
+    ports = [chosen] if chosen else choose_ports(list_ports())
 
     found: list[FoundMotor] = []
     with Progress(
