@@ -81,7 +81,9 @@ def tip_state(chain: RobotChain) -> dict[str, Any]:
         "position": [round(float(v), 5) for v in pose[:3, 3]],
         "orientation": [round(float(v), 5) for v in pose[:3, 0]],
         "rpy_deg": [round(math.degrees(v), 2) for v in chain.rpy],
-        "motors": {m.name: round(m.present_position, 2) for m in chain.motors},
+        "motors": [
+            {"name": m.name, "position": round(m.present_position, 2)} for m in chain.motors
+        ],
     }
 
 
@@ -102,7 +104,7 @@ def where(
         time.sleep(SETTLE_S)
         states = {name: tip_state(chain) for name, chain in _chains(robot).items()}
     if json_output:
-        print_json(states)
+        print_json([{"name": name, **state} for name, state in states.items()])
         return
     from rich.table import Table
 
@@ -179,7 +181,7 @@ def reach(
     result: dict[str, Any] = {
         "chain": chain.name,
         "target": target,
-        "angles": angles,
+        "motors": [{"name": name, "goal": angle} for name, angle in angles.items()],
         "waited": wait,
         "position": reached,
     }

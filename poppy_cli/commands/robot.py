@@ -59,6 +59,12 @@ def robot_state(robot: Robot | RemoteRobot) -> dict[str, dict[str, Any]]:
     return {motor.name: motor_state(motor) for motor in robot.motors}
 
 
+def records(by_name: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
+    """``{NAME: {...}}`` as the CLI's JSON gives a collection: a list of records, each with its
+    ``name`` first (docs/cli.md, JSON output)."""
+    return [{"name": name, **record} for name, record in by_name.items()]
+
+
 def status_table(robot: Robot | RemoteRobot, title: str = "robot status") -> Table:
     """A Rich table of every motor's state."""
     from rich.table import Table
@@ -141,14 +147,16 @@ def status(
     """Show every motor (position, goal, speed, load, temperature, voltage, compliance, link)
     and each bus's health (link, loop rates, errors, offline motors).
 
-    --json prints {"motors": {NAME: state}, "health": {CONTROLLER: health}}.
+    --json prints {"motors": [{name, id, position, ...}], "buses": [{name, port, ...}]}.
     """
     opened = open_remote(remote) if remote else build_robot(profile, config_file, port, sim)
     with opened as robot:
         if not remote:
             time.sleep(SETTLE_S)  # a few loop runs, so that the loop rates are measured
         if json_output:
-            print_json({"motors": robot_state(robot), "health": robot_health(robot)})
+            print_json(
+                {"motors": records(robot_state(robot)), "buses": records(robot_health(robot))}
+            )
             return
         if not watch:
             console.print(status_table(robot))
@@ -232,7 +240,8 @@ def goto(
             time.sleep(SETTLE_S)
         reached = {name: robot.motor(name).present_position for name in goals}
     if json_output:
-        print_json({"goals": goals, "positions": reached, "waited": wait})
+        motors = [{"name": n, "goal": g, "position": reached[n]} for n, g in goals.items()]
+        print_json({"motors": motors, "waited": wait})
         return
     for name, goal in goals.items():
         if wait:
@@ -284,7 +293,7 @@ def compliant(
             robot.motor(name).compliant = value
         result = {name: robot.motor(name).compliant for name in chosen}
     if json_output:
-        print_json(result)
+        print_json([{"name": name, "compliant": flag} for name, flag in result.items()])
         return
     for name, is_compliant in result.items():
         console.print(f"{name}: compliant {'on' if is_compliant else 'off'}")

@@ -8,7 +8,8 @@ from typing import Any
 def test_status_shows_bus_health(poppy: Any, ergo_jr: Any) -> None:
     common = ("--profile", "ergo-jr", "--port", ergo_jr.url)
     data = poppy("robot", "status", *common, "--json").json()
-    bus = data["health"]["my_dxl_controller"]
+    [bus] = data["buses"]
+    assert bus["name"] == "my_dxl_controller"  # the config's (pypot's) controller name
     assert bus["connected"] is True and bus["port"] == ergo_jr.url
     assert bus["offline"] == [] and bus["target_hz"]["present"] == 50.0
     assert set(bus["loop_hz"]) == {"present", "goals", "gains", "limits", "sensors"}
