@@ -135,9 +135,20 @@ def plain(text: object) -> Text:
     return Text(printable(str(text)))
 
 
+def _tidy(data: Any) -> Any:
+    """``data`` with ``-0.0`` written ``0.0`` (a motor at rest reads ``-0.0`` after a sign flip)."""
+    if isinstance(data, float):
+        return data + 0.0
+    if isinstance(data, dict):
+        return {key: _tidy(value) for key, value in data.items()}
+    if isinstance(data, list | tuple):
+        return [_tidy(value) for value in data]
+    return data
+
+
 def print_json(data: Any) -> None:
-    """Write `data` as JSON on stdout, nothing else."""
-    sys.stdout.write(json.dumps(data, indent=2, default=str) + "\n")
+    """Write `data` as JSON on stdout, nothing else (the shapes: docs/cli.md, JSON output)."""
+    sys.stdout.write(json.dumps(_tidy(data), indent=2, default=str) + "\n")
     sys.stdout.flush()
 
 
