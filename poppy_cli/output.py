@@ -217,8 +217,18 @@ def counted(count: int, noun: str) -> str:
     return f"{count} {noun}" if count == 1 else f"{count} {noun}s"
 
 
+SHOWN_UNITS = {"deg": "°", "deg/s": "°/s"}
+"""Units as people read them: registers say ``deg`` (and JSON keeps it), tables and lines ``°``."""
+
+
+def shown_unit(unit: str) -> str:
+    """``unit`` as shown to people: ``°`` for ``deg``, ``°/s`` for ``deg/s``, others as they are."""
+    return SHOWN_UNITS.get(unit, unit)
+
+
 def fmt_value(value: Any, unit: str = "") -> str:
-    """Format an SI register value with its unit for humans."""
+    """Format an SI register value with its unit for humans (``30 °``, ``4.5 V``, ``on``)."""
+    unit = shown_unit(unit)
     if isinstance(value, bool):
         return "on" if value else "off"
     if isinstance(value, float):

@@ -88,7 +88,9 @@ def tip_state(chain: RobotChain) -> dict[str, Any]:
 
 
 def _xyz(values: list[float]) -> str:
-    return "(" + ", ".join(f"{v:.3f}" for v in values) + ") m"
+    """A point for people, in millimetres (as the TUI and the web page show it; JSON and the
+    arguments of `robot reach` are metres)."""
+    return "(" + ", ".join(f"{v * 1000:.0f}" for v in values) + ") mm"
 
 
 @app.command("where")
@@ -99,7 +101,8 @@ def where(
     sim: str | None = SimOpt,
     json_output: bool = JsonOpt,
 ) -> None:
-    """Show where the tip of each kinematic chain is (metres, in the chain's base frame)."""
+    """Show where the tip of each kinematic chain is (millimetres, in the chain's base frame;
+    --json: metres)."""
     with build_robot(profile, config_file, port, sim) as robot:
         time.sleep(SETTLE_S)
         states = {name: tip_state(chain) for name, chain in _chains(robot).items()}
@@ -109,13 +112,13 @@ def where(
     from rich.table import Table
 
     table = Table(title="chain tips")
-    for column in ("chain", "x (m)", "y (m)", "z (m)", "x axis", "roll/pitch/yaw"):
+    for column in ("chain", "x (mm)", "y (mm)", "z (mm)", "x axis", "roll/pitch/yaw"):
         table.add_column(column, justify="left" if column == "chain" else "right")
     for name, state in states.items():
         x, y, z = state["position"]
-        axis = ", ".join(f"{v:.2f}" for v in state["orientation"])
+        axis = ", ".join(f"{round(v, 2) + 0.0:.2f}" for v in state["orientation"])
         rpy = " / ".join(f"{v:.0f}°" for v in state["rpy_deg"])
-        table.add_row(name, f"{x:.3f}", f"{y:.3f}", f"{z:.3f}", axis, rpy)
+        table.add_row(name, f"{x * 1000:.0f}", f"{y * 1000:.0f}", f"{z * 1000:.0f}", axis, rpy)
     console.print(table)
 
 

@@ -122,7 +122,7 @@ def health_table(health: dict[str, dict[str, Any]]) -> Table:
         )
         offline = Text(", ".join(bus["offline"]) or "none", style="red" if bus["offline"] else "")
         table.add_row(
-            Text(name),
+            Text(str(bus.get("label", name))),
             Text(bus["port"]),
             link,
             loops,

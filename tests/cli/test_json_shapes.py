@@ -90,7 +90,7 @@ BUS = {
     "name": str, "controller": str, "port": str, "connected": bool, "running": bool,
     "down_s": NUM, "losses": int, "loop_hz": Map(NUM), "target_hz": Map(NUM),
     "loop_errors": int, "timeouts": int, "retries": int, "corrupt_packets": int,
-    "motor_errors": int, "offline": [str], "ok": bool,
+    "motor_errors": int, "offline": [str], "ok": bool, "label": str,
 }  # fmt: skip
 PRIMITIVE = {
     "name": str, "class": str, "state": str, "alive": bool, "elapsed_s": NUM,

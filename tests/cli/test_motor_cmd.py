@@ -12,7 +12,7 @@ P2 = ("--baud", "1000000", "--protocol", "2")
 def test_get_prints_degrees(poppy: Any, mx_bus: Any) -> None:
     result = poppy("motor", "get", "11", "present_position", "--port", mx_bus.url)
     assert result.code == 0, result.stderr
-    assert result.stdout.strip() == "0 deg"
+    assert result.stdout.strip() == "0 °"
 
 
 def test_set_goal_moves_the_virtual_motor(poppy: Any, mx_bus: Any) -> None:
@@ -20,7 +20,7 @@ def test_set_goal_moves_the_virtual_motor(poppy: Any, mx_bus: Any) -> None:
     assert poppy("motor", "torque", "11", "on", *port).code == 0
     result = poppy("motor", "set", "11", "goal_position", "30", *port)
     assert result.code == 0, result.stderr
-    assert "goal_position = 29.97 deg" in result.stdout
+    assert "goal_position = 29.97 °" in result.stdout
     deadline = time.monotonic() + 5
     position = None
     while time.monotonic() < deadline:
@@ -206,7 +206,7 @@ def test_a_goal_to_a_compliant_motor_says_why_it_does_not_move(poppy: Any, ergo_
     port = ("--port", ergo_jr.url, *P2)
     written = poppy("motor", "set", "2", "goal_position", "-60", *port)  # no `--` needed
     assert written.code == 0, written.stderr
-    assert written.stdout.strip() == "motor 2: goal_position = -60.06 deg"
+    assert written.stdout.strip() == "motor 2: goal_position = -60.06 °"
     note = written.stderr.strip()
     assert note.startswith("note: motor 2 is compliant") and "\n" not in note
     stiffen = note.split("`")[1]

@@ -34,7 +34,7 @@ def test_where_json_lists_every_chain(poppy: Any) -> None:
 def test_where_table(poppy: Any) -> None:
     result = poppy("robot", "where", "--sim", "--profile", "ergo-jr")
     assert result.code == 0, result.stderr
-    assert "chain" in result.stdout and "0.156" in result.stdout  # the tip's z at rest
+    assert "z (mm)" in result.stdout and "│    156 │" in result.stdout  # the tip's z at rest, in mm
 
 
 def test_reach_with_negative_coordinates(poppy: Any) -> None:

@@ -10,6 +10,7 @@ from textual.binding import Binding, BindingType
 from textual.message import Message
 from textual.widgets import DataTable
 
+from poppy_cli.output import shown_unit
 from poppy_cli.tui.busio import RegisterValue, SIValue
 
 COLUMNS = ("addr", "register", "value", "mem", "")
@@ -22,7 +23,7 @@ def format_value(value: SIValue | None, unit: str) -> str:
     if isinstance(value, bool):
         return "on" if value else "off"
     text = f"{value:.1f}" if isinstance(value, float) else str(value)
-    return f"{text} {unit}".rstrip()
+    return f"{text} {shown_unit(unit)}".rstrip()
 
 
 class ControlTable(DataTable[str]):
