@@ -158,12 +158,12 @@ SCHEMAS: dict[str, Any] = {
     "robot goto": {"motors": [{"name": str, "goal": NUM, "position": NUM}], "waited": bool},
     "robot compliant": [{"name": str, "compliant": bool}],
     "robot where": [{
-        "name": str, "position": XYZ, "orientation": XYZ, "rpy_deg": XYZ,
+        "name": str, "label": str, "position": XYZ, "orientation": XYZ, "rpy_deg": XYZ,
         "motors": [{"name": str, "position": NUM}],
     }],
     "robot reach": {
-        "chain": str, "target": XYZ, "motors": [{"name": str, "goal": NUM}], "waited": bool,
-        "position": Opt(XYZ), "error_m?": NUM,
+        "chain": str, "label": str, "target": XYZ, "motors": [{"name": str, "goal": NUM}],
+        "waited": bool, "position": Opt(XYZ), "error_m?": NUM,
     },
     "primitive list": [PRIMITIVE],
     "primitive run": {**PRIMITIVE, "interrupted": bool},

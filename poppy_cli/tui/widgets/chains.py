@@ -91,7 +91,7 @@ class ChainsPanel(Vertical):
         pose = self.chains[name].pose
         x, y, z = (1000.0 * float(v) for v in pose[:3, 3])
         axis = ", ".join(f"{float(v):.2f}" for v in pose[:3, 0])
-        return name, f"{x:.1f}", f"{y:.1f}", f"{z:.1f}", axis
+        return self.chains[name].label, f"{x:.1f}", f"{y:.1f}", f"{z:.1f}", axis
 
     def poll(self) -> None:
         """Show where the tips are now (forward kinematics of the cached positions; no I/O)."""
