@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from poppy_core.motion import Move, read_move, save_move
+from tests.helpers.cli import keyed
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -106,13 +107,13 @@ def test_play_reaches_the_last_frame_on_an_emulated_bus(poppy: Any, ergo_jr: Any
     data = result.json()
     assert data["completed"] and data["duration_s"] == pytest.approx(0.5)
     assert data["played_s"] == pytest.approx(0.5, abs=0.2)
-    status = checked_json(poppy("robot", "status", *bus, "--json"))["motors"]
+    status = keyed(checked_json(poppy("robot", "status", *bus, "--json"))["motors"])
     assert status["m1"]["position"] == pytest.approx(30, abs=1.0)
     assert status["m4"]["position"] == pytest.approx(-20, abs=1.0)
     backwards = poppy("play", "reach", *bus, "--reverse", "--loop", "2", "--json")
     assert backwards.code == 0, backwards.stderr
     assert backwards.json()["played_s"] == pytest.approx(2.0, abs=0.4)
-    status = checked_json(poppy("robot", "status", *bus, "--json"))["motors"]
+    status = keyed(checked_json(poppy("robot", "status", *bus, "--json"))["motors"])
     assert status["m1"]["position"] == pytest.approx(0, abs=1.0)
 
 
