@@ -85,3 +85,22 @@ def test_counts_are_singular_for_one() -> None:
     result = run_poppy("config", "validate", str(ROOT / "profiles" / "ergo-jr" / "profile.yaml"))
     assert result.code == 0, result.stderr
     assert "6 motors, 1 controller, 2 groups" in result.stdout
+
+
+@pytest.mark.parametrize("command", ["record", "teleop"])
+def test_a_take_that_would_replace_a_move_is_refused_with_1(
+    command: str, monkeypatch: pytest.MonkeyPatch, tmp_path: Path, ergo_jr: LinkedBus
+) -> None:
+    from poppy_core.motion import Move, save_move
+
+    monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path))
+    save_move(Move.from_frames(50.0, [{"m1": 0.0}, {"m1": 1.0}]), "taken")
+    args = {
+        "record": ("record", "taken", "--sim", "--profile", "ergo-jr", "--duration", "0.2"),
+        "teleop": ("teleop", "--leader", "ergo-jr", "--leader-port", ergo_jr.url, "--follower",
+                   "ergo-jr", "--follower-port", ergo_jr.url, "--record", "taken"),
+    }[command]  # fmt: skip
+    result = run_poppy(*args)
+    assert result.code == 1, result.stderr
+    assert "exists" in result.stderr and "--force" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1  # one line, nothing unexpected
