@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, error_line, note_line
+from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, counted, error_line, note_line
 from poppy_cli.prompts import ask
 
 if TYPE_CHECKING:
@@ -30,11 +30,12 @@ def choose_ports(ports: list[PortInfo]) -> list[str]:
     adapters = [p for p in ports if p.adapter is not None]
     if adapters:
         others = len(ports) - len(adapters)
-        skipped = f"; {others} other port(s) skipped, see `poppy ports`" if others else ""
+        skipped = f"; {counted(others, 'other port')} skipped, see `poppy ports`" if others else ""
+        what = "a recognised Dynamixel adapter" if len(adapters) == 1 else "recognised adapters"
         note_line(
             "scanning "
             + ", ".join(_label(p) for p in adapters)
-            + f": recognised Dynamixel adapter(s){skipped}; give --port to scan another"
+            + f": {what}{skipped}; give --port to scan another"
         )
         return [p.device for p in adapters]
     if len(ports) == 1:

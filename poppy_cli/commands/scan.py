@@ -19,6 +19,7 @@ from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
     console,
+    counted,
     error_line,
     print_json,
     printable,
@@ -50,7 +51,7 @@ def render_found(motors: list[FoundMotor]) -> None:
     """Print scan results as a Rich table."""
     from rich.table import Table
 
-    table = Table(title=f"{len(motors)} motor(s) found")
+    table = Table(title=f"{counted(len(motors), 'motor')} found")
     for column in ("port", "baud", "protocol", "id", "model", "firmware"):
         table.add_column(column, justify="right" if column in ("baud", "id") else "left")
     for m in sorted(motors, key=lambda m: (m.port, m.protocol, -m.baudrate, m.id)):
@@ -128,7 +129,7 @@ def scan(
         except KeyboardInterrupt:
             bar.stop()
             _show(found, json_output)
-            error_line(f"scan interrupted; {len(found)} motor(s) found so far")
+            error_line(f"scan interrupted; {counted(len(found), 'motor')} found so far")
             raise typer.Exit(EXIT_INTERRUPTED) from None
     _show(found, json_output)
     if not found:

@@ -41,7 +41,10 @@ def test_scan_without_port_prefers_a_recognised_adapter_and_says_so(
     assert result.code == 0, result.stderr
     assert {m["port"] for m in result.json()} == {ergo_jr.url}
     assert f"scanning {ergo_jr.url} (U2D2, 0403:6014)" in result.stderr
-    assert "1 other port(s) skipped" in result.stderr and "--port" in result.stderr
+    assert (
+        "a recognised Dynamixel adapter; 1 other port skipped" in result.stderr
+        and "--port" in result.stderr
+    )
 
 
 def test_scan_names_the_only_port_it_falls_back_to(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -104,3 +107,9 @@ def test_a_take_that_would_replace_a_move_is_refused_with_1(
     assert result.code == 1, result.stderr
     assert "exists" in result.stderr and "--force" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1  # one line, nothing unexpected
+
+
+def test_one_motor_found_is_singular(ergo_jr: LinkedBus) -> None:
+    result = run_poppy("scan", "--port", ergo_jr.url, "--protocol", "2", "--ids", "3")
+    assert result.code == 0, result.stderr
+    assert "1 motor found" in result.stdout
