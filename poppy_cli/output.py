@@ -18,15 +18,21 @@ import unicodedata
 from collections.abc import Iterable
 from typing import Any
 
-from rich.console import Console, ConsoleOptions, RenderableType
+from rich.cells import cell_len
+from rich.console import Console, ConsoleDimensions, ConsoleOptions, RenderableType
 from rich.markup import escape
 from rich.segment import Segment
+from rich.table import Table
 from rich.text import Text
 
 EXIT_OK = 0
 EXIT_FAILURE = 1
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
+
+PIPED_WIDTH = 100_000
+"""The width of a console whose output is not a terminal: a table takes the width of its data
+and a line is never wrapped, so what a pipe or a file gets is whole lines, never cut."""
 
 _KEPT = frozenset("\n\t")
 _BIDI = frozenset("\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
@@ -46,10 +52,43 @@ def printable(text: str) -> str:
 
 class LiteralConsole(Console):
     """A Rich console that prints every string as it is: no markup, no emoji, no highlighting,
-    no terminal control (see ``printable``); styled output is built with ``styled``."""
+    no terminal control (see ``printable``); styled output is built with ``styled``.
+
+    Piped (its file is not a terminal), it is as wide as the data (``PIPED_WIDTH``): tables are
+    never cut to 80 columns nor a value wrapped over two lines, whatever ``COLUMNS`` says, and
+    a live display ends its last frame with a newline.
+    """
 
     def __init__(self, **options: Any) -> None:
         super().__init__(markup=False, emoji=False, highlight=False, **options)
+
+    @property
+    def size(self) -> ConsoleDimensions:
+        """The terminal's size; ``PIPED_WIDTH`` wide when the output is not a terminal."""
+        size = Console.size.fget(self)  # type: ignore[attr-defined]
+        assert isinstance(size, ConsoleDimensions)
+        if self.is_terminal:
+            return size
+        return ConsoleDimensions(PIPED_WIDTH, size.height)
+
+    @size.setter
+    def size(self, new_size: tuple[int, int]) -> None:
+        Console.size.fset(self, new_size)  # type: ignore[attr-defined]
+
+    def pop_render_hook(self) -> None:
+        """Rich ends a live display with a newline on a terminal only: piped, its last frame
+        (which it does print) ran into the next line (``└──┘replayed 135 frames``)."""
+        from rich.live import Live
+
+        hook = self._render_hooks[-1] if self._render_hooks else None
+        super().pop_render_hook()
+        if (
+            isinstance(hook, Live)
+            and not hook.transient
+            and not self.is_terminal
+            and hook._live_render.last_render_height
+        ):
+            self.line()
 
     def render_str(self, text: str, **options: Any) -> Text:
         """Every string printed, in a table cell, a title or a status, passes here."""
@@ -62,7 +101,12 @@ class LiteralConsole(Console):
         """Every piece of text rendered passes here, a ``Text`` built by the caller included
         (``Text.assemble(..., line)`` skips ``render_str``): its control characters are
         escaped; the console's own control segments (cursor moves of a live display) are kept.
+        Piped, a table is made as wide as its title, which would wrap otherwise.
         """
+        if isinstance(renderable, Table) and not self.is_terminal and renderable.title:
+            title = renderable.title
+            wide = title.cell_len if isinstance(title, Text) else cell_len(str(title))
+            renderable.min_width = max(renderable.min_width or 0, wide)
         for segment in super().render(renderable, options):
             if segment.control is None and not segment.text.isprintable():
                 yield Segment(printable(segment.text), segment.style)
@@ -91,9 +135,20 @@ def plain(text: object) -> Text:
     return Text(printable(str(text)))
 
 
+def _tidy(data: Any) -> Any:
+    """``data`` with ``-0.0`` written ``0.0`` (a motor at rest reads ``-0.0`` after a sign flip)."""
+    if isinstance(data, float):
+        return data + 0.0
+    if isinstance(data, dict):
+        return {key: _tidy(value) for key, value in data.items()}
+    if isinstance(data, list | tuple):
+        return [_tidy(value) for value in data]
+    return data
+
+
 def print_json(data: Any) -> None:
-    """Write `data` as JSON on stdout, nothing else."""
-    sys.stdout.write(json.dumps(data, indent=2, default=str) + "\n")
+    """Write `data` as JSON on stdout, nothing else (the shapes: docs/cli.md, JSON output)."""
+    sys.stdout.write(json.dumps(_tidy(data), indent=2, default=str) + "\n")
     sys.stdout.flush()
 
 
@@ -157,8 +212,23 @@ def log_to_stderr(level: int = logging.WARNING, fmt: str = "%(message)s") -> Non
         root.setLevel(level)
 
 
+def counted(count: int, noun: str) -> str:
+    """``1 controller``, ``2 controllers``, ``0 controllers``: ``noun`` is a regular noun."""
+    return f"{count} {noun}" if count == 1 else f"{count} {noun}s"
+
+
+SHOWN_UNITS = {"deg": "°", "deg/s": "°/s"}
+"""Units as people read them: registers say ``deg`` (and JSON keeps it), tables and lines ``°``."""
+
+
+def shown_unit(unit: str) -> str:
+    """``unit`` as shown to people: ``°`` for ``deg``, ``°/s`` for ``deg/s``, others as they are."""
+    return SHOWN_UNITS.get(unit, unit)
+
+
 def fmt_value(value: Any, unit: str = "") -> str:
-    """Format an SI register value with its unit for humans."""
+    """Format an SI register value with its unit for humans (``30 °``, ``4.5 V``, ``on``)."""
+    unit = shown_unit(unit)
     if isinstance(value, bool):
         return "on" if value else "off"
     if isinstance(value, float):

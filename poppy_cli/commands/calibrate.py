@@ -270,8 +270,8 @@ def _save(
         "path": str(saved.path),
         "backup": str(saved.backup) if saved.backup else None,
         "calibrated": calibration.created,
-        "joints": {m: {"offset": c["offset"][1], "angle_limit": list(c["angle_limit"][1])}
-                   for m, c in changes.items()},
+        "joints": [{"name": m, "offset": c["offset"][1], "angle_limit": list(c["angle_limit"][1])}
+                   for m, c in changes.items()],
     }  # fmt: skip
     if json_output:
         print_json(summary)
@@ -313,7 +313,7 @@ def _report_check(config: RobotConfig, drifts: list[JointDrift], json_output: bo
         print_json({
             "calibrated": when,
             "tolerance_deg": drifts[0].tolerance if drifts else None,
-            "joints": [{"motor": d.motor, "expected": d.expected, "measured": round(d.measured, 2),
+            "joints": [{"name": d.motor, "expected": d.expected, "measured": round(d.measured, 2),
                         "drift": round(d.drift, 2), "ok": d.ok} for d in drifts],
             "drifted": drifted,
         })  # fmt: skip

@@ -13,6 +13,7 @@ from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
     console,
+    counted,
     error_line,
     fmt_value,
     plain,
@@ -31,9 +32,13 @@ app = typer.Typer(
 
 
 def _counts(config: RobotConfig) -> str:
-    return (
-        f"{len(config.motors)} motors, {len(config.controllers)} controllers, "
-        f"{len(config.motorgroups)} groups"
+    return ", ".join(
+        counted(len(things), word)
+        for things, word in (
+            (config.motors, "motor"),
+            (config.controllers, "controller"),
+            (config.motorgroups, "group"),
+        )
     )
 
 

@@ -108,8 +108,9 @@ def info(
                 "port": bus.port,
                 "baud": bus.baudrate,
                 "protocol": bus.protocol,
-                "registers": {
-                    reg.name: {
+                "registers": [
+                    {
+                        "name": reg.name,
                         "value": value,
                         "unit": reg.unit,
                         "address": reg.address,
@@ -117,7 +118,7 @@ def info(
                         "memory": reg.memory,
                     }
                     for reg, value in rows
-                },
+                ],
             }
         )
         return
@@ -158,7 +159,7 @@ def get(
                 units[name] = reg.unit
                 values[motor_id][name] = bus.read_register(motor_id, model, name)
     if json_output:
-        print_json(values if len(id_list) > 1 else values[id_list[0]])
+        print_json([{"id": motor_id, **row} for motor_id, row in values.items()])
         return
     if len(id_list) == 1 and len(registers) == 1:
         console.print(fmt_value(values[id_list[0]][registers[0]], units[registers[0]]))
@@ -201,7 +202,7 @@ def set_register(
             "still answers afterwards",
             register=register,
         )
-    results: dict[str, dict[str, object]] = {}
+    results: list[dict[str, object]] = []
     compliant: list[int] = []
     with open_bus(require_port(port), id_list, baud, protocol) as bus:
         for motor_id in id_list:
@@ -214,7 +215,7 @@ def set_register(
                 )
             bus.write_register(motor_id, model, reg.name, parse_value(reg, value))
             written = bus.read_register(motor_id, model, reg.name)
-            results[str(motor_id)] = {reg.name: written}
+            results.append({"id": motor_id, reg.name: written})
             if not json_output:
                 console.print(f"motor {motor_id}: {reg.name} = {fmt_value(written, reg.unit)}")
             if reg.name.startswith("goal_") and not bus.read_register(

@@ -37,10 +37,10 @@ def _header(path: Path) -> dict[str, Any]:
         "motors": list(move.motors),
         "speeds": move.speeds is not None,
         "metadata": move.metadata,
-        "stats": {
-            name: {k: round(v, 2) + 0.0 for k, v in values.items()}  # + 0.0: no "-0.0"
+        "stats": [
+            {"name": name, **{k: round(v, 2) + 0.0 for k, v in values.items()}}  # no "-0.0"
             for name, values in move.stats().items()
-        },
+        ],
     }
 
 
@@ -121,10 +121,10 @@ def show(name: str = NameArg, json_output: bool = JsonOpt) -> None:
     table = Table(title="positions (°)")
     for column in ("motor", "start", "end", "min", "max", "range"):
         table.add_column(column, justify="left" if column == "motor" else "right")
-    for motor, stats in header["stats"].items():
+    for stats in header["stats"]:
         values = [f"{stats[k]:.1f}" if k in stats else "" for k in
                   ("start", "end", "min", "max", "range")]  # fmt: skip
-        table.add_row(motor, *values)
+        table.add_row(stats["name"], *values)
     console.print(table)
 
 

@@ -108,7 +108,7 @@ def list_primitives(
     with build_robot(profile, config_file, port, sim) as robot:
         primitives = robot_primitives(robot)
         if json_output:
-            print_json({name: p.describe() for name, p in primitives.items()})
+            print_json([{"name": name, **p.describe()} for name, p in primitives.items()])
             return
         console.print(primitives_table(primitives))
 

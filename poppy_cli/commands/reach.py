@@ -69,24 +69,31 @@ def _pick(robot: Robot, name: str | None) -> RobotChain:
     chains = _chains(robot)
     if name is None:
         return next(iter(chains.values()))
-    if name not in chains:
-        raise ConfigError(f"no chain {name!r} (chains: {', '.join(chains)})", field=name)
-    return chains[name]
+    for chain in chains.values():  # its name (robot.chain) or the name people see (arm)
+        if name in (chain.name, chain.label):
+            return chain
+    known = ", ".join(c.label for c in chains.values())
+    raise ConfigError(f"no chain {name!r} (chains: {known})", field=name)
 
 
 def tip_state(chain: RobotChain) -> dict[str, Any]:
     """Where a chain's tip is: position (m), x axis, roll/pitch/yaw (degrees), its motors."""
     pose = chain.pose
     return {
+        "label": chain.label,
         "position": [round(float(v), 5) for v in pose[:3, 3]],
         "orientation": [round(float(v), 5) for v in pose[:3, 0]],
         "rpy_deg": [round(math.degrees(v), 2) for v in chain.rpy],
-        "motors": {m.name: round(m.present_position, 2) for m in chain.motors},
+        "motors": [
+            {"name": m.name, "position": round(m.present_position, 2)} for m in chain.motors
+        ],
     }
 
 
 def _xyz(values: list[float]) -> str:
-    return "(" + ", ".join(f"{v:.3f}" for v in values) + ") m"
+    """A point for people, in millimetres (as the TUI and the web page show it; JSON and the
+    arguments of `robot reach` are metres)."""
+    return "(" + ", ".join(f"{v * 1000:.0f}" for v in values) + ") mm"
 
 
 @app.command("where")
@@ -97,23 +104,26 @@ def where(
     sim: str | None = SimOpt,
     json_output: bool = JsonOpt,
 ) -> None:
-    """Show where the tip of each kinematic chain is (metres, in the chain's base frame)."""
+    """Show where the tip of each kinematic chain is (millimetres, in the chain's base frame;
+    --json: metres)."""
     with build_robot(profile, config_file, port, sim) as robot:
         time.sleep(SETTLE_S)
         states = {name: tip_state(chain) for name, chain in _chains(robot).items()}
     if json_output:
-        print_json(states)
+        print_json([{"name": name, **state} for name, state in states.items()])
         return
     from rich.table import Table
 
     table = Table(title="chain tips")
-    for column in ("chain", "x (m)", "y (m)", "z (m)", "x axis", "roll/pitch/yaw"):
+    for column in ("chain", "x (mm)", "y (mm)", "z (mm)", "x axis", "roll/pitch/yaw"):
         table.add_column(column, justify="left" if column == "chain" else "right")
-    for name, state in states.items():
+    for state in states.values():
         x, y, z = state["position"]
-        axis = ", ".join(f"{v:.2f}" for v in state["orientation"])
+        axis = ", ".join(f"{round(v, 2) + 0.0:.2f}" for v in state["orientation"])
         rpy = " / ".join(f"{v:.0f}°" for v in state["rpy_deg"])
-        table.add_row(name, f"{x:.3f}", f"{y:.3f}", f"{z:.3f}", axis, rpy)
+        table.add_row(
+            state["label"], f"{x * 1000:.0f}", f"{y * 1000:.0f}", f"{z * 1000:.0f}", axis, rpy
+        )
     console.print(table)
 
 
@@ -178,8 +188,9 @@ def reach(
         reached = [float(v) for v in chain.position] if wait else None
     result: dict[str, Any] = {
         "chain": chain.name,
+        "label": chain.label,
         "target": target,
-        "angles": angles,
+        "motors": [{"name": name, "goal": angle} for name, angle in angles.items()],
         "waited": wait,
         "position": reached,
     }
@@ -190,9 +201,9 @@ def reach(
         return
     motors = ", ".join(f"{n}={a:.1f}°" for n, a in angles.items())
     if reached is None:
-        console.print(f"{chain.name}: moving to {_xyz(target)} in {duration:g} s ({motors})")
+        console.print(f"{chain.label}: moving to {_xyz(target)} in {duration:g} s ({motors})")
     else:
         console.print(
-            f"{chain.name}: at {_xyz(reached)}, {result['error_m'] * 1000:.1f} mm from "
+            f"{chain.label}: at {_xyz(reached)}, {result['error_m'] * 1000:.1f} mm from "
             f"{_xyz(target)} ({motors})"
         )

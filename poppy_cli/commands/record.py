@@ -21,7 +21,6 @@ from poppy_cli.options import (
 )
 from poppy_cli.output import (
     EXIT_FAILURE,
-    EXIT_USAGE,
     err_console,
     error_line,
     print_json,
@@ -160,7 +159,7 @@ def record(
         path = move_path(name, must_exist=False)
         if path.exists() and not force:
             error_line(f"{path} exists: pick another name or pass --force")
-            raise typer.Exit(EXIT_USAGE)
+            raise typer.Exit(EXIT_FAILURE)  # a refused file, as `output_path` refuses one
     probe_folder(path.parent, make_folder=in_library)  # before any motor goes compliant
     config = robot_config(profile, config_file, port)
     groups = {g: config.resolve_group(g) for g in config.motorgroups}

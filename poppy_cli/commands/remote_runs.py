@@ -32,7 +32,7 @@ def list_remote(url: str, json_output: bool) -> None:
     finally:
         robot.close()
     if json_output:
-        print_json(described)
+        print_json([{"name": name, **record} for name, record in described.items()])
         return
     table = Table(title=f"primitives on {url}")
     for column in ("name", "class", "state", "properties", "error"):

@@ -18,7 +18,7 @@ from poppy_cli.options import (
     SimOpt,
     finite,
 )
-from poppy_cli.output import console, fmt_value, print_json, styled
+from poppy_cli.output import EXIT_INTERRUPTED, console, fmt_value, print_json, styled
 from poppy_cli.robots import build_robot, open_remote, robot_config, start_robot
 from poppy_cli.targets import TargetSyntaxError, parse_targets
 from poppy_core.trajectory import MAX_DURATION_S
@@ -58,6 +58,12 @@ def motor_state(motor: Motor | RemoteMotor) -> dict[str, Any]:
 def robot_state(robot: Robot | RemoteRobot) -> dict[str, dict[str, Any]]:
     """Motor name -> its state."""
     return {motor.name: motor_state(motor) for motor in robot.motors}
+
+
+def records(by_name: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
+    """``{NAME: {...}}`` as the CLI's JSON gives a collection: a list of records, each with its
+    ``name`` first (docs/cli.md, JSON output)."""
+    return [{"name": name, **record} for name, record in by_name.items()]
 
 
 def status_table(robot: Robot | RemoteRobot, title: str = "robot status") -> Table:
@@ -117,7 +123,7 @@ def health_table(health: dict[str, dict[str, Any]]) -> Table:
         )
         offline = Text(", ".join(bus["offline"]) or "none", style="red" if bus["offline"] else "")
         table.add_row(
-            Text(name),
+            Text(str(bus.get("label", name))),
             Text(bus["port"]),
             link,
             loops,
@@ -142,14 +148,16 @@ def status(
     """Show every motor (position, goal, speed, load, temperature, voltage, compliance, link)
     and each bus's health (link, loop rates, errors, offline motors).
 
-    --json prints {"motors": {NAME: state}, "health": {CONTROLLER: health}}.
+    --json prints {"motors": [{name, id, position, ...}], "buses": [{name, port, ...}]}.
     """
     opened = open_remote(remote) if remote else build_robot(profile, config_file, port, sim)
     with opened as robot:
         if not remote:
             time.sleep(SETTLE_S)  # a few loop runs, so that the loop rates are measured
         if json_output:
-            print_json({"motors": robot_state(robot), "health": robot_health(robot)})
+            print_json(
+                {"motors": records(robot_state(robot)), "buses": records(robot_health(robot))}
+            )
             return
         if not watch:
             console.print(status_table(robot))
@@ -166,8 +174,8 @@ def status(
                 while True:
                     time.sleep(0.1)
                     live.update(view("robot status (Ctrl-C to stop)"))
-        except KeyboardInterrupt:
-            return
+        except KeyboardInterrupt:  # the way to stop watching, yet an interruption (130)
+            raise typer.Exit(EXIT_INTERRUPTED) from None
 
 
 def _goals(
@@ -233,7 +241,8 @@ def goto(
             time.sleep(SETTLE_S)
         reached = {name: robot.motor(name).present_position for name in goals}
     if json_output:
-        print_json({"goals": goals, "positions": reached, "waited": wait})
+        motors = [{"name": n, "goal": g, "position": reached[n]} for n, g in goals.items()]
+        print_json({"motors": motors, "waited": wait})
         return
     for name, goal in goals.items():
         if wait:
@@ -289,7 +298,7 @@ def compliant(
             robot.motor(name).compliant = value
         result = {name: robot.motor(name).compliant for name in chosen}
     if json_output:
-        print_json(result)
+        print_json([{"name": name, "compliant": flag} for name, flag in result.items()])
         return
     for name, is_compliant in result.items():
         console.print(f"{name}: compliant {'on' if is_compliant else 'off'}")

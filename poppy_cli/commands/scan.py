@@ -19,11 +19,13 @@ from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
     console,
+    counted,
     error_line,
     print_json,
     printable,
     styled,
 )
+from poppy_cli.port_choice import choose_ports
 
 if TYPE_CHECKING:
     from poppy_core.bus.results import FoundMotor
@@ -49,7 +51,7 @@ def render_found(motors: list[FoundMotor]) -> None:
     """Print scan results as a Rich table."""
     from rich.table import Table
 
-    table = Table(title=f"{len(motors)} motor(s) found")
+    table = Table(title=f"{counted(len(motors), 'motor')} found")
     for column in ("port", "baud", "protocol", "id", "model", "firmware"):
         table.add_column(column, justify="right" if column in ("baud", "id") else "left")
     for m in sorted(motors, key=lambda m: (m.port, m.protocol, -m.baudrate, m.id)):
@@ -88,10 +90,7 @@ def scan(
         raise typer.BadParameter("give either --baud or --all-bauds, not both")
     baudrates = None if all_bauds else (baud or [1_000_000])
     chosen = default_port(port)
-    ports = [chosen] if chosen else [p.device for p in list_ports()]
-    if not ports:
-        error_line("no serial port found: plug the adapter in (see `poppy ports`) or give --port")
-        raise typer.Exit(EXIT_FAILURE)
+    ports = [chosen] if chosen else choose_ports(list_ports())
 
     found: list[FoundMotor] = []
     with Progress(
@@ -130,7 +129,7 @@ def scan(
         except KeyboardInterrupt:
             bar.stop()
             _show(found, json_output)
-            error_line(f"scan interrupted; {len(found)} motor(s) found so far")
+            error_line(f"scan interrupted; {counted(len(found), 'motor')} found so far")
             raise typer.Exit(EXIT_INTERRUPTED) from None
     _show(found, json_output)
     if not found:

@@ -17,7 +17,15 @@ import typer
 
 from poppy_cli import complete
 from poppy_cli.options import SIM_ENGINES, JsonSummaryOpt, finite
-from poppy_cli.output import EXIT_USAGE, console, err_console, error_line, print_json, styled
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_USAGE,
+    console,
+    err_console,
+    error_line,
+    print_json,
+    styled,
+)
 from poppy_core.checks import MAX_DURATION_S
 
 if TYPE_CHECKING:
@@ -156,7 +164,7 @@ def teleop(
     path = move_path(record, must_exist=False) if record is not None else None
     if path is not None and path.exists() and not force:
         error_line(f"{path} exists: pick another name or pass --force")
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_FAILURE)  # a refused file: 1, as everywhere
     if path is not None:
         from poppy_core.files import probe_folder
         from poppy_core.motion.move_library import is_path

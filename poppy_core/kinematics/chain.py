@@ -303,7 +303,7 @@ class Chain:
         message = (
             f"chain {self.name!r} cannot reach the {what} ({_xyz(goal)}) m within its joint "
             f"limits: the nearest point it reaches is ({_xyz(near)}) m, "
-            f"{found.position_error_m * 100:.1f} cm away"
+            f"{found.position_error_m:.3f} m away"
         )
         if target.orientation is not None:
             message += f", its orientation {found.orientation_error_deg:.1f}° off"

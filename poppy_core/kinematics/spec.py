@@ -31,13 +31,21 @@ SECTION = "kinematics"
 
 @dataclass(frozen=True)
 class ChainSpec:
-    """One chain of the config: its motors (base to tip), passive and reversed ones, its tip."""
+    """One chain of the config: its motors (base to tip), passive and reversed ones, its tip,
+    and the name people are shown (``label``: the Ergo Jr's ``chain``, pypot's attribute name,
+    is shown as ``arm``; the name itself is kept for ``robot.chain`` and the APIs)."""
 
     name: str
     motors: tuple[str, ...]
     passive: tuple[str, ...] = ()
     reversed: tuple[str, ...] = ()
     tip: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    label: str = ""
+
+    @property
+    def shown(self) -> str:
+        """The chain's name for people: its label, else its name."""
+        return self.label or self.name
 
 
 @dataclass(frozen=True)
@@ -131,6 +139,14 @@ def parse_kinematics(data: Any, source: str = "config") -> KinematicsSpec:
                 field=f"{field}.tip",
                 value=tip,
             )
+        label = entry.get("label", "")
+        if not isinstance(label, str) or (label and not label.isidentifier()):
+            raise ConfigError(
+                f"{source}: {field}.label must be a name such as arm",
+                file=source,
+                field=f"{field}.label",
+                value=label,
+            )
         motors = _names(entry.get("motors"), f"{field}.motors")
         if not motors:
             raise ConfigError(
@@ -145,6 +161,7 @@ def parse_kinematics(data: Any, source: str = "config") -> KinematicsSpec:
                 passive=_names(entry.get("passive"), f"{field}.passive"),
                 reversed=_names(entry.get("reversed"), f"{field}.reversed"),
                 tip=(float(tip[0]), float(tip[1]), float(tip[2])),
+                label=label,
             )
         )
     reversed_ = _names(data.get("reversed"), f"{SECTION}.reversed")

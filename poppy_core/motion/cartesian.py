@@ -84,6 +84,12 @@ class RobotChain:
     def __repr__(self) -> str:
         return f"<RobotChain {self.name} motors={[m.name for m in self.motors]}>"
 
+    @property
+    def label(self) -> str:
+        """The chain's name for people (the config's ``label``: the Ergo Jr's ``chain`` is
+        ``arm``); ``name`` stays the attribute (``robot.chain``) and the APIs' name."""
+        return self._spec.chains[0].shown
+
     # -- the model, rebuilt when a motor's orientation, offset or limits change ------------------
 
     def _frame(self, name: str) -> MotorFrame:

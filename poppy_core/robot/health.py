@@ -4,6 +4,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+PYPOT_PLACEHOLDER = "my_dxl_controller"
+"""The controller name of pypot's configs (the Ergo Jr's), which says nothing of the bus: kept in
+config files and ``robot._controllers``, where pypot's API reads it, and not shown to people."""
+
+
+def bus_label(controller: str, port: str) -> str:
+    """The name people are shown for a bus: the port's last part (``ttyUSB0``, ``ttyACM0``,
+    ``emu://1``) for pypot's placeholder controller name, else the controller's own name
+    (``upper_body_controller``)."""
+    if controller != PYPOT_PLACEHOLDER or not port:
+        return controller
+    if "://" in port:
+        return port
+    return port.replace("\\", "/").rstrip("/").rsplit("/", 1)[-1] or port
+
 
 @dataclass(frozen=True)
 class LoopStats:
@@ -85,10 +100,16 @@ class BusHealth:
         """Connected, running, and every motor answering."""
         return self.connected and self.running and not self.offline
 
+    @property
+    def label(self) -> str:
+        """The bus's name for people (``bus_label``): ``ttyUSB0`` for ``my_dxl_controller``."""
+        return bus_label(self.controller, self.port)
+
     def as_dict(self) -> dict[str, object]:
         """Plain data (for ``--json`` and the REST API)."""
         data = dict(vars(self))
         data["ok"] = self.ok
+        data["label"] = self.label
         data["loop_hz"] = {name: round(hz, 2) for name, hz in self.loop_hz.items()}
         data["down_s"] = round(self.down_s, 3)
         return data

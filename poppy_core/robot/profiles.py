@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 import logging
 import re
 from dataclasses import dataclass
@@ -103,8 +104,15 @@ def _read_info(file: Path, user: bool) -> ProfileInfo | None:
         value = header.get(key, "")
         return value if isinstance(value, str) else str(value)
 
-    return ProfileInfo(name=file.parent.name, kind=text("kind"), description=text("description"),
-                       source=text("source"), directory=file.parent, file=file, user=user)
+    return ProfileInfo(
+        name=file.parent.name,
+        kind=text("kind"),
+        description=text("description"),
+        source=text("source"),
+        directory=file.parent,
+        file=file,
+        user=user,
+    )
 
 
 def list_profiles(user_dir: Path | None = None) -> list[ProfileInfo]:
@@ -148,7 +156,15 @@ def find_profile(name: str, user_dir: Path | None = None) -> ProfileInfo:
         if profile_key(info.name) == profile_key(name):
             return info
     known = ", ".join(info.name for info in profiles) or "none installed"
-    raise config_error(_SOURCE, "profile", name, f"unknown profile; known: {known}")
+    close = difflib.get_close_matches(
+        profile_key(name), [profile_key(info.name) for info in profiles], n=1, cutoff=0.6
+    )
+    hint = "".join(
+        f"did you mean {info.name}? "
+        for info in profiles
+        if close and profile_key(info.name) == close[0]
+    )
+    raise config_error(_SOURCE, "profile", name, f"unknown profile; {hint}known: {known}")
 
 
 def profile_folders(name: str, user_dir: Path | None = None) -> list[Path]:

@@ -31,7 +31,7 @@ from poppy_core.bus import DxlBus
 from poppy_core.errors import BusError, MotorError, PoppyError, PortError
 from poppy_core.models import ServoModel
 from poppy_core.robot import registers as regs
-from poppy_core.robot.health import BusHealth, LoopStats, SyncStats
+from poppy_core.robot.health import BusHealth, LoopStats, SyncStats, bus_label
 from poppy_core.robot.loops import BASE_LOOPS, LIGHT_LOOPS, LoopSpec, loops_for
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.motor_link import link_of
@@ -282,12 +282,14 @@ class BusSync:
         self._next_reopen = self._down_since + self._backoff.reset()
         for motor in self.motors:
             link_of(motor).mark_offline()
+        count = len(self.motors)
         logger.warning(
-            "%s: lost %s (%s); its %d motor(s) are offline, reopening it with backoff",
-            self.controller,
+            "bus %s: lost %s (%s); its %d %s offline, reopening it with backoff",
+            bus_label(self.controller, self.bus.port),
             self.bus.port,
             exc,
-            len(self.motors),
+            count,
+            "motor is" if count == 1 else "motors are",
         )
 
     def _reconnect(self) -> None:
@@ -302,8 +304,8 @@ class BusSync:
         now = self._clock()
         self.connected = True
         logger.warning(
-            "%s: %s is back after %.1f s; pinging its motors",
-            self.controller,
+            "bus %s: %s is back after %.1f s; pinging its motors",
+            bus_label(self.controller, self.bus.port),
             self.bus.port,
             now - self._down_since,
         )

@@ -53,7 +53,7 @@ def test_a_guided_run_writes_a_user_profile_that_profile_then_uses(
     assert check.code == 0, check.stderr
     report = check.json()
     assert report["calibrated"] == summary["calibrated"] and report["drifted"] == []
-    assert {j["motor"] for j in report["joints"]} == {f"m{i}" for i in range(1, 7)}
+    assert {j["name"] for j in report["joints"]} == {f"m{i}" for i in range(1, 7)}
 
 
 def test_quitting_writes_nothing(poppy: Any, user_dirs: Path) -> None:

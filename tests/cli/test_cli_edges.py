@@ -37,17 +37,21 @@ def one_line(result: Any, code: int) -> str:
 
 @pytest.mark.parametrize("baud", ["0", "-5", "99999999999999999999", "10000000000"])
 def test_baud_rates_out_of_range_are_usage_errors(poppy: Any, baud: str) -> None:
-    for args in (("scan", "--port", "loop://", "--baud", baud),
-                 ("motor", "get", "1", "id", "--port", "loop://", "--baud", baud)):
+    for args in (
+        ("scan", "--port", "loop://", "--baud", baud),
+        ("motor", "get", "1", "id", "--port", "loop://", "--baud", baud),
+    ):
         line = one_line(poppy(*args), 2)
         assert "--baud" in line
 
 
 @pytest.mark.parametrize("duration", ["1e300", "nan", "inf", "-1"])
 def test_durations_out_of_range_are_usage_errors(poppy: Any, duration: str) -> None:
-    for args in (("robot", "goto", "m1=10", *SIM, "--duration", duration),
-                 ("primitive", "run", "sinus", *SIM, "--duration", duration),
-                 ("record", "wave", *SIM, "--duration", duration)):
+    for args in (
+        ("robot", "goto", "m1=10", *SIM, "--duration", duration),
+        ("primitive", "run", "sinus", *SIM, "--duration", duration),
+        ("record", "wave", *SIM, "--duration", duration),
+    ):
         line = one_line(poppy(*args), 2)
         assert "--duration" in line
 
@@ -59,16 +63,23 @@ def test_play_speed_and_loops_out_of_range(poppy: Any) -> None:
 
 def test_a_300_character_move_name(poppy: Any) -> None:
     name = "a" * 300
-    for args in (("play", name, *SIM), ("record", name, *SIM, "--duration", "1"),
-                 ("moves", "show", name)):
+    for args in (
+        ("play", name, *SIM),
+        ("record", name, *SIM, "--duration", "1"),
+        ("moves", "show", name),
+    ):
         line = one_line(poppy(*args), 1)
         assert "at most 100 characters" in line
 
 
 def test_a_moves_dir_that_is_a_file(poppy: Any, library: Path) -> None:
     library.write_text("not a folder")
-    for args in (("moves", "list"), ("play", "wave", *SIM), ("record", "wave", *SIM),
-                 ("moves", "import", str(library))):
+    for args in (
+        ("moves", "list"),
+        ("play", "wave", *SIM),
+        ("record", "wave", *SIM),
+        ("moves", "import", str(library)),
+    ):
         line = one_line(poppy(*args), 1)
         assert f"{library}" in line
 
@@ -116,8 +127,12 @@ def garbage_server(request: pytest.FixtureRequest) -> Iterator[str]:
 
 
 def test_a_garbage_remote_server(poppy: Any, garbage_server: str) -> None:
-    for args in (("robot", "status"), ("play", "wave"), ("primitive", "list"),
-                 ("robot", "goto", "m1=1")):
+    for args in (
+        ("robot", "status"),
+        ("play", "wave"),
+        ("primitive", "list"),
+        ("robot", "goto", "m1=1"),
+    ):
         line = one_line(poppy(*args, "--remote", garbage_server), 1)
         assert "is not a poppy server" in line
 
@@ -134,18 +149,22 @@ def test_unknown_primitive_property_lists_properties(poppy: Any) -> None:
 
 
 def test_return_delay_out_of_range_says_nothing_first(poppy: Any, mx_bus: Any) -> None:
-    result = poppy("motor", "set-return-delay", "11", "--port", mx_bus.url, "--protocol", "1",
-                   "--", "-5")
+    result = poppy(
+        "motor", "set-return-delay", "11", "--port", mx_bus.url, "--protocol", "1", "--", "-5"
+    )
     line = one_line(result, 1)
     assert "return_delay_time" in line and "out of range" in line
     assert result.stdout == ""  # no "· motor 11: return delay -5.0 µs" progress line first
 
 
-BOMB = "\n".join(
-    [f'a0: &a0 [{",".join(["lol"] * 9)}]']
-    + [f"a{i}: &a{i} [{','.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]
-    + ["controllers: {}", "motors: {}", "sensors: {s: {x: *a8}}"]
-) + "\n"
+BOMB = (
+    "\n".join(
+        [f"a0: &a0 [{','.join(['lol'] * 9)}]"]
+        + [f"a{i}: &a{i} [{','.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]
+        + ["controllers: {}", "motors: {}", "sensors: {s: {x: *a8}}"]
+    )
+    + "\n"
+)
 
 
 def test_config_validate_refuses_an_alias_bomb(poppy: Any, tmp_path: Path) -> None:
@@ -156,8 +175,10 @@ def test_config_validate_refuses_an_alias_bomb(poppy: Any, tmp_path: Path) -> No
 
 
 def test_config_validate_refuses_deep_documents(poppy: Any, tmp_path: Path) -> None:
-    for name, text in (("deep.json", "[" * 100_000 + "]" * 100_000),
-                       ("deep.yaml", "a: " + "[" * 100_000 + "]" * 100_000)):
+    for name, text in (
+        ("deep.json", "[" * 100_000 + "]" * 100_000),
+        ("deep.yaml", "a: " + "[" * 100_000 + "]" * 100_000),
+    ):
         path = tmp_path / name
         path.write_text(text)
         line = one_line(poppy("config", "validate", str(path)), 1)
@@ -166,8 +187,9 @@ def test_config_validate_refuses_deep_documents(poppy: Any, tmp_path: Path) -> N
 
 def test_play_refuses_a_move_that_would_never_end(poppy: Any, tmp_path: Path) -> None:
     slow = tmp_path / "slow.json"
-    slow.write_text('{"framerate": 1e-300, "positions": {"0": {"m1": [0, 0]}, '
-                    '"1": {"m1": [1, 0]}}}')
+    slow.write_text(
+        '{"framerate": 1e-300, "positions": {"0": {"m1": [0, 0]}, "1": {"m1": [1, 0]}}}'
+    )
     assert "framerate must be 0.1-1000 Hz" in one_line(poppy("play", str(slow), *SIM), 1)
     far = tmp_path / "far.json"
     far.write_text('{"framerate": 50, "positions": {"0": {"m1": [1000000.0, 0]}}}')
@@ -176,8 +198,9 @@ def test_play_refuses_a_move_that_would_never_end(poppy: Any, tmp_path: Path) ->
 
 def test_play_clamps_a_move_past_the_limits_and_says_so(poppy: Any, tmp_path: Path) -> None:
     path = tmp_path / "past.json"
-    path.write_text('{"framerate": 50, "positions": {"0": {"m1": [500.0, 0]}, '
-                    '"0.02": {"m1": [500.0, 0]}}}')
+    path.write_text(
+        '{"framerate": 50, "positions": {"0": {"m1": [500.0, 0]}, "0.02": {"m1": [500.0, 0]}}}'
+    )
     result = poppy("play", str(path), *SIM, "--json")
     assert result.code == 0, result.stderr
     assert "warning: m1: the move goes" in result.stderr and "played at the limit" in result.stderr

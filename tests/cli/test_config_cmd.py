@@ -23,7 +23,7 @@ def test_validate_ok(poppy: Any) -> None:
     result = poppy("config", "validate", str(ERGO_JSON))
     assert result.code == 0, result.stderr
     assert "ok" in result.stdout
-    assert "6 motors" in result.stdout and "1 controllers" in result.stdout
+    assert "6 motors" in result.stdout and "1 controller," in result.stdout
     assert "2 groups" in result.stdout
 
 
@@ -102,7 +102,7 @@ def test_generate_from_emulator_then_validate(poppy: Any, ergo_jr: Any, tmp_path
     assert result.code == 0, result.stderr
     validated = poppy("config", "validate", str(out))
     assert validated.code == 0, validated.stderr
-    assert "6 motors, 1 controllers" in validated.stdout
+    assert "6 motors, 1 controller," in validated.stdout
     data = poppy("config", "show", str(out), "--json").json()
     assert sorted(data["motors"]) == [f"joint{i}" for i in range(1, 7)]
     assert data["motors"]["joint1"]["type"] == "XL-320"

@@ -12,7 +12,7 @@ P2 = ("--baud", "1000000", "--protocol", "2")
 def test_get_prints_degrees(poppy: Any, mx_bus: Any) -> None:
     result = poppy("motor", "get", "11", "present_position", "--port", mx_bus.url)
     assert result.code == 0, result.stderr
-    assert result.stdout.strip() == "0 deg"
+    assert result.stdout.strip() == "0 °"
 
 
 def test_set_goal_moves_the_virtual_motor(poppy: Any, mx_bus: Any) -> None:
@@ -20,11 +20,11 @@ def test_set_goal_moves_the_virtual_motor(poppy: Any, mx_bus: Any) -> None:
     assert poppy("motor", "torque", "11", "on", *port).code == 0
     result = poppy("motor", "set", "11", "goal_position", "30", *port)
     assert result.code == 0, result.stderr
-    assert "goal_position = 29.97 deg" in result.stdout
+    assert "goal_position = 29.97 °" in result.stdout
     deadline = time.monotonic() + 5
     position = None
     while time.monotonic() < deadline:
-        position = poppy("motor", "get", "11", "present_position", "--json", *port).json()
+        [position] = poppy("motor", "get", "11", "present_position", "--json", *port).json()
         if abs(position["present_position"] - 30) < 0.5:
             break
     assert position is not None and abs(position["present_position"] - 30) < 0.5
@@ -44,9 +44,9 @@ def test_get_several_motors_and_registers_as_json(poppy: Any, mx_bus: Any) -> No
     )
     assert result.code == 0, result.stderr
     values = result.json()
-    assert set(values) == {"11", "12", "13"}
-    assert 9 < values["11"]["present_voltage"] < 16
-    assert 15 < values["12"]["present_temperature"] < 60
+    assert [row["id"] for row in values] == [11, 12, 13]
+    assert 9 < values[0]["present_voltage"] < 16
+    assert 15 < values[1]["present_temperature"] < 60
 
 
 def test_info_shows_the_whole_control_table(poppy: Any, ergo_jr: Any) -> None:
@@ -54,7 +54,7 @@ def test_info_shows_the_whole_control_table(poppy: Any, ergo_jr: Any) -> None:
     assert result.code == 0, result.stderr
     info = result.json()
     assert info["model"] == "XL-320" and info["model_number"] == 350
-    registers = info["registers"]
+    registers = {register["name"]: register for register in info["registers"]}
     assert registers["id"]["value"] == 3
     assert registers["baudrate"]["value"] == 1_000_000
     assert registers["model_number"]["access"] == "R"
@@ -65,8 +65,8 @@ def test_info_shows_the_whole_control_table(poppy: Any, ergo_jr: Any) -> None:
 def test_led_colour_on_xl320(poppy: Any, ergo_jr: Any) -> None:
     port = ("--port", ergo_jr.url, *P2)
     assert poppy("motor", "led", "2", "green", *port).code == 0
-    assert poppy("motor", "get", "2", "led", "--json", *port).json() == {"led": "green"}
-    assert poppy("motor", "led", "2", "on", "--json", *port).json() == {"2": {"led": "white"}}
+    assert poppy("motor", "get", "2", "led", "--json", *port).json() == [{"id": 2, "led": "green"}]
+    assert poppy("motor", "led", "2", "on", "--json", *port).json() == [{"id": 2, "led": "white"}]
     assert poppy("motor", "led", "2", "off", *port).code == 0
     assert poppy("motor", "get", "2", "led", *port).stdout.strip() == "off"
 
@@ -206,7 +206,7 @@ def test_a_goal_to_a_compliant_motor_says_why_it_does_not_move(poppy: Any, ergo_
     port = ("--port", ergo_jr.url, *P2)
     written = poppy("motor", "set", "2", "goal_position", "-60", *port)  # no `--` needed
     assert written.code == 0, written.stderr
-    assert written.stdout.strip() == "motor 2: goal_position = -60.06 deg"
+    assert written.stdout.strip() == "motor 2: goal_position = -60.06 °"
     note = written.stderr.strip()
     assert note.startswith("note: motor 2 is compliant") and "\n" not in note
     stiffen = note.split("`")[1]
@@ -217,9 +217,8 @@ def test_a_goal_to_a_compliant_motor_says_why_it_does_not_move(poppy: Any, ergo_
     position = -999.0
     deadline = time.monotonic() + 10
     while abs(position + 60) > 0.5 and time.monotonic() < deadline:
-        position = poppy("motor", "get", "2", "present_position", "--json", *port).json()[
-            "present_position"
-        ]
+        [row] = poppy("motor", "get", "2", "present_position", "--json", *port).json()
+        position = row["present_position"]
     assert abs(position + 60) < 0.5
     quiet = poppy("motor", "set", "3", "goal_position", "10", "--json", *port)
     assert quiet.code == 0 and quiet.stderr == ""  # --json: data only
@@ -243,7 +242,7 @@ def test_set_return_delay_and_reboot_take_id_lists(poppy: Any, ergo_jr: Any) -> 
     assert result.code == 0, result.stderr
     assert [r["id"] for r in result.json()] == [1, 2, 3, 5]
     rows = poppy("motor", "get", "1-6", "return_delay_time", "torque_enable", "--json", *port)
-    assert [r["return_delay_time"] for r in rows.json().values()] == [0, 0, 0, 500, 0, 500]
-    assert [r["torque_enable"] for r in rows.json().values()] == [1, 0, 1, 0, 0, 0]
+    assert [r["return_delay_time"] for r in rows.json()] == [0, 0, 0, 500, 0, 500]
+    assert [r["torque_enable"] for r in rows.json()] == [1, 0, 1, 0, 0, 0]
     rebooted = poppy("motor", "reboot", "5-6", *port)
     assert rebooted.code == 0 and rebooted.stdout.count("verified") == 2

@@ -7,6 +7,8 @@ from typing import Any
 
 import pytest
 
+from tests.helpers.cli import keyed
+
 SIM = ("--sim", "--profile", "ergo-jr")
 
 
@@ -21,7 +23,7 @@ def xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
 def test_list_json(poppy: Any) -> None:
     result = poppy("primitive", "list", *SIM, "--json")
     assert result.code == 0, result.stderr
-    data = result.json()
+    data = keyed(result.json())
     assert {"sinus", "cosinus", "square", "position_watcher", "simple_posture"} <= set(data)
     sinus = data["sinus"]
     assert sinus["class"] == "Sinus" and sinus["state"] == "idle" and sinus["error"] is None

@@ -8,6 +8,8 @@ from typing import Any
 
 import pytest
 
+from tests.helpers.cli import keyed
+
 
 @pytest.fixture(autouse=True)
 def xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
@@ -22,17 +24,17 @@ def xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 def test_where_json_lists_every_chain(poppy: Any) -> None:
     result = poppy("robot", "where", "--sim", "--profile", "torso", "--json")
     assert result.code == 0, result.stderr
-    data = result.json()
+    data = keyed(result.json())
     assert sorted(data) == ["l_arm_chain", "r_arm_chain"]
     left = data["l_arm_chain"]
     assert len(left["position"]) == 3 and len(left["orientation"]) == 3
-    assert "l_elbow_y" in left["motors"] and "abs_z" in left["motors"]
+    assert {"l_elbow_y", "abs_z"} <= set(keyed(left["motors"]))
 
 
 def test_where_table(poppy: Any) -> None:
     result = poppy("robot", "where", "--sim", "--profile", "ergo-jr")
     assert result.code == 0, result.stderr
-    assert "chain" in result.stdout and "0.156" in result.stdout  # the tip's z at rest
+    assert "z (mm)" in result.stdout and "│    156 │" in result.stdout  # the tip's z at rest, in mm
 
 
 def test_reach_with_negative_coordinates(poppy: Any) -> None:
@@ -54,7 +56,7 @@ def test_reach_with_negative_coordinates(poppy: Any) -> None:
     assert data["chain"] == "chain" and data["waited"] is True
     assert data["error_m"] < 0.003
     assert math.dist(data["position"], [0.1, -0.1, 0.12]) < 0.003
-    assert set(data["angles"]) == {f"m{i}" for i in range(1, 7)}
+    assert set(keyed(data["motors"])) == {f"m{i}" for i in range(1, 7)}
 
 
 def test_reach_linear_with_orientation(poppy: Any) -> None:
@@ -72,7 +74,7 @@ def test_reach_linear_with_orientation(poppy: Any) -> None:
         "0.5",
     )
     assert result.code == 0, result.stderr
-    assert "chain: at (" in result.stdout and "mm from" in result.stdout
+    assert "arm: at (" in result.stdout and "mm from" in result.stdout
 
 
 def test_reach_out_of_reach_is_one_line(poppy: Any) -> None:
@@ -100,10 +102,10 @@ def test_reach_usage_errors(poppy: Any, args: list[str], message: str) -> None:
 
 def test_unknown_chain_names_the_chains(poppy: Any) -> None:
     result = poppy(
-        "robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", "arm", "0.1", "0", "0.1"
+        "robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", "leg", "0.1", "0", "0.1"
     )
     assert result.code == 1
-    assert "no chain 'arm' (chains: chain)" in result.stderr
+    assert "no chain 'leg' (chains: arm)" in result.stderr
 
 
 def test_robot_without_chains_says_how_to_add_them(poppy: Any, tmp_path: Path) -> None:
@@ -117,3 +119,31 @@ def test_robot_without_chains_says_how_to_add_them(poppy: Any, tmp_path: Path) -
     result = poppy("robot", "where", "--sim", "--config", str(path))
     assert result.code == 1
     assert "no kinematic chain" in result.stderr and "kinematics" in result.stderr
+
+
+def test_the_ergo_jr_chain_is_shown_as_arm_and_keeps_its_pypot_name(poppy: Any) -> None:
+    table = poppy("robot", "where", "--sim", "--profile", "ergo-jr")
+    assert table.code == 0, table.stderr
+    row = next(line for line in table.stdout.splitlines() if "156" in line)
+    assert row.split("│")[1].strip() == "arm"
+    [tip] = poppy("robot", "where", "--sim", "--profile", "ergo-jr", "--json").json()
+    assert tip["name"] == "chain" and tip["label"] == "arm"  # robot.chain, as pypot names it
+    for name in ("arm", "chain"):
+        moved = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", name,
+                      "0.1", "0", "0.12", "--duration", "0.2")  # fmt: skip
+        assert moved.code == 0, moved.stderr
+        assert moved.stdout.startswith("arm: at (100, ")
+    unknown = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", "leg", "0.1",
+                    "0", "0.1")  # fmt: skip
+    assert unknown.code == 1 and "(chains: arm)" in unknown.stderr
+
+
+def test_a_chain_label_must_be_a_name() -> None:
+    from poppy_core.errors import ConfigError
+    from poppy_core.kinematics.spec import parse_kinematics
+
+    section = {"model": "x.urdf", "chains": {"chain": {"motors": ["m1"], "label": "my arm"}}}
+    with pytest.raises(ConfigError, match="label must be a name"):
+        parse_kinematics(section, "robot.yaml")
+    section["chains"]["chain"]["label"] = "arm"
+    assert parse_kinematics(section, "robot.yaml").chains[0].shown == "arm"

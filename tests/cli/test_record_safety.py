@@ -94,8 +94,12 @@ def test_two_recordings_of_one_name_at_once(
     poppy: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
-    first = subprocess.Popen([*POPPY, "record", "same", *SIM, "--duration", "20"],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = subprocess.Popen(
+        [*POPPY, "record", "same", *SIM, "--duration", "20"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         assert first.stderr is not None
         line = first.stderr.readline()
@@ -131,8 +135,14 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
         (library / "filler").write_bytes(b"\0" * 28_000)
         env = dict(os.environ, POPPY_MOVES_DIR=str(library), COLUMNS="200")
         parent, child = pty.openpty()
-        proc = subprocess.Popen([*POPPY, "record", "wave", *SIM, "--duration", "6"], env=env,
-                                stdin=child, stdout=child, stderr=child, close_fds=True)
+        proc = subprocess.Popen(
+            [*POPPY, "record", "wave", *SIM, "--duration", "6"],
+            env=env,
+            stdin=child,
+            stdout=child,
+            stderr=child,
+            close_fds=True,
+        )
         os.close(child)
         try:
             shown = _read_until(parent, "Save it where?")

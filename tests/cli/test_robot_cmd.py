@@ -8,6 +8,8 @@ from typing import Any
 
 import pytest
 
+from tests.helpers.cli import keyed
+
 
 @pytest.fixture(autouse=True)
 def xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
@@ -29,7 +31,7 @@ def write_settings(xdg: Path, text: str) -> Path:
 def test_status_sim_json(poppy: Any) -> None:
     result = poppy("robot", "status", "--sim", "--profile", "ergo-jr", "--json")
     assert result.code == 0, result.stderr
-    data = result.json()["motors"]
+    data = keyed(result.json()["motors"])
     assert sorted(data) == [f"m{i}" for i in range(1, 7)]
     for name, state in data.items():
         assert abs(state["position"]) < 2, name
@@ -50,7 +52,7 @@ def test_goto_sim_reaches_target(poppy: Any) -> None:
         "--duration", "0.5", "--wait", "--json",
     )  # fmt: skip
     assert result.code == 0, result.stderr
-    reached = result.json()["positions"]
+    reached = {m["name"]: m["position"] for m in result.json()["motors"]}
     assert abs(reached["m1"] - 30) <= 2
     assert abs(reached["m2"] + 10) <= 2
 
@@ -77,12 +79,12 @@ def test_no_robot_given(poppy: Any) -> None:
 
 def test_compliant_off_then_status(poppy: Any, ergo_jr: Any) -> None:
     common = ("--profile", "ergo-jr", "--port", ergo_jr.url)
-    before = poppy("robot", "status", *common, "--json").json()["motors"]
+    before = keyed(poppy("robot", "status", *common, "--json").json()["motors"])
     assert all(state["compliant"] for state in before.values())
     off = poppy("robot", "compliant", "off", "base", *common, "--json")
     assert off.code == 0, off.stderr
-    assert off.json() == {"m1": False, "m2": False, "m3": False}
-    after = poppy("robot", "status", *common, "--json").json()["motors"]
+    assert off.json() == [{"name": f"m{i}", "compliant": False} for i in (1, 2, 3)]
+    after = keyed(poppy("robot", "status", *common, "--json").json()["motors"])
     assert [after[f"m{i}"]["compliant"] for i in range(1, 7)] == [False] * 3 + [True] * 3
 
 
@@ -101,7 +103,7 @@ def test_settings_file_then_env_override(
     assert len(from_file.json()["motors"]) == 13
     monkeypatch.setenv("POPPY_PROFILE", "ergo-jr")
     from_env = poppy("robot", "status", "--sim", "--json")
-    assert sorted(from_env.json()["motors"]) == [f"m{i}" for i in range(1, 7)]
+    assert sorted(keyed(from_env.json()["motors"])) == [f"m{i}" for i in range(1, 7)]
     from_option = poppy("robot", "status", "--sim", "--json", "--profile", "torso")
     assert len(from_option.json()["motors"]) == 13
 

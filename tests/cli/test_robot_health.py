@@ -8,14 +8,37 @@ from typing import Any
 def test_status_shows_bus_health(poppy: Any, ergo_jr: Any) -> None:
     common = ("--profile", "ergo-jr", "--port", ergo_jr.url)
     data = poppy("robot", "status", *common, "--json").json()
-    bus = data["health"]["my_dxl_controller"]
+    [bus] = data["buses"]
+    assert bus["name"] == "my_dxl_controller"  # the config's (pypot's) controller name
     assert bus["connected"] is True and bus["port"] == ergo_jr.url
     assert bus["offline"] == [] and bus["target_hz"]["present"] == 50.0
     assert set(bus["loop_hz"]) == {"present", "goals", "gains", "limits", "sensors"}
     table = poppy("robot", "status", *common)
     assert table.code == 0, table.stderr
-    assert "buses" in table.stdout and "my_dxl_controller" in table.stdout
+    assert "buses" in table.stdout and "connected" in table.stdout
     assert "connected" in table.stdout
+
+
+def test_a_bus_is_shown_by_what_it_is_not_by_pypots_placeholder(poppy: Any, ergo_jr: Any) -> None:
+    common = ("--profile", "ergo-jr", "--port", ergo_jr.url)
+    [bus] = poppy("robot", "status", *common, "--json").json()["buses"]
+    assert bus["name"] == bus["controller"] == "my_dxl_controller"  # pypot's API name, kept
+    assert bus["label"] == ergo_jr.url  # what people are shown
+    table = poppy("robot", "status", *common)
+    assert "my_dxl_controller" not in table.stdout
+    row = next(line for line in table.stdout.splitlines() if "connected" in line)
+    assert row.split("│")[1].strip() == ergo_jr.url
+
+
+def test_a_bus_label_is_the_ports_last_part_for_the_placeholder_only() -> None:
+    from poppy_core.robot.health import bus_label
+
+    assert bus_label("my_dxl_controller", "/dev/ttyUSB0") == "ttyUSB0"
+    assert bus_label("my_dxl_controller", "/dev/serial/by-id/usb-Xevelabs_USB2AX") == (
+        "usb-Xevelabs_USB2AX"
+    )
+    assert bus_label("my_dxl_controller", "socket://127.0.0.1:4000") == "socket://127.0.0.1:4000"
+    assert bus_label("upper_body_controller", "/dev/ttyUSB1") == "upper_body_controller"
 
 
 def test_health_table_says_a_bus_is_lost_and_names_offline_motors() -> None:

@@ -34,7 +34,7 @@ def test_scan_table_shows_models(poppy: Any, mx_bus: Any) -> None:
     result = poppy("scan", "--port", mx_bus.url, "--protocol", "1")
     assert result.code == 0, result.stderr
     assert "MX-28" in result.stdout and "AX-12A" in result.stdout
-    assert "4 motor(s) found" in result.stdout
+    assert "4 motors found" in result.stdout
 
 
 def test_scan_with_nothing_answering_is_one_line_and_exit_1(poppy: Any, ergo_jr: Any) -> None:
@@ -79,7 +79,7 @@ def test_ports_json_is_a_list(poppy: Any) -> None:
 def test_demo_finds_the_virtual_ergo_jr(poppy: Any) -> None:
     result = poppy("demo")
     assert result.code == 0, result.stderr
-    assert "6 motor(s) found" in result.stdout
+    assert "6 motors found" in result.stdout
     assert "XL-320" in result.stdout
 
 

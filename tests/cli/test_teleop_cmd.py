@@ -131,4 +131,4 @@ def test_an_existing_record_needs_force(poppy: Any, settings: Path) -> None:
     (settings / "taken.move").write_bytes(b"")
     result = poppy("teleop", "--leader", "ergo-jr", "--leader-port", "A", "--follower", "ergo-jr",
                    "--follower-port", "B", "--record", "taken")  # fmt: skip
-    assert result.code == 2 and "pass --force" in result.stderr
+    assert result.code == 1 and "pass --force" in result.stderr  # a refused file: 1

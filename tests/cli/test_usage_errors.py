@@ -11,8 +11,11 @@ CASES = [
     (("robot", "goto"), "Missing argument 'TARGETS'", "poppy robot goto --help"),
     (("scan", "--baud", "fast"), "Invalid value for '--baud'", "poppy scan --help"),
     (("moves", "nonsense"), "No such command 'nonsense'", "poppy moves --help"),
-    (("robot", "goto", "m1=x", "--sim", "--profile", "ergo-jr"), "'x' is not a number",
-     "poppy robot goto --help"),
+    (
+        ("robot", "goto", "m1=x", "--sim", "--profile", "ergo-jr"),
+        "'x' is not a number",
+        "poppy robot goto --help",
+    ),
 ]
 
 

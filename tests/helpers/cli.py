@@ -41,6 +41,11 @@ class Result:
         return json.loads(self.stdout)
 
 
+def keyed(records: list[dict[str, Any]], key: str = "name") -> dict[Any, dict[str, Any]]:
+    """A `--json` list of records (docs/cli.md: JSON output) by their ``key``, for lookups."""
+    return {record[key]: record for record in records}
+
+
 def run_poppy_process(
     *args: str, timeout: float = 60, input: str | None = None, env: Mapping[str, str] | None = None
 ) -> Result:

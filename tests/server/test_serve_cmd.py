@@ -13,7 +13,7 @@ from typing import Any
 
 import pytest
 
-from tests.helpers.cli import run_poppy
+from tests.helpers.cli import keyed, run_poppy
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -91,20 +91,21 @@ def _poppy(*args: str) -> subprocess.CompletedProcess[str]:
 def test_robot_commands_with_remote(served: Any) -> None:
     status = _poppy("robot", "status", "--remote", served.url, "--json")
     assert status.returncode == 0, status.stderr
-    state = json.loads(status.stdout)["motors"]
+    state = keyed(json.loads(status.stdout)["motors"])
     assert list(state) == ["m1", "m2", "m3", "m4", "m5", "m6"]
     assert state["m1"]["model"] == "XL-320" and state["m1"]["online"] is True
 
     stiff = _poppy("robot", "compliant", "off", "base", "--remote", served.url, "--json")
     assert stiff.returncode == 0, stiff.stderr
-    assert json.loads(stiff.stdout) == {"m1": False, "m2": False, "m3": False}
+    assert json.loads(stiff.stdout) == [{"name": f"m{i}", "compliant": False} for i in (1, 2, 3)]
     assert served.robot.m1.compliant is False
 
     moved = _poppy(
         "robot", "goto", "m1=12", "-d", "0.3", "--wait", "--remote", served.url, "--json"
     )
     assert moved.returncode == 0, moved.stderr
-    assert json.loads(moved.stdout)["positions"]["m1"] == pytest.approx(12, abs=2)
+    [m1] = json.loads(moved.stdout)["motors"]
+    assert m1["name"] == "m1" and m1["position"] == pytest.approx(12, abs=2)
 
     bad = _poppy("robot", "goto", "m9=12", "--remote", served.url)
     assert bad.returncode == 1 and "m9" in bad.stderr
@@ -117,7 +118,7 @@ def test_primitive_and_play_with_remote(served: Any) -> None:
 
     listed = _poppy("primitive", "list", "--remote", served.url, "--json")
     assert listed.returncode == 0, listed.stderr
-    assert "sinus" in json.loads(listed.stdout)
+    assert "sinus" in keyed(json.loads(listed.stdout))
 
     ran = _poppy(
         "primitive",

@@ -401,8 +401,14 @@ def test_camera_and_chain_jog(browser: Any, creature: Served) -> None:
     robot.compliant = False
     chain = robot.chain
     before = chain.position.copy()
-    tab.click("button[aria-label='chain z plus 1 cm']")
+    tab.click("button[aria-label='chain z plus 10 mm']")
     eventually(lambda: chain.position[2] - before[2] > 0.005, "the tip to rise by about 1 cm")
     eventually(lambda: tab.inner_text("#chain-chain output") != "", "the tip shown")
+
+    def shown_in_mm() -> bool:  # as the CLI and the TUI show a tip
+        tip = [int(v) for v in tab.inner_text("#chain-chain output").split(", ")]
+        return abs(tip[2] - chain.position[2] * 1000) < 5
+
+    eventually(shown_in_mm, "the tip shown in millimetres")
     context.close()
     robot.compliant = True

@@ -91,7 +91,8 @@ def test_sim_serves_a_physical_ergo_jr(sim_ergo: SimProcess) -> None:
     while time.monotonic() < deadline:  # the physics moves the joint, at up to 684 °/s
         got = run_here("motor", "get", "1", "present_position", *port, "--json")
         assert got.returncode == 0, got.stderr
-        position = json.loads(got.stdout)["present_position"]
+        [row] = json.loads(got.stdout)
+        position = row["present_position"]
         if abs(position - 30) < 2:
             break
     assert position is not None and abs(position - 30) < 2
@@ -103,7 +104,8 @@ def test_robot_goto_sim_mujoco() -> None:
     result = run("robot", "goto", "--sim", "mujoco", "--profile", "ergo-jr", "m1=30",
                  "--duration", "0.5", "--json")  # fmt: skip
     assert result.returncode == 0, result.stderr
-    assert abs(json.loads(result.stdout)["positions"]["m1"] - 30) < 3
+    [m1] = json.loads(result.stdout)["motors"]
+    assert m1["name"] == "m1" and abs(m1["position"] - 30) < 3
 
 
 def test_sim_with_an_unknown_engine_is_a_usage_error() -> None:

@@ -92,7 +92,7 @@ class ChainsPanel(Vertical):
         pose = self.chains[name].pose
         x, y, z = (1000.0 * float(v) for v in pose[:3, 3])
         axis = ", ".join(fixed(float(v), 2) for v in pose[:3, 0])
-        return name, fixed(x), fixed(y), fixed(z), axis
+        return self.chains[name].label, fixed(x), fixed(y), fixed(z), axis
 
     def poll(self) -> None:
         """Show where the tips are now (forward kinematics of the cached positions; no I/O)."""

@@ -10,6 +10,7 @@ from textual.binding import Binding, BindingType
 from textual.message import Message
 from textual.widgets import DataTable
 
+from poppy_cli.output import shown_unit
 from poppy_cli.tui.busio import RegisterValue, SIValue
 from poppy_cli.tui.text import fixed, set_cell
 
@@ -23,7 +24,7 @@ def format_value(value: SIValue | None, unit: str) -> str:
     if isinstance(value, bool):
         return "on" if value else "off"
     text = fixed(value) if isinstance(value, float) else str(value)
-    return f"{text} {unit}".rstrip()
+    return f"{text} {shown_unit(unit)}".rstrip()
 
 
 class ControlTable(DataTable[str]):

@@ -169,7 +169,7 @@ class RobotPanel(Vertical):
         for controller, bus in self.robot.health().items():
             link = "connected" if bus.connected else f"LOST {bus.down_s:.1f} s, reopening"
             rows[controller] = (
-                controller,
+                bus.label,
                 link,
                 f"{bus.loop_hz.get('present', 0.0):.0f}",
                 f"{bus.loop_hz.get('goals', 0.0):.0f}",

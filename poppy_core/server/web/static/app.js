@@ -29,7 +29,7 @@ function showAbout(about) {
     const text = bus.ok ? `ok · ${rate.toFixed(0)} Hz` : `${bus.connected ? "trouble" : "lost"}` +
       (bus.offline?.length ? ` · offline: ${bus.offline.join(", ")}` : "");
     return el("li", { className: bus.ok ? "ok" : "bad" },
-      el("strong", { textContent: name }), ` ${bus.port}: ${text}`);
+      el("strong", { textContent: bus.label || name }), ` ${bus.port}: ${text}`);
   }));
   const sensors = Object.entries(about.sensors ?? {});
   document.getElementById("sensors").replaceChildren(...sensors.map(([name, sensor]) => {

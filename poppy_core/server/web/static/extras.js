@@ -37,6 +37,8 @@ async function streamWithFetch(name, img) {
 }
 
 const STEP_M = 0.01;
+// The tip is shown in millimetres, as in the CLI and the TUI (the API speaks metres).
+const inMm = (position) => position.map((v) => (v * 1000).toFixed(0)).join(", ");
 
 async function jog(chain, axis, sign, tipText) {
   try {
@@ -44,7 +46,7 @@ async function jog(chain, axis, sign, tipText) {
     const target = [...now.position];
     target[axis] += sign * STEP_M;
     const answer = await post(`/api/v1/chains/${chain}/goto`, { position: target, duration: 0.5, wait: true });
-    tipText.textContent = answer.position.map((v) => (v * 100).toFixed(1)).join(", ");
+    tipText.textContent = inMm(answer.position);
   } catch (error) {
     say(`${chain}: ${error.message}`, true);
   }
@@ -56,15 +58,15 @@ export async function showChains(names) {
   for (const name of names) {
     const tip = el("output");
     const pad = el("div", { className: "jog", role: "group" });
-    pad.setAttribute("aria-label", `jog ${name} by 1 cm`);
+    pad.setAttribute("aria-label", `jog ${name} by 10 mm`);
     ["x", "y", "z"].forEach((axis, i) => {
-      pad.append(button(`${axis}−`, () => jog(name, i, -1, tip), `${name} ${axis} minus 1 cm`),
-        button(`${axis}+`, () => jog(name, i, 1, tip), `${name} ${axis} plus 1 cm`));
+      pad.append(button(`${axis}−`, () => jog(name, i, -1, tip), `${name} ${axis} minus 10 mm`),
+        button(`${axis}+`, () => jog(name, i, 1, tip), `${name} ${axis} plus 10 mm`));
     });
     list.append(el("article", { className: "card", id: `chain-${name}` },
-      el("h3", { textContent: name }), el("p", {}, "tip (cm): ", tip), pad));
+      el("h3", { textContent: name }), el("p", {}, "tip (mm): ", tip), pad));
     const refresh = async () => {
-      try { tip.textContent = (await get(`/api/v1/chains/${name}`)).position.map((v) => (v * 100).toFixed(1)).join(", "); } catch { /* shown elsewhere */ }
+      try { tip.textContent = inMm((await get(`/api/v1/chains/${name}`)).position); } catch { /* shown elsewhere */ }
     };
     refresh();
     setInterval(refresh, 2000);
