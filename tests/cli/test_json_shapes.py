@@ -154,6 +154,9 @@ SCHEMAS: dict[str, Any] = {
     "config list": [
         {"name": str, "kind": Opt(str), "description": str, "user": bool, "file": str}
     ],
+    # the user settings: a fixed set of keys, each unset (null) or its value
+    "config get": {"profile": Opt(str), "port": Opt(str)},
+    "config path": {"settings": str, "user_profiles": str, "profile_folders": [str]},
     "robot status": {"motors": [MOTOR_STATE], "buses": [BUS]},
     "robot goto": {"motors": [{"name": str, "goal": NUM, "position": NUM}], "waited": bool},
     "robot compliant": [{"name": str, "compliant": bool}],
@@ -265,6 +268,8 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
                 "motor reset": (("motor", "reset", "11", "11", *p1), ""),
                 "config show": (("config", "show", "ergo-jr"), ""),
                 "config list": (("config", "list"), ""),
+                "config get": (("config", "get"), ""),
+                "config path": (("config", "path"), ""),
                 "robot status": (("robot", "status", *SIM), ""),
                 "robot goto": (("robot", "goto", "m1=10", "--duration", "0.2", *SIM), ""),
                 "robot compliant": (("robot", "compliant", "off", "base", *SIM), ""),
