@@ -39,7 +39,7 @@ def test_sensors_not_built_yet_are_one_line_errors(kind: str, name: str) -> None
     [
         ({"cam": {"type": "WebCam"}}, 'sensors.cam.type = "WebCam": unknown sensor type'),
         ({"cam": {"type": "OpenCVCamera", "fps": 0}}, "sensors.cam.fps = 0: must be a positive"),
-        ({"cam": {"type": "OpenCVCamera", "resolution": [640]}}, "resolution must be"),
+        ({"cam": {"type": "OpenCVCamera", "resolution": [640]}}, "resolution = [640]: must be"),
         ({"cam": {"type": "OpenCVCamera", "calibration": {"camera_matrix": [1]}}}, "calibration"),
         ({"md": {"type": "MarkerDetector", "cameras": ["cam"]}}, "'cam' is not a camera here"),
         ({"cam": {"type": "DummyCamera"}, "md": {"type": "MarkerDetector", "cameras": ["cam"],
