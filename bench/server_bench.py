@@ -23,6 +23,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from bench.procs import free_port, interrupt
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
 
 CLIENTS = 4
@@ -54,12 +55,6 @@ SCENARIOS: dict[str, tuple[str, str, bytes | None]] = {
 }
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 def _wait_listening(port: int, proc: subprocess.Popen[str]) -> None:
     deadline = time.monotonic() + START_TIMEOUT_S
     while time.monotonic() < deadline:
@@ -75,7 +70,7 @@ def _wait_listening(port: int, proc: subprocess.Popen[str]) -> None:
 
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
-    port = _free_port()
+    port = free_port()
     if kind == "poppy":
         args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", "--sim"]
         args += ["--profile", "ergo-jr", "--http-port", str(port)]
@@ -88,12 +83,7 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
         _wait_listening(port, proc)
         yield port
     finally:
-        proc.send_signal(2)
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        interrupt(proc)
 
 
 def _load(port: int, method: str, path: str, body: bytes | None) -> dict[str, Any]:

@@ -22,8 +22,9 @@ from pathlib import Path
 from typing import Any
 
 from bench.emulator_proc import EmulatorProcess
+from bench.procs import free_port, interrupt
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
-from bench.server_bench import CLIENTS, DURATION_S, _free_port, _load, _load_wrk, _wait_listening
+from bench.server_bench import CLIENTS, DURATION_S, _load, _load_wrk, _wait_listening
 
 SCENARIOS: dict[str, str] = {
     "GET /motors/get/positions": "/motors/get/positions",
@@ -46,7 +47,7 @@ class ErgoJrEmulator(EmulatorProcess):
 
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
-    port = _free_port()
+    port = free_port()
     with ErgoJrEmulator() as emulator, tempfile.TemporaryDirectory() as moves:
         if kind == "poppy":
             args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--snap"]
@@ -68,12 +69,7 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
             _wait_listening(port, proc)
             yield port
         finally:
-            proc.send_signal(2)
-            try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+            interrupt(proc)
 
 
 def _warm_up(port: int) -> None:

@@ -38,6 +38,7 @@ from typing import Any
 
 from bench.clients import run_client
 from bench.emulator_proc import EmulatorError
+from bench.procs import interrupt
 from bench.registry import (
     BENCH_DIR,
     POPPY_CLI,
@@ -250,11 +251,7 @@ def torque_toggles(ctx: BenchContext) -> dict[str, Any]:
             record["control"] = run_client([*client, "--keep-output"]).record
             out[label] = record
         finally:
-            proc.send_signal(2)
-            try:
-                proc.wait(10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
+            interrupt(proc)
     return out
 
 

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from bench.link_proxy import LinkProxy
+from bench.procs import interrupt
 from bench.registry import POPPY_CLI, REPO_ROOT
 from bench.teleop_probe import BusProbe, FollowerOf, Hand, Tracker, latencies
 from poppy_core.emulator import VirtualBus, serve_pty
@@ -187,12 +188,7 @@ def poppy_server(profile: str, port: str, attempts: int = 3) -> Iterator[str]:
     try:
         yield url
     finally:
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(20)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        interrupt(proc, 20)
 
 
 def teleop_states(url: str) -> dict[str, str]:

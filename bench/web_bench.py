@@ -14,7 +14,6 @@ import argparse
 import logging
 import os
 import shutil
-import socket
 import statistics
 import subprocess
 import tempfile
@@ -23,6 +22,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from bench.procs import free_port, interrupt
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
 
 logger = logging.getLogger(__name__)
@@ -43,22 +43,17 @@ def chromium() -> str | None:
     return shutil.which("chromium") or shutil.which("chromium-browser")
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 @contextmanager
 def served(profile: str) -> Iterator[tuple[str, int]]:
     """``poppy serve --http --sim --profile PROFILE`` in its own process: (base URL, pid)."""
-    port = _free_port()
+    port = free_port()
     args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", "--sim"]
     args += ["--profile", profile, "--http-port", str(port), "--no-sensors"]
     library = tempfile.TemporaryDirectory(prefix="poppy-web-bench-")  # the user's moves stay
     env = {**os.environ, "POPPY_MOVES_DIR": library.name}
-    proc = subprocess.Popen(args, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=env)  # fmt: skip
+    proc = subprocess.Popen(
+        args, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline().strip()  # the base URL once every port is bound
@@ -67,12 +62,7 @@ def served(profile: str) -> Iterator[tuple[str, int]]:
             raise RuntimeError(f"poppy serve did not start: {why}")
         yield line, proc.pid
     finally:
-        proc.send_signal(2)
-        try:
-            proc.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        interrupt(proc, 15)
         library.cleanup()
 
 

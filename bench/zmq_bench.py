@@ -10,13 +10,13 @@ over the answered requests.
 from __future__ import annotations
 
 import json
-import socket
 import subprocess
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from bench.procs import free_port, interrupt
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
 
 DURATION_S = 1.5
@@ -49,15 +49,9 @@ SCENARIOS: dict[str, dict[str, Any]] = {
 }  # fmt: skip
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
-    port = _free_port()
+    port = free_port()
     if kind == "poppy":
         args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--zmq", "--sim"]
         args += ["--profile", "ergo-jr", "--zmq-port", str(port)]
@@ -74,12 +68,7 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
             raise RuntimeError(f"the {kind} server exited: {err.strip()[-300:]}")
         yield port
     finally:
-        proc.send_signal(2)
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        interrupt(proc)
         for stream in (proc.stdout, proc.stderr):
             if stream is not None:
                 stream.close()
