@@ -41,12 +41,14 @@ except KeyboardInterrupt:
 """
 
 SCENARIOS: dict[str, dict[str, Any]] = {
-    "get_register_value": {"robot": {"get_register_value": {
-        "motor": "m1", "register": "present_position"}}},
-    "set_register_value": {"robot": {"set_register_value": {
-        "motor": "m1", "register": "goal_position", "value": "10"}}},
+    "get_register_value": {
+        "robot": {"get_register_value": {"motor": "m1", "register": "present_position"}}
+    },
+    "set_register_value": {
+        "robot": {"set_register_value": {"motor": "m1", "register": "goal_position", "value": "10"}}
+    },
     "get_motors_list": {"robot": {"get_motors_list": {}}},
-}  # fmt: skip
+}
 
 
 @contextmanager
@@ -151,8 +153,12 @@ def zmq_bench(ctx: BenchContext) -> BenchResult:
             if median is None:
                 row += ["-", "-", "-", "-"]
                 continue
-            row += [f"{median['rps']:.0f}", _ms(median["p50_s"]), _ms(median["p99_s"]),
-                    str(median["error_replies"])]  # fmt: skip
+            row += [
+                f"{median['rps']:.0f}",
+                _ms(median["p50_s"]),
+                _ms(median["p99_s"]),
+                str(median["error_replies"]),
+            ]
         mine = raw.get("poppy", {}).get(name, {}).get("median")
         theirs = raw.get("pypot", {}).get(name, {}).get("median")
         row.append(f"{mine['rps'] / theirs['rps']:.1f}x" if mine and theirs else "-")

@@ -30,12 +30,23 @@ def _read_until(fd: int, text: str, timeout_s: float = 60) -> str:
 
 
 def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Path) -> None:
-    env = dict(os.environ, COLUMNS="120", NO_COLOR="1", XDG_CONFIG_HOME=str(tmp_path / "xdg"),
-               POPPY_PROFILE="", POPPY_PORT="")  # fmt: skip
+    env = dict(
+        os.environ,
+        COLUMNS="120",
+        NO_COLOR="1",
+        XDG_CONFIG_HOME=str(tmp_path / "xdg"),
+        POPPY_PROFILE="",
+        POPPY_PORT="",
+    )
     parent, child = pty.openpty()
-    proc = subprocess.Popen([*POPPY, "calibrate", "--sim", "--profile", "ergo-jr", "--motors",
-                             "m1"], env=env, stdin=child, stdout=child, stderr=child,
-                            close_fds=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr", "--motors", "m1"],
+        env=env,
+        stdin=child,
+        stdout=child,
+        stderr=child,
+        close_fds=True,
+    )
     try:
         shown = _read_until(parent, "q to cancel")
         assert "reference posture" in shown, shown
@@ -57,11 +68,23 @@ def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Pa
 
 
 def test_q_at_the_posture_cancels_at_once(tmp_path: Path) -> None:
-    env = dict(os.environ, COLUMNS="120", NO_COLOR="1", XDG_CONFIG_HOME=str(tmp_path / "xdg"),
-               POPPY_PROFILE="", POPPY_PORT="")  # fmt: skip
+    env = dict(
+        os.environ,
+        COLUMNS="120",
+        NO_COLOR="1",
+        XDG_CONFIG_HOME=str(tmp_path / "xdg"),
+        POPPY_PROFILE="",
+        POPPY_PORT="",
+    )
     parent, child = pty.openpty()
-    proc = subprocess.Popen([*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"], env=env,
-                            stdin=child, stdout=child, stderr=child, close_fds=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"],
+        env=env,
+        stdin=child,
+        stdout=child,
+        stderr=child,
+        close_fds=True,
+    )
     try:
         _read_until(parent, "q to cancel")
         os.write(parent, b"q")

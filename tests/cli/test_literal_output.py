@@ -158,9 +158,11 @@ def test_the_servers_suggestion_never_writes_a_clients_control_characters() -> N
 
     proc = subprocess.Popen(
         [*POPPY, "serve", "--http", "--sim", "--profile", "ergo-jr", "--http-port", "0"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
         env=dict(__import__("os").environ, **ENV),
-    )  # fmt: skip
+    )
     try:
         assert proc.stdout is not None and proc.stderr is not None
         url = proc.stdout.readline().strip()
@@ -194,8 +196,19 @@ def test_the_path_record_prints_for_scripts_is_escaped(
 ) -> None:
     monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
     target = tmp_path / f"take{ESCAPE}.move"
-    result = poppy("record", "w", "--sim", "--profile", "ergo-jr", "--motors", "m1",
-                   "--duration", "0.2", "--output", str(target))  # fmt: skip
+    result = poppy(
+        "record",
+        "w",
+        "--sim",
+        "--profile",
+        "ergo-jr",
+        "--motors",
+        "m1",
+        "--duration",
+        "0.2",
+        "--output",
+        str(target),
+    )
     assert result.code == 0, result.stderr
     assert target.is_file()
     assert result.stdout.strip().splitlines()[-1] == f"{tmp_path}/take\\x1b[2J.move"

@@ -153,8 +153,9 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
 def test_ctrl_c_where_to_save_keeps_the_take_in_a_temporary_file(tmp_path: Path) -> None:
     with tmpfs(tmp_path / "full", "32k") as library:
         (library / "filler").write_bytes(b"\0" * 28_000)
-        terminal = Terminal("record", "wave", *SIM, "--duration", "6",
-                            env={"POPPY_MOVES_DIR": str(library)})  # fmt: skip
+        terminal = Terminal(
+            "record", "wave", *SIM, "--duration", "6", env={"POPPY_MOVES_DIR": str(library)}
+        )
         try:
             assert "Save it where?" in terminal.read_until("Save it where?")
             terminal.type(CTRL_C)

@@ -73,8 +73,11 @@ def test_a_simulated_robot_has_the_profiles_sensors() -> None:
         assert camera.resolution == [640, 480] and camera.fps == 20.0
         detector = robot.marker_detector
         assert isinstance(detector, MarkerDetector) and detector.cameras == [camera]
-        assert detector.card_ids == {"caribou": [221052793], "tetris": [112259237],
-                                     "lapin": [44616414]}  # fmt: skip
+        assert detector.card_ids == {
+            "caribou": [221052793],
+            "tetris": [112259237],
+            "lapin": [44616414],
+        }
         assert detector.sees("tetris") is False
         assert set(robot.sensor_health()) == {"camera", "marker_detector"}
         assert "camera" in dir(robot)

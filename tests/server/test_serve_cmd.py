@@ -294,8 +294,11 @@ def test_a_signal_stops_a_remote_play_with_exit_130(served: Any, signum: int) ->
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
         [*POPPY, "play", "remote_long", "--remote", served.url, "--json"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         moves = served.app.state.service.moves
         assert eventually(lambda: "remote_long" in moves.playing(), timeout_s=60), proc.stderr

@@ -32,13 +32,28 @@ def test_sigterm_saves_the_rest_and_snap_recordings_and_says_where(tmp_path: Pat
     library.mkdir()
     temp.mkdir()
     (library / "taken.move").write_text("a move of that name is already saved\n")
-    env = dict(os.environ, COLUMNS="300", NO_COLOR="1", POPPY_MOVES_DIR=str(library),
-               TMPDIR=str(temp))  # fmt: skip
+    env = dict(
+        os.environ, COLUMNS="300", NO_COLOR="1", POPPY_MOVES_DIR=str(library), TMPDIR=str(temp)
+    )
     proc = subprocess.Popen(
-        [*POPPY, "serve", "--http", "--http-port", "0", "--snap", "--snap-port", "0", "--sim",
-         "--profile", "ergo-jr"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        [
+            *POPPY,
+            "serve",
+            "--http",
+            "--http-port",
+            "0",
+            "--snap",
+            "--snap-port",
+            "0",
+            "--sim",
+            "--profile",
+            "ergo-jr",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert proc.stdout is not None and proc.stderr is not None
         http = proc.stdout.readline().strip()  # the URL alone, then "docs: …", "snap: …"

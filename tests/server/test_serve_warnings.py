@@ -62,10 +62,23 @@ def served_bus() -> Iterator[Endpoint]:
 def test_a_lost_bus_is_a_warning_on_the_servers_stderr(served_bus: Endpoint) -> None:
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
-        [*POPPY, "serve", "--http", "--http-port", "0", "--profile", "ergo-jr",
-         "--port", served_bus.url, "--no-sensors"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        [
+            *POPPY,
+            "serve",
+            "--http",
+            "--http-port",
+            "0",
+            "--profile",
+            "ergo-jr",
+            "--port",
+            served_bus.url,
+            "--no-sensors",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert proc.stdout is not None and proc.stderr is not None
         assert proc.stdout.readline().startswith("http://127.0.0.1:")  # serving

@@ -49,8 +49,9 @@ def test_the_documentation_example_reads_and_writes_registers(robot: Robot, clie
     answer = client.recv_json()
     assert isinstance(answer, float)
     robot.head_z.compliant = False
-    req = {"robot": {"set_register_value": {"motor": "head_z", "register": "goal_pos",
-                                            "value": 100}}}  # fmt: skip
+    req = {
+        "robot": {"set_register_value": {"motor": "head_z", "register": "goal_pos", "value": 100}}
+    }
     client.send_json(req)
     answer = client.recv_json()
     assert answer == {}
@@ -99,14 +100,26 @@ def test_goto_with_wait(robot: Robot, client: Any) -> None:
         ({"robot": {"no_such_method": {}}}, "no method"),
         ({"robot": {"get_register_value": {"motor": "nose", "register": "x"}}}, "no motor"),
         ({"robot": {"get_register_value": {"motor": "head_z"}}}, "bad arguments"),
-        ({"robot": {"get_register_value": {"motor": "head_z", "register": "colour"}}},
-         "no register"),
-        ({"robot": {"set_register_value": {"motor": "head_z", "register": "goal_position",
-                                           "value": "\"far\""}}}, "goal_position"),
+        (
+            {"robot": {"get_register_value": {"motor": "head_z", "register": "colour"}}},
+            "no register",
+        ),
+        (
+            {
+                "robot": {
+                    "set_register_value": {
+                        "motor": "head_z",
+                        "register": "goal_position",
+                        "value": '"far"',
+                    }
+                }
+            },
+            "goal_position",
+        ),
         ({"robot": "get_motors_list"}, "expected"),
         ([1, 2, 3], "expected"),
     ],
-)  # fmt: skip
+)
 def test_bad_requests_get_an_error_and_the_server_carries_on(
     client: Any, request_: Any, says: str
 ) -> None:
@@ -143,10 +156,23 @@ def test_poppy_serve_zmq() -> None:
 
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
-        [sys.executable, "-m", "poppy_cli", "serve", "--sim", "--profile", "ergo-jr", "--zmq",
-         "--zmq-port", "0"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "poppy_cli",
+            "serve",
+            "--sim",
+            "--profile",
+            "ergo-jr",
+            "--zmq",
+            "--zmq-port",
+            "0",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline().strip()

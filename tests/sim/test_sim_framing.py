@@ -107,9 +107,26 @@ def test_a_move_render_shows_its_frames_and_time_left_on_a_terminal(tmp_path: Pa
     out = tmp_path / "turn.gif"
     env = dict(os.environ, COLUMNS="120", TERM="xterm", NO_COLOR="1")
     parent, child = pty.openpty()
-    proc = subprocess.Popen([*POPPY, "sim", "render", "--move", str(move_file), "--width", "64",
-                             "--height", "48", "-o", str(out)], env=env, stdin=child,
-                            stdout=child, stderr=child, close_fds=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [
+            *POPPY,
+            "sim",
+            "render",
+            "--move",
+            str(move_file),
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "-o",
+            str(out),
+        ],
+        env=env,
+        stdin=child,
+        stdout=child,
+        stderr=child,
+        close_fds=True,
+    )
     os.close(child)
     try:
         shown = _read_all(parent, proc)
