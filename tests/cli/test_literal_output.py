@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 
 from poppy_cli.output import LiteralConsole, console, err_console, error_line, printable, styled
+from tests.helpers.processes import reap
 
 HOSTILE = "[red]m1:x:[/]"
 ESCAPE = "\x1b[2J"
@@ -180,12 +181,7 @@ def test_the_servers_suggestion_never_writes_a_clients_control_characters() -> N
         assert proc.wait(timeout=30) == 0
         err = proc.stderr.read()
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
     assert "--allow-host ev\\x9bil.com" in err, err
     assert "--cors http://a\\x9d31m.example" in err, err
     assert "\x9b" not in err and "\x9d" not in err

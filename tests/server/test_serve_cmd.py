@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 
 from tests.helpers.cli import run_poppy
+from tests.helpers.processes import reap
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -53,12 +54,7 @@ def test_serve_prints_urls_and_stops(signum: int) -> None:
         assert code == 0
         assert proc.stderr is not None and "stopped" in proc.stderr.read()
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
 
 
 def test_public_host_without_token_warns() -> None:
@@ -276,12 +272,7 @@ def test_both_websockets_apply_the_origin_rules_and_say_how_to_allow_one() -> No
             "allow it, restart poppy serve with --cors https://evil.example"
         ]
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])

@@ -21,6 +21,7 @@ from poppy_core.emulator import Endpoint, serve_tcp
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from poppy_core.server.web.logs import LogBuffer, StderrWarnings, printable
+from tests.helpers.processes import reap
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 WAIT_S = 60.0
@@ -94,12 +95,7 @@ def test_a_lost_bus_is_a_warning_on_the_servers_stderr(served_bus: Endpoint) -> 
         wait_for_line(errors, "stopped", seen)
         assert sum("lost" in line for line in seen) == 1  # once, not once per handler
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
 
 
 def test_configured_logging_takes_the_warnings_and_two_pages_print_them_once(

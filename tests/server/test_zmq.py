@@ -12,6 +12,7 @@ from poppy_core.creatures import PoppyTorso
 from poppy_core.robot import Robot
 from poppy_core.server.zmqserver import ZmqRobotServer
 from tests.creatures.helpers import wait_until
+from tests.helpers.processes import reap
 
 zmq = pytest.importorskip("zmq")
 TIMEOUT_MS = 10_000
@@ -190,12 +191,7 @@ def test_poppy_serve_zmq() -> None:
         proc.send_signal(signal.SIGTERM)
         assert proc.wait(timeout=15) == 0
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
 
 
 def test_the_documentation_server_in_a_thread(robot: Robot) -> None:
