@@ -17,6 +17,7 @@ from poppy_core.creatures import (
 )
 from poppy_core.errors import ConfigError
 from poppy_core.robot import RobotConfig, load_profile
+from tests.helpers.pypot_names import UPPER_BODY_PRIMITIVES
 
 # Copies of the public pypot configs (no profile header), kept by the robot tests.
 PYPOT_DATA = Path(__file__).parents[1] / "robot" / "data"
@@ -103,14 +104,6 @@ def test_every_creature_declares_its_primitives() -> None:
         "chicken_demo",
         "puzzel_demo",
     } == set(CREATURES["ergo-jr"].primitives)
-    upper = {
-        "limit_torque",
-        "temperature_monitoring",
-        "dance_beat_motion",
-        "upper_body_idle_motion",
-        "head_idle_motion",
-        "arms_turn_compliant",
-        "arms_copy_motion",
-    }
+    upper = set(UPPER_BODY_PRIMITIVES)
     assert set(CREATURES["torso"].primitives) == upper | {"init_position"}
     assert set(CREATURES["humanoid"].primitives) == upper | {"stand_position", "sit_position"}

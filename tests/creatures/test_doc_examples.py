@@ -23,6 +23,7 @@ from poppy_core.motion import LoopPrimitive, Move, PositionWatcher
 from poppy_core.robot import MotorGroup, Robot, from_config, load_profile
 from tests.creatures import doc_examples as doc
 from tests.creatures.helpers import positions, reached, stop_all, virtual, wait_until
+from tests.helpers.pypot_names import TORSO_PRIMITIVES
 
 SIMULATORS = ["dummy", "mujoco"]
 TOLERANCE_DEG = {"dummy": 1.5, "mujoco": 4.0}
@@ -307,16 +308,7 @@ def test_humanoid_behaviours_and_setup(simulator: str, capsys: pytest.CaptureFix
 
 def test_torso_behaviours(torso: Robot) -> None:
     # the documentation's list (line 1969), and init_position, which poppy_torso.py attaches too
-    assert torso.primitive_names == [
-        "limit_torque",
-        "temperature_monitoring",
-        "dance_beat_motion",
-        "upper_body_idle_motion",
-        "head_idle_motion",
-        "arms_turn_compliant",
-        "arms_copy_motion",
-        "init_position",
-    ]
+    assert torso.primitive_names == TORSO_PRIMITIVES
     assert torso.temperature_monitoring.running
     stop_all(torso)
     torso.compliant = False  # "Remember to remove compliance before starting the primitives!"
