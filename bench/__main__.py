@@ -30,9 +30,19 @@ logger = logging.getLogger("bench")
 
 # Importing a benchmark module registers it; list them here so `--list` sees them all.
 _MODULES = (
-    scan_bench, robot_bench, move_bench, server_bench, sim_bench, ik_bench, camera_bench,
-    teleop_bench, soak_bench, snap_bench, web_bench, zmq_bench,
-)  # fmt: skip
+    scan_bench,
+    robot_bench,
+    move_bench,
+    server_bench,
+    sim_bench,
+    ik_bench,
+    camera_bench,
+    teleop_bench,
+    soak_bench,
+    snap_bench,
+    web_bench,
+    zmq_bench,
+)
 
 
 def main(argv: list[str] | None = None) -> int:

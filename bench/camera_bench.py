@@ -111,8 +111,11 @@ def mjpeg_latency(frames: int = MJPEG_FRAMES) -> dict[str, float]:
                         break
         finally:
             server.stop()
-    return {"median_ms": statistics.median(latencies), "max_ms": max(latencies),
-            "frames": float(len(latencies))}  # fmt: skip
+    return {
+        "median_ms": statistics.median(latencies),
+        "max_ms": max(latencies),
+        "frames": float(len(latencies)),
+    }
 
 
 @register("camera", "Simulated camera frames/s with the sync loops at 50 Hz; MJPEG; detection")
@@ -134,9 +137,16 @@ def camera_benchmark(ctx: BenchContext) -> BenchResult:
         if width == 320:
             passed = passed and ok
         loops = ", ".join(f"{n} {m:.1f}/{t:.0f} Hz" for n, (t, m) in result["loops"].items())
-        rows.append([f"{width}×{height}", f"{asked:.0f}", f"{result['fps']:.1f}", loops,
-                     f"{result['load_1min']:.2f}",
-                     ("yes" if ok else "**no**") if width == 320 else "—"])  # fmt: skip
+        rows.append(
+            [
+                f"{width}×{height}",
+                f"{asked:.0f}",
+                f"{result['fps']:.1f}",
+                loops,
+                f"{result['load_1min']:.2f}",
+                ("yes" if ok else "**no**") if width == 320 else "—",
+            ]
+        )
     detection = detection_ms()
     raw["detection_ms"] = detection
     mjpeg = mjpeg_latency()

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import os
 import select
-import signal
 import subprocess
-import time
 from pathlib import Path
 from types import TracebackType
 
+from bench.procs import interrupt
 from bench.registry import POPPY_CLI
 
 START_TIMEOUT_S = 30.0
@@ -94,12 +93,7 @@ class EmulatorProcess:
         proc, self._proc = self._proc, None
         if proc is None or proc.poll() is not None:
             return
-        proc.send_signal(signal.SIGINT)
-        deadline = time.monotonic() + STOP_TIMEOUT_S
-        while proc.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.05)
-        if proc.poll() is None:
-            proc.kill()
+        interrupt(proc, STOP_TIMEOUT_S)
         proc.communicate()
 
     def __enter__(self) -> EmulatorProcess:

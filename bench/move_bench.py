@@ -39,9 +39,11 @@ def synthetic_move() -> Move:
         for i in range(MOTORS)
     ]
     return Move(
-        FRAMERATE, [f"m{i + 1}" for i in range(MOTORS)], np.column_stack(columns),
+        FRAMERATE,
+        [f"m{i + 1}" for i in range(MOTORS)],
+        np.column_stack(columns),
         metadata={"created": "2026-01-01T00:00:00+00:00", "robot": "synthetic"},
-    )  # fmt: skip
+    )
 
 
 def _timed(func: Callable[[], object], repeat: int) -> list[float]:
@@ -74,9 +76,15 @@ def _peer(ctx: BenchContext, json_file: Path) -> dict[str, Any]:
     if ctx.peers_python is None:
         return {"error": f"peers not measured: {ctx.peers_note}", "load_s": []}
     run = run_client(
-        [str(ctx.peers_python), str(PEER_SCRIPT), "--file", str(json_file),
-         "--repeat", str(ctx.repeat)]
-    )  # fmt: skip
+        [
+            str(ctx.peers_python),
+            str(PEER_SCRIPT),
+            "--file",
+            str(json_file),
+            "--repeat",
+            str(ctx.repeat),
+        ]
+    )
     return run.record
 
 
@@ -106,31 +114,43 @@ def _result(raw: dict[str, Any], ctx: BenchContext) -> BenchResult:
     headers = ["file / loader", "file size", "load (median)", "load (min – max)", "× poppy"]
     rows = [
         [
-            "poppy `.move`, poppy `read_move`", f"{size_ours / 1e6:.1f} MB",
-            fmt_s(ours["median"]), fmt_range(ours), "1×",
+            "poppy `.move`, poppy `read_move`",
+            f"{size_ours / 1e6:.1f} MB",
+            fmt_s(ours["median"]),
+            fmt_range(ours),
+            "1×",
         ],
         [
-            "pypot JSON, poppy `read_move`", f"{size_json / 1e6:.1f} MB",
-            fmt_s(json_ours["median"]), fmt_range(json_ours),
+            "pypot JSON, poppy `read_move`",
+            f"{size_json / 1e6:.1f} MB",
+            fmt_s(json_ours["median"]),
+            fmt_range(json_ours),
             fmt_ratio(json_ours["median"], ours["median"]),
         ],
         [
             f"pypot JSON, pypot {peer.get('version', '')} `Move.load`".replace("  ", " "),
-            f"{size_json / 1e6:.1f} MB", fmt_s(peer_median),
+            f"{size_json / 1e6:.1f} MB",
+            fmt_s(peer_median),
             fmt_range(peer_stats) if peer_stats["n"] else "-",
             fmt_ratio(peer_median, ours["median"]),
         ],
-    ]  # fmt: skip
+    ]
     saves = Table(
         "Saving (poppy's writer, atomic: temporary file, fsync, rename)",
         ["format", "save (median)", "largest position error after reload"],
         [
-            ["poppy `.move` (float32)", fmt_s(summary(raw["poppy"]["save_s"])["median"]),
-             f"{raw['poppy']['max_error_deg']:.1e}°"],
-            ["pypot JSON", fmt_s(summary(raw["pypot_json"]["save_s"])["median"]),
-             f"{raw['pypot_json']['max_error_deg']:.1e}°"],
+            [
+                "poppy `.move` (float32)",
+                fmt_s(summary(raw["poppy"]["save_s"])["median"]),
+                f"{raw['poppy']['max_error_deg']:.1e}°",
+            ],
+            [
+                "pypot JSON",
+                fmt_s(summary(raw["pypot_json"]["save_s"])["median"]),
+                f"{raw['pypot_json']['max_error_deg']:.1e}°",
+            ],
         ],
-    )  # fmt: skip
+    )
     notes = [
         f"Each load is repeated {ctx.repeat} times; poppy's loads run in the benchmark process "
         "with the file in the page cache, pypot's in the peers venv (its import time, "

@@ -220,16 +220,22 @@ def _ratio_table(
                 [
                     robot["key"],
                     _bus(controller, limit),
-                    fmt_ratio(get("pypot", "default", 1.0, "jitter_p99_ms"),
-                              get("poppy", "default", 1.0, "jitter_p99_ms")),
-                    fmt_ratio(get("pypot", "default", 1.0, "error_pct"),
-                              get("poppy", "default", 1.0, "error_pct")),
-                    fmt_ratio(get("poppy", "top", 1.0, "rate_hz"),
-                              get("pypot", "top", 1.0, "rate_hz")),
-                    fmt_ratio(get("poppy", "top", 0.0, "rate_hz"),
-                              get("pypot", "top", 0.0, "rate_hz")),
+                    fmt_ratio(
+                        get("pypot", "default", 1.0, "jitter_p99_ms"),
+                        get("poppy", "default", 1.0, "jitter_p99_ms"),
+                    ),
+                    fmt_ratio(
+                        get("pypot", "default", 1.0, "error_pct"),
+                        get("poppy", "default", 1.0, "error_pct"),
+                    ),
+                    fmt_ratio(
+                        get("poppy", "top", 1.0, "rate_hz"), get("pypot", "top", 1.0, "rate_hz")
+                    ),
+                    fmt_ratio(
+                        get("poppy", "top", 0.0, "rate_hz"), get("pypot", "top", 0.0, "rate_hz")
+                    ),
                 ]
-            )  # fmt: skip
+            )
     headers = [
         "Robot",
         "Bus",

@@ -23,7 +23,10 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from bench import side_by_side
+from bench.procs import free_port, interrupt
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
+from bench.side_by_side import measure_sides, median_cells, percentile
 
 CLIENTS = 4
 DURATION_S = 1.5
@@ -54,12 +57,6 @@ SCENARIOS: dict[str, tuple[str, str, bytes | None]] = {
 }
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 def _wait_listening(port: int, proc: subprocess.Popen[str]) -> None:
     deadline = time.monotonic() + START_TIMEOUT_S
     while time.monotonic() < deadline:
@@ -75,7 +72,7 @@ def _wait_listening(port: int, proc: subprocess.Popen[str]) -> None:
 
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
-    port = _free_port()
+    port = free_port()
     if kind == "poppy":
         args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", "--sim"]
         args += ["--profile", "ergo-jr", "--http-port", str(port)]
@@ -88,12 +85,7 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
         _wait_listening(port, proc)
         yield port
     finally:
-        proc.send_signal(2)
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        interrupt(proc)
 
 
 def _load(port: int, method: str, path: str, body: bytes | None) -> dict[str, Any]:
@@ -134,15 +126,12 @@ def _load(port: int, method: str, path: str, body: bytes | None) -> dict[str, An
     elapsed = time.monotonic() - t0
     latencies.sort()
 
-    def pct(q: float) -> float | None:
-        return latencies[min(len(latencies) - 1, int(q * len(latencies)))] if latencies else None
-
     return {
         "requests": len(latencies),
         "errors": errors[0],
         "rps": len(latencies) / elapsed,
-        "p50_s": pct(0.5),
-        "p99_s": pct(0.99),
+        "p50_s": percentile(latencies, 0.5),
+        "p99_s": percentile(latencies, 0.99),
     }
 
 
@@ -241,10 +230,6 @@ def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
     return out
 
 
-def _ms(value: float | None) -> str:
-    return "-" if value is None else f"{value * 1000:.2f} ms"
-
-
 GOAL_RATIO = 2.0
 
 
@@ -252,32 +237,10 @@ GOAL_RATIO = 2.0
 def server_bench(ctx: BenchContext) -> BenchResult:
     """Measure both servers on every scenario."""
     raw: dict[str, Any] = {"clients": CLIENTS, "duration_s": DURATION_S, "goto_s": GOTO_S}
-    raw["poppy"] = _measure("poppy", ctx)
-    notes = []
-    if ctx.peers_python is not None:
-        try:
-            raw["pypot"] = _measure("pypot", ctx)
-        except RuntimeError as exc:
-            notes.append(f"pypot's server could not be measured: {exc}")
-    else:
-        notes.append(f"pypot not measured: {ctx.peers_note}")
-    rows = []
-    for name in SCENARIOS:
-        row = [name]
-        for kind in ("poppy", "pypot"):
-            median = raw.get(kind, {}).get(name, {}).get("median")
-            if median is None:
-                row += ["-", "-", "-", "-"]
-                continue
-            row += [
-                f"{median['rps']:.0f}",
-                _ms(median["p50_s"]),
-                _ms(median["p99_s"]),
-                str(median["errors"]),
-            ]
-        rows.append(row)
-    headers = ["scenario"]
-    headers += [f"{k} {c}" for k in ("poppy", "pypot") for c in ("req/s", "p50", "p99", "errors")]
+    sides, notes = measure_sides(ctx, _measure, "server")
+    raw.update(sides)
+    rows = [[name, *median_cells(raw, name)] for name in SCENARIOS]
+    headers = side_by_side.headers()
     # Goal (issue): at least 2x pypot's throughput with a lower p99.
     verdicts: list[bool] = []
     for row, name in zip(rows, SCENARIOS, strict=True):

@@ -142,9 +142,16 @@ def sim_benchmark(ctx: BenchContext) -> BenchResult:
             passed = passed and ok
             bare = step_rtf(robot)
             raw["mj_step_rtf"] = {**raw.get("mj_step_rtf", {}), robot: bare}
-            plant_rows.append([robot, f"{median:.0f}×", f"{min(values):.0f}–{max(values):.0f}×",
-                               f"{bare:.0f}×", f"≥ {PLANT_GOAL[robot]:.0f}×",
-                               "yes" if ok else "**no**"])  # fmt: skip
+            plant_rows.append(
+                [
+                    robot,
+                    f"{median:.0f}×",
+                    f"{min(values):.0f}–{max(values):.0f}×",
+                    f"{bare:.0f}×",
+                    f"≥ {PLANT_GOAL[robot]:.0f}×",
+                    "yes" if ok else "**no**",
+                ]
+            )
     finally:
         if before is not None:
             os.sched_setaffinity(0, before)
@@ -156,8 +163,15 @@ def sim_benchmark(ctx: BenchContext) -> BenchResult:
         ok = result["ratio"] >= KEEP_UP and slowest >= SYNC_RATE_OK
         passed = passed and ok
         loops = ", ".join(f"{n} {m:.1f}/{t:.0f} Hz" for n, (t, m) in result["loops"].items())
-        stack_rows.append([robot, f"{result['simulated_s']:.2f} s / {result['wall_s']:.2f} s",
-                           f"{result['ratio']:.3f}", loops, "yes" if ok else "**no**"])  # fmt: skip
+        stack_rows.append(
+            [
+                robot,
+                f"{result['simulated_s']:.2f} s / {result['wall_s']:.2f} s",
+                f"{result['ratio']:.3f}",
+                loops,
+                "yes" if ok else "**no**",
+            ]
+        )
     cores = os.cpu_count() or 1
     return BenchResult(
         name="sim",

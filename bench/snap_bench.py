@@ -21,9 +21,12 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from bench import side_by_side
 from bench.emulator_proc import EmulatorProcess
+from bench.procs import free_port, interrupt
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
-from bench.server_bench import CLIENTS, DURATION_S, _free_port, _load, _load_wrk, _wait_listening
+from bench.server_bench import CLIENTS, DURATION_S, _load, _load_wrk, _wait_listening
+from bench.side_by_side import measure_sides, median, median_cells
 
 SCENARIOS: dict[str, str] = {
     "GET /motors/get/positions": "/motors/get/positions",
@@ -46,7 +49,7 @@ class ErgoJrEmulator(EmulatorProcess):
 
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
-    port = _free_port()
+    port = free_port()
     with ErgoJrEmulator() as emulator, tempfile.TemporaryDirectory() as moves:
         if kind == "poppy":
             args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--snap"]
@@ -68,12 +71,7 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
             _wait_listening(port, proc)
             yield port
         finally:
-            proc.send_signal(2)
-            try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+            interrupt(proc)
 
 
 def _warm_up(port: int) -> None:
@@ -105,37 +103,18 @@ def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
     return out
 
 
-def _ms(value: float | None) -> str:
-    return "-" if value is None else f"{value * 1000:.2f} ms"
-
-
 @register("snap", "Snap! server requests/s and p50/p99: poppy serve --snap vs pypot's")
 def snap_bench(ctx: BenchContext) -> BenchResult:
     """Measure both Snap! servers on every scenario."""
     raw: dict[str, Any] = {"clients": CLIENTS, "duration_s": DURATION_S}
     load_start = os.getloadavg()[0]
-    raw["poppy"] = _measure("poppy", ctx)
-    notes = []
-    if ctx.peers_python is not None:
-        try:
-            raw["pypot"] = _measure("pypot", ctx)
-        except RuntimeError as exc:
-            notes.append(f"pypot's Snap! server could not be measured: {exc}")
-    else:
-        notes.append(f"pypot not measured: {ctx.peers_note}")
+    sides, notes = measure_sides(ctx, _measure, "Snap! server")
+    raw.update(sides)
     rows: list[list[str]] = []
     verdicts: list[bool] = []
     for name in SCENARIOS:
-        row = [name]
-        for kind in ("poppy", "pypot"):
-            median = raw.get(kind, {}).get(name, {}).get("median")
-            if median is None:
-                row += ["-", "-", "-", "-"]
-                continue
-            row += [f"{median['rps']:.0f}", _ms(median["p50_s"]), _ms(median["p99_s"])]
-            row.append(str(median["errors"]))
-        mine = raw.get("poppy", {}).get(name, {}).get("median")
-        theirs = raw.get("pypot", {}).get(name, {}).get("median")
+        row = [name, *median_cells(raw, name)]
+        mine, theirs = median(raw, "poppy", name), median(raw, "pypot", name)
         if mine is None or theirs is None or not theirs["rps"]:
             row += ["-", "-"]
         else:
@@ -144,8 +123,7 @@ def snap_bench(ctx: BenchContext) -> BenchResult:
             verdicts.append(met)
             row += [f"{ratio:.1f}x", "pass" if met else "**FAIL**"]
         rows.append(row)
-    headers = ["scenario"]
-    headers += [f"{k} {c}" for k in ("poppy", "pypot") for c in ("req/s", "p50", "p99", "errors")]
+    headers = side_by_side.headers()
     headers += ["poppy / pypot", f">= {GOAL_RATIO:g}x, lower p99"]
     wrk = shutil.which("wrk")
     notes.append(

@@ -38,6 +38,7 @@ from typing import Any
 
 from bench.clients import run_client
 from bench.emulator_proc import EmulatorError
+from bench.procs import interrupt
 from bench.registry import (
     BENCH_DIR,
     POPPY_CLI,
@@ -103,8 +104,9 @@ def plan(controllers: dict[str, list[int]], duration_s: float) -> list[Planned]:
     t, k = UNPLUG_FIRST_S, 0
     while t + UNPLUG_FOR_S + TAIL_S <= duration_s:
         motor = order[k % len(order)]
-        events.append(Planned(t, f"unplug {motor} {UNPLUG_FOR_S:g}", "unplug", str(motor),
-                              UNPLUG_FOR_S))  # fmt: skip
+        events.append(
+            Planned(t, f"unplug {motor} {UNPLUG_FOR_S:g}", "unplug", str(motor), UNPLUG_FOR_S)
+        )
         t, k = t + UNPLUG_EVERY_S, k + 1
     buses = list(controllers)
     t, k = LOSE_FIRST_S, 0
@@ -146,9 +148,13 @@ def soak_session(
     events: list[FaultEvent] = []
     with tempfile.TemporaryFile("w+") as errors:
         proc = subprocess.Popen(
-            client, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=errors, text=True,
+            client,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=errors,
+            text=True,
             cwd=REPO_ROOT,
-        )  # fmt: skip
+        )
         try:
             t0 = _read_ready(proc)
         except EmulatorError as exc:
@@ -230,9 +236,12 @@ def torque_toggles(ctx: BenchContext) -> dict[str, Any]:
         ("poppy sim --profile ergo-jr --pty", ["sim", "--profile", "ergo-jr", "--pty"]),
     ):
         proc = subprocess.Popen(
-            [str(POPPY_CLI), *args], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-            stdin=subprocess.DEVNULL, text=True,
-        )  # fmt: skip
+            [str(POPPY_CLI), *args],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            stdin=subprocess.DEVNULL,
+            text=True,
+        )
         try:
             assert proc.stdout is not None
             ready, _, _ = select.select([proc.stdout], [], [], 60.0)
@@ -240,8 +249,14 @@ def torque_toggles(ctx: BenchContext) -> dict[str, Any]:
             if not port:
                 out[label] = {"error": "no port printed"}
                 continue
-            client = [str(ctx.peers_python), str(BENCH_DIR / "peers" / "pypot_torque.py"),
-                      "--port", port, "--cycles", str(TORQUE_CYCLES)]  # fmt: skip
+            client = [
+                str(ctx.peers_python),
+                str(BENCH_DIR / "peers" / "pypot_torque.py"),
+                "--port",
+                port,
+                "--cycles",
+                str(TORQUE_CYCLES),
+            ]
             load_before = os.getloadavg()[0]
             record = run_client(client).record
             record["load_1min"] = [round(load_before, 2), round(os.getloadavg()[0], 2)]
@@ -250,11 +265,7 @@ def torque_toggles(ctx: BenchContext) -> dict[str, Any]:
             record["control"] = run_client([*client, "--keep-output"]).record
             out[label] = record
         finally:
-            proc.send_signal(2)
-            try:
-                proc.wait(10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
+            interrupt(proc)
     return out
 
 
@@ -270,7 +281,9 @@ def soak(ctx: BenchContext) -> BenchResult:
     raw = {
         "minutes": minutes,
         "plan": {
-            "corrupt": CORRUPT, "drop": DROP, "latency_ms": LATENCY_MS,
+            "corrupt": CORRUPT,
+            "drop": DROP,
+            "latency_ms": LATENCY_MS,
             "unplug": [UNPLUG_FIRST_S, UNPLUG_EVERY_S, UNPLUG_FOR_S],
             "lose": [LOSE_FIRST_S, LOSE_EVERY_S, LOSE_FOR_S],
         },
@@ -278,5 +291,5 @@ def soak(ctx: BenchContext) -> BenchResult:
         "robots": robots,
         "torque": toggles,
         "peers_note": ctx.peers_note,
-    }  # fmt: skip
+    }
     return build_result(raw)

@@ -270,10 +270,14 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
             (round(t - t0, 4), n, up) for t, n, up in recorder.bus_transitions
         ]
         record["motors"] = {
-            m.name: {"id": m.id, "bus": next(c for c in config.controllers
-                                              if m.name in config.motors_of_controller(c))}
+            m.name: {
+                "id": m.id,
+                "bus": next(
+                    c for c in config.controllers if m.name in config.motors_of_controller(c)
+                ),
+            }
             for m in robot.motors
-        }  # fmt: skip
+        }
         record["goal_checks"] = {
             "checked": recorder.checked,
             "unchecked": recorder.unchecked,

@@ -38,9 +38,10 @@ def _windows(events: Iterable[FaultEvent]) -> list[tuple[float, float]]:
 def healthy_rate(bins: list[int], excluded: list[tuple[float, float]], duration_s: float) -> float:
     """Mean count per second over whole seconds outside ``excluded`` (first and last left out)."""
     seconds = [
-        s for s in range(1, int(duration_s) - 1)
+        s
+        for s in range(1, int(duration_s) - 1)
         if s < len(bins) and not any(a < s + 1 and s < b for a, b in excluded)
-    ]  # fmt: skip
+    ]
     return statistics.fmean(bins[s] for s in seconds) if seconds else 0.0
 
 
@@ -80,15 +81,19 @@ def poppy_metrics(record: dict[str, Any], events: list[FaultEvent]) -> dict[str,
         times = [_first(transitions, n, True, end) for n in on_bus]
         bus_back.append(None if None in times else max(_latency(t, end) or 0.0 for t in times))
     explained = {
-        n: _windows(e for e in events
-                    if (e.kind == "unplug" and name_of[e.target] == n)
-                    or (e.kind == "lose" and motors[n]["bus"] == e.target))
+        n: _windows(
+            e
+            for e in events
+            if (e.kind == "unplug" and name_of[e.target] == n)
+            or (e.kind == "lose" and motors[n]["bus"] == e.target)
+        )
         for n in motors
-    }  # fmt: skip
+    }
     spurious = [
-        (t, n) for t, n, up in transitions
+        (t, n)
+        for t, n, up in transitions
         if not up and not any(a <= t <= b for a, b in explained[n])
-    ]  # fmt: skip
+    ]
     loop_hz = {
         bus: healthy_rate(bins, _windows(e for e in losses if e.target == bus), duration)
         for bus, bins in record["reads_per_s"].items()
@@ -185,35 +190,66 @@ def _poppy_table(results: dict[str, dict[str, Any]]) -> tuple[Table, bool]:
     verdicts = {k: _verdicts(m) for k, m in results.items()}
 
     def row(label: str, goal: str, key: str, cell: Any) -> None:
-        rows.append([label, *(cell(results[k]) for k in keys), goal,
-                     ", ".join(_ok(verdicts[k][key]) for k in keys) if key else "-"])  # fmt: skip
+        rows.append(
+            [
+                label,
+                *(cell(results[k]) for k in keys),
+                goal,
+                ", ".join(_ok(verdicts[k][key]) for k in keys) if key else "-",
+            ]
+        )
 
-    row("Sync loop rate, healthy seconds (per bus)", "≥ 49 Hz (2 % of 50)", "loop",
-        lambda m: ", ".join(f"{hz:.1f} Hz" for hz in m["loop_hz"].values()))  # fmt: skip
-    row("Motor updates, healthy seconds (slowest motor / mean)", "≥ 49 Hz", "motor",
-        lambda m: f"{min(m['motor_hz'].values()):.1f} / "
-        f"{statistics.fmean(m['motor_hz'].values()):.1f} Hz")  # fmt: skip
+    row(
+        "Sync loop rate, healthy seconds (per bus)",
+        "≥ 49 Hz (2 % of 50)",
+        "loop",
+        lambda m: ", ".join(f"{hz:.1f} Hz" for hz in m["loop_hz"].values()),
+    )
+    row(
+        "Motor updates, healthy seconds (slowest motor / mean)",
+        "≥ 49 Hz",
+        "motor",
+        lambda m: (
+            f"{min(m['motor_hz'].values()):.1f} / {statistics.fmean(m['motor_hz'].values()):.1f} Hz"
+        ),
+    )
     row("Unplugged motor marked offline", "< 0.5 s", "offline", lambda m: _fmt_s(m["offline_s"]))
-    row("Lost bus: all its motors offline", "< 0.5 s", "bus_offline",
-        lambda m: _fmt_s(m["bus_offline_s"]))  # fmt: skip
+    row(
+        "Lost bus: all its motors offline",
+        "< 0.5 s",
+        "bus_offline",
+        lambda m: _fmt_s(m["bus_offline_s"]),
+    )
     row("Replugged motor online again", "< 1.5 s", "back", lambda m: _fmt_s(m["back_s"]))
-    row("Bus back: all its motors online", "< 1.5 s", "bus_back",
-        lambda m: _fmt_s(m["bus_back_s"]))  # fmt: skip
-    row("Goal writes lost while online (checked)", "0", "writes",
-        lambda m: f"{m['goal_checks']['lost']} ({m['goal_checks']['checked']})")  # fmt: skip
-    row("Motors marked offline with no fault", "-", "",
-        lambda m: str(m["spurious_offline"]))  # fmt: skip
+    row("Bus back: all its motors online", "< 1.5 s", "bus_back", lambda m: _fmt_s(m["bus_back_s"]))
+    row(
+        "Goal writes lost while online (checked)",
+        "0",
+        "writes",
+        lambda m: f"{m['goal_checks']['lost']} ({m['goal_checks']['checked']})",
+    )
+    row("Motors marked offline with no fault", "-", "", lambda m: str(m["spurious_offline"]))
     row(
         "RSS start → end",
         "< +10 %",
         "rss",
         lambda m: f"{m['start']['VmRSS'] / 1024:.1f} → {m['end']['VmRSS'] / 1024:.1f} MB",
     )
-    row("Threads start → end", "equal", "threads",
-        lambda m: f"{m['start']['Threads']} → {m['end']['Threads']}")  # fmt: skip
-    row("Threads alive at the end (sync, primitive)", "all", "alive",
-        lambda m: f"{sum(m['alive']['sync'].values())}/{len(m['alive']['sync'])}, "
-        f"{'yes' if m['alive']['primitive'] else 'no'}")  # fmt: skip
+    row(
+        "Threads start → end",
+        "equal",
+        "threads",
+        lambda m: f"{m['start']['Threads']} → {m['end']['Threads']}",
+    )
+    row(
+        "Threads alive at the end (sync, primitive)",
+        "all",
+        "alive",
+        lambda m: (
+            f"{sum(m['alive']['sync'].values())}/{len(m['alive']['sync'])}, "
+            f"{'yes' if m['alive']['primitive'] else 'no'}"
+        ),
+    )
     row("robot.close()", "< 1 s", "close", lambda m: f"{m['close_s'] * 1000:.0f} ms")
     passed = all(all(v.values()) for v in verdicts.values())
     headers = ["poppy", *(results[k]["label"] for k in keys), "Goal", "Met"]
@@ -262,9 +298,11 @@ def _torque_lost(record: Any) -> str:
 def _control_clean(control: Any) -> bool:
     """The control run (no output flush) lost no write and failed no read."""
     return (
-        isinstance(control, dict) and not control.get("error")
-        and control["lost"] == 0 and control["reads_failed"] == 0
-    )  # fmt: skip
+        isinstance(control, dict)
+        and not control.get("error")
+        and control["lost"] == 0
+        and control["reads_failed"] == 0
+    )
 
 
 def torque_met(torque: dict[str, Any]) -> bool:
@@ -281,16 +319,22 @@ def _torque_table(torque: dict[str, Any]) -> Table:
             continue
         load = record.get("load_1min", ["?", "?"])
         control = record.get("control")
-        rows.append([
-            target, f"{_torque_lost(record)} (reads failed: {record['reads_failed']})",
-            _torque_lost(control) if control is not None else "-",
-            f"{record['elapsed_s']:.1f} s", f"{load[0]} → {load[1]}", "0",
-            "yes" if _control_clean(control) else "**no**",
-        ])  # fmt: skip
+        rows.append(
+            [
+                target,
+                f"{_torque_lost(record)} (reads failed: {record['reads_failed']})",
+                _torque_lost(control) if control is not None else "-",
+                f"{record['elapsed_s']:.1f} s",
+                f"{load[0]} → {load[1]}",
+                "0",
+                "yes" if _control_clean(control) else "**no**",
+            ]
+        )
     headers = ["Emulator", "Writes lost, pypot as is", "Writes lost, output flush skipped",
                "Time (as is)", "Load (1 min avg)", "Goal (the emulator's losses)", "Met"]
-    return Table("pypot Dxl320IO toggling the Ergo Jr's torque (flushes before every packet)",
-                 headers, rows)  # fmt: skip
+    return Table(
+        "pypot Dxl320IO toggling the Ergo Jr's torque (flushes before every packet)", headers, rows
+    )
 
 
 def build_result(raw: dict[str, Any]) -> BenchResult:
@@ -314,9 +358,18 @@ def build_result(raw: dict[str, Any]) -> BenchResult:
     faults = Table(
         "Faults injected (per robot and client)",
         ["Robot", "Minutes", "Unplugs", "Bus losses", "Reply bytes corrupted", "Replies lost"],
-        [[m["label"], f"{m['duration_s'] / 60:.1f}", str(m["unplugs"]), str(m["losses"]),
-          f"{plan['corrupt']:.0%}", f"{plan['drop']:.0%}"] for m in poppy.values()],
-    )  # fmt: skip
+        [
+            [
+                m["label"],
+                f"{m['duration_s'] / 60:.1f}",
+                str(m["unplugs"]),
+                str(m["losses"]),
+                f"{plan['corrupt']:.0%}",
+                f"{plan['drop']:.0%}",
+            ]
+            for m in poppy.values()
+        ],
+    )
     tables = [faults]
     passed: bool | None = False
     if poppy:

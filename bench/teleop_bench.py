@@ -63,12 +63,29 @@ def run_local(durations: Durations, rate_hz: float = 100.0) -> dict[str, Any]:
     hand = Hand({n: leader_bus.motor(i) for n, i in ids.items()}, ranges)
     hand.put(hand.now())
     with served([leader_bus, follower_bus]) as (leader_port, follower_port):
-        client = Client(_client("--leader-port", leader_port, "--follower-port", follower_port,
-                                "--rate", f"{rate_hz:g}"))  # fmt: skip
-        return _run(client, lambda: measure(
-            hand, leader, follower, follower_bus, follower_of, ids, 2 * RESOLUTION_DEG["XL-320"],
-            durations,
-        ))  # fmt: skip
+        client = Client(
+            _client(
+                "--leader-port",
+                leader_port,
+                "--follower-port",
+                follower_port,
+                "--rate",
+                f"{rate_hz:g}",
+            )
+        )
+        return _run(
+            client,
+            lambda: measure(
+                hand,
+                leader,
+                follower,
+                follower_bus,
+                follower_of,
+                ids,
+                2 * RESOLUTION_DEG["XL-320"],
+                durations,
+            ),
+        )
 
 
 def run_remote(durations: Durations, rate_hz: float = 50.0) -> dict[str, Any]:
@@ -81,24 +98,43 @@ def run_remote(durations: Durations, rate_hz: float = 50.0) -> dict[str, Any]:
     follower = BusProbe(follower_bus, [], [i for i, _ in follower_of.values()])
     hand = Hand({n: leader_bus.motor(i) for n, i in ids.items()}, ranges)
     hand.put(hand.now())
-    with served([leader_bus, follower_bus]) as (leader_port, follower_port), \
-            poppy_server("ergo-jr", follower_port) as url:  # fmt: skip
+    with (
+        served([leader_bus, follower_bus]) as (leader_port, follower_port),
+        poppy_server("ergo-jr", follower_port) as url,
+    ):
         host, port = url.removeprefix("http://").rsplit(":", 1)
         with LinkProxy(host, int(port)) as proxy:
-            client = Client(_client("--leader-port", leader_port, "--follower-url", proxy.url,
-                                    "--rate", f"{rate_hz:g}"))  # fmt: skip
+            client = Client(
+                _client(
+                    "--leader-port",
+                    leader_port,
+                    "--follower-url",
+                    proxy.url,
+                    "--rate",
+                    f"{rate_hz:g}",
+                )
+            )
 
             def phases() -> dict[str, Any]:
-                figures = measure(hand, leader, follower, follower_bus, follower_of, ids,
-                                  2 * RESOLUTION_DEG["XL-320"], durations)  # fmt: skip
+                figures = measure(
+                    hand,
+                    leader,
+                    follower,
+                    follower_bus,
+                    follower_of,
+                    ids,
+                    2 * RESOLUTION_DEG["XL-320"],
+                    durations,
+                )
                 figures["stall"] = stall(hand, proxy, url, follower, durations)
                 return figures
 
             return _run(client, phases)
 
 
-def run_torso(durations: Durations, peer: str, python: Path | None,
-              rate_hz: float = 50.0) -> dict[str, Any]:  # fmt: skip
+def run_torso(
+    durations: Durations, peer: str, python: Path | None, rate_hz: float = 50.0
+) -> dict[str, Any]:
     """One emulated Torso copying its left arm to its right arm (poppy or pypot)."""
     config = load_config(TORSO_JSON)
     mapping = JointMap.parse(ARMS_COPY)
@@ -110,15 +146,39 @@ def run_torso(durations: Durations, peer: str, python: Path | None,
     with served([bus]) as (port,):
         if peer == "pypot":
             assert python is not None
-            args = [str(python), str(PYPOT_SCRIPT), "--config", str(TORSO_JSON),
-                    "--port", f"upper_body_controller={port}"]  # fmt: skip
+            args = [
+                str(python),
+                str(PYPOT_SCRIPT),
+                "--config",
+                str(TORSO_JSON),
+                "--port",
+                f"upper_body_controller={port}",
+            ]
         else:
-            args = _client("--profile", "torso", "--leader-port", port, "--map", ARMS_COPY,
-                           "--rate", f"{rate_hz:g}")  # fmt: skip
+            args = _client(
+                "--profile",
+                "torso",
+                "--leader-port",
+                port,
+                "--map",
+                ARMS_COPY,
+                "--rate",
+                f"{rate_hz:g}",
+            )
         client = Client(args)
-        return _run(client, lambda: measure(
-            hand, probe, probe, bus, follower_of, ids, 2 * RESOLUTION_DEG["MX-28"], durations,
-        ))  # fmt: skip
+        return _run(
+            client,
+            lambda: measure(
+                hand,
+                probe,
+                probe,
+                bus,
+                follower_of,
+                ids,
+                2 * RESOLUTION_DEG["MX-28"],
+                durations,
+            ),
+        )
 
 
 def _run(client: Client, phases: Callable[[], dict[str, Any]]) -> dict[str, Any]:
@@ -137,8 +197,11 @@ def _pypot_python(ctx: BenchContext) -> tuple[Path | None, str]:
     """The peers venv's python when it can import poppy-torso (installing it if needed)."""
     if ctx.peers_python is None:
         return None, ctx.peers_note
-    check = [str(PEERS_PYTHON), "-c",
-             "import pypot.creatures; import poppy_torso.primitives.interaction"]  # fmt: skip
+    check = [
+        str(PEERS_PYTHON),
+        "-c",
+        "import pypot.creatures; import poppy_torso.primitives.interaction",
+    ]
     if subprocess.run(check, capture_output=True, check=False).returncode != 0:
         subprocess.run(["bash", str(SETUP_SCRIPT), "--force"], capture_output=True, check=False)
         if subprocess.run(check, capture_output=True, check=False).returncode != 0:
@@ -146,22 +209,33 @@ def _pypot_python(ctx: BenchContext) -> tuple[Path | None, str]:
     return ctx.peers_python, ""
 
 
-@register("teleop", "teleoperation: read→goal latency, rate, tracking, link stall; pypot's "
-          "arms_copy_motion")  # fmt: skip
+@register(
+    "teleop",
+    "teleoperation: read→goal latency, rate, tracking, link stall; pypot's arms_copy_motion",
+)
 def teleop_bench(ctx: BenchContext, durations: Durations | None = None) -> BenchResult:
     """Run every setup ``ctx.repeat`` times (see the module docstring)."""
     durations = durations or Durations()
     python, note = _pypot_python(ctx)
-    runs: dict[str, list[dict[str, Any]]] = {"local": [], "remote": [], "torso_poppy": [],
-                                             "torso_pypot": []}  # fmt: skip
+    runs: dict[str, list[dict[str, Any]]] = {
+        "local": [],
+        "remote": [],
+        "torso_poppy": [],
+        "torso_pypot": [],
+    }
     setups: list[tuple[str, str, Callable[[], dict[str, Any]]]] = [
         ("local", "local 100 Hz", lambda: run_local(durations)),
         ("remote", "remote 50 Hz over the WebSocket, link stall", lambda: run_remote(durations)),
         ("torso_poppy", "Torso arm copy, poppy", lambda: run_torso(durations, "poppy", None)),
     ]
     if python is not None:
-        setups.append(("torso_pypot", "Torso arm copy, pypot arms_copy_motion",
-                       lambda: run_torso(durations, "pypot", python)))  # fmt: skip
+        setups.append(
+            (
+                "torso_pypot",
+                "Torso arm copy, pypot arms_copy_motion",
+                lambda: run_torso(durations, "pypot", python),
+            )
+        )
     for index in range(ctx.repeat):
         for key, label, run in setups:
             logger.info("teleop: run %d/%d, %s", index + 1, ctx.repeat, label)

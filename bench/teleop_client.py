@@ -41,14 +41,20 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     if args.follower_url:
         follower = RemoteFollower(args.follower_url, rate_hz=args.rate)
     elif args.follower_port:
-        follower = from_profile(args.follower_profile or args.profile, args.follower_port,
-                                **options)  # fmt: skip
+        follower = from_profile(
+            args.follower_profile or args.profile, args.follower_port, **options
+        )
     else:
         follower = leader
     record["setup_s"] = time.perf_counter() - start
     try:
-        teleop = Teleoperation(leader, follower, None if args.map is None else _map(args.map),
-                               rate_hz=args.rate, on_change=_state).start()  # fmt: skip
+        teleop = Teleoperation(
+            leader,
+            follower,
+            None if args.map is None else _map(args.map),
+            rate_hz=args.rate,
+            on_change=_state,
+        ).start()
         while teleop.running and not stop.wait(0.05):
             pass
         teleop.stop()

@@ -28,8 +28,13 @@ from poppy_core.emulator import VirtualBus, VirtualMotor
 from poppy_core.protocol import Instruction, InstructionPacket, PacketDecoder
 from poppy_core.trajectory import MinimumJerk
 
-READS = {Instruction.READ, Instruction.SYNC_READ, Instruction.SYNC_READ_USB2AX,
-         Instruction.FAST_SYNC_READ, Instruction.BULK_READ}  # fmt: skip
+READS = {
+    Instruction.READ,
+    Instruction.SYNC_READ,
+    Instruction.SYNC_READ_USB2AX,
+    Instruction.FAST_SYNC_READ,
+    Instruction.BULK_READ,
+}
 STEP_S = 0.2
 SAMPLE_HZ = 100.0
 
@@ -67,8 +72,9 @@ class BusProbe:
         self._lock = self.bus.motors[0].lock  # the bus's lock: the hand waits for it too
         self.bus.receive = self._receive  # type: ignore[method-assign]
 
-    def _receive(self, data: bytes, *, line_bps: int | None = None,
-                 received_at: float | None = None) -> Any:  # fmt: skip
+    def _receive(
+        self, data: bytes, *, line_bps: int | None = None, received_at: float | None = None
+    ) -> Any:
         arrived = received_at or time.perf_counter()
         with self._lock:
             before = {i: self._motors[i].table.get("goal_position") for i in self.goal_ids}
@@ -78,9 +84,11 @@ class BusProbe:
             after = {i: self._motors[i].table.get("goal_position") for i in self.goal_ids}
         for packet in packets:
             if (
-                isinstance(packet, InstructionPacket) and packet.instruction in READS
-                and _read_address(self.bus.protocol, packet) == self._present and replies
-            ):  # fmt: skip
+                isinstance(packet, InstructionPacket)
+                and packet.instruction in READS
+                and _read_address(self.bus.protocol, packet) == self._present
+                and replies
+            ):
                 sent = replies[-1].send_at or time.perf_counter()
                 self.reads.append((sent, positions))
         for motor_id, raw in after.items():
@@ -103,8 +111,12 @@ class Hand:
         seed: the strokes' and steps' random generator seed.
     """
 
-    def __init__(self, motors: Mapping[str, VirtualMotor],
-                 ranges: Mapping[str, tuple[float, float]], seed: int = 17) -> None:  # fmt: skip
+    def __init__(
+        self,
+        motors: Mapping[str, VirtualMotor],
+        ranges: Mapping[str, tuple[float, float]],
+        seed: int = 17,
+    ) -> None:
         self.motors = dict(motors)
         self.ranges = dict(ranges)
         self.random = random.Random(seed)
@@ -178,9 +190,13 @@ def _at(plan: list[tuple[float, MinimumJerk]], t: float) -> float:
 
 
 def latencies(
-    hand: Hand, leader: BusProbe, follower: BusProbe, leader_ids: Mapping[str, int],
-    follower_of: FollowerOf, tolerance: float,
-) -> list[float]:  # fmt: skip
+    hand: Hand,
+    leader: BusProbe,
+    follower: BusProbe,
+    leader_ids: Mapping[str, int],
+    follower_of: FollowerOf,
+    tolerance: float,
+) -> list[float]:
     """Read → goal latencies (s) of every step and joint.
 
     Args:
@@ -196,14 +212,22 @@ def latencies(
         end = next_step[0] if next_step is not None else math.inf
         for name, value in targets.items():
             ident = leader_ids[name]
-            read_at = next((t for t, pos in leader.reads
-                            if t >= t_step and abs(pos[ident] - value) < 0.6), None)  # fmt: skip
+            read_at = next(
+                (t for t, pos in leader.reads if t >= t_step and abs(pos[ident] - value) < 0.6),
+                None,
+            )
             if read_at is None or read_at >= end:
                 continue
             follower_id, expected = follower_of[name]
             goal = expected(value)
-            wrote_at = next((t for t, i, g in follower.goals if i == follower_id and t >= read_at
-                             and t < end and abs(g - goal) <= tolerance), None)  # fmt: skip
+            wrote_at = next(
+                (
+                    t
+                    for t, i, g in follower.goals
+                    if i == follower_id and t >= read_at and t < end and abs(g - goal) <= tolerance
+                ),
+                None,
+            )
             if wrote_at is not None:
                 out.append(wrote_at - read_at)
     return out

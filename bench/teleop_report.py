@@ -82,32 +82,58 @@ def build_result(
             passed = passed and rate_error is not None and abs(rate_error) <= RATE_TOLERANCE
             passed = passed and f["tracking_deg"] is not None
             passed = passed and f["tracking_deg"] < TRACKING_GOAL_DEG
-        rows.append([
-            label, _ms(f["p50_s"]), _ms(f["p99_s"]) + (f" (goal < {2 * period * 1e3:.0f})"
-                                                      if goals else ""),
-            _num(f["client_hz"], " Hz") + ("" if rate_error is None else
-                                           f" ({rate_error * 100:+.1f} %)"),
-            _num(f["emulator_hz"], " Hz"), _num(f["tracking_deg"], "°", 2),
-            _num(None if f["matched"] is None else 100 * f["matched"], " %", 0),
-        ])  # fmt: skip
-    tables = [Table("Leader read → follower goal written (at the emulators)",
-                    ["setup", "p50", "p99", "rate (client)", "present reads/s (emulator)",
-                     "tracking RMS", "steps timed"], rows)]  # fmt: skip
+        rows.append(
+            [
+                label,
+                _ms(f["p50_s"]),
+                _ms(f["p99_s"]) + (f" (goal < {2 * period * 1e3:.0f})" if goals else ""),
+                _num(f["client_hz"], " Hz")
+                + ("" if rate_error is None else f" ({rate_error * 100:+.1f} %)"),
+                _num(f["emulator_hz"], " Hz"),
+                _num(f["tracking_deg"], "°", 2),
+                _num(None if f["matched"] is None else 100 * f["matched"], " %", 0),
+            ]
+        )
+    tables = [
+        Table(
+            "Leader read → follower goal written (at the emulators)",
+            [
+                "setup",
+                "p50",
+                "p99",
+                "rate (client)",
+                "present reads/s (emulator)",
+                "tracking RMS",
+                "steps timed",
+            ],
+            rows,
+        )
+    ]
     stalls = [r["stall"] for r in runs.get("remote", []) if r.get("stall")]
     if stalls:
         hold = _median([s["hold_s"] for s in stalls])
         worst = max((s["hold_s"] for s in stalls if s["hold_s"] is not None), default=None)
         passed = passed and worst is not None and worst <= HOLD_GOAL_S
         passed = passed and all(s["hold_s"] is not None for s in stalls)
-        tables.append(Table(
-            f"Remote link stalled for {durations.stall_s:g} s while the leader moves",
-            ["held after (median, worst)", "following again after the link returns",
-             "largest goal step during the resume", "leader–follower gap bridged by the ramp"],
-            [[f"{_num(hold, ' s', 2)}, {_num(worst, ' s', 2)} (goal ≤ {HOLD_GOAL_S:g} s)",
-              _num(_median([s["resume_s"] for s in stalls]), " s", 2),
-              _num(_median([s["largest_goal_step_deg"] for s in stalls]), "°"),
-              _num(_median([s["gap_at_resume_deg"] for s in stalls]), "°")]],
-        ))  # fmt: skip
+        tables.append(
+            Table(
+                f"Remote link stalled for {durations.stall_s:g} s while the leader moves",
+                [
+                    "held after (median, worst)",
+                    "following again after the link returns",
+                    "largest goal step during the resume",
+                    "leader–follower gap bridged by the ramp",
+                ],
+                [
+                    [
+                        f"{_num(hold, ' s', 2)}, {_num(worst, ' s', 2)} (goal ≤ {HOLD_GOAL_S:g} s)",
+                        _num(_median([s["resume_s"] for s in stalls]), " s", 2),
+                        _num(_median([s["largest_goal_step_deg"] for s in stalls]), "°"),
+                        _num(_median([s["gap_at_resume_deg"] for s in stalls]), "°"),
+                    ]
+                ],
+            )
+        )
     ratio = _ratio(figures, "p99_s") if "torso_pypot" in figures else None
     notes = _notes(figures, durations, peers_note, ratio)
     return BenchResult(
@@ -135,8 +161,9 @@ def _ratio(figures: dict[str, Any], key: str) -> float | None:
     return theirs / ours if ours and theirs else None
 
 
-def _notes(figures: dict[str, Any], durations: Durations, peers_note: str,
-           ratio: float | None) -> list[str]:  # fmt: skip
+def _notes(
+    figures: dict[str, Any], durations: Durations, peers_note: str, ratio: float | None
+) -> list[str]:
     notes = [
         f"Each run: {durations.strokes_s:g} s of strokes, then {durations.steps} steps of every "
         "moved joint, 0.2 s apart. Figures are medians over the runs of each run's p50/p99. "

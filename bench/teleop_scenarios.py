@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from bench.link_proxy import LinkProxy
+from bench.procs import interrupt
 from bench.registry import POPPY_CLI, REPO_ROOT
 from bench.teleop_probe import BusProbe, FollowerOf, Hand, Tracker, latencies
 from poppy_core.emulator import VirtualBus, serve_pty
@@ -84,8 +85,9 @@ def pairing(
         motor_ends = sorted(lead.to_motor(v) for v in (low, high))
         ranges[link.leader] = (motor_ends[0], motor_ends[1])
 
-        def expected(value: float, lead: Motor = lead, follow: Motor = follow,
-                     link: Any = link) -> float:  # fmt: skip
+        def expected(
+            value: float, lead: Motor = lead, follow: Motor = follow, link: Any = link
+        ) -> float:
             target = link.apply(lead.to_user(value))
             low, high = follow.angle_limit
             return follow.to_motor(min(max(target, low), high))
@@ -118,8 +120,9 @@ class Client:
     def __init__(self, args: list[str]) -> None:
         env = dict(os.environ, PYTHONUNBUFFERED="1")
         self.cpu_before = _children_cpu_s()
-        self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     text=True, cwd=REPO_ROOT, env=env)  # fmt: skip
+        self.proc = subprocess.Popen(
+            args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO_ROOT, env=env
+        )
         self.lines: list[str] = []
         self.following = threading.Event()
         threading.Thread(target=self._read, daemon=True).start()
@@ -152,8 +155,10 @@ class Client:
         try:
             record = json.loads(stdout.strip().splitlines()[-1])
         except (IndexError, ValueError):
-            record = {"error": f"no JSON line (exit {self.proc.returncode}): "
-                      + " | ".join(self.lines[-3:])}  # fmt: skip
+            record = {
+                "error": f"no JSON line (exit {self.proc.returncode}): "
+                + " | ".join(self.lines[-3:])
+            }
         record["cpu_s"] = _children_cpu_s() - self.cpu_before
         return record
 
@@ -171,10 +176,23 @@ def poppy_server(profile: str, port: str, attempts: int = 3) -> Iterator[str]:
     """
     for attempt in range(1, attempts + 1):
         proc = subprocess.Popen(
-            [str(POPPY_CLI), "serve", "--http", "--http-port", "0", "--profile", profile,
-             "--port", port, "--no-sensors"],
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL,
-        )  # fmt: skip
+            [
+                str(POPPY_CLI),
+                "serve",
+                "--http",
+                "--http-port",
+                "0",
+                "--profile",
+                profile,
+                "--port",
+                port,
+                "--no-sensors",
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            stdin=subprocess.DEVNULL,
+        )
         assert proc.stdout is not None and proc.stderr is not None
         url = proc.stdout.readline().strip()
         if url.startswith("http://"):
@@ -187,12 +205,7 @@ def poppy_server(profile: str, port: str, attempts: int = 3) -> Iterator[str]:
     try:
         yield url
     finally:
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(20)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        interrupt(proc, 20)
 
 
 def teleop_states(url: str) -> dict[str, str]:
@@ -213,9 +226,15 @@ def _wait_state(url: str, wanted: str, timeout_s: float) -> float | None:
 
 
 def measure(
-    hand: Hand, leader: BusProbe, follower: BusProbe, follower_bus: VirtualBus,
-    follower_of: FollowerOf, leader_ids: dict[str, int], tolerance: float, durations: Durations,
-) -> dict[str, Any]:  # fmt: skip
+    hand: Hand,
+    leader: BusProbe,
+    follower: BusProbe,
+    follower_bus: VirtualBus,
+    follower_of: FollowerOf,
+    leader_ids: dict[str, int],
+    tolerance: float,
+    durations: Durations,
+) -> dict[str, Any]:
     """Strokes (tracking), then steps (latency and rate); figures seen at the emulators."""
     start = time.perf_counter()
     with Tracker(hand, follower_bus, follower_of) as tracker:
@@ -235,8 +254,12 @@ def measure(
 
 
 def stall(
-    hand: Hand, proxy: LinkProxy, server_url: str, follower: BusProbe, durations: Durations,
-) -> dict[str, Any]:  # fmt: skip
+    hand: Hand,
+    proxy: LinkProxy,
+    server_url: str,
+    follower: BusProbe,
+    durations: Durations,
+) -> dict[str, Any]:
     """Stall the link while the hand moves; time the hold, then the resume with its ramp."""
     moving = threading.Event()
     strokes = threading.Thread(target=hand.strokes, args=(durations.stall_s + 3.0, moving))

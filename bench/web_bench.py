@@ -14,7 +14,6 @@ import argparse
 import logging
 import os
 import shutil
-import socket
 import statistics
 import subprocess
 import tempfile
@@ -23,6 +22,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from bench.procs import free_port, interrupt
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
 
 logger = logging.getLogger(__name__)
@@ -43,22 +43,17 @@ def chromium() -> str | None:
     return shutil.which("chromium") or shutil.which("chromium-browser")
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 @contextmanager
 def served(profile: str) -> Iterator[tuple[str, int]]:
     """``poppy serve --http --sim --profile PROFILE`` in its own process: (base URL, pid)."""
-    port = _free_port()
+    port = free_port()
     args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", "--sim"]
     args += ["--profile", profile, "--http-port", str(port), "--no-sensors"]
     library = tempfile.TemporaryDirectory(prefix="poppy-web-bench-")  # the user's moves stay
     env = {**os.environ, "POPPY_MOVES_DIR": library.name}
-    proc = subprocess.Popen(args, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=env)  # fmt: skip
+    proc = subprocess.Popen(
+        args, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline().strip()  # the base URL once every port is bound
@@ -67,12 +62,7 @@ def served(profile: str) -> Iterator[tuple[str, int]]:
             raise RuntimeError(f"poppy serve did not start: {why}")
         yield line, proc.pid
     finally:
-        proc.send_signal(2)
-        try:
-            proc.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        interrupt(proc, 15)
         library.cleanup()
 
 
@@ -136,8 +126,14 @@ def measure(repeat: int, seconds: float) -> dict[str, Any]:
         rate = (page.evaluate("window.poppy.stats.frames") - frames_before) / (
             time.monotonic() - start
         )
-    return {"idle_cpu": idle, "page_cpu": open_page, "first_ms": first, "rate_hz": rate,
-            "motors": motors, "seconds": seconds}  # fmt: skip
+    return {
+        "idle_cpu": idle,
+        "page_cpu": open_page,
+        "first_ms": first,
+        "rate_hz": rate,
+        "motors": motors,
+        "seconds": seconds,
+    }
 
 
 @register("web", "The home page in chromium: first live values (ms), stream rate, server CPU")
@@ -153,14 +149,22 @@ def web_benchmark(ctx: BenchContext) -> BenchResult:
     checks = [first < GOAL_FIRST_MS, raw["rate_hz"] >= GOAL_RATE_HZ, added < GOAL_CPU]
     yes = ["yes" if ok else "**no**" for ok in checks]
     rows = [
-        ["first live values, median of the warm loads", f"{first:.0f} ms "
-         f"(cold: {raw['first_ms'][0]:.0f} ms)", f"< {GOAL_FIRST_MS:.0f} ms", yes[0]],
-        [f"stream updates seen by the page ({raw['motors']} motors)", f"{raw['rate_hz']:.1f} Hz",
-         f"≥ {GOAL_RATE_HZ:.0f} Hz", yes[1]],
+        [
+            "first live values, median of the warm loads",
+            f"{first:.0f} ms (cold: {raw['first_ms'][0]:.0f} ms)",
+            f"< {GOAL_FIRST_MS:.0f} ms",
+            yes[0],
+        ],
+        [
+            f"stream updates seen by the page ({raw['motors']} motors)",
+            f"{raw['rate_hz']:.1f} Hz",
+            f"≥ {GOAL_RATE_HZ:.0f} Hz",
+            yes[1],
+        ],
         ["server CPU, no page open", f"{raw['idle_cpu']:.1%} of a core", "", ""],
         ["server CPU, one page open", f"{raw['page_cpu']:.1%} of a core", "", ""],
         ["server CPU the page adds", f"{added:.1%} of a core", f"< {GOAL_CPU:.0%}", yes[2]],
-    ]  # fmt: skip
+    ]
     raw["load_at_start"] = load
     return BenchResult(
         name="web",
@@ -198,16 +202,28 @@ def screenshots(folder: str) -> list[str]:
             http.put("/api/v1/robot/compliant", json={"compliant": False})
             http.post("/api/v1/moves/wave/record", json={"motors": ["m1", "m2", "m3"]})
             for angles in ([30, -20, 20], [-30, 10, -20], [0, 0, 0]):
-                http.post("/api/v1/gotos", json={"positions": dict(zip(["m1", "m2", "m3"],
-                          angles, strict=True)), "duration_s": 0.8, "wait": True})  # fmt: skip
+                http.post(
+                    "/api/v1/gotos",
+                    json={
+                        "positions": dict(zip(["m1", "m2", "m3"], angles, strict=True)),
+                        "duration_s": 0.8,
+                        "wait": True,
+                    },
+                )
             http.post("/api/v1/moves/wave/save")
             http.put("/api/v1/primitives/sinus/properties/amplitude", json={"value": 25})
             http.post("/api/v1/primitives/sinus/start")
-            shots = (("desktop", (1280, 900), False), ("phone", (390, 844), True),
-                     ("offline", (1280, 900), False))  # fmt: skip
+            shots = (
+                ("desktop", (1280, 900), False),
+                ("phone", (390, 844), True),
+                ("offline", (1280, 900), False),
+            )
             for name, size, mobile in shots:
-                context = chrome.new_context(viewport={"width": size[0], "height": size[1]},
-                                             is_mobile=mobile, device_scale_factor=1)  # fmt: skip
+                context = chrome.new_context(
+                    viewport={"width": size[0], "height": size[1]},
+                    is_mobile=mobile,
+                    device_scale_factor=1,
+                )
                 page = context.new_page()
                 page.goto(url + "/")
                 page.wait_for_function(READY, timeout=30_000)

@@ -10,14 +10,16 @@ over the answered requests.
 from __future__ import annotations
 
 import json
-import socket
 import subprocess
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from bench import side_by_side
+from bench.procs import free_port, interrupt
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
+from bench.side_by_side import measure_sides, median, median_cells, percentile
 
 DURATION_S = 1.5
 START_TIMEOUT_S = 60.0
@@ -41,23 +43,19 @@ except KeyboardInterrupt:
 """
 
 SCENARIOS: dict[str, dict[str, Any]] = {
-    "get_register_value": {"robot": {"get_register_value": {
-        "motor": "m1", "register": "present_position"}}},
-    "set_register_value": {"robot": {"set_register_value": {
-        "motor": "m1", "register": "goal_position", "value": "10"}}},
+    "get_register_value": {
+        "robot": {"get_register_value": {"motor": "m1", "register": "present_position"}}
+    },
+    "set_register_value": {
+        "robot": {"set_register_value": {"motor": "m1", "register": "goal_position", "value": "10"}}
+    },
     "get_motors_list": {"robot": {"get_motors_list": {}}},
-}  # fmt: skip
-
-
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
+}
 
 
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
-    port = _free_port()
+    port = free_port()
     if kind == "poppy":
         args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--zmq", "--sim"]
         args += ["--profile", "ergo-jr", "--zmq-port", str(port)]
@@ -74,12 +72,7 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
             raise RuntimeError(f"the {kind} server exited: {err.strip()[-300:]}")
         yield port
     finally:
-        proc.send_signal(2)
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        interrupt(proc)
         for stream in (proc.stdout, proc.stderr):
             if stream is not None:
                 stream.close()
@@ -114,13 +107,10 @@ def _load(port: int, request: dict[str, Any]) -> dict[str, Any]:
         context.term()
     latencies.sort()
 
-    def pct(q: float) -> float | None:
-        return latencies[min(len(latencies) - 1, int(q * len(latencies)))] if latencies else None
-
     return {
         "rps": len(latencies) / elapsed if elapsed else 0.0,
-        "p50_s": pct(0.5),
-        "p99_s": pct(0.99),
+        "p50_s": percentile(latencies, 0.5),
+        "p99_s": percentile(latencies, 0.99),
         "requests": len(latencies),
         "error_replies": error_replies,
         "last_reply": last_reply,
@@ -138,38 +128,19 @@ def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
     return out
 
 
-def _ms(value: float | None) -> str:
-    return "-" if value is None else f"{value * 1000:.2f} ms"
-
-
 @register("zmq", "ZMQ requests/s and p50/p99 latency: poppy serve --zmq vs pypot's ZMQRobotServer")
 def zmq_bench(ctx: BenchContext) -> BenchResult:
     """Measure both servers on every scenario."""
-    raw: dict[str, Any] = {"duration_s": DURATION_S, "poppy": _measure("poppy", ctx)}
-    notes = []
-    if ctx.peers_python is not None:
-        try:
-            raw["pypot"] = _measure("pypot", ctx)
-        except (RuntimeError, OSError) as exc:
-            notes.append(f"pypot's server could not be measured: {exc}")
-    else:
-        notes.append(f"pypot not measured: {ctx.peers_note}")
+    raw: dict[str, Any] = {"duration_s": DURATION_S}
+    sides, notes = measure_sides(ctx, _measure, "server", (RuntimeError, OSError))
+    raw.update(sides)
     rows = []
     for name in SCENARIOS:
-        row = [name]
-        for kind in ("poppy", "pypot"):
-            median = raw.get(kind, {}).get(name, {}).get("median")
-            if median is None:
-                row += ["-", "-", "-", "-"]
-                continue
-            row += [f"{median['rps']:.0f}", _ms(median["p50_s"]), _ms(median["p99_s"]),
-                    str(median["error_replies"])]  # fmt: skip
-        mine = raw.get("poppy", {}).get(name, {}).get("median")
-        theirs = raw.get("pypot", {}).get(name, {}).get("median")
+        row = [name, *median_cells(raw, name, "error_replies")]
+        mine, theirs = median(raw, "poppy", name), median(raw, "pypot", name)
         row.append(f"{mine['rps'] / theirs['rps']:.1f}x" if mine and theirs else "-")
         rows.append(row)
-    headers = ["request"]
-    headers += [f"{k} {c}" for k in ("poppy", "pypot") for c in ("req/s", "p50", "p99", "errors")]
+    headers = side_by_side.headers("request")
     headers.append("poppy / pypot")
     pypot_reply = raw.get("pypot", {}).get("get_register_value", {}).get("median", {})
     if pypot_reply.get("error_replies"):

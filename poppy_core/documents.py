@@ -41,6 +41,8 @@ class Limits:
 CONFIG_LIMITS = Limits(max_bytes=1 << 20, max_nodes=200_000, max_depth=32)
 """A robot config: the Humanoid's is 10 kB, 400 values, 4 levels."""
 SETTINGS_LIMITS = Limits(max_bytes=64 << 10, max_nodes=1_000, max_depth=8)
+REQUEST_LIMITS = Limits(max_bytes=1 << 20, max_nodes=200_000, max_depth=32)
+"""A request body or a WebSocket message (the servers bound their size before parsing)."""
 _TEXT_CHARS_PER_NODE = 64
 
 
@@ -156,8 +158,10 @@ def parse_json(text: str | bytes, source: str, limits: Limits, *, check: bool = 
                    f"{exc.msg}") from None  # fmt: skip
     except RecursionError:
         raise _bad(source, f"nested more than {limits.max_depth} levels deep") from None
-    except (ValueError, UnicodeDecodeError) as exc:  # e.g. an integer of 5,000 digits
+    except UnicodeDecodeError as exc:
         raise _bad(source, f"not valid JSON: {_first_line(exc)}") from None
+    except ValueError:  # int() of more digits than sys.get_int_max_str_digits()
+        raise _bad(source, "not valid JSON: it holds a number with too many digits") from None
     if check:
         check_shape(data, source, limits)
     return data

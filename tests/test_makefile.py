@@ -15,8 +15,14 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_make_says_it_is_installing_before_pip_runs(target: str, tmp_path: Path) -> None:
     if shutil.which("make") is None:
         pytest.skip("no make here")
-    done = subprocess.run(["make", "-n", "-B", target, f"VENV={tmp_path / '.venv'}"], cwd=ROOT,
-                          capture_output=True, text=True, timeout=60, check=False)  # fmt: skip
+    done = subprocess.run(
+        ["make", "-n", "-B", target, f"VENV={tmp_path / '.venv'}"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     install = next(i for i, line in enumerate(lines) if "pip install --quiet -e" in line)
@@ -31,8 +37,14 @@ def test_make_installs_every_extra(target: str, extras: str, tmp_path: Path) -> 
     and `make test` still get every room (pyproject's `all` extra)."""
     if shutil.which("make") is None:
         pytest.skip("no make here")
-    done = subprocess.run(["make", "-n", "-B", target, f"VENV={tmp_path / '.venv'}"], cwd=ROOT,
-                          capture_output=True, text=True, timeout=60, check=False)  # fmt: skip
+    done = subprocess.run(
+        ["make", "-n", "-B", target, f"VENV={tmp_path / '.venv'}"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
     install = [line for line in done.stdout.splitlines() if "pip install --quiet -e" in line]
     assert install and install[-1].endswith(f"-e '.{extras}'"), install

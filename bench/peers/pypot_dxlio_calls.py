@@ -31,34 +31,50 @@ def calls(io: Any) -> list[tuple[str, Callable[[], Any]]]:
     """The calls, named as the test names them."""
     return [
         ("get_control_mode([4, 11])", lambda: io.get_control_mode([4, 11])),
-        ("set_wheel_mode([5]); get_control_mode([5])",
-         lambda: _then(lambda: io.set_wheel_mode([5]), lambda: io.get_control_mode([5]))),
-        ("set_joint_mode([5]); get_control_mode([5])",
-         lambda: _then(lambda: io.set_joint_mode([5]), lambda: io.get_control_mode([5]))),
+        (
+            "set_wheel_mode([5]); get_control_mode([5])",
+            lambda: _then(lambda: io.set_wheel_mode([5]), lambda: io.get_control_mode([5])),
+        ),
+        (
+            "set_joint_mode([5]); get_control_mode([5])",
+            lambda: _then(lambda: io.set_joint_mode([5]), lambda: io.get_control_mode([5])),
+        ),
         ("get_angle_limit([11])", lambda: io.get_angle_limit([11])),
         ("get_pid_gain([4])", lambda: io.get_pid_gain([4])),
-        ("get_pid_gain([4]) after set_pid_gain({4: (4, 2, 1)})",
-         lambda: _then(lambda: io.set_pid_gain({4: (4, 2, 1)}), lambda: io.get_pid_gain([4]))),
+        (
+            "get_pid_gain([4]) after set_pid_gain({4: (4, 2, 1)})",
+            lambda: _then(lambda: io.set_pid_gain({4: (4, 2, 1)}), lambda: io.get_pid_gain([4])),
+        ),
         ("get_compliance_margin([11])", lambda: io.get_compliance_margin([11])),
         ("get_compliance_slope([11])", lambda: io.get_compliance_slope([11])),
-        ("get_goal_position_speed_load([4, 11])",
-         lambda: io.get_goal_position_speed_load([4, 11])),
-        ("get_present_position_speed_load([4, 11])",
-         lambda: io.get_present_position_speed_load([4, 11])),
+        ("get_goal_position_speed_load([4, 11])", lambda: io.get_goal_position_speed_load([4, 11])),
+        (
+            "get_present_position_speed_load([4, 11])",
+            lambda: io.get_present_position_speed_load([4, 11]),
+        ),
         ("get_alarm_shutdown([4, 11])", lambda: io.get_alarm_shutdown([4, 11])),
         ("get_alarm_LED([4, 11])", lambda: io.get_alarm_LED([4, 11])),
         ("get_voltage_limit([4, 11])", lambda: io.get_voltage_limit([4, 11])),
-        ("get_voltage_limit([4]) after set_voltage_limit({4: (7.0, 15.0)})",
-         lambda: _then(lambda: io.set_voltage_limit({4: (7.0, 15.0)}),
-                       lambda: io.get_voltage_limit([4]))),
-        ("get_highest_temperature_limit([4, 11])",
-         lambda: io.get_highest_temperature_limit([4, 11])),
+        (
+            "get_voltage_limit([4]) after set_voltage_limit({4: (7.0, 15.0)})",
+            lambda: _then(
+                lambda: io.set_voltage_limit({4: (7.0, 15.0)}), lambda: io.get_voltage_limit([4])
+            ),
+        ),
+        (
+            "get_highest_temperature_limit([4, 11])",
+            lambda: io.get_highest_temperature_limit([4, 11]),
+        ),
         ("get_drive_mode([4])", lambda: io.get_drive_mode([4])),
         ("get_status_return_level([4, 11])", lambda: io.get_status_return_level([4, 11])),
         ("get_control_table([4]) keys", lambda: tuple(io.get_control_table([4])[0])),
-        ("get_moving_speed([4]) after set_moving_speed({4: 10000})",
-         lambda: _then(lambda: io.set_moving_speed({4: 10000}), lambda: io.get_moving_speed([4]))),
-    ]  # fmt: skip
+        (
+            "get_moving_speed([4]) after set_moving_speed({4: 10000})",
+            lambda: _then(
+                lambda: io.set_moving_speed({4: 10000}), lambda: io.get_moving_speed([4])
+            ),
+        ),
+    ]
 
 
 def main() -> None:

@@ -26,9 +26,14 @@ def run(path: str, repeat: int) -> dict[str, Any]:
         The JSON-ready result; ``error`` is None on success.
     """
     record: dict[str, Any] = {
-        "peer": "pypot", "file": path, "import_s": None, "load_s": [], "frames": None,
-        "motors": None, "error": None,
-    }  # fmt: skip
+        "peer": "pypot",
+        "file": path,
+        "import_s": None,
+        "load_s": [],
+        "frames": None,
+        "motors": None,
+        "error": None,
+    }
     start = time.perf_counter()
     try:
         pypot = importlib.import_module("pypot")

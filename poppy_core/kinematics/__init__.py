@@ -20,7 +20,6 @@ from poppy_core.kinematics.spec import (
     MotorFrame,
     build_chains,
     find_model,
-    parse_kinematics,
 )
 from poppy_core.kinematics.transforms import matrix_rpy, rpy_matrix
 
@@ -41,7 +40,6 @@ __all__ = [
     "load_description",
     "make_target",
     "matrix_rpy",
-    "parse_kinematics",
     "parse_mjcf",
     "parse_urdf",
     "rotation_degrees",

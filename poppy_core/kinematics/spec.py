@@ -12,15 +12,16 @@ kinematics:
       reversed: []                 # ... in this chain only (pypot's reversed_motors)
       tip: [0, 0.18, 0]            # metres, in the last joint's child frame
 ```
+
+The section is checked with the rest of the config (``poppy_core.robot.config_sections``, every
+problem at once); this leaf receives the plain ``KinematicsSpec``.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from poppy_core.errors import ConfigError
 from poppy_core.kinematics.chain import Chain, ChainJoint
@@ -69,103 +70,6 @@ class MotorFrame:
     sign: float
     offset_deg: float
     limits_deg: tuple[float, float]
-
-
-def _names(value: Any, field: str) -> tuple[str, ...]:
-    if value is None:
-        return ()
-    if isinstance(value, str):
-        return (value,)
-    if isinstance(value, list) and all(isinstance(v, str) for v in value):
-        return tuple(value)
-    raise ConfigError(f"{field} must be a list of motor or group names", field=field, value=value)
-
-
-def parse_kinematics(data: Any, source: str = "config") -> KinematicsSpec:
-    """Check the ``kinematics`` section of a config.
-
-    Raises:
-        ConfigError: naming the field and what it must be.
-    """
-    if not isinstance(data, Mapping):
-        raise ConfigError(
-            f"{source}: {SECTION} must be a mapping with model and chains",
-            file=source,
-            field=SECTION,
-        )
-    model = data.get("model")
-    if not isinstance(model, str) or not model:
-        raise ConfigError(
-            f"{source}: {SECTION}.model must name a URDF or MJCF file",
-            file=source,
-            field=f"{SECTION}.model",
-            value=model,
-        )
-    frame = data.get("joint_frame")
-    if frame not in (None, "motor", "user"):
-        raise ConfigError(
-            f"{source}: {SECTION}.joint_frame is motor or user, not {frame!r}",
-            file=source,
-            field=f"{SECTION}.joint_frame",
-            value=frame,
-        )
-    chains_data = data.get("chains") or {}
-    if not isinstance(chains_data, Mapping):
-        raise ConfigError(
-            f"{source}: {SECTION}.chains must map chain names to chains",
-            file=source,
-            field=f"{SECTION}.chains",
-        )
-    chains = []
-    for name, entry in chains_data.items():
-        field = f"{SECTION}.chains.{name}"
-        if not isinstance(name, str) or not name.isidentifier() or name.startswith("_"):
-            raise ConfigError(
-                f"{source}: chain name {name!r} must be an identifier", file=source, field=field
-            )
-        if not isinstance(entry, Mapping):
-            raise ConfigError(
-                f"{source}: {field} must be a mapping with motors and tip", file=source, field=field
-            )
-        tip = entry.get("tip", [0.0, 0.0, 0.0])
-        if not (
-            isinstance(tip, list)
-            and len(tip) == 3
-            and all(isinstance(v, int | float) and math.isfinite(v) for v in tip)
-        ):
-            raise ConfigError(
-                f"{source}: {field}.tip must be [x, y, z] in metres",
-                file=source,
-                field=f"{field}.tip",
-                value=tip,
-            )
-        label = entry.get("label", "")
-        if not isinstance(label, str) or (label and not label.isidentifier()):
-            raise ConfigError(
-                f"{source}: {field}.label must be a name such as arm",
-                file=source,
-                field=f"{field}.label",
-                value=label,
-            )
-        motors = _names(entry.get("motors"), f"{field}.motors")
-        if not motors:
-            raise ConfigError(
-                f"{source}: {field}.motors must list the chain's motors",
-                file=source,
-                field=f"{field}.motors",
-            )
-        chains.append(
-            ChainSpec(
-                name=name,
-                motors=motors,
-                passive=_names(entry.get("passive"), f"{field}.passive"),
-                reversed=_names(entry.get("reversed"), f"{field}.reversed"),
-                tip=(float(tip[0]), float(tip[1]), float(tip[2])),
-                label=label,
-            )
-        )
-    reversed_ = _names(data.get("reversed"), f"{SECTION}.reversed")
-    return KinematicsSpec(model, tuple(chains), frame, reversed_)
 
 
 def find_model(model: str, folders: Iterable[Path]) -> Path:

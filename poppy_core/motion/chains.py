@@ -20,14 +20,14 @@ from poppy_core.kinematics import (
     build_chains,
     find_model,
     load_description,
-    parse_kinematics,
 )
-from poppy_core.kinematics.spec import SECTION
+from poppy_core.kinematics.spec import ChainSpec
 from poppy_core.motion.cartesian import RobotChain
 from poppy_core.robot.profiles import find_profile, load_profile, profile_folders
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot, RobotConfig
+    from poppy_core.robot.config_sections import KinematicsSection
 
 logger = logging.getLogger(__name__)
 
@@ -44,13 +44,12 @@ def kinematics_of(
     Raises:
         ConfigError: a malformed section or a model that cannot be found or read.
     """
-    section: Any = (config.model_extra or {}).get(SECTION)
+    section = config.kinematics
     folders: list[Path] = [config.folder] if config.folder is not None else []
-    source = str(config.folder or "config")
     if section is None and kind is not None:
         profile = find_profile(kind)
-        section = (load_profile(kind).model_extra or {}).get(SECTION)
-        folders, source = [profile.directory], str(profile.file)
+        section = load_profile(kind).kinematics
+        folders = [profile.directory]
     if section is None:
         return None
     header = config.profile
@@ -59,8 +58,17 @@ def kinematics_of(
             folders += profile_folders(name)  # a calibrated user profile hides the installed one
     if kind is not None:  # a config given as a dict (pypot's JSON) names the creature's model
         folders += profile_folders(kind)
-    spec = parse_kinematics(section, source)
+    spec = kinematics_spec(section)
     return spec, load_description(find_model(spec.model, folders))
+
+
+def kinematics_spec(section: KinematicsSection) -> KinematicsSpec:
+    """The kinematics leaf's plain spec of a checked section."""
+    chains = tuple(
+        ChainSpec(name, tuple(c.motors), tuple(c.passive), tuple(c.reversed), c.tip, c.label)
+        for name, c in section.chains.items()
+    )
+    return KinematicsSpec(section.model, chains, section.joint_frame, tuple(section.reversed))
 
 
 def chains_from_config(config: RobotConfig, kind: str | None = None) -> dict[str, Chain]:

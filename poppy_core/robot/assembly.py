@@ -20,6 +20,7 @@ from poppy_core.errors import ConfigError, PortError, RegisterError, SetupError
 from poppy_core.models import model_by_name
 from poppy_core.robot import startup
 from poppy_core.robot.config import RobotConfig
+from poppy_core.robot.config_sections import sensor_specs
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.robot import Robot
 from poppy_core.robot.startup import ReturnDelayConsent
@@ -181,7 +182,7 @@ class Assembly:
 
     def build_sensors(self) -> None:
         """The config's sensors: real devices, the MuJoCo scene, or blank frames (ideal sim)."""
-        self.sensors = build_sensors(self.config.sensors, self._camera_maker())
+        self.sensors = build_sensors(sensor_specs(self.config.sensors), self._camera_maker())
 
     def _camera_maker(self) -> CameraMaker:
         if self.mode == "mujoco":

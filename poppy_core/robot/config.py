@@ -27,8 +27,8 @@ from poppy_core.robot.config_checks import (
     whole_config_problems,
 )
 from poppy_core.robot.config_format import DEFAULT_SOURCE, config_error, validation_problems
+from poppy_core.robot.config_sections import KinematicsSection, SensorEntry, sensor_problems
 from poppy_core.robot.frames import user_limits
-from poppy_core.sensors.config import SensorProblem, check_section
 
 Degrees = Annotated[float, Strict(), Field(allow_inf_nan=False)]
 """A finite angle in degrees (ints accepted, strings and booleans refused)."""
@@ -190,7 +190,8 @@ class RobotConfig(BaseModel):
     controllers: dict[Name, ControllerConfig]
     motorgroups: dict[Name, list[Name]] = Field(default_factory=dict)
     motors: dict[Name, MotorConfig]
-    sensors: dict[Name, dict[str, Any]] = Field(default_factory=dict)
+    sensors: dict[Name, SensorEntry] = Field(default_factory=dict)
+    kinematics: KinematicsSection | None = None
 
     @property
     def folder(self) -> Path | None:
@@ -212,15 +213,9 @@ class RobotConfig(BaseModel):
         context = info.context if isinstance(info.context, dict) else {}
         source = str(context.get("source", DEFAULT_SOURCE))
         check_config(self, source)
-        try:
-            check_section(self.sensors)
-        except SensorProblem as exc:
-            raise config_error(source, f"sensors.{exc.field}", exc.value, exc.reason) from None
-        for name in self.sensors:
-            if name in self.motors or name in self.motorgroups:
-                raise config_error(source, f"sensors.{name}", name,
-                                   f"sensor {name!r} has the name of a motor or group",
-                                   show_value=False)  # fmt: skip
+        problems = sensor_problems(self.sensors, {*self.motors, *self.motorgroups}, source)
+        if problems:
+            raise ConfigError.of_problems(problems)
         return self
 
     @classmethod
@@ -250,9 +245,14 @@ class RobotConfig(BaseModel):
         # Fields failed: the checks across fields still run on what is readable, so that one
         # pass reports every problem (a duplicate ID and a reversed limit alike).
         view = CheckView.of_document(data)
+        fields = {p.field for p in problems}
         if view is not None:
-            fields = {p.field for p in problems}
             problems += [p for p in whole_config_problems(view, source) if p.field not in fields]
+        sensors = data.get("sensors")
+        if isinstance(sensors, dict):
+            taken = {*(data.get("motors") or {}), *(data.get("motorgroups") or {})}
+            more = sensor_problems(sensors, taken, source)
+            problems += [p for p in more if p.field not in fields]
         raise ConfigError.of_problems(problems) from None
 
     def to_dict(self) -> dict[str, Any]:

@@ -9,9 +9,8 @@ from poppy_core.sensors.camera import Camera, CameraCalibration, DummyCamera, Fr
 from poppy_core.sensors.config import (
     NOT_YET,
     SUPPORTED_TYPES,
-    SensorProblem,
+    SensorSpec,
     build_sensors,
-    check_section,
     dummy_camera,
     opencv_camera,
 )
@@ -37,9 +36,8 @@ __all__ = [
     "Sensor",
     "SensorHealth",
     "SensorLost",
-    "SensorProblem",
+    "SensorSpec",
     "build_sensors",
-    "check_section",
     "dummy_camera",
     "marker_image",
     "opencv_camera",

@@ -1,4 +1,4 @@
-"""Sensors from a config's ``sensors`` section (pypot's JSON form): checked, then built.
+"""Sensors from a config's ``sensors`` section (pypot's JSON form), built from checked entries.
 
 pypot's form: ``{"camera": {"type": "OpenCVCamera", "index": -1, "fps": 20.0, "resolution":
 [640, 480]}, "marker_detector": {"type": "MarkerDetector", "cameras": ["camera"], "freq": 1.0,
@@ -6,16 +6,16 @@ pypot's form: ``{"camera": {"type": "OpenCVCamera", "index": -1, "fps": 20.0, "r
 ``cards``, ``dictionary``, ``marker_size``, ``families`` (marker detector), ``sim_camera`` (the
 MuJoCo camera a simulated robot renders for it; default: the sensor's name). A ``FaceDetector``
 (pypot's: ``cameras``, ``freq``) takes ``min_size`` (pixels) and ``cascade`` (an LBP cascade XML).
+The section is checked where the rest of the config is (``poppy_core.robot.config_sections``,
+every problem at once); this leaf receives plain ``SensorSpec`` entries.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Mapping
-from typing import Any
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
 
-from poppy_core.checks import count
-from poppy_core.errors import ArgumentError, SensorError
+from poppy_core.errors import SensorError
 from poppy_core.sensors.base import Sensor
 from poppy_core.sensors.camera import (
     DEFAULT_FPS,
@@ -23,14 +23,11 @@ from poppy_core.sensors.camera import (
     Camera,
     CameraCalibration,
     DummyCamera,
-    check_resolution,
 )
 from poppy_core.sensors.detector import DEFAULT_FREQ_HZ, MarkerDetector
 from poppy_core.sensors.faces import (
     DEFAULT_FACE_FREQ_HZ,
     DEFAULT_MIN_SIZE_PX,
-    MAX_FACE_PX,
-    MIN_FACE_PX,
     FaceDetector,
 )
 from poppy_core.sensors.markers import DEFAULT_DICTIONARY, DEFAULT_MARKER_SIZE_M, FAMILIES
@@ -54,174 +51,107 @@ NOT_YET: dict[str, str] = {
 }
 
 
-class SensorProblem(Exception):
-    """A bad entry of the section: the field path under ``sensors``, its value and why."""
+@dataclass(frozen=True)
+class SensorSpec:
+    """One entry of the section, already checked (``poppy_core.robot.config_sections``).
 
-    def __init__(self, field: str, value: Any, reason: str) -> None:
-        super().__init__(f"{field}: {reason}")
-        self.field = field
-        self.value = value
-        self.reason = reason
-
-
-def _number(spec: Mapping[str, Any], key: str, default: float, name: str) -> float:
-    value = spec.get(key, default)
-    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0 or not (
-        math.isfinite(value)
-    ):
-        raise SensorProblem(f"{name}.{key}", value, "must be a positive number")
-    return float(value)
-
-
-def _type(name: str, spec: Any) -> str:
-    if not isinstance(spec, Mapping):
-        raise SensorProblem(name, spec, "must be a mapping with a type")
-    kind = spec.get("type")
-    if kind in NOT_YET:
-        raise SensorProblem(
-            f"{name}.type",
-            kind,
-            f"{NOT_YET[kind]} sensors are not supported yet (poppy drives "
-            f"{', '.join(SUPPORTED_TYPES)}): remove this sensor from the config",
-        )
-    if kind not in SUPPORTED_TYPES:
-        raise SensorProblem(
-            f"{name}.type", kind, f"unknown sensor type (one of {', '.join(SUPPORTED_TYPES)})"
-        )
-    return str(kind)
-
-
-def _cards(name: str, value: Any) -> dict[str, list[int]]:
-    if not isinstance(value, Mapping):
-        raise SensorProblem(f"{name}.cards", value, "must map card names to marker ids")
-    cards: dict[str, list[int]] = {}
-    for card, ids in value.items():
-        listed = ids if isinstance(ids, list) else [ids]
-        if not listed or not all(isinstance(i, int) and not isinstance(i, bool) for i in listed):
-            raise SensorProblem(f"{name}.cards.{card}", ids, "must be a marker id or a list")
-        cards[str(card)] = [int(i) for i in listed]
-    return cards
-
-
-def check_section(section: Mapping[str, Any]) -> None:
-    """Check every entry without opening anything.
-
-    Raises:
-        SensorProblem: the first bad entry (unknown or not yet supported type, bad value).
+    ``rate_hz`` is a camera's ``fps`` or a detector's ``freq`` (None: the kind's default);
+    ``source`` a camera's ``index`` or ``device``; the rest as the module's docstring says.
     """
-    for name, spec in section.items():
-        kind = _type(name, spec)
-        _number(spec, "fps" if kind in CAMERA_TYPES else "freq", 1.0, name)
-        if kind in CAMERA_TYPES:
-            try:
-                if "resolution" in spec:
-                    check_resolution(spec["resolution"], name)
-                if "calibration" in spec:
-                    CameraCalibration.from_config(spec["calibration"], name)
-            except SensorError as exc:
-                raise SensorProblem(name, spec, str(exc).split(": ", 1)[-1]) from None
-            continue
-        cameras = spec.get("cameras")
-        if not isinstance(cameras, list) or not cameras:
-            raise SensorProblem(f"{name}.cameras", cameras, "must list camera sensor names")
-        for camera in cameras:
-            target = section.get(camera)
-            if not isinstance(target, Mapping) or target.get("type") not in CAMERA_TYPES:
-                raise SensorProblem(f"{name}.cameras", cameras, f"{camera!r} is not a camera here")
-        if kind == "FaceDetector":
-            _face_options(name, spec)
-            continue
-        _cards(name, spec.get("cards", {}))
-        _number(spec, "marker_size", DEFAULT_MARKER_SIZE_M, name)
-        families = spec.get("families", list(FAMILIES))
-        if not isinstance(families, list) or not families or set(families) - set(FAMILIES):
-            raise SensorProblem(f"{name}.families", families, f"a list of {', '.join(FAMILIES)}")
+
+    name: str
+    type: str
+    rate_hz: float | None = None
+    resolution: tuple[int, int] | None = None
+    calibration: CameraCalibration | None = None
+    source: int | str = 0
+    sim_camera: str | None = None
+    cameras: tuple[str, ...] = ()
+    cards: Mapping[str, list[int]] = field(default_factory=dict)
+    dictionary: str = DEFAULT_DICTIONARY
+    marker_size: float = DEFAULT_MARKER_SIZE_M
+    families: tuple[str, ...] = FAMILIES
+    min_size: int = DEFAULT_MIN_SIZE_PX
+    cascade: str | None = None
+
+    @property
+    def is_camera(self) -> bool:
+        """Whether the entry is a camera (the others are detectors reading cameras)."""
+        return self.type in CAMERA_TYPES
 
 
-def _face_options(name: str, spec: Mapping[str, Any]) -> tuple[int, str | None]:
-    size = spec.get("min_size", DEFAULT_MIN_SIZE_PX)
-    try:
-        size = count(size, MIN_FACE_PX, MAX_FACE_PX, "min_size")
-    except ArgumentError as exc:
-        raise SensorProblem(f"{name}.min_size", size, str(exc)) from None
-    cascade = spec.get("cascade")
-    if cascade is not None and (not isinstance(cascade, str) or not cascade):
-        raise SensorProblem(f"{name}.cascade", cascade, "must be the path of an LBP cascade XML")
-    return size, cascade
+CameraMaker = Callable[[SensorSpec], Camera]
+"""Makes the camera of one config entry: real, dummy or simulated."""
 
 
-CameraMaker = Callable[[str, Mapping[str, Any]], Camera]
-"""Makes the camera of one config entry (name, spec): real, dummy or simulated."""
-
-
-def opencv_camera(name: str, spec: Mapping[str, Any]) -> Camera:
+def opencv_camera(spec: SensorSpec) -> Camera:
     """The camera an entry describes on real hardware (``OpenCVCamera`` opens its device).
 
     A camera is an accessory: one that cannot be opened now (unplugged, busy in another
     program) starts lost and is opened with backoff when it can be (``retry_open``).
     """
-    resolution = spec.get("resolution")
-    fps = float(spec.get("fps", DEFAULT_FPS))
-    calibration = spec.get("calibration")
-    cal = CameraCalibration.from_config(calibration, name) if calibration is not None else None
-    if spec.get("type") == "DummyCamera":
-        return DummyCamera(name, tuple(resolution or DEFAULT_RESOLUTION), fps)
+    fps = spec.rate_hz or DEFAULT_FPS
+    if spec.type == "DummyCamera":
+        return DummyCamera(spec.name, spec.resolution or DEFAULT_RESOLUTION, fps)
     from poppy_core.sensors.opencv_camera import OpenCVCamera
 
     return OpenCVCamera(
-        name,
-        spec.get("index", spec.get("device", 0)),
-        fps,
-        tuple(resolution) if resolution is not None else None,
-        calibration=cal,
-        retry_open=True,
+        spec.name, spec.source, fps, spec.resolution, calibration=spec.calibration, retry_open=True
     )
 
 
-def dummy_camera(name: str, spec: Mapping[str, Any]) -> Camera:
+def dummy_camera(spec: SensorSpec) -> Camera:
     """A blank camera for an entry (ideal simulation: there is no scene to see)."""
-    resolution = spec.get("resolution") or DEFAULT_RESOLUTION
-    return DummyCamera(name, (int(resolution[0]), int(resolution[1])),
-                       float(spec.get("fps", DEFAULT_FPS)))  # fmt: skip
+    return DummyCamera(
+        spec.name, spec.resolution or DEFAULT_RESOLUTION, spec.rate_hz or DEFAULT_FPS
+    )
 
 
 def build_sensors(
-    section: Mapping[str, Any], make_camera: CameraMaker = opencv_camera
+    specs: Iterable[SensorSpec], make_camera: CameraMaker = opencv_camera
 ) -> dict[str, Sensor]:
-    """The sensors of a checked section, cameras first; none started yet.
+    """The sensors of checked entries, cameras first; none started yet; in the entries' order.
 
     Raises:
         SensorError: a sensor cannot be made: a bad camera index, face detection without
-            scikit-image (the ones made so far are closed).
+            scikit-image, a detector reading no camera (the ones made so far are closed).
     """
+    entries = list(specs)
     sensors: dict[str, Sensor] = {}
     try:
-        for name, spec in section.items():
-            if spec.get("type") in CAMERA_TYPES:
-                sensors[name] = make_camera(name, spec)
-        for name, spec in section.items():
-            if spec.get("type") == "MarkerDetector":
-                cameras = [sensors[c] for c in spec["cameras"]]
-                sensors[name] = MarkerDetector(
-                    name,
-                    [c for c in cameras if isinstance(c, Camera)],
-                    float(spec.get("freq", DEFAULT_FREQ_HZ)),
-                    cards=_cards(name, spec.get("cards", {})),
-                    dictionary=str(spec.get("dictionary", DEFAULT_DICTIONARY)),
-                    marker_size=float(spec.get("marker_size", DEFAULT_MARKER_SIZE_M)),
-                    families=tuple(spec.get("families", FAMILIES)),
+        for spec in entries:
+            if spec.is_camera:
+                sensors[spec.name] = make_camera(spec)
+        for spec in entries:
+            if spec.is_camera:
+                continue
+            cameras = [sensors.get(c) for c in spec.cameras]
+            if not cameras or not all(isinstance(c, Camera) for c in cameras):
+                raise SensorError(
+                    f"sensor {spec.name!r}: cameras {list(spec.cameras)} must name cameras",
+                    sensor=spec.name,
                 )
-            elif spec.get("type") == "FaceDetector":
-                min_size, cascade = _face_options(name, spec)
-                sensors[name] = FaceDetector(
-                    name,
-                    [c for c in (sensors[c] for c in spec["cameras"]) if isinstance(c, Camera)],
-                    float(spec.get("freq", DEFAULT_FACE_FREQ_HZ)),
-                    min_size=min_size,
-                    cascade=cascade,
+            readable = [c for c in cameras if isinstance(c, Camera)]
+            if spec.type == "MarkerDetector":
+                sensors[spec.name] = MarkerDetector(
+                    spec.name,
+                    readable,
+                    spec.rate_hz or DEFAULT_FREQ_HZ,
+                    cards={card: list(ids) for card, ids in spec.cards.items()},
+                    dictionary=spec.dictionary,
+                    marker_size=spec.marker_size,
+                    families=spec.families,
+                )
+            elif spec.type == "FaceDetector":
+                sensors[spec.name] = FaceDetector(
+                    spec.name,
+                    readable,
+                    spec.rate_hz or DEFAULT_FACE_FREQ_HZ,
+                    min_size=spec.min_size,
+                    cascade=spec.cascade,
                 )
     except BaseException:
         for sensor in sensors.values():
             sensor.close()
         raise
-    return {name: sensors[name] for name in section if name in sensors}
+    return {spec.name: sensors[spec.name] for spec in entries if spec.name in sensors}

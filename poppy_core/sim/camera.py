@@ -10,7 +10,6 @@ multisampling: on a software renderer they cost 30× the frame (see docs/sensors
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
@@ -18,7 +17,7 @@ import numpy as np
 
 from poppy_core.errors import ConfigError, SensorError
 from poppy_core.sensors.camera import DEFAULT_FPS, DEFAULT_RESOLUTION, Camera, CameraCalibration
-from poppy_core.sensors.config import CameraMaker
+from poppy_core.sensors.config import CameraMaker, SensorSpec
 from poppy_core.sim.gl import GL_HELP, check_offscreen_gl
 
 logger = logging.getLogger(__name__)
@@ -136,14 +135,13 @@ class SimCamera(Camera):
 def sim_camera_maker(simulation: Any) -> CameraMaker:
     """Makes the ``SimCamera`` of a config's camera entry (``sim_camera``: the MuJoCo camera)."""
 
-    def make(name: str, spec: Mapping[str, Any]) -> Camera:
-        resolution = spec.get("resolution") or DEFAULT_RESOLUTION
+    def make(spec: SensorSpec) -> Camera:
         return SimCamera(
-            name,
+            spec.name,
             simulation,
-            str(spec.get("sim_camera", name)),
-            (int(resolution[0]), int(resolution[1])),
-            float(spec.get("fps", DEFAULT_FPS)),
+            spec.sim_camera or spec.name,
+            spec.resolution or DEFAULT_RESOLUTION,
+            spec.rate_hz or DEFAULT_FPS,
         )
 
     return make

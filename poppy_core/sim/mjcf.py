@@ -19,8 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
+from poppy_core.documents import CONFIG_LIMITS, parse_yaml, read_limited
 from poppy_core.files import write_file
 from poppy_core.models import model_by_name
 from poppy_core.sim.servos import servo_params
@@ -211,10 +210,10 @@ def _along(offset: Vec3, axis: Vec3) -> bool:
 
 
 def load_profile_data(profiles_dir: Path, robot: str) -> dict[str, Any]:
-    """``profiles/<robot>/profile.yaml``, parsed."""
-    data: dict[str, Any] = yaml.safe_load(
-        (profiles_dir / robot / "profile.yaml").read_text(encoding="utf-8")
-    )
+    """``profiles/<robot>/profile.yaml``, read and parsed within a config's bounds."""
+    path = profiles_dir / robot / "profile.yaml"
+    text = read_limited(path, CONFIG_LIMITS.max_bytes, "profile")
+    data: dict[str, Any] = parse_yaml(text, str(path), CONFIG_LIMITS)
     return data
 
 

@@ -129,8 +129,16 @@ def test_core_loads_no_ui_or_server_library() -> None:
         "import poppy_core.protocol, poppy_core.models, poppy_core.bus.scan, "
         "poppy_core.emulator, poppy_core.robot"
     )
-    assert not loaded & {"typer", "rich", "textual", "fastapi", "uvicorn", "mujoco", "matplotlib",
-                         "cv2"}  # fmt: skip
+    assert not loaded & {
+        "typer",
+        "rich",
+        "textual",
+        "fastapi",
+        "uvicorn",
+        "mujoco",
+        "matplotlib",
+        "cv2",
+    }
 
 
 def test_cli_start_up_is_lazy() -> None:
@@ -157,7 +165,8 @@ def test_trajectory_is_a_leaf_still_reachable_from_motion() -> None:
     assert old_path.MinimumJerk is trajectory.MinimumJerk
     assert old_path.check_goto is trajectory.check_goto
     code = "import sys, poppy_core.trajectory\nprint('\\n'.join(sys.modules))"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, cwd=ROOT).stdout.split()  # fmt: skip
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT
+    ).stdout.split()
     ours = {name for name in out if name.startswith("poppy_core.")}
     assert ours <= {"poppy_core.trajectory", "poppy_core.errors", "poppy_core.checks"}, ours

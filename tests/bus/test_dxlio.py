@@ -46,10 +46,12 @@ def test_scan_and_group_calls(mx_port: str) -> None:
         assert dxl_io.get_model([4, 11]) == ("MX-28", "AX-12A")
         dxl_io.enable_torque([4, 5, 6])
         dxl_io.set_goal_position({4: 0, 5: 10, 6: -25})
-        assert eventually(lambda: all(
-            abs(a - b) < 1.0
-            for a, b in zip(dxl_io.get_present_position([4, 5, 6]), (0, 10, -25), strict=True)
-        ))  # fmt: skip
+        assert eventually(
+            lambda: all(
+                abs(a - b) < 1.0
+                for a, b in zip(dxl_io.get_present_position([4, 5, 6]), (0, 10, -25), strict=True)
+            )
+        )
         dxl_io.set_angle_limit({5: (-90, 90)})
         assert dxl_io.get_angle_limit([5]) == (pytest.approx((-90, 90), abs=0.2),)
         dxl_io.set_moving_speed({4: 100})
@@ -145,8 +147,11 @@ PYPOT_ANSWERS = {
 def _close(answer: object, expected: object) -> bool:
     """Equal, numbers within 0.3 (the two libraries' degree scales differ by up to 0.29°)."""
     if isinstance(expected, tuple):
-        return (isinstance(answer, tuple) and len(answer) == len(expected)
-                and all(_close(a, e) for a, e in zip(answer, expected, strict=True)))  # fmt: skip
+        return (
+            isinstance(answer, tuple)
+            and len(answer) == len(expected)
+            and all(_close(a, e) for a, e in zip(answer, expected, strict=True))
+        )
     if isinstance(expected, float):
         return isinstance(answer, int | float) and abs(answer - expected) <= 0.3
     return answer == expected
@@ -179,16 +184,20 @@ def test_gains_margins_and_grouped_registers_as_pypot(mx_port: str) -> None:
             ("get_compliance_margin([11])", dxl_io.get_compliance_margin([11])),
             ("get_compliance_slope([11])", dxl_io.get_compliance_slope([11])),
             ("get_goal_position_speed_load([4, 11])", dxl_io.get_goal_position_speed_load([4, 11])),
-            ("get_present_position_speed_load([4, 11])",
-             dxl_io.get_present_position_speed_load([4, 11])),
+            (
+                "get_present_position_speed_load([4, 11])",
+                dxl_io.get_present_position_speed_load([4, 11]),
+            ),
             ("get_alarm_shutdown([4, 11])", dxl_io.get_alarm_shutdown([4, 11])),
             ("get_alarm_LED([4, 11])", dxl_io.get_alarm_LED([4, 11])),
             ("get_voltage_limit([4, 11])", dxl_io.get_voltage_limit([4, 11])),
-            ("get_highest_temperature_limit([4, 11])",
-             dxl_io.get_highest_temperature_limit([4, 11])),
+            (
+                "get_highest_temperature_limit([4, 11])",
+                dxl_io.get_highest_temperature_limit([4, 11]),
+            ),
             ("get_drive_mode([4])", dxl_io.get_drive_mode([4])),
             ("get_status_return_level([4, 11])", dxl_io.get_status_return_level([4, 11])),
-        ):  # fmt: skip
+        ):
             assert _close(answer, PYPOT_ANSWERS[call]), (call, answer)
         dxl_io.set_pid_gain({4: (4, 2, 1)})
         assert _close(
@@ -202,8 +211,11 @@ def test_gains_margins_and_grouped_registers_as_pypot(mx_port: str) -> None:
         )
         dxl_io.set_goal_position_speed_load({4: (10.0, 50.0, 80.0)})
         goal, speed, load = dxl_io.get_goal_position_speed_load([4])[0]
-        assert (goal, speed, load) == (pytest.approx(10.0, abs=0.1), pytest.approx(50.0, abs=1.0),
-                                       pytest.approx(80.0, abs=0.2))  # fmt: skip
+        assert (goal, speed, load) == (
+            pytest.approx(10.0, abs=0.1),
+            pytest.approx(50.0, abs=1.0),
+            pytest.approx(80.0, abs=0.2),
+        )
         dxl_io.set_alarm_shutdown({11: ("Overload Error",)})
         assert dxl_io.get_alarm_shutdown([11]) == (("Overload Error",),)
         dxl_io.set_highest_temperature_limit({11: 65})

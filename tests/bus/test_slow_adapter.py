@@ -95,8 +95,10 @@ class DropFirst(FaultInjector):
 def test_a_robot_is_not_refused_for_a_motor_late_twice_at_startup() -> None:
     # Two lost replies in a row exceed the bus's single retry; the startup check retries more.
     motor = VirtualMotor(model_by_name("MX-28"), 7, 1_000_000)
-    with serve_pty(VirtualBus([motor], 1, faults=DropFirst(2))) as server, \
-            DxlBus(server.url, 1_000_000, 1) as bus:  # fmt: skip
+    with (
+        serve_pty(VirtualBus([motor], 1, faults=DropFirst(2))) as server,
+        DxlBus(server.url, 1_000_000, 1) as bus,
+    ):
         assert bus.retries < 2
         robot_motor = Motor("m7", model_by_name("MX-28"), 7)
         assert check_presence(bus, "c", [robot_motor]) == []

@@ -66,16 +66,21 @@ def test_quitting_writes_nothing(poppy: Any, user_dirs: Path) -> None:
 
 
 def test_an_interrupted_calibration_leaves_the_previous_one(poppy: Any, user_dirs: Path) -> None:
-    first = poppy("calibrate", "--sim", "--profile", "ergo-jr", "--motors", "m1", "--yes",
-                  input="\n\ny\n")  # fmt: skip
+    first = poppy(
+        "calibrate", "--sim", "--profile", "ergo-jr", "--motors", "m1", "--yes", input="\n\ny\n"
+    )
     assert first.code == 0, first.stderr
     path = user_dirs / "ergo-jr" / "profile.yaml"
     before = path.read_text()
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
-        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"], stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     assert proc.stderr is not None and proc.stdin is not None
     while "Put the robot in this posture" not in proc.stderr.readline():
         assert proc.poll() is None

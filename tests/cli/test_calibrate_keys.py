@@ -4,46 +4,40 @@ from __future__ import annotations
 
 import os
 import pty
-import select
 import subprocess
 import termios
-import time
 from pathlib import Path
 
 from tests.helpers.cli import POPPY
-
-
-def _read_until(fd: int, text: str, timeout_s: float = 60) -> str:
-    seen = b""
-    deadline = time.monotonic() + timeout_s
-    while text.encode() not in seen and time.monotonic() < deadline:
-        ready, _, _ = select.select([fd], [], [], 0.2)
-        if ready:
-            try:
-                chunk = os.read(fd, 4096)
-            except OSError:
-                break
-            if not chunk:
-                break
-            seen += chunk
-    return seen.decode(errors="replace")
+from tests.helpers.processes import read_until
 
 
 def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Path) -> None:
-    env = dict(os.environ, COLUMNS="120", NO_COLOR="1", XDG_CONFIG_HOME=str(tmp_path / "xdg"),
-               POPPY_PROFILE="", POPPY_PORT="")  # fmt: skip
+    env = dict(
+        os.environ,
+        COLUMNS="120",
+        NO_COLOR="1",
+        XDG_CONFIG_HOME=str(tmp_path / "xdg"),
+        POPPY_PROFILE="",
+        POPPY_PORT="",
+    )
     parent, child = pty.openpty()
-    proc = subprocess.Popen([*POPPY, "calibrate", "--sim", "--profile", "ergo-jr", "--motors",
-                             "m1"], env=env, stdin=child, stdout=child, stderr=child,
-                            close_fds=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr", "--motors", "m1"],
+        env=env,
+        stdin=child,
+        stdout=child,
+        stderr=child,
+        close_fds=True,
+    )
     try:
-        shown = _read_until(parent, "q to cancel")
+        shown = read_until(parent, "q to cancel")
         assert "reference posture" in shown, shown
         os.write(parent, b"\r")  # Enter: the posture is taken
-        shown = _read_until(parent, "q to cancel")
+        shown = read_until(parent, "q to cancel")
         assert "slowly" in shown, shown
         os.write(parent, b"q")  # one key, no Enter
-        shown = _read_until(parent, "nothing was written", timeout_s=30)
+        shown = read_until(parent, "nothing was written", timeout_s=30)
         assert "calibration cancelled" in shown, shown
         assert proc.wait(timeout=30) == 1
         lflag = termios.tcgetattr(child)[3]
@@ -57,15 +51,27 @@ def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Pa
 
 
 def test_q_at_the_posture_cancels_at_once(tmp_path: Path) -> None:
-    env = dict(os.environ, COLUMNS="120", NO_COLOR="1", XDG_CONFIG_HOME=str(tmp_path / "xdg"),
-               POPPY_PROFILE="", POPPY_PORT="")  # fmt: skip
+    env = dict(
+        os.environ,
+        COLUMNS="120",
+        NO_COLOR="1",
+        XDG_CONFIG_HOME=str(tmp_path / "xdg"),
+        POPPY_PROFILE="",
+        POPPY_PORT="",
+    )
     parent, child = pty.openpty()
-    proc = subprocess.Popen([*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"], env=env,
-                            stdin=child, stdout=child, stderr=child, close_fds=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"],
+        env=env,
+        stdin=child,
+        stdout=child,
+        stderr=child,
+        close_fds=True,
+    )
     try:
-        _read_until(parent, "q to cancel")
+        read_until(parent, "q to cancel")
         os.write(parent, b"q")
-        shown = _read_until(parent, "nothing was written", timeout_s=30)
+        shown = read_until(parent, "nothing was written", timeout_s=30)
         assert "calibration cancelled" in shown, shown
         assert proc.wait(timeout=30) == 1
     finally:

@@ -22,8 +22,13 @@ def poppy(*args: str) -> subprocess.CompletedProcess[str]:
 
 def poppy_rendering(*args: str) -> subprocess.CompletedProcess[str]:
     """`poppy ARGS` in a process of its own: OpenGL stays out of the test process."""
-    return subprocess.run([sys.executable, "-m", "poppy_cli", *args], capture_output=True,
-                          text=True, timeout=120, check=False)  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "poppy_cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
 
 
 def test_list_prints_json() -> None:
@@ -57,9 +62,20 @@ def test_usage_errors_are_one_line(args: tuple[str, ...], words: str) -> None:
 
 def test_snapshot_and_detect_in_simulation(tmp_path: Path) -> None:
     out = tmp_path / "head.png"
-    result = poppy_rendering("camera", "snapshot", "-o", str(out), "--sim", "mujoco",
-                             "--profile", "ergo-jr", "--marker", "7",
-                             "--resolution", "320x240")  # fmt: skip
+    result = poppy_rendering(
+        "camera",
+        "snapshot",
+        "-o",
+        str(out),
+        "--sim",
+        "mujoco",
+        "--profile",
+        "ergo-jr",
+        "--marker",
+        "7",
+        "--resolution",
+        "320x240",
+    )
     if result.returncode != 0 and "cannot render" in result.stderr:
         pytest.skip(f"no OpenGL here: {result.stderr.strip()}")
     assert result.returncode == 0, result.stderr
@@ -67,8 +83,19 @@ def test_snapshot_and_detect_in_simulation(tmp_path: Path) -> None:
 
     image = cv2.imread(str(out))
     assert image.shape == (240, 320, 3)
-    detected = poppy_rendering("camera", "detect", "--sim", "mujoco", "--profile", "ergo-jr",
-                               "--card", "caribou", "--marker", "3", "--json")  # fmt: skip
+    detected = poppy_rendering(
+        "camera",
+        "detect",
+        "--sim",
+        "mujoco",
+        "--profile",
+        "ergo-jr",
+        "--card",
+        "caribou",
+        "--marker",
+        "3",
+        "--json",
+    )
     assert detected.returncode == 0, detected.stderr
     found = {(m["id"], m["card"]) for m in json.loads(detected.stdout)}
     assert found == {(3, None), (221052793, "caribou")}

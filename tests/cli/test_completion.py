@@ -22,12 +22,14 @@ ROOT = Path(__file__).resolve().parents[2]
 def complete(line: str, env: dict[str, str] | None = None) -> list[str]:
     """What bash completion offers for the last word of ``line`` (a trailing space: a new word)."""
     words = [*shlex.split(line), *([""] if line.endswith(" ") else [])]
-    result = run_poppy(env={
-        "_POPPY_COMPLETE": "complete_bash",
-        "COMP_WORDS": " ".join(words),
-        "COMP_CWORD": str(len(words) - 1),
-        **(env or {}),
-    })  # fmt: skip
+    result = run_poppy(
+        env={
+            "_POPPY_COMPLETE": "complete_bash",
+            "COMP_WORDS": " ".join(words),
+            "COMP_CWORD": str(len(words) - 1),
+            **(env or {}),
+        }
+    )
     assert result.code == 0, result.stderr
     return result.stdout.split()
 
@@ -103,8 +105,12 @@ def test_small_choices() -> None:
 
 def test_an_unknown_profile_still_gives_the_builtins() -> None:
     assert complete("poppy primitive run --profile no-such-robot ") == [
-        "sinus", "cosinus", "square", "position_watcher", "simple_posture",
-    ]  # fmt: skip
+        "sinus",
+        "cosinus",
+        "square",
+        "position_watcher",
+        "simple_posture",
+    ]
 
 
 def test_completion_in_a_shell_process_loads_no_heavy_library(tmp_path: Path) -> None:
@@ -116,11 +122,23 @@ def test_completion_in_a_shell_process_loads_no_heavy_library(tmp_path: Path) ->
     )
     for line in ("poppy primitive run --profile ergo-jr ", "poppy play ", "poppy scan -p "):
         words = [*shlex.split(line), ""]
-        env = dict(os.environ, **ENV, _POPPY_COMPLETE="complete_bash",
-                   COMP_WORDS=" ".join(words), COMP_CWORD=str(len(words) - 1),
-                   PYTHONPATH=str(ROOT), POPPY_MOVES_DIR=str(tmp_path))  # fmt: skip
-        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                              env=env, timeout=60, cwd=ROOT)  # fmt: skip
+        env = dict(
+            os.environ,
+            **ENV,
+            _POPPY_COMPLETE="complete_bash",
+            COMP_WORDS=" ".join(words),
+            COMP_CWORD=str(len(words) - 1),
+            PYTHONPATH=str(ROOT),
+            POPPY_MOVES_DIR=str(tmp_path),
+        )
+        proc = subprocess.run(
+            [sys.executable, "-c", code],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=60,
+            cwd=ROOT,
+        )
         modules = set(proc.stderr.split("MODULES", 1)[1].split())
         assert not modules & {"mujoco", "fastapi", "uvicorn", "textual", "cv2", "matplotlib"}
         if "primitive" in line:

@@ -131,3 +131,25 @@ def test_validate_lists_every_problem_one_line_each(poppy: Any, tmp_path: Path) 
     assert any("motors.m3.angle_limit = [90, -90]: min must be below max" in line for line in lines)
     assert any("motors.m4.type" in line for line in lines)
     assert "Traceback" not in result.stderr
+
+
+def test_validate_lists_chains_and_sensors_problems_one_line_each(
+    poppy: Any, tmp_path: Path
+) -> None:
+    data = json.loads(ERGO_JSON.read_text())
+    data["kinematics"] = {"model": "", "chains": {"arm": {"motors": ["m1"]}}}
+    data["sensors"] = {
+        "camera": {"type": "OpenCVCamera", "resolution": [640]},
+        "imu": {"type": "IMU"},
+    }
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    result = poppy("config", "validate", str(bad))
+    assert result.code == 1
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 3, result.stderr
+    assert any("sensors.camera.resolution = [640]: must be [width, " in line for line in lines)
+    assert any("sensors.imu.type" in line and "not supported yet" in line for line in lines)
+    assert any('kinematics.model = "": must not be empty' in line for line in lines)
+    assert all(line.startswith(f"error: {bad}: ") for line in lines)
+    assert "Traceback" not in result.stderr

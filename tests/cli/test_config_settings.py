@@ -72,8 +72,9 @@ def test_the_stored_port_is_used_by_bus_commands_and_the_env_wins(home: dict[str
     env = dict(home, POPPY_PORT="/nonexistent/ttyEnv")
     from_env = run_poppy("motor", "get", "1", "present_position", env=env)
     assert "/nonexistent/ttyEnv" in from_env.stderr
-    flag = run_poppy("motor", "get", "1", "present_position", "--port", "/nonexistent/ttyFlag",
-                     env=env)  # fmt: skip
+    flag = run_poppy(
+        "motor", "get", "1", "present_position", "--port", "/nonexistent/ttyFlag", env=env
+    )
     assert "/nonexistent/ttyFlag" in flag.stderr
 
 

@@ -40,9 +40,11 @@ def _where(path: str) -> str:
 
 def test_every_long_flag_is_in_the_table() -> None:
     missing = {
-        name: _where(path) for path, option in _uses() for name in _longs(option)
+        name: _where(path)
+        for path, option in _uses()
+        for name in _longs(option)
         if name not in FLAGS
-    }  # fmt: skip
+    }
     assert not missing, (
         f"add these flags to FLAGS in poppy_cli/flags.py (short flag, value, meaning) and to "
         f"docs/cli.md: {missing}"
@@ -120,9 +122,12 @@ def test_deprecated_spellings_still_work_with_a_warning(
     # a number within the option's range (a baud rate is 1200 bps at least, a loop count 2)
     value = ("57600" if "baud" in alias.new else "2") if _kind(option) == "number" else "dummy"
     needed = {
-        ("robot", "goto"): ["m1=1"], ("play",): ["wave"], ("motor", "reset"): ["1", "2"],
-        ("config", "generate"): ["-o", "robot.yaml"], ("camera", "snapshot"): ["-o", "x.png"],
-    }.get(alias.command, [])  # fmt: skip
+        ("robot", "goto"): ["m1=1"],
+        ("play",): ["wave"],
+        ("motor", "reset"): ["1", "2"],
+        ("config", "generate"): ["-o", "robot.yaml"],
+        ("camera", "snapshot"): ["-o", "x.png"],
+    }.get(alias.command, [])
     old = parse([*alias.command, *needed, alias.old, value])
     warning = rf"warning: `{alias.old}` is deprecated: use `{alias.new}`"
     assert re.search(warning, capsys.readouterr().err)

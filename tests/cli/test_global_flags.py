@@ -32,8 +32,11 @@ def _options(command: Any, path: str = "poppy") -> Iterator[tuple[str, str]]:
 
 def test_no_command_gives_the_root_flags_another_meaning() -> None:
     taken = {("-q", "--quiet"), ("-V", "--version")}
-    used = [(path, name) for path, name in _options(typer.main.get_command(app))
-            if path != "poppy" and any(name in pair for pair in taken)]  # fmt: skip
+    used = [
+        (path, name)
+        for path, name in _options(typer.main.get_command(app))
+        if path != "poppy" and any(name in pair for pair in taken)
+    ]
     assert used == []
 
 

@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 
 from poppy_cli.output import LiteralConsole, console, err_console, error_line, printable, styled
+from tests.helpers.processes import reap
 
 HOSTILE = "[red]m1:x:[/]"
 ESCAPE = "\x1b[2J"
@@ -158,9 +159,11 @@ def test_the_servers_suggestion_never_writes_a_clients_control_characters() -> N
 
     proc = subprocess.Popen(
         [*POPPY, "serve", "--http", "--sim", "--profile", "ergo-jr", "--http-port", "0"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
         env=dict(__import__("os").environ, **ENV),
-    )  # fmt: skip
+    )
     try:
         assert proc.stdout is not None and proc.stderr is not None
         url = proc.stdout.readline().strip()
@@ -178,12 +181,7 @@ def test_the_servers_suggestion_never_writes_a_clients_control_characters() -> N
         assert proc.wait(timeout=30) == 0
         err = proc.stderr.read()
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
     assert "--allow-host ev\\x9bil.com" in err, err
     assert "--cors http://a\\x9d31m.example" in err, err
     assert "\x9b" not in err and "\x9d" not in err
@@ -194,8 +192,19 @@ def test_the_path_record_prints_for_scripts_is_escaped(
 ) -> None:
     monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
     target = tmp_path / f"take{ESCAPE}.move"
-    result = poppy("record", "w", "--sim", "--profile", "ergo-jr", "--motors", "m1",
-                   "--duration", "0.2", "--output", str(target))  # fmt: skip
+    result = poppy(
+        "record",
+        "w",
+        "--sim",
+        "--profile",
+        "ergo-jr",
+        "--motors",
+        "m1",
+        "--duration",
+        "0.2",
+        "--output",
+        str(target),
+    )
     assert result.code == 0, result.stderr
     assert target.is_file()
     assert result.stdout.strip().splitlines()[-1] == f"{tmp_path}/take\\x1b[2J.move"

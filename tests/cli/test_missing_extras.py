@@ -52,8 +52,13 @@ def test_a_missing_extra_is_one_line_naming_it(
     env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path)}
     done = subprocess.run(
         [sys.executable, "-c", RUN, blocked, *(a.format(tmp=tmp_path) for a in argv)],
-        capture_output=True, text=True, timeout=90, env=env, cwd=tmp_path, check=False,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=90,
+        env=env,
+        cwd=tmp_path,
+        check=False,
+    )
     assert done.returncode == 1, (done.stdout, done.stderr)
     assert "Traceback" not in done.stderr
     lines = done.stderr.strip().splitlines()
@@ -70,8 +75,13 @@ def _poppy_without_extras(argv: list[str], tmp_path: Path) -> subprocess.Complet
     env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path)}
     return subprocess.run(
         [sys.executable, "-c", RUN, EVERY_EXTRA, *argv],
-        capture_output=True, text=True, timeout=120, env=env, cwd=tmp_path, check=False,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+        cwd=tmp_path,
+        check=False,
+    )
 
 
 def test_the_core_scans_drives_and_reports_a_robot_without_any_extra(tmp_path: Path) -> None:

@@ -51,9 +51,11 @@ def library(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 def wave() -> Move:
     t = np.arange(51) / 50
     return Move(
-        50, ["m1", "m2"], np.column_stack([30 * np.sin(2 * np.pi * t), 10 * t]),
+        50,
+        ["m1", "m2"],
+        np.column_stack([30 * np.sin(2 * np.pi * t), 10 * t]),
         metadata={"robot": "ergo-jr"},
-    )  # fmt: skip
+    )
 
 
 def test_list_and_show(poppy: Any, library: Path) -> None:

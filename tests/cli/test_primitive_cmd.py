@@ -40,9 +40,18 @@ def test_list_table(poppy: Any) -> None:
 
 def test_run_for_a_duration(poppy: Any) -> None:
     result = poppy(
-        "primitive", "run", "sinus", *SIM, "--duration", "0.5",
-        "--set", "amplitude=20", "--set", "motor_list=m1,m2", "--json",
-    )  # fmt: skip
+        "primitive",
+        "run",
+        "sinus",
+        *SIM,
+        "--duration",
+        "0.5",
+        "--set",
+        "amplitude=20",
+        "--set",
+        "motor_list=m1,m2",
+        "--json",
+    )
     assert result.code == 0, result.stderr
     report = result.json()
     assert report["name"] == "sinus" and report["state"] == "stopped"

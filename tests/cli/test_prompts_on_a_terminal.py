@@ -67,8 +67,17 @@ def _ended(terminals: list[Terminal], *args: str) -> tuple[int, Terminal]:
 
 
 def _teleop(port: str) -> tuple[str, ...]:
-    return ("teleop", "--leader", "ergo-jr", "--leader-port", port,
-            "--follower", "ergo-jr", "--follower-sim", "ideal")  # fmt: skip
+    return (
+        "teleop",
+        "--leader",
+        "ergo-jr",
+        "--leader-port",
+        port,
+        "--follower",
+        "ergo-jr",
+        "--follower-sim",
+        "ideal",
+    )
 
 
 @pytest.mark.parametrize(
@@ -97,8 +106,18 @@ def test_record_ctrl_c_at_the_question_saves_nothing(
     emulated: str, terminals: list[Terminal], tmp_path: Path
 ) -> None:
     library = tmp_path / "moves"
-    terminal = _asked(terminals, "record", "wave", "--profile", "ergo-jr", "--port", emulated,
-                      "--duration", "5", env={"POPPY_MOVES_DIR": str(library)})  # fmt: skip
+    terminal = _asked(
+        terminals,
+        "record",
+        "wave",
+        "--profile",
+        "ergo-jr",
+        "--port",
+        emulated,
+        "--duration",
+        "5",
+        env={"POPPY_MOVES_DIR": str(library)},
+    )
     terminal.type(CTRL_C)
     assert terminal.wait() == 130, terminal.text[-2000:]
     assert "recorded" not in terminal.text and "Traceback" not in terminal.text

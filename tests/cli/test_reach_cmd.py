@@ -139,11 +139,16 @@ def test_the_ergo_jr_chain_is_shown_as_arm_and_keeps_its_pypot_name(poppy: Any) 
 
 
 def test_a_chain_label_must_be_a_name() -> None:
-    from poppy_core.errors import ConfigError
-    from poppy_core.kinematics.spec import parse_kinematics
+    from pydantic import ValidationError
 
-    section = {"model": "x.urdf", "chains": {"chain": {"motors": ["m1"], "label": "my arm"}}}
-    with pytest.raises(ConfigError, match="label must be a name"):
-        parse_kinematics(section, "robot.yaml")
+    from poppy_core.motion.chains import kinematics_spec
+    from poppy_core.robot.config_sections import KinematicsSection
+
+    section: dict[str, Any] = {
+        "model": "x.urdf", "chains": {"chain": {"motors": ["m1"], "label": "my arm"}}
+    }
+    with pytest.raises(ValidationError, match="must be a name such as arm"):
+        KinematicsSection.model_validate(section)
     section["chains"]["chain"]["label"] = "arm"
-    assert parse_kinematics(section, "robot.yaml").chains[0].shown == "arm"
+    spec = kinematics_spec(KinematicsSection.model_validate(section))
+    assert spec.chains[0].shown == "arm"

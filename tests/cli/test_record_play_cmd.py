@@ -36,9 +36,12 @@ def start_recording(*args: str) -> subprocess.Popen[str]:
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
         [*POPPY, "record", *args],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+        text=True,
         env=env,
-    )  # fmt: skip
+    )
     assert proc.stderr is not None
     line = proc.stderr.readline()
     assert line.startswith("recording"), line + proc.stderr.read()
@@ -147,9 +150,12 @@ def test_a_signal_during_play_exits_130_after_the_summary(signum: int) -> None:
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
         [*POPPY, "play", "long", "--sim", "--profile", "ergo-jr", "--json"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+        text=True,
         env=env,
-    )  # fmt: skip
+    )
     assert proc.stderr is not None
     line = proc.stderr.readline()
     assert line.startswith("playing long"), line + proc.stderr.read()

@@ -5,9 +5,7 @@ from __future__ import annotations
 import contextlib
 import os
 import pty
-import select
 import subprocess
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -16,6 +14,7 @@ import pytest
 
 from poppy_core.motion import read_move
 from tests.helpers.cli import POPPY
+from tests.helpers.processes import read_until
 from tests.helpers.terminal import CTRL_C, Terminal
 
 SIM = ("--sim", "--profile", "ergo-jr")
@@ -114,22 +113,6 @@ def test_two_recordings_of_one_name_at_once(
     assert len(read_move(tmp_path / "moves" / "same.move")) > 0  # the first take, untouched
 
 
-def _read_until(fd: int, text: str, timeout_s: float = 60) -> str:
-    seen = b""
-    deadline = time.monotonic() + timeout_s
-    while text.encode() not in seen and time.monotonic() < deadline:
-        ready, _, _ = select.select([fd], [], [], 0.2)
-        if ready:
-            try:
-                chunk = os.read(fd, 4096)
-            except OSError:
-                break
-            if not chunk:
-                break
-            seen += chunk
-    return seen.decode(errors="replace")
-
-
 def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
     with tmpfs(tmp_path / "full", "32k") as library:
         (library / "filler").write_bytes(b"\0" * 28_000)
@@ -145,12 +128,12 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
         )
         os.close(child)
         try:
-            shown = _read_until(parent, "Save it where?")
+            shown = read_until(parent, "Save it where?")
             assert "no space left on the device" in shown
             os.write(parent, f"{tmp_path / 'missing' / 'x.move'}\n".encode())
-            assert "does not exist" in _read_until(parent, "Save it where?")
+            assert "does not exist" in read_until(parent, "Save it where?")
             os.write(parent, f"{tmp_path}\n".encode())
-            tail = _read_until(parent, "recorded")
+            tail = read_until(parent, "recorded")
             assert "recorded" in tail, tail[-2000:]
             assert proc.wait(timeout=30) == 0
         finally:
@@ -163,8 +146,9 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
 def test_ctrl_c_where_to_save_keeps_the_take_in_a_temporary_file(tmp_path: Path) -> None:
     with tmpfs(tmp_path / "full", "32k") as library:
         (library / "filler").write_bytes(b"\0" * 28_000)
-        terminal = Terminal("record", "wave", *SIM, "--duration", "6",
-                            env={"POPPY_MOVES_DIR": str(library)})  # fmt: skip
+        terminal = Terminal(
+            "record", "wave", *SIM, "--duration", "6", env={"POPPY_MOVES_DIR": str(library)}
+        )
         try:
             assert "Save it where?" in terminal.read_until("Save it where?")
             terminal.type(CTRL_C)

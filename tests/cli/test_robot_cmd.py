@@ -48,9 +48,18 @@ def test_status_table(poppy: Any) -> None:
 
 def test_goto_sim_reaches_target(poppy: Any) -> None:
     result = poppy(
-        "robot", "goto", "--sim", "--profile", "ergo-jr", "m1=30", "m2=-10",
-        "--duration", "0.5", "--wait", "--json",
-    )  # fmt: skip
+        "robot",
+        "goto",
+        "--sim",
+        "--profile",
+        "ergo-jr",
+        "m1=30",
+        "m2=-10",
+        "--duration",
+        "0.5",
+        "--wait",
+        "--json",
+    )
     assert result.code == 0, result.stderr
     reached = {m["name"]: m["position"] for m in result.json()["motors"]}
     assert abs(reached["m1"] - 30) <= 2

@@ -47,10 +47,17 @@ def test_health_table_says_a_bus_is_lost_and_names_offline_motors() -> None:
     from poppy_cli.commands.robot import health_table
 
     bus = {
-        "port": "/dev/ttyUSB0", "connected": False, "running": True, "down_s": 2.4,
-        "loop_hz": {"present": 0.0}, "target_hz": {"present": 50.0}, "timeouts": 3,
-        "retries": 1, "corrupt_packets": 0, "offline": ["m1", "m2"],
-    }  # fmt: skip
+        "port": "/dev/ttyUSB0",
+        "connected": False,
+        "running": True,
+        "down_s": 2.4,
+        "loop_hz": {"present": 0.0},
+        "target_hz": {"present": 50.0},
+        "timeouts": 3,
+        "retries": 1,
+        "corrupt_packets": 0,
+        "offline": ["m1", "m2"],
+    }
     console = Console(record=True, width=160)
     console.print(health_table({"upper": bus}))
     text = console.export_text()

@@ -15,8 +15,9 @@ from poppy_core.errors import ArgumentError, ConfigError
 KNOWN = ["m1", "m2", "m3"]
 
 
-@given(st.dictionaries(st.sampled_from(KNOWN), st.floats(-MAX_MAGNITUDE, MAX_MAGNITUDE),
-                       min_size=1))  # fmt: skip
+@given(
+    st.dictionaries(st.sampled_from(KNOWN), st.floats(-MAX_MAGNITUDE, MAX_MAGNITUDE), min_size=1)
+)
 def test_written_targets_read_back(targets: dict[str, float]) -> None:
     words = [f"{name}={value!r}" for name, value in targets.items()]
     assert parse_targets(words, KNOWN) == targets

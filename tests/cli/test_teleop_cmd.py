@@ -53,8 +53,14 @@ def follower_bus() -> Iterator[tuple[VirtualBus, EmulatorServer]]:
 def run_with_hand(args: list[str], hand: VirtualBus, timeout_s: float = 60.0) -> Result:
     """Run `poppy ARGS`, waving the leader's joints (motor frame) until it exits."""
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    proc = subprocess.Popen([*POPPY, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            stdin=subprocess.DEVNULL, text=True, env=env)  # fmt: skip
+    proc = subprocess.Popen(
+        [*POPPY, *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+        text=True,
+        env=env,
+    )
     start = time.monotonic()
     while proc.poll() is None and time.monotonic() - start < timeout_s:
         t = time.monotonic() - start
@@ -70,10 +76,24 @@ def test_a_follower_copies_the_leader_and_the_run_is_recorded(
 ) -> None:
     (hand, leader), (follow, follower) = leader_bus, follower_bus
     result = run_with_hand(
-        ["teleop", "--leader", "ergo-jr", "--leader-port", leader.url, "--follower", "ergo-jr",
-         "--follower-port", follower.url, "--duration", "2.5", "--record", "copied", "--json"],
+        [
+            "teleop",
+            "--leader",
+            "ergo-jr",
+            "--leader-port",
+            leader.url,
+            "--follower",
+            "ergo-jr",
+            "--follower-port",
+            follower.url,
+            "--duration",
+            "2.5",
+            "--record",
+            "copied",
+            "--json",
+        ],
         hand,
-    )  # fmt: skip
+    )
     assert result.code == 0, result.stderr
     summary = result.json()
     assert summary["map"] == "m1=m1, m2=m2, m3=m3, m4=m4, m5=m5, m6=m6"
@@ -92,11 +112,26 @@ def test_a_follower_copies_the_leader_and_the_run_is_recorded(
 def test_a_simulated_follower_with_a_map(leader_bus: Any) -> None:
     hand, leader = leader_bus
     result = run_with_hand(
-        ["teleop", "--leader", "ergo-jr", "--leader-port", leader.url, "--follower", "torso",
-         "--follower-sim", "ideal", "--map", "r_shoulder_y=m2, r_elbow_y=-m3+30",
-         "--rate", "50", "--duration", "1.5", "--json"],
+        [
+            "teleop",
+            "--leader",
+            "ergo-jr",
+            "--leader-port",
+            leader.url,
+            "--follower",
+            "torso",
+            "--follower-sim",
+            "ideal",
+            "--map",
+            "r_shoulder_y=m2, r_elbow_y=-m3+30",
+            "--rate",
+            "50",
+            "--duration",
+            "1.5",
+            "--json",
+        ],
         hand,
-    )  # fmt: skip
+    )
     assert result.code == 0, result.stderr
     assert result.json()["map"] == "r_shoulder_y=m2, r_elbow_y=-m3+30"
 
@@ -129,6 +164,17 @@ def test_bad_input_is_one_line(poppy: Any, args: list[str], code: int, message: 
 def test_an_existing_record_needs_force(poppy: Any, settings: Path) -> None:
     settings.mkdir(parents=True)
     (settings / "taken.move").write_bytes(b"")
-    result = poppy("teleop", "--leader", "ergo-jr", "--leader-port", "A", "--follower", "ergo-jr",
-                   "--follower-port", "B", "--record", "taken")  # fmt: skip
+    result = poppy(
+        "teleop",
+        "--leader",
+        "ergo-jr",
+        "--leader-port",
+        "A",
+        "--follower",
+        "ergo-jr",
+        "--follower-port",
+        "B",
+        "--record",
+        "taken",
+    )
     assert result.code == 1 and "pass --force" in result.stderr  # a refused file: 1

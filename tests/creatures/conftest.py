@@ -8,13 +8,10 @@ import pytest
 
 from poppy_core.creatures import from_profile
 from poppy_core.robot import Robot
+from tests.helpers.fixtures import ergo_fixture
 
-
-@pytest.fixture(scope="module")
-def ergo() -> Iterator[Robot]:
-    """One simulated Ergo Jr per module."""
-    with from_profile("ergo-jr", sim=True) as robot:
-        yield robot
+ergo = ergo_fixture(scope="module")
+"""One simulated Ergo Jr per module."""
 
 
 @pytest.fixture(scope="module")

@@ -35,8 +35,11 @@ def run(code: str, **names: Any) -> dict[str, Any]:
     source = source.replace("time.sleep(", "_doc_sleep(").replace("time.time()", "_doc_clock()")
     source = source.replace("self.elapsed_time", "_doc_elapsed(self)")
     namespace: dict[str, Any] = {
-        "_doc_sleep": _sleep, "_doc_clock": _clock, "_doc_elapsed": _elapsed, **names
-    }  # fmt: skip
+        "_doc_sleep": _sleep,
+        "_doc_clock": _clock,
+        "_doc_elapsed": _elapsed,
+        **names,
+    }
     exec(compile(source, "<documentation example>", "exec"), namespace)
     return namespace
 

@@ -17,6 +17,7 @@ from poppy_core.creatures import (
 )
 from poppy_core.errors import ConfigError
 from poppy_core.robot import RobotConfig, load_profile
+from tests.helpers.pypot_names import UPPER_BODY_PRIMITIVES
 
 # Copies of the public pypot configs (no profile header), kept by the robot tests.
 PYPOT_DATA = Path(__file__).parents[1] / "robot" / "data"
@@ -67,9 +68,15 @@ def test_ergo_jr_motor_names_with_one_missing_is_no_creature() -> None:
 
 @pytest.mark.parametrize(
     ("spelling", "kind"),
-    [("PoppyErgoJr", "ergo-jr"), ("ergo_jr", "ergo-jr"), ("Poppy Humanoid", "humanoid"),
-     ("TORSO", "torso"), ("poppy-torso", "torso"), ("spider", None)],
-)  # fmt: skip
+    [
+        ("PoppyErgoJr", "ergo-jr"),
+        ("ergo_jr", "ergo-jr"),
+        ("Poppy Humanoid", "humanoid"),
+        ("TORSO", "torso"),
+        ("poppy-torso", "torso"),
+        ("spider", None),
+    ],
+)
 def test_normalize_kind(spelling: str, kind: str | None) -> None:
     assert normalize_kind(spelling) == kind
 
@@ -84,11 +91,19 @@ def test_a_plain_robot_gets_no_behaviour_and_a_named_one_can_be_attached() -> No
 
 def test_every_creature_declares_its_primitives() -> None:
     assert set(CREATURES) == {"ergo-jr", "torso", "humanoid"}
-    assert {"base_posture", "rest_posture", "curious_posture", "tetris_posture", "safe_power_up",
-            "dance", "jump", "tinsel_demo", "stubborn_demo", "chicken_demo",
-            "puzzel_demo"} == set(CREATURES["ergo-jr"].primitives)  # fmt: skip
-    upper = {"limit_torque", "temperature_monitoring", "dance_beat_motion",
-             "upper_body_idle_motion", "head_idle_motion", "arms_turn_compliant",
-             "arms_copy_motion"}  # fmt: skip
+    assert {
+        "base_posture",
+        "rest_posture",
+        "curious_posture",
+        "tetris_posture",
+        "safe_power_up",
+        "dance",
+        "jump",
+        "tinsel_demo",
+        "stubborn_demo",
+        "chicken_demo",
+        "puzzel_demo",
+    } == set(CREATURES["ergo-jr"].primitives)
+    upper = set(UPPER_BODY_PRIMITIVES)
     assert set(CREATURES["torso"].primitives) == upper | {"init_position"}
     assert set(CREATURES["humanoid"].primitives) == upper | {"stand_position", "sit_position"}

@@ -23,6 +23,7 @@ from poppy_core.motion import LoopPrimitive, Move, PositionWatcher
 from poppy_core.robot import MotorGroup, Robot, from_config, load_profile
 from tests.creatures import doc_examples as doc
 from tests.creatures.helpers import positions, reached, stop_all, virtual, wait_until
+from tests.helpers.pypot_names import TORSO_PRIMITIVES
 
 SIMULATORS = ["dummy", "mujoco"]
 TOLERANCE_DEG = {"dummy": 1.5, "mujoco": 4.0}
@@ -307,10 +308,7 @@ def test_humanoid_behaviours_and_setup(simulator: str, capsys: pytest.CaptureFix
 
 def test_torso_behaviours(torso: Robot) -> None:
     # the documentation's list (line 1969), and init_position, which poppy_torso.py attaches too
-    assert torso.primitive_names == [
-        "limit_torque", "temperature_monitoring", "dance_beat_motion", "upper_body_idle_motion",
-        "head_idle_motion", "arms_turn_compliant", "arms_copy_motion", "init_position",
-    ]  # fmt: skip
+    assert torso.primitive_names == TORSO_PRIMITIVES
     assert torso.temperature_monitoring.running
     stop_all(torso)
     torso.compliant = False  # "Remember to remove compliance before starting the primitives!"
@@ -336,8 +334,9 @@ def test_a_minimal_config_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
     (tmp_path / "my_config.json").write_text(doc.MINIMAL_CONFIG_JSON)
     with doc.run(doc.FROM_JSON)["poppy"] as poppy:
         assert [(m.name, m.id, m.model.name) for m in poppy.motors] == [
-            ("head_z", 36, "AX-12A"), ("head_y", 37, "AX-12A"),
-        ]  # fmt: skip
+            ("head_z", 36, "AX-12A"),
+            ("head_y", 37, "AX-12A"),
+        ]
         assert poppy.alias == ["head"] and poppy.head == [poppy.head_z, poppy.head_y]
         poppy.head.compliant = False
         poppy.head_z.goal_position = 30
@@ -442,8 +441,9 @@ MISSING_NAMES = {"numpy": np, "LoopPrimitive": LoopPrimitive, "song": "my_favori
 
 
 def test_own_primitive_runs_its_30_seconds(ergo_robot: Robot) -> None:
-    names = doc.run(_custom(doc.DANCE_PRIMITIVE, doc.DANCE_START), ergo_robot=ergo_robot,
-                    **MISSING_NAMES)  # fmt: skip
+    names = doc.run(
+        _custom(doc.DANCE_PRIMITIVE, doc.DANCE_START), ergo_robot=ergo_robot, **MISSING_NAMES
+    )
     dance = names["dance"]
     assert dance.running
     _swings_opposite(ergo_robot, 1.5, 15.0)  # amp 60
@@ -452,8 +452,11 @@ def test_own_primitive_runs_its_30_seconds(ergo_robot: Robot) -> None:
 
 
 def test_loop_primitive_dances_until_stopped(ergo_robot: Robot) -> None:
-    names = doc.run(_custom(doc.DANCE_PRIMITIVE, doc.LOOP_DANCE_PRIMITIVE, doc.LOOP_DANCE_START),
-                    ergo_robot=ergo_robot, **MISSING_NAMES)  # fmt: skip
+    names = doc.run(
+        _custom(doc.DANCE_PRIMITIVE, doc.LOOP_DANCE_PRIMITIVE, doc.LOOP_DANCE_START),
+        ergo_robot=ergo_robot,
+        **MISSING_NAMES,
+    )
     dance = names["dance"]
     try:
         _swings_opposite(ergo_robot, 1.5, 15.0)  # amp 40
@@ -464,8 +467,11 @@ def test_loop_primitive_dances_until_stopped(ergo_robot: Robot) -> None:
 
 
 def test_attached_primitive_started_by_another(ergo_robot: Robot) -> None:
-    names = doc.run(_custom(doc.DANCE_PRIMITIVE, doc.ATTACH_DANCE, doc.SELECTOR_PRIMITIVE),
-                    ergo_robot=ergo_robot, **MISSING_NAMES)  # fmt: skip
+    names = doc.run(
+        _custom(doc.DANCE_PRIMITIVE, doc.ATTACH_DANCE, doc.SELECTOR_PRIMITIVE),
+        ergo_robot=ergo_robot,
+        **MISSING_NAMES,
+    )
     dance = ergo_robot.dance
     assert isinstance(dance, names["DancePrimitive"]) and dance.name == "dance"
     assert dance in ergo_robot.primitives and dance.running

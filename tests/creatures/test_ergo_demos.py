@@ -23,8 +23,9 @@ def poppy() -> Iterator[Robot]:
 
 
 def _at(robot: Robot, posture: tuple[float, ...] | list[float], tolerance: float = 3.0) -> bool:
-    return all(abs(m.present_position - v) <= tolerance
-               for m, v in zip(robot.motors, posture, strict=True))  # fmt: skip
+    return all(
+        abs(m.present_position - v) <= tolerance for m, v in zip(robot.motors, posture, strict=True)
+    )
 
 
 def _push(robot: Robot, name: str, position: float) -> None:
@@ -41,8 +42,10 @@ def test_tinsel_cycles_the_colours_until_stopped(poppy: Robot) -> None:
     tinsel.colors = ["red", "green", "blue"]
     seen: set[str] = set()
     tinsel.start()
-    assert wait_until(lambda: seen.update({m.led for m in poppy.motors}) or
-                      {"red", "green", "blue"} <= seen, WAIT_S)  # fmt: skip
+    assert wait_until(
+        lambda: seen.update({m.led for m in poppy.motors}) or {"red", "green", "blue"} <= seen,
+        WAIT_S,
+    )
     tinsel.stop()
     assert not tinsel.is_alive() and len({m.led for m in poppy.motors}) == 1
 
@@ -50,14 +53,20 @@ def test_tinsel_cycles_the_colours_until_stopped(poppy: Robot) -> None:
 def test_chicken_keeps_the_head_level(poppy: Robot) -> None:
     chicken = poppy.chicken_demo
     chicken.start()
-    assert wait_until(lambda: [m.led for m in poppy.motors] == ["green"] * 3 + ["red"] * 3
-                      and [m.compliant for m in poppy.motors] == [True] * 3 + [False] * 3,
-                      WAIT_S)  # fmt: skip
+    assert wait_until(
+        lambda: (
+            [m.led for m in poppy.motors] == ["green"] * 3 + ["red"] * 3
+            and [m.compliant for m in poppy.motors] == [True] * 3 + [False] * 3
+        ),
+        WAIT_S,
+    )
     assert _at(poppy, DEMO_POSTURE)
     _push(poppy, "m1", 30.0)
     _push(poppy, "m3", 40.0)
-    assert wait_until(lambda: abs(poppy.m4.present_position + 30) < 2
-                      and abs(poppy.m6.present_position + 40) < 2, WAIT_S)  # fmt: skip
+    assert wait_until(
+        lambda: abs(poppy.m4.present_position + 30) < 2 and abs(poppy.m6.present_position + 40) < 2,
+        WAIT_S,
+    )
     chicken.stop()
     assert {m.led for m in poppy.motors} == {"off"} and poppy.compliant
 
@@ -72,10 +81,13 @@ def test_stubborn_takes_its_posture_back(poppy: Robot) -> None:
     assert _at(poppy, kept)
     colours: set[str] = set()
     _push(poppy, "m2", kept[1] + 30.0)
-    assert wait_until(lambda: colours.update({m.led for m in poppy.motors}) or
-                      {"yellow", "red"} <= colours, WAIT_S)  # fmt: skip
-    assert wait_until(lambda: _at(poppy, kept, 6.0) and
-                      {m.led for m in poppy.motors} == {"green"}, WAIT_S)  # fmt: skip
+    assert wait_until(
+        lambda: colours.update({m.led for m in poppy.motors}) or {"yellow", "red"} <= colours,
+        WAIT_S,
+    )
+    assert wait_until(
+        lambda: _at(poppy, kept, 6.0) and {m.led for m in poppy.motors} == {"green"}, WAIT_S
+    )
     stubborn.stop()
     assert _at(poppy, DEMO_POSTURE) and {m.led for m in poppy.motors} == {"off"}
 

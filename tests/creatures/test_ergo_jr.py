@@ -16,10 +16,20 @@ from poppy_core.robot import Robot
 from tests.creatures.helpers import positions, reached, virtual, wait_until
 
 ERGO_JR_PRIMITIVES = [
-    "safe_power_up", "dance", "base_posture", "rest_posture", "curious_posture",
-    "tetris_posture", "jump", "tinsel_demo", "stubborn_demo", "chicken_demo", "puzzel_demo",
-    "tracking_feedback", "marker_follow",
-]  # fmt: skip
+    "safe_power_up",
+    "dance",
+    "base_posture",
+    "rest_posture",
+    "curious_posture",
+    "tetris_posture",
+    "jump",
+    "tinsel_demo",
+    "stubborn_demo",
+    "chicken_demo",
+    "puzzel_demo",
+    "tracking_feedback",
+    "marker_follow",
+]
 
 
 @pytest.fixture(autouse=True)
@@ -55,9 +65,12 @@ def test_setup_limits_torque_and_sets_the_gains(ergo: Robot) -> None:
 
 @pytest.mark.parametrize(
     ("name", "targets"),
-    [("curious_posture", ERGO_JR_CURIOUS), ("rest_posture", ERGO_JR_REST),
-     ("base_posture", {f"m{i}": 0.0 for i in range(1, 7)})],
-)  # fmt: skip
+    [
+        ("curious_posture", ERGO_JR_CURIOUS),
+        ("rest_posture", ERGO_JR_REST),
+        ("base_posture", {f"m{i}": 0.0 for i in range(1, 7)}),
+    ],
+)
 def test_postures_reach_their_targets(ergo: Robot, name: str, targets: dict[str, float]) -> None:
     posture = getattr(ergo, name)
     posture.duration = 0.5

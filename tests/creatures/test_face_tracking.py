@@ -4,7 +4,6 @@ attached to an Ergo Jr whose config has a face detector."""
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -14,6 +13,7 @@ from poppy_core.creatures import FaceTracking, from_config, from_profile
 from poppy_core.robot import RobotConfig, load_profile
 from poppy_core.sensors import Face, FaceDetector
 from tests.creatures.test_tracking import HEIGHT, WIDTH, SeenPoint
+from tests.helpers.fixtures import ergo_fixture
 from tests.helpers.waiting import eventually
 
 pytest.importorskip("skimage")
@@ -32,12 +32,7 @@ def face_at(u: float, v: float, size: int) -> Face:
     return Face(rect, (u, v), (2 * u / WIDTH - 1, 2 * v / HEIGHT - 1), "camera", 10)
 
 
-@pytest.fixture
-def ergo() -> Iterator[Any]:
-    with from_profile("ergo-jr", sim=True, sensors=False) as robot:
-        robot.compliant = False
-        robot.goto_position({m.name: 0.0 for m in robot.motors}, 0.3, wait=True)
-        yield robot
+ergo = ergo_fixture(sensors=False, home=True)
 
 
 def to_the_side(robot: Any) -> tuple[float, float, float]:

@@ -12,12 +12,7 @@ from poppy_core.creatures.postures import humanoid_sit
 from poppy_core.motion import primitive_manager
 from poppy_core.robot import Robot
 from tests.creatures.helpers import positions, reached, stop_all, virtual, wait_until
-
-HUMANOID_PRIMITIVES = [
-    "stand_position", "sit_position", "limit_torque", "temperature_monitoring",
-    "dance_beat_motion", "upper_body_idle_motion", "head_idle_motion", "arms_turn_compliant",
-    "arms_copy_motion",
-]  # fmt: skip
+from tests.helpers.pypot_names import HUMANOID_PRIMITIVES
 
 
 @pytest.fixture(autouse=True)

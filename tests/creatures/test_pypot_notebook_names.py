@@ -110,9 +110,10 @@ def test_tetris_posture(poppy: Robot) -> None:
     assert wait_until(lambda: {m.led for m in poppy.motors} == {"yellow"}, 10.0)
     poppy.tetris_posture.wait_to_stop()
     expected = {"m1": 0.0, "m2": -90.0, "m3": 90.0, "m4": 0.0, "m5": -90.0, "m6": -90.0}
-    assert wait_until(lambda: all(
-        abs(poppy.motor(n).present_position - v) < 2.0 for n, v in expected.items()
-    ), 10.0)  # fmt: skip
+    assert wait_until(
+        lambda: all(abs(poppy.motor(n).present_position - v) < 2.0 for n, v in expected.items()),
+        10.0,
+    )
     assert {m.led for m in poppy.motors} == {"off"}
 
 
@@ -131,8 +132,9 @@ def test_torso_init_position() -> None:
 
 def test_snap_run_returns_when_the_server_already_serves() -> None:
     # pypot's notebooks: PoppyErgoJr(use_snap=True); poppy.snap.run() returned at once.
-    with PoppyErgoJr(simulator="dummy", use_snap=True, snap_port=0, use_http=True,
-                     http_port=0) as robot:  # fmt: skip
+    with PoppyErgoJr(
+        simulator="dummy", use_snap=True, snap_port=0, use_http=True, http_port=0
+    ) as robot:
         for server, route in ((robot.snap, "/motors/motors"), (robot.http, "/motors/list.json")):
             returned = threading.Event()
             runner = threading.Thread(target=lambda s=server, r=returned: (s.run(), r.set()))
@@ -156,19 +158,22 @@ def test_moving_speed_beyond_the_top_is_capped_in_python_and_over_rest() -> None
         answer = httpx.post(url, json=10000, timeout=10)
         assert answer.status_code < 300, answer.text
         assert robot.m2.moving_speed == pytest.approx(top)
-        refused = httpx.post(url, content=b"NaN", timeout=10,
-                             headers={"content-type": "application/json"})  # fmt: skip
+        refused = httpx.post(
+            url, content=b"NaN", timeout=10, headers={"content-type": "application/json"}
+        )
         assert refused.status_code == 400 and robot.m2.moving_speed == pytest.approx(top)
-        pid = httpx.post(f"{robot.http.url}/motor/m3/register/pid/value.json",
-                         json=[100, 2, 0], timeout=10)  # fmt: skip
+        pid = httpx.post(
+            f"{robot.http.url}/motor/m3/register/pid/value.json", json=[100, 2, 0], timeout=10
+        )
         assert pid.status_code < 300, pid.text
         assert robot.m3.pid[0] == pytest.approx(254 / 8)  # the P gain register's top
 
 
 def test_a_bound_only_server_serves_in_run_until_close() -> None:
     # start_background_services=False: the script serves with run(), which blocks until close.
-    robot = PoppyErgoJr(simulator="dummy", use_snap=True, snap_port=0,
-                        start_background_services=False)  # fmt: skip
+    robot = PoppyErgoJr(
+        simulator="dummy", use_snap=True, snap_port=0, start_background_services=False
+    )
     try:
         runner = threading.Thread(target=robot.snap.run, daemon=True)
         runner.start()

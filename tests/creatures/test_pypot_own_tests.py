@@ -65,8 +65,12 @@ def test_pypot_test_primitive_passes_with_the_import_changed(tmp_path: Path) -> 
     try:
         run = subprocess.run(
             [sys.executable, "-m", "unittest", "-v", "pypot_test_primitive"],
-            cwd=tmp_path, env=env, capture_output=True, text=True, timeout=RUN_TIMEOUT_S,
-        )  # fmt: skip
+            cwd=tmp_path,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=RUN_TIMEOUT_S,
+        )
     except subprocess.TimeoutExpired as exc:
         pytest.fail(f"pypot's test_primitive.py hung ({RUN_TIMEOUT_S:g} s):\n{exc.stderr!s}")
     assert run.returncode == 0, run.stderr

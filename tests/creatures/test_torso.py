@@ -9,6 +9,7 @@ import pytest
 from poppy_core.creatures import from_profile
 from poppy_core.robot import Robot
 from tests.creatures.helpers import positions, wait_until
+from tests.helpers.pypot_names import TORSO_PRIMITIVES
 
 
 @pytest.fixture(scope="module")
@@ -20,10 +21,7 @@ def torso() -> Iterator[Robot]:
 
 def test_behaviours_are_attached(torso: Robot) -> None:
     assert torso.creature.kind == "torso" and torso.creature.goto_control == "minjerk"
-    assert torso.primitive_names == [
-        "limit_torque", "temperature_monitoring", "dance_beat_motion", "upper_body_idle_motion",
-        "head_idle_motion", "arms_turn_compliant", "arms_copy_motion", "init_position",
-    ]  # fmt: skip
+    assert torso.primitive_names == TORSO_PRIMITIVES
     assert "stand_position" not in torso.extensions  # no legs
     assert torso.active_primitives == [torso.temperature_monitoring]
     assert all(m.compliant_behavior == "safe" for m in torso.torso)

@@ -4,17 +4,17 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator
 from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pytest
 
-from poppy_core.creatures import MarkerFollow, TrackingFeedback, from_profile
+from poppy_core.creatures import MarkerFollow, TrackingFeedback
 from poppy_core.errors import SensorError
 from poppy_core.sensors.camera import CameraCalibration
 from poppy_core.sensors.markers import Marker
+from tests.helpers.fixtures import ergo_fixture
 from tests.helpers.waiting import eventually
 
 WIDTH, HEIGHT = 640, 480
@@ -73,11 +73,7 @@ class SeenPoint:
         return self.markers
 
 
-@pytest.fixture
-def ergo() -> Iterator[Any]:
-    with from_profile("ergo-jr", sim=True, sensors=False) as robot:
-        robot.compliant = False
-        yield robot
+ergo = ergo_fixture(sensors=False, stiff=True)
 
 
 def off_centre_px(detector: SeenPoint) -> float:

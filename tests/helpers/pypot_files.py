@@ -89,8 +89,13 @@ def snap_project_files() -> dict[str, Path]:
         if not all((folder / name).is_file() for name in SNAP_FILES):
             try:
                 _download(folder)
-            except (OSError, RuntimeError, subprocess.SubprocessError, tarfile.TarError,
-                    zipfile.BadZipFile) as exc:  # fmt: skip
+            except (
+                OSError,
+                RuntimeError,
+                subprocess.SubprocessError,
+                tarfile.TarError,
+                zipfile.BadZipFile,
+            ) as exc:
                 message = (
                     f"pypot {PYPOT_VERSION}'s Snap! files are needed (bench/.venv-peers, or "
                     f"PyPI through pip download, cached in {folder}): {exc}"

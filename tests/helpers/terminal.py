@@ -38,8 +38,12 @@ class Terminal:
         full = dict(os.environ, **ENV, **(env or {}))
         self.proc = subprocess.Popen(
             [sys.executable, "-c", _SHIM, *POPPY, *args],
-            stdin=slave, stdout=slave, stderr=slave, env=full, close_fds=True,
-        )  # fmt: skip
+            stdin=slave,
+            stdout=slave,
+            stderr=slave,
+            env=full,
+            close_fds=True,
+        )
         os.close(slave)
         self.shown = ""
 

@@ -13,10 +13,10 @@ import yaml
 
 from poppy_core.creatures import from_config
 from poppy_core.errors import ConfigError
-from poppy_core.kinematics import load_description, parse_kinematics
+from poppy_core.kinematics import load_description
 from poppy_core.motion.cartesian import RobotChain
 from poppy_core.motion.chains import chains_from_config
-from poppy_core.robot import load_config, load_profile
+from poppy_core.robot import RobotConfig, load_config, load_profile
 
 PROFILES = Path(__file__).resolve().parents[2] / "profiles"
 
@@ -81,12 +81,15 @@ def test_pypot_json_of_a_creature_gets_the_profile_chains(tmp_path: Path) -> Non
     ("section", "message"),
     [
         ({"model": "nowhere.urdf", "chains": {"arm": ARM}}, "'nowhere.urdf' not found"),
-        ({"chains": {"arm": ARM}}, "kinematics.model must name"),
+        ({"chains": {"arm": ARM}}, "kinematics.model: missing"),
         (
             {"model": "poppy_ergo_jr.urdf", "chains": {"arm": {"tip": [0, 0, 0]}}},
-            "motors must list",
+            "kinematics.chains.arm.motors: missing",
         ),
-        ({"model": "poppy_ergo_jr.urdf", "chains": {"arm": {**ARM, "tip": [0, 0]}}}, "tip must be"),
+        (
+            {"model": "poppy_ergo_jr.urdf", "chains": {"arm": {**ARM, "tip": [0, 0]}}},
+            r"tip = \[0, 0\]: must be \[x, y, z\]",
+        ),
         (
             {"model": "poppy_ergo_jr.urdf", "chains": {"arm": {**ARM, "motors": ["m1", "m9"]}}},
             "names 'm9', which is no motor",
@@ -101,7 +104,7 @@ def test_pypot_json_of_a_creature_gets_the_profile_chains(tmp_path: Path) -> Non
         ),
         (
             {"model": "poppy_ergo_jr.urdf", "joint_frame": "raw", "chains": {"arm": ARM}},
-            "joint_frame is motor or user",
+            "joint_frame = \"raw\": must be 'motor' or 'user'",
         ),
         ({"model": "poppy_ergo_jr.urdf", "chains": {"m1": ARM}}, "already a motor"),
         (
@@ -137,5 +140,6 @@ def test_unreadable_models_are_one_line(tmp_path: Path, name: str, text: str) ->
 
 
 def test_section_must_be_a_mapping() -> None:
-    with pytest.raises(ConfigError, match="must be a mapping"):
-        parse_kinematics(["model.urdf"])
+    data = {"controllers": {}, "motors": {}, "kinematics": ["model.urdf"]}
+    with pytest.raises(ConfigError, match=r"kinematics = .*: must be a valid dictionary"):
+        RobotConfig.from_dict(data)

@@ -15,9 +15,8 @@ from poppy_core.kinematics import (
     MotorFrame,
     build_chains,
     load_description,
-    parse_kinematics,
 )
-from poppy_core.motion.chains import group_expander
+from poppy_core.motion.chains import group_expander, kinematics_spec
 from poppy_core.robot import load_profile
 
 DATA = Path(__file__).parent / "data"
@@ -94,7 +93,8 @@ def test_mjcf_chains_match_urdf_chains(kind: str) -> None:
     """
     pytest.importorskip("mujoco")
     config = load_profile(kind)
-    spec = parse_kinematics((config.model_extra or {})["kinematics"])
+    assert config.kinematics is not None
+    spec = kinematics_spec(config.kinematics)
     urdf = load_description(PROFILES / kind / spec.model)
     mjcf = load_description(PROFILES / kind / "model.xml")
     assert (urdf.joint_frame, mjcf.joint_frame) == ("motor", "motor")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -12,15 +11,12 @@ from poppy_core.creatures import from_profile
 from poppy_core.errors import KinematicsError
 from poppy_core.motion.cartesian import RobotChain
 from poppy_core.robot import Robot
+from tests.helpers.fixtures import ergo_fixture
 
 SETTLE_S = 0.3
 
 
-@pytest.fixture(scope="module")
-def ergo() -> Iterator[Robot]:
-    with from_profile("ergo-jr", sim=True) as robot:
-        robot.compliant = False
-        yield robot
+ergo = ergo_fixture(scope="module", stiff=True)
 
 
 def _settle(robot: Robot) -> None:

@@ -18,6 +18,7 @@ from poppy_core.motion.cartesian import RobotChain
 from poppy_core.motion.chains import chains_from_config
 from poppy_core.robot import Robot, load_profile
 from poppy_core.robot.frames import to_motor
+from tests.helpers.fixtures import ergo_fixture
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -26,11 +27,7 @@ PROFILES = Path(__file__).resolve().parents[2] / "profiles"
 TIP_M = np.array([0.0, 0.0, -0.07])
 
 
-@pytest.fixture(scope="module")
-def ergo() -> Iterator[Robot]:
-    with from_profile("ergo-jr", sim="mujoco") as robot:
-        robot.compliant = False
-        yield robot
+ergo = ergo_fixture(scope="module", sim="mujoco", stiff=True)
 
 
 def _simulated_tip(robot: Robot) -> np.ndarray:

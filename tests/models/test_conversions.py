@@ -265,8 +265,9 @@ def test_decode_si_reads_a_register_wherever_its_bytes_start() -> None:
 def test_decode_table_gives_the_registers_the_bytes_hold() -> None:
     table = bytes(XL_320.table_size)
     values = XL_320.decode_table(table)
-    assert list(values) == [r.name for r in sorted(XL_320.registers.values(),
-                                                      key=lambda r: r.address)]  # fmt: skip
+    assert list(values) == [
+        r.name for r in sorted(XL_320.registers.values(), key=lambda r: r.address)
+    ]
     assert values["led"] == "off" and values["goal_position"] == XL_320.register(
         "goal_position"
     ).to_si(0)

@@ -25,8 +25,10 @@ from poppy_core.motion import (
 
 names = st.lists(
     st.text(st.characters(codec="utf-8", exclude_categories=["Cs"]), min_size=1, max_size=8),
-    min_size=1, max_size=5, unique=True,
-)  # fmt: skip
+    min_size=1,
+    max_size=5,
+    unique=True,
+)
 angles = st.floats(-1000.0, 1000.0, allow_nan=False, allow_infinity=False)
 rates = st.sampled_from([1.0, 10.0, 25.0, 30.0, 50.0, 100.0, 1000.0 / 3])
 
@@ -40,9 +42,12 @@ def moves(draw: st.DrawFn, speeds: bool | None = None) -> Move:
     with_speeds = draw(st.booleans()) if speeds is None else speeds
     metadata = draw(st.dictionaries(st.sampled_from(["robot", "created", "note"]), st.text()))
     return Move(
-        draw(rates), motors, positions, speeds=-positions if with_speeds else None,
+        draw(rates),
+        motors,
+        positions,
+        speeds=-positions if with_speeds else None,
         metadata=metadata,
-    )  # fmt: skip
+    )
 
 
 @settings(max_examples=150, deadline=None)

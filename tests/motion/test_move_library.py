@@ -51,9 +51,13 @@ def test_reversed_select_stats_and_from_frames() -> None:
     assert back.position_at(0.05)["a"] == pytest.approx(20.0)
     assert move.select(["b"]).motors == ("b",)
     assert move.stats()["a"] == {
-        "min": 0.0, "max": 30.0, "range": 30.0, "mean": pytest.approx(40 / 3), "start": 0.0,
+        "min": 0.0,
+        "max": 30.0,
+        "range": 30.0,
+        "mean": pytest.approx(40 / 3),
+        "start": 0.0,
         "end": 30.0,
-    }  # fmt: skip
+    }
     rebuilt = Move.from_frames(10, [move.frame(i) for i in range(3)])
     assert rebuilt.same_as(move)
     with pytest.raises(UnknownMotorError, match="c"):

@@ -6,7 +6,6 @@ import contextlib
 import json
 import struct
 import tracemalloc
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +15,8 @@ from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion import Move, MovePlayer, read_move
 from poppy_core.motion.move import MAX_VALUES
 from poppy_core.motion.move_format import MAGIC, decode_move, decode_pypot
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
+from tests.helpers.fixtures import ergo_fixture
 
 # The 103-byte pypot move: two frames 1e5 s apart at 1e6 Hz (1e11 frames once resampled).
 SPARSE = json.dumps({"framerate": 1e6, "positions": {"0.0": {"m1": [0, 0]},
@@ -85,10 +85,7 @@ def test_deep_or_huge_pypot_json_is_one_error(tmp_path: Path) -> None:
         read_move(path)
 
 
-@pytest.fixture(scope="module")
-def ergo() -> Iterator[Robot]:
-    with from_profile("ergo-jr", sim=True) as robot:
-        yield robot
+ergo = ergo_fixture(scope="module")
 
 
 def test_positions_past_the_limits_are_clamped_before_the_ramp(ergo: Robot) -> None:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections.abc import Iterator
 
 import pytest
 
@@ -22,6 +21,7 @@ from poppy_core.motion import (
 )
 from poppy_core.robot import Robot, from_profile
 from tests.helpers import eventually
+from tests.helpers.fixtures import ergo_fixture
 
 
 def state(primitive: Primitive) -> str:
@@ -29,13 +29,7 @@ def state(primitive: Primitive) -> str:
     return primitive.state
 
 
-@pytest.fixture
-def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True, creature=False)  # no Ergo Jr primitives
-    try:
-        yield robot
-    finally:
-        robot.close()
+ergo = ergo_fixture(creature=False)  # no Ergo Jr primitives
 
 
 class Counter(Primitive):

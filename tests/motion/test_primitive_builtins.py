@@ -21,15 +21,9 @@ from poppy_core.motion import (
     attach_builtins,
 )
 from poppy_core.robot import Robot, from_profile
+from tests.helpers.fixtures import ergo_fixture
 
-
-@pytest.fixture
-def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True)
-    try:
-        yield robot
-    finally:
-        robot.close()
+ergo = ergo_fixture()
 
 
 @pytest.fixture(scope="module")

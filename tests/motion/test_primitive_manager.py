@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 
 import pytest
 
@@ -16,18 +15,11 @@ from poppy_core.motion import (
     Sinus,
     primitive_manager,
 )
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from tests.helpers import eventually
+from tests.helpers.fixtures import ergo_fixture
 
-
-@pytest.fixture
-def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True, creature=False)  # no Ergo Jr primitives
-    robot.compliant = False
-    try:
-        yield robot
-    finally:
-        robot.close()
+ergo = ergo_fixture(stiff=True, creature=False)  # no Ergo Jr primitives
 
 
 def constant(robot: Robot, motor: str, value: float) -> Sinus:

@@ -37,8 +37,15 @@ def test_capabilities_follow_the_e_manual() -> None:
     # Protocol 2 adds broadcast ping, sync/fast sync read, bulk write, reboot, clear and the
     # factory reset options; protocol 1 has only the USB2AX adapter's sync read.
     v1, v2 = PROTOCOL_1, PROTOCOL_2
-    for name in ("has_broadcast_ping", "has_sync_read", "has_fast_sync_read", "has_bulk_write",
-                 "has_reboot", "has_clear", "has_factory_reset_options"):  # fmt: skip
+    for name in (
+        "has_broadcast_ping",
+        "has_sync_read",
+        "has_fast_sync_read",
+        "has_bulk_write",
+        "has_reboot",
+        "has_clear",
+        "has_factory_reset_options",
+    ):
         assert (getattr(v1, name), getattr(v2, name)) == (False, True), name
     assert (v1.usb2ax_sync_read, v2.usb2ax_sync_read) == (True, False)
     assert (v1.sync_read_instruction, v2.sync_read_instruction) == (

@@ -79,8 +79,9 @@ def robot() -> Iterator[Robot]:
 
 
 def test_zeros_and_ranges_become_offsets_and_limits(robot: Robot) -> None:
-    answers = ScriptedAnswers(robot, zeros={"m1": 3.0, "m2": -4.0},
-                              ranges={"m1": (-140.0, 130.0), "m2": (-120.0, 100.0)})  # fmt: skip
+    answers = ScriptedAnswers(
+        robot, zeros={"m1": 3.0, "m2": -4.0}, ranges={"m1": (-140.0, 130.0), "m2": (-120.0, 100.0)}
+    )
     calibration = CalibrationSession(robot, answers, ["m1", "m2"], settle_s=READ_S).run()
     assert answers.moves == [["m1"], ["m2"]]  # one joint at a time
     config = calibration.apply(robot.config, "my-ergo")  # type: ignore[arg-type]
@@ -104,8 +105,9 @@ def test_zeros_and_ranges_become_offsets_and_limits(robot: Robot) -> None:
 def test_a_posture_with_angles_and_all_joints_at_once(robot: Robot) -> None:
     posture = ReferencePosture("elbow bent", positions={"m3": 30.0})
     answers = ScriptedAnswers(robot, zeros={"m3": -30.0})  # m3 is indirect
-    session = CalibrationSession(robot, answers, ["m1", "m3"], posture=posture,
-                                 one_at_a_time=False, settle_s=READ_S)  # fmt: skip
+    session = CalibrationSession(
+        robot, answers, ["m1", "m3"], posture=posture, one_at_a_time=False, settle_s=READ_S
+    )
     calibration = session.run()
     assert answers.moves == [["m1", "m3"]]
     assert calibration.joints["m3"].offset("indirect") == pytest.approx(0.0, abs=0.3)
@@ -126,8 +128,9 @@ def test_a_joint_barely_moved_is_asked_about(robot: Robot) -> None:
 
 
 def test_a_zero_far_from_the_current_one_is_asked_about(robot: Robot) -> None:
-    answers = ScriptedAnswers(robot, zeros={"m1": 60.0}, ranges={"m1": (-90.0, 90.0)},
-                              answers=[False, True])  # fmt: skip
+    answers = ScriptedAnswers(
+        robot, zeros={"m1": 60.0}, ranges={"m1": (-90.0, 90.0)}, answers=[False, True]
+    )
     calibration = CalibrationSession(robot, answers, ["m1"], settle_s=READ_S).run()
     assert answers.postures == 2 and "reference posture" in answers.questions[0]
     assert calibration.joints["m1"].zero == pytest.approx(60.0, abs=0.3)
@@ -145,8 +148,14 @@ servo = st.sampled_from(["XL-320", "AX-12A", "MX-28", "MX-64"])
 angles = st.floats(-400.0, 400.0, allow_nan=False)
 
 
-@given(servo, st.sampled_from(["direct", "indirect"]), st.floats(-60, 60), angles, angles,
-       st.floats(-45, 45))  # fmt: skip
+@given(
+    servo,
+    st.sampled_from(["direct", "indirect"]),
+    st.floats(-60, 60),
+    angles,
+    angles,
+    st.floats(-45, 45),
+)
 def test_ranges_never_widen_beyond_the_servo(
     model: str, orientation: str, zero: float, a: float, b: float, posture: float
 ) -> None:
@@ -172,8 +181,9 @@ def test_the_profile_is_written_atomically_and_the_previous_one_kept(tmp_path: P
     assert first.backup is None and first.path == tmp_path / "ergo-jr" / "profile.yaml"
     assert load_profile("ergo-jr", tmp_path).motors["m1"].offset == 2.0
     old_text = first.path.read_text()
-    second = save_user_profile(_calibration(5.0).apply(base), "ergo-jr", tmp_path,
-                               comment="calibrated again")  # fmt: skip
+    second = save_user_profile(
+        _calibration(5.0).apply(base), "ergo-jr", tmp_path, comment="calibrated again"
+    )
     assert second.backup == tmp_path / "ergo-jr" / "profile.yaml.bak"
     assert second.backup.read_text() == old_text
     assert second.path.read_text().startswith("# calibrated again\n")

@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 
 from poppy_core.errors import ConfigError
+from poppy_core.motion.chains import kinematics_spec
 from poppy_core.robot import RobotConfig, load_config
 
 Data = dict[str, Any]
@@ -245,6 +246,37 @@ def test_every_problem_is_listed_in_one_pass(base_config: Callable[[], Data]) ->
     assert {p.field for p in info.value.problems} == {
         "motors.m3.angle_limit", "controllers.upper.protocol", "motors.m2.id", "motorgroups.arm[2]"
     }
+
+
+def test_chains_and_sensors_problems_are_all_listed(base_config: Callable[[], Data]) -> None:
+    """The kinematics and sensors sections report every problem, as the rest of the config."""
+    data = base_config()
+    data["kinematics"] = {"model": "arm.urdf", "chains": {"arm": {"motors": ["m1"], "tip": [0, 0]}}}
+    data["sensors"] = {
+        "camera": {"type": "OpenCVCamera", "fps": -5},
+        "markers": {"type": "MarkerDetector", "cameras": ["nothing"]},
+    }
+    with pytest.raises(ConfigError) as info:
+        RobotConfig.from_dict(data, source="robot.yaml")
+    lines = [str(p) for p in info.value.problems]
+    assert lines == [
+        "robot.yaml: sensors.camera.fps = -5: must be a positive number",
+        "robot.yaml: kinematics.chains.arm.tip = [0, 0]: must be [x, y, z] in metres",
+        "robot.yaml: sensors.markers.cameras = [\"nothing\"]: 'nothing' is not a camera here",
+    ]
+
+
+def test_a_valid_kinematics_section_reaches_the_leaf_as_plain_data(
+    base_config: Callable[[], Data],
+) -> None:
+    data = base_config()
+    arm = {"motors": "m1", "tip": [0, 0, 1]}
+    data["kinematics"] = {"model": "arm.urdf", "chains": {"arm": arm}}
+    config = RobotConfig.from_dict(data)
+    assert config.kinematics is not None
+    spec = kinematics_spec(config.kinematics)
+    assert spec.chains[0].motors == ("m1",) and spec.chains[0].tip == (0.0, 0.0, 1.0)
+    assert config.to_dict()["kinematics"]["chains"]["arm"]["tip"] == [0.0, 0.0, 1.0]
 
 
 def test_checks_across_fields_all_report(base_config: Callable[[], Data]) -> None:

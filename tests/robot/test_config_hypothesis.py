@@ -88,12 +88,15 @@ def robot_configs(draw: st.DrawFn) -> dict[str, Any]:
     data: dict[str, Any] = {"controllers": controllers, "motorgroups": groups, "motors": motors}
     if draw(st.booleans()):
         # sensors of the types poppy builds, with any extra keys (kept as they are)
-        extras = st.dictionaries(NAMES.filter(lambda n: n not in SENSOR_KEYS), JSON_VALUES,
-                                 max_size=3)  # fmt: skip
+        extras = st.dictionaries(
+            NAMES.filter(lambda n: n not in SENSOR_KEYS), JSON_VALUES, max_size=3
+        )
         free = NAMES.filter(lambda n: n not in data["motors"] and n not in groups)
         cameras = draw(st.dictionaries(free, extras, max_size=2))
-        data["sensors"] = {name: {"type": draw(st.sampled_from(["OpenCVCamera", "DummyCamera"])),
-                                  **extra} for name, extra in cameras.items()}  # fmt: skip
+        data["sensors"] = {
+            name: {"type": draw(st.sampled_from(["OpenCVCamera", "DummyCamera"])), **extra}
+            for name, extra in cameras.items()
+        }
     if draw(st.booleans()):
         data["x_extra"] = draw(JSON_VALUES)
     return data

@@ -24,7 +24,7 @@ def test_public_config_loads_unchanged(public_config: tuple[Path, dict[str, Any]
         assert motor.orientation == source["orientation"]
         assert motor.offset == source["offset"]
         assert list(motor.angle_limit) == source["angle_limit"]
-    assert config.sensors == raw["sensors"]
+    assert config.to_dict()["sensors"] == raw["sensors"]
     assert config.motorgroups == raw["motorgroups"]
 
 

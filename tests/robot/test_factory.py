@@ -144,8 +144,13 @@ def test_eeprom_written_at_start_up_on_stiff_motors_which_stay_stiff(
     assert [m.table.get("return_delay_time") for m in bus.motors] == [0] * 6
     assert [m.table.get("torque_enable") for m in bus.motors] == [1] * 3 + [0] * 3
     limits = [tuple(config.motors[f"m{m.id}"].angle_limit) for m in bus.motors]
-    read = [tuple(round(XL320.register(n).to_si(m.table.get(n)), 0) for n in
-                  ("min_position_limit", "max_position_limit")) for m in bus.motors]  # fmt: skip
+    read = [
+        tuple(
+            round(XL320.register(n).to_si(m.table.get(n)), 0)
+            for n in ("min_position_limit", "max_position_limit")
+        )
+        for m in bus.motors
+    ]
     assert read == [tuple(round(v, 0) for v in pair) for pair in limits]
 
 

@@ -51,7 +51,13 @@ def _limits() -> None:
 @pytest.mark.slow
 def test_every_property_under_cpu_and_memory_limits() -> None:
     code = "from tests.robot.loader_fuzz import run_all; run_all(); print('ok')"
-    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
-                          preexec_fn=_limits, timeout=CPU_SECONDS * 3)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        preexec_fn=_limits,
+        timeout=CPU_SECONDS * 3,
+    )
     assert done.returncode == 0, (done.returncode, done.stderr[-3000:])
     assert done.stdout.strip() == "ok"

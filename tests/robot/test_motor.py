@@ -53,14 +53,16 @@ def test_limit_frames_are_inverse_and_ordered(
 
 def test_config_limits_are_motor_frame_and_the_motor_shows_them_in_the_user_frame() -> None:
     """pypot's reading of poppy_torso.json: l_elbow_y (direct, offset -90) [-140, 0]."""
-    entry = MotorConfig(id=44, type="MX-28", orientation="direct", offset=-90.0,
-                        angle_limit=(-140.0, 0.0))  # fmt: skip
+    entry = MotorConfig(
+        id=44, type="MX-28", orientation="direct", offset=-90.0, angle_limit=(-140.0, 0.0)
+    )
     assert entry.user_angle_limit == (-50.0, 90.0)
     motor = Motor.from_config("l_elbow_y", entry, MX)
     assert motor.angle_limit == (-50.0, 90.0)
     assert motor.motor_limits() == (-140.0, 0.0) == motor.config_limits()
-    right = MotorConfig(id=54, type="MX-28", orientation="indirect", offset=-90.0,
-                        angle_limit=(0.0, 147.0))  # fmt: skip
+    right = MotorConfig(
+        id=54, type="MX-28", orientation="indirect", offset=-90.0, angle_limit=(0.0, 147.0)
+    )
     assert Motor.from_config("r_elbow_y", right, MX).angle_limit == (-57.0, 90.0)
 
 
@@ -181,19 +183,66 @@ def test_bad_limits_refused() -> None:
 
 
 SYNC_SIDE = {
-    "update", "take_pending", "restore_pending", "has_pending", "mark_missed", "mark_answered",
-    "mark_offline", "mark_closed", "resend_state", "set_goal", "set_torque", "attach_runner",
-    "cached", "cached_number", "store", "runner", "lock", "torque",
-}  # fmt: skip
+    "update",
+    "take_pending",
+    "restore_pending",
+    "has_pending",
+    "mark_missed",
+    "mark_answered",
+    "mark_offline",
+    "mark_closed",
+    "resend_state",
+    "set_goal",
+    "set_torque",
+    "attach_runner",
+    "cached",
+    "cached_number",
+    "store",
+    "runner",
+    "lock",
+    "torque",
+}
 USER_API = {
-    "id", "name", "model", "orientation", "offset", "direct", "wheel_mode", "online", "errors",
-    "present_position", "present_speed", "present_load", "present_temperature",
-    "present_voltage", "temperature", "voltage", "load", "goal_position", "goal_speed",
-    "moving_speed", "torque_limit", "max_torque", "compliant", "compliant_behavior",
-    "safe_compliant", "torque_enabled", "goto_behavior", "goto_position", "angle_limit",
-    "lower_limit", "upper_limit", "control_mode", "registers", "led", "to_user", "to_motor",
-    "motor_limits", "config_limits", "from_config",
-}  # fmt: skip
+    "id",
+    "name",
+    "model",
+    "orientation",
+    "offset",
+    "direct",
+    "wheel_mode",
+    "online",
+    "errors",
+    "present_position",
+    "present_speed",
+    "present_load",
+    "present_temperature",
+    "present_voltage",
+    "temperature",
+    "voltage",
+    "load",
+    "goal_position",
+    "goal_speed",
+    "moving_speed",
+    "torque_limit",
+    "max_torque",
+    "compliant",
+    "compliant_behavior",
+    "safe_compliant",
+    "torque_enabled",
+    "goto_behavior",
+    "goto_position",
+    "angle_limit",
+    "lower_limit",
+    "upper_limit",
+    "control_mode",
+    "registers",
+    "led",
+    "to_user",
+    "to_motor",
+    "motor_limits",
+    "config_limits",
+    "from_config",
+}
 
 
 @pytest.mark.parametrize("model", [AX, MX, XL, XM], ids=lambda m: m.name)
@@ -210,8 +259,18 @@ def test_tab_completion_shows_the_user_api_and_not_the_sync_side(model: object) 
 def test_the_sync_loop_side_is_not_on_the_users_motor() -> None:
     motor = Motor("m", MX, 1)
     public = {name for name in dir(motor) if not name.startswith("_")}
-    sync_side = {"update", "take_pending", "restore_pending", "has_pending", "mark_missed",
-                 "mark_answered", "mark_offline", "resend_state", "set_goal", "lock"}  # fmt: skip
+    sync_side = {
+        "update",
+        "take_pending",
+        "restore_pending",
+        "has_pending",
+        "mark_missed",
+        "mark_answered",
+        "mark_offline",
+        "resend_state",
+        "set_goal",
+        "lock",
+    }
     assert public.isdisjoint(sync_side), public & sync_side
     assert {"goal_position", "present_position", "compliant", "online"} <= public
     assert link_of(motor).take_pending(["goal_position"]) == {}

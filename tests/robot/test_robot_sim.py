@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Iterator
 
 import pytest
 
@@ -12,18 +11,13 @@ from poppy_core.errors import ConfigError, RobotClosedError
 from poppy_core.robot import Robot, from_profile
 from poppy_core.trajectory import MinimumJerk
 from tests.helpers import eventually
+from tests.helpers.fixtures import ergo_fixture
 
 CONTROLLER = "my_dxl_controller"
 
 
 
-@pytest.fixture
-def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True)
-    try:
-        yield robot
-    finally:
-        robot.close()
+ergo = ergo_fixture()
 
 
 def virtual(robot: Robot, motor_id: int):  # type: ignore[no-untyped-def]

@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from poppy_core.creatures import from_profile as creature_from_profile
 from poppy_core.errors import (
     ArgumentError,
     ConfigError,
@@ -20,12 +18,9 @@ from poppy_core.errors import (
 from poppy_core.motion import MovePlayer, PositionWatcher, Sinus, Square
 from poppy_core.motion.move import Move
 from poppy_core.robot import Robot, RobotConfig, from_config, from_profile, load_profile
+from tests.helpers.fixtures import ergo_fixture
 
-
-@pytest.fixture(scope="module")
-def ergo() -> Iterator[Robot]:
-    with creature_from_profile("ergo-jr", sim=True) as robot:
-        yield robot
+ergo = ergo_fixture(scope="module")
 
 
 # -- item 6: from_config(dict) and json.dumps(robot.to_config()) ---------------------------------

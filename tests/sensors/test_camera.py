@@ -11,8 +11,9 @@ from typing import Any
 import pytest
 
 from poppy_core.errors import SensorError
-from poppy_core.sensors import DummyCamera, build_sensors, check_section, opencv_camera
+from poppy_core.sensors import DummyCamera, build_sensors, opencv_camera
 from poppy_core.sensors.opencv_camera import OpenCVCamera, list_devices
+from tests.helpers.configs import checked_sensors
 
 cv2 = pytest.importorskip("cv2")
 
@@ -158,8 +159,7 @@ def test_sections_build_cameras_from_files(video_file: Path) -> None:
         "camera": {"type": "OpenCVCamera", "index": str(video_file), "fps": 30.0},
         "marker_detector": {"type": "MarkerDetector", "cameras": ["camera"], "freq": 10.0},
     }
-    check_section(section)
-    sensors = build_sensors(section, opencv_camera)
+    sensors = build_sensors(checked_sensors(section), opencv_camera)
     try:
         assert list(sensors) == ["camera", "marker_detector"]
         assert sensors["marker_detector"].read("markers") == []

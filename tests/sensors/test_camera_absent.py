@@ -34,8 +34,11 @@ def ergo_url() -> Iterator[str]:
 
 
 def camera_warnings(caplog: pytest.LogCaptureFixture) -> list[str]:
-    return [r.getMessage() for r in caplog.records
-            if r.levelno >= logging.WARNING and "camera" in r.getMessage()]  # fmt: skip
+    return [
+        r.getMessage()
+        for r in caplog.records
+        if r.levelno >= logging.WARNING and "camera" in r.getMessage()
+    ]
 
 
 def plug_in(video: Path, device: Path) -> None:
@@ -124,9 +127,14 @@ def test_poppy_serve_starts_without_its_camera_and_the_page_says_so(tmp_path: Pa
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1", POPPY_MOVES_DIR=str(tmp_path))
     with emulate_bus("XL-320:1-6", via="tcp") as (_bus, url):
         args = ["serve", "--http", "--http-port", "0", "--profile", "ergo-jr", "--port", url]
-        proc = subprocess.Popen([sys.executable, "-m", "poppy_cli", *args], env=env,
-                                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, text=True)  # fmt: skip
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "poppy_cli", *args],
+            env=env,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         try:
             assert proc.stdout is not None
             http_url = proc.stdout.readline().strip()

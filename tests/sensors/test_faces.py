@@ -8,19 +8,18 @@ from typing import Any
 import numpy as np
 import pytest
 
-from poppy_core.errors import ArgumentError, SensorError
+from poppy_core.errors import ArgumentError, ConfigError, SensorError
 from poppy_core.sensors import (
     NOT_YET,
     SUPPORTED_TYPES,
     DummyCamera,
     FaceDetector,
     FaceFinder,
-    SensorProblem,
     build_sensors,
-    check_section,
 )
 from poppy_core.sensors.config import opencv_camera  # the package's name is the submodule too
 from poppy_core.sensors.opencv_camera import OpenCVCamera
+from tests.helpers.configs import checked_sensors
 from tests.helpers.waiting import eventually
 
 cv2 = pytest.importorskip("cv2")
@@ -128,8 +127,7 @@ def test_a_face_detector_on_a_video_file_from_a_config(tmp_path: Path) -> None:
             "type": "FaceDetector", "cameras": ["camera"], "freq": 4.0, "min_size": 30
         },
     }
-    check_section(section)
-    sensors = build_sensors(section, opencv_camera)
+    sensors = build_sensors(checked_sensors(section), opencv_camera)
     try:
         detector = sensors["face_detector"]
         assert isinstance(detector, FaceDetector) and detector.rate_hz == 4.0
@@ -157,9 +155,9 @@ def test_face_detectors_are_no_longer_refused() -> None:
 )
 def test_bad_face_detector_entries_name_their_field(spec: dict[str, Any], field: str) -> None:
     entry = {"type": "FaceDetector", "cameras": ["camera"], **spec}
-    with pytest.raises(SensorProblem) as caught:
-        check_section({"camera": {"type": "DummyCamera"}, "face_detector": entry})
-    assert caught.value.field == field
+    with pytest.raises(ConfigError) as caught:
+        checked_sensors({"camera": {"type": "DummyCamera"}, "face_detector": entry})
+    assert caught.value.field == f"sensors.{field}"
 
 
 def test_a_face_detector_on_a_camera_plugged_in_later(tmp_path: Path) -> None:

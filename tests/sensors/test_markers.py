@@ -46,8 +46,10 @@ def scene(*markers: tuple[np.ndarray, int, int]) -> np.ndarray:
 
 
 def test_aruco_and_hamming_markers_are_found() -> None:
-    frame = scene((marker_image(7, size_px=120), 40, 40),
-                  (marker_image(CARIBOU, "hamming", size_px=180), 200, 300))  # fmt: skip
+    frame = scene(
+        (marker_image(7, size_px=120), 40, 40),
+        (marker_image(CARIBOU, "hamming", size_px=180), 200, 300),
+    )
     found = {(m.family, m.id): m for m in MarkerFinder().find(frame, camera="camera")}
     assert set(found) == {("aruco", 7), ("hamming", CARIBOU)}
     aruco = found[("aruco", 7)]
@@ -58,8 +60,10 @@ def test_aruco_and_hamming_markers_are_found() -> None:
 
 
 def test_only_the_asked_families_are_looked_for() -> None:
-    frame = scene((marker_image(7, size_px=120), 40, 40),
-                  (marker_image(CARIBOU, "hamming", size_px=180), 200, 300))  # fmt: skip
+    frame = scene(
+        (marker_image(7, size_px=120), 40, 40),
+        (marker_image(CARIBOU, "hamming", size_px=180), 200, 300),
+    )
     assert [m.id for m in MarkerFinder(families=("aruco",)).find(frame)] == [7]
     assert [m.id for m in MarkerFinder(families=("hamming",)).find(frame)] == [CARIBOU]
 
@@ -71,8 +75,9 @@ def test_a_pose_is_where_the_marker_was_put() -> None:
     image = marker_image(3, size_px=side_px)
     border = (image.shape[0] - side_px) // 2
     half = 0.025
-    corners_3d = np.float32([[-half, -half, 0.4], [half, -half, 0.4], [half, half, 0.4],
-                             [-half, half, 0.4]])  # fmt: skip
+    corners_3d = np.float32(
+        [[-half, -half, 0.4], [half, -half, 0.4], [half, half, 0.4], [-half, half, 0.4]]
+    )
     projected, _ = cv2.projectPoints(
         corners_3d, np.zeros(3), np.zeros(3), calibration.camera_matrix, calibration.dist_coeffs
     )

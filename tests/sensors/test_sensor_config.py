@@ -39,7 +39,7 @@ def test_sensors_not_built_yet_are_one_line_errors(kind: str, name: str) -> None
     [
         ({"cam": {"type": "WebCam"}}, 'sensors.cam.type = "WebCam": unknown sensor type'),
         ({"cam": {"type": "OpenCVCamera", "fps": 0}}, "sensors.cam.fps = 0: must be a positive"),
-        ({"cam": {"type": "OpenCVCamera", "resolution": [640]}}, "resolution must be"),
+        ({"cam": {"type": "OpenCVCamera", "resolution": [640]}}, "resolution = [640]: must be"),
         ({"cam": {"type": "OpenCVCamera", "calibration": {"camera_matrix": [1]}}}, "calibration"),
         ({"md": {"type": "MarkerDetector", "cameras": ["cam"]}}, "'cam' is not a camera here"),
         ({"cam": {"type": "DummyCamera"}, "md": {"type": "MarkerDetector", "cameras": ["cam"],
@@ -73,8 +73,11 @@ def test_a_simulated_robot_has_the_profiles_sensors() -> None:
         assert camera.resolution == [640, 480] and camera.fps == 20.0
         detector = robot.marker_detector
         assert isinstance(detector, MarkerDetector) and detector.cameras == [camera]
-        assert detector.card_ids == {"caribou": [221052793], "tetris": [112259237],
-                                     "lapin": [44616414]}  # fmt: skip
+        assert detector.card_ids == {
+            "caribou": [221052793],
+            "tetris": [112259237],
+            "lapin": [44616414],
+        }
         assert detector.sees("tetris") is False
         assert set(robot.sensor_health()) == {"camera", "marker_detector"}
         assert "camera" in dir(robot)

@@ -77,8 +77,12 @@ def test_stream_rate(served: Served, rate_hz: float) -> None:
             count += 1
     assert set(frame) == {"m1", "m2", "m3", "m4", "m5", "m6"}
     assert set(frame["m1"]) == {
-        "present_position", "present_speed", "present_load", "present_temperature", "led",
-    }  # fmt: skip
+        "present_position",
+        "present_speed",
+        "present_load",
+        "present_temperature",
+        "led",
+    }
     assert rate_hz * 0.6 <= count <= rate_hz * 1.4
 
 

@@ -86,13 +86,15 @@ def test_robot_json_keeps_pypot_keys_and_types(client: httpx.Client) -> None:
         ("/primitive/list.json", "/primitives/list.json"),
         ("/primitive/running/list.json", "/primitives/running/list.json"),
         ("/primitive/sinus/property/list.json", "/primitives/sinus/properties/list.json"),
-        ("/primitive/sinus/property/amplitude",
-         "/primitives/sinus/properties/amplitude/value.json"),
+        (
+            "/primitive/sinus/property/amplitude",
+            "/primitives/sinus/properties/amplitude/value.json",
+        ),
         ("/primitive/sinus/method/list.json", "/primitives/sinus/methods/list.json"),
         ("/motors/list.json", None),
         ("/motor/../robot.json", None),
     ],
-)  # fmt: skip
+)
 def test_old_spellings_map_to_the_current_routes(old: str, new: str | None) -> None:
     assert current_path(old) == new
 

@@ -158,8 +158,11 @@ def cli(*args: str) -> Callable[[Surfaces], Refusal]:
 
 
 def zmq_property(prop: str, value: float) -> dict[str, Any]:
-    return {"robot": {"set_primitive_property": {"primitive": "sinus", "property": prop,
-                                                 "value": value}}}  # fmt: skip
+    return {
+        "robot": {
+            "set_primitive_property": {"primitive": "sinus", "property": prop, "value": value}
+        }
+    }
 
 
 # -- the table -------------------------------------------------------------------------------
@@ -175,24 +178,45 @@ CASES: list[tuple[str, Callable[[Surfaces], Refusal], str]] = [
     ("rest-gotos-duration-nan", rest("POST", "/api/v1/gotos", goto("10", "NaN")), "duration_s"),
     ("rest-gotos-position-inf", rest("POST", "/api/v1/gotos", goto("Infinity", "1")), "m1"),
     ("rest-gotos-position-1e309", rest("POST", "/api/v1/gotos", goto("1e309", "1")), "m1"),
-    ("rest-solve-nan", rest("POST", "/api/v1/chains/chain/solve", '{"position": [NaN, 0, 0]}'),
-     "position"),
-    ("rest-chain-goto-inf", rest("POST", "/api/v1/chains/chain/goto",
-                                 '{"position": [0.1, 0, 0.1], "duration": Infinity}'), "duration"),
-    ("rest-forward-nan", rest("POST", "/api/v1/chains/chain/forward", '{"joints": {"m1": NaN}}'),
-     "m1"),
+    (
+        "rest-solve-nan",
+        rest("POST", "/api/v1/chains/chain/solve", '{"position": [NaN, 0, 0]}'),
+        "position",
+    ),
+    (
+        "rest-chain-goto-inf",
+        rest(
+            "POST", "/api/v1/chains/chain/goto", '{"position": [0.1, 0, 0.1], "duration": Infinity}'
+        ),
+        "duration",
+    ),
+    (
+        "rest-forward-nan",
+        rest("POST", "/api/v1/chains/chain/forward", '{"joints": {"m1": NaN}}'),
+        "m1",
+    ),
     ("rest-play-speed-nan", rest("POST", "/api/v1/moves/wave/play", '{"speed": NaN}'), "speed"),
-    ("rest-compliant-nan", rest("PUT", "/api/v1/robot/compliant", '{"compliant": NaN}'),
-     "compliant"),
-    ("rest-ik-xyz-400-digits", rest("POST", "/ik/chain/goto.json",
-                                    IK_XYZ_HUGE), "xyz"),
-    ("rest-ik-duration-400-digits", rest("POST", "/ik/chain/goto.json",
-                                         IK_DURATION_HUGE),
-     "duration"),
-    ("rest-v1-frequency-1e308", rest("PUT", "/api/v1/primitives/sinus/properties/frequency",
-                                     '{"value": 1e308}'), "frequency"),
-    ("rest-pypot-update-freq-1e-300",
-     rest("POST", "/primitives/sinus/properties/update_freq/value.json", "1e-300"), "update_freq"),
+    (
+        "rest-compliant-nan",
+        rest("PUT", "/api/v1/robot/compliant", '{"compliant": NaN}'),
+        "compliant",
+    ),
+    ("rest-ik-xyz-400-digits", rest("POST", "/ik/chain/goto.json", IK_XYZ_HUGE), "xyz"),
+    (
+        "rest-ik-duration-400-digits",
+        rest("POST", "/ik/chain/goto.json", IK_DURATION_HUGE),
+        "duration",
+    ),
+    (
+        "rest-v1-frequency-1e308",
+        rest("PUT", "/api/v1/primitives/sinus/properties/frequency", '{"value": 1e308}'),
+        "frequency",
+    ),
+    (
+        "rest-pypot-update-freq-1e-300",
+        rest("POST", "/primitives/sinus/properties/update_freq/value.json", "1e-300"),
+        "update_freq",
+    ),
     ("rest-mjpeg-fps-1e-300", mjpeg("?fps=1e-300"), "fps"),
     ("ws-rate-nan", ws_rate("nan"), "rate_hz"),
     ("ws-rate-0", ws_rate("0"), "rate_hz"),
@@ -203,15 +227,18 @@ CASES: list[tuple[str, Callable[[Surfaces], Refusal], str]] = [
     ("snap-update-freq-1e-300", snap("/primitive/sinus/set/update_freq/1e-300"), "update_freq"),
     ("zmq-update-freq-1e-300", zmq(zmq_property("update_freq", 1e-300)), "update_freq"),
     ("zmq-frequency-1e308", zmq(zmq_property("frequency", 1e308)), "frequency"),
-    ("cli-goto-duration-1e-300", cli("robot", "goto", "m1=10", "--duration", "1e-300"),
-     "duration"),
-    ("cli-sinus-frequency-1e308",
-     cli("primitive", "run", "sinus", "--set", "frequency=1e308", "--duration", "0.2"),
-     "frequency"),
-    ("cli-sinus-update-freq-1e-300",
-     cli("primitive", "run", "sinus", "--set", "update_freq=1e-300", "--duration", "0.2"),
-     "update_freq"),
-]  # fmt: skip
+    ("cli-goto-duration-1e-300", cli("robot", "goto", "m1=10", "--duration", "1e-300"), "duration"),
+    (
+        "cli-sinus-frequency-1e308",
+        cli("primitive", "run", "sinus", "--set", "frequency=1e308", "--duration", "0.2"),
+        "frequency",
+    ),
+    (
+        "cli-sinus-update-freq-1e-300",
+        cli("primitive", "run", "sinus", "--set", "update_freq=1e-300", "--duration", "0.2"),
+        "update_freq",
+    ),
+]
 
 
 @pytest.mark.parametrize(("send", "field"), [c[1:] for c in CASES], ids=[c[0] for c in CASES])

@@ -165,9 +165,11 @@ def test_links_and_images_cannot_start_a_primitive(served: Served) -> None:
     # <img src=".../primitives/sinus/start.json">: a GET without Origin, Sec-Fetch-Site cross-site
     with httpx.Client(base_url=served.url) as http:
         spellings = (  # every spelling reaching the route (chromium tries them: test_browser)
-            "/primitives/sinus/start.json", "/primitive/sinus/start.json",
-            "/primitives/sinus/start.json/", "/primitive%2Fsinus/start.json",
-        )  # fmt: skip
+            "/primitives/sinus/start.json",
+            "/primitive/sinus/start.json",
+            "/primitives/sinus/start.json/",
+            "/primitive%2Fsinus/start.json",
+        )
         for site in ("cross-site", "same-site"):
             for path in spellings:
                 answer = http.get(path, headers={"Sec-Fetch-Site": site})

@@ -36,23 +36,31 @@ PAGE_CALLS: list[tuple[str, str, str | None, dict[str, str], int, Any]] = [
     # puppet-master, templates/EN/move-recorder.html
     ("GET", "/motors/aliases/list.json", None, {}, 200, {"aliases": ["base", "tip"]}),
     ("GET", "/motors/base/list.json", None, {}, 200, {"base": ["m1", "m2", "m3"]}),
-    ("POST", "/motors/m1/registers/compliant/value.json", "false", FORM, 202,
-     {"compliant": False}),
-    ("POST", "/motors/m1/registers/compliant/value.json", "true", FORM, 202,
-     {"compliant": True}),
+    ("POST", "/motors/m1/registers/compliant/value.json", "false", FORM, 202, {"compliant": False}),
+    ("POST", "/motors/m1/registers/compliant/value.json", "true", FORM, 202, {"compliant": True}),
     ("GET", "/records/list.json", None, {}, 200, lambda body: isinstance(body["moves"], list)),
-    ("GET", "/primitives/running/list.json", None, {}, 200,
-     lambda body: isinstance(body["running_primitives"], list)),
+    (
+        "GET",
+        "/primitives/running/list.json",
+        None,
+        {},
+        200,
+        lambda body: isinstance(body["running_primitives"], list),
+    ),
     # poppy-monitor, js/poppy-object.js (the old spellings, rewritten to the routes)
-    ("GET", "/robot.json", None, {}, 200,
-     lambda body: body["motors"][0]["name"] == "m1" and body["primitives"]),
-    ("POST", "/motor/m2/register/compliant/value.json", "true", XHR_JSON, 202,
-     {"compliant": True}),
+    (
+        "GET",
+        "/robot.json",
+        None,
+        {},
+        200,
+        lambda body: body["motors"][0]["name"] == "m1" and body["primitives"],
+    ),
+    ("POST", "/motor/m2/register/compliant/value.json", "true", XHR_JSON, 202, {"compliant": True}),
     ("POST", "/motor/m2/register/led/value.json", '"green"', XHR_JSON, 202, {"led": "green"}),
     ("POST", "/primitive/sinus/property/amplitude/value.json", "10", XHR_JSON, 204, None),
-    ("POST", "/primitive/sinus/method/stop/args.json", "{}", XHR_JSON, 200,
-     {"sinus:stop": None}),
-]  # fmt: skip
+    ("POST", "/primitive/sinus/method/stop/args.json", "{}", XHR_JSON, 200, {"sinus:stop": None}),
+]
 
 
 @pytest.mark.parametrize(
@@ -113,8 +121,9 @@ def test_a_played_move_is_listed_as_pypot_named_its_player(
         assert isinstance(names, list)
         return names
 
-    recorded = client.post("/records/pm_take/record.json", content='{"motors": "m1,m2"}',
-                           headers=FORM)  # fmt: skip
+    recorded = client.post(
+        "/records/pm_take/record.json", content='{"motors": "m1,m2"}', headers=FORM
+    )
     assert pypot_answer(recorded, 202) == {"pm_take": "recording"}
     assert "_pm_take_recorder" in running()
     assert eventually(lambda: client.get("/records/pm_take/value.json").json()["length"] > 50)

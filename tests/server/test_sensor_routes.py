@@ -29,8 +29,12 @@ def test_pypot_sensor_routes(client: httpx.Client) -> None:
 
 
 def test_unknown_sensors_and_registers_are_404_in_pypots_shape(client: httpx.Client) -> None:
-    for path in ("/sensors/lidar/registers/list.json", "/sensors/camera/registers/x/value.json",
-                 "/sensors/lidar/frame.png", "/sensors/camera/frame.gif"):  # fmt: skip
+    for path in (
+        "/sensors/lidar/registers/list.json",
+        "/sensors/camera/registers/x/value.json",
+        "/sensors/lidar/frame.png",
+        "/sensors/camera/frame.gif",
+    ):
         answer = client.get(path)
         assert answer.status_code == 404, path
         assert set(answer.json()) == {"error", "tip", "details"}

@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 
 from tests.helpers.cli import keyed, run_poppy
+from tests.helpers.processes import reap
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -53,12 +54,7 @@ def test_serve_prints_urls_and_stops(signum: int) -> None:
         assert code == 0
         assert proc.stderr is not None and "stopped" in proc.stderr.read()
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
 
 
 def test_public_host_without_token_warns() -> None:
@@ -277,12 +273,7 @@ def test_both_websockets_apply_the_origin_rules_and_say_how_to_allow_one() -> No
             "allow it, restart poppy serve with --cors https://evil.example"
         ]
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
@@ -295,8 +286,11 @@ def test_a_signal_stops_a_remote_play_with_exit_130(served: Any, signum: int) ->
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
         [*POPPY, "play", "remote_long", "--remote", served.url, "--json"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         moves = served.app.state.service.moves
         assert eventually(lambda: "remote_long" in moves.playing(), timeout_s=60), proc.stderr

@@ -21,6 +21,7 @@ from poppy_core.robot import from_profile
 from poppy_core.server import moves as moves_module
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
+from tests.helpers.processes import reap
 from tests.helpers.waiting import eventually
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -32,13 +33,28 @@ def test_sigterm_saves_the_rest_and_snap_recordings_and_says_where(tmp_path: Pat
     library.mkdir()
     temp.mkdir()
     (library / "taken.move").write_text("a move of that name is already saved\n")
-    env = dict(os.environ, COLUMNS="300", NO_COLOR="1", POPPY_MOVES_DIR=str(library),
-               TMPDIR=str(temp))  # fmt: skip
+    env = dict(
+        os.environ, COLUMNS="300", NO_COLOR="1", POPPY_MOVES_DIR=str(library), TMPDIR=str(temp)
+    )
     proc = subprocess.Popen(
-        [*POPPY, "serve", "--http", "--http-port", "0", "--snap", "--snap-port", "0", "--sim",
-         "--profile", "ergo-jr"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        [
+            *POPPY,
+            "serve",
+            "--http",
+            "--http-port",
+            "0",
+            "--snap",
+            "--snap-port",
+            "0",
+            "--sim",
+            "--profile",
+            "ergo-jr",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert proc.stdout is not None and proc.stderr is not None
         http = proc.stdout.readline().strip()  # the URL alone, then "docs: …", "snap: …"
@@ -62,12 +78,7 @@ def test_sigterm_saves_the_rest_and_snap_recordings_and_says_where(tmp_path: Pat
         assert proc.wait(timeout=WAIT_S) == 0
         errors = proc.stderr.read()
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
     assert "stopped" in errors
     for name in ("rest_take", "snap_take"):
         saved = library / f"{name}.move"

@@ -21,6 +21,7 @@ from poppy_core.emulator import Endpoint, serve_tcp
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from poppy_core.server.web.logs import LogBuffer, StderrWarnings, printable
+from tests.helpers.processes import reap
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 WAIT_S = 60.0
@@ -62,10 +63,23 @@ def served_bus() -> Iterator[Endpoint]:
 def test_a_lost_bus_is_a_warning_on_the_servers_stderr(served_bus: Endpoint) -> None:
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
-        [*POPPY, "serve", "--http", "--http-port", "0", "--profile", "ergo-jr",
-         "--port", served_bus.url, "--no-sensors"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        [
+            *POPPY,
+            "serve",
+            "--http",
+            "--http-port",
+            "0",
+            "--profile",
+            "ergo-jr",
+            "--port",
+            served_bus.url,
+            "--no-sensors",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert proc.stdout is not None and proc.stderr is not None
         assert proc.stdout.readline().startswith("http://127.0.0.1:")  # serving
@@ -81,12 +95,7 @@ def test_a_lost_bus_is_a_warning_on_the_servers_stderr(served_bus: Endpoint) -> 
         wait_for_line(errors, "stopped", seen)
         assert sum("lost" in line for line in seen) == 1  # once, not once per handler
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
 
 
 def test_configured_logging_takes_the_warnings_and_two_pages_print_them_once(

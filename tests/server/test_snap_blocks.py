@@ -253,13 +253,24 @@ def test_the_library_has_the_blocks_the_poppy_documentation_lists(snap: Served) 
     """A connection test, a motor's index, moves played together and in sequence (issue 23)."""
     http = snap[2]
     for document, labels in (
-        ("/snap-blocks.xml", ("robot connected?", "index of motor %'motor'",
-                              "play moves %'moves' together at speed × %'speed'",
-                              "play moves %'moves' one after the other at speed × %'speed'")),
-        ("/snap/poppy-blocks-fr", ("robot connecté ?", "numéro du moteur %'motor'",
-                                   "jouer les mouvements %'moves' ensemble à la vitesse × "
-                                   "%'speed'")),
-    ):  # fmt: skip
+        (
+            "/snap-blocks.xml",
+            (
+                "robot connected?",
+                "index of motor %'motor'",
+                "play moves %'moves' together at speed × %'speed'",
+                "play moves %'moves' one after the other at speed × %'speed'",
+            ),
+        ),
+        (
+            "/snap/poppy-blocks-fr",
+            (
+                "robot connecté ?",
+                "numéro du moteur %'motor'",
+                "jouer les mouvements %'moves' ensemble à la vitesse × %'speed'",
+            ),
+        ),
+    ):
         root = ET.fromstring(http.get(document).content)
         defined = {d.get("s") for d in root.iter("block-definition")}
         assert set(labels) <= defined, document

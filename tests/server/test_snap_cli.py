@@ -50,8 +50,16 @@ def test_serve_snap_with_http_prints_the_snap_urls_and_serves_both(tmp_path: Pat
         editor = next(line for line in lines if line.startswith("Snap! with the Poppy blocks: "))
         assert snap_url.startswith("http://127.0.0.1:")
         assert ws_url.startswith("ws://127.0.0.1:")
-        assert len({http_url.rsplit(":", 1)[1], ws_url.rsplit(":", 1)[1].strip("/"),
-                    snap_url.rsplit(":", 1)[1]}) == 3  # fmt: skip
+        assert (
+            len(
+                {
+                    http_url.rsplit(":", 1)[1],
+                    ws_url.rsplit(":", 1)[1].strip("/"),
+                    snap_url.rsplit(":", 1)[1],
+                }
+            )
+            == 3
+        )
         assert editor.endswith(f"{snap_url}/app/snap.html#open:{snap_url}/snap-blocks.xml")
         deadline = time.monotonic() + 30
         while not opened.exists() and time.monotonic() < deadline:
@@ -96,8 +104,19 @@ def test_snap_options_are_checked_before_the_robot_is_built(tmp_path: Path) -> N
 
 def test_snap_blocks_writes_the_library_and_refuses_to_overwrite(tmp_path: Path) -> None:
     target = tmp_path / "blocks.xml"
-    done = _run("snap", "blocks", "-o", str(target), "--profile", "ergo-jr", "--lang", "fr",
-                "--host", "192.168.1.20", cwd=tmp_path)  # fmt: skip
+    done = _run(
+        "snap",
+        "blocks",
+        "-o",
+        str(target),
+        "--profile",
+        "ergo-jr",
+        "--lang",
+        "fr",
+        "--host",
+        "192.168.1.20",
+        cwd=tmp_path,
+    )
     assert done.returncode == 0, done.stderr
     root = ET.parse(target).getroot()
     assert root.get("name") == "poppy-blocks-fr"
@@ -105,8 +124,16 @@ def test_snap_blocks_writes_the_library_and_refuses_to_overwrite(tmp_path: Path)
     assert host is not None and host.findtext("l") == "192.168.1.20"
     again = _run("snap", "blocks", "-o", str(target), "--profile", "ergo-jr", cwd=tmp_path)
     assert again.returncode == 1 and len(again.stderr.strip().splitlines()) == 1
-    example = _run("snap", "project", "record-replay", "-o", str(tmp_path), "--profile",
-                   "ergo-jr", cwd=tmp_path)  # fmt: skip
+    example = _run(
+        "snap",
+        "project",
+        "record-replay",
+        "-o",
+        str(tmp_path),
+        "--profile",
+        "ergo-jr",
+        cwd=tmp_path,
+    )
     assert example.returncode == 0, example.stderr
     assert ET.parse(tmp_path / "record-replay.xml").getroot().get("name") == "record-replay"
     unknown = _run("snap", "project", "nope", "-o", str(tmp_path), cwd=tmp_path)

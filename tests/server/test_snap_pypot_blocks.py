@@ -128,9 +128,11 @@ def set_register(replay: Replay, block: UrlBlock) -> Iterator[Call]:
             for motors in motor_sets(replay):
 
                 def check(
-                    answer: httpx.Response, register: str = register, value: Any = value,
+                    answer: httpx.Response,
+                    register: str = register,
+                    value: Any = value,
                     motors: list[str] = motors,
-                ) -> None:  # fmt: skip
+                ) -> None:
                     assert answer.text == "Done!"
                     for name in motors:
                         now = getattr(replay.robot.motors_of([name])[0], register)
@@ -276,9 +278,10 @@ def behaviour_lists(replay: Replay, block: UrlBlock) -> Iterator[Call]:
     for what in block.options("input"):
         for primitive in service.primitives():
             names = (
-                service.method_names(primitive) if what == "methodes"
+                service.method_names(primitive)
+                if what == "methodes"
                 else service.property_names(primitive)
-            )  # fmt: skip
+            )
             yield Call({"input": what, "primitive": primitive}, _ok("/".join(names)))
 
 

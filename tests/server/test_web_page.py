@@ -316,8 +316,10 @@ def test_the_sensors_are_shown_and_a_lost_camera_says_why(
     why = "/dev/video0 does not exist: plug the camera in"
     lost = dataclasses.replace(camera.health(), connected=False, last_error=why)
     monkeypatch.setattr(camera, "health", lambda: lost)  # as an unplugged camera's
-    eventually(lambda: "lost · /dev/video0 does not exist" in page.inner_text("#sensors"),
-               "the lost camera shown (the page refreshes every 5 s)")  # fmt: skip
+    eventually(
+        lambda: "lost · /dev/video0 does not exist" in page.inner_text("#sensors"),
+        "the lost camera shown (the page refreshes every 5 s)",
+    )
     assert page.get_attribute("#sensors li:first-child", "class") == "bad"
 
 

@@ -12,6 +12,7 @@ from poppy_core.creatures import PoppyTorso
 from poppy_core.robot import Robot
 from poppy_core.server.zmqserver import ZmqRobotServer
 from tests.creatures.helpers import wait_until
+from tests.helpers.processes import reap
 
 zmq = pytest.importorskip("zmq")
 TIMEOUT_MS = 10_000
@@ -49,8 +50,9 @@ def test_the_documentation_example_reads_and_writes_registers(robot: Robot, clie
     answer = client.recv_json()
     assert isinstance(answer, float)
     robot.head_z.compliant = False
-    req = {"robot": {"set_register_value": {"motor": "head_z", "register": "goal_pos",
-                                            "value": 100}}}  # fmt: skip
+    req = {
+        "robot": {"set_register_value": {"motor": "head_z", "register": "goal_pos", "value": 100}}
+    }
     client.send_json(req)
     answer = client.recv_json()
     assert answer == {}
@@ -99,14 +101,26 @@ def test_goto_with_wait(robot: Robot, client: Any) -> None:
         ({"robot": {"no_such_method": {}}}, "no method"),
         ({"robot": {"get_register_value": {"motor": "nose", "register": "x"}}}, "no motor"),
         ({"robot": {"get_register_value": {"motor": "head_z"}}}, "bad arguments"),
-        ({"robot": {"get_register_value": {"motor": "head_z", "register": "colour"}}},
-         "no register"),
-        ({"robot": {"set_register_value": {"motor": "head_z", "register": "goal_position",
-                                           "value": "\"far\""}}}, "goal_position"),
+        (
+            {"robot": {"get_register_value": {"motor": "head_z", "register": "colour"}}},
+            "no register",
+        ),
+        (
+            {
+                "robot": {
+                    "set_register_value": {
+                        "motor": "head_z",
+                        "register": "goal_position",
+                        "value": '"far"',
+                    }
+                }
+            },
+            "goal_position",
+        ),
         ({"robot": "get_motors_list"}, "expected"),
         ([1, 2, 3], "expected"),
     ],
-)  # fmt: skip
+)
 def test_bad_requests_get_an_error_and_the_server_carries_on(
     client: Any, request_: Any, says: str
 ) -> None:
@@ -143,10 +157,23 @@ def test_poppy_serve_zmq() -> None:
 
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
     proc = subprocess.Popen(
-        [sys.executable, "-m", "poppy_cli", "serve", "--sim", "--profile", "ergo-jr", "--zmq",
-         "--zmq-port", "0"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "poppy_cli",
+            "serve",
+            "--sim",
+            "--profile",
+            "ergo-jr",
+            "--zmq",
+            "--zmq-port",
+            "0",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline().strip()
@@ -164,12 +191,7 @@ def test_poppy_serve_zmq() -> None:
         proc.send_signal(signal.SIGTERM)
         assert proc.wait(timeout=15) == 0
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
+        reap(proc)
 
 
 def test_the_documentation_server_in_a_thread(robot: Robot) -> None:

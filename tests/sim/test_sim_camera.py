@@ -75,8 +75,7 @@ def test_an_object_in_front_changes_the_frame_and_its_marker_is_detected(robot: 
 
 def test_a_poppy_card_is_seen_by_name(robot: Any) -> None:
     x, y, z = ahead(robot, 0.3)
-    robot.simulation.add_marker("caribou", 221052793, (x + 0.08, y, z), size=0.05,
-                                family="hamming")  # fmt: skip
+    robot.simulation.add_marker("caribou", 221052793, (x + 0.08, y, z), size=0.05, family="hamming")
     fresh(robot.camera)
     deadline = time.monotonic() + 20
     while not robot.marker_detector.sees("caribou") and time.monotonic() < deadline:

@@ -25,8 +25,9 @@ def run(
     *args: str, timeout: float = 60, env: dict[str, str] | None = None
 ) -> subprocess.CompletedProcess[str]:
     full = dict(os.environ, COLUMNS="200", NO_COLOR="1", **(env or {}))
-    return subprocess.run([*POPPY, *args], capture_output=True, text=True, timeout=timeout,
-                          env=full, check=False)  # fmt: skip
+    return subprocess.run(
+        [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=full, check=False
+    )
 
 
 def run_here(*args: str) -> subprocess.CompletedProcess[str]:
@@ -39,8 +40,13 @@ class SimProcess:
     """A `poppy sim ...` process; ``url`` is the first stdout line."""
 
     def __init__(self, *args: str, env: dict[str, str] | None = None) -> None:
-        self.proc = subprocess.Popen([*POPPY, "sim", *args], stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True, env=env)  # fmt: skip
+        self.proc = subprocess.Popen(
+            [*POPPY, "sim", *args],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
         assert self.proc.stdout is not None
         self.url = self.proc.stdout.readline().strip()
         if not self.url:
@@ -101,8 +107,18 @@ def test_sim_serves_a_physical_ergo_jr(sim_ergo: SimProcess) -> None:
 
 
 def test_robot_goto_sim_mujoco() -> None:
-    result = run("robot", "goto", "--sim", "mujoco", "--profile", "ergo-jr", "m1=30",
-                 "--duration", "0.5", "--json")  # fmt: skip
+    result = run(
+        "robot",
+        "goto",
+        "--sim",
+        "mujoco",
+        "--profile",
+        "ergo-jr",
+        "m1=30",
+        "--duration",
+        "0.5",
+        "--json",
+    )
     assert result.returncode == 0, result.stderr
     [m1] = json.loads(result.stdout)["motors"]
     assert m1["name"] == "m1" and abs(m1["position"] - 30) < 3
@@ -139,8 +155,20 @@ def test_render_png(tmp_path: Path) -> None:
     from PIL import Image, ImageStat
 
     out = tmp_path / "x.png"
-    _rendered(run("sim", "render", "--profile", "ergo-jr", "--width", "160", "--height", "120",
-                  "-o", str(out)))  # fmt: skip
+    _rendered(
+        run(
+            "sim",
+            "render",
+            "--profile",
+            "ergo-jr",
+            "--width",
+            "160",
+            "--height",
+            "120",
+            "-o",
+            str(out),
+        )
+    )
     with Image.open(out) as image:
         assert image.size == (160, 120)
         spread = ImageStat.Stat(image.convert("L")).stddev[0]
@@ -155,8 +183,20 @@ def test_render_move_gif(tmp_path: Path) -> None:
     frames = [{"m1": 60.0 * i / 10, "m2": -20.0 * i / 10} for i in range(11)]
     move_file = write_move(Move.from_frames(10, frames), tmp_path / "turn.move.json")
     out = tmp_path / "turn.gif"
-    _rendered(run("sim", "render", "--move", str(move_file), "--width", "96", "--height", "72",
-                  "-o", str(out)))  # fmt: skip
+    _rendered(
+        run(
+            "sim",
+            "render",
+            "--move",
+            str(move_file),
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "-o",
+            str(out),
+        )
+    )
     with Image.open(out) as gif:
         assert gif.size == (96, 72)
         count = int(getattr(gif, "n_frames", 1))
@@ -171,8 +211,13 @@ def test_render_move_gif(tmp_path: Path) -> None:
 def test_reachable_space_example(tmp_path: Path) -> None:
     out = tmp_path / "space.png"
     script = ROOT / "docs" / "examples" / "reachable_space.py"
-    done = subprocess.run([sys.executable, str(script), "--samples", "5", "--output", str(out)],
-                          capture_output=True, text=True, timeout=60, check=False)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, str(script), "--samples", "5", "--output", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
     assert "5 forearm positions" in done.stdout
     assert out.stat().st_size > 10_000

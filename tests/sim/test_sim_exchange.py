@@ -43,9 +43,15 @@ def test_non_finite_state_goes_the_slow_way() -> None:
 
 
 registers = st.sampled_from(
-    ["goal_position", "moving_speed", "torque_limit", "torque_enable",
-     "min_position_limit", "max_position_limit"]
-)  # fmt: skip
+    [
+        "goal_position",
+        "moving_speed",
+        "torque_limit",
+        "torque_enable",
+        "min_position_limit",
+        "max_position_limit",
+    ]
+)
 
 
 @settings(max_examples=60, deadline=None)

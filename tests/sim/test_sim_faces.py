@@ -57,8 +57,9 @@ def test_a_face_in_the_scene_is_found_then_followed_to_the_middle(ergo: Any) -> 
     assert faces_now(ergo) == []  # the empty scene: no face
     picture = skimage_data.astronaut()[0:256, 100:356]  # her head and shoulders
     centre = where + 0.3 * look + 0.06 * right
-    sim.add_picture("astronaut", picture, (float(centre[0]), float(centre[1]),
-                                           float(centre[2])), size=0.14)  # fmt: skip
+    sim.add_picture(
+        "astronaut", picture, (float(centre[0]), float(centre[1]), float(centre[2])), size=0.14
+    )
     (face,) = faces_now(ergo)
     assert face.position[0] > 0.2 and abs(face.position[1]) < 0.3, face  # right of the middle
     assert 80 <= face.size <= 170

@@ -6,15 +6,14 @@ import math
 import os
 import pty
 import re
-import select
 import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from tests.helpers.cli import POPPY
+from tests.helpers.processes import read_until
 
 ROOT = Path(__file__).resolve().parents[2]
 ASPECT = 640 / 480  # the default render size
@@ -81,24 +80,6 @@ def test_the_front_camera_sees_the_ergo_jr_large_enough() -> None:
     assert (max(heights) - min(heights)) / 2 > 0.2
 
 
-def _read_all(fd: int, proc: subprocess.Popen[bytes], timeout_s: float = 240) -> str:
-    seen = b""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        ready, _, _ = select.select([fd], [], [], 0.2)
-        if ready:
-            try:
-                chunk = os.read(fd, 4096)
-            except OSError:
-                break
-            if not chunk:
-                break
-            seen += chunk
-        elif proc.poll() is not None:
-            break
-    return seen.decode(errors="replace")
-
-
 def test_a_move_render_shows_its_frames_and_time_left_on_a_terminal(tmp_path: Path) -> None:
     from poppy_core.motion import Move, write_move
 
@@ -107,12 +88,29 @@ def test_a_move_render_shows_its_frames_and_time_left_on_a_terminal(tmp_path: Pa
     out = tmp_path / "turn.gif"
     env = dict(os.environ, COLUMNS="120", TERM="xterm", NO_COLOR="1")
     parent, child = pty.openpty()
-    proc = subprocess.Popen([*POPPY, "sim", "render", "--move", str(move_file), "--width", "64",
-                             "--height", "48", "-o", str(out)], env=env, stdin=child,
-                            stdout=child, stderr=child, close_fds=True)  # fmt: skip
+    proc = subprocess.Popen(
+        [
+            *POPPY,
+            "sim",
+            "render",
+            "--move",
+            str(move_file),
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "-o",
+            str(out),
+        ],
+        env=env,
+        stdin=child,
+        stdout=child,
+        stderr=child,
+        close_fds=True,
+    )
     os.close(child)
     try:
-        shown = _read_all(parent, proc)
+        shown = read_until(parent, None, 240, proc)
         code = proc.wait(timeout=60)
     finally:
         if proc.poll() is None:

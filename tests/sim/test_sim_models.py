@@ -124,8 +124,10 @@ def test_the_model_is_the_urdf_driven_by_the_motor_angles(robot: str, seed: int)
     profile = load_profile(robot)
     reversed_ = reversed_joints(PROFILES, robot)
     user = {n: float(rng.uniform(*m.user_angle_limit)) for n, m in profile.motors.items()}
-    motor = {n: to_motor(v, profile.motors[n].orientation, profile.motors[n].offset)
-             for n, v in user.items()}  # fmt: skip
+    motor = {
+        n: to_motor(v, profile.motors[n].orientation, profile.motors[n].offset)
+        for n, v in user.items()
+    }
     expected = _urdf_positions(robot, {n: -v if n in reversed_ else v for n, v in motor.items()})
     _, data = _posed(robot, user)
     rot = data.xmat[1].reshape(3, 3)

@@ -24,9 +24,17 @@ def test_motor_tables_start_at_the_model_pose(torso: World) -> None:
 
 @pytest.mark.parametrize(
     ("name", "target"),
-    [("l_shoulder_y", 30.0), ("r_shoulder_x", -30.0), ("r_elbow_y", 30.0), ("l_elbow_y", -30.0),
-     ("head_y", 5.0), ("bust_x", -5.0), ("bust_y", 15.0), ("abs_z", 30.0)],
-)  # fmt: skip
+    [
+        ("l_shoulder_y", 30.0),
+        ("r_shoulder_x", -30.0),
+        ("r_elbow_y", 30.0),
+        ("l_elbow_y", -30.0),
+        ("head_y", 5.0),
+        ("bust_x", -5.0),
+        ("bust_y", 15.0),
+        ("abs_z", 30.0),
+    ],
+)
 def test_the_joint_takes_the_motor_angle(torso: World, name: str, target: float) -> None:
     """Motors of each kind (direct/indirect, with and without offset): the joint turns to the
     motor's own angle, which the motor reads back."""

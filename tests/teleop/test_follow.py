@@ -81,8 +81,9 @@ def test_hold_stops_where_the_motors_are_and_the_next_target_ramps(follower: Rob
     hand = Hand(follower)
     clock = Clock()
     changes: list[str] = []
-    session = FollowSession(follower, ["m1"], ramp_s=0.5,
-                            on_change=lambda c: changes.append(c.state), clock=clock)  # fmt: skip
+    session = FollowSession(
+        follower, ["m1"], ramp_s=0.5, on_change=lambda c: changes.append(c.state), clock=clock
+    )
     session.start()
     session.push({"m1": 0.0})
     clock.now += 1.0
@@ -99,8 +100,7 @@ def test_hold_stops_where_the_motors_are_and_the_next_target_ramps(follower: Rob
 
 def test_watchdog_expires_only_while_the_stream_runs() -> None:
     clock = Clock()
-    session = FollowSession(_robot_with_m1(), ["m1"], watchdog_s=0.25, write_now=False,
-                            clock=clock)  # fmt: skip
+    session = FollowSession(_robot_with_m1(), ["m1"], watchdog_s=0.25, write_now=False, clock=clock)
     assert not session.expired()
     session.push({"m1": 0.0})  # a motor never read: already there, following
     assert session.state == "following"

@@ -58,8 +58,10 @@ def served() -> Iterator[Served]:
 def test_a_served_robot_follows_over_the_websocket(leader: Robot, served: Served) -> None:
     follower = RemoteFollower(served.proxy.url, rate_hz=50)
     assert follower.motor_names == [f"m{i}" for i in range(1, 7)]
-    with Waving(leader, ["m1", "m2"]), teleoperate(leader, follower, "m1=m1, m2=m2",
-                                                     rate_hz=50) as teleop:  # fmt: skip
+    with (
+        Waving(leader, ["m1", "m2"]),
+        teleoperate(leader, follower, "m1=m1, m2=m2", rate_hz=50) as teleop,
+    ):
         assert wait_for(lambda: teleop.status().state == "following", timeout_s=5.0)
         assert served.states() == {"m1": "following", "m2": "following"}
         time.sleep(0.3)
@@ -74,8 +76,10 @@ def test_a_stalled_link_holds_the_follower_then_it_resumes_with_a_ramp(
     leader: Robot, served: Served
 ) -> None:
     follower = RemoteFollower(served.proxy.url, rate_hz=50)
-    with Waving(leader, ["m1"], 40.0) as waving, teleoperate(leader, follower, "m1=m1",
-                                                              rate_hz=50) as teleop:  # fmt: skip
+    with (
+        Waving(leader, ["m1"], 40.0) as waving,
+        teleoperate(leader, follower, "m1=m1", rate_hz=50) as teleop,
+    ):
         assert wait_for(lambda: served.states().get("m1") == "following", timeout_s=5.0)
         served.proxy.pause()  # nothing gets through; the connection stays open
         assert wait_for(lambda: served.states().get("m1") == "held", timeout_s=3.0)

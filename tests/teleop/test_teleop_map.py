@@ -24,8 +24,11 @@ def test_parse_reads_signs_scales_and_offsets() -> None:
         JointLink("w", "m4", -2.0, -7.5),
     )
     assert parsed.apply({"m1": 10, "m2": 20, "m3": 30, "m4": 1}) == {
-        "r_shoulder_y": 20, "r_shoulder_x": -10, "r_elbow_y": 25, "w": -9.5,
-    }  # fmt: skip
+        "r_shoulder_y": 20,
+        "r_shoulder_x": -10,
+        "r_elbow_y": 25,
+        "w": -9.5,
+    }
     assert parsed.leaders == ["m2", "m1", "m3", "m4"]
 
 
@@ -97,5 +100,6 @@ def test_a_map_file_is_read_through_the_bounded_loaders(tmp_path: Path) -> None:
 def test_the_shipped_example_map_loads() -> None:
     example = Path(__file__).parents[2] / "docs" / "examples" / "ergo-jr-to-torso-arm.yaml"
     mapping = JointMap.load(example)
-    mapping.check([f"m{i}" for i in range(1, 7)],
-                  ["r_shoulder_y", "r_shoulder_x", "r_arm_z", "r_elbow_y"])  # fmt: skip
+    mapping.check(
+        [f"m{i}" for i in range(1, 7)], ["r_shoulder_y", "r_shoulder_x", "r_arm_z", "r_elbow_y"]
+    )

@@ -54,8 +54,12 @@ def test_the_follower_follows_the_leader_moved_by_hand(leader: Robot, follower: 
         assert wait_for(lambda: teleop.status().state == "following", timeout_s=5.0)
         for _ in range(20):  # the follower's goals keep close to the leader
             time.sleep(0.05)
-            gaps.append(max(abs(follower.motor(m).goal_position - leader.motor(m).present_position)
-                            for m in arm))  # fmt: skip
+            gaps.append(
+                max(
+                    abs(follower.motor(m).goal_position - leader.motor(m).present_position)
+                    for m in arm
+                )
+            )
         assert all(leader.motor(m).compliant for m in arm)
         assert not any(follower.motor(m).compliant for m in arm)
     # a hand moving up to 60°/s, goals written within a few ticks: a few degrees apart at most
@@ -72,8 +76,13 @@ def test_the_start_ramp_does_not_jump(leader: Robot, follower: Robot) -> None:
     time.sleep(READ_S)
     goals: list[float] = []
     changes: list[str] = []
-    teleop = teleoperate(leader, follower, "m1=m1, m2=m2", rate_hz=100,
-                         on_change=lambda state, _: changes.append(state))  # fmt: skip
+    teleop = teleoperate(
+        leader,
+        follower,
+        "m1=m1, m2=m2",
+        rate_hz=100,
+        on_change=lambda state, _: changes.append(state),
+    )
     with teleop:
         deadline = time.monotonic() + 3.0
         while time.monotonic() < deadline and teleop.status().state != "following":
@@ -111,8 +120,15 @@ def test_record_saves_the_followers_trajectory(
 ) -> None:
     path = f"{tmp_path}/teleop.move"
     with Waving(leader, ["m1"]):
-        report = teleoperate(leader, follower, "m1=m1", rate_hz=50, duration_s=1.5,
-                             record=path, record_metadata={"robot": "ergo-jr"}).run()  # fmt: skip
+        report = teleoperate(
+            leader,
+            follower,
+            "m1=m1",
+            rate_hz=50,
+            duration_s=1.5,
+            record=path,
+            record_metadata={"robot": "ergo-jr"},
+        ).run()
     move = read_move(path)
     assert move.motors == ("m1",) and move.framerate == 50
     assert 1.45 <= move.duration_s < 2.5  # the 1.5 s on the 50 Hz grid; its end may come late
@@ -128,8 +144,10 @@ def torso() -> Iterator[Robot]:
 
 def test_one_robot_copies_its_left_arm_to_its_right_arm(torso: Robot) -> None:
     mirror = "r_shoulder_y=l_shoulder_y, r_shoulder_x=-l_shoulder_x, r_arm_z=-l_arm_z"
-    with Waving(torso, ["l_shoulder_y", "l_shoulder_x", "l_arm_z"], 20.0), \
-            teleoperate(torso, torso, mirror, rate_hz=50) as teleop:  # fmt: skip
+    with (
+        Waving(torso, ["l_shoulder_y", "l_shoulder_x", "l_arm_z"], 20.0),
+        teleoperate(torso, torso, mirror, rate_hz=50) as teleop,
+    ):
         assert wait_for(lambda: teleop.status().state == "following", timeout_s=5.0)
         time.sleep(0.3)
         left = torso.l_shoulder_x.present_position

@@ -34,14 +34,20 @@ async def test_a_calibration_from_the_robot_tab_is_saved(user_dirs: Path) -> Non
         assert isinstance(screen, CalibrationScreen)
         await wait_for(pilot, lambda: bool(screen.query("#calibration-continue")), what="buttons")
         go = screen.query_one("#calibration-continue", Button)
-        await wait_for(pilot, lambda: "posture" in step_title(screen).lower() and not go.disabled,
-                       what="posture step")  # fmt: skip
+        await wait_for(
+            pilot,
+            lambda: "posture" in step_title(screen).lower() and not go.disabled,
+            what="posture step",
+        )
         for motor_id in range(1, 7):
             hand(robot, motor_id).move_by_hand(5.0)  # the posture reads 5° off the old zero
         go.press()
         for step in range(6):  # one joint at a time: each swept through 60°
-            await wait_for(pilot, lambda: step_title(screen) == "Ranges" and not go.disabled,
-                           what=f"range step {step + 1}")  # fmt: skip
+            await wait_for(
+                pilot,
+                lambda: step_title(screen) == "Ranges" and not go.disabled,
+                what=f"range step {step + 1}",
+            )
             virtual = hand(robot, step + 1)
             for angle in (-25.0, 35.0, 5.0):
                 virtual.move_by_hand(angle)

@@ -1,0 +1,275 @@
+"""The config's ``kinematics`` and ``sensors`` sections as pydantic models: every problem at once.
+
+The leaves do not validate: ``SensorEntry.spec`` hands ``poppy_core.sensors`` a plain
+``SensorSpec``, and ``poppy_core.motion.chains`` turns a ``KinematicsSection`` into the
+kinematics leaf's ``KinematicsSpec``. The sections' forms are in ``poppy_core.kinematics.spec``
+and ``poppy_core.sensors.config``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Mapping
+from typing import Annotated, Any, Literal
+
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, Strict
+from pydantic_core import PydanticCustomError
+
+from poppy_core.errors import ConfigError, SensorError
+from poppy_core.robot.config_format import config_error
+from poppy_core.sensors.camera import CameraCalibration, check_resolution
+from poppy_core.sensors.config import CAMERA_TYPES, NOT_YET, SUPPORTED_TYPES, SensorSpec
+from poppy_core.sensors.faces import MAX_FACE_PX, MIN_FACE_PX
+from poppy_core.sensors.markers import FAMILIES
+
+Name = Annotated[str, Strict()]
+Finite = Annotated[float, Strict(), Field(allow_inf_nan=False)]
+
+
+def _positive(value: float) -> float:
+    if not value > 0:
+        raise PydanticCustomError("positive", "must be a positive number")
+    return value
+
+
+Positive = Annotated[float, Strict(), Field(allow_inf_nan=False), AfterValidator(_positive)]
+
+
+def _one_or_many(value: Any) -> Any:
+    """None is no name, one name is a list of one (as the hand-written form allows)."""
+    if value is None:
+        return []
+    return [value] if isinstance(value, str) else value
+
+
+def _identifier(name: str) -> str:
+    if not name.isidentifier() or name.startswith("_"):
+        raise PydanticCustomError("chain_name", "must be an identifier (not starting with _)")
+    return name
+
+
+Names = Annotated[list[Name], BeforeValidator(_one_or_many)]
+ChainName = Annotated[Name, AfterValidator(_identifier)]
+
+
+def _non_empty(value: str) -> str:
+    if not value:
+        raise PydanticCustomError("empty", "must not be empty")
+    return value
+
+
+def _some(names: list[str]) -> list[str]:
+    if not names:
+        raise PydanticCustomError("motors", "must list the chain's motors or groups")
+    return names
+
+
+def _xyz(value: Any) -> Any:
+    if not isinstance(value, list | tuple) or len(value) != 3:
+        raise PydanticCustomError("tip", "must be [x, y, z] in metres")
+    return value
+
+
+def _label(value: str) -> str:
+    if value and not value.isidentifier():
+        raise PydanticCustomError("label", "must be a name such as arm")
+    return value
+
+
+class ChainSection(BaseModel):
+    """One chain: its motors or groups (base to tip), passive and reversed ones, its tip (m),
+    and the name people are shown (``label``; the chain's own name stays pypot's attribute)."""
+
+    model_config = ConfigDict(extra="allow")
+
+    motors: Annotated[Names, AfterValidator(_some)]
+    passive: Names = Field(default_factory=list)
+    reversed: Names = Field(default_factory=list)
+    tip: Annotated[tuple[Finite, Finite, Finite], BeforeValidator(_xyz)] = (0.0, 0.0, 0.0)
+    label: Annotated[str, AfterValidator(_label)] = ""
+
+
+class KinematicsSection(BaseModel):
+    """The section: the model file (URDF or MJCF), joint frame, chains, reversed motors."""
+
+    model_config = ConfigDict(extra="allow")
+
+    model: Annotated[Name, AfterValidator(_non_empty)]
+    joint_frame: Literal["motor", "user"] | None = None
+    reversed: Names = Field(default_factory=list)
+    chains: Annotated[
+        dict[ChainName, ChainSection], BeforeValidator(lambda v: {} if v is None else v)
+    ] = Field(default_factory=dict)
+
+
+def _sensor_type(value: str) -> str:
+    if value in NOT_YET:
+        raise PydanticCustomError(
+            "sensor_type",
+            "{kind} sensors are not supported yet (poppy drives {known}): remove this sensor "
+            "from the config",
+            {"kind": NOT_YET[value], "known": ", ".join(SUPPORTED_TYPES)},
+        )
+    if value not in SUPPORTED_TYPES:
+        raise PydanticCustomError(
+            "sensor_type",
+            "unknown sensor type (one of {known})",
+            {"known": ", ".join(SUPPORTED_TYPES)},
+        )
+    return value
+
+
+def _resolution(value: Any) -> Any:
+    try:
+        return list(check_resolution(value, ""))
+    except SensorError:
+        raise PydanticCustomError("resolution", "must be [width, height] in pixels") from None
+
+
+def _calibration(value: Any) -> Any:
+    try:
+        CameraCalibration.from_config(value, "")
+    except SensorError as exc:
+        raise PydanticCustomError("calibration", "{why}", {"why": _reason(exc)}) from None
+    return value
+
+
+def _families(value: list[str]) -> list[str]:
+    if not value or set(value) - set(FAMILIES):
+        raise PydanticCustomError(
+            "families", "must be a list of {known}", {"known": ", ".join(FAMILIES)}
+        )
+    return value
+
+
+def _min_size(value: int) -> int:
+    if not MIN_FACE_PX <= value <= MAX_FACE_PX:
+        raise PydanticCustomError(
+            "min_size", "must be {low}-{high} pixels", {"low": MIN_FACE_PX, "high": MAX_FACE_PX}
+        )
+    return value
+
+
+def _reason(exc: Exception) -> str:
+    return str(exc).split(": ", 1)[-1]
+
+
+MarkerIds = Annotated[
+    list[Annotated[int, Strict()]],
+    BeforeValidator(lambda v: v if isinstance(v, list) else [v]),
+    Field(min_length=1),
+]
+
+
+class SensorEntry(BaseModel):
+    """One sensor (pypot's keys and poppy's); unknown keys are kept as they are."""
+
+    model_config = ConfigDict(extra="allow")
+
+    type: Annotated[Name, AfterValidator(_sensor_type)]
+    fps: Positive | None = None
+    freq: Positive | None = None
+    index: Annotated[int, Strict()] | Name | None = None
+    device: Annotated[int, Strict()] | Name | None = None
+    resolution: Annotated[Any, AfterValidator(_resolution)] = None
+    calibration: Annotated[Any, AfterValidator(_calibration)] = None
+    sim_camera: Name | None = None
+    cameras: list[Name] | None = None
+    cards: dict[Name, MarkerIds] = Field(default_factory=dict)
+    dictionary: Name | None = None
+    marker_size: Positive | None = None
+    families: Annotated[list[Name], AfterValidator(_families)] | None = None
+    min_size: Annotated[Annotated[int, Strict()], AfterValidator(_min_size)] | None = None
+    cascade: Annotated[Name, AfterValidator(_non_empty)] | None = None
+
+    def spec(self, name: str) -> SensorSpec:
+        """The plain entry the sensors leaf builds from."""
+        given: dict[str, Any] = {
+            "rate_hz": self.fps if self.type in CAMERA_TYPES else self.freq,
+            "resolution": tuple(self.resolution) if self.resolution is not None else None,
+            "calibration": (
+                CameraCalibration.from_config(self.calibration, name)
+                if self.calibration is not None
+                else None
+            ),
+            "source": next((s for s in (self.index, self.device) if s is not None), 0),
+            "sim_camera": self.sim_camera or name,
+            "cameras": tuple(self.cameras or ()),
+            "cards": {card: list(ids) for card, ids in self.cards.items()},
+            "dictionary": self.dictionary,
+            "marker_size": self.marker_size,
+            "families": tuple(self.families) if self.families is not None else None,
+            "min_size": self.min_size,
+            "cascade": self.cascade,
+        }
+        keep = {"rate_hz", "resolution", "calibration", "cascade"}
+        return SensorSpec(
+            name, self.type, **{k: v for k, v in given.items() if v is not None or k in keep}
+        )
+
+
+def sensor_specs(sensors: Mapping[str, SensorEntry]) -> list[SensorSpec]:
+    """The plain entries of a checked section, in its order."""
+    return [entry.spec(name) for name, entry in sensors.items()]
+
+
+def sensor_problems(
+    sensors: Mapping[str, Any], taken: Collection[str], source: str
+) -> list[ConfigError]:
+    """Every problem across the section's entries: a detector reading no camera, a name clash.
+
+    Args:
+        sensors: the section, raw or validated (entries that are not mappings are skipped).
+        taken: the names of the motors and groups.
+        source: the file name (or label) for messages.
+    """
+    problems: list[ConfigError] = []
+
+    def kind(entry: Any) -> Any:
+        return (
+            entry.type
+            if isinstance(entry, SensorEntry)
+            else (entry.get("type") if isinstance(entry, Mapping) else None)
+        )
+
+    for name, entry in sensors.items():
+        if name in taken:
+            problems.append(
+                config_error(
+                    source,
+                    f"sensors.{name}",
+                    name,
+                    f"sensor {name!r} has the name of a motor or group",
+                    show_value=False,
+                )
+            )
+        if kind(entry) not in ("MarkerDetector", "FaceDetector"):
+            continue
+        cameras = entry.cameras if isinstance(entry, SensorEntry) else entry.get("cameras")
+        if not isinstance(cameras, list) or not cameras:
+            problems.append(
+                config_error(
+                    source, f"sensors.{name}.cameras", cameras, "must list camera sensor names"
+                )
+            )
+            continue
+        for camera in cameras:
+            if not isinstance(camera, str) or kind(sensors.get(camera)) not in CAMERA_TYPES:
+                problems.append(
+                    config_error(
+                        source,
+                        f"sensors.{name}.cameras",
+                        cameras,
+                        f"{camera!r} is not a camera here",
+                    )
+                )
+                break
+    return problems
+
+
+__all__ = [
+    "ChainSection",
+    "KinematicsSection",
+    "SensorEntry",
+    "sensor_problems",
+    "sensor_specs",
+]

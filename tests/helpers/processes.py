@@ -1,0 +1,43 @@
+"""Child processes of the tests: read a pty until a text shows, and leave nothing running."""
+
+from __future__ import annotations
+
+import os
+import select
+import subprocess
+import time
+from typing import Any
+
+
+def read_until(
+    fd: int,
+    text: str | None,
+    timeout_s: float = 60,
+    proc: subprocess.Popen[Any] | None = None,
+) -> str:
+    """What ``fd`` gives until ``text`` shows (None: until it ends), ``proc`` ends, or timeout."""
+    seen = b""
+    deadline = time.monotonic() + timeout_s
+    while (text is None or text.encode() not in seen) and time.monotonic() < deadline:
+        ready, _, _ = select.select([fd], [], [], 0.2)
+        if ready:
+            try:
+                chunk = os.read(fd, 4096)
+            except OSError:
+                break
+            if not chunk:
+                break
+            seen += chunk
+        elif proc is not None and proc.poll() is not None:
+            break
+    return seen.decode(errors="replace")
+
+
+def reap(proc: subprocess.Popen[Any]) -> None:
+    """Kill ``proc`` if it still runs, wait for it, and close its pipes."""
+    if proc.poll() is None:
+        proc.kill()
+    proc.wait()
+    for stream in (proc.stdin, proc.stdout, proc.stderr):
+        if stream is not None:
+            stream.close()
