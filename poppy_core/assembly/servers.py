@@ -176,15 +176,13 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     try:
         if app is not None:
             where = listens["http"]
-            servers.servers["http"] = BackgroundServer(
-                "http", ServerThread(app, where.host, where.port).bind()
-            )
+            thread = ServerThread(app, where.host, where.port).bind()
+            servers.servers["http"] = BackgroundServer("http", thread, service=service)
         if "ws" in listens:
             where = listens["ws"]
             stream = create_stream_app(service, spec.ws_rate_hz, spec.token, policy)
-            servers.servers["ws"] = BackgroundServer(
-                "ws", ServerThread(stream, where.host, where.port).bind()
-            )
+            thread = ServerThread(stream, where.host, where.port).bind()
+            servers.servers["ws"] = BackgroundServer("ws", thread, service=service)
         if "zmq" in listens:
             from poppy_core.server.zmqserver import ZmqRobotServer
 

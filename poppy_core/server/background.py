@@ -6,7 +6,12 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
+from typing import TYPE_CHECKING
+
 from poppy_core.server.runner import ServerThread
+
+if TYPE_CHECKING:
+    from poppy_core.server.service import RobotService
 
 
 class BackgroundServer:
@@ -16,12 +21,19 @@ class BackgroundServer:
         name: what it serves (``"http"``, ``"ws"``...), for messages.
         thread: the uvicorn thread, bound and not yet started.
         on_stop: called once it stopped (to release what it used).
+        service: the robot service it serves (shared by the servers of one set).
     """
 
     def __init__(
-        self, name: str, thread: ServerThread, on_stop: Callable[[], None] | None = None
+        self,
+        name: str,
+        thread: ServerThread,
+        on_stop: Callable[[], None] | None = None,
+        *,
+        service: RobotService | None = None,
     ) -> None:
         self.name = name
+        self.service = service
         self._thread = thread
         self._on_stop = on_stop
         self._stopped = threading.Event()
