@@ -117,7 +117,7 @@ class ServerSet:
     @property
     def running(self) -> bool:
         """True while every server serves."""
-        return bool(self.servers) and all(_running(s) for s in self.servers.values())
+        return bool(self.servers) and all(s.running for s in self.servers.values())
 
     def start(self) -> ServerSet:
         """Serve every server in the background (each was bound by ``serve``)."""
@@ -140,11 +140,6 @@ class ServerSet:
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
-
-
-def _running(server: Any) -> bool:
-    thread = getattr(server, "thread", None)  # a SnapServer
-    return bool(thread.running if thread is not None else server.running)
 
 
 def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:

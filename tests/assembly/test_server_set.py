@@ -55,7 +55,7 @@ def test_the_creature_path_and_the_cli_path_give_the_same_server_set(
     assert not any(server_running for server_running in _states(creature_set))
 
     def stop_at_once(servers: list[Any]) -> None:  # `poppy serve` waits for Ctrl-C here
-        assert all(_running(s) for s in servers)
+        assert all(s.running for s in servers)
 
     monkeypatch.setattr("poppy_cli.commands.serve._wait_for_signal", stop_at_once)
     args = ["serve", "--sim", "--profile", "ergo-jr", "--http", "--ws", "--zmq", "--snap"]
@@ -72,13 +72,8 @@ def test_the_creature_path_and_the_cli_path_give_the_same_server_set(
     assert not any(_states(cli_set))
 
 
-def _running(server: Any) -> bool:
-    thread = getattr(server, "thread", None)
-    return bool(thread.running if thread is not None else server.running)
-
-
 def _states(servers: ServerSet) -> list[bool]:
-    return [_running(s) for s in servers.servers.values()]
+    return [s.running for s in servers.servers.values()]
 
 
 def _teleop(ws: ClientConnection, motor: str) -> dict[str, Any]:
