@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
-
 from typing import TYPE_CHECKING
 
 from poppy_core.server.runner import ServerThread
