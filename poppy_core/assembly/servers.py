@@ -147,10 +147,11 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     is False (each then serves on ``server.start()`` or pypot's ``server.run()``).
 
     Every port is bound before any server serves, so a busy port is an error before anything
-    runs; the servers bound so far are then stopped.
+    runs; when a step fails, whatever was bound or started is stopped.
 
     Raises:
         ListenError: a port is taken or an address unusable.
+        RuntimeError: a server did not start (its log says why).
         ValueError: an origin in ``cors`` or a name in ``allow_hosts`` that is not one.
         MissingExtraError: the ``server`` (or ``zmq``) extra is missing.
     """
@@ -186,10 +187,12 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
         if "snap" in listens:
             _add_snap(servers, robot, spec, listens["snap"])
         _own_pages(servers)
+        if start:
+            servers.start()
     except BaseException:
         servers.stop()
         raise
-    return servers.start() if start else servers
+    return servers
 
 
 def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) -> None:
