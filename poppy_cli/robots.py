@@ -2,7 +2,7 @@
 
 Every command that needs a robot gets it here (``build_robot``, or ``robot_config`` and
 ``start_robot`` when it looks at the config first; ``open_remote`` for ``--remote``), and every
-one goes through ``poppy_core.robot.from_config``: one way to build a robot.
+one goes through ``poppy_core.assembly.from_config``: one way to build a robot.
 """
 
 from __future__ import annotations
@@ -61,13 +61,13 @@ def start_robot(config: RobotConfig, sim: bool | str | None, *, sensors: bool = 
     """Build and start the robot of ``config``: the one way every command builds a robot.
 
     A Poppy creature (Ergo Jr, Torso, Humanoid: named by its profile, or recognised by its motor
-    names) gets its behaviours attached (``poppy_core.robot.from_config`` does it).
+    names) gets its behaviours attached (``poppy_core.assembly.from_config`` does it).
 
     Motors answering after a return delay above 0 µs slow every transaction: on a terminal the
     user is asked whether to set it to 0; otherwise it is only reported (a warning).
     The config's sensors (cameras) are built only when ``sensors`` (commands that show them).
     """
-    from poppy_core.robot import from_config
+    from poppy_core.assembly import from_config
 
     return from_config(config, sim=sim or False, fix_return_delay=ask_return_delay, sensors=sensors)
 

@@ -105,6 +105,10 @@ def play_remote(
                     time.sleep(REFRESH_S)
         except KeyboardInterrupt:
             interrupted = True
+            # the signal may have cut a request short, leaving its connection half used: the stop
+            # goes on a connection of its own
+            robot.close()
+            robot = open_remote(url)
             robot.moves.stop(name)
         elapsed = time.monotonic() - started
     finally:

@@ -11,15 +11,14 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import typer
 
-from poppy_cli.commands.serve_snap import announce_snap, check_snap_options, snap_server_for
+from poppy_cli.commands.serve_snap import announce_snap, check_snap_options
 from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, finite
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, warn_line
 from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
-    from poppy_core.server import ServerThread
+    from poppy_core.assembly import ServerSet, ServeSpec
     from poppy_core.server.moves import SavedTake
-    from poppy_core.server.zmqserver import ZmqRobotServer
 
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 
@@ -95,91 +94,85 @@ def serve(
         open_browser,
         {"--http-port": http_port if http else 0, "--ws-port": ws_port if ws else 0},
     )
-    from poppy_core.server import OriginPolicy, ServerThread, create_app, create_stream_app
+    from poppy_core.assembly import Listen, ServeSpec, serve
 
-    try:
-        policy = OriginPolicy.for_server(
-            host, cors=cors or (), allow_hosts=allow_host or (), report=_report
-        )
-    except ValueError as exc:
-        _usage(f"{exc} (--cors takes an origin or '*', --allow-host a host name)")
-    if zmq and host not in LOOPBACK:
-        warn_line(
-            f"serving the ZMQ API on {host}: it has no token, anyone who can reach this machine "
-            "can move the robot; keep --host 127.0.0.1 unless the network is yours"
-        )
-    if host not in LOOPBACK and not token:
-        warn_line(
-            f"serving on {host} without --token: anyone who can reach this machine can move "
-            "the robot (and write its EEPROM); pass --token or keep --host 127.0.0.1"
-        )
-    if policy.any_origin:
-        warn_line(
-            "--cors '*': every web page you open can move the robot; allow the origins you "
-            "use instead (e.g. --cors https://snap.berkeley.edu)"
-        )
+    spec = ServeSpec(
+        http=Listen(host, http_port) if http else None,
+        ws=Listen(host, ws_port) if ws else None,
+        zmq=Listen(host, zmq_port) if zmq else None,
+        snap=Listen(host, snap_port) if snap else None,
+        token=token or None,
+        cors=tuple(cors or ()),
+        allow_hosts=tuple(allow_host or ()),
+        ws_rate_hz=ws_rate,
+        snap_dir=snap_dir,
+        report=_report,
+    )
+    any_origin = _check_origins(spec)
+    _warn_exposure(spec, host, any_origin)
     with build_robot(profile, config_file, port, sim, sensors=not no_sensors) as robot:
-        app = create_app(robot, token=token or None, policy=policy, stream_rate_hz=ws_rate)
-        servers: list[ServerThread] = []
-        if http:
-            servers.append(ServerThread(app, host, http_port))
-        if ws:
-            stream_app = create_stream_app(app.state.service, ws_rate, token or None, policy)
-            servers.append(ServerThread(stream_app, host, ws_port))
-        snap_server = None
-        if snap:
-            snap_server = snap_server_for(
-                robot,
-                app.state.service,
-                host,
-                snap_port,
-                cors,
-                allow_host,
-                snap_dir,
-                token or None,
-                _report,
-            )
-            servers.append(snap_server.thread)
-        zmq_server: ZmqRobotServer | None = None
+        servers: ServerSet | None = None
         try:
-            for server in servers:  # bind every port before serving any: errors come first
-                server.bind()
-            if zmq:
-                from poppy_core.server.zmqserver import ZmqRobotServer
-
-                zmq_server = ZmqRobotServer(robot, host, zmq_port)  # binds: ListenError here
-            policy.with_ports(server.port for server in servers)
-            if snap_server is not None:
-                snap_server.bound([server.port for server in servers])
-            if snap_server is not None and http:
-                from poppy_core.server.web import add_link
-
-                add_link(app, "Snap! with the Poppy blocks", snap_server.editor_url)
-            for server in servers:
-                server.start()
-            base = _host(host)
-            if http:
-                print(f"http://{base}:{servers[0].port}", flush=True)
-            if ws:
-                print(f"ws://{base}:{servers[1 if http else 0].port}/", flush=True)
-            if zmq_server is not None:
-                print(f"zmq: tcp://{base}:{zmq_server.start().port}", flush=True)
-            if http:
-                print(f"docs: http://{base}:{servers[0].port}/docs", flush=True)
-            if snap_server is not None:
-                announce_snap(snap_server, open_browser)
-            _wait_for_signal([*servers, *([zmq_server] if zmq_server else [])])
+            servers = serve(robot, spec)
+            _announce(servers, host, open_browser)
+            _wait_for_signal(list(servers.servers.values()))
         except RuntimeError as exc:
             error_line(f"{exc} (the server's log above says why)")
             raise typer.Exit(EXIT_FAILURE) from None
         finally:
-            if zmq_server is not None:
-                zmq_server.stop()
-            for server in reversed(servers):
-                server.stop()
-            app.state.service.close()  # done already by the HTTP app's lifespan, if it ran
-            _say_where_takes_went(app.state.service.moves.saved_on_close)
+            if servers is not None:
+                servers.stop()
+                _say_where_takes_went(servers.service.moves.saved_on_close)
     print("stopped", file=sys.stderr, flush=True)
+
+
+def _check_origins(spec: ServeSpec) -> bool:
+    """Refuse a --cors or --allow-host that is not one, before the robot is built; True when
+    every origin is allowed."""
+    from poppy_core.server import OriginPolicy
+    from poppy_core.server.snap import snap_policy
+
+    try:
+        policy = OriginPolicy.for_server(spec.host, cors=spec.cors, allow_hosts=spec.allow_hosts)
+        if spec.snap is not None:
+            snap_policy(spec.host, cors=spec.cors, allow_hosts=spec.allow_hosts)
+    except ValueError as exc:
+        _usage(f"{exc} (--cors takes an origin or '*', --allow-host a host name)")
+    return policy.any_origin
+
+
+def _warn_exposure(spec: ServeSpec, host: str, any_origin: bool) -> None:
+    """Say what a server reachable from the network, or open to every page, lets others do."""
+    if spec.zmq is not None and host not in LOOPBACK:
+        warn_line(
+            f"serving the ZMQ API on {host}: it has no token, anyone who can reach this machine "
+            "can move the robot; keep --host 127.0.0.1 unless the network is yours"
+        )
+    if host not in LOOPBACK and not spec.token:
+        warn_line(
+            f"serving on {host} without --token: anyone who can reach this machine can move "
+            "the robot (and write its EEPROM); pass --token or keep --host 127.0.0.1"
+        )
+    if any_origin:
+        warn_line(
+            "--cors '*': every web page you open can move the robot; allow the origins you "
+            "use instead (e.g. --cors https://snap.berkeley.edu)"
+        )
+
+
+def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
+    """Print where each server serves (the tests and scripts read these lines)."""
+    base = _host(host)
+    if servers.http is not None:
+        print(f"http://{base}:{servers.http.port}", flush=True)
+    if servers.ws is not None:
+        print(f"ws://{base}:{servers.ws.port}/", flush=True)
+    if servers.zmq is not None:
+        print(f"zmq: tcp://{base}:{servers.zmq.port}", flush=True)
+    if servers.http is not None:
+        print(f"docs: http://{base}:{servers.http.port}/docs", flush=True)
+    if servers.snap is not None:
+        announce_snap(servers.snap, open_browser)
 
 
 def _say_where_takes_went(saved: list[SavedTake]) -> None:

@@ -1,8 +1,11 @@
-"""The Snap! part of `poppy serve --snap`: options checked, server built, URLs printed."""
+"""The Snap! part of `poppy serve --snap`: options checked, URLs printed.
+
+``poppy_core.assembly.serve`` builds the server, with the others.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
@@ -11,8 +14,6 @@ import typer
 from poppy_cli.output import EXIT_USAGE, error_line, warn_line
 
 if TYPE_CHECKING:
-    from poppy_core.robot import Robot
-    from poppy_core.server import RobotService
     from poppy_core.server.snap import SnapServer
 
 
@@ -42,36 +43,6 @@ def check_snap_options(
             f"--snap-dir {snap_dir}: no snap.html there; give the folder of a downloaded Snap! "
             "(unzipped from https://github.com/jmoenig/Snap/releases)"
         )
-
-
-def snap_server_for(
-    robot: Robot,
-    service: RobotService,
-    host: str,
-    port: int,
-    cors: list[str] | None,
-    allow_hosts: list[str] | None,
-    snap_dir: Path | None,
-    token: str | None,
-    report: Callable[[str], None],
-) -> SnapServer:
-    """The Snap! server of `poppy serve`, sharing the HTTP server's robot service."""
-    from poppy_core.server.snap import create_snap_server
-
-    try:
-        return create_snap_server(
-            robot,
-            host,
-            port,
-            service=service,
-            cors=cors or (),
-            allow_hosts=allow_hosts or (),
-            snap_dir=snap_dir,
-            token=token,
-            report=report,
-        )
-    except ValueError as exc:
-        _usage(f"{exc} (--cors takes an origin or '*', --allow-host a host name)")
 
 
 def announce_snap(server: SnapServer, open_browser: bool) -> None:

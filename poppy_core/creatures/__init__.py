@@ -1,21 +1,20 @@
-"""Creatures: what is specific to Poppy Ergo Jr, Torso and Humanoid (setup and primitives)."""
+"""Creatures: what is specific to Poppy Ergo Jr, Torso and Humanoid (setup and primitives).
 
-from types import MappingProxyType
+pypot's creature classes (``PoppyErgoJr``...), ``installed_poppy_creatures`` and the
+``from_config`` / ``from_profile`` of earlier releases build robots and start servers: they are
+the assembly's (``poppy_core.assembly``), re-exported here on first use by ``__getattr__`` (the
+one import that climbs, by design: docs/internals.md, "The composition root").
+"""
+
+from typing import TYPE_CHECKING, Any
 
 from poppy_core import __version__
 from poppy_core.creatures.body import DanceBeatMotion, HeadIdleMotion, UpperBodyIdleMotion
 from poppy_core.creatures.ergo_jr import Dance, Jump, SafePowerUp
 from poppy_core.creatures.face_tracking import FaceTracking
-from poppy_core.creatures.factory import from_config, from_profile
 from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.creatures.interaction import ArmsCopyMotion, ArmsTurnCompliant
 from poppy_core.creatures.postures import CreaturePosture
-from poppy_core.creatures.pypot_creatures import (
-    AbstractPoppyCreature,
-    PoppyErgoJr,
-    PoppyHumanoid,
-    PoppyTorso,
-)
 from poppy_core.creatures.registry import (
     CREATURES,
     Creature,
@@ -27,11 +26,29 @@ from poppy_core.creatures.registry import (
 from poppy_core.creatures.safety import LimitTorque, TemperatureMonitor
 from poppy_core.creatures.tracking import FollowInView, MarkerFollow, TrackingFeedback
 
-installed_poppy_creatures = MappingProxyType(
-    {"poppy-humanoid": PoppyHumanoid, "poppy-torso": PoppyTorso, "poppy-ergo-jr": PoppyErgoJr}
-)
-"""pypot's ``pypot.creatures.installed_poppy_creatures``: package name -> creature class (all three
-are part of poppy)."""
+if TYPE_CHECKING:
+    from poppy_core.assembly import (
+        AbstractPoppyCreature,
+        PoppyErgoJr,
+        PoppyHumanoid,
+        PoppyTorso,
+        from_config,
+        from_profile,
+        installed_poppy_creatures,
+    )
+
+ASSEMBLED = frozenset({"AbstractPoppyCreature", "PoppyErgoJr", "PoppyHumanoid", "PoppyTorso",
+                       "from_config", "from_profile", "installed_poppy_creatures"})  # fmt: skip
+"""The names re-exported from the assembly."""
+
+
+def __getattr__(name: str) -> Any:
+    """The assembly's creature classes and builders, imported when first asked for."""
+    if name in ASSEMBLED:
+        import poppy_core.assembly
+
+        return getattr(poppy_core.assembly, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "CREATURES",

@@ -5,8 +5,9 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from poppy_core.errors import ConfigError
-from poppy_core.motion.manager import MANAGER_KEY, PrimitiveManager
+from poppy_core.motion.manager import PrimitiveManager
 from poppy_core.motion.primitive import Primitive
+from poppy_core.robot.robot_pypot import MANAGER_KEY
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError
 from poppy_core.motion.sandbox import NUMERIC_REGISTERS
+from poppy_core.robot.robot_pypot import MANAGER_KEY
 from poppy_core.schedule import Periodic, RateMeter, Worker
 
 if TYPE_CHECKING:
@@ -32,8 +33,6 @@ Filter = Callable[[Sequence[float]], float]
 FILTERS: dict[str, Filter] = {"mean": statistics.fmean, "sum": math.fsum}
 """Named filters: ``"mean"`` (pypot's default) and ``"sum"``."""
 DEFAULT_FREQ_HZ = 50.0
-MANAGER_KEY = "primitive_manager"
-"""Name of the manager in ``robot.extensions`` (so ``robot.primitive_manager`` works)."""
 
 
 def _resolve_filter(value: str | Filter) -> Filter:

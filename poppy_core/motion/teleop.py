@@ -31,10 +31,11 @@ from poppy_core.motion.teleop_follower import Follower, LocalFollower
 from poppy_core.motion.teleop_map import JointMap
 from poppy_core.motion.teleop_record import TrajectoryRecorder
 from poppy_core.motion.teleop_stats import TeleopReport, TeleopStatus
+from poppy_core.robot.robot import Robot
 from poppy_core.schedule import Backoff, Periodic
 
 if TYPE_CHECKING:
-    from poppy_core.robot import Motor, Robot
+    from poppy_core.robot import Motor
 
 logger = logging.getLogger(__name__)
 
@@ -101,8 +102,6 @@ class Teleoperation:
             raise ConfigError(
                 f"the rate must be in (0, {MAX_RATE_HZ:g}] Hz, not {rate_hz:g}", field="rate_hz"
             )
-        from poppy_core.robot.robot import Robot  # at run time: motion loads under robot
-
         self._on_change = on_change
         self._clock = clock
         self.follower: Follower = (

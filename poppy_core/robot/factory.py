@@ -1,4 +1,8 @@
-"""Build a ``Robot``: from a config, a profile, or whatever motors a scan finds; real or simulated.
+"""Build a plain ``Robot``: from a config, a profile, or the motors a scan finds; real or simulated.
+
+Plain: its motors, buses, sync loops and sensors, no creature. The assembly
+(``poppy_core.assembly``, the floor above every room) adds the primitive manager and the
+creature; ``poppy_core.robot.from_profile`` is the assembly's.
 
 ``sim=True`` starts one in-process emulator per controller (a ``VirtualBus`` with the configured
 models, IDs and baud rate, reached through the in-process link ``emu://NAME``), so the robot
@@ -19,7 +23,6 @@ from poppy_core.models import model_by_name
 from poppy_core.robot.assembly import SIM_MODES, Assembly, SimMode, sim_mode
 from poppy_core.robot.config import RobotConfig
 from poppy_core.robot.config_io import ConfigSource, as_config
-from poppy_core.robot.creature_hook import attach_behaviours
 from poppy_core.robot.profile_match import matching_profile
 from poppy_core.robot.profiles import load_profile
 from poppy_core.robot.robot import Robot
@@ -29,7 +32,7 @@ from poppy_core.robot.virtual import start_emulators, start_simulation, virtual_
 __all__ = [
     "SIM_MODES",
     "SimMode",
-    "autodetect",
+    "detect_config",
     "from_config",
     "from_profile",
     "start_emulators",
@@ -51,14 +54,11 @@ def from_config(
     ports: Sequence[str] | None = None,
     start_sync: bool = True,
     sensors: bool = True,
-    creature: bool = True,
-    start_defaults: bool = True,
 ) -> Robot:
-    """Build and start a robot from a config (a ``RobotConfig``, a dict or a JSON/YAML file).
+    """Build and start a plain robot from a config (a ``RobotConfig``, a dict or a JSON/YAML file).
 
-    The one way robots are built (the CLI, the server, the TUI, ``from_profile``,
-    ``autodetect`` and ``poppy_core.creatures`` all come here); the steps are
-    ``poppy_core.robot.assembly``'s.
+    The one way robots are built (``poppy_core.assembly.from_config`` comes here, then adds the
+    creature); the steps are ``poppy_core.robot.assembly``'s.
 
     Args:
         config: the config, a dict as pypot's ``from_config(my_config)`` takes, or a file path.
@@ -76,10 +76,6 @@ def from_config(
         sensors: build the config's sensors (cameras open their device now; each starts on
             first use): OpenCV devices on hardware, the MuJoCo scene seen from the robot with
             ``sim="mujoco"``, blank frames with the ideal simulation. False: none.
-        creature: attach what the config makes the robot (``creature_hook``): a Poppy
-            creature's primitives and postures (``robot.dance``...), or the kinematic chains
-            its config describes. False: a bare robot.
-        start_defaults: start the primitives the creature starts by default.
 
     Returns:
         The running robot (close it, or use it in a ``with`` block).
@@ -102,8 +98,6 @@ def from_config(
     try:
         if start_sync:
             robot.start_sync()
-        if creature:
-            attach_behaviours(robot, start_defaults=start_defaults)
     except BaseException:
         robot.close()
         raise
@@ -139,7 +133,7 @@ def with_ports(
 def from_profile(
     name: str, port: str | Mapping[str, str] | None = None, sim: SimMode = False, **options: Any
 ) -> Robot:
-    """Build a robot from an installed or user profile (``"ergo-jr"``, ``"torso"``...).
+    """Build a plain robot from an installed or user profile (``"ergo-jr"``, ``"torso"``...).
 
     Args:
         name: the profile name.
@@ -154,31 +148,27 @@ def from_profile(
     return from_config(config, sim, **options)
 
 
-def autodetect(
+def detect_config(
     port: str | None = None,
     *,
     baudrates: Iterable[int] | None = None,
     protocols: Iterable[int] = (1, 2),
     ids: Iterable[int] = range(254),
-    **options: Any,
-) -> Robot:
-    """Scan for motors and build a robot of them.
+    match_profile: bool = True,
+) -> RobotConfig:
+    """Scan for motors and give the config of a robot made of them.
 
     When the motors found are exactly a profile's (IDs, models, one bus per controller at its
-    rate and protocol: an Ergo Jr, a Torso...), the robot is built from that profile, as
-    :func:`from_profile` on the ports found would: its names, groups, orientations, limits and
-    its creature (``robot.dance``...). Otherwise (or with ``creature=False``) the motors are
-    named ``m<id>``, one controller per port, with the angle limits stored in the motors (the
-    whole range when unset).
+    rate and protocol: an Ergo Jr, a Torso...) and ``match_profile``, the config is that
+    profile's on the ports found. Otherwise the motors are named ``m<id>``, one controller per
+    port, with the angle limits stored in the motors (the whole range when unset).
 
     Args:
         port: the port to scan; None scans every port.
         baudrates: rates to try (None: the standard ones).
         protocols: protocols to try.
         ids: IDs to look for.
-        **options: passed to :func:`from_config`; ``creature=False`` builds a bare robot of
-            the motors found. ``sensors`` defaults to False here (a scan finds motors, not
-            cameras): pass ``sensors=True`` for a matched profile's camera.
+        match_profile: look for a profile made of the motors found.
 
     Raises:
         SetupError: no motor found.
@@ -188,12 +178,11 @@ def autodetect(
     found = [f for f in found if f.model is not None]
     if not found:
         raise SetupError(f"no known motor found on {', '.join(ports) or 'any port'}")
-    options.setdefault("sensors", False)
-    match = matching_profile(found) if options.get("creature", True) else None
+    match = matching_profile(found) if match_profile else None
     if match is not None:
         name, profile, profile_ports = match
         logger.info("the motors found are a %s: building it from its profile", name)
-        return from_config(with_ports(profile, profile_ports, source=f"profile {name}"), **options)
+        return with_ports(profile, profile_ports, source=f"profile {name}")
     controllers: dict[str, Any] = {}
     motors: dict[str, Any] = {}
     for index, device in enumerate(sorted({f.port for f in found}), start=1):
@@ -209,10 +198,9 @@ def autodetect(
         with DxlBus(device, setting[0], setting[1]) as bus:
             for f in chosen:
                 motors[f"m{f.id}"] = _detected_motor(bus, f.id, str(f.model))
-    config = RobotConfig.from_dict(
+    return RobotConfig.from_dict(
         {"controllers": controllers, "motorgroups": {}, "motors": motors}, source="autodetect"
     )
-    return from_config(config, **options)
 
 
 def _detected_motor(bus: DxlBus, motor_id: int, model_name: str) -> dict[str, Any]:

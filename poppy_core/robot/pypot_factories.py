@@ -1,49 +1,15 @@
-"""pypot's robot factories by their names: ``from_json(path)`` and ``from_remote(host, port)``.
+"""pypot's ``from_remote(host, port)``: the client of a served robot.
 
-``from_config`` itself takes pypot's config dicts and files already (``poppy_core.robot``).
+pypot's ``from_json`` builds a robot, so it is the assembly's (``poppy_core.assembly.build``),
+re-exported as ``poppy_core.robot.from_json``.
 """
 
 from __future__ import annotations
 
-import os
-from typing import TYPE_CHECKING, Any
-
-from poppy_core.errors import ArgumentError
-from poppy_core.robot.factory import from_config
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from poppy_core.remote import RemoteRobot
-    from poppy_core.robot.robot import Robot
-
-
-def from_json(
-    json_file: str | os.PathLike[str],
-    sync: bool = True,
-    strict: bool = True,
-    use_dummy_io: bool = False,
-    **options: Any,
-) -> Robot:
-    """Build a robot from a pypot JSON config file, as ``pypot.robot.from_json`` does.
-
-    Args:
-        json_file: the config file (pypot JSON; poppy's YAML works too).
-        sync: start the sync loops.
-        strict: missing or mismatched motors raise ``SetupError``.
-        use_dummy_io: serve the motors from virtual servos instead of hardware.
-        **options: passed to ``poppy_core.robot.from_config``.
-
-    Returns:
-        The running robot (a plain robot: the creature classes add their behaviours).
-    """
-    if not isinstance(json_file, str | os.PathLike):
-        raise ArgumentError(
-            f"from_json takes a file path, not {type(json_file).__name__}: use from_config for "
-            "a dict",
-            field="json_file", value=json_file,
-        )  # fmt: skip
-    return from_config(
-        os.fspath(json_file), sim=bool(use_dummy_io), strict=strict, start_sync=sync, **options
-    )
 
 
 def from_remote(host: str, port: int = 8080, *, token: str | None = None) -> RemoteRobot:

@@ -8,11 +8,16 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Protocol
 
+from poppy_core.errors import ConfigError
 from poppy_core.robot.group import MotorGroup
 from poppy_core.robot.motor import Motor
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import RobotConfig
+
+MANAGER_KEY = "primitive_manager"
+"""Where the assembly keeps the primitive manager in ``robot.extensions`` (``motion.manager``'s
+``MANAGER_KEY``)."""
 
 
 class Behaviour(Protocol):
@@ -49,10 +54,20 @@ class PypotRobotMixin:
 
     @property
     def _primitive_manager(self) -> Any:
-        """The primitive manager (pypot's name; also ``robot.primitive_manager``)."""
-        from poppy_core.robot.creature_hook import MANAGER_HOOK, resolve_hook
+        """The primitive manager (pypot's name; also ``robot.primitive_manager``), attached by
+        the assembly when it builds the robot (``poppy_core.motion.primitive_manager``).
 
-        return resolve_hook(MANAGER_HOOK)(self)  # motion sits above robot: an entry point
+        Raises:
+            ConfigError: a plain robot (``poppy_core.robot.factory``) that has none yet.
+        """
+        manager = self.extensions.get(MANAGER_KEY)
+        if manager is None:
+            raise ConfigError(
+                "this robot has no primitive manager: build it with poppy_core.robot.from_config "
+                "(or from_profile), or call poppy_core.motion.primitive_manager(robot)",
+                field="_primitive_manager",
+            )
+        return manager
 
     def attach_primitive(self, primitive: Behaviour, name: str) -> None:
         """Attach a primitive as ``robot.<name>`` and list it in ``primitives`` (pypot's order).

@@ -36,6 +36,7 @@ def create_app(
     max_body_bytes: int = MAX_BODY_BYTES,
     stream_rate_hz: float = DEFAULT_STREAM_HZ,
     builtins: bool = True,
+    service: RobotService | None = None,
 ) -> FastAPI:
     """Build the app serving ``robot`` (which the caller keeps and closes).
 
@@ -47,9 +48,11 @@ def create_app(
         max_body_bytes: largest request body accepted (413 beyond).
         stream_rate_hz: default rate of the WebSocket state stream.
         builtins: attach the built-in primitives to the robot.
+        service: the robot service shared with the other servers of the robot
+            (``poppy_core.assembly.serve``), which closes it; by default the app makes its own.
 
     Returns:
-        The app; its lifespan stops the recordings and playbacks it started on shutdown.
+        The app; its lifespan stops the recordings and playbacks of its own service on shutdown.
     """
     from fastapi import FastAPI
 
@@ -67,7 +70,8 @@ def create_app(
     from poppy_core.server.sensors import SensorService
     from poppy_core.server.stream import add_stream_routes
 
-    service = RobotService(robot, builtins=builtins)
+    owns_service = service is None
+    service = service or RobotService(robot, builtins=builtins)
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -76,7 +80,8 @@ def create_app(
             yield
         finally:
             app.state.web_logs.detach()
-            service.close()
+            if owns_service:
+                service.close()
 
     app = FastAPI(
         title="poppy robot API",

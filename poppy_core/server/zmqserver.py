@@ -185,17 +185,27 @@ class ZmqRobotServer:
         robot: the robot (the caller keeps and closes it).
         host: the address to bind (loopback by default).
         port: the port (pypot's documentation uses 6768); 0 picks a free one.
+        service: the robot service shared with the other servers of the robot
+            (``poppy_core.assembly.serve``, which closes it); by default its own.
 
     Raises:
         ListenError: the address or port cannot be used.
     """
 
-    def __init__(self, robot: Robot, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
+    def __init__(
+        self,
+        robot: Robot,
+        host: str = "127.0.0.1",
+        port: int = DEFAULT_PORT,
+        *,
+        service: RobotService | None = None,
+    ) -> None:
         require("zmq", extra="zmq", feature="pypot's ZMQ server")
         import zmq
 
         self.host = host
-        self.service = RobotService(robot)
+        self._owns_service = service is None
+        self.service = service or RobotService(robot)
         self.requests = ZmqRequests(self.service)
         self._context = zmq.Context()
         self._socket = self._context.socket(zmq.REP)
@@ -292,7 +302,8 @@ class ZmqRobotServer:
         else:
             self._socket.close()
             self._context.term()
-        self.service.close()
+        if self._owns_service:
+            self.service.close()
 
 
 ZMQRobotServer = ZmqRobotServer

@@ -12,6 +12,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("poppy_core", "poppy_cli")
+RE_EXPORTS = {("poppy_core.robot", "poppy_core.assembly"),
+              ("poppy_core.creatures", "poppy_core.assembly")}  # fmt: skip
+"""The re-exports of the composition root by the rooms below it, in their package's
+``__getattr__`` on first use (``tests/architecture/test_layers.py`` allows them there only): the
+assembly is imported after the room, never while it loads, so they close no circle at import
+time (docs/internals.md, "The composition root")."""
 
 
 def _module_name(path: Path) -> str:
@@ -117,4 +123,6 @@ def test_the_finder_sees_a_circle() -> None:
 def test_no_module_imports_itself_back() -> None:
     modules = _modules()
     graph = {name: _imported(name, path, modules) for name, path in modules.items()}
+    for package, root in RE_EXPORTS:
+        graph[package].discard(root)
     assert import_circles(graph) == []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -38,31 +39,79 @@ ALLOWED: dict[str, set[str]] = {
     "server": {"robot", "motion", "creatures", "models", "kinematics", "sensors"},
     "remote": set(),
 }
-# pypot's creature constructors start servers (use_http=True...): creatures/services.py, and only
-# it, reaches the server room, inside functions (importing creatures loads no server library).
+# the composition root (floor 8): builds a robot with its creature, and its servers; every room
+ALLOWED["assembly"] = set(ALLOWED)
+# The one kind of import that climbs, by design (docs/internals.md, "The composition root"): a
+# room's package re-exports the assembly's user-facing names (``poppy_core.robot.from_profile``,
+# ``poppy_core.creatures.PoppyErgoJr`` of user code and the documentation) through its module
+# ``__getattr__``, loaded on first use only.
 FILE_EXCEPTIONS = {
-    ("creatures/services.py", "poppy_core.server.background"),
-    ("creatures/services.py", "poppy_core.server.zmqserver"),
-    ("creatures/services.py", "poppy_core.server.snap"),
+    ("robot/__init__.py", "__getattr__", "poppy_core.assembly"),
+    ("creatures/__init__.py", "__getattr__", "poppy_core.assembly"),
 }
+DYNAMIC_IMPORTERS = {"import_module", "__import__"}
+# a room that imports a module whose name is computed: only the optional third-party libraries
+EXTRAS_LOADER = "extras.py"
+ENTRY_POINT = re.compile(r"poppy_core(\.[A-Za-z_][A-Za-z0-9_]*)+(:[A-Za-z_][A-Za-z0-9_.]*)?")
 
 
 def _imports(path: Path) -> set[str]:
+    return {name for name, _ in _imports_where(path)}
+
+
+def _imports_where(path: Path) -> set[tuple[str, str]]:
+    """Our modules ``path`` imports, each with the function it is imported in ("" at top level):
+    import statements anywhere, ``importlib.import_module("...")`` / ``__import__("...")`` and
+    entry points in strings (``"poppy_core.x.y:function"``), which climb just the same."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
-    names: set[str] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            names.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            names.add(node.module)
-    return names
+    found: set[tuple[str, str]] = set()
+
+    def visit(node: ast.AST, where: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and _type_checking_only(child):
+                continue  # for the type checker only: never imported at run time
+            inside = where
+            if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef):
+                inside = child.name if not where else f"{where}.{child.name}"
+            if isinstance(child, ast.Import):
+                found.update((alias.name, inside) for alias in child.names)
+            elif isinstance(child, ast.ImportFrom) and child.module and child.level == 0:
+                found.add((child.module, inside))
+            elif isinstance(child, ast.Call) and _called(child.func) in DYNAMIC_IMPORTERS:
+                first = child.args[0] if child.args else None
+                if isinstance(first, ast.Constant) and isinstance(first.value, str):
+                    found.add((first.value, inside))
+                elif path.name != EXTRAS_LOADER:
+                    found.add(("<a module named at run time>", inside))
+            elif isinstance(child, ast.Constant) and ENTRY_POINT.fullmatch(str(child.value)):
+                found.add((str(child.value).partition(":")[0], inside))
+            visit(child, inside)
+
+    visit(tree, "")
+    return found
 
 
-def test_rooms_import_only_downwards() -> None:
+def _type_checking_only(node: ast.If) -> bool:
+    test = node.test
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
+    )
+
+
+def _called(func: ast.expr) -> str:
+    if isinstance(func, ast.Attribute):
+        return func.attr
+    return func.id if isinstance(func, ast.Name) else ""
+
+
+def _climbing(rooms: dict[str, set[str]]) -> list[str]:
     bad = []
-    for room, allowed in ALLOWED.items():
+    for room, allowed in rooms.items():
         for path in sorted((ROOT / "poppy_core" / room).rglob("*.py")):
-            for name in _imports(path):
+            for name, where in sorted(_imports_where(path)):
+                if name.startswith("<"):
+                    bad.append(f"{path.relative_to(ROOT)} imports {name} in {where or 'its body'}")
+                    continue
                 parts = name.split(".")
                 if parts[0] == "poppy_cli":
                     bad.append(f"{path.relative_to(ROOT)} imports {name}")
@@ -72,10 +121,65 @@ def test_rooms_import_only_downwards() -> None:
                 if target == room or target in LEAVES or target in allowed:
                     continue
                 local = path.relative_to(ROOT / "poppy_core").as_posix()
-                if (local, name) in FILE_EXCEPTIONS:
+                if (local, where, name) in FILE_EXCEPTIONS:
                     continue
-                bad.append(f"{path.relative_to(ROOT)} imports {name}")
-    assert bad == []
+                inside = f" in {where}()" if where else ""
+                bad.append(f"{path.relative_to(ROOT)} imports {name}{inside}")
+    return bad
+
+
+def test_rooms_import_only_downwards() -> None:
+    """No room imports a higher one: at module level, in a function, or by an import string."""
+    assert _climbing(ALLOWED) == []
+
+
+def test_every_room_of_the_package_is_in_the_plan() -> None:
+    rooms = {p.name for p in (ROOT / "poppy_core").iterdir() if (p / "__init__.py").is_file()}
+    assert rooms <= set(ALLOWED), rooms - set(ALLOWED)
+
+
+@pytest.mark.parametrize(
+    "source",
+    [
+        "import importlib\nimportlib.import_module('poppy_core.creatures.attach')\n",
+        "def f():\n    __import__('poppy_core.server.app')\n",
+        "def f():\n    from poppy_core.creatures import registry\n",
+        "HOOK = 'poppy_core.motion.manager:primitive_manager'\n",
+        "import importlib\ndef f(name):\n    return importlib.import_module(name)\n",
+    ],
+)
+def test_the_layer_check_sees_every_way_of_climbing(
+    source: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An import string, a computed module name and a function-level import all climb."""
+    room = tmp_path / "poppy_core" / "robot"
+    room.mkdir(parents=True)
+    (room / "climber.py").write_text(source, encoding="utf-8")
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    assert len(_climbing({"robot": ALLOWED["robot"]})) == 1
+
+
+@pytest.mark.parametrize("room", ["robot", "creatures"])
+def test_the_one_exception_is_a_re_export_of_the_assembly(room: str) -> None:
+    """The package's ``__getattr__`` imports the assembly, only on first use, and only the
+    assembly's names; importing the room loads no assembly."""
+    found = _imports_where(ROOT / "poppy_core" / room / "__init__.py")
+    climbing = {(n, w) for n, w in found if n.split(".")[1:2] in (["assembly"], ["server"])}
+    assert climbing == {("poppy_core.assembly", "__getattr__")}
+    loaded = subprocess.run(
+        [sys.executable, "-c", f"import sys, poppy_core.{room}\nprint('\\n'.join(sys.modules))"],
+        capture_output=True, text=True, check=True, cwd=ROOT,
+    ).stdout.split()  # fmt: skip
+    assert "poppy_core.assembly" not in loaded
+    import importlib
+
+    from poppy_core import assembly
+
+    package = importlib.import_module(f"poppy_core.{room}")
+    for name in package.ASSEMBLED:
+        assert getattr(package, name) is getattr(assembly, name)
+    with pytest.raises(AttributeError):
+        package.nothing_of_that_name  # noqa: B018
 
 
 def _module_level_imports(path: Path) -> set[str]:

@@ -7,12 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core import creatures
-from poppy_core.creatures import Dance, attach
+from poppy_core import assembly, creatures
+from poppy_core.creatures import Dance
 from poppy_core.emulator import build_bus_from_spec, ergo_jr_bus, serve_link
 from poppy_core.errors import ConfigError
 from poppy_core.robot import autodetect, from_config, from_profile, load_profile, with_ports
-from poppy_core.robot.creature_hook import CREATURE_HOOK, resolve_hook
 
 
 def test_from_profile_attaches_the_creature() -> None:
@@ -33,8 +32,18 @@ def test_the_creatures_alias_builds_the_same_robot() -> None:
         assert robot.creature is not None and isinstance(robot.dance, Dance)
 
 
-def test_the_hook_is_an_entry_point_resolved_at_run_time() -> None:
-    assert resolve_hook(CREATURE_HOOK) is attach.attach_behaviours
+def test_the_robot_and_creatures_names_are_the_assemblys() -> None:
+    import poppy_core.robot
+
+    assert poppy_core.robot.from_profile is assembly.from_profile
+    assert poppy_core.robot.from_config is assembly.from_config
+    assert creatures.from_profile is assembly.from_profile
+    assert creatures.PoppyErgoJr is assembly.PoppyErgoJr
+
+
+def test_a_bare_robot_still_has_pypots_primitive_manager() -> None:
+    with from_config(load_profile("ergo-jr"), sim=True, sensors=False, creature=False) as robot:
+        assert robot._primitive_manager is robot.primitive_manager
 
 
 def test_with_ports_replaces_the_one_port_or_refuses_in_one_line() -> None:

@@ -35,7 +35,7 @@ def open_robot(source: str, sim: SimMode) -> Robot:
 
     It goes through ``poppy_core.robot``: a Poppy creature gets its behaviours attached.
     """
-    from poppy_core.robot import from_config, from_profile
+    from poppy_core.assembly import from_config, from_profile
 
     if Path(source).is_file():
         return from_config(Path(source), sim, sensors=False)

@@ -101,6 +101,11 @@ class SnapServer:
         return self.thread.port
 
     @property
+    def running(self) -> bool:
+        """True while it serves."""
+        return bool(self.thread.running)
+
+    @property
     def url(self) -> str:
         """``http://host:port`` (the address a browser on another machine would use for 0.0.0.0)."""
         host = self.site.address(None)

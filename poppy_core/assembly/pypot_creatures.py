@@ -1,9 +1,12 @@
 """pypot's creature classes: ``PoppyErgoJr(...)``, ``PoppyTorso(...)``, ``PoppyHumanoid(...)``.
 
 As in pypot, calling the class builds and returns the robot (a ``Robot`` made by the one factory,
-``poppy_core.creatures.from_profile`` / ``from_config``) with the creature's behaviours attached,
-and the servers asked for started. The constructor takes pypot's arguments; each is honoured or
-refused with a one-line error saying what to use instead.
+``poppy_core.assembly.from_profile`` / ``from_config``) with the creature's behaviours attached,
+and the servers asked for started by the one ``serve`` (``assembly.servers``), each attached
+under pypot's name (``robot.http``, ``robot.ws``, ``robot.zmq``, ``robot.snap``). They live in the
+assembly because they start servers; ``poppy_core.creatures.PoppyErgoJr`` re-exports them.
+The constructor takes pypot's arguments; each is honoured or refused with a one-line error
+saying what to use instead.
 """
 
 from __future__ import annotations
@@ -13,9 +16,9 @@ from collections.abc import Mapping
 from os import PathLike
 from typing import Any, ClassVar
 
-from poppy_core.creatures.factory import from_config, from_profile
+from poppy_core.assembly.build import from_config, from_profile
+from poppy_core.assembly.servers import DEFAULT_PORTS, Listen, ServeSpec, serve
 from poppy_core.creatures.registry import CREATURES, attach_creature
-from poppy_core.creatures.services import ServiceRequest, start_services
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.robot import Robot
 
@@ -25,8 +28,6 @@ SIMULATORS: dict[str | None, bool | str] = {None: False, "dummy": True, "mujoco"
 """pypot's ``simulator=`` values -> the factory's ``sim``: virtual servos with the ideal plant
 (``'dummy'``), with MuJoCo physics (``'mujoco'``), or hardware (None)."""
 LOOPBACK = "127.0.0.1"
-DEFAULT_PORTS = {"http": 8080, "snap": 6969, "ws": 9009, "zmq": 6768}
-"""pypot's default ports (``zmq``: the documentation's ZMQ example)."""
 
 
 def _simulator(value: object) -> bool | str:
@@ -113,16 +114,12 @@ class AbstractPoppyCreature:
             use_http = True  # pypot: poppy-simu is the dummy robot served over HTTP
         _refuse_vrep_options(base_path, scene, port, id, shared_vrep_io, use_remote)
         sensors = _sensor_switches(extra)
-        requests = [
-            ServiceRequest(name, host_, port_)
-            for name, wanted, host_, port_ in (
-                ("http", use_http, http_host, http_port),
-                ("ws", use_ws, ws_host, ws_port),
-                ("zmq", use_zmq, zmq_host, zmq_port),
-                ("snap", use_snap, snap_host, snap_port),
-            )
-            if wanted
-        ]
+        spec = ServeSpec(
+            http=Listen(http_host, http_port) if use_http else None,
+            ws=Listen(ws_host, ws_port) if use_ws else None,
+            zmq=Listen(zmq_host, zmq_port) if use_zmq else None,
+            snap=Listen(snap_host, snap_port) if use_snap else None,
+        )
         options: dict[str, Any] = {"start_sync": sync}
         if not sensors:
             options["sensors"] = False
@@ -135,7 +132,8 @@ class AbstractPoppyCreature:
             cls.setup(robot)
             if sim:
                 hold_start_pose(robot)
-            start_services(robot, requests, start_background_services)
+            if spec.listens():
+                start_services(robot, spec, start_background_services)
         except BaseException:
             robot.close()
             raise
@@ -151,6 +149,23 @@ class AbstractPoppyCreature:
         control = CREATURES[cls.kind].goto_control
         for motor in robot.motors:
             motor.goto_behavior = control
+
+
+def start_services(robot: Robot, spec: ServeSpec, start: bool) -> None:
+    """Serve ``spec`` (one server set) and attach each server as ``robot.<name>``, pypot's
+    names; ``robot.close()`` stops them all, in the set's order.
+
+    Args:
+        start: serve now (pypot's ``start_background_services``); False binds only, the
+            caller serves with ``robot.<name>.run()``.
+
+    Raises:
+        ListenError: a port is taken or an address unusable (nothing is left serving).
+    """
+    servers = serve(robot, spec, start=start)
+    robot.on_close(servers.stop)
+    for name, server in servers.servers.items():
+        robot.attach(name, server)
 
 
 def hold_start_pose(robot: Robot) -> None:

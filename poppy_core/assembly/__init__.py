@@ -1,0 +1,41 @@
+"""The composition root: the one place a robot is put together and its servers started.
+
+The top room of ``poppy_core`` (it may import every other): ``from_config``, ``from_profile``,
+``autodetect`` and pypot's ``from_json`` build a plain robot (``robot.factory``) and add its
+primitive manager and creature; ``serve(robot, spec)`` builds every server of a robot around one
+service; pypot's creature classes (``PoppyErgoJr(use_http=True)``) do both.
+``poppy_core.robot`` and ``poppy_core.creatures`` re-export the user-facing names.
+"""
+
+from types import MappingProxyType
+
+from poppy_core.assembly.build import autodetect, from_config, from_json, from_profile
+from poppy_core.assembly.pypot_creatures import (
+    AbstractPoppyCreature,
+    PoppyErgoJr,
+    PoppyHumanoid,
+    PoppyTorso,
+)
+from poppy_core.assembly.servers import Listen, ServerSet, ServeSpec, serve
+
+installed_poppy_creatures = MappingProxyType(
+    {"poppy-humanoid": PoppyHumanoid, "poppy-torso": PoppyTorso, "poppy-ergo-jr": PoppyErgoJr}
+)
+"""pypot's ``pypot.creatures.installed_poppy_creatures``: package name -> creature class (all three
+are part of poppy)."""
+
+__all__ = [
+    "AbstractPoppyCreature",
+    "Listen",
+    "PoppyErgoJr",
+    "PoppyHumanoid",
+    "PoppyTorso",
+    "ServeSpec",
+    "ServerSet",
+    "autodetect",
+    "from_config",
+    "from_json",
+    "from_profile",
+    "installed_poppy_creatures",
+    "serve",
+]

@@ -1,0 +1,221 @@
+"""``serve(robot, spec) -> ServerSet``: the one place a robot's servers are built and stopped.
+
+``poppy serve`` and the creature classes (``PoppyErgoJr(use_http=True, use_ws=True)``) both come
+here. Every protocol of one set shares one ``RobotService`` (so one teleoperation registry: a
+motor is teleoperated by one WebSocket connection, whichever port it came through), one Host and
+Origin policy (Snap!'s adds snap.berkeley.edu), one token, and one shutdown order: ZMQ, Snap!,
+WebSocket, HTTP (the reverse of starting), then the service's recordings and teleoperations.
+Importing this module loads no server library; ``serve`` does.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from poppy_core.robot import Robot
+    from poppy_core.server import OriginPolicy, RobotService
+    from poppy_core.server.background import BackgroundServer
+    from poppy_core.server.snap import SnapServer
+    from poppy_core.server.zmqserver import ZmqRobotServer
+
+PROTOCOLS = ("http", "ws", "zmq", "snap")
+"""pypot's attribute names of the servers (``robot.http``...), in the order they start."""
+DEFAULT_PORTS = {"http": 8080, "ws": 9009, "zmq": 6768, "snap": 6969}
+"""pypot's default ports (``zmq``: the documentation's ZMQ example)."""
+LOOPBACK = "127.0.0.1"
+
+
+@dataclass(frozen=True)
+class Listen:
+    """Where one server listens (``port`` 0 picks a free one)."""
+
+    host: str = LOOPBACK
+    port: int = 0
+
+
+@dataclass(frozen=True)
+class ServeSpec:
+    """Which servers to build for a robot, and the rules they share.
+
+    Attributes:
+        http: the REST API and page (with the stream at ``/api/v1/ws``), or None.
+        ws: pypot's WebSocket port (the state stream at ``/``), or None.
+        zmq: pypot's ZMQ request/reply server, or None.
+        snap: the Snap! server, or None.
+        token: required on every route and WebSocket (not ZMQ, which has none).
+        cors: browser origins allowed besides the servers' own pages (``"*"``: any).
+        allow_hosts: Host names answered besides loopback names, IPs and the listening host.
+        ws_rate_hz: the state stream's default rate.
+        snap_dir: a downloaded Snap! served at ``/app/`` on the Snap! port.
+        report: called with one line the first time an origin or Host name is refused.
+    """
+
+    http: Listen | None = None
+    ws: Listen | None = None
+    zmq: Listen | None = None
+    snap: Listen | None = None
+    token: str | None = None
+    cors: tuple[str, ...] = ()
+    allow_hosts: tuple[str, ...] = ()
+    ws_rate_hz: float = 30.0
+    snap_dir: Path | None = None
+    report: Callable[[str], None] | None = field(default=None, compare=False)
+
+    def listens(self) -> dict[str, Listen]:
+        """Protocol -> where it listens, for the servers asked for, in starting order."""
+        wanted = {"http": self.http, "ws": self.ws, "zmq": self.zmq, "snap": self.snap}
+        return {name: where for name, where in wanted.items() if where is not None}
+
+    @property
+    def host(self) -> str:
+        """The address the policy is made for: the first server's (loopback when none)."""
+        listens = list(self.listens().values())
+        return listens[0].host if listens else LOOPBACK
+
+
+class ServerSet:
+    """The servers of one robot, sharing ``service`` and ``policy``.
+
+    Attributes:
+        service: the one ``RobotService`` of every protocol.
+        policy: the Host and Origin rules of the HTTP and WebSocket servers.
+        app: the HTTP app (``None`` without ``http``).
+        servers: protocol -> its server (each has ``url``, ``port``, ``run()``, ``stop()``).
+    """
+
+    def __init__(self, service: RobotService, policy: OriginPolicy, app: Any) -> None:
+        self.service = service
+        self.policy = policy
+        self.app = app
+        self.servers: dict[str, Any] = {}
+        self._stopped = False
+
+    @property
+    def http(self) -> BackgroundServer | None:
+        """The REST server."""
+        return self.servers.get("http")
+
+    @property
+    def ws(self) -> BackgroundServer | None:
+        """pypot's WebSocket server."""
+        return self.servers.get("ws")
+
+    @property
+    def zmq(self) -> ZmqRobotServer | None:
+        """pypot's ZMQ server."""
+        return self.servers.get("zmq")
+
+    @property
+    def snap(self) -> SnapServer | None:
+        """The Snap! server."""
+        return self.servers.get("snap")
+
+    @property
+    def running(self) -> bool:
+        """True while every server serves."""
+        return bool(self.servers) and all(s.running for s in self.servers.values())
+
+    def start(self) -> ServerSet:
+        """Serve every server in the background (each was bound by ``serve``)."""
+        for server in self.servers.values():
+            server.start()
+        return self
+
+    def stop(self) -> None:
+        """Stop the servers (ZMQ, Snap!, WebSocket, HTTP), then the service (again: nothing)."""
+        if self._stopped:
+            return
+        self._stopped = True
+        for name in reversed(PROTOCOLS):
+            if name in self.servers:
+                self.servers[name].stop()
+        self.service.close()
+
+    def __enter__(self) -> ServerSet:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
+    """Build (and bind) the servers ``spec`` asks for over ``robot``; serve them unless ``start``
+    is False (each then serves on ``server.start()`` or pypot's ``server.run()``).
+
+    Every port is bound before any server serves, so a busy port is an error before anything
+    runs; when a step fails, whatever was bound or started is stopped.
+
+    Raises:
+        ListenError: a port is taken or an address unusable.
+        RuntimeError: a server did not start (its log says why).
+        ValueError: an origin in ``cors`` or a name in ``allow_hosts`` that is not one.
+        MissingExtraError: the ``server`` (or ``zmq``) extra is missing.
+    """
+    from poppy_core.server import OriginPolicy, RobotService, ServerThread, create_app
+    from poppy_core.server.background import BackgroundServer
+    from poppy_core.server.stream import create_stream_app
+
+    listens = spec.listens()
+    policy = OriginPolicy.for_server(
+        spec.host, cors=spec.cors, allow_hosts=spec.allow_hosts, report=spec.report
+    )
+    service = RobotService(robot)
+    app = None
+    if "http" in listens:
+        app = create_app(robot, service=service, token=spec.token, policy=policy,
+                         stream_rate_hz=spec.ws_rate_hz)  # fmt: skip
+    servers = ServerSet(service, policy, app)
+    try:
+        if app is not None:
+            where = listens["http"]
+            thread = ServerThread(app, where.host, where.port).bind()
+            servers.servers["http"] = BackgroundServer("http", thread, service=service)
+        if "ws" in listens:
+            where = listens["ws"]
+            stream = create_stream_app(service, spec.ws_rate_hz, spec.token, policy)
+            thread = ServerThread(stream, where.host, where.port).bind()
+            servers.servers["ws"] = BackgroundServer("ws", thread, service=service)
+        if "zmq" in listens:
+            from poppy_core.server.zmqserver import ZmqRobotServer
+
+            where = listens["zmq"]
+            servers.servers["zmq"] = ZmqRobotServer(robot, where.host, where.port, service=service)
+        if "snap" in listens:
+            _add_snap(servers, robot, spec, listens["snap"])
+        _own_pages(servers)
+        if start:
+            servers.start()
+    except BaseException:
+        servers.stop()
+        raise
+    return servers
+
+
+def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) -> None:
+    from poppy_core.server.snap import create_snap_server
+
+    snap = create_snap_server(
+        robot, where.host, where.port, service=servers.service, cors=spec.cors,
+        allow_hosts=spec.allow_hosts, snap_dir=spec.snap_dir, token=spec.token,
+        report=spec.report,
+    )  # fmt: skip
+    servers.servers["snap"] = snap
+    snap.thread.bind()
+
+
+def _own_pages(servers: ServerSet) -> None:
+    """The pages of every port count as the servers' own; the home page links to Snap!."""
+    ports = [s.port for name, s in servers.servers.items() if name != "zmq"]
+    servers.policy.with_ports(ports)
+    snap = servers.snap
+    if snap is None:
+        return
+    snap.bound(ports)
+    if servers.app is not None:
+        from poppy_core.server.web import add_link
+
+        add_link(servers.app, "Snap! with the Poppy blocks", snap.editor_url)

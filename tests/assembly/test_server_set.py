@@ -1,0 +1,151 @@
+"""One server set: the creature classes and `poppy serve` build it with the same ``serve()``,
+one service (so one teleoperation registry) behind every protocol."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+from websockets.sync.client import ClientConnection, connect
+
+from poppy_core import assembly
+from poppy_core.assembly import Listen, ServerSet, ServeSpec, pypot_creatures
+from poppy_core.creatures import PoppyErgoJr
+from poppy_core.robot import from_profile
+from tests.helpers.cli import run_poppy
+
+EVERY = ("http", "ws", "zmq", "snap")
+
+
+@pytest.fixture
+def built(monkeypatch: pytest.MonkeyPatch) -> list[tuple[ServeSpec, ServerSet]]:
+    """Every (spec, server set) ``serve`` built, whichever path called it."""
+    seen: list[tuple[ServeSpec, ServerSet]] = []
+    real = assembly.serve
+
+    def spy(robot: Any, spec: ServeSpec, **options: Any) -> ServerSet:
+        servers = real(robot, spec, **options)
+        seen.append((spec, servers))
+        return servers
+
+    monkeypatch.setattr(assembly, "serve", spy)
+    monkeypatch.setattr(pypot_creatures, "serve", spy)
+    return seen
+
+
+def _shape(servers: ServerSet) -> dict[str, str]:
+    """Protocol -> the type of its server, each checked to use the set's one service."""
+    for name, server in servers.servers.items():
+        assert server.service is servers.service, name
+    return {name: type(server).__name__ for name, server in servers.servers.items()}
+
+
+def test_the_creature_path_and_the_cli_path_give_the_same_server_set(
+    built: list[tuple[ServeSpec, ServerSet]], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    ports = {f"{name}_port": 0 for name in EVERY}
+    with PoppyErgoJr(simulator="dummy", use_http=True, use_ws=True, use_zmq=True,
+                     use_snap=True, **ports) as robot:  # fmt: skip
+        (creature_spec, creature_set), = built
+        assert {name: getattr(robot, name) for name in EVERY} == creature_set.servers
+        creature_shape = _shape(creature_set)
+        assert creature_set.running
+    assert not any(server_running for server_running in _states(creature_set))
+
+    def stop_at_once(servers: list[Any]) -> None:  # `poppy serve` waits for Ctrl-C here
+        assert all(s.running for s in servers)
+
+    monkeypatch.setattr("poppy_cli.commands.serve._wait_for_signal", stop_at_once)
+    args = ["serve", "--sim", "--profile", "ergo-jr", "--http", "--ws", "--zmq", "--snap"]
+    args += [f"--{name}-port=0" for name in EVERY]
+    result = run_poppy(*args)
+    assert result.code == 0, result.stderr
+    (cli_spec, cli_set), = built[1:]
+    assert cli_spec == creature_spec
+    assert _shape(cli_set) == creature_shape == {
+        "http": "BackgroundServer", "ws": "BackgroundServer", "zmq": "ZmqRobotServer",
+        "snap": "SnapServer",
+    }  # fmt: skip
+    assert cli_set.app.state.service is cli_set.service
+    assert not any(_states(cli_set))
+
+
+def _states(servers: ServerSet) -> list[bool]:
+    return [s.running for s in servers.servers.values()]
+
+
+def _teleop(ws: ClientConnection, motor: str) -> dict[str, Any]:
+    """Ask for ``motor`` and give the server's answer (started, or the refusal)."""
+    ws.send(json.dumps({"type": "teleop.start", "motors": [motor], "client": str(id(ws))}))
+    while True:
+        message = json.loads(ws.recv(timeout=10))
+        if message.get("type") == "teleop.started" or "error" in message:
+            return dict(message)
+
+
+@pytest.fixture
+def ergo_served_twice() -> Iterator[tuple[str, str]]:
+    """A virtual Ergo Jr built with use_http and use_ws: its two WebSocket URLs."""
+    with PoppyErgoJr(simulator="dummy", use_http=True, http_port=0, use_ws=True,
+                     ws_port=0) as robot:  # fmt: skip
+        http_port, ws_port = robot.http.port, robot.ws.port
+        yield f"ws://127.0.0.1:{http_port}/api/v1/ws", f"ws://127.0.0.1:{ws_port}/"
+
+
+@pytest.mark.parametrize("second", [0, 1], ids=["same port", "other port"])
+def test_two_websocket_clients_cannot_teleoperate_one_motor(
+    ergo_served_twice: tuple[str, str], second: int
+) -> None:
+    """Whether the second client comes through the HTTP port's stream or pypot's WebSocket
+    port, the motor is already taken."""
+    first_url = ergo_served_twice[1]
+    with connect(first_url) as first, connect(ergo_served_twice[second]) as other:
+        assert _teleop(first, "m1").get("type") == "teleop.started"
+        refused = _teleop(other, "m1")
+        assert "already teleoperated by another connection" in str(refused.get("error")), refused
+
+
+def test_a_busy_port_stops_the_servers_already_bound() -> None:
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        busy = taken.getsockname()[1]
+        with from_profile("ergo-jr", sim=True, sensors=False) as robot:
+            from poppy_core.server import ListenError
+
+            spec = ServeSpec(http=Listen(port=0), ws=Listen(port=busy))
+            with pytest.raises(ListenError, match="already in use"):
+                assembly.serve(robot, spec)
+            # the HTTP port bound first was released: a second set can be served
+            with assembly.serve(robot, ServeSpec(http=Listen(port=0))) as servers:
+                assert servers.running
+
+
+def test_stopping_the_set_stops_the_service_after_every_server(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    order: list[str] = []
+    with from_profile("ergo-jr", sim=True, sensors=False) as robot:
+        servers = assembly.serve(robot, ServeSpec(http=Listen(port=0), ws=Listen(port=0)))
+        for name, server in servers.servers.items():
+            _record(monkeypatch, server, "stop", order, name)
+        _record(monkeypatch, servers.service, "close", order, "service")
+        servers.stop()
+        servers.stop()
+    assert order == ["ws", "http", "service"]
+
+
+def _record(
+    monkeypatch: pytest.MonkeyPatch, target: Any, method: str, order: list[str], name: str
+) -> None:
+    real: Callable[[], None] = getattr(target, method)
+
+    def recorded() -> None:
+        order.append(name)
+        real()
+
+    monkeypatch.setattr(target, method, recorded)
