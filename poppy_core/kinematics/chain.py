@@ -68,8 +68,11 @@ class Chain:
         joints: Sequence[ChainJoint],
         tip: Sequence[float] = (0.0, 0.0, 0.0),
         options: SolverOptions | None = None,
+        label: str = "",
     ) -> None:
         self.name = name
+        self.label = label or name
+        """The chain's name in messages (the Ergo Jr's ``chain`` is its ``arm``)."""
         self.joints = tuple(joints)
         self.options = options or SolverOptions()
         names = [j.name for j in self.joints]
@@ -301,7 +304,7 @@ class Chain:
         near = _triple(found.pose[:3, 3])
         what = "position" if target.orientation is None else "pose"
         message = (
-            f"chain {self.name!r} cannot reach the {what} ({_xyz(goal)}) m within its joint "
+            f"chain {self.label!r} cannot reach the {what} ({_xyz(goal)}) m within its joint "
             f"limits: the nearest point it reaches is ({_xyz(near)}) m, "
             f"{found.position_error_m:.3f} m away"
         )

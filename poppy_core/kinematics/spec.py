@@ -153,5 +153,7 @@ def build_chains(
                     active=name not in passive,
                 )
             )
-        chains[chain.name] = Chain(chain.name, description, joints, chain.tip)
+        chains[chain.name] = Chain(
+            chain.name, description, joints, chain.tip, label=chain.shown
+        )
     return chains

@@ -32,6 +32,7 @@ def chain_state(chain: RobotChain) -> dict[str, Any]:
     pose = chain.pose
     return {
         "name": chain.name,
+        "label": chain.label,
         "motors": [m.name for m in chain.motors],
         "active_motors": [m.name for m in chain.active_motors],
         "base": chain.base,

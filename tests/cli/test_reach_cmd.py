@@ -136,6 +136,8 @@ def test_the_ergo_jr_chain_is_shown_as_arm_and_keeps_its_pypot_name(poppy: Any) 
     unknown = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", "leg", "0.1",
                     "0", "0.1")  # fmt: skip
     assert unknown.code == 1 and "(chains: arm)" in unknown.stderr
+    far = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", "1", "0", "0.1")
+    assert far.code == 1 and "chain 'arm' cannot reach" in far.stderr, far.stderr
 
 
 def test_a_chain_label_must_be_a_name() -> None:

@@ -412,5 +412,7 @@ def test_camera_and_chain_jog(browser: Any, creature: Served) -> None:
         return abs(tip[2] - chain.position[2] * 1000) < 5
 
     eventually(shown_in_mm, "the tip shown in millimetres")
+    # the Ergo Jr's chain keeps pypot's name in the URLs, and is shown as what it is
+    eventually(lambda: tab.inner_text("#chain-chain h3") == "arm", "the chain shown as arm")
     context.close()
     robot.compliant = True

@@ -23,6 +23,7 @@ class ChainInfo(BaseModel):
     """A chain: its motors and where its tip is (metres, in the chain's base frame)."""
 
     name: str
+    label: str = Field(description="the name people are shown (the Ergo Jr's chain: arm)")
     motors: list[str]
     active_motors: list[str] = Field(description="the motors solves and gotos move")
     base: str = Field(description="the link positions are expressed in")

@@ -63,10 +63,15 @@ export async function showChains(names) {
       pad.append(button(`${axis}−`, () => jog(name, i, -1, tip), `${name} ${axis} minus 10 mm`),
         button(`${axis}+`, () => jog(name, i, 1, tip), `${name} ${axis} plus 10 mm`));
     });
+    const heading = el("h3", { textContent: name });
     list.append(el("article", { className: "card", id: `chain-${name}` },
-      el("h3", { textContent: name }), el("p", {}, "tip (mm): ", tip), pad));
+      heading, el("p", {}, "tip (mm): ", tip), pad));
     const refresh = async () => {
-      try { tip.textContent = inMm((await get(`/api/v1/chains/${name}`)).position); } catch { /* shown elsewhere */ }
+      try {
+        const state = await get(`/api/v1/chains/${name}`);
+        heading.textContent = state.label || name;  // the Ergo Jr's `chain` is shown as its arm
+        tip.textContent = inMm(state.position);
+      } catch { /* shown elsewhere */ }
     };
     refresh();
     setInterval(refresh, 2000);
