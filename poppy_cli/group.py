@@ -16,7 +16,7 @@ from typer.core import TyperArgument, TyperGroup, TyperOption
 
 from poppy_cli.examples import examples_epilog
 from poppy_cli.flags import FLAGS, rewrite_deprecated
-from poppy_cli.options import SimArgsGroup
+from poppy_cli.options import SimArgsGroup, command_path
 from poppy_cli.output import warn_line
 
 if TYPE_CHECKING:
@@ -101,18 +101,4 @@ class PoppyGroup(SimArgsGroup):
 
 def _command_path(group: TyperGroup, ctx: _click.Context, args: list[str]) -> tuple[str, ...]:
     """The words naming the (sub)command ``args`` runs, e.g. ``("motor", "reset")``."""
-    path: list[str] = []
-    command: Any = group
-    for token in args:
-        if token == "--":
-            break
-        if token.startswith("-"):
-            continue
-        if not hasattr(command, "get_command"):
-            break
-        found = command.get_command(ctx, token)
-        if found is None:
-            break
-        path.append(token)
-        command = found
-    return tuple(path)
+    return tuple(command_path(group, ctx, args)[0])

@@ -203,8 +203,10 @@ RemoteOpt = typer.Option(
 # -- `--sim [ENGINE]`: an option whose value may be left out ---------------------------------
 
 
-def _leaf_command(group: TyperGroup, ctx: _click.Context, args: list[str]) -> Any:
-    """The command ``args`` will run (through nested groups), or None."""
+def command_path(group: TyperGroup, ctx: _click.Context, args: list[str]) -> tuple[list[str], Any]:
+    """The words naming the (sub)command ``args`` runs (e.g. ``["motor", "reset"]``) and that
+    command (through nested groups; ``group`` itself when ``args`` names none)."""
+    path: list[str] = []
     command: Any = group
     for token in args:
         if token == "--":
@@ -216,7 +218,14 @@ def _leaf_command(group: TyperGroup, ctx: _click.Context, args: list[str]) -> An
         found = command.get_command(ctx, token)
         if found is None:
             break
+        path.append(token)
         command = found
+    return path, command
+
+
+def _leaf_command(group: TyperGroup, ctx: _click.Context, args: list[str]) -> Any:
+    """The command ``args`` will run (through nested groups), or None."""
+    command = command_path(group, ctx, args)[1]
     return None if command is group else command
 
 

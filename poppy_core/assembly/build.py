@@ -16,8 +16,7 @@ from poppy_core.errors import ArgumentError
 from poppy_core.motion.manager import primitive_manager
 from poppy_core.robot import factory
 from poppy_core.robot.config_io import ConfigSource
-from poppy_core.robot.factory import SimMode, with_ports
-from poppy_core.robot.profiles import load_profile
+from poppy_core.robot.factory import SimMode, profile_config
 from poppy_core.robot.robot import Robot
 
 __all__ = ["autodetect", "from_config", "from_json", "from_profile"]
@@ -86,10 +85,7 @@ def from_profile(
         sim: serve the motors from emulators (True/``"ideal"`` or ``"mujoco"``).
         **options: passed to :func:`from_config` (``start_defaults``, ``creature``...).
     """
-    config = load_profile(name)
-    if port is not None:
-        config = with_ports(config, port)
-    return from_config(config, sim, **options)
+    return from_config(profile_config(name, port), sim, **options)
 
 
 def autodetect(

@@ -130,6 +130,13 @@ def with_ports(
     return RobotConfig.from_dict(data, source=source)
 
 
+def profile_config(name: str, port: str | Mapping[str, str] | None = None) -> RobotConfig:
+    """The config of an installed or user profile, on ``port`` (one controller) or on the
+    controllers' ports of a mapping; None keeps the profile's (``"auto"``: searched for)."""
+    config = load_profile(name)
+    return config if port is None else with_ports(config, port)
+
+
 def from_profile(
     name: str, port: str | Mapping[str, str] | None = None, sim: SimMode = False, **options: Any
 ) -> Robot:
@@ -137,15 +144,11 @@ def from_profile(
 
     Args:
         name: the profile name.
-        port: the port (one controller) or controller name -> port; None keeps the profile's
-            (``"auto"`` searches for the bus holding the motors).
+        port: see :func:`profile_config`.
         sim: serve the motors from emulators (True/``"ideal"`` or ``"mujoco"``).
         **options: passed to :func:`from_config`.
     """
-    config = load_profile(name)
-    if port is not None:
-        config = with_ports(config, port)
-    return from_config(config, sim, **options)
+    return from_config(profile_config(name, port), sim, **options)
 
 
 def detect_config(
