@@ -38,10 +38,10 @@ from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_bus, find_port
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
 from poppy_core.bus.settle import answers, doubt_learned, ping_found, settle
-from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, LinkTiming
+from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, LinkTiming, silence_s
 from poppy_core.bus.transport import Transport
 from poppy_core.errors import PortError
-from poppy_core.models import standard_baudrates
+from poppy_core.models import model_by_number, standard_baudrates
 
 __all__ = [
     "DEFAULT_SEARCH_FIRST_BPS",
@@ -129,6 +129,7 @@ def _scan_rate(
     *,
     first: bool = False,
     last: bool = False,
+    final: bool = False,
     pass_latency_s: float | None = None,
 ) -> set[int]:
     """Scan one (port, rate, protocol); motors answering are confirmed before being reported.
@@ -136,7 +137,9 @@ def _scan_rate(
     ``first``: nothing was sent on the port before in this scan, so no late reply from another
     rate can be taken for a motor here: the motors found are reported without asking again.
     ``last``: no rate comes after on this port; after a trusted broadcast ping no reply is
-    still coming, and the line need not be left quiet. ``pass_latency_s``: the latency the
+    still coming, and the line need not be left quiet. ``final``: no later rate of this protocol
+    comes to look back here, so two empty broadcasts are believed only after a silence (module
+    docstring). ``pass_latency_s``: the latency the
     pass over every ID assumes (the port's, not one learned since; None: the bus's).
 
     Returns:
@@ -168,6 +171,10 @@ def _scan_rate(
                 bus.baudrate,
             )
     late: set[int] = set()
+    heard: dict[int, PingResult] = {}
+    if trusted and not candidates and final:
+        heard = _heard_in_silence(bus, wanted)
+        late.update(heard)
     if not trusted:
         late.update(s.id for s in bus.take_strays() if s.id in wanted)  # late broadcast replies
         # The pass keeps the port's deadline, whatever is learned (module docstring).
@@ -192,7 +199,8 @@ def _scan_rate(
     if not (trusted and last):
         late |= settle(bus) & wanted
     for motor_id in sorted(late - set(candidates)):
-        result = ping_found(bus, motor_id, retries=1)
+        # A late broadcast reply, if asking again goes unanswered (the other end still late).
+        result = ping_found(bus, motor_id, retries=1) or heard.get(motor_id)
         if result is not None:
             candidates[motor_id] = result
     if first:
@@ -206,6 +214,31 @@ def _scan_rate(
     if bus.latency_s > began_s and here:
         doubt_learned(bus, began_s, max(here))
     return (unconfirmed | late) - set(here)
+
+
+def _heard_in_silence(bus: DxlBus, wanted: set[int]) -> dict[int, PingResult]:
+    """Listen until the line has been silent ``silence_s`` since the last broadcast ping.
+
+    Returns:
+        The ping replies of ``wanted`` IDs that came late meanwhile (kept aside as strays during
+        the second broadcast, or arriving now), by ID.
+    """
+    quiet_s = silence_s(bus.latency_s) - bus.transport.since_written_s()
+    heard: dict[int, PingResult] = {}
+    for status in bus.listen(max(0.0, quiet_s)):
+        if status.id in wanted and len(status.params) == bus.proto.ping_params:
+            number = int.from_bytes(status.params[:2], "little")
+            heard[status.id] = PingResult(
+                status.id, number, status.params[2], model_by_number(number)
+            )
+    if heard:
+        logger.info(
+            "%s: both broadcast pings at %d bps missed late replies from %s: asking again",
+            bus.port,
+            bus.baudrate,
+            ", ".join(map(str, sorted(heard))),
+        )
+    return heard
 
 
 def _ping_deadline_s(bus: DxlBus, latency_s: float) -> float:
@@ -362,7 +395,14 @@ def scan(
                     last = protocol == protocol_list[-1] and rate == rates[protocol][-1]
                     assumed = bus.latency_s if assumed is None else assumed
                     heard_late = _scan_rate(
-                        state, port, bus, broadcast, first=first, last=last, pass_latency_s=assumed
+                        state,
+                        port,
+                        bus,
+                        broadcast,
+                        first=first,
+                        last=last,
+                        final=rate == rates[protocol][-1],
+                        pass_latency_s=assumed,
                     )
                     first = False
                     learned = bus.latency_s
