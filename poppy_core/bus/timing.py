@@ -52,9 +52,9 @@ MARGIN_FRACTION = 0.1
 SETTLE_LATENCIES = 3.0
 SETTLE_MIN_S = 0.01
 
-# Silence that must follow two empty broadcast pings at the last rate of a protocol before the
-# bus is taken for empty there: the replies of a motor whose other end the OS ran late (an
-# emulator on a busy machine, a USB adapter held up) arrive in it. This many adapter latencies,
+# Silence that must follow two empty broadcast pings before the bus is taken for empty at that
+# rate: the replies of a motor whose other end the OS ran late (an emulator on a busy machine, a
+# USB adapter held up) arrive in it. This many adapter latencies,
 # at least SILENCE_MIN_S (longer than the stalls seen on a loaded machine, 10-30 ms).
 SILENCE_LATENCIES = 10.0
 SILENCE_MIN_S = 0.05

@@ -117,7 +117,10 @@ class LateFirst(FaultInjector):
         return data
 
 
-@pytest.mark.parametrize("rates", [[1_000_000], [2_000_000, 1_000_000]])
+@pytest.mark.parametrize(
+    "rates",
+    [[1_000_000], [2_000_000, 1_000_000], [1_000_000, 2_000_000], [57_600, 1_000_000, 2_000_000]],
+)
 def test_two_late_empty_broadcasts_do_not_hide_the_motors(rates: list[int]) -> None:
     # Both broadcast pings' replies (3 motors x 2) come far past their deadline: the pair
     # agrees and the line stays clean, but the silence was lateness, not an empty bus.
