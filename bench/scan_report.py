@@ -249,9 +249,7 @@ def _notes(
             notes.append(
                 f"**Correctness failure**: `{client}` on the protocol {protocol} bus, "
                 f"{agg['problem']}. A scan that misses motors is a bug, not noise; it fails this "
-                "benchmark whatever the times. In protocol 2 poppy trusts an empty broadcast "
-                "ping when the line stayed clean, so one late or lost broadcast reply hides "
-                "every motor at that rate."
+                "benchmark whatever the times."
             )
     if peers_note:
         notes.append(f"Peers not measured: {peers_note}.")

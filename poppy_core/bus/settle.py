@@ -6,8 +6,9 @@ import logging
 
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.results import PingResult
-from poppy_core.bus.timing import settle_s
+from poppy_core.bus.timing import settle_s, silence_s
 from poppy_core.errors import CorruptPacketError
+from poppy_core.models import model_by_number
 
 logger = logging.getLogger(__name__)
 
@@ -34,6 +35,34 @@ def settle(bus: DxlBus, min_s: float = 0.0) -> set[int]:
     """
     quiet_s = max(settle_s(bus.latency_s), min_s)
     return {status.id for status in bus.listen(max(0.0, quiet_s - bus.transport.since_written_s()))}
+
+
+def heard_in_silence(bus: DxlBus, wanted: set[int]) -> dict[int, PingResult]:
+    """Listen until ``silence_s`` has passed since the last instruction (the second broadcast).
+
+    Two empty broadcast pings may only mean that the other end was run late past both
+    deadlines (see ``poppy_core.bus.scan``).
+
+    Returns:
+        The ping replies of ``wanted`` IDs that came late meanwhile (kept aside as strays during
+        the second broadcast, or arriving now), by ID.
+    """
+    quiet_s = silence_s(bus.latency_s) - bus.transport.since_written_s()
+    heard: dict[int, PingResult] = {}
+    for status in bus.listen(max(0.0, quiet_s)):
+        if status.id in wanted and len(status.params) == bus.proto.ping_params:
+            number = int.from_bytes(status.params[:2], "little")
+            heard[status.id] = PingResult(
+                status.id, number, status.params[2], model_by_number(number)
+            )
+    if heard:
+        logger.info(
+            "%s: both broadcast pings at %d bps missed late replies from %s: asking again",
+            bus.port,
+            bus.baudrate,
+            ", ".join(map(str, sorted(heard))),
+        )
+    return heard
 
 
 def answers(bus: DxlBus, motor_id: int) -> bool:

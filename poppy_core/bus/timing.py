@@ -52,10 +52,16 @@ MARGIN_FRACTION = 0.1
 SETTLE_LATENCIES = 3.0
 SETTLE_MIN_S = 0.01
 
+# Silence that must follow two empty broadcast pings before the bus is taken for empty at that
+# rate: the replies of a motor whose other end the OS ran late (an emulator on a busy machine, a
+# USB adapter held up) arrive in it. This many adapter latencies,
+# at least SILENCE_MIN_S (longer than the stalls seen on a loaded machine, 10-30 ms).
+SILENCE_LATENCIES = 10.0
+SILENCE_MIN_S = 0.05
+
 # Factory return delay of AX/MX/X servos: 250 x 2 µs (e-manual: "Return Delay Time", address 5
 # on protocol 1 models, 9 on X series).
 DEFAULT_RETURN_DELAY_S = 0.0005
-
 
 
 def byte_time_s(baudrate: int) -> float:
@@ -76,6 +82,11 @@ def status_size(protocol: int | DxlProtocol, n_params: int) -> int:
 def settle_s(latency_s: float) -> float:
     """How long to listen for late replies on an adapter of ``latency_s`` (see above)."""
     return max(SETTLE_MIN_S, SETTLE_LATENCIES * latency_s)
+
+
+def silence_s(latency_s: float) -> float:
+    """How long an empty bus must stay silent on an adapter of ``latency_s`` (see above)."""
+    return max(SILENCE_MIN_S, SILENCE_LATENCIES * latency_s)
 
 
 def scheduling_margin_s(physical_s: float) -> float:

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from poppy_core.bus import DxlBus, find_port, locate, scan
-from poppy_core.emulator import FaultInjector, VirtualBus, VirtualMotor, serve_pty
+from poppy_core.emulator import FaultInjector, VirtualBus, VirtualMotor, serve_link, serve_pty
 from poppy_core.errors import PortError
 from poppy_core.models import model_by_name
 from poppy_core.robot import Motor
@@ -103,3 +103,31 @@ def test_a_robot_is_not_refused_for_a_motor_late_twice_at_startup() -> None:
         robot_motor = Motor("m7", model_by_name("MX-28"), 7)
         assert check_presence(bus, "c", [robot_motor]) == []
         assert robot_motor.online
+
+
+class LateFirst(FaultInjector):
+    """Holds the first ``count`` replies back ``delay_s``, as an emulator the OS ran late."""
+
+    def __init__(self, count: int, delay_s: float) -> None:
+        super().__init__()
+        self.left = count
+        self.delay_s = delay_s
+
+    def filter_reply(self, data: bytes) -> bytes | None:
+        self.left -= 1
+        self._extra_delay_s = self.delay_s if self.left >= 0 else 0.0
+        return data
+
+
+@pytest.mark.parametrize(
+    "rates",
+    [[1_000_000], [2_000_000, 1_000_000], [1_000_000, 2_000_000], [57_600, 1_000_000, 2_000_000]],
+)
+def test_two_late_empty_broadcasts_do_not_hide_the_motors(rates: list[int]) -> None:
+    # Both broadcast pings' replies (3 motors x 2) come far past their deadline: the pair
+    # agrees and the line stays clean, but the silence was lateness, not an empty bus.
+    motors = [VirtualMotor(model_by_name("XL-320"), i, 1_000_000) for i in (1, 2, 3)]
+    with serve_link(VirtualBus(motors, 2, faults=LateFirst(6, 0.025))) as server:
+        found = scan(server.url, rates, [2])
+    assert _found(found) == [(1, 1_000_000), (2, 1_000_000), (3, 1_000_000)]
+    assert all(f.model == "XL-320" for f in found)
