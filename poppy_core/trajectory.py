@@ -31,11 +31,25 @@ def control_name(control: str) -> str:
         )  # fmt: skip
     return name
 
+
 MAX_DURATION_S = checks.MAX_DURATION_S
 """The longest goto or move (a day): longer is a typing mistake that would never end."""
+MIN_DURATION_S = checks.MIN_DURATION_S
 """A goto shorter than this (one period of the fastest loop) is a jump: the goal is sent at once
 at full speed, as for 0 (no loop could sample it, and a minimum-jerk curve of 1e-300 s divides
 by zero)."""
+
+
+def goto_duration(value: object) -> float:
+    """A goto's duration given as a number or as text (a URL segment, a JSON string), checked.
+
+    The one duration rule of every surface (Python, CLI, REST, Snap!, ZMQ): ``checks.duration``.
+
+    Raises:
+        ArgumentError: not a number, not finite, negative, between 0 and ``MIN_DURATION_S``, or
+            longer than ``MAX_DURATION_S``.
+    """
+    return checks.duration(checks.number_from(value, "duration"))
 
 
 def check_goto(duration_s: float, control: str) -> None:

@@ -19,7 +19,8 @@ from poppy_core import checks
 from poppy_core.errors import PoppyError
 from poppy_core.extras import require
 from poppy_core.server.errors import ApiError, ListenError
-from poppy_core.server.service import RobotService, check_duration
+from poppy_core.server.service import RobotService
+from poppy_core.trajectory import goto_duration
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
@@ -134,7 +135,7 @@ class ZmqRequests:
     ) -> None:
         handle = self.service.goto({motor: position}, duration)
         if wait:
-            handle.wait(check_duration(duration) + 5.0)
+            handle.wait(goto_duration(duration) + 5.0)
 
     def set_goto_positions_for_motors(
         self,
@@ -151,7 +152,7 @@ class ZmqRequests:
         handle = self.service.goto(dict(zip(motors, positions, strict=True)), duration,
                                    control or "minjerk")  # fmt: skip
         if wait:
-            handle.wait(check_duration(duration) + 5.0)
+            handle.wait(goto_duration(duration) + 5.0)
 
     def _control(self, primitive: str, action: str) -> None:
         self.service.control_primitive(primitive, action)
