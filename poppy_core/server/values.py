@@ -21,7 +21,7 @@ from poppy_core.models import ServoModel
 from poppy_core.robot import Motor
 from poppy_core.robot import registers as regs
 from poppy_core.server.errors import ApiError
-from poppy_core.trajectory import CONTROLS, control_name
+from poppy_core.trajectory import CONTROLS, clamp_goal, control_name
 
 REGISTER_TIP = "the registers of a motor are listed by /motors/<motor_name>/registers/list.json"
 
@@ -142,10 +142,7 @@ def check_position(motor: Motor, name: str, value: Any) -> float:
     clamped value. A wheel has no limits.
     """
     position = number(motor, name, value)
-    if motor.wheel_mode:
-        return position
-    low, high = motor.angle_limit
-    return min(max(position, low), high)
+    return clamp_goal(position, None if motor.wheel_mode else motor.angle_limit)
 
 
 def _goal_speed(motor: Motor, name: str, value: Any) -> float:
