@@ -126,6 +126,18 @@ def from_poppy_error(exc: PoppyError) -> ApiError:
     return ApiError("invalid", str(exc))
 
 
+def refusal_kind(exc: BaseException) -> Kind:
+    """The kind of a refusal, for the surfaces that answer without a status (WebSocket frames
+    and ZMQ replies carry it as ``"kind"``): an ``ApiError``'s own, a core error's by its type,
+    and ``"invalid"`` for a bad argument Python itself refused (``ValueError``, ``TypeError``).
+    """
+    if isinstance(exc, ApiError):
+        return exc.kind
+    if isinstance(exc, PoppyError):
+        return from_poppy_error(exc).kind
+    return "invalid"
+
+
 async def _api_error(request: Request, exc: Exception) -> Response:
     assert isinstance(exc, ApiError)
     return error_response(request, exc)

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 from poppy_core import checks
 from poppy_core.errors import PoppyError
 from poppy_core.extras import require
-from poppy_core.server.errors import ApiError, ListenError
+from poppy_core.server.errors import ApiError, ListenError, refusal_kind
 from poppy_core.server.service import RobotService
 from poppy_core.trajectory import goto_duration
 
@@ -95,9 +95,9 @@ class ZmqRequests:
                     arguments[key] = _json_argument(arguments[key])
             result = method(**arguments)
         except TypeError as exc:  # missing or unexpected arguments
-            return {"error": f"bad arguments: {exc}"}
+            return {"error": f"bad arguments: {exc}", "kind": "invalid"}
         except (ApiError, PoppyError, ValueError, KeyError, ArithmeticError) as exc:
-            return {"error": _one_line(exc)}
+            return {"error": _one_line(exc), "kind": refusal_kind(exc)}
         return {} if result is None else result
 
     @staticmethod
