@@ -13,8 +13,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from poppy_core.errors import UnknownPrimitiveError
-from poppy_core.motion import Primitive, attach_builtins, attached_primitives
+from poppy_core.motion import Primitive, attach_builtins, attached_primitive, attached_primitives
 from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
 from poppy_core.server.errors import ApiError
@@ -188,14 +187,7 @@ class RobotService:
 
     def primitive(self, name: str) -> Primitive:
         """The primitive ``name`` (``UnknownPrimitiveError``, a 404, for another name)."""
-        found = self.primitives().get(name)
-        if found is None:
-            known = list(self.primitives())
-            raise UnknownPrimitiveError(
-                f"no primitive {name!r} (primitives: {', '.join(known) or 'none'})",
-                name=str(name), known=known,
-            )  # fmt: skip
-        return found
+        return attached_primitive(self.robot, name)
 
     def running_primitives(self) -> list[str]:
         """Names of the primitives running (or paused)."""
