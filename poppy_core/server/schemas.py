@@ -5,6 +5,7 @@ from typing import Annotated
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, JsonValue
 
 from poppy_core import checks
+from poppy_core.motion.player import MAX_SPEED, MIN_SPEED
 from poppy_core.trajectory import CONTROLS, control_name
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -174,7 +175,9 @@ class PlayRequest(BaseModel):
     """How to play a move."""
 
     model_config = ConfigDict(extra="forbid")
-    speed: Finite = Field(1.0, gt=0, le=100, description="2.0 plays twice as fast")
+    speed: Finite = Field(
+        1.0, ge=MIN_SPEED, le=MAX_SPEED, description="2.0 plays twice as fast (the player's range)"
+    )
     backwards: bool = False
 
 
