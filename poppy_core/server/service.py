@@ -237,7 +237,7 @@ class RobotService:
         if isinstance(value, float) and not math.isfinite(value):
             raise ApiError("invalid", f"{name}.{prop}: expected a finite number")
         try:
-            primitive.set_property(prop, value)  # ConfigError -> 4xx "invalid"
+            primitive.set_property(prop, value)  # ArgumentError -> 4xx "invalid"
         except (OverflowError, RecursionError):
             raise ApiError("invalid", f"{name}.{prop}: the value is out of range") from None
         return values.jsonable(primitive.get_property(prop))
