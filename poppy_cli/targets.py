@@ -5,7 +5,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 
 from poppy_core import checks
-from poppy_core.errors import ArgumentError, ConfigError
+from poppy_core.errors import ArgumentError, UnknownMotorError
+from poppy_core.trajectory import clamp_goal
 
 
 class TargetSyntaxError(ArgumentError):
@@ -19,13 +20,12 @@ def parse_targets(
     limits: Mapping[str, tuple[float, float] | None] | None = None,
 ) -> dict[str, float]:
     """Parse ``NAME=DEGREES`` words into motor name -> degrees, checking the names against
-    ``known`` and the angles against ``limits`` (motor -> its angle limits, None for a wheel),
-    as the REST API does.
+    ``known``; an angle beyond ``limits`` (motor -> its angle limits in the user frame, None for
+    a wheel) is clamped to them, as the library and every server do (``trajectory.clamp_goal``).
 
     Raises:
         TargetSyntaxError: a word that is not NAME=DEGREES with a finite number, or no word.
-        ConfigError: an unknown motor (the known ones are listed).
-        ArgumentError: an angle outside the motor's limits.
+        UnknownMotorError: an unknown motor (the known ones are listed).
     """
     targets: dict[str, float] = {}
     for word in words:
@@ -34,8 +34,8 @@ def parse_targets(
         if not sep or not name:
             raise TargetSyntaxError(f"{word!r} is not NAME=DEGREES (e.g. m1=30)", value=word)
         if name not in known:
-            raise ConfigError(
-                f"no motor {name!r} (motors: {', '.join(known)})", field=name, value=name
+            raise UnknownMotorError(
+                f"no motor {name!r} (motors: {', '.join(known)})", motor=name, known=list(known)
             )
         try:
             value = float(text)
@@ -50,13 +50,7 @@ def parse_targets(
                 f"{word!r}: the angle must be a finite number of degrees within "
                 f"±{checks.MAX_MAGNITUDE:g}", field=name, value=value,
             ) from None  # fmt: skip
-        bounds = (limits or {}).get(name)
-        if bounds is not None and not bounds[0] <= value <= bounds[1]:
-            raise ArgumentError(
-                f"{name}: {value:g}° is outside the angle limits [{bounds[0]:g}, {bounds[1]:g}]",
-                field=name, value=value, motor=name,
-            )  # fmt: skip
-        targets[name] = value
+        targets[name] = clamp_goal(value, (limits or {}).get(name))
     if not targets:
         raise TargetSyntaxError("no target: type e.g. m1=30 m2=-10")
     return targets

@@ -22,8 +22,13 @@ The tree (catch the bases, raise the leaves)::
     ├── SetupError                a setup operation refused or could not be verified (ID taken, ...)
     ├── ConfigError               a bad robot config, move or name; carries ``file``, ``field``,
     │   │                         ``value``, ``reason`` and ``problems`` (every problem found)
-    │   └── UnknownMotorError     a motor (or group) name the robot does not have; carries
-    │                             ``motor`` and ``known``
+    │   └── UnknownNameError      a name that is not there; carries ``kind``, ``name``, ``known``
+    │       │                     (servers answer 404 for every one)
+    │       ├── UnknownMotorError a motor (or group) name the robot does not have; ``motor``
+    │       │   └── UnknownGroupError  a group name
+    │       ├── UnknownPrimitiveError  a primitive not attached
+    │       ├── UnknownMoveError  a move not in the moves folder
+    │       └── UnknownCardError  a card (marker name) a detector does not know
     ├── KinematicsError           a target out of a chain's reach; carries ``nearest``
     ├── SensorError               a camera or other sensor cannot be opened or read; ``sensor``
     ├── MissingExtraError         a feature whose optional dependencies (an extra, e.g.
@@ -185,13 +190,88 @@ class ConfigError(PoppyError):
         return error
 
 
-class UnknownMotorError(ConfigError):
-    """A motor or group name the robot does not have."""
+class SensorError(PoppyError):
+    """A sensor (camera...) cannot be opened, or gave no value in time."""
+
+    def __init__(
+        self, message: str, *, sensor: str | None = None, device: str | None = None
+    ) -> None:
+        super().__init__(message)
+        self.sensor = sensor
+        self.device = device
+
+
+class UnknownNameError(ConfigError):
+    """A name (motor, group, primitive, move, card...) that is not there.
+
+    Attributes:
+        kind: what was looked for (``"motor"``, ``"group"``, ``"primitive"``, ``"move"``,
+            ``"card"``); servers answer "not found" (404) for every kind.
+        name: the name asked for.
+        known: the names that are there (for the message's "did you mean").
+    """
+
+    kind_name = "name"
+    """The ``kind`` of the subclass (what it looks for)."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        name: str,
+        known: list[str] | None = None,
+        kind: str | None = None,
+    ) -> None:
+        self.kind = kind or self.kind_name
+        super().__init__(message, field=name, value=name, reason=f"unknown {self.kind}")
+        self.name = name
+        self.known = list(known or [])
+
+
+class UnknownMotorError(UnknownNameError):
+    """A motor or group name the robot does not have (``motor`` is the name asked for)."""
+
+    kind_name = "motor"
+
+    def __init__(
+        self, message: str, *, motor: str, known: list[str] | None = None, kind: str = "motor"
+    ) -> None:
+        super().__init__(message, name=motor, known=known, kind=kind)
+        self.motor = motor
+
+
+class UnknownGroupError(UnknownMotorError):
+    """A group name (an alias of several motors) the robot does not have."""
+
+    kind_name = "group"
 
     def __init__(self, message: str, *, motor: str, known: list[str] | None = None) -> None:
-        super().__init__(message, field=motor, value=motor, reason="unknown motor")
-        self.motor = motor
-        self.known = list(known or [])
+        super().__init__(message, motor=motor, known=known, kind="group")
+
+
+class UnknownPrimitiveError(UnknownNameError):
+    """A primitive name that is not attached to the robot."""
+
+    kind_name = "primitive"
+
+
+class UnknownMoveError(UnknownNameError):
+    """A recorded move name that is not in the moves folder."""
+
+    kind_name = "move"
+
+
+class UnknownCardError(UnknownNameError, SensorError):
+    """A card (a marker's name) a detector does not know (also a ``SensorError``)."""
+
+    kind_name = "card"
+
+    def __init__(
+        self, message: str, *, name: str, known: list[str] | None = None, sensor: str | None = None
+    ) -> None:
+        super().__init__(message, name=name, known=known)
+        self.sensor = sensor
+        self.device = None
 
 
 class KinematicsError(PoppyError):
@@ -218,17 +298,6 @@ class KinematicsError(PoppyError):
         self.target = target
         self.nearest = nearest
         self.distance_m = distance_m
-
-
-class SensorError(PoppyError):
-    """A sensor (camera...) cannot be opened, or gave no value in time."""
-
-    def __init__(
-        self, message: str, *, sensor: str | None = None, device: str | None = None
-    ) -> None:
-        super().__init__(message)
-        self.sensor = sensor
-        self.device = device
 
 
 class PrimitiveError(PoppyError):

@@ -31,11 +31,35 @@ def control_name(control: str) -> str:
         )  # fmt: skip
     return name
 
+
 MAX_DURATION_S = checks.MAX_DURATION_S
 """The longest goto or move (a day): longer is a typing mistake that would never end."""
+MIN_DURATION_S = checks.MIN_DURATION_S
 """A goto shorter than this (one period of the fastest loop) is a jump: the goal is sent at once
 at full speed, as for 0 (no loop could sample it, and a minimum-jerk curve of 1e-300 s divides
 by zero)."""
+
+
+def clamp_goal(target: float, limits: tuple[float, float] | None) -> float:
+    """``target`` clamped to the angle ``limits`` (None: a wheel, no limits).
+
+    The one clamp-or-refuse rule of every surface (docs/rest.md, "Arguments and errors"): a
+    finite goal beyond the limits is clamped (as ``Motor.goal_position`` and pypot do) and the
+    answer says where the motor goes; a goal that is not a finite number is refused before.
+    """
+    return target if limits is None else min(max(target, limits[0]), limits[1])
+
+
+def goto_duration(value: object) -> float:
+    """A goto's duration given as a number or as text (a URL segment, a JSON string), checked.
+
+    The one duration rule of every surface (Python, CLI, REST, Snap!, ZMQ): ``checks.duration``.
+
+    Raises:
+        ArgumentError: not a number, not finite, negative, between 0 and ``MIN_DURATION_S``, or
+            longer than ``MAX_DURATION_S``.
+    """
+    return checks.duration(checks.number_from(value, "duration"))
 
 
 def check_goto(duration_s: float, control: str) -> None:
@@ -202,7 +226,7 @@ def plan_goto(
     """
     name = control_name(control)
     check_goto(duration_s, name)
-    goal = target if limits is None else min(max(target, limits[0]), limits[1])
+    goal = clamp_goal(target, limits)
     if name == "dummy" or duration_s == 0:
         speed = dummy_speed(start, goal, duration_s)
         return GotoPlan(goal, None, max(speed, min_speed) if speed else 0.0)

@@ -21,7 +21,8 @@ from poppy_cli.options import (
 from poppy_cli.output import EXIT_INTERRUPTED, console, fmt_value, print_json, styled
 from poppy_cli.robots import build_robot, open_remote, robot_config, start_robot
 from poppy_cli.targets import TargetSyntaxError, parse_targets
-from poppy_core.trajectory import MAX_DURATION_S
+from poppy_core.errors import ArgumentError
+from poppy_core.trajectory import MAX_DURATION_S, control_name
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -218,8 +219,10 @@ def goto(
     A --sim robot lives only within the command, so --sim always waits; a --remote robot
     (served by `poppy serve`) moves on its own, so the command waits only with --wait.
     """
-    if control not in ("minjerk", "dummy"):
-        raise typer.BadParameter(f"{control!r} is not minjerk or dummy", param_hint="--trajectory")
+    try:
+        control = control_name(control)
+    except ArgumentError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--trajectory") from None
     robot: Robot | RemoteRobot
     if remote:
         robot = open_remote(remote)
@@ -227,7 +230,7 @@ def goto(
     else:
         config = robot_config(profile, config_file, port)
         limits = {
-            name: None if motor.wheel_mode else motor.angle_limit
+            name: None if motor.wheel_mode else motor.user_angle_limit
             for name, motor in config.motors.items()
         }
         goals = _goals(targets, list(config.motors), limits)

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
-from poppy_core.errors import ArgumentError
+from poppy_core import checks
 from poppy_core.motion import LoopPrimitive
 
 if TYPE_CHECKING:
@@ -52,14 +52,6 @@ DANCE_BPM = 100.0
 DANCE_AMPLITUDE_DEG = 10.0
 
 
-def _positive(name: str, value: float) -> float:
-    if not math.isfinite(value) or value < 0:
-        raise ArgumentError(
-            f"{name} must be a finite number >= 0, got {value}", field=name, value=value
-        )
-    return float(value)
-
-
 class SwingMotion(LoopPrimitive):
     """Adds sinusoids to the start positions of some motors (subclasses give ``swings()``).
 
@@ -82,7 +74,7 @@ class SwingMotion(LoopPrimitive):
 
     @amplitude_scale.setter
     def amplitude_scale(self, value: float) -> None:
-        self._amplitude_scale = _positive("amplitude_scale", value)
+        self._amplitude_scale = checks.non_negative(value, "amplitude_scale")
 
     def swings(self) -> Sequence[Swing]:
         """The sinusoids to add."""
@@ -153,7 +145,7 @@ class DanceBeatMotion(SwingMotion):
 
     @bpm.setter
     def bpm(self, value: float) -> None:
-        self._bpm = _positive("bpm", value)
+        self._bpm = checks.non_negative(value, "bpm")
 
     @property
     def amplitude(self) -> float:
@@ -162,7 +154,7 @@ class DanceBeatMotion(SwingMotion):
 
     @amplitude.setter
     def amplitude(self, value: float) -> None:
-        self._amplitude = _positive("amplitude", value)
+        self._amplitude = checks.non_negative(value, "amplitude")
 
     def swings(self) -> Sequence[Swing]:
         """Nod on each beat, sway over two beats."""

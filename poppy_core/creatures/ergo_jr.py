@@ -7,6 +7,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
+from poppy_core import checks
 from poppy_core.creatures.postures import ERGO_JR_IDLE, clamp_to_limits
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import LoopPrimitive, Primitive
@@ -59,14 +60,6 @@ JUMP_PID: tuple[float, float, float] = (10.0, 0.0, 0.0)  # jump.py: stiff P gain
 SAFE_POWER_UP_S = 3.0  # postures.py SafePowerUp: IdlePosture(robot, 3.0)
 
 
-def _finite(name: str, value: float, low: float = 0.0) -> float:
-    if not math.isfinite(value) or value < low:
-        raise ArgumentError(
-            f"{name} must be a finite number >= {low:g}, got {value}", field=name, value=value
-        )
-    return float(value)
-
-
 class Dance(LoopPrimitive):
     """Ergo Jr's dance: sums of sinusoids on its joints, after going to 0° (looping).
 
@@ -115,7 +108,7 @@ class Dance(LoopPrimitive):
 
     @amplitude_scale.setter
     def amplitude_scale(self, value: float) -> None:
-        self._amplitude_scale = _finite("amplitude_scale", value)
+        self._amplitude_scale = checks.non_negative(value, "amplitude_scale")
 
     @property
     def tempo_scale(self) -> float:
@@ -124,7 +117,7 @@ class Dance(LoopPrimitive):
 
     @tempo_scale.setter
     def tempo_scale(self, value: float) -> None:
-        self._tempo_scale = _finite("tempo_scale", value)
+        self._tempo_scale = checks.non_negative(value, "tempo_scale")
 
     @property
     def intro_s(self) -> float:
@@ -133,7 +126,7 @@ class Dance(LoopPrimitive):
 
     @intro_s.setter
     def intro_s(self, value: float) -> None:
-        self._intro_s = _finite("intro_s", value)
+        self._intro_s = checks.non_negative(value, "intro_s")
 
     @property
     def speed_dps(self) -> float:
@@ -142,7 +135,7 @@ class Dance(LoopPrimitive):
 
     @speed_dps.setter
     def speed_dps(self, value: float) -> None:
-        self._speed_dps = _finite("speed_dps", value)
+        self._speed_dps = checks.non_negative(value, "speed_dps")
 
     def _dancers(self) -> list[str]:
         known = {m.name for m in self.real_robot.motors}
@@ -289,7 +282,7 @@ class SafePowerUp(Primitive):
 
     @duration.setter
     def duration(self, value: float) -> None:
-        self._duration = _finite("duration", value)
+        self._duration = checks.non_negative(value, "duration")
 
     @property
     def control(self) -> str:
@@ -307,11 +300,7 @@ class SafePowerUp(Primitive):
 
     @torque_limit.setter
     def torque_limit(self, value: float) -> None:
-        if not math.isfinite(value) or not 0.0 <= value <= 100.0:
-            raise ArgumentError(
-                f"torque_limit must be 0..100 %, got {value}", field="torque_limit", value=value
-            )
-        self._torque_limit = float(value)
+        self._torque_limit = checks.in_range(value, 0.0, 100.0, "torque_limit", "%")
 
     def run(self) -> None:
         """Limit the torque, stiffen, go to the idle posture and wait until it is reached."""

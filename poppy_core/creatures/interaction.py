@@ -5,12 +5,11 @@ mirrors the left one.
 from __future__ import annotations
 
 import logging
-import math
 import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, ClassVar
 
-from poppy_core.errors import ArgumentError
+from poppy_core import checks
 from poppy_core.motion import LoopPrimitive
 
 if TYPE_CHECKING:
@@ -46,14 +45,6 @@ def arm_motors(robot: Robot, side: str) -> list[str]:
     """The arm joints (``shoulder_y``...) of ``side`` (``"l"`` or ``"r"``) the robot has."""
     names = {m.name for m in robot.motors}
     return [f"{side}_{joint}" for joint in ARM_JOINTS if f"{side}_{joint}" in names]
-
-
-def _positive(name: str, value: float) -> float:
-    if not math.isfinite(value) or value <= 0:
-        raise ArgumentError(
-            f"{name} must be a positive number, got {value}", field=name, value=value
-        )
-    return float(value)
 
 
 class ArmsCopyMotion(LoopPrimitive):
@@ -125,9 +116,9 @@ class ArmsTurnCompliant(LoopPrimitive):
         release_after_s: float = RELEASE_AFTER_S,
     ) -> None:
         super().__init__(robot, freq)
-        self.load_threshold = _positive("load_threshold", load_threshold)
-        self.error_threshold_deg = _positive("error_threshold_deg", error_threshold_deg)
-        self.release_after_s = _positive("release_after_s", release_after_s)
+        self.load_threshold = checks.positive(load_threshold, "load_threshold")
+        self.error_threshold_deg = checks.positive(error_threshold_deg, "error_threshold_deg")
+        self.release_after_s = checks.positive(release_after_s, "release_after_s")
         self.compliant_arms: list[str] = []
         self._arms: dict[str, list[str]] = {}
         self._still_since: dict[str, float] = {}

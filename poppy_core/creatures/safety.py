@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import logging
-import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, ClassVar
 
-from poppy_core.errors import ArgumentError
+from poppy_core import checks
 from poppy_core.motion import LoopPrimitive
 
 if TYPE_CHECKING:
@@ -94,11 +93,7 @@ class LimitTorque(LoopPrimitive):
 
     @full_torque_at_deg.setter
     def full_torque_at_deg(self, value: float) -> None:
-        if not math.isfinite(value) or value <= 0:
-            raise ArgumentError(
-                f"full_torque_at_deg must be > 0 degrees, got {value}",
-                field="full_torque_at_deg", value=value,
-            )  # fmt: skip
+        checks.positive(value, "full_torque_at_deg")
         self._full_at = float(value)
 
     def torque_for(self, distance_deg: float) -> float:
@@ -125,9 +120,7 @@ class LimitTorque(LoopPrimitive):
 
 
 def _percent(name: str, value: float) -> float:
-    if not math.isfinite(value) or not 0.0 <= value <= 100.0:
-        raise ArgumentError(f"{name} must be 0..100 %, got {value}", field=name, value=value)
-    return float(value)
+    return checks.in_range(value, 0.0, 100.0, name, "%")
 
 
 class TemperatureMonitor(LoopPrimitive):
@@ -161,11 +154,7 @@ class TemperatureMonitor(LoopPrimitive):
 
     @temperature_limit.setter
     def temperature_limit(self, value: float) -> None:
-        if not math.isfinite(value) or value <= 0:
-            raise ArgumentError(
-                f"temperature_limit must be a positive number of °C, got {value}",
-                field="temperature_limit", value=value,
-            )  # fmt: skip
+        checks.positive(value, "temperature_limit")
         self._limit = float(value)
 
     def setup(self) -> None:

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from poppy_core.errors import PoppyError, SensorError
+from poppy_core.errors import PoppyError, SensorError, UnknownCardError
 from poppy_core.motion import LoopPrimitive
 from poppy_core.motion.cartesian import RobotChain
 
@@ -60,8 +60,11 @@ def _wanted_ids(detector: Any, marker: str | int | None) -> set[int] | None:
         return {int(text)}
     cards: dict[str, list[int]] = getattr(detector, "card_ids", {})
     if text not in cards:
-        known = ", ".join(cards) or "none"
-        raise SensorError(f"no card {text!r} (cards: {known}; or give a marker id)")
+        known = list(cards)
+        raise UnknownCardError(
+            f"no card {text!r} (cards: {', '.join(known) or 'none'}; or give a marker id)",
+            name=text, known=known,
+        )  # fmt: skip
     return set(cards[text])
 
 

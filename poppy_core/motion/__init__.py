@@ -1,6 +1,11 @@
 """Motion: trajectories (minimum jerk, constant speed); primitives and moves build on them."""
 
-from poppy_core.motion.attached import active_primitives, attach_primitive, attached_primitives
+from poppy_core.motion.attached import (
+    active_primitives,
+    attach_primitive,
+    attached_primitive,
+    attached_primitives,
+)
 from poppy_core.motion.builtins import (
     BUILTINS,
     Cosinus,
@@ -73,6 +78,7 @@ __all__ = [
     "active_primitives",
     "attach_builtins",
     "attach_primitive",
+    "attached_primitive",
     "attached_primitives",
     "dummy_speed",
     "primitive_manager",

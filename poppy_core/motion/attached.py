@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ConfigError, UnknownPrimitiveError
 from poppy_core.motion.manager import PrimitiveManager
 from poppy_core.motion.primitive import Primitive
 from poppy_core.robot.robot_pypot import MANAGER_KEY
@@ -31,6 +31,23 @@ def attached_primitives(robot: Robot) -> dict[str, Primitive]:
         for name in robot.primitive_names
         if isinstance(obj := robot.extensions.get(name), Primitive)
     }
+
+
+def attached_primitive(robot: Robot, name: str) -> Primitive:
+    """The primitive attached to ``robot`` under ``name``.
+
+    Raises:
+        UnknownPrimitiveError: no such primitive (the attached ones are listed).
+    """
+    attached = attached_primitives(robot)
+    found = attached.get(name)
+    if found is None:
+        known = list(attached)
+        raise UnknownPrimitiveError(
+            f"no primitive {name!r} (primitives: {', '.join(known) or 'none'})",
+            name=str(name), known=known,
+        )  # fmt: skip
+    return found
 
 
 def active_primitives(robot: Robot) -> list[Primitive]:

@@ -14,14 +14,14 @@ WebSocket teleop channel. Targets arrive at the stream's rate; each one is writt
 from __future__ import annotations
 
 import logging
-import math
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
-from poppy_core.errors import ConfigError, PoppyError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, PoppyError, UnknownMotorError
 from poppy_core.trajectory import minimum_jerk_weight
 
 if TYPE_CHECKING:
@@ -62,7 +62,7 @@ class FollowSession:
         clock: monotonic time in seconds.
 
     Raises:
-        ConfigError: an unknown motor name, or no motor.
+        UnknownMotorError: an unknown motor name. ArgumentError: no motor, a bad ramp.
     """
 
     def __init__(
@@ -78,9 +78,9 @@ class FollowSession:
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         if not motors:
-            raise ConfigError("no motor to follow", field="motors")
-        if ramp_s is not None and not (math.isfinite(ramp_s) and ramp_s >= 0):
-            raise ConfigError(f"the ramp must last 0 s or more, not {ramp_s}", field="ramp_s")
+            raise ArgumentError("no motor to follow", field="motors")
+        if ramp_s is not None:
+            checks.duration(ramp_s, "ramp_s")
         self.robot = robot
         self.motors: list[Motor] = [robot.motor(name) for name in motors]
         self.ramp_s = ramp_s
@@ -123,7 +123,7 @@ class FollowSession:
             The goals written (ramped while a ramp runs).
 
         Raises:
-            ConfigError: a motor that is not driven by this session.
+            UnknownMotorError: a motor that is not driven by this session.
         """
         now = self._clock()
         with self._lock:
@@ -132,11 +132,10 @@ class FollowSession:
             by_name = {m.name: m for m in self.motors}
             unknown = [name for name in targets if name not in by_name]
             if unknown:
-                raise ConfigError(
+                raise UnknownMotorError(
                     f"not followed: {', '.join(unknown)} (followed: {', '.join(by_name)})",
-                    field="motors",
-                    value=unknown,
-                )
+                    motor=str(unknown[0]), known=list(by_name),
+                )  # fmt: skip
             self._last_target_s = now
             if self.state in ("held", "idle"):
                 self._begin_ramp(targets, now)

@@ -41,11 +41,11 @@ def _resolve_filter(value: str | Filter) -> Filter:
             return FILTERS[value]
         except KeyError:
             known = ", ".join(FILTERS)
-            raise ConfigError(
+            raise ArgumentError(
                 f"unknown filter {value!r} (filters: {known}, or a function)", field="filter"
             ) from None
     if not callable(value):
-        raise ConfigError(f"filter must be a name or a function, not {value!r}", field="filter")
+        raise ArgumentError(f"filter must be a name or a function, not {value!r}", field="filter")
     return value
 
 
@@ -61,10 +61,7 @@ class PrimitiveManager:
     def __init__(
         self, robot: Robot, freq: float = DEFAULT_FREQ_HZ, filter: str | Filter = "mean"
     ) -> None:
-        try:
-            self.freq = checks.rate(freq, "freq")
-        except ArgumentError as exc:
-            raise ConfigError(f"manager frequency: {exc}", field="freq") from None
+        self.freq = checks.rate(freq, "manager frequency")
         self._robot = robot
         self._filter = _resolve_filter(filter)
         self._lock = threading.RLock()

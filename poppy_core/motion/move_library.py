@@ -15,7 +15,7 @@ from pathlib import Path
 
 import platformdirs
 
-from poppy_core.errors import ConfigError, FileError
+from poppy_core.errors import ConfigError, FileError, UnknownMoveError
 from poppy_core.files import output_path, write_file
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import (
@@ -130,12 +130,12 @@ def move_path(ref: str | os.PathLike[str], *, must_exist: bool = True) -> Path:
         must_exist: raise when there is no such move (else give the path a new move would take).
 
     Raises:
-        ConfigError: no such move.
+        UnknownMoveError: no such move (a ``ConfigError``).
     """
     if is_path(ref):
         path = Path(ref).expanduser()
         if must_exist and not path.is_file():
-            raise ConfigError(f"no move file {path}", file=str(path), reason="not found")
+            raise UnknownMoveError(f"no move file {path}", name=str(path))
         return path
     name = check_name(os.fspath(ref))
     root = library()
@@ -144,10 +144,13 @@ def move_path(ref: str | os.PathLike[str], *, must_exist: bool = True) -> Path:
         if candidate.is_file():
             return candidate
     if must_exist:
-        known = ", ".join(e.name for e in list_moves()) or "none"
-        raise ConfigError(
-            f"no move {name!r} in {root} (moves: {known})", file=str(root), field=name
-        )
+        known = [e.name for e in list_moves()]
+        error = UnknownMoveError(
+            f"no move {name!r} in {root} (moves: {', '.join(known) or 'none'})",
+            name=name, known=known,
+        )  # fmt: skip
+        error.file = str(root)
+        raise error
     return root / f"{name}{MOVE_SUFFIX}"
 
 
@@ -191,7 +194,7 @@ def delete_move(ref: str | os.PathLike[str]) -> Path:
         The path deleted.
 
     Raises:
-        ConfigError: no such move.
+        UnknownMoveError: no such move (a ``ConfigError``).
     """
     path = move_path(ref)
     path.unlink()

@@ -8,7 +8,6 @@ recorded, until the last frame.
 from __future__ import annotations
 
 import logging
-import math
 import os
 import threading
 import time
@@ -19,6 +18,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
+from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import read_move
@@ -165,11 +165,7 @@ class MovePlayer:
                 raise ArgumentError("give the move, or move_filename= a move file",
                                     field="move")  # fmt: skip
             move = read_move(move_filename)
-        if not (math.isfinite(speed) and MIN_SPEED <= speed <= MAX_SPEED):
-            raise ArgumentError(
-                f"speed must be {MIN_SPEED:g}-{MAX_SPEED:g} (1 = as recorded), got {speed}",
-                field="speed", value=speed,
-            )  # fmt: skip
+        checks.in_range(speed, MIN_SPEED, MAX_SPEED, "speed")
         if not 1 <= loops <= MAX_LOOPS:
             raise ArgumentError(
                 f"loops must be 1-{MAX_LOOPS}, got {loops}", field="loops", value=loops

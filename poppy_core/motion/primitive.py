@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 from poppy_core import checks
-from poppy_core.errors import ConfigError, PrimitiveError
+from poppy_core.errors import ArgumentError, PrimitiveError, UnknownNameError
 from poppy_core.motion.manager import PrimitiveManager, primitive_manager
 from poppy_core.motion.primitive_values import convert_value
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
@@ -338,7 +338,7 @@ class Primitive:
         """The value of declared property ``name``.
 
         Raises:
-            ConfigError: ``name`` is not in ``properties``.
+            UnknownNameError: ``name`` is not in ``properties`` (``kind`` ``"property"``).
         """
         self._check_name(name, self.properties, "property")
         return getattr(self, name)
@@ -349,16 +349,15 @@ class Primitive:
         Text is parsed (``"0.5"``, ``"true"``, ``"m1,m2"``), so command-line and JSON values work.
 
         Raises:
-            ConfigError: unknown property, a value of the wrong type, or one the primitive refuses.
+            UnknownNameError: an unknown property (``kind`` ``"property"``).
+            ArgumentError: a value of the wrong type, or one the primitive refuses.
         """
         self._check_name(name, self.properties, "property")
         converted = convert_value(name, getattr(self, name), value)
         try:
             setattr(self, name, converted)
         except (TypeError, ValueError) as exc:
-            raise ConfigError(
-                f"property {name}: {exc}", field=name, value=value, reason=str(exc)
-            ) from None
+            raise ArgumentError(f"property {name}: {exc}", field=name, value=value) from None
 
     def property_values(self) -> dict[str, Any]:
         """Every declared property and its value."""
@@ -368,7 +367,7 @@ class Primitive:
         """Call declared method ``name`` with ``args`` and return its result.
 
         Raises:
-            ConfigError: ``name`` is not in ``methods``.
+            UnknownNameError: ``name`` is not in ``methods`` (``kind`` ``"method"``).
         """
         self._check_name(name, self.methods, "method")
         return getattr(self, name)(*args)
@@ -376,11 +375,10 @@ class Primitive:
     def _check_name(self, name: str, known: Sequence[str], kind: str) -> None:
         if name not in known:
             listed = ", ".join(known) or "none"
-            raise ConfigError(
+            raise UnknownNameError(
                 f"{type(self).__name__} has no {kind} {name!r} ({_PLURALS[kind]}: {listed})",
-                field=name,
-                value=name,
-            )
+                name=str(name), known=list(known), kind=kind,
+            )  # fmt: skip
 
     def describe(self) -> dict[str, Any]:
         """State, elapsed time, properties, methods and error as plain values (for JSON)."""

@@ -7,7 +7,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from poppy_core import checks
-from poppy_core.errors import ArgumentError, ConfigError
+from poppy_core.errors import ArgumentError
 
 _TRUE = ("1", "true", "yes", "on")
 _FALSE = ("0", "false", "no", "off")
@@ -17,11 +17,11 @@ def convert_value(name: str, current: Any, value: Any) -> Any:
     """``value`` converted to the type of ``current`` (text from a command line is parsed).
 
     Raises:
-        ConfigError: the value does not fit.
+        ArgumentError: the value does not fit.
     """
 
-    def bad(reason: str) -> ConfigError:
-        return ConfigError(f"property {name}: {reason}", field=name, value=value, reason=reason)
+    def bad(reason: str) -> ArgumentError:
+        return ArgumentError(f"property {name}: {reason}", field=name, value=value)
 
     if current is None:
         return value
@@ -57,7 +57,7 @@ def convert_value(name: str, current: Any, value: Any) -> Any:
     raise bad(f"cannot set a {type(current).__name__} from {value!r}")
 
 
-def _mapping(value: Any, bad: Callable[[str], ConfigError]) -> dict[str, float]:
+def _mapping(value: Any, bad: Callable[[str], ArgumentError]) -> dict[str, float]:
     """``{"m1": 10}`` or the text ``"m1=10,m2=-5"`` as a name -> number mapping."""
     if isinstance(value, str):
         pairs = [item.partition("=") for item in value.split(",") if item.strip()]

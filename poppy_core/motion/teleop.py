@@ -16,7 +16,6 @@ driven over its WebSocket).
 from __future__ import annotations
 
 import logging
-import math
 import threading
 import time
 from collections import deque
@@ -25,6 +24,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any
 
+from poppy_core import checks
 from poppy_core.errors import ConfigError, FileError, PoppyError
 from poppy_core.motion.follow import FollowChange
 from poppy_core.motion.teleop_follower import Follower, LocalFollower
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 DEFAULT_RATE_HZ = 100.0
-MAX_RATE_HZ = 1000.0
+MAX_RATE_HZ = checks.MAX_RATE_HZ
 RETRY_FIRST_S = 0.1
 RETRY_MAX_S = 1.0
 """A lost leader is read again after 0.1 s, then twice as late each time, up to 1 s."""
@@ -80,8 +80,9 @@ class Teleoperation:
         clock: monotonic time in seconds.
 
     Raises:
-        ConfigError: a map naming unknown motors, a leader joint also driven as a follower
-            joint of the same robot, or a rate outside (0, 1000] Hz.
+        ConfigError: a map naming unknown motors, or a leader joint also driven as a follower
+            joint of the same robot.
+        ArgumentError: a rate that is not ``checks.rate`` (once a day to 1000 Hz).
     """
 
     def __init__(
@@ -98,10 +99,7 @@ class Teleoperation:
         on_change: ChangeCallback | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        if not (math.isfinite(rate_hz) and 0 < rate_hz <= MAX_RATE_HZ):
-            raise ConfigError(
-                f"the rate must be in (0, {MAX_RATE_HZ:g}] Hz, not {rate_hz:g}", field="rate_hz"
-            )
+        checks.rate(rate_hz, "rate_hz")
         self._on_change = on_change
         self._clock = clock
         self.follower: Follower = (

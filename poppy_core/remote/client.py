@@ -6,9 +6,19 @@ import http.client
 import json
 import threading
 from typing import Any
-from urllib.parse import quote, urlsplit
+from urllib.parse import quote, unquote, urlsplit
 
-from poppy_core.errors import BusTimeout, CommunicationError, ConfigError, RegisterError
+from poppy_core.errors import (
+    BusTimeout,
+    CommunicationError,
+    ConfigError,
+    RegisterError,
+    UnknownGroupError,
+    UnknownMotorError,
+    UnknownMoveError,
+    UnknownNameError,
+    UnknownPrimitiveError,
+)
 
 DEFAULT_TIMEOUT_S = 10.0
 
@@ -73,7 +83,8 @@ class HttpClient:
 
         Raises:
             CommunicationError: the server cannot be reached (``BusTimeout`` on a timeout).
-            ConfigError: refused: unknown name, wrong token, conflict (the server's message).
+            UnknownNameError: a 404: an unknown motor, group, primitive, move... (a ConfigError).
+            ConfigError: refused: wrong token, conflict, bad value (the server's message).
             RegisterError: a register value the server refused (422 on a register).
         """
         payload = None if body is None else json.dumps(body).encode()
@@ -127,6 +138,9 @@ class HttpClient:
             raise RegisterError(where, register=path.rsplit("/", 1)[-1])
         if status >= 500:
             raise CommunicationError(f"{self.base_url}: {where}", port=self.base_url)
+        unknown = _unknown(path, where) if status == 404 else None
+        if unknown is not None:
+            raise unknown
         raise ConfigError(where, reason=message)
 
     def get(self, path: str) -> Any:
@@ -151,3 +165,31 @@ def _message(decoded: Any) -> str:
             )
         return str(detail) if detail is not None else json.dumps(decoded)
     return str(decoded) if decoded else ""
+
+
+_KINDS = ("motors", "groups", "primitives", "moves")
+"""The v1 collections whose 404 is an unknown name (a typed ``UnknownNameError``)."""
+_DEEPER = ("registers", "properties", "methods")
+
+
+def _unknown(path: str, message: str) -> UnknownNameError | None:
+    """The typed error of a 404 on ``path`` (``/api/v1/motors/m9``: motor ``m9``); None when
+    the path names something deeper (a register, a property) that may be the unknown one."""
+    parts = [unquote(p) for p in path.split("?")[0].split("/") if p]
+    for index, part in enumerate(parts[:-1]):
+        if part in _KINDS:
+            if index + 2 < len(parts) and parts[index + 2] in (
+                "registers",
+                "properties",
+                "methods",
+            ):
+                return None  # /motors/m1/registers/nope: the register may be what is unknown
+            name = parts[index + 1]
+            if part == "motors":
+                return UnknownMotorError(message, motor=name)
+            if part == "groups":
+                return UnknownGroupError(message, motor=name)
+            if part == "primitives":
+                return UnknownPrimitiveError(message, name=name)
+            return UnknownMoveError(message, name=name)
+    return None

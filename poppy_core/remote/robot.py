@@ -9,7 +9,13 @@ from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
 
-from poppy_core.errors import CommunicationError, ConfigError
+from poppy_core.errors import (
+    CommunicationError,
+    ConfigError,
+    UnknownGroupError,
+    UnknownMotorError,
+    UnknownPrimitiveError,
+)
 from poppy_core.remote.client import DEFAULT_TIMEOUT_S, HttpClient, path_of
 
 _OWN = ("_client", "name", "id", "model", "registers")
@@ -307,14 +313,19 @@ class RemoteRobot:
         try:
             return self._by_name[name]
         except KeyError:
-            known = ", ".join(self._by_name)
-            raise ConfigError(f"no motor {name!r} (motors: {known})", field=name) from None
+            known = list(self._by_name)
+            raise UnknownMotorError(
+                f"no motor {name!r} (motors: {', '.join(known)})", motor=str(name), known=known
+            ) from None
 
     def group(self, name: str) -> list[RemoteMotor]:
         """The motors of group ``name``."""
         if name not in self._groups:
-            known = ", ".join(self._groups) or "none"
-            raise ConfigError(f"no group {name!r} (groups: {known})", field=name)
+            known = list(self._groups)
+            raise UnknownGroupError(
+                f"no group {name!r} (groups: {', '.join(known) or 'none'})",
+                motor=str(name), known=known,
+            )  # fmt: skip
         return [self._by_name[n] for n in self._groups[name]]
 
     @property
@@ -367,7 +378,10 @@ class RemoteRobot:
     def primitive(self, name: str) -> RemotePrimitive:
         """The primitive called ``name``."""
         if name not in self.primitive_names:
-            raise ConfigError(f"no primitive {name!r} on the server", field=name)
+            raise UnknownPrimitiveError(
+                f"no primitive {name!r} on the server", name=str(name),
+                known=list(self.primitive_names),
+            )  # fmt: skip
         return RemotePrimitive(self._client, name)
 
     def close(self) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
+from poppy_core import checks
 from poppy_core.errors import ArgumentError, UnknownMotorError
 from poppy_core.robot.goto import GotoHandle
 from poppy_core.robot.motor import Motor
@@ -93,16 +94,24 @@ class MotorGroup(list[Motor]):
 
 
 def degrees(name: str, value: object) -> float:
-    """``value`` as a finite number of degrees for motor ``name``, or ``ArgumentError``."""
+    """``value`` as a finite number of degrees for motor ``name``, or ``ArgumentError``.
+
+    The rule is ``checks.number`` (finite, within ±``MAX_MAGNITUDE``): a sane goal beyond the
+    angle limits is clamped later, a huge one is refused, on every surface.
+    """
     try:
         number = float(value)  # type: ignore[arg-type]
+    except OverflowError:  # an integer beyond a float's range: refused below as huge
+        number = float("inf")
     except (TypeError, ValueError):
         raise ArgumentError(
             f"{name}: {value!r} is not a number of degrees", field=name, value=value, motor=name
         ) from None
-    if number != number or number in (float("inf"), float("-inf")):
+    try:
+        return checks.number(number, name)
+    except ArgumentError as exc:
         raise ArgumentError(
-            f"{name}: the target must be a finite number of degrees, got {value!r}",
+            f"{name}: the target must be a finite number of degrees within "
+            f"±{checks.MAX_MAGNITUDE:g}, got {value!r}",
             field=name, value=value, motor=name,
-        )  # fmt: skip
-    return number
+        ) from exc  # fmt: skip

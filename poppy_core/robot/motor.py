@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 from typing import TYPE_CHECKING, Literal
 
+from poppy_core import checks
 from poppy_core.errors import RegisterError
 from poppy_core.models import ServoModel
 from poppy_core.robot import frames
@@ -216,7 +217,7 @@ class Motor(PypotMotorMixin):
 
     @goal_position.setter
     def goal_position(self, value: float) -> None:
-        target = regs.finite(value, f"{self.name}.goal_position")
+        target = checks.number(value, f"{self.name}.goal_position")  # huge: refused, not clamped
         self._link.runner.cancel(self)
         self._set_goal(target)
 

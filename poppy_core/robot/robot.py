@@ -16,7 +16,7 @@ from types import TracebackType
 from typing import TYPE_CHECKING, Any
 
 from poppy_core.bus import DxlBus
-from poppy_core.errors import ConfigError, RobotClosedError, UnknownMotorError
+from poppy_core.errors import ConfigError, RobotClosedError, UnknownGroupError, UnknownMotorError
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.group import MotorGroup, degrees
 from poppy_core.robot.health import BusHealth, SyncStats
@@ -186,8 +186,11 @@ class Robot(PypotRobotMixin, VrepNames):
         try:
             return list(self._groups[name])
         except KeyError:
-            known = ", ".join(self._groups) or "none"
-            raise ConfigError(f"no group {name!r} (groups: {known})", field=name) from None
+            known = list(self._groups)
+            raise UnknownGroupError(
+                f"no group {name!r} (groups: {', '.join(known) or 'none'})",
+                motor=str(name), known=known,
+            ) from None  # fmt: skip
 
     # -- extensions: attached objects ---------------------------------------------------------
 

@@ -14,7 +14,7 @@ from typing import ClassVar, Generic, TypeVar
 
 import numpy as np
 
-from poppy_core.errors import SensorError
+from poppy_core.errors import SensorError, UnknownCardError
 from poppy_core.sensors.base import FIRST_VALUE_TIMEOUT_S, Sensor
 from poppy_core.sensors.camera import Camera
 from poppy_core.sensors.markers import (
@@ -154,8 +154,10 @@ class MarkerDetector(FrameDetector[Marker]):
         elif card_or_id in self.card_ids:
             wanted = set(self.card_ids[card_or_id])
         else:
-            known = ", ".join(self.card_ids) or "none"
-            raise SensorError(
-                f"no card {card_or_id!r} (cards: {known}; or give a marker id)", sensor=self.name
-            )
+            known = list(self.card_ids)
+            listed = ", ".join(known) or "none"
+            raise UnknownCardError(
+                f"no card {card_or_id!r} (cards: {listed}; or give a marker id)",
+                name=str(card_or_id), known=known, sensor=self.name,
+            )  # fmt: skip
         return any(m.id in wanted for m in self.markers)

@@ -16,6 +16,7 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse, Response
 
 from poppy_core.errors import (
+    ArgumentError,
     BusError,
     BusTimeout,
     ConfigError,
@@ -25,6 +26,7 @@ from poppy_core.errors import (
     RegisterError,
     RobotClosedError,
     SensorError,
+    UnknownNameError,
 )
 from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.refusals import one_line
@@ -92,9 +94,26 @@ def error_response(request: Request, error: ApiError) -> JSONResponse:
     return PypotJSON(pypot_body(message, one_line(error.tip), message), status_code=status)
 
 
+NAME_TIPS: dict[str, str] = {
+    "motor": "the motors are listed by /motors/list.json",
+    "group": "the groups are listed by /motors/aliases/list.json",
+    "primitive": "the primitives are listed by /primitives/list.json",
+    "move": "the moves are listed by /records/list.json",
+    "card": "a card is a name the marker detector knows (caribou, tetris, lapin) or an id",
+}
+"""How to find the right name, for each ``UnknownNameError.kind``."""
+
+
 def from_poppy_error(exc: PoppyError) -> ApiError:
-    """Translate a core error: bad values are 4xx, bus trouble is 503/504-like ``unavailable``."""
-    if isinstance(exc, RegisterError | ConfigError):
+    """Translate a core error by its TYPE (never its text).
+
+    ``UnknownNameError`` (motor, group, primitive, move, card) is ``not_found``; an
+    ``ArgumentError``, ``RegisterError`` or other ``ConfigError`` is ``invalid``; bus trouble,
+    a closed robot or a sensor that does not answer is ``unavailable``; a file is ``storage``.
+    """
+    if isinstance(exc, UnknownNameError):
+        return ApiError("not_found", str(exc), tip=NAME_TIPS.get(exc.kind, ""))
+    if isinstance(exc, ArgumentError | RegisterError | ConfigError):
         return ApiError("invalid", str(exc))
     if isinstance(exc, BusTimeout | BusError | MotorError):
         return ApiError("unavailable", f"the robot did not answer: {exc}")
@@ -105,6 +124,18 @@ def from_poppy_error(exc: PoppyError) -> ApiError:
     if isinstance(exc, FileError):
         return ApiError("storage", str(exc))
     return ApiError("invalid", str(exc))
+
+
+def refusal_kind(exc: BaseException) -> Kind:
+    """The kind of a refusal, for the surfaces that answer without a status (WebSocket frames
+    and ZMQ replies carry it as ``"kind"``): an ``ApiError``'s own, a core error's by its type,
+    and ``"invalid"`` for a bad argument Python itself refused (``ValueError``, ``TypeError``).
+    """
+    if isinstance(exc, ApiError):
+        return exc.kind
+    if isinstance(exc, PoppyError):
+        return from_poppy_error(exc).kind
+    return "invalid"
 
 
 async def _api_error(request: Request, exc: Exception) -> Response:

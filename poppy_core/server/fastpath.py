@@ -14,7 +14,7 @@ from typing import Any
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from poppy_core.errors import ArgumentError
+from poppy_core.errors import PoppyError
 from poppy_core.server.errors import ApiError
 from poppy_core.server.jsonio import parse_json
 from poppy_core.server.pypot_json import pypot_bytes, pypot_raw_headers
@@ -48,7 +48,7 @@ class RegisterFastPath:
         if scope["method"] == "GET":
             try:
                 value = self.service.read(motor, register)
-            except ApiError:
+            except (ApiError, PoppyError):
                 await self.app(scope, receive, send)  # the route answers with the error
                 return
             await _answer(send, 200, {register: value})
@@ -61,7 +61,7 @@ class RegisterFastPath:
         try:
             value = pypot_value(motor, register, parse_json(body))
             written = self.service.write(motor, register, value)
-        except (ApiError, ArgumentError):
+        except (ApiError, PoppyError):  # an unknown name, a refused value: the route answers
             await self.app(scope, _replay(message, receive), send)
             return
         await _answer(send, 202, {register: written})

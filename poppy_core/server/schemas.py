@@ -1,10 +1,12 @@
 """Pydantic bodies and answers of the v1 API (they make the OpenAPI schema)."""
 
-from typing import Annotated, Literal
+from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, JsonValue
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, JsonValue
 
-from poppy_core.server.service import MAX_GOTO_S, MIN_GOTO_S
+from poppy_core import checks
+from poppy_core.motion.player import MAX_SPEED, MIN_SPEED
+from poppy_core.trajectory import CONTROLS, control_name
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 MotorName = Annotated[str, Field(min_length=1, max_length=64)]
@@ -79,6 +81,12 @@ class ValueBody(BaseModel):
     value: JsonValue
 
 
+GOTO_DURATION = (
+    "seconds the motion lasts: 0 (at once) or "
+    f"{checks.MIN_DURATION_S:g}-{checks.MAX_DURATION_S:g} (the library's rule)"
+)
+
+
 class GotoRequest(BaseModel):
     """Move motors so that they arrive together."""
 
@@ -86,8 +94,12 @@ class GotoRequest(BaseModel):
     positions: dict[MotorName, Finite] = Field(
         min_length=1, max_length=64, description="motor name -> target in degrees"
     )
-    duration_s: Finite = Field(ge=MIN_GOTO_S, le=MAX_GOTO_S, description="seconds the motion lasts")
-    control: Literal["minjerk", "dummy"] = "minjerk"
+    duration_s: Annotated[Finite, AfterValidator(lambda v: checks.duration(v, "duration_s"))] = (
+        Field(ge=0, le=checks.MAX_DURATION_S, description=GOTO_DURATION)
+    )
+    control: Annotated[str, AfterValidator(control_name)] = Field(
+        "minjerk", description=f"one of {', '.join(CONTROLS)} ('minijerk' is 'minjerk')"
+    )
     wait: bool = Field(False, description="answer once the motion is over")
 
 
@@ -163,7 +175,9 @@ class PlayRequest(BaseModel):
     """How to play a move."""
 
     model_config = ConfigDict(extra="forbid")
-    speed: Finite = Field(1.0, gt=0, le=100, description="2.0 plays twice as fast")
+    speed: Finite = Field(
+        1.0, ge=MIN_SPEED, le=MAX_SPEED, description="2.0 plays twice as fast (the player's range)"
+    )
     backwards: bool = False
 
 

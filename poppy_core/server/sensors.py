@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from poppy_core.errors import SensorError
+from poppy_core.errors import UnknownCardError
 from poppy_core.robot import Robot
 from poppy_core.sensors import Camera, MarkerDetector, Sensor
 from poppy_core.sensors.opencv import encode_image
@@ -120,9 +120,7 @@ class SensorService:
             card = CARD_SPELLINGS[card]
         try:
             return detector.sees(card)
-        except SensorError as exc:
-            if "no card" in str(exc):
-                known = ", ".join(detector.card_ids) or "none"
-                raise ApiError("not_found", "The code you asked for does not exist",
-                               tip=f"All preset codes are {known}") from None  # fmt: skip
-            raise
+        except UnknownCardError as exc:
+            known = ", ".join(exc.known) or "none"
+            raise ApiError("not_found", "The code you asked for does not exist",
+                           tip=f"All preset codes are {known}") from None  # fmt: skip

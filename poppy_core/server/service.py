@@ -13,28 +13,20 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from poppy_core import checks
-from poppy_core.motion import Primitive, attach_builtins, attached_primitives
+from poppy_core.motion import Primitive, attach_builtins, attached_primitive, attached_primitives
 from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from poppy_core.server.pypot_json import html_safe
 from poppy_core.server.teleop import TeleopRegistry
+from poppy_core.trajectory import control_name, goto_duration
 
 DESCRIPTION_TTL_S = 0.01
 
 logger = logging.getLogger(__name__)
 
-MAX_GOTO_S = 600.0
-"""The longest goto accepted (seconds)."""
-MIN_GOTO_S = 0.001
-"""The shortest goto accepted (seconds): shorter ones are a jump (and 1e-100 overflows the
-trajectory's arithmetic)."""
-
-MOTOR_TIP = "the motors are listed by /motors/list.json"
 PRIMITIVE_TIP = "the primitives are listed by /primitives/list.json"
-CONTROLS = ("minjerk", "dummy")
 
 
 class RobotService:
@@ -52,18 +44,13 @@ class RobotService:
         self.moves = MoveService(robot)
         self.teleop = TeleopRegistry()
         """Which WebSocket connection teleoperates which motor."""
-        self._by_name = {m.name: m for m in robot.motors}
         self._description: tuple[float, bytes] | None = None
 
     # -- motors and groups ---------------------------------------------------------------------
 
     def motor(self, name: str) -> Motor:
-        """The motor ``name``, or ``ApiError("not_found")``."""
-        motor = self._by_name.get(name)
-        if motor is not None:
-            return motor
-        known = ", ".join(m.name for m in self.robot.motors)
-        raise ApiError("not_found", f"no motor {name!r} (motors: {known})", tip=MOTOR_TIP)
+        """The motor ``name`` (``UnknownMotorError``, a 404, for another name)."""
+        return self.robot.motor(name)
 
     def motor_names(self) -> list[str]:
         """Every motor name, in config order."""
@@ -137,19 +124,32 @@ class RobotService:
     ) -> GotoHandle:
         """Start a goto of several motors after checking every target and the duration.
 
+        The rules are the library's (``trajectory.goto_duration``, ``control_name``); a target
+        outside a motor's angle limits is clamped to them, as ``Motor.goal_position`` does.
+
         Raises:
-            ApiError: unknown motor, a target outside the limits, a bad duration or control.
+            UnknownMotorError: an unknown motor.
+            ArgumentError: a target that is not a finite number, a bad duration or control.
+            ApiError: no motor.
         """
-        duration = check_duration(duration_s)
-        if control not in CONTROLS:
-            raise ApiError("invalid", f"control must be one of {', '.join(CONTROLS)}")
+        duration = goto_duration(duration_s)
+        control = control_name(control)
+        targets = self.targets(positions)
+        return self.robot.goto_position(targets, duration, control=control, wait=False)
+
+    def targets(self, positions: Mapping[str, Any]) -> dict[str, float]:
+        """Motor name -> goal checked and clamped to its angle limits (what a goto will aim at).
+
+        Raises:
+            UnknownMotorError: an unknown motor.
+            ApiError: no motor, or a goal that is not a finite number.
+        """
         if not positions:
             raise ApiError("invalid", "no motor to move")
-        targets = {
+        return {
             name: values.check_position(self.motor(name), "goal_position", value)
             for name, value in positions.items()
         }
-        return self.robot.goto_position(targets, duration, control=control, wait=False)
 
     # -- primitives ------------------------------------------------------------------------------
 
@@ -186,14 +186,8 @@ class RobotService:
         return {"motors": motors, "primitives": primitives}
 
     def primitive(self, name: str) -> Primitive:
-        """The primitive ``name``, or ``ApiError("not_found")``."""
-        found = self.primitives().get(name)
-        if found is None:
-            known = ", ".join(self.primitives()) or "none"
-            raise ApiError(
-                "not_found", f"no primitive {name!r} (primitives: {known})", tip=PRIMITIVE_TIP
-            )
-        return found
+        """The primitive ``name`` (``UnknownPrimitiveError``, a 404, for another name)."""
+        return attached_primitive(self.robot, name)
 
     def running_primitives(self) -> list[str]:
         """Names of the primitives running (or paused)."""
@@ -243,7 +237,7 @@ class RobotService:
         if isinstance(value, float) and not math.isfinite(value):
             raise ApiError("invalid", f"{name}.{prop}: expected a finite number")
         try:
-            primitive.set_property(prop, value)  # ConfigError -> 4xx "invalid"
+            primitive.set_property(prop, value)  # ArgumentError -> 4xx "invalid"
         except (OverflowError, RecursionError):
             raise ApiError("invalid", f"{name}.{prop}: the value is out of range") from None
         return values.jsonable(primitive.get_property(prop))
@@ -292,13 +286,3 @@ class RobotService:
         """Stop the recordings, playbacks and teleoperations this server started."""
         self.teleop.close()
         self.moves.close()
-
-
-def check_duration(value: Any) -> float:
-    """A goto duration: a finite number of seconds (or its text) in [MIN_GOTO_S, MAX_GOTO_S].
-
-    Raises:
-        ArgumentError: anything else (NaN, 1e309, a 400-digit integer, ``"abc"``).
-    """
-    return checks.in_range(checks.number_from(value, "duration"), MIN_GOTO_S, MAX_GOTO_S,
-                           "duration", "s")  # fmt: skip

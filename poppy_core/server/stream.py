@@ -23,7 +23,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketDiscon
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, PoppyError
 from poppy_core.schedule import Periodic
-from poppy_core.server.errors import ApiError
+from poppy_core.server.errors import ApiError, refusal_kind
 from poppy_core.server.jsonio import parse_json
 from poppy_core.server.middleware import TokenMiddleware, token_protocol
 from poppy_core.server.origins import OriginGuard, OriginPolicy
@@ -128,9 +128,9 @@ async def _receive_commands(
             else:
                 service.write_many(data)
         except ApiError as exc:
-            await send({"error": one_line(exc.message)})
+            await send({"error": one_line(exc.message), "kind": exc.kind})
         except PoppyError as exc:
-            await send({"error": one_line(str(exc))})
+            await send({"error": one_line(str(exc)), "kind": refusal_kind(exc)})
 
 
 async def _teleop(channel: TeleopChannel, data: dict[str, Any]) -> dict[str, Any] | None:

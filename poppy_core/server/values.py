@@ -1,8 +1,10 @@
 """Motor registers over the network: JSON-ready reads and validated writes.
 
-A write is checked in full (type, finiteness, the model's register range, the motor's angle
-limits) before the motor is touched, so a bad value is refused with an ``ApiError("invalid")``
-and never reaches the bus.
+A write is checked in full (type, finiteness, the model's register range) before the motor is
+touched, so a bad value is refused with an ``ApiError("invalid")`` and never reaches the bus.
+The rules are the library's (``poppy_core.checks``, ``trajectory.control_name``); a goal outside
+the angle limits is clamped to them, as ``Motor.goal_position`` does (docs/rest.md, "Arguments
+and errors").
 """
 
 from __future__ import annotations
@@ -13,11 +15,13 @@ from typing import Any
 
 import numpy as np
 
-from poppy_core.errors import PoppyError, RegisterError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, PoppyError, RegisterError
 from poppy_core.models import ServoModel
 from poppy_core.robot import Motor
 from poppy_core.robot import registers as regs
 from poppy_core.server.errors import ApiError
+from poppy_core.trajectory import CONTROLS, clamp_goal, control_name
 
 REGISTER_TIP = "the registers of a motor are listed by /motors/<motor_name>/registers/list.json"
 
@@ -98,16 +102,13 @@ def _bad(motor: Motor, name: str, reason: str) -> ApiError:
 
 
 def number(motor: Motor, name: str, value: Any) -> float:
-    """``value`` as a finite float (JSON numbers only; no bools, strings, NaN or infinity)."""
+    """``value`` as a finite float (JSON numbers only; the rule is ``checks.number``)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise _bad(motor, name, f"expected a number, got {json_type(value)}")
     try:
-        result = float(value)
-    except OverflowError:  # an integer beyond 1.8e308
-        result = math.inf
-    if not math.isfinite(result):
-        raise _bad(motor, name, "expected a finite number")
-    return result
+        return checks.number(value, f"{motor.name}.{name}")
+    except ArgumentError as exc:
+        raise ApiError("invalid", str(exc), tip=REGISTER_TIP) from None
 
 
 def json_type(value: Any) -> str:
@@ -135,12 +136,13 @@ def _fits(motor: Motor, register: str, value: object, name: str) -> None:
 
 
 def check_position(motor: Motor, name: str, value: Any) -> float:
-    """A goal position: a finite number inside the motor's angle limits (user frame)."""
+    """A goal position: a finite number, clamped to the motor's angle limits (user frame).
+
+    The library's rule (``Motor.goal_position`` clamps, as pypot did): the answer says the
+    clamped value. A wheel has no limits.
+    """
     position = number(motor, name, value)
-    low, high = motor.angle_limit
-    if not motor.wheel_mode and not low <= position <= high:
-        raise _bad(motor, name, f"{position:g}° is outside the angle limits [{low:g}, {high:g}]")
-    return position
+    return clamp_goal(position, None if motor.wheel_mode else motor.angle_limit)
 
 
 def _goal_speed(motor: Motor, name: str, value: Any) -> float:
@@ -180,9 +182,13 @@ def _behavior(motor: Motor, name: str, value: Any) -> str:
 
 
 def _goto_behavior(motor: Motor, name: str, value: Any) -> str:
-    if value not in ("minjerk", "dummy", "minijerk"):
-        raise _bad(motor, name, "expected 'minjerk' or 'dummy'")
-    return str(value)
+    if not isinstance(value, str):
+        raise _bad(motor, name, f"expected {' or '.join(map(repr, CONTROLS))}")
+    try:
+        control_name(value)
+    except ArgumentError as exc:
+        raise _bad(motor, name, str(exc)) from None
+    return value
 
 
 def _led(motor: Motor, name: str, value: Any) -> Any:

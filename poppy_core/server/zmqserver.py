@@ -18,8 +18,9 @@ from typing import TYPE_CHECKING, Any
 from poppy_core import checks
 from poppy_core.errors import PoppyError
 from poppy_core.extras import require
-from poppy_core.server.errors import ApiError, ListenError
-from poppy_core.server.service import RobotService, check_duration
+from poppy_core.server.errors import ApiError, ListenError, refusal_kind
+from poppy_core.server.service import RobotService
+from poppy_core.trajectory import goto_duration
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
@@ -94,9 +95,9 @@ class ZmqRequests:
                     arguments[key] = _json_argument(arguments[key])
             result = method(**arguments)
         except TypeError as exc:  # missing or unexpected arguments
-            return {"error": f"bad arguments: {exc}"}
+            return {"error": f"bad arguments: {exc}", "kind": "invalid"}
         except (ApiError, PoppyError, ValueError, KeyError, ArithmeticError) as exc:
-            return {"error": _one_line(exc)}
+            return {"error": _one_line(exc), "kind": refusal_kind(exc)}
         return {} if result is None else result
 
     @staticmethod
@@ -134,7 +135,7 @@ class ZmqRequests:
     ) -> None:
         handle = self.service.goto({motor: position}, duration)
         if wait:
-            handle.wait(check_duration(duration) + 5.0)
+            handle.wait(goto_duration(duration) + 5.0)
 
     def set_goto_positions_for_motors(
         self,
@@ -151,7 +152,7 @@ class ZmqRequests:
         handle = self.service.goto(dict(zip(motors, positions, strict=True)), duration,
                                    control or "minjerk")  # fmt: skip
         if wait:
-            handle.wait(check_duration(duration) + 5.0)
+            handle.wait(goto_duration(duration) + 5.0)
 
     def _control(self, primitive: str, action: str) -> None:
         self.service.control_primitive(primitive, action)

@@ -10,7 +10,7 @@ import pytest
 from poppy_core.creatures import Dance, attach_creature
 from poppy_core.creatures.ergo_jr import DANCE_WAVES, ERGO_JR_PID
 from poppy_core.creatures.postures import ERGO_JR_CURIOUS, ERGO_JR_IDLE, ERGO_JR_REST
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError
 from poppy_core.motion import primitive_manager
 from poppy_core.robot import Robot
 from tests.creatures.helpers import positions, reached, virtual, wait_until
@@ -119,7 +119,7 @@ def test_dance_positions_are_the_sum_of_its_sinusoids(ergo: Robot) -> None:
     assert quarter["m1"] == pytest.approx(0.5 * 90.0 + slow)
     assert quarter["m4"] == pytest.approx(-0.5 * 90.0 + slow)
     assert len(DANCE_WAVES) == 5
-    with pytest.raises(ConfigError):
+    with pytest.raises(ArgumentError):
         dance.set_property("tempo_scale", "-1")
 
 
@@ -153,5 +153,5 @@ def test_jump_folds_unfolds_and_gives_the_gains_back(ergo: Robot) -> None:
     assert jump.state == "stopped" and jump.error is None
     assert min(seen_m2) < -60 and max(seen_m2) > -40  # folded (-75°), then up (-10°)
     assert all(m.pid == pytest.approx(ERGO_JR_PID, abs=0.02) for m in ergo.motors)
-    with pytest.raises(ConfigError):
+    with pytest.raises(ArgumentError):
         jump.set_property("jumps", "-2")

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from poppy_core.errors import ConfigError, PrimitiveError, RobotClosedError
+from poppy_core.errors import ArgumentError, ConfigError, PrimitiveError, RobotClosedError
 from poppy_core.motion import (
     LoopPrimitive,
     Primitive,
@@ -234,13 +234,13 @@ def test_properties_get_set_and_validation(ergo: Robot) -> None:
     assert sinus.get_property("frequency") == 2.0
     sinus.set_property("motor_list", "m1, m2")
     assert sinus.motor_list == ["m1", "m2"]
-    with pytest.raises(ConfigError, match="not a number"):
+    with pytest.raises(ArgumentError, match="not a number"):
         sinus.set_property("amplitude", "loud")
-    with pytest.raises(ConfigError, match="not a number"):
+    with pytest.raises(ArgumentError, match="not a number"):
         sinus.set_property("amplitude", True)
-    with pytest.raises(ConfigError, match="finite"):
+    with pytest.raises(ArgumentError, match="finite"):
         sinus.set_property("offset", "nan")
-    with pytest.raises(ConfigError, match="frequency"):
+    with pytest.raises(ArgumentError, match="frequency"):
         sinus.set_property("frequency", -1)
     with pytest.raises(ConfigError, match="no property 'colour'"):
         sinus.set_property("colour", 1)
@@ -250,7 +250,7 @@ def test_properties_get_set_and_validation(ergo: Robot) -> None:
     posture = SimplePosture(ergo)
     posture.set_property("target_position", "m1=10, m2=-5")
     assert posture.target_position == {"m1": 10.0, "m2": -5.0}
-    with pytest.raises(ConfigError, match="NAME=NUMBER"):
+    with pytest.raises(ArgumentError, match="NAME=NUMBER"):
         posture.set_property("target_position", "m1")
 
 

@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from poppy_core.errors import ConfigError, RegisterError
+from poppy_core.errors import ArgumentError, ConfigError, RegisterError
 from poppy_core.motion import (
     FILTERS,
     MockupMotor,
@@ -134,7 +134,7 @@ def test_two_sinus_combine_by_sum(ergo: Robot) -> None:
     assert eventually(lambda: abs(ergo.m1.goal_position - 15.0) < 0.5)
     first.stop()
     second.stop()
-    with pytest.raises(ConfigError, match="unknown filter"):
+    with pytest.raises(ArgumentError, match="unknown filter"):
         manager.filter = "median-ish"
 
 
@@ -178,5 +178,5 @@ def test_bad_filter_result_is_counted_not_applied(ergo: Robot) -> None:
     manager.update()
     assert manager.errors >= 1 and manager.last_error is not None
     manager.close()
-    with pytest.raises(ConfigError):
+    with pytest.raises(ArgumentError, match="manager frequency"):
         PrimitiveManager(ergo, freq=0)

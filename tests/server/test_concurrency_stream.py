@@ -120,7 +120,7 @@ def test_stream_commands_are_checked(served: Served) -> None:
             ws.recv(timeout=2)
         assert served.robot.m4.led == "red"
         before = served.robot.m4.goal_position
-        ws.send(json.dumps({"m4": {"goal_position": 1e9}, "m5": {"led": "blue"}}))
+        ws.send(json.dumps({"m4": {"goal_position": 1e12}, "m5": {"led": "blue"}}))  # beyond ±1e9
         ws.send("not json")
         errors = []
         while len(errors) < 2 and time.monotonic() < deadline + 2:

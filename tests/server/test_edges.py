@@ -83,7 +83,7 @@ def test_v1_routes_refuse_huge_numbers_and_deep_documents(
     _one_line_4xx(client.request(method, path, content=template.format(value), headers=headers))
 
 
-@pytest.mark.parametrize("duration", ["1e-100", "1e-300", "5e-324", "0.0000001", "0"])
+@pytest.mark.parametrize("duration", ["1e-100", "1e-300", "5e-324", "0.0000001"])
 def test_vanishing_goto_durations_are_refused(
     client: httpx.Client, served: Served, duration: str
 ) -> None:
@@ -92,7 +92,7 @@ def test_vanishing_goto_durations_are_refused(
     assert client.post("/api/v1/gotos", content=v1, headers=headers).status_code == 422
     pypot = f'{{"position": 10, "duration": {duration}}}'
     error = _one_line_4xx(client.post("/motors/m1/goto.json", content=pypot))
-    assert "duration must be 0.001-600 s" in error["error"]
+    assert "duration must be 0 (at once) or at least 0.001 s" in error["error"]  # the library's
     several = f'{{"motors": ["m1"], "positions": [10], "duration": {duration}}}'
     _one_line_4xx(client.post("/motors/goto.json", content=several))
 

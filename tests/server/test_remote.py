@@ -6,8 +6,18 @@ import time
 
 import pytest
 
-from poppy_core.errors import CommunicationError, ConfigError, RegisterError
+from poppy_core.errors import (
+    CommunicationError,
+    ConfigError,
+    RegisterError,
+    UnknownGroupError,
+    UnknownMotorError,
+    UnknownMoveError,
+    UnknownNameError,
+    UnknownPrimitiveError,
+)
 from poppy_core.remote import RemoteRobot
+from poppy_core.remote.client import path_of
 from tests.helpers.server import Served
 from tests.helpers.waiting import eventually
 
@@ -33,8 +43,9 @@ def test_same_names_groups_and_registers(remote: RemoteRobot, served: Served) ->
 def test_registers_read_and_write(remote: RemoteRobot, served: Served) -> None:
     remote.m4.led = "yellow"
     assert served.robot.m4.led == "yellow" and remote.m4.led == "yellow"
-    with pytest.raises(RegisterError):
-        remote.m4.goal_position = 1000.0
+    remote.m4.goal_position = 1000.0  # beyond the angle limits: clamped, as the library does
+    top = served.robot.m4.angle_limit[1]
+    assert eventually(lambda: abs(served.robot.m4.goal_position - top) < 0.5)
     with pytest.raises(RegisterError, match="read-only"):
         remote.m4.present_position = 3.0
     with pytest.raises(AttributeError):
@@ -86,3 +97,22 @@ def test_keep_alive_and_unreachable_server(remote: RemoteRobot) -> None:
     assert len(remote._client._all) == 1
     with pytest.raises(CommunicationError):
         RemoteRobot("http://127.0.0.1:9", timeout_s=1.0)
+
+
+def test_a_404_is_a_typed_unknown_name(remote: RemoteRobot) -> None:
+    """The Python API over REST raises what the local robot raises for an unknown name."""
+    client = remote._client
+    with pytest.raises(UnknownMotorError) as motor:
+        client.get(path_of("motors", "m9"))
+    assert motor.value.kind == "motor" and motor.value.motor == "m9"
+    with pytest.raises(UnknownGroupError):
+        client.get(path_of("groups", "nope"))
+    with pytest.raises(UnknownPrimitiveError):
+        client.request("POST", path_of("primitives", "nope", "start"))
+    with pytest.raises(UnknownMoveError):
+        client.get(path_of("moves", "nope"))
+    with pytest.raises(UnknownNameError):
+        remote.primitive("nope")
+    with pytest.raises(ConfigError) as register:  # an unknown register: not an unknown motor
+        client.get(path_of("motors", "m1", "registers", "nope"))
+    assert not isinstance(register.value, UnknownNameError)

@@ -291,7 +291,7 @@ def test_the_plot_has_a_time_axis_in_seconds(page: Any, timed: str) -> None:
         assert abs(x - (start + (end - start) * seconds / 2.98)) < 1.0, (seconds, x)
 
 
-def test_a_refused_goal_is_shown(page: Any, served: Served) -> None:
+def test_a_clamped_goal_is_shown(page: Any, served: Served) -> None:
     motor = served.robot.m5
     old = motor.angle_limit
     motor.angle_limit = (-10.0, 10.0)  # narrowed after the page drew its slider (-90..90)
@@ -299,10 +299,10 @@ def test_a_refused_goal_is_shown(page: Any, served: Served) -> None:
         slider = page.locator("#motor-m5 input[type=range]")
         slider.fill("60")
         slider.dispatch_event("change")
-        eventually(lambda: "refused" in page.inner_text("#message"), "the refusal")
-        assert "outside the angle limits" in page.inner_text("#message")
-        assert "refused" in (page.get_attribute("#motor-m5", "class") or "")
-        assert motor.goal_position <= 10.0
+        eventually(lambda: "clamped" in page.inner_text("#message"), "the clamp")
+        assert "m5 → 10° (clamped to the angle limits)" in page.inner_text("#message")
+        assert "refused" not in (page.get_attribute("#motor-m5", "class") or "")
+        eventually(lambda: abs(motor.goal_position - 10.0) < 0.5, "the goal clamped to the limit")
     finally:
         motor.angle_limit = old
 

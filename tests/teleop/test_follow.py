@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError, ConfigError, UnknownMotorError
 from poppy_core.motion.follow import FollowSession
 from poppy_core.robot import Robot
 from poppy_core.trajectory import minimum_jerk_weight
@@ -122,11 +122,11 @@ def _robot_with_m1() -> Robot:
 def test_unknown_motors_are_refused_and_a_stopped_session_takes_nothing(follower: Robot) -> None:
     with pytest.raises(ConfigError, match="no motor 'm9'"):
         FollowSession(follower, ["m1", "m9"])
-    with pytest.raises(ConfigError, match="no motor to follow"):
+    with pytest.raises(ArgumentError, match="no motor to follow"):
         FollowSession(follower, [])
     session = FollowSession(follower, ["m1"], ramp_s=0.0)
     session.start()
-    with pytest.raises(ConfigError, match="not followed: m2"):
+    with pytest.raises(UnknownMotorError, match="not followed: m2"):
         session.push({"m2": 1.0})
     session.push({"m1": 20.0})
     session.stop()

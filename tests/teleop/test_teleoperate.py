@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core.errors import ConfigError
+from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion import read_move
 from poppy_core.motion.teleop import Teleoperation, teleoperate
 from poppy_core.motion.teleop_map import JointMap
@@ -160,7 +160,7 @@ def test_bad_teleoperations_are_refused(leader: Robot, follower: Robot) -> None:
         Teleoperation(leader, leader, JointMap.parse("m1=m2, m2=m1"))
     with pytest.raises(ConfigError, match="the leader has no motor m9"):
         Teleoperation(leader, follower, JointMap.parse("m1=m9"))
-    with pytest.raises(ConfigError, match="rate"):
+    with pytest.raises(ArgumentError, match="rate"):
         Teleoperation(leader, follower, rate_hz=0)
     with pytest.raises(ConfigError, match="not a joint link"):
         teleoperate(leader, follower, "m1 = = m2")

@@ -20,7 +20,7 @@ from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
 from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.routers.common import json_body, truthy, wait_goto
-from poppy_core.server.service import check_duration
+from poppy_core.trajectory import goto_duration
 
 router = APIRouter(tags=["pypot"])
 
@@ -68,7 +68,7 @@ async def ik_goto(chain: str, request: Request, service: Service) -> PypotJSON:
     if not isinstance(data, dict) or "duration" not in data:
         raise ApiError("invalid", "A 'KeyError' occured. A parameter must be missing", tip=GOTO_TIP)
     try:
-        duration = check_duration(data["duration"])
+        duration = goto_duration(data["duration"])
     except ArgumentError as exc:
         raise ApiError("invalid", str(exc), tip=GOTO_TIP) from None
     xyz, rot, rpy = _numbers(data, "xyz"), _numbers(data, "rot"), _numbers(data, "rpy")

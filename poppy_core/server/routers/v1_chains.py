@@ -6,12 +6,12 @@ from fastapi import APIRouter  # noqa: TID253 (the server room is FastAPI's)
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 from starlette.concurrency import run_in_threadpool
 
+from poppy_core.checks import MAX_DURATION_S
 from poppy_core.kinematics import rotation_degrees
 from poppy_core.server.chains import chain_state, find_chain
 from poppy_core.server.deps import Service
 from poppy_core.server.routers.common import wait_goto
 from poppy_core.server.schemas import Problem
-from poppy_core.server.service import MAX_GOTO_S
 
 router = APIRouter(tags=["chains"], responses={404: {"model": Problem}, 422: {"model": Problem}})
 
@@ -61,7 +61,7 @@ class SolveBody(Target):
 class GotoBody(Target):
     """A target and how to get there."""
 
-    duration: Annotated[float, Field(gt=0, le=MAX_GOTO_S)] = 1.0
+    duration: Annotated[float, Field(gt=0, le=MAX_DURATION_S)] = 1.0
     wait: bool = False
     linear: bool = Field(False, description="move the tip along a straight line")
 

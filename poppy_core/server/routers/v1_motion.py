@@ -34,10 +34,11 @@ router = APIRouter(responses=ERRORS)
 @router.post("/gotos", tags=["gotos"], summary="Move motors so that they arrive together")
 async def goto(body: GotoRequest, service: Service) -> GotoResult:
     """Starts the motion; with ``wait`` answers once it is over (other requests go on)."""
-    handle = service.goto(body.positions, body.duration_s, body.control)
+    targets = service.targets(body.positions)  # clamped to the angle limits: the answer says so
+    handle = service.goto(targets, body.duration_s, body.control)
     waited = await wait_goto(handle) if body.wait else False
     return GotoResult(
-        positions=body.positions,
+        positions=targets,
         duration_s=body.duration_s,
         control=body.control,
         waited=body.wait,

@@ -18,7 +18,7 @@ from poppy_core.server.chains import find_chain
 from poppy_core.server.errors import ApiError
 from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.sensors import SensorService
-from poppy_core.server.service import RobotService, check_duration
+from poppy_core.server.service import RobotService
 from poppy_core.server.snap.playlists import Playlists
 from poppy_core.server.snap.text import (
     DONE,
@@ -29,6 +29,7 @@ from poppy_core.server.snap.text import (
     value_text,
     values_text,
 )
+from poppy_core.trajectory import goto_duration
 
 NO_DETECTOR = "Error: marker detector is not activated"
 """pypot's answer to ``/detect/<marker>`` without a detector."""
@@ -154,7 +155,7 @@ class SnapRobot:
             name, position, duration = (p.strip() for p in parts)
             motor = self.service.motor(name)
             target = values.check_position(motor, "goal_position", number(position, "position"))
-            seconds = check_duration(number(duration, "duration"))
+            seconds = goto_duration(number(duration, "duration"))
             by_duration.setdefault(seconds, {})[name] = target
         if not by_duration:
             raise ApiError("invalid", "no motor:position:duration given, e.g. m1:30:2")
@@ -328,7 +329,7 @@ class SnapRobot:
         """``/ik/<chain>/goto/<x>/<y>/<z>/<duration>``: move the tip there (metres)."""
         found = find_chain(self.robot, chain)
         target = [number(v, axis) for v, axis in zip(xyz, "xyz", strict=True)]
-        seconds = check_duration(number(duration, "duration"))
+        seconds = goto_duration(number(duration, "duration"))
         try:
             found.goto(target, None, duration=seconds, wait=False)
         except KinematicsError as exc:

@@ -41,8 +41,9 @@ async function setCompliant(names, value) {
 
 async function setGoal(name, value, slider) {
   try {
-    await post("/api/v1/gotos", { positions: { [name]: value }, duration_s: 0.5 });
-    say(`${name} → ${value}°`);
+    const answer = await post("/api/v1/gotos", { positions: { [name]: value }, duration_s: 0.5 });
+    const aimed = answer.positions[name]; // a goal beyond the angle limits is clamped to them
+    say(aimed === value ? `${name} → ${value}°` : `${name} → ${aimed}° (clamped to the angle limits)`);
   } catch (error) {
     say(`${name}: refused: ${error.message}`, true);
     slider.closest("tr").classList.add("refused");
