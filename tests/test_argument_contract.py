@@ -131,7 +131,7 @@ def ws(command: str) -> Send:
                 frame = json.loads(socket.recv(timeout=10))
                 if "error" not in frame:
                     continue  # a state frame
-                if "the message is not valid JSON" in frame["error"]:
+                if "JSON syntax error" in frame["error"]:  # the probe's answer
                     return "accepted", ""
                 return frame.get("kind", "no kind"), frame["error"]
         return "unclear", "no frame"
