@@ -100,7 +100,7 @@ def test_the_core_scans_drives_and_reports_a_robot_without_any_extra(tmp_path: P
         assert result.returncode == 0, (argv, result.stderr)
         assert "Traceback" not in result.stderr
     assert '"id":6' in done[0].stdout.replace(" ", "")
-    assert done[2].stdout.startswith("9.96 deg")  # 10° on the XL-320's 0.29° steps
+    assert done[2].stdout.startswith("9.96 °")  # 10° on the XL-320's 0.29° steps
     assert "m6" in done[3].stdout
 
 
