@@ -357,7 +357,9 @@ def test_with_a_token_the_page_works_after_it_is_entered(browser: Any, with_toke
     assert "refused" in tab.inner_text("#token-error")
     tab.fill("#token-input", "s3cret-page")
     tab.click("#token-ok")
-    tab.wait_for_function(LIVE)
+    # the page then opens its stream: under two busy loops and two workers this once took over
+    # the usual 30 s (a wait, not a speed check)
+    tab.wait_for_function(LIVE, timeout=2 * WAIT_S * 1000)
     assert tab.inner_text("#robot-name") == "ergo-jr"
     tab.uncheck("#motor-m2 input[type=checkbox]")
     eventually(lambda: with_token.robot.m2.compliant is False, "m2 stiff with the token")

@@ -51,10 +51,18 @@ def shown(app: PoppyApp, word: str) -> str:
 
 
 async def see(pilot: Any, app: PoppyApp, word: str, pattern: str) -> None:
-    """Wait until the screen line with ``word`` matches ``pattern``."""
-    await wait_for(
-        pilot, lambda: re.search(pattern, shown(app, word)) is not None, what=f"{pattern!r}"
-    )
+    """Wait until the screen line with ``word`` matches ``pattern`` (30 s: a loaded machine
+    once took longer than the usual 15 s); a failure says what the line showed."""
+    seen: list[str] = []
+
+    def matches() -> bool:
+        seen[:] = [shown(app, word)]
+        return re.search(pattern, seen[0]) is not None
+
+    try:
+        await wait_for(pilot, matches, timeout_s=30, what=f"{pattern!r}")
+    except AssertionError as exc:
+        raise AssertionError(f"{exc}; the line was {seen[0]!r}") from None
 
 
 def footer(app: PoppyApp) -> str:
