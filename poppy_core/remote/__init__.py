@@ -15,7 +15,7 @@ from poppy_core.remote.robot import (
     RemotePrimitive,
     RemoteRobot,
 )
-from poppy_core.remote.teleop import RemoteFollower
+from poppy_core.remote.teleop_follower import RemoteFollower
 
 __all__ = [
     "HttpClient",

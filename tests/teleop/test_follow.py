@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from poppy_core.errors import ArgumentError, ConfigError, UnknownMotorError
-from poppy_core.motion.follow import FollowSession
+from poppy_core.motion.teleop.follow_session import FollowSession
 from poppy_core.robot import Robot
 from poppy_core.trajectory import minimum_jerk_weight
 from tests.teleop.hands import READ_S, Hand, wait_for

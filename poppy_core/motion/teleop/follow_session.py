@@ -1,8 +1,8 @@
 """``FollowSession``: goal positions streamed to some motors, with a start ramp, hold and resume.
 
-The follower side of teleoperation, shared by a local follower (``teleop``) and the server's
-WebSocket teleop channel. Targets arrive at the stream's rate; each one is written at once
-(``Robot.run_loop("goals")``) rather than at the sync loop's next write.
+The follower side of teleoperation, shared by a local follower (``motion.teleop.follower``) and
+the server's WebSocket teleop channel. Targets arrive at the stream's rate; each one is
+written at once (``Robot.run_loop("goals")``) rather than at the sync loop's next write.
 
 - **Ramp**: when a stream starts, or resumes after a hold, the goals blend from where the motors
   are to the (moving) target with a minimum-jerk weight, ``goal = start + s(τ) · (target −

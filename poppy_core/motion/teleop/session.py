@@ -26,11 +26,11 @@ from typing import TYPE_CHECKING, Any
 
 from poppy_core import checks
 from poppy_core.errors import ConfigError, FileError, PoppyError
-from poppy_core.motion.follow import FollowChange
-from poppy_core.motion.teleop_follower import Follower, LocalFollower
-from poppy_core.motion.teleop_map import JointMap
-from poppy_core.motion.teleop_record import TrajectoryRecorder
-from poppy_core.motion.teleop_stats import TeleopReport, TeleopStatus
+from poppy_core.motion.teleop.follow_session import FollowChange
+from poppy_core.motion.teleop.follower import Follower, LocalFollower
+from poppy_core.motion.teleop.joint_map import JointMap
+from poppy_core.motion.teleop.recording import TrajectoryRecorder
+from poppy_core.motion.teleop.stats import TeleopReport, TeleopStatus
 from poppy_core.robot.robot import Robot
 from poppy_core.schedule import Backoff, Periodic
 

@@ -28,7 +28,7 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from poppy_core import checks
-from poppy_core.motion.follow import FollowChange, FollowSession
+from poppy_core.motion.teleop.follow_session import FollowChange, FollowSession
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
 

@@ -10,7 +10,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Protocol
 
-from poppy_core.motion.follow import FollowChange, FollowSession
+from poppy_core.motion.teleop.follow_session import FollowChange, FollowSession
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
