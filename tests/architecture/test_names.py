@@ -30,7 +30,6 @@ SHARED_MODULE_NAMES = {
     "motor.py": "robot/motor.py (Motor), emulator/motor.py (VirtualMotor)",
     "plant.py": "emulator/plant.py (an ideal servo), sim/plant.py (MuJoCo's)",
     "routes.py": "server/snap/routes.py (Snap!'s), server/web/routes.py (the web page's)",
-    "server.py": "emulator/server.py (a virtual bus served), server/snap/server.py (Snap!'s)",
     "spec.py": "emulator/spec.py (virtual bus spec), kinematics/spec.py (kinematics section)",
     "timing.py": "bus/timing.py (transaction deadlines), emulator/timing.py (wire time, sleep)",
     "trajectory.py": "trajectory.py (the leaf), motion/trajectory.py (its re-export for users)",
