@@ -26,7 +26,6 @@ SHARED_MODULE_NAMES = {
     "chains.py": "motion/chains.py (chains attached), server/chains.py (as the server shows them)",
     "config.py": "robot/config.py (the robot config), sensors/config.py (its sensors section)",
     "errors.py": "errors.py (the typed errors), server/errors.py (their HTTP mapping)",
-    "line.py": "line.py (the byte-line contract), bus/line.py (the lines a bus opens)",
     "motor.py": "robot/motor.py (Motor), emulator/motor.py (VirtualMotor)",
     "plant.py": "emulator/plant.py (an ideal servo), sim/plant.py (MuJoCo's)",
     "routes.py": "server/snap/routes.py (Snap!'s), server/web/routes.py (the web page's)",
