@@ -15,7 +15,7 @@ from poppy_core.emulator.linespeed import baud_matches
 from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.emulator.plant import IdealPlant, Plant
 from poppy_core.emulator.sniff import CorruptSniffer
-from poppy_core.emulator.timing import LineClock, transfer_time_s
+from poppy_core.emulator.wire_timing import LineClock, transfer_time_s
 from poppy_core.errors import ConfigError
 from poppy_core.protocol import InstructionPacket, PacketDecoder, protocol_for
 

@@ -6,7 +6,7 @@ import logging
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from poppy_core.emulator.timing import transfer_time_s
+from poppy_core.emulator.wire_timing import transfer_time_s
 from poppy_core.errors import ProtocolError
 from poppy_core.protocol import (
     BROADCAST_ID,

@@ -23,14 +23,11 @@ SHARED_MODULE_NAMES = {
     "base.py": "protocol/base.py (a protocol's contract), sensors/base.py (a sensor's)",
     "camera.py": "sensors/camera.py (a camera sensor), sim/camera.py (MuJoCo's rendering of it)",
     "catalog.py": "models/catalog.py (servo models), server/snap/catalog.py (Snap! blocks)",
-    "chains.py": "motion/chains.py (chains attached), server/chains.py (as the server shows them)",
     "config.py": "robot/config.py (the robot config), sensors/config.py (its sensors section)",
     "errors.py": "errors.py (the typed errors), server/errors.py (their HTTP mapping)",
     "motor.py": "robot/motor.py (Motor), emulator/motor.py (VirtualMotor)",
     "plant.py": "emulator/plant.py (an ideal servo), sim/plant.py (MuJoCo's)",
     "routes.py": "server/snap/routes.py (Snap!'s), server/web/routes.py (the web page's)",
-    "spec.py": "emulator/spec.py (virtual bus spec), kinematics/spec.py (kinematics section)",
-    "timing.py": "bus/timing.py (transaction deadlines), emulator/timing.py (wire time, sleep)",
     "trajectory.py": "trajectory.py (the leaf), motion/trajectory.py (its re-export for users)",
 }
 

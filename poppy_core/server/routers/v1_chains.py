@@ -8,7 +8,7 @@ from starlette.concurrency import run_in_threadpool
 
 from poppy_core.checks import MAX_DURATION_S
 from poppy_core.kinematics import rotation_degrees
-from poppy_core.server.chains import chain_state, find_chain
+from poppy_core.server.chain_lookup import chain_state, find_chain
 from poppy_core.server.deps import Service
 from poppy_core.server.routers.common import wait_goto
 from poppy_core.server.schemas import Problem
