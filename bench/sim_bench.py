@@ -35,7 +35,7 @@ SYNC_RATE_OK = 0.9  # fraction of the 50 Hz target counted as "holds its rate"
 
 
 def _world(robot: str) -> tuple[Any, dict[str, VirtualMotor], dict[str, Any]]:
-    from poppy_core.sim.plant import JointLink, MujocoPlant
+    from poppy_core.sim.plant import MotorJoint, MujocoPlant
     from poppy_core.sim.world import Simulation
 
     config = load_profile(robot)
@@ -48,7 +48,7 @@ def _world(robot: str) -> tuple[Any, dict[str, VirtualMotor], dict[str, Any]]:
         bus_motors = []
         for name in config.motors_of_controller(controller):
             m = config.motors[name]
-            ids[m.id] = JointLink(name)
+            ids[m.id] = MotorJoint(name)
             links[name] = m
             motors[name] = VirtualMotor(model_by_name(m.type), m.id)
             bus_motors.append(motors[name])

@@ -34,7 +34,7 @@ from bench.teleop_scenarios import (
     served,
     stall,
 )
-from poppy_core.motion.teleop_map import JointMap
+from poppy_core.motion.teleop.joint_map import JointMap
 from poppy_core.robot import load_config, load_profile
 
 logger = logging.getLogger(__name__)

@@ -26,7 +26,7 @@ def _state(state: str, reason: str) -> None:
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Build the robots, teleoperate until a signal, return the JSON-ready record."""
-    from poppy_core.motion.teleop import Teleoperation
+    from poppy_core.motion.teleop.session import Teleoperation
     from poppy_core.remote import RemoteFollower
     from poppy_core.robot import from_profile
 
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _map(text: str) -> Any:
-    from poppy_core.motion.teleop_map import JointMap
+    from poppy_core.motion.teleop.joint_map import JointMap
 
     return JointMap.parse(text)
 

@@ -31,7 +31,7 @@ from bench.registry import POPPY_CLI, REPO_ROOT
 from bench.teleop_probe import BusProbe, FollowerOf, Hand, Tracker, latencies
 from poppy_core.emulator import VirtualBus, serve_pty
 from poppy_core.models import model_by_name
-from poppy_core.motion.teleop_map import JointMap
+from poppy_core.motion.teleop.joint_map import JointMap
 from poppy_core.robot import Motor, RobotConfig
 from poppy_core.robot.factory import virtual_buses
 

@@ -31,8 +31,8 @@ from poppy_core.checks import MAX_DURATION_S
 if TYPE_CHECKING:
     from rich.table import Table
 
-    from poppy_core.motion.teleop import Teleoperation
-    from poppy_core.motion.teleop_map import JointMap
+    from poppy_core.motion.teleop.joint_map import JointMap
+    from poppy_core.motion.teleop.session import Teleoperation
     from poppy_core.robot import Robot, RobotConfig
 
 REFRESH_S = 0.1
@@ -59,7 +59,7 @@ def _config(spec: str, port: str | None, role: str) -> RobotConfig:
 
 
 def _joint_map(text: str | None, file: Path | None) -> JointMap | None:
-    from poppy_core.motion.teleop_map import JointMap
+    from poppy_core.motion.teleop.joint_map import JointMap
 
     if text is not None and file is not None:
         raise typer.BadParameter("give --map or --map-file, not both", param_hint="--map")
@@ -222,7 +222,7 @@ def teleop(
 def _check_map(
     mapping: JointMap | None, leader: list[str], follower: list[str], same_robot: bool
 ) -> None:
-    from poppy_core.motion.teleop_map import JointMap
+    from poppy_core.motion.teleop.joint_map import JointMap
 
     if same_robot and mapping is None:
         raise typer.BadParameter("--follower self needs a --map of other joints, e.g. "
@@ -255,7 +255,7 @@ def _start(
     leader: Robot, follower: Any, mapping: JointMap | None, rate: float, ramp: float | None,
     duration: float | None, path: Path | None, leader_config: RobotConfig, follower_spec: str,
 ) -> Teleoperation:  # fmt: skip
-    from poppy_core.motion.teleop import Teleoperation
+    from poppy_core.motion.teleop.session import Teleoperation
 
     name = leader_config.profile.name if leader_config.profile is not None else "leader"
     metadata = {"description": f"teleoperated: {name} → {follower_spec}"}

@@ -60,7 +60,7 @@ class MotorRef:
 
 
 @dataclass(frozen=True)
-class RegisterValue:
+class RegisterRow:
     """One control-table row as shown: the register and its SI value (None: unreadable)."""
 
     register: Register
@@ -152,21 +152,21 @@ class BusPool:
             self._drop(port)
 
 
-def read_table(bus: DxlBus, motor_id: int, model: ServoModel) -> list[RegisterValue]:
+def read_table(bus: DxlBus, motor_id: int, model: ServoModel) -> list[RegisterRow]:
     """Read the whole control table in one transaction (one read per register as a fallback)."""
     registers = sorted(model.registers.values(), key=lambda reg: reg.address)
     try:
         data = bus.read(motor_id, 0, model.table_size)
     except PoppyError as exc:
         logger.debug("block read of motor %d failed (%s); reading one by one", motor_id, exc)
-        return [RegisterValue(reg, _read_one(bus, motor_id, reg)) for reg in registers]
+        return [RegisterRow(reg, _read_one(bus, motor_id, reg)) for reg in registers]
     rows = []
     for reg in registers:
         try:
             value: SIValue | None = reg.decode_si(data, start=0)
         except RegisterError:
             value = None
-        rows.append(RegisterValue(reg, value))
+        rows.append(RegisterRow(reg, value))
     return rows
 
 

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from textual.message import Message
 
 if TYPE_CHECKING:
-    from poppy_cli.tui.busio import LiveValues, MotorRef, RegisterValue
+    from poppy_cli.tui.busio import LiveValues, MotorRef, RegisterRow
     from poppy_cli.tui.ops import WriteOutcome
     from poppy_core.bus import FoundMotor, PortInfo, ScanProgress
     from poppy_core.robot import Robot
@@ -50,7 +50,7 @@ class TableRead(Message):
     """A motor's whole control table was read."""
 
     motor: MotorRef
-    rows: list[RegisterValue]
+    rows: list[RegisterRow]
 
 
 @dataclass

@@ -3,7 +3,6 @@
 from poppy_core.bus.core import is_alarm_only
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.dxlio import Dxl320IO, DxlIO, get_available_ports
-from poppy_core.bus.line import Line, LineOpener, SerialLine, open_line, register_scheme
 from poppy_core.bus.ports import (
     KNOWN_ADAPTERS,
     PortInfo,
@@ -16,6 +15,7 @@ from poppy_core.bus.ports import (
 )
 from poppy_core.bus.results import BusStats, FoundMotor, PingResult, ScanProgress, SetupResult
 from poppy_core.bus.scan import find_bus, find_port, scan
+from poppy_core.bus.serial_line import Line, LineOpener, SerialLine, open_line, register_scheme
 from poppy_core.bus.setup import (
     change_baudrate,
     change_id,

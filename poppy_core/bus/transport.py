@@ -6,7 +6,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 
-from poppy_core.bus.line import Line, open_line, port_error
+from poppy_core.bus.serial_line import Line, open_line, port_error
 from poppy_core.bus.timing import Deadline
 from poppy_core.protocol import PacketDecoder, StatusPacket
 
@@ -16,7 +16,7 @@ __all__ = ["Transport", "port_error"]
 class Transport:
     """A serial line that writes instruction bytes and reads decoded status packets.
 
-    The bytes travel on a :class:`~poppy_core.bus.line.Line` opened from ``port``: a device
+    The bytes travel on a :class:`~poppy_core.line.Line` opened from ``port``: a device
     path (``/dev/ttyUSB0``, ``COM3``), a pty path, ``socket://host:port``, ``loop://`` (pyserial)
     or a registered scheme such as the emulator's in-process ``emu://NAME``. Reads never block
     past the given deadline, whatever the line.

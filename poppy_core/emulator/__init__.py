@@ -12,12 +12,7 @@ Typical use::
 """
 
 from poppy_core.emulator.bus import ADAPTERS, Adapter, Reply, VirtualBus
-from poppy_core.emulator.faults import FaultInjector, fault_bits
-from poppy_core.emulator.linespeed import BAUD_TOLERANCE, baud_matches, read_pty_baudrate
-from poppy_core.emulator.link import LinkServer, VirtualLine, serve_link
-from poppy_core.emulator.motor import VirtualMotor
-from poppy_core.emulator.plant import IdealPlant, Plant
-from poppy_core.emulator.server import (
+from poppy_core.emulator.bus_servers import (
     EmulatorServer,
     Endpoint,
     PtyServer,
@@ -25,8 +20,18 @@ from poppy_core.emulator.server import (
     serve_pty,
     serve_tcp,
 )
-from poppy_core.emulator.spec import EmulatorConfig, build_bus_from_spec, ergo_jr_bus, parse_spec
-from poppy_core.emulator.timing import byte_time_s, sleep_until, transfer_time_s
+from poppy_core.emulator.bus_spec import (
+    EmulatorConfig,
+    build_bus_from_spec,
+    ergo_jr_bus,
+    parse_spec,
+)
+from poppy_core.emulator.faults import FaultInjector, fault_bits
+from poppy_core.emulator.linespeed import BAUD_TOLERANCE, baud_matches, read_pty_baudrate
+from poppy_core.emulator.link import LinkServer, VirtualLine, serve_link
+from poppy_core.emulator.motor import VirtualMotor
+from poppy_core.emulator.plant import IdealPlant, Plant
+from poppy_core.emulator.wire_timing import byte_time_s, sleep_until, transfer_time_s
 
 __all__ = [
     "ADAPTERS",

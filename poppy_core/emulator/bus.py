@@ -9,13 +9,13 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Literal
 
-from poppy_core.emulator.dispatch import Frame, dispatch
+from poppy_core.emulator.dispatch import ReplyFrame, dispatch
 from poppy_core.emulator.faults import FaultInjector
 from poppy_core.emulator.linespeed import baud_matches
 from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.emulator.plant import IdealPlant, Plant
 from poppy_core.emulator.sniff import CorruptSniffer
-from poppy_core.emulator.timing import LineClock, transfer_time_s
+from poppy_core.emulator.wire_timing import LineClock, transfer_time_s
 from poppy_core.errors import ConfigError
 from poppy_core.protocol import InstructionPacket, PacketDecoder, protocol_for
 
@@ -215,7 +215,7 @@ class VirtualBus:
                 return []
             if self.auto_step:
                 self.advance()
-            frames: list[Frame] = []
+            frames: list[ReplyFrame] = []
             if corrupt:
                 frames += self._checksum_replies(corrupt, line)
             for packet in packets:
@@ -228,17 +228,19 @@ class VirtualBus:
         """Handle instruction bytes and return every reply at once (no waiting)."""
         return b"".join(reply.data for reply in self.receive(data, line_bps=line_bps))
 
-    def _checksum_replies(self, count: int, line: int) -> list[Frame]:
-        frames: list[Frame] = []
+    def _checksum_replies(self, count: int, line: int) -> list[ReplyFrame]:
+        frames: list[ReplyFrame] = []
         for packet_id, instruction in self._sniffer.corrupt_frames(count):
             for motor in self._motors:
                 if motor.id == packet_id and self.hears(motor, line):
                     status = motor.checksum_error(instruction)
                     if status is not None:
-                        frames.append(Frame.status(self.protocol, motor, status))
+                        frames.append(ReplyFrame.status(self.protocol, motor, status))
         return frames
 
-    def _schedule(self, frames: list[Frame], arrival: float, line: int, now: float) -> list[Reply]:
+    def _schedule(
+        self, frames: list[ReplyFrame], arrival: float, line: int, now: float
+    ) -> list[Reply]:
         """Put replies on the line one after the other and apply the fault knobs."""
         replies: list[Reply] = []
         t = arrival

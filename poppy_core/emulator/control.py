@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from functools import partial
 
 from poppy_core import checks
-from poppy_core.emulator.server import Endpoint
+from poppy_core.emulator.bus_servers import Endpoint
 from poppy_core.errors import ArgumentError
 
 logger = logging.getLogger(__name__)

@@ -6,7 +6,7 @@ import logging
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from poppy_core.emulator.timing import transfer_time_s
+from poppy_core.emulator.wire_timing import transfer_time_s
 from poppy_core.errors import ProtocolError
 from poppy_core.protocol import (
     BROADCAST_ID,
@@ -36,7 +36,7 @@ _IDLE = 0xFF
 
 
 @dataclass(frozen=True)
-class Frame:
+class ReplyFrame:
     """One reply on the line: bytes, the silence before them, whether they take line time."""
 
     data: bytes
@@ -44,19 +44,19 @@ class Frame:
     on_wire: bool = True
 
     @classmethod
-    def status(cls, protocol: int, motor: VirtualMotor, packet: StatusPacket) -> Frame:
+    def status(cls, protocol: int, motor: VirtualMotor, packet: StatusPacket) -> ReplyFrame:
         """A motor's status packet, sent after its return delay."""
         return cls(encode_status(protocol, packet), motor.return_delay_s)
 
 
-def _collide(frames: list[Frame]) -> Frame:
+def _collide(frames: list[ReplyFrame]) -> ReplyFrame:
     """Several motors answering at once: the bytes overlap (AND of the levels)."""
     size = max(len(frame.data) for frame in frames)
     out = bytearray([_IDLE] * size)
     for frame in frames:
         for i, byte in enumerate(frame.data):
             out[i] &= byte
-    return Frame(bytes(out), min(frame.delay_s for frame in frames))
+    return ReplyFrame(bytes(out), min(frame.delay_s for frame in frames))
 
 
 def _listener(bus: VirtualBus, motor_id: int, line: int) -> VirtualMotor | None:
@@ -80,7 +80,7 @@ def supports(motor: VirtualMotor, instruction: int) -> bool:
     return True
 
 
-def dispatch(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Frame]:
+def dispatch(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[ReplyFrame]:
     """Execute ``packet`` on every motor that hears it; return the replies in line order."""
     ins = packet.instruction
     try:
@@ -103,8 +103,8 @@ def dispatch(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Fram
         and packet.id == USB2AX_ID
         and ins == Instruction.PING
     ):
-        return [Frame(encode_status(1, StatusPacket(USB2AX_ID, 0)), 0.0, on_wire=False)]
-    frames: list[Frame] = []
+        return [ReplyFrame(encode_status(1, StatusPacket(USB2AX_ID, 0)), 0.0, on_wire=False)]
+    frames: list[ReplyFrame] = []
     targets = [
         motor
         for motor in bus.motors
@@ -113,13 +113,13 @@ def dispatch(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Fram
     for motor in sorted(targets, key=lambda m: m.id):
         status = motor.handle(packet)
         if status is not None:
-            frames.append(Frame.status(bus.protocol, motor, status))
+            frames.append(ReplyFrame.status(bus.protocol, motor, status))
     if packet.id != BROADCAST_ID and len(frames) > 1:
         return [_collide(frames)]
     return frames
 
 
-def _group(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Frame]:
+def _group(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[ReplyFrame]:
     proto, ins, params = bus.proto, packet.instruction, packet.params
     if ins == Instruction.SYNC_WRITE:
         address, _, data = parse_sync_write(proto, params)
@@ -148,7 +148,7 @@ def _group(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Frame]
 
 def _read_chain(
     bus: VirtualBus, ins: int, requests: list[tuple[int, int, int]], line: int
-) -> list[Frame]:
+) -> list[ReplyFrame]:
     """Motors answer in request order, each after the previous one's status packet.
 
     A motor that does not answer breaks the chain: the next ones wait for its status forever
@@ -165,7 +165,7 @@ def _read_chain(
         blocks.append((motor, code, data))
     if ins != Instruction.FAST_SYNC_READ:
         return [
-            Frame.status(bus.protocol, motor, motor.status(code, data))
+            ReplyFrame.status(bus.protocol, motor, motor.status(code, data))
             for motor, code, data in blocks
         ]
     if not blocks:
@@ -176,15 +176,15 @@ def _read_chain(
         for motor, code, data in blocks
     ]
     if len(blocks) == len(requests):
-        return [Frame(encode_fast_sync_status(parts), blocks[0][0].return_delay_s)]
+        return [ReplyFrame(encode_fast_sync_status(parts), blocks[0][0].return_delay_s)]
     # A missing motor: the combined packet announces every block but stops where it would be.
     missing = [(motor_id, 0, bytes(length)) for motor_id, _, _ in requests[len(blocks) :]]
     whole = encode_fast_sync_status(parts + missing)
     sent = len(encode_fast_sync_status(parts))
-    return [Frame(whole[:sent], blocks[0][0].return_delay_s)]
+    return [ReplyFrame(whole[:sent], blocks[0][0].return_delay_s)]
 
 
-def _usb2ax_sync_read(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[Frame]:
+def _usb2ax_sync_read(bus: VirtualBus, packet: InstructionPacket, line: int) -> list[ReplyFrame]:
     """USB2AX sync read (0x84): the adapter reads each motor itself and answers once.
 
     USB2AX firmware (advanced_commands.txt): a motor that does not answer leaves 0xFF bytes.
@@ -205,4 +205,4 @@ def _usb2ax_sync_read(bus: VirtualBus, packet: InstructionPacket, line: int) -> 
             continue
         bus_time += motor.return_delay_s + transfer_time_s(6 + length, line)
         chunks.append(data)
-    return [Frame(encode_status(1, usb2ax_sync_status(chunks)), bus_time, on_wire=False)]
+    return [ReplyFrame(encode_status(1, usb2ax_sync_status(chunks)), bus_time, on_wire=False)]

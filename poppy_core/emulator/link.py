@@ -122,7 +122,7 @@ class LinkServer:
 
 
 class VirtualLine(Line):
-    """The host's end of an in-process link (a :class:`~poppy_core.bus.line.Line`)."""
+    """The host's end of an in-process link (a :class:`~poppy_core.line.Line`)."""
 
     def __init__(self, server: LinkServer, generation: int, baudrate: int) -> None:
         self.port = server.url

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from types import TracebackType
 
 from poppy_core.emulator.bus import Reply, VirtualBus
-from poppy_core.emulator.timing import SPIN_WINDOW_S, sleep_until
+from poppy_core.emulator.wire_timing import SPIN_WINDOW_S, sleep_until
 
 logger = logging.getLogger(__name__)
 

@@ -50,13 +50,14 @@ from poppy_core.motion.recorder import MoveRecorder
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
 from poppy_core.motion.teleop import (
     Follower,
+    JointLink,
+    JointMap,
     LocalFollower,
     Teleoperation,
     TeleopReport,
     TeleopStatus,
     teleoperate,
 )
-from poppy_core.motion.teleop_map import JointLink, JointMap
 from poppy_core.trajectory import CONTROLS, MinimumJerk, dummy_speed
 
 __all__ = [

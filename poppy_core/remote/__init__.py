@@ -7,7 +7,7 @@ It speaks the server's ``/api/v1`` with the standard library only (keep-alive co
 """
 
 from poppy_core.remote.client import HttpClient
-from poppy_core.remote.robot import (
+from poppy_core.remote.remote_robot import (
     ModelInfo,
     RemoteGoto,
     RemoteMotor,
@@ -15,7 +15,7 @@ from poppy_core.remote.robot import (
     RemotePrimitive,
     RemoteRobot,
 )
-from poppy_core.remote.teleop import RemoteFollower
+from poppy_core.remote.teleop_follower import RemoteFollower
 
 __all__ = [
     "HttpClient",

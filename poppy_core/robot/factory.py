@@ -20,7 +20,7 @@ from typing import Any
 from poppy_core.bus import DxlBus, list_ports, scan
 from poppy_core.errors import ConfigError, SetupError
 from poppy_core.models import model_by_name
-from poppy_core.robot.assembly import SIM_MODES, Assembly, SimMode, sim_mode
+from poppy_core.robot.build_steps import SIM_MODES, BuildSteps, SimMode, sim_mode
 from poppy_core.robot.config import RobotConfig
 from poppy_core.robot.config_io import ConfigSource, as_config
 from poppy_core.robot.profile_match import matching_profile
@@ -58,7 +58,7 @@ def from_config(
     """Build and start a plain robot from a config (a ``RobotConfig``, a dict or a JSON/YAML file).
 
     The one way robots are built (``poppy_core.assembly.from_config`` comes here, then adds the
-    creature); the steps are ``poppy_core.robot.assembly``'s.
+    creature); the steps are ``poppy_core.robot.build_steps``'s.
 
     Args:
         config: the config, a dict as pypot's ``from_config(my_config)`` takes, or a file path.
@@ -88,7 +88,7 @@ def from_config(
             motors whose model differs from the config.
         PortError: a port cannot be opened.
     """
-    with Assembly(as_config(config), sim_mode(sim)) as parts:
+    with BuildSteps(as_config(config), sim_mode(sim)) as parts:
         parts.start_virtual_motors()
         parts.open_buses(ports, strict)
         parts.prepare_motors(fix_return_delay, write_angle_limits)

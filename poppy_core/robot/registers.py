@@ -48,7 +48,7 @@ def has_compliance_slopes(model: ServoModel) -> bool:
 
 
 @dataclass(frozen=True)
-class Block:
+class ReadBlock:
     """One contiguous read: registers of several motors sharing the same address layout.
 
     Attributes:
@@ -73,7 +73,7 @@ class Block:
 MAX_BLOCK_GAP = 8
 
 
-def read_blocks(model: ServoModel, names: Sequence[str]) -> list[Block]:
+def read_blocks(model: ServoModel, names: Sequence[str]) -> list[ReadBlock]:
     """How to read ``names`` (those ``model`` has) in as few contiguous reads as possible.
 
     Args:
@@ -91,8 +91,9 @@ def read_blocks(model: ServoModel, names: Sequence[str]) -> list[Block]:
     end = max(r.address + r.size for _, r in registers)
     useful = sum(r.size for _, r in registers)
     if end - start - useful <= MAX_BLOCK_GAP:
-        return [Block(start, end - start, tuple((n, r.address - start, r) for n, r in registers))]
-    return [Block(r.address, r.size, ((n, 0, r),)) for n, r in registers]
+        fields = tuple((n, r.address - start, r) for n, r in registers)
+        return [ReadBlock(start, end - start, fields)]
+    return [ReadBlock(r.address, r.size, ((n, 0, r),)) for n, r in registers]
 
 
 def decode_table(model: ServoModel, data: bytes, names: Sequence[str] = STATE) -> dict[str, object]:

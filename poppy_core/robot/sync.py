@@ -107,7 +107,7 @@ class BusSync:
         self._loops: list[_Loop] = []
         self._worker = Worker(f"sync {controller}", self._run)
         self._stop = self._worker.stopping
-        self._blocks: dict[tuple[str, ServoModel], list[regs.Block]] = {}
+        self._blocks: dict[tuple[str, ServoModel], list[regs.ReadBlock]] = {}
         self._driven: set[str] = set()
         self._retry_turn = 0
         self.connected = True
@@ -324,7 +324,7 @@ class BusSync:
         else:
             self._read(spec)
 
-    def _blocks_for(self, spec: LoopSpec, model: ServoModel) -> list[regs.Block]:
+    def _blocks_for(self, spec: LoopSpec, model: ServoModel) -> list[regs.ReadBlock]:
         key = (spec.name, model)
         if key not in self._blocks:
             self._blocks[key] = regs.read_blocks(model, spec.registers)
@@ -333,7 +333,7 @@ class BusSync:
     def _read(self, spec: LoopSpec) -> None:
         # Motors whose blocks share address and length go in one transaction, whatever their
         # model (AX and MX have the same layout); each decodes with its own registers.
-        batches: dict[tuple[int, int], list[tuple[Motor, regs.Block]]] = {}
+        batches: dict[tuple[int, int], list[tuple[Motor, regs.ReadBlock]]] = {}
         for motor in self.motors:
             if motor.online:
                 for block in self._blocks_for(spec, motor.model):

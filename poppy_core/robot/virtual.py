@@ -53,10 +53,10 @@ def _model_kind(config: RobotConfig) -> str:
 
 
 def _mujoco_plant(config: RobotConfig, controller: str, simulation: Any) -> Plant:
-    from poppy_core.sim.plant import JointLink, MujocoPlant
+    from poppy_core.sim.plant import MotorJoint, MujocoPlant
 
     names = config.motors_of_controller(controller)
-    links = {config.motors[name].id: JointLink(name) for name in names}
+    links = {config.motors[name].id: MotorJoint(name) for name in names}
     return MujocoPlant(simulation, links)
 
 

@@ -141,7 +141,7 @@ class MethodResult(BaseModel):
     result: JsonValue
 
 
-class MoveEntry(BaseModel):
+class LibraryMoveInfo(BaseModel):
     """A move of the library."""
 
     name: str

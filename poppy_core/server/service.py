@@ -19,7 +19,7 @@ from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from poppy_core.server.pypot_json import html_safe
-from poppy_core.server.teleop import TeleopRegistry
+from poppy_core.server.teleop_channel import TeleopRegistry
 from poppy_core.trajectory import control_name, goto_duration
 
 DESCRIPTION_TTL_S = 0.01

@@ -3,9 +3,9 @@
 Frames sent: ``{motor: {present_position, present_speed, present_load, present_temperature,
 led}}`` (pypot's ws server). Frames received: ``{motor: {register: value}}``, checked in full
 before anything is written; a refused command gets ``{"error": "..."}`` back. Messages with a
-string ``type`` are teleoperation messages (``poppy_core.server.teleop``: a client streams goal
-positions, a watchdog holds the motors when they stop coming). The send loop runs in its own
-task, so it keeps its rate whatever the client sends and whatever HTTP requests do.
+string ``type`` are teleoperation messages (``poppy_core.server.teleop_channel``: a client
+streams goal positions, a watchdog holds the motors when they stop coming). The send loop runs in
+its own task, so it keeps its rate whatever the client sends and whatever HTTP requests do.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from poppy_core.server.middleware import TokenMiddleware, token_protocol
 from poppy_core.server.origins import OriginGuard, OriginPolicy
 from poppy_core.server.refusals import one_line
 from poppy_core.server.service import RobotService
-from poppy_core.server.teleop import TeleopChannel
+from poppy_core.server.teleop_channel import TeleopChannel
 
 if TYPE_CHECKING:
     from fastapi import FastAPI

@@ -14,7 +14,7 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class JointLink:
+class MotorJoint:
     """The joint one motor drives.
 
     The joint's angle is the motor's own angle, the one its control table holds (poppy's models
@@ -40,7 +40,7 @@ class MujocoPlant:
         links: motor id -> its joint.
     """
 
-    def __init__(self, simulation: Simulation, links: Mapping[int, JointLink]) -> None:
+    def __init__(self, simulation: Simulation, links: Mapping[int, MotorJoint]) -> None:
         self.simulation = simulation
         self.links = dict(links)
 

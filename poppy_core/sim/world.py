@@ -20,7 +20,7 @@ from poppy_core.sim.drive import Drive, Joint
 from poppy_core.sim.exchange import MotorPort
 from poppy_core.sim.gl import check_offscreen_gl
 from poppy_core.sim.objects import ObjectSpec, add_objects, facing_quat
-from poppy_core.sim.plant import JointLink
+from poppy_core.sim.plant import MotorJoint
 
 logger = logging.getLogger(__name__)
 
@@ -34,7 +34,7 @@ STATE_PERIOD_S = 0.01
 @dataclass
 class _Binding:
     motor: VirtualMotor
-    link: JointLink
+    link: MotorJoint
     port: MotorPort
     index: int  # in the Drive's arrays
 
@@ -78,7 +78,7 @@ class Simulation:
             raise ConfigError(f"the simulation model has no joint/actuator {joint!r}", field=joint)
         return int(self.model.jnt_qposadr[index]), int(self.model.jnt_dofadr[index]), actuator
 
-    def bind(self, motor: VirtualMotor, link: JointLink) -> None:
+    def bind(self, motor: VirtualMotor, link: MotorJoint) -> None:
         """Let ``motor`` drive joint ``link.joint``; its table starts at the joint's pose.
 
         The motor's lock must be the one it keeps (a ``VirtualBus`` sets it before attaching

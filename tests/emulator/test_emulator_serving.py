@@ -23,7 +23,7 @@ from poppy_core.emulator import (
     sleep_until,
     transfer_time_s,
 )
-from poppy_core.emulator.timing import LineClock
+from poppy_core.emulator.wire_timing import LineClock
 from poppy_core.errors import ConfigError, PortError
 from poppy_core.protocol import ping, read
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from poppy_core.emulator import VirtualBus, VirtualMotor, serve_link
-from poppy_core.emulator.server import EmulatorServer
+from poppy_core.emulator.bus_servers import EmulatorServer
 from poppy_core.errors import SetupError
 from poppy_core.models import model_by_name
 from poppy_core.robot import (

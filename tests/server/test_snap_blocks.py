@@ -15,7 +15,7 @@ from poppy_core.creatures import from_profile
 from poppy_core.motion import Move, save_move
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, robot_facts, start_snap_server
-from poppy_core.server.snap.catalog import BLOCKS, Block
+from poppy_core.server.snap.catalog import BLOCKS, SnapBlock
 from poppy_core.server.snap.examples import project_names
 from poppy_core.server.snap.routing import TextRouter
 from tests.server.snap_helpers import near, wait_until
@@ -106,7 +106,7 @@ def test_blocks_xml_is_the_english_library_with_french_translations(snap: Served
     assert defaults == ["m1;m2;m3", "0", "1"]  # the served robot's motors
 
 
-def fill(block: Block, facts_default: dict[str, str]) -> list[str]:
+def fill(block: SnapBlock, facts_default: dict[str, str]) -> list[str]:
     """The URLs a block calls with its default inputs (once per motor for ``each`` blocks)."""
     values = {i.name: facts_default[i.name] for i in block.inputs}
     if block.each:

@@ -10,7 +10,7 @@ from poppy_core.models import model_by_name
 from poppy_core.robot.config import MotorConfig
 from poppy_core.robot.frames import to_motor, to_user
 from poppy_core.robot.profiles import load_profile
-from poppy_core.sim.plant import JointLink, MujocoPlant
+from poppy_core.sim.plant import MotorJoint, MujocoPlant
 from poppy_core.sim.world import Simulation
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -50,11 +50,11 @@ def make_world(robot: str) -> World:
     sim = Simulation((PROFILES / robot / "model.xml").read_text(encoding="utf-8"))
     motors: dict[str, VirtualMotor] = {}
     for controller, entry in config.controllers.items():
-        ids: dict[int, JointLink] = {}
+        ids: dict[int, MotorJoint] = {}
         bus_motors = []
         for name in config.motors_of_controller(controller):
             motor_entry = config.motors[name]
-            ids[motor_entry.id] = JointLink(name)
+            ids[motor_entry.id] = MotorJoint(name)
             motors[name] = VirtualMotor(model_by_name(motor_entry.type), motor_entry.id)
             bus_motors.append(motors[name])
         VirtualBus(bus_motors, entry.protocol, plant=MujocoPlant(sim, ids), auto_step=False)

@@ -15,7 +15,7 @@ from websockets.sync.client import connect
 
 from bench.link_proxy import LinkProxy
 from poppy_core.errors import ConfigError
-from poppy_core.motion.teleop import teleoperate
+from poppy_core.motion.teleop.session import teleoperate
 from poppy_core.remote import RemoteFollower
 from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app

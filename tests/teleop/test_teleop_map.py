@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from poppy_core.errors import ConfigError
-from poppy_core.motion.teleop_map import JointLink, JointMap
+from poppy_core.motion.teleop.joint_map import JointLink, JointMap
 
 names = st.from_regex(r"[a-z_][a-z0-9_]{0,8}", fullmatch=True)
 numbers = st.decimals(min_value=0, max_value=1000, places=2).map(float)

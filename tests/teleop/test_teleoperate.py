@@ -13,8 +13,8 @@ import pytest
 
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion import read_move
-from poppy_core.motion.teleop import Teleoperation, teleoperate
-from poppy_core.motion.teleop_map import JointMap
+from poppy_core.motion.teleop.joint_map import JointMap
+from poppy_core.motion.teleop.session import Teleoperation, teleoperate
 from poppy_core.robot import Robot, from_profile
 from tests.teleop.hands import READ_S, Hand, wait_for
 

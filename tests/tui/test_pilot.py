@@ -7,7 +7,7 @@ import pytest
 from poppy_cli.tui.app import make_app
 from poppy_cli.tui.screens.main import MainScreen
 from poppy_cli.tui.screens.modals import Confirm, EditValue
-from poppy_cli.tui.widgets.control_table import ControlTable
+from poppy_cli.tui.widgets.control_table import ControlTableView
 from poppy_cli.tui.widgets.live import LivePanel
 from poppy_cli.tui.widgets.motor_panel import MotorPanel
 from poppy_cli.tui.widgets.motor_tree import MotorTree
@@ -30,7 +30,7 @@ async def open_motor(pilot: object, screen: MainScreen, motor_id: int) -> MotorP
     tree.move_cursor(nodes[0])
     tree.select_node(nodes[0])  # what Enter does
     panel = screen.query_one(MotorPanel)
-    table = screen.query_one(ControlTable)
+    table = screen.query_one(ControlTableView)
     notes = screen.app._notifications
     await wait_for(
         pilot, lambda: table.row_count > 0, what=f"control table ({[n.message for n in notes]})"
@@ -57,7 +57,7 @@ async def test_id_change_lands_on_the_emulator(xl320_server: Endpoint) -> None:
         screen = app.main
         await wait_for(pilot, lambda: screen.last_scan is not None)
         panel = await open_motor(pilot, screen, 3)
-        table = screen.query_one(ControlTable)
+        table = screen.query_one(ControlTableView)
         table.move_cursor(row=table.get_row_index("id"))
         await pilot.press("enter")
         assert isinstance(app.screen, EditValue)
@@ -107,7 +107,7 @@ async def test_eeprom_edit_with_torque_on_is_refused(xl320_server: Endpoint) -> 
         virtual = xl320_server.bus.motor(2)
         await wait_for(pilot, lambda: virtual.torque_enabled, what="torque on")
         before = virtual.return_delay_s
-        table = screen.query_one(ControlTable)
+        table = screen.query_one(ControlTableView)
         table.move_cursor(row=table.get_row_index("return_delay_time"))
         await pilot.press("enter")
         app.screen.query_one("#edit-value").value = "0"  # type: ignore[attr-defined]
@@ -131,7 +131,7 @@ async def test_bad_value_stays_in_the_modal(xl320_server: Endpoint) -> None:
         screen = app.main
         await wait_for(pilot, lambda: screen.last_scan is not None)
         await open_motor(pilot, screen, 1)
-        table = screen.query_one(ControlTable)
+        table = screen.query_one(ControlTableView)
         table.move_cursor(row=table.get_row_index("goal_position"))
         await pilot.press("enter")
         app.screen.query_one("#edit-value").value = "9999"  # type: ignore[attr-defined]

@@ -15,7 +15,7 @@ from poppy_cli.tui.app import PoppyApp, make_app
 from poppy_cli.tui.busio import LiveValues
 from poppy_cli.tui.messages import LiveSampled
 from poppy_cli.tui.text import fixed, short
-from poppy_cli.tui.widgets.control_table import ControlTable, format_value
+from poppy_cli.tui.widgets.control_table import ControlTableView, format_value
 from poppy_cli.tui.widgets.live import LivePanel
 from poppy_cli.tui.widgets.motor_tree import MotorTree
 from poppy_cli.tui.widgets.robot_panel import RobotPanel
@@ -151,7 +151,7 @@ async def test_control_table_shows_the_live_values(xl320_server: Endpoint) -> No
         screen = app.main
         await wait_for(pilot, lambda: screen.last_scan is not None, what="scan")
         await open_motor(pilot, screen, 2)
-        table = screen.query_one(ControlTable)
+        table = screen.query_one(ControlTableView)
         xl320_server.bus.motor(2).move_by_hand(29.9)
         table.move_cursor(row=table.get_row_index("present_position"), animate=False)
         await wait_for(pilot, lambda: "29.9 °" in shown(app, "position "), what="live")

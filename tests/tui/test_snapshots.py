@@ -11,7 +11,7 @@ from textual.widgets import Input  # noqa: TID253  (a TUI test)
 from poppy_cli.tui.app import PoppyApp, make_app
 from poppy_cli.tui.busio import LiveValues
 from poppy_cli.tui.messages import LiveSampled
-from poppy_cli.tui.widgets.control_table import ControlTable
+from poppy_cli.tui.widgets.control_table import ControlTableView
 from poppy_cli.tui.widgets.motor_panel import MotorPanel
 from poppy_cli.tui.widgets.motor_tree import MotorTree
 from poppy_cli.tui.widgets.robot_panel import RobotPanel
@@ -76,7 +76,7 @@ async def motor_open(pilot: Any) -> None:
     tree = screen.query_one(MotorTree)
     node = next(n for n in tree._motors.values() if n.data is not None and n.data.id == 1)
     tree.select_node(node)
-    table = screen.query_one(ControlTable)
+    table = screen.query_one(ControlTableView)
     await wait_for(pilot, lambda: table.row_count > 0, what="table")
     panel = screen.query_one(MotorPanel)
     for position in (0.0, 5.0, 10.0, 15.0, 10.0, 5.0):

@@ -11,7 +11,7 @@ from textual.message import Message
 from textual.widgets import DataTable
 
 from poppy_cli.output import shown_unit
-from poppy_cli.tui.busio import RegisterValue, SIValue
+from poppy_cli.tui.busio import RegisterRow, SIValue
 from poppy_cli.tui.text import fixed, set_cell
 
 COLUMNS = ("addr", "register", "value", "mem", "")
@@ -27,7 +27,7 @@ def format_value(value: SIValue | None, unit: str) -> str:
     return f"{text} {shown_unit(unit)}".rstrip()
 
 
-class ControlTable(DataTable[str]):
+class ControlTableView(DataTable[str]):
     """Address, name, SI value with unit, EEPROM/RAM, read-only mark. Enter edits a row."""
 
     BINDINGS: ClassVar[list[BindingType]] = [
@@ -47,13 +47,13 @@ class ControlTable(DataTable[str]):
 
     def __init__(self, *, id: str | None = None) -> None:
         super().__init__(id=id, cursor_type="row", zebra_stripes=True)
-        self.values: dict[str, RegisterValue] = {}
+        self.values: dict[str, RegisterRow] = {}
 
     def on_mount(self) -> None:
         for column in COLUMNS:
             self.add_column(column, key=column or "ro")
 
-    def show(self, rows: list[RegisterValue]) -> None:
+    def show(self, rows: list[RegisterRow]) -> None:
         """Fill the table (keeping the cursor row when the registers are the same)."""
         same = [row.register.name for row in rows] == list(self.values)
         self.values = {row.register.name: row for row in rows}
@@ -81,15 +81,15 @@ class ControlTable(DataTable[str]):
         row = self.values.get(name)
         if row is None:
             return
-        self.values[name] = RegisterValue(row.register, value)
+        self.values[name] = RegisterRow(row.register, value)
         set_cell(self, name, "value", self._text(self.values[name]))
 
     @staticmethod
-    def _text(row: RegisterValue) -> str:
+    def _text(row: RegisterRow) -> str:
         return format_value(row.value, row.register.unit)
 
     @property
-    def current(self) -> RegisterValue | None:
+    def current(self) -> RegisterRow | None:
         """The register under the cursor."""
         if not self.values or self.row_count == 0:
             return None

@@ -23,7 +23,7 @@ from poppy_cli.tui.messages import (
 )
 from poppy_cli.tui.ops import restart, toggled, write_value
 from poppy_cli.tui.screens.modals import Confirm, EditValue
-from poppy_cli.tui.widgets.control_table import ControlTable, format_value
+from poppy_cli.tui.widgets.control_table import ControlTableView, format_value
 from poppy_cli.tui.widgets.live import LivePanel
 from poppy_core.errors import PoppyError, SetupError
 from poppy_core.models import ServoModel
@@ -58,7 +58,7 @@ class MotorPanel(Horizontal):
         self.goal_deg: float | None = None
 
     def compose(self) -> ComposeResult:
-        yield ControlTable(id="control-table")
+        yield ControlTableView(id="control-table")
         yield LivePanel(id="live")
 
     @property
@@ -84,7 +84,7 @@ class MotorPanel(Horizontal):
         live.reset()
         extra = f" (+{len(self.others)} marked)" if self.others else ""
         live.set_title(f"id {motor.id} {motor.model or '?'}{extra}")
-        self.query_one(ControlTable).show([])
+        self.query_one(ControlTableView).show([])
         if motor.model is None:
             self.notify(f"motor {motor.id}: unknown model, no table", severity="warning")
             return
@@ -97,7 +97,7 @@ class MotorPanel(Horizontal):
         model = self.model
         if model is None or not model.has_register(name):
             return None
-        row = self.query_one(ControlTable).values.get(model.register(name).name)
+        row = self.query_one(ControlTableView).values.get(model.register(name).name)
         return None if row is None else row.value
 
     # -- workers (thread: every bus transaction blocks) ----------------------------------------
@@ -170,7 +170,7 @@ class MotorPanel(Horizontal):
         message.stop()
         if self.motor is None or message.motor.key != self.motor.key:
             return
-        self.query_one(ControlTable).show(message.rows)
+        self.query_one(ControlTableView).show(message.rows)
         goal = self.value("goal_position")
         self.goal_deg = float(goal) if isinstance(goal, int | float) else None
         self._show_goal()
@@ -185,7 +185,7 @@ class MotorPanel(Horizontal):
         if model is None:
             return
         # The table shows the present values of this sample too, not those of the last full read.
-        table = self.query_one(ControlTable)
+        table = self.query_one(ControlTableView)
         for name, value in message.values.registers().items():
             row = table.values.get(model.register(name).name) if model.has_register(name) else None
             if row is None:
@@ -236,7 +236,7 @@ class MotorPanel(Horizontal):
     @on(DataTable.RowSelected, "#control-table")
     def _edit(self, event: DataTable.RowSelected) -> None:
         event.stop()
-        row = self.query_one(ControlTable).current
+        row = self.query_one(ControlTableView).current
         if row is None or self.motor is None:
             return
         if not row.register.writable:
@@ -252,8 +252,8 @@ class MotorPanel(Horizontal):
 
         self.app.push_screen(EditValue(row.register, current, len(targets)), done)
 
-    @on(ControlTable.Dialled)
-    def _dialled(self, message: ControlTable.Dialled) -> None:
+    @on(ControlTableView.Dialled)
+    def _dialled(self, message: ControlTableView.Dialled) -> None:
         message.stop()
         if self.motor is None or self.model is None:
             return
@@ -262,7 +262,7 @@ class MotorPanel(Horizontal):
             return
         low, high = self._limits()
         self.goal_deg = min(high, max(low, self.goal_deg + message.delta_deg))
-        self.query_one(ControlTable).set_value(
+        self.query_one(ControlTableView).set_value(
             self.model.register("goal_position").name, self.goal_deg
         )
         self._show_goal()
@@ -274,7 +274,7 @@ class MotorPanel(Horizontal):
             return
         register = model.register(name)
         value = toggled(self.value(name), register)
-        self.query_one(ControlTable).set_value(register.name, value)
+        self.query_one(ControlTableView).set_value(register.name, value)
         self._show_goal()
         self.write(self.targets, register.name, value)
 

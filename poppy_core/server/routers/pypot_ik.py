@@ -15,7 +15,7 @@ from starlette.concurrency import run_in_threadpool
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, KinematicsError
 from poppy_core.motion.cartesian import RobotChain
-from poppy_core.server.chains import find_chain
+from poppy_core.server.chain_lookup import find_chain
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
 from poppy_core.server.pypot_json import PypotJSON

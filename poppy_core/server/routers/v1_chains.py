@@ -8,7 +8,7 @@ from starlette.concurrency import run_in_threadpool
 
 from poppy_core.checks import MAX_DURATION_S
 from poppy_core.kinematics import rotation_degrees
-from poppy_core.server.chains import chain_state, find_chain
+from poppy_core.server.chain_lookup import chain_state, find_chain
 from poppy_core.server.deps import Service
 from poppy_core.server.routers.common import wait_goto
 from poppy_core.server.schemas import Problem
@@ -33,7 +33,7 @@ class ChainInfo(BaseModel):
     pose: list[list[float]] = Field(description="4x4 transform of the tip")
 
 
-class Target(BaseModel):
+class TipTarget(BaseModel):
     """Where the tip must go: a position, and optionally its x axis or its roll/pitch/yaw."""
 
     model_config = ConfigDict(extra="forbid")
@@ -42,7 +42,7 @@ class Target(BaseModel):
     rpy_deg: Vector | None = Field(None, description="the tip's roll, pitch, yaw in degrees")
 
     @model_validator(mode="after")
-    def _one_orientation(self) -> "Target":
+    def _one_orientation(self) -> "TipTarget":
         if self.orientation is not None and self.rpy_deg is not None:
             raise ValueError("give orientation or rpy_deg, not both")
         return self
@@ -52,13 +52,13 @@ class Target(BaseModel):
         return rotation_degrees(self.rpy_deg) if self.rpy_deg is not None else self.orientation
 
 
-class SolveBody(Target):
+class SolveBody(TipTarget):
     """A target and, optionally, the angles to start from (degrees; default: present)."""
 
     seed: dict[str, Finite] | None = None
 
 
-class GotoBody(Target):
+class GotoBody(TipTarget):
     """A target and how to get there."""
 
     duration: Annotated[float, Field(gt=0, le=MAX_DURATION_S)] = 1.0
@@ -73,14 +73,14 @@ class ForwardBody(BaseModel):
     joints: dict[str, Finite]
 
 
-class Solution(BaseModel):
+class SolveAnswer(BaseModel):
     """The active motors' angles (degrees) that bring the tip to the target."""
 
     chain: str
     angles: dict[str, float]
 
 
-class GotoAnswer(Solution):
+class GotoAnswer(SolveAnswer):
     """The angles the motors go to; with ``wait``, where the tip ended."""
 
     duration: float
@@ -118,11 +118,11 @@ async def forward(chain: str, body: ForwardBody, service: Service) -> Pose:
 
 
 @router.post("/chains/{chain}/solve", summary="Angles that bring the tip to a target")
-async def solve(chain: str, body: SolveBody, service: Service) -> Solution:
+async def solve(chain: str, body: SolveBody, service: Service) -> SolveAnswer:
     """Nothing moves. 422 when out of reach, naming the nearest point."""
     found = find_chain(service.robot, chain)
     angles = await run_in_threadpool(found.solve, body.position, body.goal(), body.seed)
-    return Solution(chain=chain, angles=angles)
+    return SolveAnswer(chain=chain, angles=angles)
 
 
 @router.post("/chains/{chain}/goto", summary="Move the tip to a target")

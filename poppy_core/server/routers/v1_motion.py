@@ -8,9 +8,9 @@ from poppy_core.server.routers.common import wait_goto
 from poppy_core.server.schemas import (
     GotoRequest,
     GotoResult,
+    LibraryMoveInfo,
     MethodCall,
     MethodResult,
-    MoveEntry,
     MoveInfo,
     MovesStatus,
     PlayRequest,
@@ -117,9 +117,9 @@ def call(primitive: str, method: str, body: MethodCall, service: Service) -> Met
 
 
 @router.get("/moves", tags=["moves"], summary="The moves of the library")
-def moves(service: Service) -> list[MoveEntry]:
+def moves(service: Service) -> list[LibraryMoveInfo]:
     """Name, format, size, duration and frames of each."""
-    return [MoveEntry.model_validate(e) for e in service.moves.entries()]
+    return [LibraryMoveInfo.model_validate(e) for e in service.moves.entries()]
 
 
 @router.get("/moves/status", tags=["moves"], summary="Moves being recorded and played")

@@ -26,10 +26,10 @@ from poppy_core.errors import PoppyError
 from poppy_core.server.errors import ApiError
 from poppy_core.server.middleware import TokenMiddleware, request_token
 from poppy_core.server.service import RobotService
-from poppy_core.server.snap.robot import SnapRobot
 from poppy_core.server.snap.routes import ROUTES
 from poppy_core.server.snap.routing import TEXT, TextRouter, error_text
 from poppy_core.server.snap.site import SnapSite
+from poppy_core.server.snap.snap_robot import SnapRobot
 
 XML = "application/xml; charset=utf-8"
 APP_PREFIX = "/app"

@@ -15,7 +15,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from urllib.parse import quote
 
-from poppy_core.server.snap.catalog import BLOCKS, Block, Input
+from poppy_core.server.snap.catalog import BLOCKS, Input, SnapBlock
 
 APP = "Snap! 9, https://snap.berkeley.edu"
 LANGS = ("en", "fr")
@@ -152,7 +152,7 @@ def show_error() -> ET.Element:
 SPLIT = {"names": "/", "values": ";", "numbers": ","}
 
 
-def block_script(block: Block) -> ET.Element:
+def block_script(block: SnapBlock) -> ET.Element:
     """The definition's script: call the route, read or check the answer."""
     if block.each:
         call = prim("reportURL", url_expression(block.template, "motor"))
@@ -180,7 +180,7 @@ def block_script(block: Block) -> ET.Element:
     return script(prim("doReport", reported))
 
 
-def definition(block: Block, lang: str, facts: RobotFacts) -> ET.Element:
+def definition(block: SnapBlock, lang: str, facts: RobotFacts) -> ET.Element:
     """A ``<block-definition>`` (label in ``lang``, the other language as a translation)."""
     label = block.fr if lang == "fr" else block.en
     other = ("en", block.en) if lang == "fr" else ("fr", block.fr)
@@ -214,7 +214,7 @@ def host_block(lang: str) -> ET.Element:
     return element
 
 
-def use(block: Block, lang: str, *args: str | bool) -> ET.Element:
+def use(block: SnapBlock, lang: str, *args: str | bool) -> ET.Element:
     """A use of a Poppy block in a script (arguments in label order)."""
     label = block.fr if lang == "fr" else block.en
     element = E("custom-block", s=label_spec(label, block.inputs))

@@ -7,8 +7,8 @@ before the generic primitive routes (a move may be called ``get``), ``/motors/al
 
 from __future__ import annotations
 
-from poppy_core.server.snap.robot import SnapRobot
 from poppy_core.server.snap.routing import Handler, TextRoute
+from poppy_core.server.snap.snap_robot import SnapRobot
 
 
 def _control(action: str) -> Handler:

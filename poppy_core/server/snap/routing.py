@@ -18,7 +18,7 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 from poppy_core.errors import PoppyError
 from poppy_core.server.errors import PYPOT_STATUS, ApiError, from_poppy_error
 from poppy_core.server.refusals import one_line
-from poppy_core.server.snap.robot import SnapRobot
+from poppy_core.server.snap.snap_robot import SnapRobot
 
 logger = logging.getLogger(__name__)
 

@@ -14,7 +14,7 @@ from typing import Any
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, KinematicsError
 from poppy_core.server import values
-from poppy_core.server.chains import find_chain
+from poppy_core.server.chain_lookup import find_chain
 from poppy_core.server.errors import ApiError
 from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.sensors import SensorService

@@ -1,9 +1,9 @@
 """The named steps of building a robot from a config, and the clean-up when one of them fails.
 
-``from_config`` runs them in order: :meth:`Assembly.start_virtual_motors` (``sim``: emulators,
-MuJoCo), :meth:`Assembly.open_buses` (ports, presence check), :meth:`Assembly.prepare_motors`
-(first state, return delays, EEPROM limits, torque/gains), :meth:`Assembly.build_sensors`,
-:meth:`Assembly.robot`. An ``Assembly`` used as a context manager closes whatever it opened when
+``from_config`` runs them in order: :meth:`BuildSteps.start_virtual_motors` (``sim``: emulators,
+MuJoCo), :meth:`BuildSteps.open_buses` (ports, presence check), :meth:`BuildSteps.prepare_motors`
+(first state, return delays, EEPROM limits, torque/gains), :meth:`BuildSteps.build_sensors`,
+:meth:`BuildSteps.robot`. A ``BuildSteps`` used as a context manager closes whatever it opened when
 a step raises; once ``robot()`` handed them over, the robot owns them.
 """
 
@@ -51,7 +51,7 @@ def sim_mode(sim: SimMode | None) -> str | None:
                       field="sim", value=sim)  # fmt: skip
 
 
-class Assembly:
+class BuildSteps:
     """A robot being built from ``config``: what is open so far, and the steps still to run.
 
     Args:
@@ -70,7 +70,7 @@ class Assembly:
         self.sensors: dict[str, Sensor] = {}
         self._handed_over = False
 
-    def __enter__(self) -> Assembly:
+    def __enter__(self) -> BuildSteps:
         return self
 
     def __exit__(

@@ -1,6 +1,6 @@
 """The follower side of ``teleoperate``: the ``Follower`` interface and ``LocalFollower``.
 
-A local robot follows through a ``FollowSession`` (ramp, hold); a robot served by ``poppy serve``
+A local robot follows through a ``GoalStream`` (ramp, hold); a robot served by ``poppy serve``
 follows through ``poppy_core.remote.RemoteFollower``, which has the same interface.
 """
 
@@ -10,7 +10,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Protocol
 
-from poppy_core.motion.follow import FollowChange, FollowSession
+from poppy_core.motion.teleop.goal_stream import GoalStream, GoalStreamChange
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
@@ -51,12 +51,12 @@ class Follower(Protocol):
 
 
 class LocalFollower:
-    """A local robot as a follower (a ``FollowSession`` on its motors).
+    """A local robot as a follower (a ``GoalStream`` on its motors).
 
     Args:
         robot: the follower robot.
         ramp_s: duration of the start and resume ramps (None: from the distance).
-        on_change: called with each ``FollowChange``.
+        on_change: called with each ``GoalStreamChange``.
         clock: monotonic time in seconds.
     """
 
@@ -65,14 +65,14 @@ class LocalFollower:
         robot: Robot,
         *,
         ramp_s: float | None = None,
-        on_change: Callable[[FollowChange], None] | None = None,
+        on_change: Callable[[GoalStreamChange], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.robot = robot
         self.ramp_s = ramp_s
         self.on_change = on_change
         self._clock = clock
-        self.session: FollowSession | None = None
+        self.session: GoalStream | None = None
 
     @property
     def motor_names(self) -> list[str]:
@@ -86,7 +86,7 @@ class LocalFollower:
 
     def start(self, motors: Sequence[str]) -> None:
         """Stiffen ``motors`` where they are."""
-        self.session = FollowSession(
+        self.session = GoalStream(
             self.robot, motors, ramp_s=self.ramp_s, on_change=self.on_change, clock=self._clock
         )
         self.session.start()
@@ -108,7 +108,7 @@ class LocalFollower:
         if self.session is not None:
             self.session.stop()
 
-    def _session(self) -> FollowSession:
+    def _session(self) -> GoalStream:
         if self.session is None:
             raise RuntimeError("the follower was not started")
         return self.session

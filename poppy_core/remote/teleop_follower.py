@@ -1,6 +1,6 @@
 """``RemoteFollower``: a robot served by ``poppy serve --http`` as a teleoperation follower.
 
-It speaks the server's WebSocket (``/api/v1/ws``, see ``poppy_core.server.teleop``): one
+It speaks the server's WebSocket (``/api/v1/ws``, see ``poppy_core.server.teleop_channel``): one
 ``teleop.start``, then a ``teleop.goals`` message per tick, never one HTTP request per frame. The
 server ramps at the start, writes each goal at once and holds the motors where they are when
 the goals stop coming (its watchdog). The state frames the server streams give the follower's

@@ -26,11 +26,11 @@ from typing import TYPE_CHECKING, Any
 
 from poppy_core import checks
 from poppy_core.errors import ConfigError, FileError, PoppyError
-from poppy_core.motion.follow import FollowChange
-from poppy_core.motion.teleop_follower import Follower, LocalFollower
-from poppy_core.motion.teleop_map import JointMap
-from poppy_core.motion.teleop_record import TrajectoryRecorder
-from poppy_core.motion.teleop_stats import TeleopReport, TeleopStatus
+from poppy_core.motion.teleop.follower import Follower, LocalFollower
+from poppy_core.motion.teleop.goal_stream import GoalStreamChange
+from poppy_core.motion.teleop.joint_map import JointMap
+from poppy_core.motion.teleop.recording import TrajectoryRecorder
+from poppy_core.motion.teleop.stats import TeleopReport, TeleopStatus
 from poppy_core.robot.robot import Robot
 from poppy_core.schedule import Backoff, Periodic
 
@@ -323,7 +323,7 @@ class Teleoperation:
             self.follower.hold(reason)
             self._changed("leader lost", reason)
 
-    def _follow_changed(self, change: FollowChange) -> None:
+    def _follow_changed(self, change: GoalStreamChange) -> None:
         self._changed(change.state, change.reason)
 
     def _changed(self, state: str, reason: str) -> None:

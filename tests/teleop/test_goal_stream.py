@@ -1,4 +1,4 @@
-"""``FollowSession``: the start ramp, goals written at once, hold, resume, the watchdog."""
+"""``GoalStream``: the start ramp, goals written at once, hold, resume, the watchdog."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from poppy_core.errors import ArgumentError, ConfigError, UnknownMotorError
-from poppy_core.motion.follow import FollowSession
+from poppy_core.motion.teleop.goal_stream import GoalStream
 from poppy_core.robot import Robot
 from poppy_core.trajectory import minimum_jerk_weight
 from tests.teleop.hands import READ_S, Hand, wait_for
@@ -38,7 +38,7 @@ def test_start_ramps_from_where_the_follower_is_to_the_moving_target(follower: R
     hand.put({"m1": 10.0, "m2": -20.0})
     time.sleep(READ_S)
     clock = Clock()
-    session = FollowSession(follower, ["m1", "m2"], ramp_s=1.0, clock=clock)
+    session = GoalStream(follower, ["m1", "m2"], ramp_s=1.0, clock=clock)
     session.start()
     assert session.state == "held" and not follower.m1.compliant
     first = session.push({"m1": 60.0, "m2": 20.0})
@@ -62,7 +62,7 @@ def test_start_ramps_from_where_the_follower_is_to_the_moving_target(follower: R
 
 def test_automatic_ramp_lasts_by_distance_and_none_when_already_there(follower: Robot) -> None:
     clock = Clock()
-    session = FollowSession(follower, ["m1"], clock=clock)
+    session = GoalStream(follower, ["m1"], clock=clock)
     session.start()
     session.push({"m1": 0.2})
     assert session.state == "following" and session.ramps == 0
@@ -81,7 +81,7 @@ def test_hold_stops_where_the_motors_are_and_the_next_target_ramps(follower: Rob
     hand = Hand(follower)
     clock = Clock()
     changes: list[str] = []
-    session = FollowSession(
+    session = GoalStream(
         follower, ["m1"], ramp_s=0.5, on_change=lambda c: changes.append(c.state), clock=clock
     )
     session.start()
@@ -100,7 +100,7 @@ def test_hold_stops_where_the_motors_are_and_the_next_target_ramps(follower: Rob
 
 def test_watchdog_expires_only_while_the_stream_runs() -> None:
     clock = Clock()
-    session = FollowSession(_robot_with_m1(), ["m1"], watchdog_s=0.25, write_now=False, clock=clock)
+    session = GoalStream(_robot_with_m1(), ["m1"], watchdog_s=0.25, write_now=False, clock=clock)
     assert not session.expired()
     session.push({"m1": 0.0})  # a motor never read: already there, following
     assert session.state == "following"
@@ -121,10 +121,10 @@ def _robot_with_m1() -> Robot:
 
 def test_unknown_motors_are_refused_and_a_stopped_session_takes_nothing(follower: Robot) -> None:
     with pytest.raises(ConfigError, match="no motor 'm9'"):
-        FollowSession(follower, ["m1", "m9"])
+        GoalStream(follower, ["m1", "m9"])
     with pytest.raises(ArgumentError, match="no motor to follow"):
-        FollowSession(follower, [])
-    session = FollowSession(follower, ["m1"], ramp_s=0.0)
+        GoalStream(follower, [])
+    session = GoalStream(follower, ["m1"], ramp_s=0.0)
     session.start()
     with pytest.raises(UnknownMotorError, match="not followed: m2"):
         session.push({"m2": 1.0})

@@ -1,8 +1,8 @@
-"""``FollowSession``: goal positions streamed to some motors, with a start ramp, hold and resume.
+"""``GoalStream``: goal positions streamed to some motors, with a start ramp, hold and resume.
 
-The follower side of teleoperation, shared by a local follower (``teleop``) and the server's
-WebSocket teleop channel. Targets arrive at the stream's rate; each one is written at once
-(``Robot.run_loop("goals")``) rather than at the sync loop's next write.
+The follower side of teleoperation, shared by a local follower (``motion.teleop.follower``) and
+the server's WebSocket teleop channel. Targets arrive at the stream's rate; each one is
+written at once (``Robot.run_loop("goals")``) rather than at the sync loop's next write.
 
 - **Ramp**: when a stream starts, or resumes after a hold, the goals blend from where the motors
   are to the (moving) target with a minimum-jerk weight, ``goal = start + s(τ) · (target −
@@ -39,7 +39,7 @@ RAMP_SKIP_DEG = 0.5
 
 
 @dataclass(frozen=True)
-class FollowChange:
+class GoalStreamChange:
     """A change of state, given to ``on_change``: the new state and why."""
 
     state: FollowState
@@ -47,7 +47,7 @@ class FollowChange:
     time_s: float
 
 
-class FollowSession:
+class GoalStream:
     """Streams goals to ``motors`` of ``robot`` (see the module docstring).
 
     Args:
@@ -58,7 +58,7 @@ class FollowSession:
         ramp_speed_dps: mean speed of an automatic ramp.
         watchdog_s: ``expired`` is True once no target arrived for this long (None: never).
         write_now: send the goals to the bus at each target instead of at the next sync write.
-        on_change: called with a ``FollowChange`` at each change of state.
+        on_change: called with a ``GoalStreamChange`` at each change of state.
         clock: monotonic time in seconds.
 
     Raises:
@@ -74,7 +74,7 @@ class FollowSession:
         ramp_speed_dps: float = DEFAULT_RAMP_SPEED_DPS,
         watchdog_s: float | None = None,
         write_now: bool = True,
-        on_change: Callable[[FollowChange], None] | None = None,
+        on_change: Callable[[GoalStreamChange], None] | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         if not motors:
@@ -226,6 +226,6 @@ class FollowSession:
         logger.info("follower %s: %s", state, reason)
         if self.on_change is not None:
             try:
-                self.on_change(FollowChange(state, reason, self._clock()))
+                self.on_change(GoalStreamChange(state, reason, self._clock()))
             except Exception:
                 logger.exception("follow state callback failed")

@@ -12,7 +12,7 @@ have no string ``type`` and are unchanged)::
     → {"type": "teleop.stop"}
     ← {"type": "teleop.stopped"}
 
-Each connection has at most one session (a ``FollowSession``) and a worker thread that writes
+Each connection has at most one session (a ``GoalStream``) and a worker thread that writes
 the newest goals at once (a burst of late messages collapses into the newest) and holds the
 motors where they are when no goals came for ``watchdog_s`` or the connection closes; the next
 goals resume with a ramp. A motor is teleoperated by one connection at a time, except that a
@@ -28,7 +28,7 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from poppy_core import checks
-from poppy_core.motion.follow import FollowChange, FollowSession
+from poppy_core.motion.teleop.goal_stream import GoalStream, GoalStreamChange
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
 
@@ -109,7 +109,7 @@ class TeleopChannel:
         self.robot = robot
         self.registry = registry
         self.notify = notify
-        self.session: FollowSession | None = None
+        self.session: GoalStream | None = None
         self.client = ""
         """The id the client gave (a reconnecting client takes its motors back)."""
         self._lock = threading.Lock()
@@ -164,7 +164,7 @@ class TeleopChannel:
         self.close("a new teleoperation starts")
         self.client = (client or "")[:100]
         self.registry.claim(self, list(motors))
-        session = FollowSession(
+        session = GoalStream(
             self.robot, motors, ramp_s=ramp_s, watchdog_s=watchdog, on_change=self._changed
         )
         with self._lock:
@@ -219,7 +219,7 @@ class TeleopChannel:
         finally:
             session.stop(self._close_reason)
 
-    def _changed(self, change: FollowChange) -> None:
+    def _changed(self, change: GoalStreamChange) -> None:
         self.notify({"type": "teleop.state", "state": change.state, "reason": change.reason})
 
     def close(self, reason: str) -> None:
