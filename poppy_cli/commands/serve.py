@@ -110,19 +110,26 @@ def serve(
     )
     any_origin = _check_origins(spec)
     _warn_exposure(spec, host, any_origin)
-    with build_robot(profile, config_file, port, sim, sensors=not no_sensors) as robot:
-        servers: ServerSet | None = None
-        try:
-            servers = serve(robot, spec)
-            _announce(servers, host, open_browser)
-            _wait_for_signal(list(servers.servers.values()))
-        except RuntimeError as exc:
-            error_line(f"{exc} (the server's log above says why)")
-            raise typer.Exit(EXIT_FAILURE) from None
-        finally:
-            if servers is not None:
-                servers.stop()
-                _say_where_takes_went(servers.service.moves.saved_on_close)
+    # SIGTERM is taken before anything serves: a client may stop the server as soon as its
+    # address is printed (the default action, exit -15, when it came that early)
+    stop = threading.Event()
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: stop.set())
+    try:
+        with build_robot(profile, config_file, port, sim, sensors=not no_sensors) as robot:
+            servers: ServerSet | None = None
+            try:
+                servers = serve(robot, spec)
+                _announce(servers, host, open_browser)
+                _wait_for_signal(list(servers.servers.values()), stop)
+            except RuntimeError as exc:
+                error_line(f"{exc} (the server's log above says why)")
+                raise typer.Exit(EXIT_FAILURE) from None
+            finally:
+                if servers is not None:
+                    servers.stop()
+                    _say_where_takes_went(servers.service.moves.saved_on_close)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     print("stopped", file=sys.stderr, flush=True)
 
 
@@ -209,19 +216,11 @@ def _host(host: str) -> str:
     return f"[{host}]" if ":" in host else host
 
 
-def _wait_for_signal(servers: list[Any]) -> None:
-    """Block until Ctrl-C, SIGTERM, or a server thread ended on its own."""
-    stop = threading.Event()
-
-    def on_signal(signum: int, frame: object) -> None:
-        stop.set()
-
-    previous = signal.signal(signal.SIGTERM, on_signal)
+def _wait_for_signal(servers: list[Any], stop: threading.Event) -> None:
+    """Block until Ctrl-C, SIGTERM (``stop`` set), or a server thread ended on its own."""
     try:
         while not stop.wait(0.2):
             if any(not s.running for s in servers):
                 break
     except KeyboardInterrupt:
         pass
-    finally:
-        signal.signal(signal.SIGTERM, previous)

@@ -36,6 +36,12 @@ async def open_motor(pilot: object, screen: MainScreen, motor_id: int) -> MotorP
         pilot, lambda: table.row_count > 0, what=f"control table ({[n.message for n in notes]})"
     )
     assert panel.motor is not None and panel.motor.id == motor_id
+    # The focus given to the tree above and the select happen in one tick, which no user can
+    # do: the tree's focus, handled after the switch to the Motor tab, may pull its Bus tab back
+    # (seen once in a CI-like run). Show the Motor tab as Enter leaves it.
+    await pilot.pause()  # type: ignore[attr-defined]
+    screen.action_tab("motor")
+    await wait_for(pilot, lambda: screen.query_one("#tabs").active == "motor", what="Motor tab")
     return panel
 
 
