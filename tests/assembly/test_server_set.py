@@ -54,7 +54,7 @@ def test_the_creature_path_and_the_cli_path_give_the_same_server_set(
         assert creature_set.running
     assert not any(server_running for server_running in _states(creature_set))
 
-    def stop_at_once(servers: list[Any]) -> None:  # `poppy serve` waits for Ctrl-C here
+    def stop_at_once(servers: list[Any], stop: Any) -> None:  # `poppy serve` waits here
         assert all(s.running for s in servers)
 
     monkeypatch.setattr("poppy_cli.commands.serve._wait_for_signal", stop_at_once)
