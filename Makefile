@@ -32,6 +32,7 @@ TEST_WORKERS ?= 2
 # OpenGL tests run in a pytest process of their own.
 test: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
+	$(BIN)/ruff format --check poppy_core poppy_cli tests bench
 	$(BIN)/mypy
 	$(BIN)/pytest -m "not gl" -n $(TEST_WORKERS) --dist loadgroup
 	$(BIN)/pytest -m gl
@@ -39,6 +40,7 @@ test: $(VENV)/.installed-test
 # The inner loop (under 90 s on a quiet machine): lint, then every test not marked `slow`.
 test-fast: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
+	$(BIN)/ruff format --check poppy_core poppy_cli tests bench
 	$(BIN)/pytest -q -m "not slow" -n $(TEST_WORKERS) --dist loadgroup
 
 # The whole suite with LOOPS busy loops beside it (default 2, one per core), as on a shared CI
@@ -51,6 +53,7 @@ test-loaded: $(VENV)/.installed-test
 
 lint: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
+	$(BIN)/ruff format --check poppy_core poppy_cli tests bench
 	$(BIN)/mypy
 
 completions: $(VENV)/.installed

@@ -97,16 +97,19 @@ def mjpeg_latency(frames: int = MJPEG_FRAMES) -> dict[str, float]:
         camera = robot.camera
         server = ServerThread(create_app(robot)).start()
         try:
-            with httpx.Client(base_url=server.url, timeout=10) as http, http.stream(
-                "GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 60}
-            ) as answer:
+            with (
+                httpx.Client(base_url=server.url, timeout=10) as http,
+                http.stream(
+                    "GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 60}
+                ) as answer,
+            ):
                 buffer = b""
                 for chunk in answer.iter_bytes():
                     buffer += chunk
                     while buffer.count(b"--frame") >= 2:
                         now = camera.clock_s()
                         latencies.append((now - camera.latest().time_s) * 1000)
-                        buffer = buffer[buffer.index(b"--frame", 2):]
+                        buffer = buffer[buffer.index(b"--frame", 2) :]
                     if len(latencies) >= frames:
                         break
         finally:
@@ -167,14 +170,30 @@ def camera_benchmark(ctx: BenchContext) -> BenchResult:
             "ArUco marker and a Poppy card (median of 30)."
         ),
         tables=[
-            Table("Simulated camera (Ergo Jr head)",
-                  ["resolution", "fps asked", "fps rendered", "50 Hz loops (measured/target)",
-                   "load (1 min)", "goal met"], rows),
-            Table("MJPEG stream and detection", ["measure", "value"], [
-                ["MJPEG latency, median / max", f"{mjpeg['median_ms']:.1f} / "
-                 f"{mjpeg['max_ms']:.1f} ms ({mjpeg['frames']:.0f} frames)"],
-                *[[f"detection ms/frame ({k})", f"{v:.2f}"] for k, v in detection.items()],
-            ]),
+            Table(
+                "Simulated camera (Ergo Jr head)",
+                [
+                    "resolution",
+                    "fps asked",
+                    "fps rendered",
+                    "50 Hz loops (measured/target)",
+                    "load (1 min)",
+                    "goal met",
+                ],
+                rows,
+            ),
+            Table(
+                "MJPEG stream and detection",
+                ["measure", "value"],
+                [
+                    [
+                        "MJPEG latency, median / max",
+                        f"{mjpeg['median_ms']:.1f} / "
+                        f"{mjpeg['max_ms']:.1f} ms ({mjpeg['frames']:.0f} frames)",
+                    ],
+                    *[[f"detection ms/frame ({k})", f"{v:.2f}"] for k, v in detection.items()],
+                ],
+            ),
         ],
         notes=[
             "Rendering is the camera's cost: shadows and reflections are switched off and the "

@@ -34,7 +34,6 @@ measured. Each run rewrites the sections of the benchmarks it ran from their lat
 """
 
 
-
 def _stamp(date: str) -> str:
     return date.replace(":", "").replace("-", "").replace("+0000", "Z")
 
@@ -151,4 +150,3 @@ def write_doc(names: Iterable[str], path: Path = DOC_PATH) -> Path:
     parts += list(fresh.values())
     path.write_text("\n\n".join(parts) + "\n")
     return path
-

@@ -330,8 +330,15 @@ def _torque_table(torque: dict[str, Any]) -> Table:
                 "yes" if _control_clean(control) else "**no**",
             ]
         )
-    headers = ["Emulator", "Writes lost, pypot as is", "Writes lost, output flush skipped",
-               "Time (as is)", "Load (1 min avg)", "Goal (the emulator's losses)", "Met"]
+    headers = [
+        "Emulator",
+        "Writes lost, pypot as is",
+        "Writes lost, output flush skipped",
+        "Time (as is)",
+        "Load (1 min avg)",
+        "Goal (the emulator's losses)",
+        "Met",
+    ]
     return Table(
         "pypot Dxl320IO toggling the Ergo Jr's torque (flushes before every packet)", headers, rows
     )
@@ -399,8 +406,11 @@ def build_result(raw: dict[str, Any]) -> BenchResult:
     notes = [
         f"Machine load (1-minute average) at start and end of the soak: "
         f"{raw['load_1min'][0]} → {raw['load_1min'][1]}"
-        + ("; the machine was shared with other work, which delays the emulator and the "
-           "clients." if max(raw["load_1min"]) > 1.0 else " (otherwise idle)."),
+        + (
+            "; the machine was shared with other work, which delays the emulator and the clients."
+            if max(raw["load_1min"]) > 1.0
+            else " (otherwise idle)."
+        ),
         "Recovery times are measured from the moment the fault command was written to the "
         "emulator to the moment the client saw the flag change (polled every 2 ms, one "
         "monotonic clock for all processes). Goal writes are checked once a second on every "

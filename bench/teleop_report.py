@@ -184,7 +184,8 @@ def _notes(
     if loads:
         notes.append(
             f"Machine load (1-min average) during the runs: {min(loads):.1f}–{max(loads):.1f}; "
-            "client CPU per run: " + ", ".join(f"{k} {v:.1f} s" for k, v in cpu.items())
+            "client CPU per run: "
+            + ", ".join(f"{k} {v:.1f} s" for k, v in cpu.items())
             + ". A shared 2-core machine delays the emulator threads too, so the rates and "
             "latencies above are upper bounds of what the wire allows."
         )

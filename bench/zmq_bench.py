@@ -152,7 +152,7 @@ def zmq_bench(ctx: BenchContext) -> BenchResult:
         )
     notes.append(
         f"One REQ client, {DURATION_S} s per run, median of {ctx.repeat} runs (by req/s); "
-        "`errors` counts `{\"error\": ...}` replies. The value is sent JSON-encoded in a "
+        '`errors` counts `{"error": ...}` replies. The value is sent JSON-encoded in a '
         "string, as pypot's clients do."
     )
     return BenchResult(

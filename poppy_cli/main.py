@@ -104,8 +104,13 @@ def _root(
 
 # `poppy --help` lists the commands in these panels, in this order.
 START, SETUP, DRIVE, MOVES, SERVE, SIMULATE = (
-    "Start here", "Set up", "Drive", "Moves", "Serve", "Simulate"
-)  # fmt: skip
+    "Start here",
+    "Set up",
+    "Drive",
+    "Moves",
+    "Serve",
+    "Simulate",
+)
 
 app.command("demo", rich_help_panel=START)(demo.demo)
 app.command("tui", rich_help_panel=START)(tui_cmd.tui)

@@ -303,10 +303,11 @@ def values_last(params: list[Any], args: list[str]) -> list[str]:
     takes_value = {
         name: param.nargs
         for param in params
-        if getattr(param, "param_type_name", "") == "option" and not param.is_flag
+        if getattr(param, "param_type_name", "") == "option"
+        and not param.is_flag
         and not param.count
         for name in (*param.opts, *param.secondary_opts)
-    }  # fmt: skip
+    }
     options: list[str] = []
     values: list[str] = []
     index = 0

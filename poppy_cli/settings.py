@@ -41,8 +41,9 @@ def load_settings(path: Path | None = None) -> Settings:
     file = path if path is not None else settings_file()
     if not file.exists() and not file.is_symlink():
         return Settings()
-    data = parse_yaml(read_limited(file, SETTINGS_LIMITS.max_bytes, "settings file"), str(file),
-                      SETTINGS_LIMITS)  # fmt: skip
+    data = parse_yaml(
+        read_limited(file, SETTINGS_LIMITS.max_bytes, "settings file"), str(file), SETTINGS_LIMITS
+    )
     if data is None:
         return Settings()
     if not isinstance(data, dict):
@@ -85,8 +86,9 @@ def check_key(key: str) -> str:
     from poppy_core.errors import ConfigError
 
     if key not in SETTINGS_KEYS:
-        raise ConfigError(f"unknown setting {key!r} (settings: {', '.join(SETTINGS_KEYS)})",
-                          field=key)  # fmt: skip
+        raise ConfigError(
+            f"unknown setting {key!r} (settings: {', '.join(SETTINGS_KEYS)})", field=key
+        )
     return key
 
 
@@ -102,8 +104,7 @@ def check_setting(key: str, value: str) -> str:
     check_key(key)
     text = value.strip()
     if not text:
-        raise ConfigError(f"{key}: give a value (`poppy config unset {key}` removes it)",
-                          field=key)  # fmt: skip
+        raise ConfigError(f"{key}: give a value (`poppy config unset {key}` removes it)", field=key)
     if key == "profile":
         from poppy_core.robot.profiles import find_profile
 

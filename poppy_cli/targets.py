@@ -48,8 +48,10 @@ def parse_targets(
         except ArgumentError:
             raise TargetSyntaxError(
                 f"{word!r}: the angle must be a finite number of degrees within "
-                f"±{checks.MAX_MAGNITUDE:g}", field=name, value=value,
-            ) from None  # fmt: skip
+                f"±{checks.MAX_MAGNITUDE:g}",
+                field=name,
+                value=value,
+            ) from None
         targets[name] = clamp_goal(value, (limits or {}).get(name))
     if not targets:
         raise TargetSyntaxError("no target: type e.g. m1=30 m2=-10")

@@ -74,8 +74,9 @@ def read_limited(path: str | os.PathLike[str], max_bytes: int, what: str = "file
         raise _bad(source, f"cannot read the {what}: it is {kind}")
     with os.fdopen(fd, "rb") as handle:
         if info.st_size > max_bytes:
-            raise _bad(source, f"the {what} is {info.st_size:,} bytes; at most {max_bytes:,} "
-                       "are read")  # fmt: skip
+            raise _bad(
+                source, f"the {what} is {info.st_size:,} bytes; at most {max_bytes:,} are read"
+            )
         try:
             data = handle.read(max_bytes + 1)
         except OSError as exc:
@@ -127,8 +128,9 @@ def check_shape(data: Any, source: str, limits: Limits) -> None:
             if depth > limits.max_depth:
                 raise _bad(source, f"nested more than {limits.max_depth} levels deep")
             if nodes > limits.max_nodes:
-                raise _bad(source, f"more than {limits.max_nodes:,} values once YAML aliases "
-                           "are expanded")  # fmt: skip
+                raise _bad(
+                    source, f"more than {limits.max_nodes:,} values once YAML aliases are expanded"
+                )
             continue
         if key in sizes:
             continue
@@ -154,8 +156,9 @@ def parse_json(text: str | bytes, source: str, limits: Limits, *, check: bool = 
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise _bad(source, f"JSON syntax error at line {exc.lineno}, column {exc.colno}: "
-                   f"{exc.msg}") from None  # fmt: skip
+        raise _bad(
+            source, f"JSON syntax error at line {exc.lineno}, column {exc.colno}: {exc.msg}"
+        ) from None
     except RecursionError:
         raise _bad(source, f"nested more than {limits.max_depth} levels deep") from None
     except UnicodeDecodeError as exc:
@@ -167,8 +170,12 @@ def parse_json(text: str | bytes, source: str, limits: Limits, *, check: bool = 
     return data
 
 
-_OPENS = (yaml.BlockMappingStartToken, yaml.BlockSequenceStartToken,
-          yaml.FlowMappingStartToken, yaml.FlowSequenceStartToken)  # fmt: skip
+_OPENS = (
+    yaml.BlockMappingStartToken,
+    yaml.BlockSequenceStartToken,
+    yaml.FlowMappingStartToken,
+    yaml.FlowSequenceStartToken,
+)
 _CLOSES = (yaml.BlockEndToken, yaml.FlowMappingEndToken, yaml.FlowSequenceEndToken)
 
 

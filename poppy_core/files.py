@@ -69,8 +69,10 @@ def file_error(exc: OSError, path: Path | str, action: str) -> FileError:
 def is_disk_full(error: BaseException) -> bool:
     """True for an error that says the disk (or quota, or file-size limit) is full."""
     return isinstance(error, FileError | OSError) and error.errno in (
-        errno.ENOSPC, errno.EDQUOT, errno.EFBIG,
-    )  # fmt: skip
+        errno.ENOSPC,
+        errno.EDQUOT,
+        errno.EFBIG,
+    )
 
 
 def _kind(mode: int) -> str:
@@ -103,8 +105,9 @@ def _check_target(path: Path, replace: bool) -> os.stat_result | None:
             path=str(path),
         )
     if not replace:
-        raise FileError(f"{path} already exists: pass --force to replace it", path=str(path),
-                        errno=errno.EEXIST)  # fmt: skip
+        raise FileError(
+            f"{path} already exists: pass --force to replace it", path=str(path), errno=errno.EEXIST
+        )
     return info
 
 
@@ -116,8 +119,11 @@ def _check_folder(folder: Path, make_folder: bool) -> None:
             raise file_error(exc, folder, "create the folder") from None
     if not folder.is_dir():
         what = "is not a folder" if folder.exists() else "does not exist: create it first"
-        raise FileError(f"cannot write in {folder}: the folder {what}", path=str(folder),
-                        errno=errno.ENOTDIR if folder.exists() else errno.ENOENT)  # fmt: skip
+        raise FileError(
+            f"cannot write in {folder}: the folder {what}",
+            path=str(folder),
+            errno=errno.ENOTDIR if folder.exists() else errno.ENOENT,
+        )
 
 
 def output_path(
@@ -212,7 +218,7 @@ def write_file(
         try:
             view = memoryview(payload)
             while view:
-                view = view[os.write(fd, view):]
+                view = view[os.write(fd, view) :]
             if existing is not None:
                 os.fchmod(fd, stat.S_IMODE(existing.st_mode))
             os.fsync(fd)
@@ -237,8 +243,11 @@ def _put_in_place(temp: Path, target: Path, replace: bool) -> None:
     try:
         os.link(temp, target)  # fails if anything is there now: nothing is ever clobbered
     except FileExistsError:
-        raise FileError(f"{target} already exists: pass --force to replace it",
-                        path=str(target), errno=errno.EEXIST) from None  # fmt: skip
+        raise FileError(
+            f"{target} already exists: pass --force to replace it",
+            path=str(target),
+            errno=errno.EEXIST,
+        ) from None
     except OSError as exc:
         if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.EXDEV, errno.EMLINK):
             raise
@@ -314,8 +323,9 @@ class FileLock:
                 raise FileError(
                     f"another poppy process (pid {holder}) is writing {self.target}: wait for "
                     "it, or pick another name",
-                    path=str(self.target), errno=errno.EBUSY,
-                ) from None  # fmt: skip
+                    path=str(self.target),
+                    errno=errno.EBUSY,
+                ) from None
             if _same_file(fd, self.path):
                 os.ftruncate(fd, 0)
                 os.write(fd, f"{os.getpid()}\n".encode())
@@ -324,8 +334,9 @@ class FileLock:
             os.close(fd)  # its holder removed it meanwhile: lock the file now at the path
         raise FileError(
             f"cannot lock {self.target}: its lock file {self.path} keeps being replaced",
-            path=str(self.target), errno=errno.EBUSY,
-        )  # fmt: skip
+            path=str(self.target),
+            errno=errno.EBUSY,
+        )
 
     def release(self) -> None:
         """Drop the lock and its file (again: nothing).

@@ -27,8 +27,9 @@ def control_name(control: str) -> str:
     if name not in CONTROLS:
         raise ArgumentError(
             f"control must be one of {', '.join(CONTROLS)}, not {control!r}",
-            field="control", value=control,
-        )  # fmt: skip
+            field="control",
+            value=control,
+        )
     return name
 
 

@@ -181,13 +181,14 @@ def goal_case(name: str, kind: str, position: str) -> Case:
         name,
         kind,
         python=python(set_goal),
-        rest_v1=rest_v1("PUT", "/api/v1/motors/m1/registers/goal_position",
-                        f'{{"value": {_json(p)}}}'),
+        rest_v1=rest_v1(
+            "PUT", "/api/v1/motors/m1/registers/goal_position", f'{{"value": {_json(p)}}}'
+        ),
         rest_pypot=rest_pypot("POST", "/motors/m1/registers/goal_position/value.json", _json(p)),
         ws=ws(f'{{"m1": {{"goal_position": {_json(p)}}}}}'),
         snap=snap(f"/motor/m1/set/goal_position/{position}"),
         zmq=zmq("set_register_value", motor="m1", register="goal_position", value=p),
-    )  # fmt: skip
+    )
 
 
 def _json(value: float) -> str:

@@ -92,4 +92,3 @@ def test_worker_error_is_logged_once_kept_and_raised_to_the_joiner(
     assert worker.close() is True  # an owner's close goes on; the error stays in .error
     warnings = [r for r in caplog.records if "test breaker failed" in r.getMessage()]
     assert len(warnings) == 1 and warnings[0].levelno == logging.WARNING
-

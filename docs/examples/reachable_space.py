@@ -83,7 +83,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--samples", type=int, default=150, help="random goals (default 150)")
     parser.add_argument("--seed", type=int, default=1, help="random seed")
     parser.add_argument("--speed", type=float, default=4.0,
-                        help="simulated seconds per real second (default 4)")  # fmt: skip
+                        help="simulated seconds per real second (default 4)")
     parser.add_argument("--output", type=Path, default=HERE / "reachable_space.png")
     args = parser.parse_args(argv)
     points = sample(args.samples, args.seed, args.speed)

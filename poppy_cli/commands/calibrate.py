@@ -59,8 +59,10 @@ class RichAnswers:
         if posture.positions:
             text += "\n\nangles: " + ", ".join(f"{m} {v:g}°" for m, v in posture.positions.items())
         err_console.print(Panel(text, title="reference posture", expand=False))
-        return _enter(f"Put the robot in this posture ({', '.join(motors)} are free to move), "
-                      "then press Enter (q to cancel)")  # fmt: skip
+        return _enter(
+            f"Put the robot in this posture ({', '.join(motors)} are free to move), "
+            "then press Enter (q to cancel)"
+        )
 
     def move(self, motors: Sequence[str], watch: RangeWatch) -> bool:
         """Show the joints' ranges live until Enter."""
@@ -68,10 +70,13 @@ class RichAnswers:
         answer: list[bool] = []
         done = threading.Event()
         with single_keys() as keys:  # before the prompt: a key typed at once is not lost
-            err_console.print(styled(
-                "Move [bold]{}[/] slowly from one end of its range to the other, back to the "
-                "posture, then press Enter (q to cancel)", which
-            ))  # fmt: skip
+            err_console.print(
+                styled(
+                    "Move [bold]{}[/] slowly from one end of its range to the other, back to the "
+                    "posture, then press Enter (q to cancel)",
+                    which,
+                )
+            )
             sys.stderr.flush()
 
             def read_answer() -> None:
@@ -270,9 +275,11 @@ def _save(
         "path": str(saved.path),
         "backup": str(saved.backup) if saved.backup else None,
         "calibrated": calibration.created,
-        "joints": [{"name": m, "offset": c["offset"][1], "angle_limit": list(c["angle_limit"][1])}
-                   for m, c in changes.items()],
-    }  # fmt: skip
+        "joints": [
+            {"name": m, "offset": c["offset"][1], "angle_limit": list(c["angle_limit"][1])}
+            for m, c in changes.items()
+        ],
+    }
     if json_output:
         print_json(summary)
         return
@@ -289,11 +296,13 @@ def _changes_table(changes: dict[str, dict[str, Any]]) -> Table:
     for motor, change in changes.items():
         (old_offset, new_offset), (old_limit, new_limit) = change["offset"], change["angle_limit"]
         table.add_row(
-            motor, fmt_value(old_offset), fmt_value(new_offset),
+            motor,
+            fmt_value(old_offset),
+            fmt_value(new_offset),
             f"{fmt_value(old_limit[0])} … {fmt_value(old_limit[1])}",
             f"{fmt_value(new_limit[0])} … {fmt_value(new_limit[1])}"
             + ("" if change["range_recorded"] else " (kept)"),
-        )  # fmt: skip
+        )
     return table
 
 
@@ -310,13 +319,23 @@ def _report_check(config: RobotConfig, drifts: list[JointDrift], json_output: bo
     when = calibrated_on(config)
     drifted = [d.motor for d in drifts if not d.ok]
     if json_output:
-        print_json({
-            "calibrated": when,
-            "tolerance_deg": drifts[0].tolerance if drifts else None,
-            "joints": [{"name": d.motor, "expected": d.expected, "measured": round(d.measured, 2),
-                        "drift": round(d.drift, 2), "ok": d.ok} for d in drifts],
-            "drifted": drifted,
-        })  # fmt: skip
+        print_json(
+            {
+                "calibrated": when,
+                "tolerance_deg": drifts[0].tolerance if drifts else None,
+                "joints": [
+                    {
+                        "name": d.motor,
+                        "expected": d.expected,
+                        "measured": round(d.measured, 2),
+                        "drift": round(d.drift, 2),
+                        "ok": d.ok,
+                    }
+                    for d in drifts
+                ],
+                "drifted": drifted,
+            }
+        )
     else:
         title = f"calibrated {when}" if when else "not calibrated: profile zeros"
         table = Table(title=f"drift in the reference posture ({title})")
@@ -327,7 +346,9 @@ def _report_check(config: RobotConfig, drifts: list[JointDrift], json_output: bo
             table.add_row(d.motor, _deg(d.expected), _deg(d.measured), _deg(d.drift, "+"), mark)
         console.print(table)
         if drifted:
-            console.print(f"{', '.join(drifted)} drifted more than {drifts[0].tolerance:g}°: "
-                          "run `poppy calibrate` again")  # fmt: skip
+            console.print(
+                f"{', '.join(drifted)} drifted more than {drifts[0].tolerance:g}°: "
+                "run `poppy calibrate` again"
+            )
     if drifted:
         raise typer.Exit(EXIT_FAILURE)

@@ -46,8 +46,10 @@ def _resolution(text: str | None) -> tuple[int, int] | None:
     if not (width.isdigit() and height.isdigit()):
         raise typer.BadParameter(f"{text!r}: give WIDTHxHEIGHT, e.g. 640x480")
     try:  # checked before a camera or a renderer is asked for that many pixels
-        return (checks.count(int(width), 1, MAX_SIDE, "the width"),
-                checks.count(int(height), 1, MAX_SIDE, "the height"))  # fmt: skip
+        return (
+            checks.count(int(width), 1, MAX_SIDE, "the width"),
+            checks.count(int(height), 1, MAX_SIDE, "the height"),
+        )
     except (ArgumentError, ValueError) as exc:
         raise typer.BadParameter(f"{text!r}: {exc}") from None
 
@@ -108,8 +110,9 @@ def _source(
         yield camera, (found[0] if found else MarkerDetector("marker_detector", [camera], 5.0))
 
 
-def _pose_for_camera(robot: Any, marker: int | None, card: str | None,
-                     detector: MarkerDetector | None) -> None:  # fmt: skip
+def _pose_for_camera(
+    robot: Any, marker: int | None, card: str | None, detector: MarkerDetector | None
+) -> None:
     """Stand the simulated robot at its zero pose (head ahead) and hold the cards asked for."""
     import numpy as np
 
@@ -131,8 +134,9 @@ def _pose_for_camera(robot: Any, marker: int | None, card: str | None,
             known = ", ".join(detector.card_ids) if detector is not None else "none"
             _usage(f"no card {card!r} in this robot's profile (cards: {known})")
             return
-        sim.add_marker(card, ids[0], tuple(ahead + 0.045 * matrix[:, 0]), size=0.05,
-                       family="hamming")  # fmt: skip
+        sim.add_marker(
+            card, ids[0], tuple(ahead + 0.045 * matrix[:, 0]), size=0.05, family="hamming"
+        )
 
 
 def list_cameras(json_output: bool = JsonOpt) -> None:
@@ -226,8 +230,13 @@ def _print_markers(markers: list[Any], names: dict[int, str]) -> None:
     table = Table("id", "family", "card", "position x, y", "distance m")
     for m in markers:
         distance = f"{m.pose.distance_m:.3f}" if m.pose is not None else "-"
-        table.add_row(str(m.id), m.family, names.get(m.id, ""),
-                      f"{m.position[0]:+.2f}, {m.position[1]:+.2f}", distance)  # fmt: skip
+        table.add_row(
+            str(m.id),
+            m.family,
+            names.get(m.id, ""),
+            f"{m.position[0]:+.2f}, {m.position[1]:+.2f}",
+            distance,
+        )
     console.print(table)
 
 

@@ -176,8 +176,10 @@ def build_config(found: list[FoundMotor], prefix: str) -> dict[str, Any]:
     motors: dict[str, Any] = {}
     groups = sorted({(f.port, f.protocol, f.baudrate) for f in found})
     for index, (device, protocol, baudrate) in enumerate(groups, start=1):
-        chosen = sorted((f for f in found if (f.port, f.protocol, f.baudrate) ==
-                         (device, protocol, baudrate)), key=lambda f: f.id)  # fmt: skip
+        chosen = sorted(
+            (f for f in found if (f.port, f.protocol, f.baudrate) == (device, protocol, baudrate)),
+            key=lambda f: f.id,
+        )
         names = [f"{prefix}{f.id}" for f in chosen]
         controllers[f"controller_{index}"] = {
             "port": device,

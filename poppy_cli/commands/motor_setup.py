@@ -73,7 +73,10 @@ def set_id(
 def set_baudrate(
     motor_id: int = typer.Argument(..., help="Motor ID.", min=0, max=253),
     rate: int = typer.Argument(
-        ..., metavar="BPS", help="New baud rate in bps, e.g. 1000000.", min=MIN_BAUD,
+        ...,
+        metavar="BPS",
+        help="New baud rate in bps, e.g. 1000000.",
+        min=MIN_BAUD,
         max=MAX_BAUD,
     ),
     port: str | None = BusPortOpt,
@@ -136,8 +139,14 @@ def set_return_delay(
     """
     from poppy_core.bus.setup import set_return_delay as run
 
-    _run_each(port, ids, baud, protocol, json_output,
-              lambda bus, motor_id, say: run(bus, motor_id, delay_us, progress=say))  # fmt: skip
+    _run_each(
+        port,
+        ids,
+        baud,
+        protocol,
+        json_output,
+        lambda bus, motor_id, say: run(bus, motor_id, delay_us, progress=say),
+    )
 
 
 @app.command("angle-limits", cls=NumbersCommand)
@@ -163,9 +172,14 @@ def angle_limits(
         raise typer.Exit(EXIT_USAGE)
     if min_deg is not None and max_deg is not None:
         low, high = min_deg, max_deg
-        _run_each(port, ids, baud, protocol, json_output,
-                  lambda bus, motor_id, say: set_angle_limits(bus, motor_id, low, high,
-                                                              progress=say))  # fmt: skip
+        _run_each(
+            port,
+            ids,
+            baud,
+            protocol,
+            json_output,
+            lambda bus, motor_id, say: set_angle_limits(bus, motor_id, low, high, progress=say),
+        )
         return
     id_list = parse_ids(ids)
     rows = []
@@ -173,11 +187,13 @@ def angle_limits(
         for motor_id in id_list:
             model = ping_model(bus, motor_id).model
             assert model is not None
-            rows.append({
-                "id": motor_id,
-                "min": bus.read_register(motor_id, model, "min_position_limit"),
-                "max": bus.read_register(motor_id, model, "max_position_limit"),
-            })  # fmt: skip
+            rows.append(
+                {
+                    "id": motor_id,
+                    "min": bus.read_register(motor_id, model, "min_position_limit"),
+                    "max": bus.read_register(motor_id, model, "max_position_limit"),
+                }
+            )
     if json_output:
         print_json(rows)
         return
@@ -198,8 +214,14 @@ def reboot(
     """Reboot motors (clears a hardware alarm) and wait until each answers again."""
     from poppy_core.bus.setup import reboot as run
 
-    _run_each(port, ids, baud, protocol, json_output,
-              lambda bus, motor_id, say: run(bus, motor_id, progress=say))  # fmt: skip
+    _run_each(
+        port,
+        ids,
+        baud,
+        protocol,
+        json_output,
+        lambda bus, motor_id, say: run(bus, motor_id, progress=say),
+    )
 
 
 @app.command("factory-reset")
@@ -223,8 +245,9 @@ def factory_reset(
     if not yes:
         from poppy_cli.prompts import require_yes
 
-        require_yes(f"Reset motor {motor_id} to its factory settings?",
-                    declined="factory reset cancelled")  # fmt: skip
+        require_yes(
+            f"Reset motor {motor_id} to its factory settings?", declined="factory reset cancelled"
+        )
     _run_setup(
         port,
         motor_id,

@@ -55,9 +55,11 @@ def list_cmd(json_output: bool = JsonOpt) -> None:
     rows: list[dict[str, Any]] = []
     for entry in list_moves():
         row: dict[str, Any] = {
-            "name": entry.name, "path": str(entry.path), "format": entry.format,
+            "name": entry.name,
+            "path": str(entry.path),
+            "format": entry.format,
             "size_bytes": entry.size_bytes,
-        }  # fmt: skip
+        }
         try:
             header = _header(entry.path)
             row.update(
@@ -80,9 +82,14 @@ def list_cmd(json_output: bool = JsonOpt) -> None:
             table.add_row(row["name"], row["format"], styled("[red]unreadable[/]"), "", "", "", "")
             continue
         table.add_row(
-            row["name"], row["format"], f"{row['duration_s']:.2f} s", str(row["frames"]),
-            f"{row['framerate']:g} Hz", ", ".join(row["motors"]), _size(row["size_bytes"]),
-        )  # fmt: skip
+            row["name"],
+            row["format"],
+            f"{row['duration_s']:.2f} s",
+            str(row["frames"]),
+            f"{row['framerate']:g} Hz",
+            ", ".join(row["motors"]),
+            _size(row["size_bytes"]),
+        )
     console.print(table)
 
 
@@ -122,8 +129,9 @@ def show(name: str = NameArg, json_output: bool = JsonOpt) -> None:
     for column in ("motor", "start", "end", "min", "max", "range"):
         table.add_column(column, justify="left" if column == "motor" else "right")
     for stats in header["stats"]:
-        values = [f"{stats[k]:.1f}" if k in stats else "" for k in
-                  ("start", "end", "min", "max", "range")]  # fmt: skip
+        values = [
+            f"{stats[k]:.1f}" if k in stats else "" for k in ("start", "end", "min", "max", "range")
+        ]
         table.add_row(stats["name"], *values)
     console.print(table)
 
@@ -239,8 +247,12 @@ def import_cmd(
     move = read_move(target)
     if json_output:
         print_json(
-            {"name": target.stem, "path": str(target), "frames": len(move),
-             "motors": list(move.motors)}
-        )  # fmt: skip
+            {
+                "name": target.stem,
+                "path": str(target),
+                "frames": len(move),
+                "motors": list(move.motors),
+            }
+        )
         return
     console.print(f"imported {file} as {target.stem} ({len(move)} frames) into {target}")

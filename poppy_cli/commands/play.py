@@ -120,10 +120,11 @@ def _run(player: MovePlayer, stop: threading.Event, *, show: bool) -> None:
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     columns = (
-        TextColumn("{task.description}", markup=False), BarColumn(),
+        TextColumn("{task.description}", markup=False),
+        BarColumn(),
         TextColumn("{task.percentage:>3.0f}%"),
         TimeRemainingColumn(),
-    )  # fmt: skip
+    )
     with Progress(*columns, console=err_console, transient=True) as progress:
         task = progress.add_task("going to the first frame", total=1.0)
 

@@ -170,8 +170,9 @@ def record(
     # delays) is answered, or Ctrl-C there ends the command with nothing recorded.
     with start_robot(config, sim) as robot:
         watcher = _install_stop(stop)
-        recorder = MoveRecorder(robot, freq, names, checkpoint_path=path, replace=force,
-                                make_folder=in_library)  # fmt: skip
+        recorder = MoveRecorder(
+            robot, freq, names, checkpoint_path=path, replace=force, make_folder=in_library
+        )
         recorder.start()  # refused here when another `poppy record` writes the same file
         for motor_name in names:
             robot.motor(motor_name).compliant = True
@@ -256,10 +257,15 @@ def _save_to_temp(recorder: MoveRecorder, name: str) -> Path:
     try:
         written = recorder.save(fallback)
     except FileError as exc:
-        raise FileError(f"the take could not be saved to {fallback} either ({exc.args[0]}): "
-                        "it is lost", path=str(fallback), errno=exc.errno) from None  # fmt: skip
-    error_line(f"the take was saved to {written} instead: `poppy moves import {written}` puts "
-               "it in the library")  # fmt: skip
+        raise FileError(
+            f"the take could not be saved to {fallback} either ({exc.args[0]}): it is lost",
+            path=str(fallback),
+            errno=exc.errno,
+        ) from None
+    error_line(
+        f"the take was saved to {written} instead: `poppy moves import {written}` puts "
+        "it in the library"
+    )
     return written
 
 

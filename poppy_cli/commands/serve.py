@@ -189,15 +189,19 @@ def _say_where_takes_went(saved: list[SavedTake]) -> None:
             err_console.print(
                 f"the take {take.name!r} ({take.frames} frames) was not saved yet: saved it "
                 f"to the move library, {take.path}",
-                soft_wrap=True, highlight=False, markup=False,
-            )  # fmt: skip
+                soft_wrap=True,
+                highlight=False,
+                markup=False,
+            )
         else:
             err_console.print(
                 f"the take {take.name!r} ({take.frames} frames) was not saved yet and the "
                 f"library could not have it: saved it to {take.path}; `poppy moves import "
                 f"{take.path}` puts it in the library",
-                soft_wrap=True, highlight=False, markup=False,
-            )  # fmt: skip
+                soft_wrap=True,
+                highlight=False,
+                markup=False,
+            )
 
 
 def _report(line: str) -> None:

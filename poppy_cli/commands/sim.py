@@ -167,8 +167,9 @@ def _gl_works(backend: str) -> bool:
     code = "import mujoco; mujoco.GLContext(8, 8).make_current()"
     env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
     try:
-        done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                              timeout=30, check=False)  # fmt: skip
+        done = subprocess.run(
+            [sys.executable, "-c", code], env=env, capture_output=True, timeout=30, check=False
+        )
     except (OSError, subprocess.TimeoutExpired):
         return False
     return done.returncode == 0
@@ -222,13 +223,20 @@ def _render_with_progress(
     if move is not None:
         unknown = [m for m in move.motors if m not in config.motors]
         if unknown:
-            raise ConfigError(f"move {move_ref!r} drives motors {profile} has not: "
-                              f"{', '.join(unknown)}", field="move")  # fmt: skip
+            raise ConfigError(
+                f"move {move_ref!r} drives motors {profile} has not: {', '.join(unknown)}",
+                field="move",
+            )
     columns = (
-        TextColumn("{task.description}", markup=False), BarColumn(),
-        MofNCompleteColumn(), TextColumn("frames ·"), TimeElapsedColumn(),
-        TextColumn("·"), TimeRemainingColumn(), TextColumn("left"),
-    )  # fmt: skip
+        TextColumn("{task.description}", markup=False),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("frames ·"),
+        TimeElapsedColumn(),
+        TextColumn("·"),
+        TimeRemainingColumn(),
+        TextColumn("left"),
+    )
     with Progress(*columns, console=err_console, transient=True) as bar:
         task = bar.add_task(f"rendering {profile} ({backend})", total=frame_count(move))
 
@@ -255,8 +263,14 @@ def save_frames(frames: list[Any], output: Path, *, replace: bool = False) -> Pa
     suffix = output.suffix.lower()
     image = io.BytesIO()
     if suffix == ".gif":
-        images[0].save(image, format="GIF", save_all=True, append_images=images[1:],
-                       duration=round(1000 / GIF_FPS), loop=0)  # fmt: skip
+        images[0].save(
+            image,
+            format="GIF",
+            save_all=True,
+            append_images=images[1:],
+            duration=round(1000 / GIF_FPS),
+            loop=0,
+        )
     else:
         images[-1].save(image, format="JPEG" if suffix in (".jpg", ".jpeg") else "PNG")
     return write_file(output, image.getvalue(), replace=replace)

@@ -175,13 +175,16 @@ def teleop(
         leader_config = robot_config(None, leader_file, leader_port)
     else:
         leader_config = robot_config(leader, None, leader_port)
-    follower_config = None if remote or follower == SELF else _config(follower, follower_port,
-                                                                        "follower")  # fmt: skip
+    follower_config = (
+        None if remote or follower == SELF else _config(follower, follower_port, "follower")
+    )
     if follower_config is not None and follower_sim is None:
         shared = _ports_of(leader_config) & _ports_of(follower_config)
         if shared:
-            error_line(f"the leader and the follower cannot share {', '.join(sorted(shared))}: "
-                       "give each its own port (or --follower self for one robot)")  # fmt: skip
+            error_line(
+                f"the leader and the follower cannot share {', '.join(sorted(shared))}: "
+                "give each its own port (or --follower self for one robot)"
+            )
             raise typer.Exit(EXIT_USAGE)
     with ExitStack() as stack:
         # Everything that can be refused is, before a robot is built (nothing turns compliant).
@@ -195,20 +198,28 @@ def teleop(
         _check_map(mapping, list(leader_config.motors), follower_motors, follower == SELF)
         lead = stack.enter_context(_build(leader_config, None))
         if follow is None:
-            follow = (lead if follower_config is None
-                      else stack.enter_context(_build(follower_config, follower_sim)))  # fmt: skip
+            follow = (
+                lead
+                if follower_config is None
+                else stack.enter_context(_build(follower_config, follower_sim))
+            )
         # Only now do Ctrl-C and Enter stop a teleoperation: before, a question asked at
         # start-up (return delays) is answered, or Ctrl-C there ends the command.
         stop = threading.Event()
         _install_stop(stop)
-        teleop_run = _start(lead, follow, mapping, rate, ramp, duration, path, leader_config,
-                            follower)  # fmt: skip
+        teleop_run = _start(
+            lead, follow, mapping, rate, ramp, duration, path, leader_config, follower
+        )
         _watch(teleop_run, stop, show=not json_output)
         report = teleop_run.report()
         if teleop_run.error is not None:
             raise teleop_run.error
-    summary = {"leader": leader or "settings", "follower": follower,
-               "map": str(teleop_run.joint_map), **report.as_dict()}  # fmt: skip
+    summary = {
+        "leader": leader or "settings",
+        "follower": follower,
+        "map": str(teleop_run.joint_map),
+        **report.as_dict(),
+    }
     if json_output:
         print_json(summary)
         return
@@ -225,16 +236,21 @@ def _check_map(
     from poppy_core.motion.teleop.joint_map import JointMap
 
     if same_robot and mapping is None:
-        raise typer.BadParameter("--follower self needs a --map of other joints, e.g. "
-                                 "r_elbow_y=l_elbow_y", param_hint="--map")  # fmt: skip
+        raise typer.BadParameter(
+            "--follower self needs a --map of other joints, e.g. r_elbow_y=l_elbow_y",
+            param_hint="--map",
+        )
     chosen = mapping or JointMap.same_names(leader, follower)
     chosen.check(leader, follower)
     both = sorted(set(chosen.leaders) & set(chosen.followers)) if same_robot else []
     if both:
         from poppy_core.errors import ConfigError
 
-        raise ConfigError(f"{', '.join(both)} cannot lead and follow at once: map other joints",
-                          field="map", value=both)  # fmt: skip
+        raise ConfigError(
+            f"{', '.join(both)} cannot lead and follow at once: map other joints",
+            field="map",
+            value=both,
+        )
 
 
 def _build(config: RobotConfig, sim: str | None) -> Robot:
@@ -252,9 +268,16 @@ def _remote(url: str, rate: float) -> Any:
 
 
 def _start(
-    leader: Robot, follower: Any, mapping: JointMap | None, rate: float, ramp: float | None,
-    duration: float | None, path: Path | None, leader_config: RobotConfig, follower_spec: str,
-) -> Teleoperation:  # fmt: skip
+    leader: Robot,
+    follower: Any,
+    mapping: JointMap | None,
+    rate: float,
+    ramp: float | None,
+    duration: float | None,
+    path: Path | None,
+    leader_config: RobotConfig,
+    follower_spec: str,
+) -> Teleoperation:
     from poppy_core.motion.teleop.session import Teleoperation
 
     name = leader_config.profile.name if leader_config.profile is not None else "leader"
@@ -262,10 +285,16 @@ def _start(
     if getattr(follower, "config", None) is not None and follower.config.profile is not None:
         metadata["robot"] = follower.config.profile.name
     teleop_run = Teleoperation(
-        leader, follower, mapping, rate_hz=rate, ramp_s=ramp, duration_s=duration,
-        record=path, record_metadata=metadata,
+        leader,
+        follower,
+        mapping,
+        rate_hz=rate,
+        ramp_s=ramp,
+        duration_s=duration,
+        record=path,
+        record_metadata=metadata,
         on_change=lambda state, reason: err_console.print(styled("[dim]{}: {}[/]", state, reason)),
-    )  # fmt: skip
+    )
     err_console.print(
         f"teleoperating {follower_spec} from the leader at {rate:g} Hz "
         f"({teleop_run.joint_map}) — move the leader by hand; Enter or Ctrl-C stops",

@@ -119,9 +119,12 @@ def autodetect(
     """
     options.setdefault("sensors", False)
     config = factory.detect_config(
-        port, baudrates=baudrates, protocols=protocols, ids=ids,
+        port,
+        baudrates=baudrates,
+        protocols=protocols,
+        ids=ids,
         match_profile=options.get("creature", True),
-    )  # fmt: skip
+    )
     return from_config(config, **options)
 
 
@@ -148,8 +151,9 @@ def from_json(
         raise ArgumentError(
             f"from_json takes a file path, not {type(json_file).__name__}: use from_config for "
             "a dict",
-            field="json_file", value=json_file,
-        )  # fmt: skip
+            field="json_file",
+            value=json_file,
+        )
     return from_config(
         os.fspath(json_file), sim=bool(use_dummy_io), strict=strict, start_sync=sync, **options
     )

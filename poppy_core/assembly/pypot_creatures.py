@@ -35,15 +35,17 @@ def _simulator(value: object) -> bool | str:
         raise ConfigError(
             "simulator='vrep' is not supported: V-REP is replaced by MuJoCo, use "
             "simulator='mujoco' (or 'dummy' for virtual servos without physics)",
-            field="simulator", value=value,
-        )  # fmt: skip
+            field="simulator",
+            value=value,
+        )
     if value == "poppy-simu":
         return True
     if value not in SIMULATORS:
         raise ConfigError(
             f"unknown simulator {value!r}: use None (hardware), 'dummy' or 'mujoco'",
-            field="simulator", value=value,
-        )  # fmt: skip
+            field="simulator",
+            value=value,
+        )
     return SIMULATORS[value]
 
 
@@ -107,8 +109,10 @@ class AbstractPoppyCreature:
         **extra: Any,
     ) -> Robot:
         if not cls.kind:
-            raise ConfigError("AbstractPoppyCreature is abstract: use PoppyErgoJr, PoppyTorso "
-                              "or PoppyHumanoid", field="kind")  # fmt: skip
+            raise ConfigError(
+                "AbstractPoppyCreature is abstract: use PoppyErgoJr, PoppyTorso or PoppyHumanoid",
+                field="kind",
+            )
         sim = _simulator(simulator)
         if simulator == "poppy-simu":
             use_http = True  # pypot: poppy-simu is the dummy robot served over HTTP
@@ -197,21 +201,32 @@ def _refuse_vrep_options(
     base_path: object, scene: object, port: object, id: object, shared: object, remote: bool
 ) -> None:
     if base_path is not None:
-        raise ConfigError("base_path is not supported: the creature's files are poppy profiles; "
-                          "give config= a config file instead", field="base_path")  # fmt: skip
+        raise ConfigError(
+            "base_path is not supported: the creature's files are poppy profiles; "
+            "give config= a config file instead",
+            field="base_path",
+        )
     if scene is not None:
-        raise ConfigError("scene= is a V-REP option: with simulator='mujoco' the scene is the "
-                          "profile's model.xml", field="scene", value=scene)  # fmt: skip
+        raise ConfigError(
+            "scene= is a V-REP option: with simulator='mujoco' the scene is the "
+            "profile's model.xml",
+            field="scene",
+            value=scene,
+        )
     if port is not None and not isinstance(port, str):
-        raise ConfigError(f"port={port!r} is V-REP's port: give the serial port as a string "
-                          "(port='/dev/ttyUSB0') or leave it out", field="port")  # fmt: skip
+        raise ConfigError(
+            f"port={port!r} is V-REP's port: give the serial port as a string "
+            "(port='/dev/ttyUSB0') or leave it out",
+            field="port",
+        )
     if id is not None or shared is not None:
-        raise ConfigError("id= and shared_vrep_io= are V-REP options: leave them out",
-                          field="id")  # fmt: skip
+        raise ConfigError("id= and shared_vrep_io= are V-REP options: leave them out", field="id")
     if remote:
-        raise ConfigError("use_remote (pypot's zerorpc server) is not supported: use "
-                          "use_zmq=True (pypot's ZMQ server) or use_http=True",
-                          field="use_remote")  # fmt: skip
+        raise ConfigError(
+            "use_remote (pypot's zerorpc server) is not supported: use "
+            "use_zmq=True (pypot's ZMQ server) or use_http=True",
+            field="use_remote",
+        )
 
 
 def _sensor_switches(extra: Mapping[str, Any]) -> bool:
@@ -222,8 +237,9 @@ def _sensor_switches(extra: Mapping[str, Any]) -> bool:
                 f"unexpected argument {key}={value!r}: the creature classes take pypot's "
                 "arguments (config, simulator, use_http, http_port, use_ws, use_zmq, use_snap, "
                 "start_background_services, sync...) and <sensor>='dummy'",
-                field=key, value=value,
-            )  # fmt: skip
+                field=key,
+                value=value,
+            )
     return not extra
 
 

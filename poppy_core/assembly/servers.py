@@ -166,8 +166,9 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     service = RobotService(robot)
     app = None
     if "http" in listens:
-        app = create_app(robot, service=service, token=spec.token, policy=policy,
-                         stream_rate_hz=spec.ws_rate_hz)  # fmt: skip
+        app = create_app(
+            robot, service=service, token=spec.token, policy=policy, stream_rate_hz=spec.ws_rate_hz
+        )
     servers = ServerSet(service, policy, app)
     try:
         if app is not None:
@@ -199,10 +200,16 @@ def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) 
     from poppy_core.server.snap import create_snap_server
 
     snap = create_snap_server(
-        robot, where.host, where.port, service=servers.service, cors=spec.cors,
-        allow_hosts=spec.allow_hosts, snap_dir=spec.snap_dir, token=spec.token,
+        robot,
+        where.host,
+        where.port,
+        service=servers.service,
+        cors=spec.cors,
+        allow_hosts=spec.allow_hosts,
+        snap_dir=spec.snap_dir,
+        token=spec.token,
         report=spec.report,
-    )  # fmt: skip
+    )
     servers.servers["snap"] = snap
     snap.thread.bind()
 

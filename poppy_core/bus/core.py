@@ -45,6 +45,7 @@ from poppy_core.protocol import (
 
 logger = logging.getLogger(__name__)
 
+
 def is_alarm_only(protocol: int | DxlProtocol, error: int) -> bool:
     """True when ``error`` carries only alarm bits (the instruction was still executed)."""
     return protocol_for(protocol).is_alarm_only(error)

@@ -155,8 +155,7 @@ class DxlBus(BusCore):
         """Refuse ``what`` on a protocol without it (only protocol 1 lacks any of them)."""
         if not capability:
             raise ProtocolError(
-                f"{what} exists only in protocol 2 (bus {self._port} is protocol "
-                f"{self._protocol})"
+                f"{what} exists only in protocol 2 (bus {self._port} is protocol {self._protocol})"
             )
 
     # -- registers in SI units -----------------------------------------------------------------

@@ -69,10 +69,16 @@ class DxlIO(PypotCalls):
         if error_handler_cls is not None or not convert:
             raise ArgumentError(
                 "error_handler_cls and convert=False are not supported: errors are raised as "
-                "poppy's typed errors and values are in degrees", field="error_handler_cls",
-            )  # fmt: skip
-        self.bus = bus or DxlBus(port, baudrate, self.protocol, sync_read=use_sync_read or None,
-                                 min_timeout_s=float(timeout))  # fmt: skip
+                "poppy's typed errors and values are in degrees",
+                field="error_handler_cls",
+            )
+        self.bus = bus or DxlBus(
+            port,
+            baudrate,
+            self.protocol,
+            sync_read=use_sync_read or None,
+            min_timeout_s=float(timeout),
+        )
         self._models: dict[int, ServoModel] = {}
 
     # -- the bus ---------------------------------------------------------------------------------
@@ -124,11 +130,14 @@ class DxlIO(PypotCalls):
         if model is None:
             found = self.bus.ping(id)
             if found is None:
-                raise CommunicationError(f"motor {id} does not answer on {self.port} at "
-                                         f"{self.baudrate} bps", port=self.port)  # fmt: skip
+                raise CommunicationError(
+                    f"motor {id} does not answer on {self.port} at {self.baudrate} bps",
+                    port=self.port,
+                )
             if found.model is None:
-                raise RegisterError(f"motor {id}: unknown model number {found.model_number}",
-                                    motor=str(id))  # fmt: skip
+                raise RegisterError(
+                    f"motor {id}: unknown model number {found.model_number}", motor=str(id)
+                )
             model = self._models[id] = found.model
         return model
 

@@ -129,12 +129,16 @@ class PypotCalls:
         """``{id: 'joint' | 'wheel'}``."""
         for motor_id, mode in _mapping(mode_for_id).items():
             if mode not in ("joint", "wheel"):
-                raise ArgumentError(f"control mode must be 'joint' or 'wheel', got {mode!r}",
-                                    field="mode")  # fmt: skip
+                raise ArgumentError(
+                    f"control mode must be 'joint' or 'wheel', got {mode!r}", field="mode"
+                )
             model = self._model(motor_id)
             if model.has_register("control_mode"):
-                self.bus.write(motor_id, model.register("control_mode").address,
-                               bytes([1 if mode == "wheel" else 2]))  # fmt: skip
+                self.bus.write(
+                    motor_id,
+                    model.register("control_mode").address,
+                    bytes([1 if mode == "wheel" else 2]),
+                )
                 continue
             cw, ccw = model.register("cw_angle_limit"), model.register("ccw_angle_limit")
             top = 0 if mode == "wheel" else ccw.max_raw
@@ -176,8 +180,10 @@ class PypotCalls:
         codes = {}
         for motor_id, level in _mapping(value_for_id).items():
             if level not in STATUS_LEVELS and level not in range(3):
-                raise ArgumentError(f"status return level must be one of {STATUS_LEVELS}, got "
-                                    f"{level!r}", field="status_return_level")  # fmt: skip
+                raise ArgumentError(
+                    f"status return level must be one of {STATUS_LEVELS}, got {level!r}",
+                    field="status_return_level",
+                )
             codes[motor_id] = STATUS_LEVELS.index(level) if isinstance(level, str) else level
         self.set("status_return_level", codes)
 
@@ -187,8 +193,11 @@ class PypotCalls:
         modes = []
         for motor_id in _ids(ids):
             model = self._model(motor_id)
-            raw = int(self.get("drive_mode", [motor_id])[0]) if model.has_register(
-                "drive_mode") else 0  # fmt: skip
+            raw = (
+                int(self.get("drive_mode", [motor_id])[0])
+                if model.has_register("drive_mode")
+                else 0
+            )
             modes.append(("reverse" if raw & 1 else "normal", "slave" if raw & 2 else "master"))
         return tuple(modes)
 

@@ -37,8 +37,17 @@ if TYPE_CHECKING:
         installed_poppy_creatures,
     )
 
-ASSEMBLED = frozenset({"AbstractPoppyCreature", "PoppyErgoJr", "PoppyHumanoid", "PoppyTorso",
-                       "from_config", "from_profile", "installed_poppy_creatures"})  # fmt: skip
+ASSEMBLED = frozenset(
+    {
+        "AbstractPoppyCreature",
+        "PoppyErgoJr",
+        "PoppyHumanoid",
+        "PoppyTorso",
+        "from_config",
+        "from_profile",
+        "installed_poppy_creatures",
+    }
+)
 """The names re-exported from the assembly."""
 
 
@@ -49,6 +58,7 @@ def __getattr__(name: str) -> Any:
 
         return getattr(poppy_core.assembly, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "CREATURES",

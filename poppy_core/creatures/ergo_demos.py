@@ -220,9 +220,15 @@ class ChickenDemo(DemoPrimitive):
 
 # Puzzel's figures (m1..m6, degrees); m1, m4 and m6 are then set from LEVEL_ANGLES by level.
 FIGURES = (
-    (0, 0, -90, 0, 45, 0), (0, 0, 90, 0, -45, 0), (0, 0, 0, 0, -90, 0), (0, 0, 0, 0, 90, 0),
-    (0, 45, -90, 0, 0, 0), (0, 45, -90, 0, 90, 0), (0, -45, 90, 0, 0, 0), (0, -45, 90, 0, -90, 0),
-)  # fmt: skip
+    (0, 0, -90, 0, 45, 0),
+    (0, 0, 90, 0, -45, 0),
+    (0, 0, 0, 0, -90, 0),
+    (0, 0, 0, 0, 90, 0),
+    (0, 45, -90, 0, 0, 0),
+    (0, 45, -90, 0, 90, 0),
+    (0, -45, 90, 0, 0, 0),
+    (0, -45, 90, 0, -90, 0),
+)
 LEVEL_ANGLES = (-75, -45, 0, 0, 45, 75)
 PRECISIONS = {"easy": 20.0, "normal": 10.0, "hard": 5.0}
 LEVELS = {"veryeasy": 1, "easy": 2, "normal": 3, "hard": 4, "veryhard": 5}
@@ -261,9 +267,17 @@ class PuzzleDemo(DemoPrimitive):
 
     properties: ClassVar[Sequence[str]] = ("countdown_s", "level", "precision", "search_s")
     methods: ClassVar[Sequence[str]] = (
-        *Primitive.methods, "level_growing", "level_veryeasy", "level_easy", "level_normal",
-        "level_hard", "level_veryhard", "precision_easy", "precision_normal", "precision_hard",
-    )  # fmt: skip
+        *Primitive.methods,
+        "level_growing",
+        "level_veryeasy",
+        "level_easy",
+        "level_normal",
+        "level_hard",
+        "level_veryhard",
+        "precision_easy",
+        "precision_normal",
+        "precision_hard",
+    )
     show_s, search_s, replay_hold_s, dance_s = 5.0, 10.0, 2.0, 5.0
 
     def __init__(self, robot: Robot, level: int = 0, precision: float = 20.0) -> None:

@@ -72,8 +72,12 @@ class Dance(LoopPrimitive):
     """
 
     properties: ClassVar[Sequence[str]] = (
-        "amplitude_scale", "tempo_scale", "intro_s", "speed_dps", "update_freq",
-    )  # fmt: skip
+        "amplitude_scale",
+        "tempo_scale",
+        "intro_s",
+        "speed_dps",
+        "update_freq",
+    )
 
     def __init__(
         self,

@@ -26,8 +26,11 @@ ARM_JOINTS: tuple[str, ...] = ("shoulder_y", "shoulder_x", "arm_z", "elbow_y")
 # (poppy-humanoid, poppy-torso primitives/interaction.py) copies the left position with the
 # sign +1 for the left arm's direct motors (shoulder_y, elbow_y) and -1 for its indirect ones.
 MIRROR_SIGNS: dict[str, float] = {
-    "shoulder_y": 1.0, "shoulder_x": -1.0, "arm_z": -1.0, "elbow_y": 1.0,
-}  # fmt: skip
+    "shoulder_y": 1.0,
+    "shoulder_x": -1.0,
+    "arm_z": -1.0,
+    "elbow_y": 1.0,
+}
 INTERACTION_HZ = 50.0  # the primitive manager's rate (poppy_core.motion.manager)
 
 # arms_turn_compliant (Poppy documentation: "turns the arms compliant when a force is applied").
@@ -67,9 +70,10 @@ class ArmsCopyMotion(LoopPrimitive):
         """Free the left arm, stiffen the right one."""
         right = set(arm_motors(self.real_robot, "r"))
         self._pairs = [
-            (left, "r" + left[1:]) for left in arm_motors(self.real_robot, "l")
+            (left, "r" + left[1:])
+            for left in arm_motors(self.real_robot, "l")
             if "r" + left[1:] in right
-        ]  # fmt: skip
+        ]
         for left, right_name in self._pairs:
             self.robot.motor(left).compliant = True
             self.robot.motor(right_name).compliant = False
@@ -103,9 +107,12 @@ class ArmsTurnCompliant(LoopPrimitive):
     """
 
     properties: ClassVar[Sequence[str]] = (
-        "load_threshold", "error_threshold_deg", "release_after_s", "update_freq",
+        "load_threshold",
+        "error_threshold_deg",
+        "release_after_s",
+        "update_freq",
         "compliant_arms",
-    )  # fmt: skip
+    )
 
     def __init__(
         self,

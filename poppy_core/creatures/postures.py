@@ -28,16 +28,31 @@ HUMANOID_POSTURE_S = 2.0
 ERGO_JR_BASE: dict[str, float] = {f"m{i}": 0.0 for i in range(1, 7)}
 # poppy_ergo_jr/primitives/postures.py (RestPosture), degrees.
 ERGO_JR_REST: dict[str, float] = {
-    "m1": 0.0, "m2": -90.0, "m3": 35.0, "m4": 0.0, "m5": 55.0, "m6": -5.0,
-}  # fmt: skip
+    "m1": 0.0,
+    "m2": -90.0,
+    "m3": 35.0,
+    "m4": 0.0,
+    "m5": 55.0,
+    "m6": -5.0,
+}
 # poppy_ergo_jr/primitives/postures.py (CuriousPosture), degrees.
 ERGO_JR_CURIOUS: dict[str, float] = {
-    "m1": 0.0, "m2": -15.0, "m3": 40.0, "m4": 0.0, "m5": -35.0, "m6": -60.0,
-}  # fmt: skip
+    "m1": 0.0,
+    "m2": -15.0,
+    "m3": 40.0,
+    "m4": 0.0,
+    "m5": -35.0,
+    "m6": -60.0,
+}
 # poppy_ergo_jr/primitives/postures.py (TetrisPosture, yellow LEDs), degrees.
 ERGO_JR_TETRIS: dict[str, float] = {
-    "m1": 0.0, "m2": -90.0, "m3": 90.0, "m4": 0.0, "m5": -90.0, "m6": -90.0,
-}  # fmt: skip
+    "m1": 0.0,
+    "m2": -90.0,
+    "m3": 90.0,
+    "m4": 0.0,
+    "m5": -90.0,
+    "m6": -90.0,
+}
 # poppy_torso/primitives/posture.py (InitPosition): every motor to 0° in 3 s, then the bust
 # leans 4° (bust_y) in 1 s.
 TORSO_INIT_S = 3.0
@@ -45,8 +60,13 @@ TORSO_INIT_LEAN: tuple[str, float, float] = ("bust_y", 4.0, 1.0)
 # poppy_ergo_jr/primitives/postures.py (IdlePosture), degrees; SafePowerUp goes there (m2's
 # user range is [-125, 90]: the profile's [-90, 125] is in the motor frame and m2 is indirect).
 ERGO_JR_IDLE: dict[str, float] = {
-    "m1": 0.0, "m2": -110.0, "m3": 65.0, "m4": 0.0, "m5": 34.0, "m6": 20.0,
-}  # fmt: skip
+    "m1": 0.0,
+    "m2": -110.0,
+    "m3": 65.0,
+    "m4": 0.0,
+    "m5": 34.0,
+    "m6": 20.0,
+}
 
 # Poppy documentation (poppy_humanoid library): "stand_position: the robot moves to standing
 # position (0 to all motors)".
@@ -56,9 +76,16 @@ ERGO_JR_IDLE: dict[str, float] = {
 # motor frame, give l_knee_y and r_knee_y both [-3.5, 134] in the user frame). pypot then frees
 # the knees and ankles; poppy's posture holds them.
 HUMANOID_SIT: dict[str, float] = {
-    "l_hip_y": -39.0, "r_hip_y": -39.0, "l_knee_y": 134.0, "r_knee_y": 134.0,
-    "abs_x": 0.0, "abs_y": 3.0, "abs_z": 0.0, "bust_x": 0.0, "bust_y": 0.0,
-}  # fmt: skip
+    "l_hip_y": -39.0,
+    "r_hip_y": -39.0,
+    "l_knee_y": 134.0,
+    "r_knee_y": 134.0,
+    "abs_x": 0.0,
+    "abs_y": 3.0,
+    "abs_z": 0.0,
+    "bust_x": 0.0,
+    "bust_y": 0.0,
+}
 
 
 def humanoid_sit() -> dict[str, float]:
@@ -114,8 +141,9 @@ class CreaturePosture(SimplePosture):
         if value not in CONTROLS:
             raise ArgumentError(
                 f"control must be one of {', '.join(CONTROLS)}, not {value!r}",
-                field="control", value=value,
-            )  # fmt: skip
+                field="control",
+                value=value,
+            )
         self._control = value
 
     def setup(self) -> None:

@@ -28,16 +28,37 @@ Factory = Callable[["Robot", "CreatureSpec"], Primitive]
 
 # Motor names of the pypot configurations (poppy_ergo_jr.json, poppy_torso.json,
 # poppy_humanoid.json), to recognise a config that has no profile header.
-TORSO_MOTORS: frozenset[str] = frozenset({
-    "abs_z", "bust_y", "bust_x", "head_z", "head_y",
-    "l_shoulder_y", "l_shoulder_x", "l_arm_z", "l_elbow_y",
-    "r_shoulder_y", "r_shoulder_x", "r_arm_z", "r_elbow_y",
-})  # fmt: skip
+TORSO_MOTORS: frozenset[str] = frozenset(
+    {
+        "abs_z",
+        "bust_y",
+        "bust_x",
+        "head_z",
+        "head_y",
+        "l_shoulder_y",
+        "l_shoulder_x",
+        "l_arm_z",
+        "l_elbow_y",
+        "r_shoulder_y",
+        "r_shoulder_x",
+        "r_arm_z",
+        "r_elbow_y",
+    }
+)
 HUMANOID_MOTORS: frozenset[str] = TORSO_MOTORS | {
-    "abs_y", "abs_x",
-    "l_hip_x", "l_hip_z", "l_hip_y", "l_knee_y", "l_ankle_y",
-    "r_hip_x", "r_hip_z", "r_hip_y", "r_knee_y", "r_ankle_y",
-}  # fmt: skip
+    "abs_y",
+    "abs_x",
+    "l_hip_x",
+    "l_hip_z",
+    "l_hip_y",
+    "l_knee_y",
+    "l_ankle_y",
+    "r_hip_x",
+    "r_hip_z",
+    "r_hip_y",
+    "r_knee_y",
+    "r_ankle_y",
+}
 ERGO_JR_MOTORS: frozenset[str] = frozenset(ergo_jr.ERGO_JR_MOTORS)
 
 

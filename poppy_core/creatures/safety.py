@@ -51,8 +51,11 @@ class LimitTorque(LoopPrimitive):
     """
 
     properties: ClassVar[Sequence[str]] = (
-        "min_torque", "max_torque", "full_torque_at_deg", "update_freq",
-    )  # fmt: skip
+        "min_torque",
+        "max_torque",
+        "full_torque_at_deg",
+        "update_freq",
+    )
 
     def __init__(
         self,
@@ -172,8 +175,10 @@ class TemperatureMonitor(LoopPrimitive):
                 hot.append(motor.name)
                 logger.warning(
                     "%s is too hot: %.0f °C (limit %.0f °C): let it cool down (turn it compliant)",
-                    motor.name, temperature, self.temperature_limit,
-                )  # fmt: skip
+                    motor.name,
+                    temperature,
+                    self.temperature_limit,
+                )
             elif motor.name in hot and temperature < self.temperature_limit - (
                 TEMPERATURE_HYSTERESIS_C
             ):

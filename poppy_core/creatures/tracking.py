@@ -63,8 +63,9 @@ def _wanted_ids(detector: Any, marker: str | int | None) -> set[int] | None:
         known = list(cards)
         raise UnknownCardError(
             f"no card {text!r} (cards: {', '.join(known) or 'none'}; or give a marker id)",
-            name=text, known=known,
-        )  # fmt: skip
+            name=text,
+            known=known,
+        )
     return set(cards[text])
 
 

@@ -153,7 +153,5 @@ def build_chains(
                     active=name not in passive,
                 )
             )
-        chains[chain.name] = Chain(
-            chain.name, description, joints, chain.tip, label=chain.shown
-        )
+        chains[chain.name] = Chain(chain.name, description, joints, chain.tip, label=chain.shown)
     return chains

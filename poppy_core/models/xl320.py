@@ -43,7 +43,6 @@ XL320_LED = Choice(
 )
 
 
-
 class XL320LEDColors(Enum):
     """pypot's enum of the LED colours (``pypot.dynamixel.conversion``): each is its register
     code + 1 (``XL320LEDColors(code + 1).name``, ``XL320LEDColors.red.value - 1``)."""

@@ -45,8 +45,9 @@ def attached_primitive(robot: Robot, name: str) -> Primitive:
         known = list(attached)
         raise UnknownPrimitiveError(
             f"no primitive {name!r} (primitives: {', '.join(known) or 'none'})",
-            name=str(name), known=known,
-        )  # fmt: skip
+            name=str(name),
+            known=known,
+        )
     return found
 
 

@@ -55,8 +55,13 @@ class Sinus(LoopPrimitive):
     """
 
     properties: ClassVar[Sequence[str]] = (
-        "frequency", "amplitude", "offset", "phase", "motor_list", "update_freq",
-    )  # fmt: skip
+        "frequency",
+        "amplitude",
+        "offset",
+        "phase",
+        "motor_list",
+        "update_freq",
+    )
 
     def __init__(
         self,

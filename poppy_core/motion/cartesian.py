@@ -175,8 +175,9 @@ class RobotChain:
         """pypot's IK representation: 0, each joint's model angle (radians), 0 (pypot's ends)."""
         count = len(self.model.names)
         if len(joints) != count:
-            raise KinematicsError(f"chain {self.name!r} has {count} joints, got {len(joints)} "
-                                  "angles", chain=self.name)  # fmt: skip
+            raise KinematicsError(
+                f"chain {self.name!r} has {count} joints, got {len(joints)} angles", chain=self.name
+            )
         theta = self.model.to_model(np.asarray(joints, dtype=float))
         return [0.0, *(float(v) for v in theta), 0.0]
 
@@ -184,12 +185,19 @@ class RobotChain:
         """Degrees (user frame) from pypot's IK representation (``convert_to_ik_angles``)."""
         count = len(self.model.names)
         if len(joints) != count + 2:
-            raise KinematicsError(f"chain {self.name!r}: pypot's IK angles are {count + 2} "
-                                  f"values, got {len(joints)}", chain=self.name)  # fmt: skip
+            raise KinematicsError(
+                f"chain {self.name!r}: pypot's IK angles are {count + 2} values, got {len(joints)}",
+                chain=self.name,
+            )
         return [float(v) for v in self.model.from_model(np.asarray(joints[1:-1], dtype=float))]
 
-    def plot(self, joints: Sequence[float] | None = None, ax: Any = None, target: Any = None,
-             show: bool = False) -> Any:  # fmt: skip
+    def plot(
+        self,
+        joints: Sequence[float] | None = None,
+        ax: Any = None,
+        target: Any = None,
+        show: bool = False,
+    ) -> Any:
         """Draw the chain in 3D on a matplotlib axis (pypot's ``chain.plot(joints, ax)``).
 
         Args:

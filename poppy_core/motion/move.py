@@ -81,8 +81,9 @@ class Move:
         if not math.isfinite(rate) or rate <= 0:
             raise ArgumentError(
                 f"framerate must be a positive number, got {framerate!r}",
-                field="framerate", value=framerate,
-            )  # fmt: skip
+                field="framerate",
+                value=framerate,
+            )
         names = tuple(str(m) for m in motors)
         if any(not n for n in names):
             raise ArgumentError("motor names must not be empty", field="motors", value=names)
@@ -166,11 +167,14 @@ class Move:
         if set(names) != set(self.motors):
             raise ArgumentError(
                 f"the frame's motors ({', '.join(names)}) are not the move's "
-                f"({', '.join(self.motors)})", field="pos", value=names,
-            )  # fmt: skip
+                f"({', '.join(self.motors)})",
+                field="pos",
+                value=names,
+            )
         if time is not None and len(self) and float(time) < self.duration_s:
-            raise ArgumentError(f"frame time {time} s comes before the last frame's",
-                                field="time", value=time)  # fmt: skip
+            raise ArgumentError(
+                f"frame time {time} s comes before the last frame's", field="time", value=time
+            )
         values = [pos[m][0] if isinstance(pos[m], list | tuple) else pos[m] for m in self.motors]
         row = self._checked([values], "pos", MAX_POSITION_DEG)
         check_size(self.framerate, len(self) + 1, len(self.motors))
@@ -193,10 +197,11 @@ class Move:
         """pypot's ``move.positions()``: time -> motor name -> ``[degrees, speed]``."""
         speeds = self.speeds if self.speeds is not None else np.zeros_like(self.positions)
         return {
-            float(t): {m: [float(p), float(v)] for m, p, v in zip(self.motors, prow, vrow,
-                                                                   strict=True)}
+            float(t): {
+                m: [float(p), float(v)] for m, p, v in zip(self.motors, prow, vrow, strict=True)
+            }
             for t, prow, vrow in zip(self.times(), self.positions, speeds, strict=True)
-        }  # fmt: skip
+        }
 
     def iterpositions(self) -> Iterator[tuple[float, dict[str, list[float]]]]:
         """pypot's ``iterpositions()``: (time, frame) pairs."""
@@ -270,8 +275,9 @@ class Move:
         if motor not in self.motors:
             raise UnknownMotorError(
                 f"the move has no motor {motor!r} (motors: {', '.join(self.motors)})",
-                motor=motor, known=list(self.motors),
-            )  # fmt: skip
+                motor=motor,
+                known=list(self.motors),
+            )
         return self.positions[:, self.motors.index(motor)].copy()
 
     def positions_at(self, t_s: float) -> FloatArray:
@@ -300,9 +306,12 @@ class Move:
         """The same move played from its last frame to its first."""
         speeds = None if self.speeds is None else -self.speeds[::-1]
         return Move(
-            self.framerate, self.motors, self.positions[::-1], speeds=speeds,
+            self.framerate,
+            self.motors,
+            self.positions[::-1],
+            speeds=speeds,
             metadata=self.metadata,
-        )  # fmt: skip
+        )
 
     def select(self, motors: Sequence[str]) -> Move:
         """A move holding only ``motors`` (in that order).
@@ -314,14 +323,18 @@ class Move:
         if missing:
             raise UnknownMotorError(
                 f"the move has no motor {', '.join(missing)} (motors: {', '.join(self.motors)})",
-                motor=missing[0], known=list(self.motors),
-            )  # fmt: skip
+                motor=missing[0],
+                known=list(self.motors),
+            )
         columns = [self.motors.index(m) for m in motors]
         speeds = None if self.speeds is None else self.speeds[:, columns]
         return Move(
-            self.framerate, motors, self.positions[:, columns], speeds=speeds,
+            self.framerate,
+            motors,
+            self.positions[:, columns],
+            speeds=speeds,
             metadata=self.metadata,
-        )  # fmt: skip
+        )
 
     def stats(self) -> dict[str, dict[str, float]]:
         """Per motor: ``min``, ``max``, ``mean``, ``start``, ``end`` (degrees), ``range``."""

@@ -35,8 +35,9 @@ def check_size(framerate: float, frames: int, motors: int) -> None:
     if not MIN_FRAMERATE_HZ <= framerate <= MAX_FRAMERATE_HZ:  # also refuses NaN
         raise ArgumentError(
             f"framerate must be {MIN_FRAMERATE_HZ:g}-{MAX_FRAMERATE_HZ:g} Hz, got {framerate:g}",
-            field="framerate", value=framerate,
-        )  # fmt: skip
+            field="framerate",
+            value=framerate,
+        )
     if motors > MAX_MOTORS:
         raise ArgumentError(
             f"{motors} motors: a move holds at most {MAX_MOTORS}", field="motors", value=motors
@@ -44,14 +45,16 @@ def check_size(framerate: float, frames: int, motors: int) -> None:
     if frames < 0 or frames * max(motors, 1) > MAX_VALUES:
         raise ArgumentError(
             f"{frames} frames of {motors} motors: a move holds at most {MAX_VALUES:,} values",
-            field="frames", value=frames,
-        )  # fmt: skip
+            field="frames",
+            value=frames,
+        )
     if (frames - 1) / framerate > MAX_DURATION_S:
         raise ArgumentError(
             f"{frames} frames at {framerate:g} Hz last {(frames - 1) / framerate:.3g} s: a move "
             f"lasts at most {MAX_DURATION_S:g} s",
-            field="frames", value=frames,
-        )  # fmt: skip
+            field="frames",
+            value=frames,
+        )
 
 
 def resample(times_s: npt.ArrayLike, positions: npt.ArrayLike, framerate: float) -> FloatArray:

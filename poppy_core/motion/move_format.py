@@ -43,8 +43,15 @@ MOVE_SUFFIX = ".move"
 PYPOT_SUFFIX = ".json"
 FORMATS: tuple[str, ...] = ("poppy", "pypot")
 HEADER_KEYS: tuple[str, ...] = (
-    "format", "version", "framerate", "motors", "frames", "dtype", "speeds", "units",
-)  # fmt: skip
+    "format",
+    "version",
+    "framerate",
+    "motors",
+    "frames",
+    "dtype",
+    "speeds",
+    "units",
+)
 _DTYPES: dict[str, np.dtype[Any]] = {"<f4": np.dtype("<f4"), "<f8": np.dtype("<f8")}
 _LENGTH = struct.Struct("<I")
 MAX_HEADER_BYTES = 1 << 20

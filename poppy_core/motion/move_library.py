@@ -90,8 +90,9 @@ def check_name(name: str) -> str:
     if len(name) > MAX_NAME_CHARS:
         raise ConfigError(
             f"a move name has at most {MAX_NAME_CHARS} characters ({len(name)} given)",
-            field="name", value=name,
-        )  # fmt: skip
+            field="name",
+            value=name,
+        )
     if not is_move_name(name):
         raise ConfigError(
             f"{name!r} is not a move name: use letters, digits, '.', '_', '-' or spaces",
@@ -147,8 +148,9 @@ def move_path(ref: str | os.PathLike[str], *, must_exist: bool = True) -> Path:
         known = [e.name for e in list_moves()]
         error = UnknownMoveError(
             f"no move {name!r} in {root} (moves: {', '.join(known) or 'none'})",
-            name=name, known=known,
-        )  # fmt: skip
+            name=name,
+            known=known,
+        )
         error.file = str(root)
         raise error
     return root / f"{name}{MOVE_SUFFIX}"
@@ -242,9 +244,12 @@ def import_move(
         )
     move.metadata.setdefault("imported_from", str(src))
     target = write_move(
-        move, library() / f"{target_name}{MOVE_SUFFIX}", "poppy", replace=overwrite,
+        move,
+        library() / f"{target_name}{MOVE_SUFFIX}",
+        "poppy",
+        replace=overwrite,
         make_folder=True,
-    )  # fmt: skip
+    )
     for path in taken:
         if path != target:
             path.unlink()

@@ -162,8 +162,7 @@ class MovePlayer:
             ramp_speed_dps = start_max_speed
         if move is None:
             if move_filename is None:
-                raise ArgumentError("give the move, or move_filename= a move file",
-                                    field="move")  # fmt: skip
+                raise ArgumentError("give the move, or move_filename= a move file", field="move")
             move = read_move(move_filename)
         checks.in_range(speed, MIN_SPEED, MAX_SPEED, "speed")
         if not 1 <= loops <= MAX_LOOPS:
@@ -197,8 +196,10 @@ class MovePlayer:
         """Motor -> how far (degrees) the move went past its angle limits, for each motor it did
         (those frames are played at the limit)."""
         if self.clamped:
-            logger.warning("the move goes past the angle limits of %s: played at the limits",
-                           ", ".join(f"{n} (by {d:.1f}°)" for n, d in self.clamped.items()))
+            logger.warning(
+                "the move goes past the angle limits of %s: played at the limits",
+                ", ".join(f"{n} (by {d:.1f}°)" for n, d in self.clamped.items()),
+            )
         played = _within_limits(move, self._motors) if self.clamped else move
         self._played = played.reversed() if backwards else played
         self._stop = threading.Event()

@@ -377,8 +377,10 @@ class Primitive:
             listed = ", ".join(known) or "none"
             raise UnknownNameError(
                 f"{type(self).__name__} has no {kind} {name!r} ({_PLURALS[kind]}: {listed})",
-                name=str(name), known=list(known), kind=kind,
-            )  # fmt: skip
+                name=str(name),
+                known=list(known),
+                kind=kind,
+            )
 
     def describe(self) -> dict[str, Any]:
         """State, elapsed time, properties, methods and error as plain values (for JSON)."""

@@ -108,8 +108,9 @@ class MoveRecorder:
         if not MIN_FREQ_HZ <= freq <= MAX_FREQ_HZ:  # also refuses NaN
             raise ArgumentError(
                 f"the recording frequency must be {MIN_FREQ_HZ:g}-{MAX_FREQ_HZ:g} Hz, got {freq}",
-                field="freq", value=freq,
-            )  # fmt: skip
+                field="freq",
+                value=freq,
+            )
         self.robot = robot
         self.freq = float(freq)
         self.motors = resolve_motors(robot, motors)
@@ -199,13 +200,13 @@ class MoveRecorder:
         """
         if path is None:
             if self.checkpoint_path is None:
-                raise ArgumentError("give a path: this recorder has no checkpoint path",
-                                    field="path")  # fmt: skip
+                raise ArgumentError(
+                    "give a path: this recorder has no checkpoint path", field="path"
+                )
             target, replace = self.checkpoint_path, True
         else:
             name = self.checkpoint_path.name if self.checkpoint_path else f"take{MOVE_SUFFIX}"
-            target = output_path(path, default_name=name, replace=replace,
-                                 make_folder=make_folder)  # fmt: skip
+            target = output_path(path, default_name=name, replace=replace, make_folder=make_folder)
         return self._write(self.move, target, replace=replace, make_folder=make_folder)
 
     def _write(
@@ -214,9 +215,11 @@ class MoveRecorder:
         """Write ``move``; the checkpoint file may be replaced once it is ours."""
         ours = target == self.checkpoint_path and (self._replace or self.checkpoints > 0)
         written = write_move(
-            move, target, replace=ours if replace is None else replace,
+            move,
+            target,
+            replace=ours if replace is None else replace,
             make_folder=make_folder or (target == self.checkpoint_path and self._make_folder),
-        )  # fmt: skip
+        )
         if target == self.checkpoint_path:
             self.checkpoints += 1
         self.saved_path = written
@@ -230,8 +233,9 @@ class MoveRecorder:
             UnknownMotorError: a name the robot does not have.
         """
         if self.recording:
-            raise ArgumentError("add the motors before start(): a recording keeps its motors",
-                                field="motors")  # fmt: skip
+            raise ArgumentError(
+                "add the motors before start(): a recording keeps its motors", field="motors"
+            )
         added = [m for m in resolve_motors(self.robot, motors) if m not in self.motors]
         self.motors = [*self.motors, *added]
         self._samples = _Samples(1 + len(self.motors) * (2 if self.with_speeds else 1))
@@ -312,8 +316,11 @@ class MoveRecorder:
             self._write(self.move, self.checkpoint_path)
         except (FileError, OSError) as exc:  # the take stays in memory; stop() tries again
             if self.checkpoint_error is None:  # once per failing streak, not every second
-                logger.warning("checkpoint to %s failed (the take is kept in memory): %s",
-                               self.checkpoint_path, exc)  # fmt: skip
+                logger.warning(
+                    "checkpoint to %s failed (the take is kept in memory): %s",
+                    self.checkpoint_path,
+                    exc,
+                )
             self.checkpoint_error = exc
             return
         if self.checkpoint_error is not None:

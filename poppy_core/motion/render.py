@@ -75,8 +75,9 @@ def render_frames(
     if move is not None:
         unknown = [m for m in move.motors if m not in config.motors]
         if unknown:
-            raise ConfigError(f"the move drives motors the robot has not: {', '.join(unknown)}",
-                              field="move")  # fmt: skip
+            raise ConfigError(
+                f"the move drives motors the robot has not: {', '.join(unknown)}", field="move"
+            )
     total = frame_count(move)
     simulation = start_simulation(config)
     servers = start_emulators(config, simulation)

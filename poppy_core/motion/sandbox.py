@@ -34,12 +34,14 @@ Requests = dict[str, dict[str, Any]]
 
 def _number(motor: str, register: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise RegisterError(f"{motor}: {register} takes a number, not {value!r}",
-                            register=register, motor=motor)  # fmt: skip
+        raise RegisterError(
+            f"{motor}: {register} takes a number, not {value!r}", register=register, motor=motor
+        )
     number = float(value)
     if not math.isfinite(number):
-        raise RegisterError(f"{motor}: {register} must be finite, got {value}",
-                            register=register, motor=motor)  # fmt: skip
+        raise RegisterError(
+            f"{motor}: {register} must be finite, got {value}", register=register, motor=motor
+        )
     return number
 
 
@@ -115,8 +117,9 @@ class MockupMotor:
             raise RegisterError(
                 f"{self._motor.name}: a primitive may request only "
                 f"{', '.join(REQUESTABLE)} or goal_speed, not {name!r}",
-                register=name, motor=self._motor.name,
-            )  # fmt: skip
+                register=name,
+                motor=self._motor.name,
+            )
         checked = self._checked(register, value)
         with self._lock:
             if register == "goal_position":
@@ -129,8 +132,9 @@ class MockupMotor:
             if not isinstance(value, bool | int):
                 raise RegisterError(
                     f"{motor.name}: compliant takes True or False",
-                    register=register, motor=motor.name,
-                )  # fmt: skip
+                    register=register,
+                    motor=motor.name,
+                )
             return bool(value)
         if register == "led":
             motor.model.register("led").from_si(value)  # raises RegisterError when invalid
@@ -139,19 +143,22 @@ class MockupMotor:
         if register == "moving_speed" and number < 0:
             raise RegisterError(
                 f"{motor.name}: moving_speed is a magnitude (>= 0), got {value}",
-                register=register, motor=motor.name,
-            )  # fmt: skip
+                register=register,
+                motor=motor.name,
+            )
         if register == "torque_limit":
             if not motor.model.has_torque_limit:
                 raise RegisterError(
                     f"{motor.name}: {motor.model.name} has no torque limit register",
-                    register=register, motor=motor.name,
+                    register=register,
+                    motor=motor.name,
                 )
             if not 0.0 <= number <= 100.0:
                 raise RegisterError(
                     f"{motor.name}: torque_limit is 0..100 %, got {value}",
-                    register=register, motor=motor.name,
-                )  # fmt: skip
+                    register=register,
+                    motor=motor.name,
+                )
         return number
 
     def _requested_goal(self) -> float:
@@ -197,9 +204,13 @@ class MockupMotor:
         target = _number(motor.name, "goal_position", position)
         start = self._requested_goal() if self._has_goal() else motor.present_position
         plan = plan_goto(
-            start, target, duration, control, motor.angle_limit,
+            start,
+            target,
+            duration,
+            control,
+            motor.angle_limit,
             min_speed=abs(float(motor.model.register("moving_speed").to_si(1))),
-        )  # fmt: skip
+        )
         if plan.trajectory is None:
             self.moving_speed = plan.speed
             self.goal_position = plan.goal

@@ -47,8 +47,9 @@ class HttpClient:
             parts = urlsplit(base_url)
             port = parts.port  # parsed here: raises on a port out of 0-65535
         except ValueError as exc:
-            raise ConfigError(f"{base_url!r} is not an http://host:port URL ({exc})",
-                              field="url") from None  # fmt: skip
+            raise ConfigError(
+                f"{base_url!r} is not an http://host:port URL ({exc})", field="url"
+            ) from None
         if parts.scheme != "http" or not parts.hostname:
             raise ConfigError(f"{base_url!r} is not an http://host:port URL", field="url")
         self.base_url = base_url.rstrip("/")

@@ -324,8 +324,9 @@ class RemoteRobot:
             known = list(self._groups)
             raise UnknownGroupError(
                 f"no group {name!r} (groups: {', '.join(known) or 'none'})",
-                motor=str(name), known=known,
-            )  # fmt: skip
+                motor=str(name),
+                known=known,
+            )
         return [self._by_name[n] for n in self._groups[name]]
 
     @property
@@ -379,9 +380,10 @@ class RemoteRobot:
         """The primitive called ``name``."""
         if name not in self.primitive_names:
             raise UnknownPrimitiveError(
-                f"no primitive {name!r} on the server", name=str(name),
+                f"no primitive {name!r} on the server",
+                name=str(name),
                 known=list(self.primitive_names),
-            )  # fmt: skip
+            )
         return RemotePrimitive(self._client, name)
 
     def close(self) -> None:

@@ -192,9 +192,13 @@ class RemoteFollower:
         headers = {"Authorization": f"Bearer {self.token}"} if self.token else None
         try:
             ws = connect(
-                self.ws_url, additional_headers=headers, open_timeout=self.timeout_s,
-                ping_interval=PING_INTERVAL_S, ping_timeout=PING_TIMEOUT_S, close_timeout=1.0,
-            )  # fmt: skip
+                self.ws_url,
+                additional_headers=headers,
+                open_timeout=self.timeout_s,
+                ping_interval=PING_INTERVAL_S,
+                ping_timeout=PING_TIMEOUT_S,
+                close_timeout=1.0,
+            )
             # Entered as its context manager would be (websockets 17 warns otherwise); the
             # threads below share it and close() ends it.
             ws.__enter__()
@@ -202,17 +206,21 @@ class RemoteFollower:
             status = exc.response.status_code
             if status == 401:
                 raise ConfigError(f"{self.url} refused the token", field="token") from None
-            raise CommunicationError(f"{self.ws_url}: refused (HTTP {status})",
-                                     port=self.url) from None  # fmt: skip
+            raise CommunicationError(
+                f"{self.ws_url}: refused (HTTP {status})", port=self.url
+            ) from None
         except (OSError, TimeoutError, WebSocketException) as exc:
             raise CommunicationError(f"cannot reach {self.ws_url}: {exc}", port=self.url) from None
         self._started.clear()
         self._last_frame = time.monotonic()
         threading.Thread(target=self._receive, args=(ws,), name="teleop ws", daemon=True).start()
         start = {
-            "type": "teleop.start", "motors": self._motors, "ramp_s": self.ramp_s,
-            "watchdog_s": self.watchdog_s, "client": self._client_id,
-        }  # fmt: skip
+            "type": "teleop.start",
+            "motors": self._motors,
+            "ramp_s": self.ramp_s,
+            "watchdog_s": self.watchdog_s,
+            "client": self._client_id,
+        }
         try:
             ws.send(json.dumps(start))
         except (OSError, WebSocketException) as exc:

@@ -47,8 +47,11 @@ def sim_mode(sim: SimMode | None) -> str | None:
         return "ideal"
     if sim in SIM_MODES:
         return str(sim)
-    raise ConfigError(f"unknown simulation {sim!r} (expected one of {', '.join(SIM_MODES)})",
-                      field="sim", value=sim)  # fmt: skip
+    raise ConfigError(
+        f"unknown simulation {sim!r} (expected one of {', '.join(SIM_MODES)})",
+        field="sim",
+        value=sim,
+    )
 
 
 class BuildSteps:
@@ -199,9 +202,16 @@ class BuildSteps:
         every = [m for name in cfg.controllers for m in self.motors.get(name, [])]
         present = {m.name for m in every}
         groups = {g: [n for n in cfg.resolve_group(g) if n in present] for g in cfg.motorgroups}
-        robot = Robot(every, groups=groups, syncs=self.syncs, buses=self.buses, config=cfg,
-                      emulators=self.emulators, simulation=self.simulation,
-                      sensors=self.sensors)  # fmt: skip
+        robot = Robot(
+            every,
+            groups=groups,
+            syncs=self.syncs,
+            buses=self.buses,
+            config=cfg,
+            emulators=self.emulators,
+            simulation=self.simulation,
+            sensors=self.sensors,
+        )
         self._handed_over = True
         return robot
 

@@ -216,8 +216,11 @@ def reference_posture(config: RobotConfig) -> ReferencePosture:
             raise ConfigError(f"{where}.positions: no motor {motor!r}", field=f"{where}.{motor}")
         number = isinstance(value, int | float) and not isinstance(value, bool)
         if not number or not math.isfinite(value):
-            raise ConfigError(f"{where}.positions.{motor} must be a number of degrees",
-                              field=f"{where}.{motor}", value=value)  # fmt: skip
+            raise ConfigError(
+                f"{where}.positions.{motor} must be a number of degrees",
+                field=f"{where}.{motor}",
+                value=value,
+            )
     folder = config.folder
     picture = None
     if image is not None:
@@ -248,19 +251,27 @@ def check_motors(config: RobotConfig, motors: Iterable[str] | None) -> list[str]
         ConfigError: an unknown motor or group, or a wheel (it has no range to record).
     """
     if motors is None:
-        return [n for n, m in config.motors.items() if not m.wheel_mode
-                and config.controller_of(n) is not None]  # fmt: skip
+        return [
+            n
+            for n, m in config.motors.items()
+            if not m.wheel_mode and config.controller_of(n) is not None
+        ]
     chosen: list[str] = []
     for item in motors:
         if item not in config.motors and item not in config.motorgroups:
             groups = ", ".join(config.motorgroups) or "none"
-            raise ConfigError(f"no motor or group {item!r} (motors: {', '.join(config.motors)}; "
-                              f"groups: {groups})", field="motors", value=item)  # fmt: skip
+            raise ConfigError(
+                f"no motor or group {item!r} (motors: {', '.join(config.motors)}; "
+                f"groups: {groups})",
+                field="motors",
+                value=item,
+            )
         names = config.resolve_group(item)  # a motor name gives that motor alone
         for motor in names:
             if config.motors[motor].wheel_mode:
-                raise ConfigError(f"{motor} is a wheel: it has no range to calibrate",
-                                  field=f"motors.{motor}")  # fmt: skip
+                raise ConfigError(
+                    f"{motor} is a wheel: it has no range to calibrate", field=f"motors.{motor}"
+                )
             if motor not in chosen:
                 chosen.append(motor)
     if not chosen:

@@ -150,8 +150,9 @@ class RangeWatch:
             for motor in self._motors:
                 sign = 1.0 if motor.direct else -1.0
                 offset = self._offsets[motor.name]
-                ends = sorted(sign * v - offset for v in (self._low[motor.name],
-                                                           self._high[motor.name]))
+                ends = sorted(
+                    sign * v - offset for v in (self._low[motor.name], self._high[motor.name])
+                )
                 current = sign * self._current[motor.name] - offset
                 out.append(JointReading(motor.name, current, ends[0], ends[1]))
         return out
@@ -189,13 +190,16 @@ class CalibrationSession:
         settle_s: float = SETTLE_S,
     ) -> None:
         if robot.config is None:
-            raise ConfigError("this robot was built by hand: calibrate a robot built from a "
-                              "profile or a config")  # fmt: skip
+            raise ConfigError(
+                "this robot was built by hand: calibrate a robot built from a profile or a config"
+            )
         self.robot = robot
         self.answers = answers
-        names = list(motors) if motors is not None else [
-            m.name for m in robot.motors if not m.wheel_mode
-        ]  # fmt: skip
+        names = (
+            list(motors)
+            if motors is not None
+            else [m.name for m in robot.motors if not m.wheel_mode]
+        )
         self.motors: list[Motor] = [robot.motor(n) for n in names]
         self.posture = posture if posture is not None else reference_posture(robot.config)
         self.one_at_a_time = one_at_a_time
@@ -217,17 +221,20 @@ class CalibrationSession:
         time.sleep(self.settle_s)
         self._event("compliant", "the joints are compliant: they move freely by hand")
         zeros = self._zeros()
-        offsets = {m.name: (1.0 if m.direct else -1.0) * zeros[m.name] - self.posture.angle(m.name)
-                   for m in self.motors}  # fmt: skip
+        offsets = {
+            m.name: (1.0 if m.direct else -1.0) * zeros[m.name] - self.posture.angle(m.name)
+            for m in self.motors
+        }
         steps = [[m] for m in self.motors] if self.one_at_a_time else [self.motors]
         ranges: dict[str, tuple[float, float] | None] = {}
         for index, group in enumerate(steps, start=1):
             ranges.update(self._ranges(group, offsets, index, len(steps)))
         joints = {
-            m.name: JointCalibration(m.name, zeros[m.name], self.posture.angle(m.name),
-                                     ranges.get(m.name))
+            m.name: JointCalibration(
+                m.name, zeros[m.name], self.posture.angle(m.name), ranges.get(m.name)
+            )
             for m in self.motors
-        }  # fmt: skip
+        }
         self._event("done", f"{len(joints)} joints calibrated", tuple(joints))
         return Calibration(joints, self.posture)
 
@@ -261,8 +268,9 @@ class CalibrationSession:
     ) -> dict[str, tuple[float, float] | None]:
         names = tuple(m.name for m in group)
         while True:
-            self._event("joints", f"move {', '.join(names)} through the whole range", names,
-                        index, total)  # fmt: skip
+            self._event(
+                "joints", f"move {', '.join(names)} through the whole range", names, index, total
+            )
             with RangeWatch(group, offsets, self.sample_period_s) as watch:
                 done = self.answers.move(list(names), watch)
             if not done:
@@ -283,9 +291,13 @@ class CalibrationSession:
         return dict(found)
 
     def _event(
-        self, step: str, message: str, motors: tuple[str, ...] = (), index: int = 0,
+        self,
+        step: str,
+        message: str,
+        motors: tuple[str, ...] = (),
+        index: int = 0,
         total: int = 0,
-    ) -> None:  # fmt: skip
+    ) -> None:
         logger.debug("calibration %s: %s", step, message)
         if self.on_event is not None:
             self.on_event(CalibrationEvent(step, message, motors, index, total))
@@ -302,8 +314,11 @@ def read_motor_frame(robot: Robot, motors: Sequence[Motor], settle_s: float) -> 
     robot.run_loop("present")
     silent = [m.name for m in motors if not m.online]
     if silent:
-        raise ConfigError(f"{', '.join(silent)} not answering: check the cables and power",
-                          field="motors", value=silent)  # fmt: skip
+        raise ConfigError(
+            f"{', '.join(silent)} not answering: check the cables and power",
+            field="motors",
+            value=silent,
+        )
     return {m.name: _motor_frame_position(m) for m in motors}
 
 
@@ -351,9 +366,11 @@ def check_calibration(
     """
     if robot.config is None:
         raise ConfigError("this robot was built by hand: it has no calibration to check")
-    chosen = [robot.motor(n) for n in motors] if motors is not None else [
-        m for m in robot.motors if not m.wheel_mode
-    ]  # fmt: skip
+    chosen = (
+        [robot.motor(n) for n in motors]
+        if motors is not None
+        else [m for m in robot.motors if not m.wheel_mode]
+    )
     reference = posture if posture is not None else reference_posture(robot.config)
     for motor in chosen:
         motor.compliant = True

@@ -297,8 +297,13 @@ class RobotConfig(BaseModel):
         """
         if name not in self.motorgroups and name not in self.motors:
             known = ", ".join(sorted(self.motorgroups)) or "none"
-            raise config_error(DEFAULT_SOURCE, f"motorgroups.{name}", name,
-                               f"no such group (groups: {known})", show_value=False)
+            raise config_error(
+                DEFAULT_SOURCE,
+                f"motorgroups.{name}",
+                name,
+                f"no such group (groups: {known})",
+                show_value=False,
+            )
         return expand([name], self.motors, self.motorgroups)
 
     def motors_of_controller(self, name: str) -> list[str]:
@@ -316,8 +321,13 @@ class RobotConfig(BaseModel):
         controller = self.controllers.get(name)
         if controller is None:
             known = ", ".join(sorted(self.controllers))
-            raise config_error(DEFAULT_SOURCE, f"controllers.{name}", name,
-                               f"no such controller (controllers: {known})", show_value=False)
+            raise config_error(
+                DEFAULT_SOURCE,
+                f"controllers.{name}",
+                name,
+                f"no such controller (controllers: {known})",
+                show_value=False,
+            )
         return expand(controller.attached_motors, self.motors, self.motorgroups)
 
     def controller_of(self, motor: str) -> str | None:

@@ -121,12 +121,24 @@ def _unknown_name_reason(name: str, view: CheckView) -> str:
 def _check_groups(view: CheckView, source: str, problems: list[ConfigError]) -> None:
     for group, items in view.groups.items():
         if group in view.motors:
-            problems.append(config_error(source, f"motorgroups.{group}", items,
-                                         f"group name {group!r} is already a motor name"))
+            problems.append(
+                config_error(
+                    source,
+                    f"motorgroups.{group}",
+                    items,
+                    f"group name {group!r} is already a motor name",
+                )
+            )
         for index, item in enumerate(items):
             if item not in view.motors and item not in view.groups:
-                problems.append(config_error(source, f"motorgroups.{group}[{index}]", item,
-                                             _unknown_name_reason(item, view)))
+                problems.append(
+                    config_error(
+                        source,
+                        f"motorgroups.{group}[{index}]",
+                        item,
+                        _unknown_name_reason(item, view),
+                    )
+                )
     _check_cycles(view, source, problems)
 
 
@@ -147,12 +159,17 @@ def _check_cycles(view: CheckView, source: str, problems: list[ConfigError]) -> 
                     continue
                 if state.get(item) == on_path:
                     names = [name for name, _ in path]
-                    cycle = [*names[names.index(item):], item]
+                    cycle = [*names[names.index(item) :], item]
                     if frozenset(cycle) not in reported:
                         reported.add(frozenset(cycle))
-                        problems.append(config_error(
-                            source, f"motorgroups.{cycle[0]}", view.groups[cycle[0]],
-                            "cyclic groups: " + " → ".join(cycle)))
+                        problems.append(
+                            config_error(
+                                source,
+                                f"motorgroups.{cycle[0]}",
+                                view.groups[cycle[0]],
+                                "cyclic groups: " + " → ".join(cycle),
+                            )
+                        )
                 elif item not in state:
                     state[item] = on_path
                     path.append((item, iter(view.groups[item])))
@@ -169,15 +186,23 @@ def _check_controllers(view: CheckView, source: str, problems: list[ConfigError]
         ids: dict[int, str] = {}
         for index, item in enumerate(attached):
             if item not in view.motors and item not in view.groups:
-                problems.append(config_error(source, f"{field}[{index}]", item,
-                                             _unknown_name_reason(item, view)))
+                problems.append(
+                    config_error(
+                        source, f"{field}[{index}]", item, _unknown_name_reason(item, view)
+                    )
+                )
                 continue
             for motor in expand([item], view.motors, view.groups):
                 previous = owner.get(motor)
                 if previous is not None and previous != cname:
-                    problems.append(config_error(source, f"{field}[{index}]", item,
-                                                 f"motor {motor!r} is already attached to "
-                                                 f"controller {previous!r}"))
+                    problems.append(
+                        config_error(
+                            source,
+                            f"{field}[{index}]",
+                            item,
+                            f"motor {motor!r} is already attached to controller {previous!r}",
+                        )
+                    )
                 if previous is not None:
                     continue
                 owner[motor] = cname
@@ -189,30 +214,54 @@ def _check_controllers(view: CheckView, source: str, problems: list[ConfigError]
     return set(owner)
 
 
-def _check_id(source: str, motor: str, motor_id: int, cname: str, protocol: int | None,
-              ids: dict[int, str], problems: list[ConfigError]) -> None:
+def _check_id(
+    source: str,
+    motor: str,
+    motor_id: int,
+    cname: str,
+    protocol: int | None,
+    ids: dict[int, str],
+    problems: list[ConfigError],
+) -> None:
     # IDs past MAX_ID are the motor's own check; a protocol may reserve some below it.
     top = MAX_ID if protocol is None else protocol_for(protocol).max_motor_id
     if top < MAX_ID and motor_id > top:
-        problems.append(config_error(source, f"motors.{motor}.id", motor_id,
-                                     f"protocol {protocol} IDs are 0-{top} (controller "
-                                     f"{cname!r})"))
+        problems.append(
+            config_error(
+                source,
+                f"motors.{motor}.id",
+                motor_id,
+                f"protocol {protocol} IDs are 0-{top} (controller {cname!r})",
+            )
+        )
     if motor_id in ids:
-        problems.append(config_error(source, f"motors.{motor}.id", motor_id,
-                                     f"duplicate ID on controller {cname!r} "
-                                     f"(also used by {ids[motor_id]!r})"))
+        problems.append(
+            config_error(
+                source,
+                f"motors.{motor}.id",
+                motor_id,
+                f"duplicate ID on controller {cname!r} (also used by {ids[motor_id]!r})",
+            )
+        )
     else:
         ids[motor_id] = motor
 
 
-def _check_protocol(source: str, motor: str, type_name: str, cname: str, protocol: int,
-                    problems: list[ConfigError]) -> None:
+def _check_protocol(
+    source: str, motor: str, type_name: str, cname: str, protocol: int, problems: list[ConfigError]
+) -> None:
     model = model_by_name(type_name)
     if model.protocol != protocol:
-        problems.append(config_error(source, f"motors.{motor}.type", type_name,
-                                     f"a protocol {model.protocol} model on controller "
-                                     f"{cname!r}, which uses protocol {protocol} (set "
-                                     f"controllers.{cname}.protocol)"))
+        problems.append(
+            config_error(
+                source,
+                f"motors.{motor}.type",
+                type_name,
+                f"a protocol {model.protocol} model on controller "
+                f"{cname!r}, which uses protocol {protocol} (set "
+                f"controllers.{cname}.protocol)",
+            )
+        )
 
 
 def whole_config_problems(view: CheckView, source: str) -> list[ConfigError]:
@@ -230,8 +279,9 @@ def whole_config_problems(view: CheckView, source: str) -> list[ConfigError]:
     attached = _check_controllers(view, source, problems)
     for motor in view.motors:
         if motor not in attached:
-            logger.warning("%s: motors.%s is attached to no controller; it will not be driven",
-                           source, motor)
+            logger.warning(
+                "%s: motors.%s is attached to no controller; it will not be driven", source, motor
+            )
     return problems
 
 
@@ -240,8 +290,9 @@ def _warn_typos(model: BaseModel, path: str, source: str) -> None:
     for key in model.model_extra or {}:
         close = difflib.get_close_matches(key, known, n=1, cutoff=0.8)
         if close:
-            logger.warning("%s: %s.%s: unknown key kept as is (did you mean %s?)",
-                           source, path, key, close[0])
+            logger.warning(
+                "%s: %s.%s: unknown key kept as is (did you mean %s?)", source, path, key, close[0]
+            )
 
 
 def check_config(config: RobotConfig, source: str) -> None:

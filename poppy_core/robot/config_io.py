@@ -76,8 +76,13 @@ def load_config(path: str | os.PathLike[str]) -> RobotConfig:
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise config_error(source, "", None, f"cannot read: not UTF-8 text ({exc.reason} at "
-                           f"byte {exc.start})", show_value=False) from None  # fmt: skip
+        raise config_error(
+            source,
+            "",
+            None,
+            f"cannot read: not UTF-8 text ({exc.reason} at byte {exc.start})",
+            show_value=False,
+        ) from None
     data = parse_config_text(text, source, fmt=_format_of(file, text))
     return RobotConfig.from_dict(data, source=source).with_folder(file.resolve().parent)
 
@@ -101,8 +106,13 @@ def as_config(config: ConfigSource) -> RobotConfig:
         return RobotConfig.from_dict(dict(config), source=DICT_SOURCE)
     if isinstance(config, str | os.PathLike):
         return load_config(config)
-    raise config_error(DICT_SOURCE, "", None, f"the config must be a RobotConfig, a mapping or a "
-                       f"file path, not {type(config).__name__}", show_value=False)
+    raise config_error(
+        DICT_SOURCE,
+        "",
+        None,
+        f"the config must be a RobotConfig, a mapping or a file path, not {type(config).__name__}",
+        show_value=False,
+    )
 
 
 class _ConfigDumper(yaml.SafeDumper):
@@ -141,14 +151,18 @@ def config_to_text(config: RobotConfig, fmt: str) -> str:
     """
     if fmt == "json":
         return json.dumps(config.to_pypot_dict(), indent=2, ensure_ascii=False) + "\n"
-    dumped: str = yaml.dump(config.to_dict(), Dumper=_ConfigDumper, sort_keys=False,
-                            allow_unicode=True, default_flow_style=False, width=120)
+    dumped: str = yaml.dump(
+        config.to_dict(),
+        Dumper=_ConfigDumper,
+        sort_keys=False,
+        allow_unicode=True,
+        default_flow_style=False,
+        width=120,
+    )
     return dumped
 
 
-def dump_config(
-    config: RobotConfig, path: str | os.PathLike[str], *, replace: bool = True
-) -> Path:
+def dump_config(config: RobotConfig, path: str | os.PathLike[str], *, replace: bool = True) -> Path:
     """Write a config atomically; ``.json`` gives pypot JSON, ``.yaml``/``.yml`` our YAML.
 
     Args:

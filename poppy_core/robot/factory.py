@@ -190,14 +190,19 @@ def detect_config(
     motors: dict[str, Any] = {}
     for index, device in enumerate(sorted({f.port for f in found}), start=1):
         on_port = [f for f in found if f.port == device]
-        setting = max({(f.baudrate, f.protocol) for f in on_port},
-                      key=lambda s: sum((f.baudrate, f.protocol) == s for f in on_port))
+        setting = max(
+            {(f.baudrate, f.protocol) for f in on_port},
+            key=lambda s: sum((f.baudrate, f.protocol) == s for f in on_port),
+        )
         chosen = [f for f in on_port if (f.baudrate, f.protocol) == setting]
         names = [f"m{f.id}" for f in chosen]
         controllers[f"controller_{index}"] = {
-            "port": device, "baudrate": setting[0], "protocol": setting[1],
-            "sync_read": setting[1] == 2, "attached_motors": names,
-        }  # fmt: skip
+            "port": device,
+            "baudrate": setting[0],
+            "protocol": setting[1],
+            "sync_read": setting[1] == 2,
+            "attached_motors": names,
+        }
         with DxlBus(device, setting[0], setting[1]) as bus:
             for f in chosen:
                 motors[f"m{f.id}"] = _detected_motor(bus, f.id, str(f.model))
@@ -214,5 +219,11 @@ def _detected_motor(bus: DxlBus, motor_id: int, model_name: str) -> dict[str, An
     wheel = low == high == -span  # AX/MX wheel mode: both limits raw 0
     if not isinstance(low, float) or not isinstance(high, float) or not low < high:
         low, high = -span, span
-    return {"id": motor_id, "type": model.name, "orientation": "direct", "offset": 0.0,
-            "angle_limit": [low, high], "wheel_mode": wheel}  # fmt: skip
+    return {
+        "id": motor_id,
+        "type": model.name,
+        "orientation": "direct",
+        "offset": 0.0,
+        "angle_limit": [low, high],
+        "wheel_mode": wheel,
+    }

@@ -112,10 +112,13 @@ class GotoRunner:
             for motor, target in targets.items():
                 self._cancel_locked(motor)
                 plan = plan_goto(
-                    motor.present_position, float(target), duration_s, controls[motor],
+                    motor.present_position,
+                    float(target),
+                    duration_s,
+                    controls[motor],
                     None if motor.wheel_mode else motor.angle_limit,
                     min_speed=abs(float(motor.model.register("moving_speed").to_si(1))),
-                )  # fmt: skip
+                )
                 motor.moving_speed = plan.speed
                 if plan.trajectory is None:
                     link_of(motor).set_goal(plan.goal)

@@ -11,10 +11,20 @@ from poppy_core.robot.goto import GotoHandle
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.motor_link import link_of
 
-GROUP_SETTABLE = frozenset({
-    "compliant", "compliant_behavior", "goto_behavior", "goal_position", "goal_speed",
-    "moving_speed", "torque_limit", "max_torque", "led", "pid",
-})  # fmt: skip
+GROUP_SETTABLE = frozenset(
+    {
+        "compliant",
+        "compliant_behavior",
+        "goto_behavior",
+        "goal_position",
+        "goal_speed",
+        "moving_speed",
+        "torque_limit",
+        "max_torque",
+        "led",
+        "pid",
+    }
+)
 """Motor attributes a group sets on each of its motors (``robot.head.compliant = False``)."""
 
 
@@ -72,8 +82,9 @@ class MotorGroup(list[Motor]):
             if len(values) != len(self):
                 raise ArgumentError(
                     f"group {self.name}: {len(values)} positions for {len(self)} motors",
-                    field="position", value=values,
-                )  # fmt: skip
+                    field="position",
+                    value=values,
+                )
             targets = {m: degrees(m.name, p) for m, p in zip(self, values, strict=True)}
         if not self:
             return GotoHandle(0, 0.0)
@@ -89,8 +100,9 @@ class MotorGroup(list[Motor]):
                 return motor
         raise UnknownMotorError(
             f"group {self.name} has no motor {name!r} (motors: {', '.join(m.name for m in self)})",
-            motor=name, known=[m.name for m in self],
-        )  # fmt: skip
+            motor=name,
+            known=[m.name for m in self],
+        )
 
 
 def degrees(name: str, value: object) -> float:
@@ -113,5 +125,7 @@ def degrees(name: str, value: object) -> float:
         raise ArgumentError(
             f"{name}: the target must be a finite number of degrees within "
             f"±{checks.MAX_MAGNITUDE:g}, got {value!r}",
-            field=name, value=value, motor=name,
-        ) from exc  # fmt: skip
+            field=name,
+            value=value,
+            motor=name,
+        ) from exc

@@ -75,7 +75,8 @@ class Motor(PypotMotorMixin):
         if orientation not in ("direct", "indirect"):
             raise RegisterError(
                 f"{name}: orientation must be 'direct' or 'indirect', not {orientation!r}",
-                register="orientation", motor=name,
+                register="orientation",
+                motor=name,
             )
         self.name = name
         self.model = model
@@ -162,7 +163,8 @@ class Motor(PypotMotorMixin):
         if not low < high:
             raise RegisterError(
                 f"{self.name}: angle limits must be (min, max) with min < max, got {low}, {high}",
-                register="angle_limit", motor=self.name,
+                register="angle_limit",
+                motor=self.name,
             )
         return float(low), float(high)
 
@@ -246,7 +248,8 @@ class Motor(PypotMotorMixin):
         if speed < 0:
             raise RegisterError(
                 f"{self.name}: moving_speed is a magnitude (>= 0), got {value}",
-                register="moving_speed", motor=self.name,
+                register="moving_speed",
+                motor=self.name,
             )
         register = self.model.register("moving_speed")
         self._link.store("moving_speed", regs.capped(register, speed, "moving_speed"))
@@ -289,7 +292,8 @@ class Motor(PypotMotorMixin):
         if not self.model.has_torque_limit:
             raise RegisterError(
                 f"{self.name}: {self.model.name} has no torque limit register",
-                register="torque_limit", motor=self.name,
+                register="torque_limit",
+                motor=self.name,
             )
         self._link.store("torque_limit", regs.finite(value, f"{self.name}.torque_limit"))
 
@@ -331,7 +335,8 @@ class Motor(PypotMotorMixin):
         if value not in BEHAVIORS:
             raise RegisterError(
                 f"{self.name}: compliant behavior must be 'dummy' or 'safe', not {value!r}",
-                register="compliant_behavior", motor=self.name,
+                register="compliant_behavior",
+                motor=self.name,
             )
         link = self._link
         with link.lock:
@@ -401,4 +406,3 @@ class Motor(PypotMotorMixin):
         if wait:
             handle.wait()
         return handle
-

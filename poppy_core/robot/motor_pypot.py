@@ -70,7 +70,8 @@ class PypotMotorMixin:
         if names is None:
             raise RegisterError(
                 f"{self.name}: {self.model.name} has no PID gains (use compliance_margin/slope)",
-                register="pid", motor=self.name,
+                register="pid",
+                motor=self.name,
             )
         return names
 
@@ -106,7 +107,8 @@ class PypotMotorMixin:
         if not regs.has_compliance_slopes(self.model):
             raise RegisterError(
                 f"{self.name}: {self.model.name} has no compliance margin/slope (use pid)",
-                register="compliance_margin", motor=self.name,
+                register="compliance_margin",
+                motor=self.name,
             )
 
     @property
@@ -159,7 +161,8 @@ class PypotMotorMixin:
         except ArgumentError as exc:
             raise RegisterError(
                 f"{self.name}: goto_behavior must be 'minjerk' or 'dummy', not {value!r}",
-                register="goto_behavior", motor=self.name,
+                register="goto_behavior",
+                motor=self.name,
             ) from exc
 
     @property
@@ -186,13 +189,30 @@ class PypotMotorMixin:
     @functools.cached_property
     def _register_names(self) -> tuple[str, ...]:
         names = [
-            "id", "name", "model", "orientation", "offset", "angle_limit",
-            "present_position", "present_speed", "present_load",
-            "present_temperature", "present_voltage",
-            "goal_position", "goal_speed", "moving_speed", "compliant", "compliant_behavior",
-            "led", "lower_limit", "upper_limit", "goto_behavior", "control_mode", "registers",
+            "id",
+            "name",
+            "model",
+            "orientation",
+            "offset",
+            "angle_limit",
+            "present_position",
+            "present_speed",
+            "present_load",
+            "present_temperature",
+            "present_voltage",
+            "goal_position",
+            "goal_speed",
+            "moving_speed",
+            "compliant",
+            "compliant_behavior",
+            "led",
+            "lower_limit",
+            "upper_limit",
+            "goto_behavior",
+            "control_mode",
+            "registers",
             "safe_compliant",
-        ]  # fmt: skip
+        ]
         if self.model.has_torque_limit:
             names += ["torque_limit", "max_torque"]
         if regs.pid_names(self.model) is not None:

@@ -24,8 +24,10 @@ MotorSpec = str | NamedMotor | Iterable[str | NamedMotor]
 
 def is_motor(item: object) -> bool:
     """True for a motor-like object (a name and a present position), not a name."""
-    return not isinstance(item, str) and isinstance(getattr(item, "name", None), str) and hasattr(
-        item, "present_position"
+    return (
+        not isinstance(item, str)
+        and isinstance(getattr(item, "name", None), str)
+        and hasattr(item, "present_position")
     )
 
 
@@ -45,8 +47,9 @@ def resolve(
     if not isinstance(items, Iterable):
         raise ArgumentError(
             f"motors must be a name, a motor or a list of them, not {spec!r}",
-            field="motors", value=spec,
-        )  # fmt: skip
+            field="motors",
+            value=spec,
+        )
     chosen: list[Motor] = []
     for item in items:
         for motor in _named(item, by_name, groups):
@@ -67,8 +70,9 @@ def _named(
         group_names = ", ".join(groups) or "none"
         raise UnknownMotorError(
             f"no motor or group {item!r} (motors: {', '.join(known)}; groups: {group_names})",
-            motor=item, known=known,
-        )  # fmt: skip
+            motor=item,
+            known=known,
+        )
     if is_motor(item):
         name = getattr(item, "name", None)
         if isinstance(name, str) and name in by_name:
@@ -76,10 +80,12 @@ def _named(
         known = list(by_name)
         raise UnknownMotorError(
             f"{name!r} is not a motor of this robot (motors: {', '.join(known)})",
-            motor=str(name), known=known,
-        )  # fmt: skip
+            motor=str(name),
+            known=known,
+        )
     known = list(by_name)
     raise UnknownMotorError(
         f"{item!r} is not a motor name (motors: {', '.join(known)})",
-        motor=str(item), known=known,
-    )  # fmt: skip
+        motor=str(item),
+        known=known,
+    )

@@ -99,7 +99,11 @@ def save_calibration(
         ConfigError: a bad name, or a file that cannot be written (the previous one is intact).
     """
     base = config.profile.name if config.profile is not None else "a config"
-    return save_user_profile(calibration.apply(config, name), name, comment=(
-        f"Profile {name!r}: {base} calibrated by `{by}` on {calibration.created}.\n"
-        "The file it replaced, if any, is kept beside it as profile.yaml.bak."
-    ))  # fmt: skip
+    return save_user_profile(
+        calibration.apply(config, name),
+        name,
+        comment=(
+            f"Profile {name!r}: {base} calibrated by `{by}` on {calibration.created}.\n"
+            "The file it replaced, if any, is kept beside it as profile.yaml.bak."
+        ),
+    )

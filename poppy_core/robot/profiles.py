@@ -92,8 +92,9 @@ def profile_key(name: str) -> str:
 
 def _read_info(file: Path, user: bool) -> ProfileInfo | None:
     try:
-        data = parse_yaml(read_limited(file, CONFIG_LIMITS.max_bytes, "profile"), str(file),
-                          CONFIG_LIMITS)  # fmt: skip
+        data = parse_yaml(
+            read_limited(file, CONFIG_LIMITS.max_bytes, "profile"), str(file), CONFIG_LIMITS
+        )
     except ConfigError as exc:
         logger.warning("skipping profile %s: %s", file, exc)
         return None

@@ -189,8 +189,9 @@ class Robot(PypotRobotMixin, VrepNames):
             known = list(self._groups)
             raise UnknownGroupError(
                 f"no group {name!r} (groups: {', '.join(known) or 'none'})",
-                motor=str(name), known=known,
-            ) from None  # fmt: skip
+                motor=str(name),
+                known=known,
+            ) from None
 
     # -- extensions: attached objects ---------------------------------------------------------
 

@@ -187,5 +187,3 @@ def write_angle_limits(bus: DxlBus, motors: Sequence[Motor]) -> None:
             tuple(round(p, 1) for p in present),
             tuple(round(w, 1) for w in wanted),
         )
-
-

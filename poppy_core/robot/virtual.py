@@ -35,8 +35,11 @@ def start_simulation(config: RobotConfig) -> Any:
         path = directory / kind / "model.xml"
         if kind and path.is_file():
             return Simulation(path.read_text(encoding="utf-8"))
-    raise ConfigError(f"no simulation model for robot kind {kind!r} (profiles/<kind>/model.xml)",
-                      field="profile.kind", value=kind)  # fmt: skip
+    raise ConfigError(
+        f"no simulation model for robot kind {kind!r} (profiles/<kind>/model.xml)",
+        field="profile.kind",
+        value=kind,
+    )
 
 
 def _model_kind(config: RobotConfig) -> str:

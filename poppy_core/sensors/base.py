@@ -353,8 +353,12 @@ class Sensor:
         self._errors += 1
         self._last_error = reason
         if at_start:
-            logger.warning("%s %s is not available: %s; starting without it, retrying",
-                           self.kind, self._name, reason)  # fmt: skip
+            logger.warning(
+                "%s %s is not available: %s; starting without it, retrying",
+                self.kind,
+                self._name,
+                reason,
+            )
         else:
             logger.warning("%s %s lost: %s; retrying", self.kind, self._name, reason)
 

@@ -58,8 +58,10 @@ class CameraCalibration:
         except (TypeError, KeyError, ValueError, AttributeError):
             matrix = np.zeros(0)
             dist = np.zeros(0)
-        if matrix.shape != (3, 3) or dist.size not in (4, 5, 8, 12, 14) or not np.all(
-            np.isfinite(matrix)
+        if (
+            matrix.shape != (3, 3)
+            or dist.size not in (4, 5, 8, 12, 14)
+            or not np.all(np.isfinite(matrix))
         ):
             raise SensorError(
                 f"sensor {sensor!r}: calibration must be {{camera_matrix: 3x3 numbers, "

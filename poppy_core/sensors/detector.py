@@ -158,6 +158,8 @@ class MarkerDetector(FrameDetector[Marker]):
             listed = ", ".join(known) or "none"
             raise UnknownCardError(
                 f"no card {card_or_id!r} (cards: {listed}; or give a marker id)",
-                name=str(card_or_id), known=known, sensor=self.name,
-            )  # fmt: skip
+                name=str(card_or_id),
+                known=known,
+                sensor=self.name,
+            )
         return any(m.id in wanted for m in self.markers)

@@ -103,8 +103,9 @@ class FaceFinder:
         height, width = grey.shape[:2]
         scale = min(1.0, WORK_WIDTH_PX / width)
         if scale < 1.0:
-            grey = cv2.resize(grey, (round(width * scale), round(height * scale)),
-                              interpolation=cv2.INTER_AREA)  # fmt: skip
+            grey = cv2.resize(
+                grey, (round(width * scale), round(height * scale)), interpolation=cv2.INTER_AREA
+            )
         side = min(grey.shape[:2])
         if side < self.min_size:
             return []
@@ -121,8 +122,15 @@ class FaceFinder:
         for (x, y, w), hits in _group([(d["c"], d["r"], d["width"]) for d in windows]):
             x, y, w = x / scale, y / scale, w / scale
             cx, cy = x + w / 2, y + w / 2
-            faces.append(Face((round(x), round(y), round(w), round(w)), (cx, cy),
-                              (2 * cx / width - 1, 2 * cy / height - 1), camera, hits))  # fmt: skip
+            faces.append(
+                Face(
+                    (round(x), round(y), round(w), round(w)),
+                    (cx, cy),
+                    (2 * cx / width - 1, 2 * cy / height - 1),
+                    camera,
+                    hits,
+                )
+            )
         return faces
 
 

@@ -19,8 +19,17 @@ _DATA = (2, 4, 5, 6)  # positions of d1..d4 in a codeword
 # parity checks: a codeword c is valid when H @ c = 0 (mod 2)
 _H = np.array([[0, 0, 0, 1, 1, 1, 1], [0, 1, 1, 0, 0, 1, 1], [1, 0, 1, 0, 1, 0, 1]])
 # generator: c = G @ d (mod 2)
-_G = np.array([[1, 1, 0, 1], [1, 0, 1, 1], [1, 0, 0, 0], [0, 1, 1, 1],
-               [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])  # fmt: skip
+_G = np.array(
+    [
+        [1, 1, 0, 1],
+        [1, 0, 1, 1],
+        [1, 0, 0, 0],
+        [0, 1, 1, 1],
+        [0, 1, 0, 0],
+        [0, 0, 1, 0],
+        [0, 0, 0, 1],
+    ]
+)
 
 
 def encode(marker_id: int) -> np.ndarray:

@@ -104,8 +104,9 @@ def aruco_image(marker_id: int, dictionary: str = DEFAULT_DICTIONARY, size_px: i
     return cv2.copyMakeBorder(inner, margin, margin, margin, margin, cv2.BORDER_CONSTANT, value=255)
 
 
-def marker_image(marker_id: int, family: str = "aruco", dictionary: str = DEFAULT_DICTIONARY,
-                 size_px: int = 200) -> Any:  # fmt: skip
+def marker_image(
+    marker_id: int, family: str = "aruco", dictionary: str = DEFAULT_DICTIONARY, size_px: int = 200
+) -> Any:
     """A printable grey image of a marker of either family (white margin included).
 
     Raises:
@@ -210,8 +211,9 @@ class MarkerFinder:
     def _hamming_ids(self, grey: np.ndarray, quad: np.ndarray) -> list[int]:
         cv2 = cv()
         side = hamming.GRID * _WARP_CELL_PX
-        target = np.array([[0, 0], [side - 1, 0], [side - 1, side - 1], [0, side - 1]],
-                          dtype=np.float32)  # fmt: skip
+        target = np.array(
+            [[0, 0], [side - 1, 0], [side - 1, side - 1], [0, side - 1]], dtype=np.float32
+        )
         warp = cv2.getPerspectiveTransform(quad, target)
         square = cv2.warpPerspective(grey, warp, (side, side))
         return hamming.decode_rotations(hamming.read_cells(square))
@@ -254,5 +256,6 @@ class MarkerFinder:
             return None
         r = rvec.ravel()
         t = tvec.ravel()
-        return MarkerPose((float(r[0]), float(r[1]), float(r[2])),
-                          (float(t[0]), float(t[1]), float(t[2])))  # fmt: skip
+        return MarkerPose(
+            (float(r[0]), float(r[1]), float(r[2])), (float(t[0]), float(t[1]), float(t[2]))
+        )

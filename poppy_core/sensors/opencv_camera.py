@@ -88,8 +88,9 @@ def parse_source(value: Any, sensor: str) -> Source:
         try:
             checks.count(source, 0, MAX_DEVICE_INDEX, "the device index")
         except ArgumentError as exc:
-            raise SensorError(f"sensor {sensor!r}: {exc} (-1: the first camera found)",
-                              sensor=sensor) from None  # fmt: skip
+            raise SensorError(
+                f"sensor {sensor!r}: {exc} (-1: the first camera found)", sensor=sensor
+            ) from None
     return source
 
 

@@ -41,8 +41,12 @@ Kind = Literal["not_found", "invalid", "conflict", "unavailable", "storage"]
 V1_PREFIX = "/api/v1"
 
 V1_STATUS: dict[Kind, int] = {
-    "not_found": 404, "invalid": 422, "conflict": 409, "unavailable": 503, "storage": 507,
-}  # fmt: skip
+    "not_found": 404,
+    "invalid": 422,
+    "conflict": 409,
+    "unavailable": 503,
+    "storage": 507,
+}
 """HTTP status of each kind of error on the v1 API."""
 
 PYPOT_STATUS: dict[Kind, int] = {

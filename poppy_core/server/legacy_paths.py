@@ -18,20 +18,26 @@ REWRITES: tuple[tuple[re.Pattern[str], str], ...] = tuple(
         (r"/motor/goto\.json", "/motors/goto.json"),
         (rf"/motor/({NAME})/list\.json", r"/motors/\1/list.json"),
         (rf"/motor/({NAME})/register/list\.json", r"/motors/\1/registers/list.json"),
-        (rf"/motor/({NAME})/register/({NAME})(?:/value\.json)?",
-         r"/motors/\1/registers/\2/value.json"),
+        (
+            rf"/motor/({NAME})/register/({NAME})(?:/value\.json)?",
+            r"/motors/\1/registers/\2/value.json",
+        ),
         (rf"/motor/({NAME})/goto\.json", r"/motors/\1/goto.json"),
         (r"/primitive/list\.json", "/primitives/list.json"),
         (r"/primitive/running/list\.json", "/primitives/running/list.json"),
         (rf"/primitive/({NAME})/(start|stop|pause|resume)\.json", r"/primitives/\1/\2.json"),
         (rf"/primitive/({NAME})/property/list\.json", r"/primitives/\1/properties/list.json"),
-        (rf"/primitive/({NAME})/property/({NAME})(?:/value\.json)?",
-         r"/primitives/\1/properties/\2/value.json"),
+        (
+            rf"/primitive/({NAME})/property/({NAME})(?:/value\.json)?",
+            r"/primitives/\1/properties/\2/value.json",
+        ),
         (rf"/primitive/({NAME})/method/list\.json", r"/primitives/\1/methods/list.json"),
-        (rf"/primitive/({NAME})/method/({NAME})/args\.json",
-         r"/primitives/\1/methods/\2/args.json"),
+        (
+            rf"/primitive/({NAME})/method/({NAME})/args\.json",
+            r"/primitives/\1/methods/\2/args.json",
+        ),
     )
-)  # fmt: skip
+)
 
 
 def current_path(path: str) -> str | None:

@@ -98,9 +98,14 @@ class MoveService:
         for entry in listed:
             duration_s, frames = self._length(entry.path)
             answer.append(
-                {"name": entry.name, "format": entry.format, "size_bytes": entry.size_bytes,
-                 "duration_s": duration_s, "frames": frames}
-            )  # fmt: skip
+                {
+                    "name": entry.name,
+                    "format": entry.format,
+                    "size_bytes": entry.size_bytes,
+                    "duration_s": duration_s,
+                    "frames": frames,
+                }
+            )
         return answer
 
     def _length(self, path: Path) -> tuple[float | None, int | None]:
@@ -211,9 +216,11 @@ class MoveService:
         except FileError as exc:
             logger.warning("saving move %s failed, the recording is kept: %s", name, exc)
             raise ApiError(
-                "storage", f"the recording {name!r} could not be saved ({exc}); it is kept: "
-                "save it again once there is room", tip="free some space, then save again",
-            ) from None  # fmt: skip
+                "storage",
+                f"the recording {name!r} could not be saved ({exc}); it is kept: "
+                "save it again once there is room",
+                tip="free some space, then save again",
+            ) from None
         with self._lock:
             if self._recorders.get(name) is recorder:
                 del self._recorders[name]

@@ -28,8 +28,11 @@ def json_value(value: Any, sensor: str) -> Any:
     """A register value as JSON data (a frame is described, not sent: see its image routes)."""
     if isinstance(value, np.ndarray):
         if value.ndim == 3:
-            return {"shape": list(value.shape), "png": f"/sensors/{sensor}/frame.png",
-                    "jpg": f"/sensors/{sensor}/frame.jpg"}  # fmt: skip
+            return {
+                "shape": list(value.shape),
+                "png": f"/sensors/{sensor}/frame.png",
+                "jpg": f"/sensors/{sensor}/frame.jpg",
+            }
         return value.tolist()
     if isinstance(value, list):
         return [json_value(v, sensor) for v in value]
@@ -122,5 +125,8 @@ class SensorService:
             return detector.sees(card)
         except UnknownCardError as exc:
             known = ", ".join(exc.known) or "none"
-            raise ApiError("not_found", "The code you asked for does not exist",
-                           tip=f"All preset codes are {known}") from None  # fmt: skip
+            raise ApiError(
+                "not_found",
+                "The code you asked for does not exist",
+                tip=f"All preset codes are {known}",
+            ) from None

@@ -48,8 +48,9 @@ def clamp_rate(rate_hz: float) -> float:
 
 def check_rate(value: object) -> float:
     """A stream rate asked by a client: a number (or its text) within the stream's range."""
-    return checks.in_range(checks.number_from(value, "rate_hz"), MIN_RATE_HZ, MAX_RATE_HZ,
-                           "rate_hz", "Hz")  # fmt: skip
+    return checks.in_range(
+        checks.number_from(value, "rate_hz"), MIN_RATE_HZ, MAX_RATE_HZ, "rate_hz", "Hz"
+    )
 
 
 async def stream(websocket: WebSocket, service: RobotService, rate_hz: float | str) -> None:

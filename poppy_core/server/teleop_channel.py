@@ -190,8 +190,10 @@ class TeleopChannel:
         followed = set(session.motor_names)
         for name, value in positions.items():
             if name not in followed:
-                raise ApiError("not_found", f"{name!r} is not teleoperated (motors: "
-                               f"{', '.join(session.motor_names)})")  # fmt: skip
+                raise ApiError(
+                    "not_found",
+                    f"{name!r} is not teleoperated (motors: {', '.join(session.motor_names)})",
+                )
             goals[name] = checks.number(value, name)  # ArgumentError: an error frame
         with self._lock:
             self._newest = goals if self._newest is None else {**self._newest, **goals}

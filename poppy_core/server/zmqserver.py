@@ -88,8 +88,9 @@ class ZmqRequests:
             name, arguments = self._parse(request)
             method = self.methods.get(name)
             if method is None:
-                raise ApiError("not_found", f"no method {name!r} (methods: "
-                               f"{', '.join(sorted(self.methods))})")  # fmt: skip
+                raise ApiError(
+                    "not_found", f"no method {name!r} (methods: {', '.join(sorted(self.methods))})"
+                )
             for key in ("value", "args"):
                 if key in arguments:
                     arguments[key] = _json_argument(arguments[key])
@@ -145,12 +146,15 @@ class ZmqRequests:
         control: str | None = None,
         wait: Any = False,
     ) -> None:
-        if not isinstance(motors, list) or not isinstance(positions, list) or len(motors) != len(
-            positions
+        if (
+            not isinstance(motors, list)
+            or not isinstance(positions, list)
+            or len(motors) != len(positions)
         ):
             raise ApiError("invalid", "motors and positions must be lists of the same length")
-        handle = self.service.goto(dict(zip(motors, positions, strict=True)), duration,
-                                   control or "minjerk")  # fmt: skip
+        handle = self.service.goto(
+            dict(zip(motors, positions, strict=True)), duration, control or "minjerk"
+        )
         if wait:
             handle.wait(goto_duration(duration) + 5.0)
 
@@ -222,8 +226,10 @@ class ZmqRobotServer:
         except zmq.ZMQError as exc:
             self._socket.close()
             self._context.term()
-            raise ListenError(f"cannot listen on {host}:{port}: {exc}; choose another port "
-                              "(--zmq-port) or stop the program using it") from None  # fmt: skip
+            raise ListenError(
+                f"cannot listen on {host}:{port}: {exc}; choose another port "
+                "(--zmq-port) or stop the program using it"
+            ) from None
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._serve, name="zmq server", daemon=True)
         self.requests_served = 0

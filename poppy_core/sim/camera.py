@@ -22,8 +22,11 @@ from poppy_core.sim.gl import GL_HELP, check_offscreen_gl
 
 logger = logging.getLogger(__name__)
 
-_OFF = (mujoco.mjtRndFlag.mjRND_SHADOW, mujoco.mjtRndFlag.mjRND_REFLECTION,
-        mujoco.mjtRndFlag.mjRND_SKYBOX)  # fmt: skip
+_OFF = (
+    mujoco.mjtRndFlag.mjRND_SHADOW,
+    mujoco.mjtRndFlag.mjRND_REFLECTION,
+    mujoco.mjtRndFlag.mjRND_SKYBOX,
+)
 
 
 def camera_names(model: Any) -> list[str]:

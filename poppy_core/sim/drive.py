@@ -174,5 +174,6 @@ class Drive:
         if not self._settled:
             moving |= np.abs(self.goal - self.target) > _REACHED_RAD
         moving &= self.on
-        return list(zip(position.tolist(), speed.tolist(), load.tolist(), moving.tolist(),
-                        strict=True))  # fmt: skip
+        return list(
+            zip(position.tolist(), speed.tolist(), load.tolist(), moving.tolist(), strict=True)
+        )

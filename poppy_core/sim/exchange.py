@@ -39,8 +39,14 @@ COMMAND_REGISTERS = (
     "torque_limit",
 )
 STATE_REGISTERS = ("present_position", "present_speed", "present_load", "moving")
-_FORMATS = {(1, False): "B", (2, False): "H", (4, False): "I",
-            (1, True): "b", (2, True): "h", (4, True): "i"}  # fmt: skip
+_FORMATS = {
+    (1, False): "B",
+    (2, False): "H",
+    (4, False): "I",
+    (1, True): "b",
+    (2, True): "h",
+    (4, True): "i",
+}
 
 Encoder = Callable[[float], int]
 
@@ -126,8 +132,9 @@ class MotorPort:
         if not motor.model.has_torque_limit:
             found["torque_limit"] = None
         self._registers = {name: reg for name, reg in found.items() if reg is not None}
-        ordered = sorted({r.address: r for r in self._registers.values()}.values(),
-                         key=lambda r: r.address)  # fmt: skip
+        ordered = sorted(
+            {r.address: r for r in self._registers.values()}.values(), key=lambda r: r.address
+        )
         self._read_at = ordered[0].address if ordered else 0
         self._read_layout = _layout(ordered) if ordered else "<"
         self._slot = {name: ordered.index(reg) for name, reg in self._registers.items()}
@@ -157,8 +164,14 @@ class MotorPort:
                 runs[-1].append(item)
             else:
                 runs.append([item])
-        return [_Run(run[0][1].address, _layout([r for _, r in run]),
-                     tuple((i, r, _encoder(r)) for i, r in run)) for run in runs]  # fmt: skip
+        return [
+            _Run(
+                run[0][1].address,
+                _layout([r for _, r in run]),
+                tuple((i, r, _encoder(r)) for i, r in run),
+            )
+            for run in runs
+        ]
 
     def forget(self) -> None:
         """Make the next :meth:`read_command` convert the table even if it did not change."""

@@ -12,8 +12,12 @@ from poppy_core.errors import ConfigError
 
 KINDS = ("cube", "sphere", "cylinder")
 CARD_HALF_THICKNESS_M = 0.001
-_COLORS = {"cube": [0.85, 0.2, 0.2, 1.0], "sphere": [0.2, 0.5, 0.85, 1.0], "card": [1.0] * 4,
-           "cylinder": [0.2, 0.7, 0.3, 1.0]}  # fmt: skip
+_COLORS = {
+    "cube": [0.85, 0.2, 0.2, 1.0],
+    "sphere": [0.2, 0.5, 0.85, 1.0],
+    "card": [1.0] * 4,
+    "cylinder": [0.2, 0.7, 0.3, 1.0],
+}
 
 
 @dataclass(frozen=True)
@@ -46,8 +50,11 @@ class ObjectSpec:
             ConfigError: unknown kind, bad size or mass.
         """
         if kind not in KINDS:
-            raise ConfigError(f"unknown object kind {kind!r} (one of {', '.join(KINDS)})",
-                              field="kind", value=kind)  # fmt: skip
+            raise ConfigError(
+                f"unknown object kind {kind!r} (one of {', '.join(KINDS)})",
+                field="kind",
+                value=kind,
+            )
         sizes = (float(size),) if isinstance(size, (int, float)) else tuple(map(float, size))
         if not sizes or min(sizes) <= 0 or mass <= 0:
             raise ConfigError("object size and mass must be positive", field="size", value=size)
@@ -101,9 +108,12 @@ def _textured(spec: Any, name: str, image: np.ndarray) -> str:
     pixels = np.ascontiguousarray(image[:, :, :3], dtype=np.uint8)
     height, width = pixels.shape[:2]
     texture = spec.add_texture(
-        name=f"{name}_texture", type=mujoco.mjtTexture.mjTEXTURE_2D, width=width,
-        height=height, nchannel=3,
-    )  # fmt: skip
+        name=f"{name}_texture",
+        type=mujoco.mjtTexture.mjTEXTURE_2D,
+        width=width,
+        height=height,
+        nchannel=3,
+    )
     texture.data = pixels.tobytes()
     material = spec.add_material(name=f"{name}_material")
     roles = list(material.textures)

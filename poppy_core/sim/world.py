@@ -226,8 +226,10 @@ class Simulation:
 
     def body_names(self) -> list[str]:
         """Names of the bodies (robot links and added objects)."""
-        names = (mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, i) for i in
-                 range(1, self.model.nbody))  # fmt: skip
+        names = (
+            mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, i)
+            for i in range(1, self.model.nbody)
+        )
         return [n for n in names if n]
 
     def get_object_position(self, name: str, relative_to: str | None = None) -> list[float]:
@@ -329,13 +331,24 @@ class Simulation:
         """
         pixels = np.asarray(image)
         if pixels.ndim != 3 or pixels.shape[2] < 3 or pixels.dtype != np.uint8:
-            raise ConfigError("a picture is an (height, width, 3) uint8 RGB image",
-                              field="image", value=getattr(pixels, "shape", None))  # fmt: skip
+            raise ConfigError(
+                "a picture is an (height, width, 3) uint8 RGB image",
+                field="image",
+                value=getattr(pixels, "shape", None),
+            )
         side = positive(size, "size")
         if facing is None:
             facing = self._toward_camera(position)
-        spec = ObjectSpec("card", name, tuple(float(v) for v in position),  # type: ignore[arg-type]
-                          (side / 2,), 0.01, facing_quat(facing), True, pixels)  # fmt: skip
+        spec = ObjectSpec(
+            "card",
+            name,
+            tuple(float(v) for v in position),  # type: ignore[arg-type]
+            (side / 2,),
+            0.01,
+            facing_quat(facing),
+            True,
+            pixels,
+        )
         self._add(spec)
 
     def _toward_camera(self, position: tuple[float, float, float]) -> tuple[float, float, float]:

@@ -12,8 +12,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("poppy_core", "poppy_cli")
-RE_EXPORTS = {("poppy_core.robot", "poppy_core.assembly"),
-              ("poppy_core.creatures", "poppy_core.assembly")}  # fmt: skip
+RE_EXPORTS = {
+    ("poppy_core.robot", "poppy_core.assembly"),
+    ("poppy_core.creatures", "poppy_core.assembly"),
+}
 """The re-exports of the composition root by the rooms below it, in their package's
 ``__getattr__`` on first use (``tests/architecture/test_layers.py`` allows them there only): the
 assembly is imported after the room, never while it loads, so they close no circle at import

@@ -168,8 +168,11 @@ def test_the_one_exception_is_a_re_export_of_the_assembly(room: str) -> None:
     assert climbing == {("poppy_core.assembly", "__getattr__")}
     loaded = subprocess.run(
         [sys.executable, "-c", f"import sys, poppy_core.{room}\nprint('\\n'.join(sys.modules))"],
-        capture_output=True, text=True, check=True, cwd=ROOT,
-    ).stdout.split()  # fmt: skip
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+    ).stdout.split()
     assert "poppy_core.assembly" not in loaded
     import importlib
 

@@ -26,4 +26,3 @@ def test_no_protocol_number_branches_outside_the_protocol_objects() -> None:
         if BRANCH.search(line)
     ]
     assert found == [], "ask the protocol object (protocol_for(n)) instead:\n" + "\n".join(found)
-

@@ -46,9 +46,10 @@ def test_the_creature_path_and_the_cli_path_give_the_same_server_set(
     built: list[tuple[ServeSpec, ServerSet]], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     ports = {f"{name}_port": 0 for name in EVERY}
-    with PoppyErgoJr(simulator="dummy", use_http=True, use_ws=True, use_zmq=True,
-                     use_snap=True, **ports) as robot:  # fmt: skip
-        (creature_spec, creature_set), = built
+    with PoppyErgoJr(
+        simulator="dummy", use_http=True, use_ws=True, use_zmq=True, use_snap=True, **ports
+    ) as robot:
+        ((creature_spec, creature_set),) = built
         assert {name: getattr(robot, name) for name in EVERY} == creature_set.servers
         creature_shape = _shape(creature_set)
         assert creature_set.running
@@ -62,12 +63,18 @@ def test_the_creature_path_and_the_cli_path_give_the_same_server_set(
     args += [f"--{name}-port=0" for name in EVERY]
     result = run_poppy(*args)
     assert result.code == 0, result.stderr
-    (cli_spec, cli_set), = built[1:]
+    ((cli_spec, cli_set),) = built[1:]
     assert cli_spec == creature_spec
-    assert _shape(cli_set) == creature_shape == {
-        "http": "BackgroundServer", "ws": "BackgroundServer", "zmq": "ZmqRobotServer",
-        "snap": "SnapServer",
-    }  # fmt: skip
+    assert (
+        _shape(cli_set)
+        == creature_shape
+        == {
+            "http": "BackgroundServer",
+            "ws": "BackgroundServer",
+            "zmq": "ZmqRobotServer",
+            "snap": "SnapServer",
+        }
+    )
     assert cli_set.app.state.service is cli_set.service
     assert not any(_states(cli_set))
 
@@ -88,8 +95,9 @@ def _teleop(ws: ClientConnection, motor: str) -> dict[str, Any]:
 @pytest.fixture
 def ergo_served_twice() -> Iterator[tuple[str, str]]:
     """A virtual Ergo Jr built with use_http and use_ws: its two WebSocket URLs."""
-    with PoppyErgoJr(simulator="dummy", use_http=True, http_port=0, use_ws=True,
-                     ws_port=0) as robot:  # fmt: skip
+    with PoppyErgoJr(
+        simulator="dummy", use_http=True, http_port=0, use_ws=True, ws_port=0
+    ) as robot:
         http_port, ws_port = robot.http.port, robot.ws.port
         yield f"ws://127.0.0.1:{http_port}/api/v1/ws", f"ws://127.0.0.1:{ws_port}/"
 

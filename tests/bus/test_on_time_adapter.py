@@ -85,9 +85,7 @@ def test_a_reply_late_once_does_not_lengthen_the_scans_wait(
     # Motor 3's ping reply comes 15 ms late (the OS ran the emulator late once): it is caught
     # and pinged again after the pass, and every silent ID is waited for as long as ID 0 was.
     motors = [VirtualMotor(model_by_name("MX-28"), i, 1_000_000) for i in (3, 9)]
-    virtual = VirtualBus(
-        motors, 1, wire_timing=True, latency_s=0.001, faults=LateOnce(1, 0.015)
-    )
+    virtual = VirtualBus(motors, 1, wire_timing=True, latency_s=0.001, faults=LateOnce(1, 0.015))
     with serve_link(virtual) as server:
         found = scan(server.url, [1_000_000], [1], ids=range(30), latency_s=0.001)
     assert sorted(f.id for f in found) == [3, 9]
@@ -103,9 +101,7 @@ def test_a_reply_late_once_does_not_lengthen_the_next_rates_wait(
     # A motor found at 1 Mbps answers on time when asked again: the latency the late reply
     # taught is dropped, and 500 kbps is scanned with the deadline of an adapter on time.
     motors = [VirtualMotor(model_by_name("MX-28"), i, 1_000_000) for i in (3, 9)]
-    virtual = VirtualBus(
-        motors, 1, wire_timing=True, latency_s=0.001, faults=LateOnce(1, 0.015)
-    )
+    virtual = VirtualBus(motors, 1, wire_timing=True, latency_s=0.001, faults=LateOnce(1, 0.015))
     with serve_link(virtual) as server:
         found = scan(server.url, [1_000_000, 500_000], [1], ids=range(30), latency_s=0.001)
     assert sorted((f.id, f.baudrate) for f in found) == [(3, 1_000_000), (9, 1_000_000)]
@@ -117,8 +113,10 @@ def test_a_reply_within_its_deadline_teaches_no_latency() -> None:
     # A reply 0.9 ms slower than the latency assumed, well within the deadline's margin, shows
     # the deadlines already work: the latency stays. A reply after the deadline raises it.
     motor = VirtualMotor(model_by_name("MX-28"), 4, 57_600)
-    with serve_link(VirtualBus([motor], 1, 57_600)) as server, \
-            DxlBus(server.url, 57_600, 1, latency_s=0.001) as bus:  # fmt: skip
+    with (
+        serve_link(VirtualBus([motor], 1, 57_600)) as server,
+        DxlBus(server.url, 57_600, 1, latency_s=0.001) as bus,
+    ):
         bus.adaptive_latency = True
         timing = bus.timing
         tx, rx = instruction_size(1, 0), status_size(1, 0)
@@ -160,8 +158,10 @@ def test_the_quiet_time_after_a_rate_counts_from_the_last_instruction(
     monkeypatch.setattr(bus_core, "Deadline", Recorded)
     motor = VirtualMotor(model_by_name("MX-28"), 1, 1_000_000)
     options = {"latency_s": 0.001, "min_timeout_s": 0.0}
-    with serve_link(VirtualBus([motor], 1)) as server, \
-            DxlBus(server.url, 1_000_000, 1, **options) as bus:  # fmt: skip
+    with (
+        serve_link(VirtualBus([motor], 1)) as server,
+        DxlBus(server.url, 1_000_000, 1, **options) as bus,
+    ):
         assert bus.ping(5, retries=0) is None
         ping_wait = waits[-1]
         settle(bus)

@@ -100,9 +100,20 @@ def test_a_take_that_would_replace_a_move_is_refused_with_1(
     save_move(Move.from_frames(50.0, [{"m1": 0.0}, {"m1": 1.0}]), "taken")
     args = {
         "record": ("record", "taken", "--sim", "--profile", "ergo-jr", "--duration", "0.2"),
-        "teleop": ("teleop", "--leader", "ergo-jr", "--leader-port", ergo_jr.url, "--follower",
-                   "ergo-jr", "--follower-port", ergo_jr.url, "--record", "taken"),
-    }[command]  # fmt: skip
+        "teleop": (
+            "teleop",
+            "--leader",
+            "ergo-jr",
+            "--leader-port",
+            ergo_jr.url,
+            "--follower",
+            "ergo-jr",
+            "--follower-port",
+            ergo_jr.url,
+            "--record",
+            "taken",
+        ),
+    }[command]
     result = run_poppy(*args)
     assert result.code == 1, result.stderr
     assert "exists" in result.stderr and "--force" in result.stderr

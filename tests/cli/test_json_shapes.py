@@ -78,60 +78,142 @@ def problems(data: Any, schema: Any, where: str = "$") -> Iterator[str]:
 # -- the shapes -------------------------------------------------------------------------------
 
 SETUP = {
-    "operation": str, "port": str, "id": int, "baud": int, "protocol": int,
-    "changes": Map([ANY]), "verified": bool, "notes": [str],
-}  # fmt: skip
+    "operation": str,
+    "port": str,
+    "id": int,
+    "baud": int,
+    "protocol": int,
+    "changes": Map([ANY]),
+    "verified": bool,
+    "notes": [str],
+}
 MOTOR_STATE = {
-    "name": str, "id": int, "model": str, "position": NUM, "goal": NUM, "speed": NUM,
-    "load": NUM, "temperature": NUM, "voltage": NUM, "compliant": bool, "online": bool,
+    "name": str,
+    "id": int,
+    "model": str,
+    "position": NUM,
+    "goal": NUM,
+    "speed": NUM,
+    "load": NUM,
+    "temperature": NUM,
+    "voltage": NUM,
+    "compliant": bool,
+    "online": bool,
     "errors": int,
-}  # fmt: skip
+}
 BUS = {
-    "name": str, "controller": str, "port": str, "connected": bool, "running": bool,
-    "down_s": NUM, "losses": int, "loop_hz": Map(NUM), "target_hz": Map(NUM),
-    "loop_errors": int, "timeouts": int, "retries": int, "corrupt_packets": int,
-    "motor_errors": int, "offline": [str], "ok": bool, "label": str,
-}  # fmt: skip
+    "name": str,
+    "controller": str,
+    "port": str,
+    "connected": bool,
+    "running": bool,
+    "down_s": NUM,
+    "losses": int,
+    "loop_hz": Map(NUM),
+    "target_hz": Map(NUM),
+    "loop_errors": int,
+    "timeouts": int,
+    "retries": int,
+    "corrupt_packets": int,
+    "motor_errors": int,
+    "offline": [str],
+    "ok": bool,
+    "label": str,
+}
 PRIMITIVE = {
-    "name": str, "class": str, "state": str, "alive": bool, "elapsed_s": NUM,
-    "properties": Map(ANY), "methods": [str], "error": Opt(Map(ANY)),
-}  # fmt: skip
+    "name": str,
+    "class": str,
+    "state": str,
+    "alive": bool,
+    "elapsed_s": NUM,
+    "properties": Map(ANY),
+    "methods": [str],
+    "error": Opt(Map(ANY)),
+}
 MS = {"p50": Opt(NUM), "p99": Opt(NUM), "max": Opt(NUM)}
 XYZ = [NUM]
 
 SCHEMAS: dict[str, Any] = {
-    "ports": [{
-        "device": str, "description": str, "usb_id": Opt(str), "serial_number": Opt(str),
-        "adapter": Opt(str), "latency_timer_ms": Opt(int), "accessible": bool, "advice": [str],
-    }],
-    "scan": [{
-        "port": str, "baud": int, "protocol": int, "id": int, "model": Opt(str),
-        "model_number": int, "firmware": Opt(int),
-    }],
+    "ports": [
+        {
+            "device": str,
+            "description": str,
+            "usb_id": Opt(str),
+            "serial_number": Opt(str),
+            "adapter": Opt(str),
+            "latency_timer_ms": Opt(int),
+            "accessible": bool,
+            "advice": [str],
+        }
+    ],
+    "scan": [
+        {
+            "port": str,
+            "baud": int,
+            "protocol": int,
+            "id": int,
+            "model": Opt(str),
+            "model_number": int,
+            "firmware": Opt(int),
+        }
+    ],
     "record": {"path": str, "frames": int, "duration_s": NUM, "framerate": NUM, "motors": [str]},
     "play": {
-        "path": str, "motors": [str], "speed": NUM, "reverse": bool, "loops": int,
-        "duration_s": NUM, "played_s": NUM, "completed": bool,
+        "path": str,
+        "motors": [str],
+        "speed": NUM,
+        "reverse": bool,
+        "loops": int,
+        "duration_s": NUM,
+        "played_s": NUM,
+        "completed": bool,
     },
     "calibrate": {
-        "profile": str, "path": str, "backup": Opt(str), "calibrated": str,
+        "profile": str,
+        "path": str,
+        "backup": Opt(str),
+        "calibrated": str,
         "joints": [{"name": str, "offset": NUM, "angle_limit": XYZ}],
     },
     "calibrate --check": {
-        "calibrated": Opt(str), "tolerance_deg": Opt(NUM), "drifted": [str],
+        "calibrated": Opt(str),
+        "tolerance_deg": Opt(NUM),
+        "drifted": [str],
         "joints": [{"name": str, "expected": NUM, "measured": NUM, "drift": NUM, "ok": bool}],
     },
     "teleop": {
-        "leader": str, "follower": str, "map": str, "rate_hz": NUM, "duration_s": NUM,
-        "ticks": int, "measured_hz": NUM, "missed_periods": int, "holds": int,
-        "read_ms": MS, "pipeline_ms": MS, "record_path": Opt(str), "recorded_frames": int,
+        "leader": str,
+        "follower": str,
+        "map": str,
+        "rate_hz": NUM,
+        "duration_s": NUM,
+        "ticks": int,
+        "measured_hz": NUM,
+        "missed_periods": int,
+        "holds": int,
+        "read_ms": MS,
+        "pipeline_ms": MS,
+        "record_path": Opt(str),
+        "recorded_frames": int,
     },
     "motor info": {
-        "id": int, "model": str, "model_number": int, "firmware": int, "port": str,
-        "baud": int, "protocol": int,
-        "registers": [{
-            "name": str, "value": ANY, "unit": str, "address": int, "access": str, "memory": str,
-        }],
+        "id": int,
+        "model": str,
+        "model_number": int,
+        "firmware": int,
+        "port": str,
+        "baud": int,
+        "protocol": int,
+        "registers": [
+            {
+                "name": str,
+                "value": ANY,
+                "unit": str,
+                "address": int,
+                "access": str,
+                "memory": str,
+            }
+        ],
     },
     "motor get": [{"id": int, "*": ANY}],
     "motor set": [{"id": int, "*": ANY}],
@@ -151,35 +233,61 @@ SCHEMAS: dict[str, Any] = {
         "motors": Map({"id": int, "type": str, "*": ANY}),
         "*": ANY,
     },
-    "config list": [
-        {"name": str, "kind": Opt(str), "description": str, "user": bool, "file": str}
-    ],
+    "config list": [{"name": str, "kind": Opt(str), "description": str, "user": bool, "file": str}],
     # the user settings: a fixed set of keys, each unset (null) or its value
     "config get": {"profile": Opt(str), "port": Opt(str)},
     "config path": {"settings": str, "user_profiles": str, "profile_folders": [str]},
     "robot status": {"motors": [MOTOR_STATE], "buses": [BUS]},
     "robot goto": {"motors": [{"name": str, "goal": NUM, "position": NUM}], "waited": bool},
     "robot compliant": [{"name": str, "compliant": bool}],
-    "robot where": [{
-        "name": str, "label": str, "position": XYZ, "orientation": XYZ, "rpy_deg": XYZ,
-        "motors": [{"name": str, "position": NUM}],
-    }],
+    "robot where": [
+        {
+            "name": str,
+            "label": str,
+            "position": XYZ,
+            "orientation": XYZ,
+            "rpy_deg": XYZ,
+            "motors": [{"name": str, "position": NUM}],
+        }
+    ],
     "robot reach": {
-        "chain": str, "label": str, "target": XYZ, "motors": [{"name": str, "goal": NUM}],
-        "waited": bool, "position": Opt(XYZ), "error_m?": NUM,
+        "chain": str,
+        "label": str,
+        "target": XYZ,
+        "motors": [{"name": str, "goal": NUM}],
+        "waited": bool,
+        "position": Opt(XYZ),
+        "error_m?": NUM,
     },
     "primitive list": [PRIMITIVE],
     "primitive run": {**PRIMITIVE, "interrupted": bool},
     "moves list": {
         "folder": str,
-        "moves": [{
-            "name": str, "path": str, "format": str, "size_bytes": int, "frames?": int,
-            "framerate?": NUM, "duration_s?": NUM, "motors?": [str], "error": Opt(str),
-        }],
+        "moves": [
+            {
+                "name": str,
+                "path": str,
+                "format": str,
+                "size_bytes": int,
+                "frames?": int,
+                "framerate?": NUM,
+                "duration_s?": NUM,
+                "motors?": [str],
+                "error": Opt(str),
+            }
+        ],
     },
     "moves show": {
-        "name": str, "path": str, "format": str, "size_bytes": int, "framerate": NUM,
-        "frames": int, "duration_s": NUM, "motors": [str], "speeds": bool, "metadata": Map(ANY),
+        "name": str,
+        "path": str,
+        "format": str,
+        "size_bytes": int,
+        "framerate": NUM,
+        "frames": int,
+        "duration_s": NUM,
+        "motors": [str],
+        "speeds": bool,
+        "metadata": Map(ANY),
         "stats": [{"name": str, "*": NUM}],
     },
     "moves plot": {"move": str, "output": str},
@@ -187,12 +295,19 @@ SCHEMAS: dict[str, Any] = {
     "moves import": {"name": str, "path": str, "frames": int, "motors": [str]},
     "moves rm": {"deleted": str},
     "camera list": [{"device": str, "index": int, "name": str}],
-    "camera detect": [{
-        "id": int, "family": str, "position": XYZ, "center": XYZ, "corners": [XYZ],
-        "camera": str, "card": Opt(str),
-        "pose?": {"rvec": XYZ, "tvec": XYZ, "distance_m": NUM},
-    }],
-}  # fmt: skip
+    "camera detect": [
+        {
+            "id": int,
+            "family": str,
+            "position": XYZ,
+            "center": XYZ,
+            "corners": [XYZ],
+            "camera": str,
+            "card": Opt(str),
+            "pose?": {"rvec": XYZ, "tvec": XYZ, "distance_m": NUM},
+        }
+    ],
+}
 
 
 def commands_with_json() -> list[str]:
@@ -229,8 +344,10 @@ ANSWERS = "\n\ny\n\ny\ny\n"  # calibrate: as tests/cli/test_calibrate_cmd.py ans
 def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ...]]:
     """Each command's run (once, in order: record before play...): name -> its result."""
     tmp = tmp_path_factory.mktemp("json")
-    saved = {k: os.environ.get(k) for k in ("POPPY_MOVES_DIR", "XDG_CONFIG_HOME", "POPPY_PROFILE",
-                                            "POPPY_PORT")}  # fmt: skip
+    saved = {
+        k: os.environ.get(k)
+        for k in ("POPPY_MOVES_DIR", "XDG_CONFIG_HOME", "POPPY_PROFILE", "POPPY_PORT")
+    }
     os.environ.update(POPPY_MOVES_DIR=str(tmp / "moves"), XDG_CONFIG_HOME=str(tmp / "xdg"))
     os.environ.pop("POPPY_PROFILE", None)
     os.environ.pop("POPPY_PORT", None)
@@ -313,9 +430,13 @@ def test_json_follows_its_schema(name: str, outputs: dict[str, Any]) -> None:
 
 @pytest.mark.parametrize(
     ("args", "count"),
-    [(("motor", "get", "3", "present_position"), 1), (("motor", "get", "2-4", "led"), 3),
-     (("motor", "set", "3", "led", "on"), 1), (("motor", "set", "1,3", "led", "on"), 2)],
-)  # fmt: skip
+    [
+        (("motor", "get", "3", "present_position"), 1),
+        (("motor", "get", "2-4", "led"), 3),
+        (("motor", "set", "3", "led", "on"), 1),
+        (("motor", "set", "1,3", "led", "on"), 2),
+    ],
+)
 def test_one_shape_whatever_the_number_of_motors(args: tuple[str, ...], count: int) -> None:
     with emulate_bus("XL-320:1-6", protocol=2) as (_, url):
         result = run_poppy(*args, "--port", url, "--baud", "1000000", "--protocol", "2", "--json")

@@ -129,12 +129,25 @@ def test_the_ergo_jr_chain_is_shown_as_arm_and_keeps_its_pypot_name(poppy: Any) 
     [tip] = poppy("robot", "where", "--sim", "--profile", "ergo-jr", "--json").json()
     assert tip["name"] == "chain" and tip["label"] == "arm"  # robot.chain, as pypot names it
     for name in ("arm", "chain"):
-        moved = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", name,
-                      "0.1", "0", "0.12", "--duration", "0.2")  # fmt: skip
+        moved = poppy(
+            "robot",
+            "reach",
+            "--sim",
+            "--profile",
+            "ergo-jr",
+            "--chain",
+            name,
+            "0.1",
+            "0",
+            "0.12",
+            "--duration",
+            "0.2",
+        )
         assert moved.code == 0, moved.stderr
         assert moved.stdout.startswith("arm: at (100, ")
-    unknown = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", "leg", "0.1",
-                    "0", "0.1")  # fmt: skip
+    unknown = poppy(
+        "robot", "reach", "--sim", "--profile", "ergo-jr", "--chain", "leg", "0.1", "0", "0.1"
+    )
     assert unknown.code == 1 and "(chains: arm)" in unknown.stderr
     far = poppy("robot", "reach", "--sim", "--profile", "ergo-jr", "1", "0", "0.1")
     assert far.code == 1 and "chain 'arm' cannot reach" in far.stderr, far.stderr
@@ -147,7 +160,8 @@ def test_a_chain_label_must_be_a_name() -> None:
     from poppy_core.robot.config_sections import KinematicsSection
 
     section: dict[str, Any] = {
-        "model": "x.urdf", "chains": {"chain": {"motors": ["m1"], "label": "my arm"}}
+        "model": "x.urdf",
+        "chains": {"chain": {"motors": ["m1"], "label": "my arm"}},
     }
     with pytest.raises(ValidationError, match="must be a name such as arm"):
         KinematicsSection.model_validate(section)

@@ -485,8 +485,12 @@ def test_readme_tour_through_pipes(tour: Tour) -> None:
     stop_background(tour)
     result = subprocess.run(
         [sys.executable, "-c", python_block()],
-        capture_output=True, text=True, env=tour.env, cwd=tour.home, timeout=RUN_S,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        env=tour.env,
+        cwd=tour.home,
+        timeout=RUN_S,
+    )
     python = Step("README's Python block", ["python"], False)
     check_code(tour, python, result.returncode, 0, result.stderr)
     check_output(tour, python, result.stdout, result.stderr)
@@ -591,8 +595,10 @@ def _on_a_terminal(tour: Tour, step: Step, answered: set[str]) -> None:
     if code is None:
         tour.problem(step, f"on a terminal: still running; it shows {terminal.text[-300:]!r}")
     elif code != screen.code:
-        tour.problem(step, f"on a terminal: exit {code}, expected {screen.code}: "
-                     f"{terminal.text.strip()[-300:]!r}")  # fmt: skip
+        tour.problem(
+            step,
+            f"on a terminal: exit {code}, expected {screen.code}: {terminal.text.strip()[-300:]!r}",
+        )
     if stop is not None:
         tour.problem(step, f"on a terminal: never showed {stop[0]!r}")
     check_output(tour, step, "", terminal.text, piped=False)

@@ -124,7 +124,8 @@ def test_puzzle_round_found_then_missed(poppy: Robot) -> None:
     for motor, value in zip(poppy.motors, figure, strict=True):
         _push(poppy, motor.name, value)
     assert wait_until(lambda: puzzle.score == 1, WAIT_S), (
-        puzzle.phase, [round(m.present_position) for m in poppy.motors]
+        puzzle.phase,
+        [round(m.present_position) for m in poppy.motors],
     )
     # Round 2: the player does nothing; the figure is shown again and the score is lost.
     assert wait_until(lambda: puzzle.phase == "search", WAIT_S)

@@ -81,8 +81,9 @@ def test_arms_copy_motion_mirrors_the_left_arm_on_the_right(humanoid: Robot) -> 
         left = [virtual(humanoid, m.name) for m in humanoid.l_arm]
         # The primitive sets the left arm compliant from its own thread: wait for both ends.
         assert wait_until(
-            lambda: all(m.compliant for m in humanoid.l_arm)
-            and not any(v.torque_enabled for v in left),
+            lambda: (
+                all(m.compliant for m in humanoid.l_arm) and not any(v.torque_enabled for v in left)
+            ),
             2.0,
         )
         assert not any(m.compliant for m in humanoid.r_arm)

@@ -33,7 +33,6 @@ class SdkSession:
         self.port.closePort()
 
 
-
 def reg(bus: VirtualBus, motor_id: int, name: str) -> tuple[int, int]:
     register = bus.motor(motor_id).model.register(name)
     return register.address, register.size
@@ -114,8 +113,9 @@ def test_v1_sync_write(v1: SdkSession, v1_bus: VirtualBus) -> None:
         assert group.addParam(motor_id, list(value.to_bytes(2, "little")))
     assert group.txPacket() == COMM_SUCCESS
     assert eventually(
-        lambda: [v1_bus.motor(i).table.get("goal_position") for i in (1, 2, 3)]
-        == [1000, 2000, 3000]
+        lambda: (
+            [v1_bus.motor(i).table.get("goal_position") for i in (1, 2, 3)] == [1000, 2000, 3000]
+        )
     )
 
 

@@ -19,8 +19,9 @@ from poppy_core.robot import Robot
 from tests.helpers.fixtures import ergo_fixture
 
 # The 103-byte pypot move: two frames 1e5 s apart at 1e6 Hz (1e11 frames once resampled).
-SPARSE = json.dumps({"framerate": 1e6, "positions": {"0.0": {"m1": [0, 0]},
-                                                     "100000.0": {"m1": [1, 0]}}})
+SPARSE = json.dumps(
+    {"framerate": 1e6, "positions": {"0.0": {"m1": [0, 0]}, "100000.0": {"m1": [1, 0]}}}
+)
 
 
 def _peak(work: object) -> int:
@@ -59,8 +60,16 @@ def test_positions_out_of_any_servo_range_are_refused(position: float) -> None:
 
 
 def test_a_binary_header_cannot_announce_a_huge_move() -> None:
-    header = json.dumps({"format": "poppy-move", "version": 1, "framerate": 50,
-                         "motors": ["m1"], "frames": 10**12, "dtype": "<f4"}).encode()
+    header = json.dumps(
+        {
+            "format": "poppy-move",
+            "version": 1,
+            "framerate": 50,
+            "motors": ["m1"],
+            "frames": 10**12,
+            "dtype": "<f4",
+        }
+    ).encode()
     data = MAGIC + struct.pack("<I", len(header)) + header
     with pytest.raises(ConfigError, match="at most 5,000,000 values"):
         decode_move(data, "x.move")

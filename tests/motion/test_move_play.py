@@ -29,7 +29,6 @@ def ergo() -> Iterator[Robot]:
         robot.close()
 
 
-
 def virtual_position(robot: Robot, name: str) -> float:
     """The horn's position in the user frame, read from the emulator (no sync-loop delay)."""
     motor = robot.motor(name)

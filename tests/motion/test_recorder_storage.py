@@ -45,8 +45,9 @@ def test_a_failing_destination_keeps_the_take(
 
     monkeypatch.setattr(recorder_module, "write_move", full)
     target = tmp_path / "w.move"
-    recorder = MoveRecorder(ergo, 50, ["m1", "m2"], checkpoint_path=target,
-                            checkpoint_period_s=0.02)
+    recorder = MoveRecorder(
+        ergo, 50, ["m1", "m2"], checkpoint_path=target, checkpoint_period_s=0.02
+    )
     with caplog.at_level(logging.WARNING, logger="poppy_core.motion.recorder"):
         recorder.start()
         _wait_frames(recorder, 30)
@@ -78,8 +79,9 @@ def test_a_checkpoint_that_works_again_is_said_once(
         return real_write(*args, **kwargs)  # type: ignore[arg-type]
 
     monkeypatch.setattr(recorder_module, "write_move", flaky)
-    recorder = MoveRecorder(ergo, 50, ["m1"], checkpoint_path=tmp_path / "w.move",
-                            checkpoint_period_s=0.02)
+    recorder = MoveRecorder(
+        ergo, 50, ["m1"], checkpoint_path=tmp_path / "w.move", checkpoint_period_s=0.02
+    )
     with caplog.at_level(logging.WARNING, logger="poppy_core.motion.recorder"):
         recorder.start()
         _wait_frames(recorder, 10)
@@ -108,8 +110,9 @@ def test_two_recorders_cannot_write_one_file(ergo: Robot, tmp_path: Path) -> Non
 def test_an_existing_file_is_not_replaced_unless_asked(ergo: Robot, tmp_path: Path) -> None:
     target = tmp_path / "mine.move"
     target.write_bytes(b"not a take")
-    recorder = MoveRecorder(ergo, 50, ["m1"], checkpoint_path=target, replace=False,
-                            checkpoint_period_s=0.02)
+    recorder = MoveRecorder(
+        ergo, 50, ["m1"], checkpoint_path=target, replace=False, checkpoint_period_s=0.02
+    )
     recorder.start()
     _wait_frames(recorder, 10)
     with pytest.raises(FileError, match="already exists"):

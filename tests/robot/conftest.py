@@ -30,12 +30,27 @@ def small_config() -> dict[str, Any]:
         },
         "motorgroups": {"arm": ["m1", "m2"], "all": ["arm", "m3"]},
         "motors": {
-            "m1": {"id": 1, "type": "MX-28", "orientation": "direct", "offset": 0.0,
-                   "angle_limit": [-90.0, 90.0]},
-            "m2": {"id": 2, "type": "AX-12", "orientation": "indirect", "offset": 10,
-                   "angle_limit": [-150, 150]},
-            "m3": {"id": 1, "type": "MX-64", "orientation": "direct", "offset": 0.0,
-                   "angle_limit": [-45.0, 45.0]},
+            "m1": {
+                "id": 1,
+                "type": "MX-28",
+                "orientation": "direct",
+                "offset": 0.0,
+                "angle_limit": [-90.0, 90.0],
+            },
+            "m2": {
+                "id": 2,
+                "type": "AX-12",
+                "orientation": "indirect",
+                "offset": 10,
+                "angle_limit": [-150, 150],
+            },
+            "m3": {
+                "id": 1,
+                "type": "MX-64",
+                "orientation": "direct",
+                "offset": 0.0,
+                "angle_limit": [-45.0, 45.0],
+            },
         },
     }
 

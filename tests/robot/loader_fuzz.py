@@ -45,20 +45,30 @@ VALID = {
     "controllers": {"bus": {"port": "auto", "protocol": 2, "attached_motors": ["arm", "m3"]}},
     "motorgroups": {"arm": ["m1", "m2"]},
     "motors": {
-        name: {"id": index, "type": "XL-320", "orientation": "direct", "offset": 0.0,
-               "angle_limit": [-90.0, 90.0]}
+        name: {
+            "id": index,
+            "type": "XL-320",
+            "orientation": "direct",
+            "offset": 0.0,
+            "angle_limit": [-90.0, 90.0],
+        }
         for index, name in enumerate(("m1", "m2", "m3"), start=1)
     },
 }
 
 scalars = (
-    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=12)
+    st.none()
+    | st.booleans()
+    | st.integers()
+    | st.floats()
+    | st.text(max_size=12)
     | st.sampled_from(["XL-320", "MX-28", "direct", "indirect", "auto", "m1", "arm"])
 )
 values = st.recursive(
     scalars,
-    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner,
-                                                                 max_size=4),
+    lambda inner: (
+        st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=8), inner, max_size=4)
+    ),
     max_leaves=30,
 )
 
@@ -69,10 +79,35 @@ def mutated_configs(draw: st.DrawFn) -> Any:
     data: Any = json.loads(json.dumps(VALID))
     for _ in range(draw(st.integers(1, 4))):
         node = data
-        path = draw(st.lists(st.sampled_from(
-            ["controllers", "bus", "motorgroups", "arm", "motors", "m1", "m2", "m3", "id", "type",
-             "angle_limit", "orientation", "offset", "protocol", "attached_motors", "pid",
-             "sensors", "profile", "x"]), min_size=1, max_size=4))
+        path = draw(
+            st.lists(
+                st.sampled_from(
+                    [
+                        "controllers",
+                        "bus",
+                        "motorgroups",
+                        "arm",
+                        "motors",
+                        "m1",
+                        "m2",
+                        "m3",
+                        "id",
+                        "type",
+                        "angle_limit",
+                        "orientation",
+                        "offset",
+                        "protocol",
+                        "attached_motors",
+                        "pid",
+                        "sensors",
+                        "profile",
+                        "x",
+                    ]
+                ),
+                min_size=1,
+                max_size=4,
+            )
+        )
         for key in path[:-1]:
             child = node.get(key) if isinstance(node, dict) else None
             if not isinstance(child, dict):
@@ -113,8 +148,19 @@ adversarial_texts = st.one_of(
     st.integers(1, 20_000).map(lambda n: '{"motors": {"m1": {"id": ' + "9" * n + "}}}"),
     st.integers(1, 20_000).map(lambda n: "motors: {m1: {id: " + "9" * n + "}}"),
     st.text(max_size=300),
-    st.sampled_from(["&a [*a]", "&a {k: *a}", "!!python/object:os.system x", "{", "[1,", "\0",
-                     "--- !!binary AAAA", "? [a]: b", "a: !!float nan"]),
+    st.sampled_from(
+        [
+            "&a [*a]",
+            "&a {k: *a}",
+            "!!python/object:os.system x",
+            "{",
+            "[1,",
+            "\0",
+            "--- !!binary AAAA",
+            "? [a]: b",
+            "a: !!float nan",
+        ]
+    ),
 )
 config_texts = st.one_of(
     adversarial_texts,
@@ -162,8 +208,8 @@ def check_config_data(data: Any) -> None:
 # -- moves ----------------------------------------------------------------------------------------
 
 extreme_floats = st.one_of(
-    st.floats(), st.sampled_from([1e6, 1e-300, 1e308, -1.0, 0.0, MIN_FRAMERATE_HZ,
-                                  MAX_FRAMERATE_HZ, 50.0]),
+    st.floats(),
+    st.sampled_from([1e6, 1e-300, 1e308, -1.0, 0.0, MIN_FRAMERATE_HZ, MAX_FRAMERATE_HZ, 50.0]),
 )
 time_keys = st.one_of(extreme_floats.map(repr), st.sampled_from(["nan", "inf", "-inf", "x", ""]))
 frames = st.dictionaries(
@@ -207,8 +253,9 @@ move_bytes = st.one_of(
     pypot_moves(),
     poppy_moves(),
     st.binary(max_size=300),
-    st.integers(1, 100_000).map(lambda n: b'{"framerate": 50, "positions": ' + b"[" * n
-                                + b"]" * n + b"}"),
+    st.integers(1, 100_000).map(
+        lambda n: b'{"framerate": 50, "positions": ' + b"[" * n + b"]" * n + b"}"
+    ),
 )
 
 

@@ -189,7 +189,8 @@ def test_the_profile_is_written_atomically_and_the_previous_one_kept(tmp_path: P
     assert second.path.read_text().startswith("# calibrated again\n")
     assert load_profile("ergo-jr", tmp_path).motors["m1"].offset == 5.0
     assert sorted(p.name for p in (tmp_path / "ergo-jr").iterdir()) == [
-        "profile.yaml", "profile.yaml.bak"
+        "profile.yaml",
+        "profile.yaml.bak",
     ]  # no temporary file left
 
 

@@ -42,62 +42,126 @@ def _delete(path: str) -> Callable[[Data], None]:
 
 
 CASES: list[tuple[str, Callable[[Data], None], str]] = [
-    ("limit order", _set("motors.m3.angle_limit", [90, -90]),
-     "robot.yaml: motors.m3.angle_limit = [90, -90]: min must be below max"),
-    ("limit equal", _set("motors.m3.angle_limit", [10.5, 10.5]),
-     "robot.yaml: motors.m3.angle_limit = [10.5, 10.5]: min must be below max"),
-    ("limit shape", _set("motors.m3.angle_limit", [1, 2, 3]),
-     "robot.yaml: motors.m3.angle_limit = [1, 2, 3]: must be [min, max] in degrees"),
-    ("limit not a number", _set("motors.m3.angle_limit", [-10, "90"]),
-     'robot.yaml: motors.m3.angle_limit[1] = "90": must be a valid number'),
-    ("id too big", _set("motors.m2.id", 254),
-     "robot.yaml: motors.m2.id = 254: ID must be in 0-253 (254 is broadcast)"),
-    ("id negative", _set("motors.m2.id", -1),
-     "robot.yaml: motors.m2.id = -1: ID must be in 0-253 (254 is broadcast)"),
-    ("id as string", _set("motors.m2.id", "2"),
-     'robot.yaml: motors.m2.id = "2": must be a valid integer'),
-    ("id missing", _delete("motors.m2.id"),
-     "robot.yaml: motors.m2.id: missing (required)"),
-    ("orientation", _set("motors.m1.orientation", "sideways"),
-     "robot.yaml: motors.m1.orientation = \"sideways\": must be 'direct' or 'indirect'"),
-    ("protocol", _set("controllers.upper.protocol", 3),
-     "robot.yaml: controllers.upper.protocol = 3: must be 1 or 2"),
-    ("baudrate", _set("controllers.upper.baudrate", 0),
-     "robot.yaml: controllers.upper.baudrate = 0: must be a positive number of bits/s"),
-    ("sync_read", _set("controllers.upper.sync_read", "yes"),
-     'robot.yaml: controllers.upper.sync_read = "yes": must be a valid boolean'),
-    ("max torque", _set("motors.m1.max_torque", 120),
-     "robot.yaml: motors.m1.max_torque = 120: must be a percentage in 0-100"),
-    ("return delay", _set("motors.m1.return_delay_time", 600),
-     "robot.yaml: motors.m1.return_delay_time = 600: must be in 0-508 µs"),
-    ("pid shape", _set("motors.m1.pid", [1, 2]),
-     "robot.yaml: motors.m1.pid = [1, 2]: must be [p, i, d]"),
-    ("duplicate id", _set("motors.m2.id", 1),
-     "robot.yaml: motors.m2.id = 1: duplicate ID on controller 'upper' (also used by 'm1')"),
-    ("two controllers", _set("controllers.lower.attached_motors", ["m3", "m1"]),
-     "robot.yaml: controllers.lower.attached_motors[1] = \"m1\": motor 'm1' is already "
-     "attached to controller 'upper'"),
-    ("unknown group member", _set("motorgroups.arm", ["m1", "m22"]),
-     "robot.yaml: motorgroups.arm[1] = \"m22\": no motor or group of that name "
-     "(did you mean 'm2'?)"),
-    ("unknown attached name", _set("controllers.upper.attached_motors", ["legs"]),
-     'robot.yaml: controllers.upper.attached_motors[0] = "legs": no motor or group of that '
-     "name"),
-    ("cyclic groups", _set("motorgroups.arm", ["m1", "all"]),
-     'robot.yaml: motorgroups.arm = ["m1", "all"]: cyclic groups: arm → all → arm'),
-    ("self cycle", _set("motorgroups.loop", ["loop"]),
-     'robot.yaml: motorgroups.loop = ["loop"]: cyclic groups: loop → loop'),
-    ("group named like motor", _set("motorgroups.m1", ["m2"]),
-     "robot.yaml: motorgroups.m1 = [\"m2\"]: group name 'm1' is already a motor name"),
-    ("not a mapping", _set("motors", ["m1"]),
-     'robot.yaml: motors = ["m1"]: must be a valid dictionary'),
+    (
+        "limit order",
+        _set("motors.m3.angle_limit", [90, -90]),
+        "robot.yaml: motors.m3.angle_limit = [90, -90]: min must be below max",
+    ),
+    (
+        "limit equal",
+        _set("motors.m3.angle_limit", [10.5, 10.5]),
+        "robot.yaml: motors.m3.angle_limit = [10.5, 10.5]: min must be below max",
+    ),
+    (
+        "limit shape",
+        _set("motors.m3.angle_limit", [1, 2, 3]),
+        "robot.yaml: motors.m3.angle_limit = [1, 2, 3]: must be [min, max] in degrees",
+    ),
+    (
+        "limit not a number",
+        _set("motors.m3.angle_limit", [-10, "90"]),
+        'robot.yaml: motors.m3.angle_limit[1] = "90": must be a valid number',
+    ),
+    (
+        "id too big",
+        _set("motors.m2.id", 254),
+        "robot.yaml: motors.m2.id = 254: ID must be in 0-253 (254 is broadcast)",
+    ),
+    (
+        "id negative",
+        _set("motors.m2.id", -1),
+        "robot.yaml: motors.m2.id = -1: ID must be in 0-253 (254 is broadcast)",
+    ),
+    (
+        "id as string",
+        _set("motors.m2.id", "2"),
+        'robot.yaml: motors.m2.id = "2": must be a valid integer',
+    ),
+    ("id missing", _delete("motors.m2.id"), "robot.yaml: motors.m2.id: missing (required)"),
+    (
+        "orientation",
+        _set("motors.m1.orientation", "sideways"),
+        "robot.yaml: motors.m1.orientation = \"sideways\": must be 'direct' or 'indirect'",
+    ),
+    (
+        "protocol",
+        _set("controllers.upper.protocol", 3),
+        "robot.yaml: controllers.upper.protocol = 3: must be 1 or 2",
+    ),
+    (
+        "baudrate",
+        _set("controllers.upper.baudrate", 0),
+        "robot.yaml: controllers.upper.baudrate = 0: must be a positive number of bits/s",
+    ),
+    (
+        "sync_read",
+        _set("controllers.upper.sync_read", "yes"),
+        'robot.yaml: controllers.upper.sync_read = "yes": must be a valid boolean',
+    ),
+    (
+        "max torque",
+        _set("motors.m1.max_torque", 120),
+        "robot.yaml: motors.m1.max_torque = 120: must be a percentage in 0-100",
+    ),
+    (
+        "return delay",
+        _set("motors.m1.return_delay_time", 600),
+        "robot.yaml: motors.m1.return_delay_time = 600: must be in 0-508 µs",
+    ),
+    (
+        "pid shape",
+        _set("motors.m1.pid", [1, 2]),
+        "robot.yaml: motors.m1.pid = [1, 2]: must be [p, i, d]",
+    ),
+    (
+        "duplicate id",
+        _set("motors.m2.id", 1),
+        "robot.yaml: motors.m2.id = 1: duplicate ID on controller 'upper' (also used by 'm1')",
+    ),
+    (
+        "two controllers",
+        _set("controllers.lower.attached_motors", ["m3", "m1"]),
+        "robot.yaml: controllers.lower.attached_motors[1] = \"m1\": motor 'm1' is already "
+        "attached to controller 'upper'",
+    ),
+    (
+        "unknown group member",
+        _set("motorgroups.arm", ["m1", "m22"]),
+        'robot.yaml: motorgroups.arm[1] = "m22": no motor or group of that name '
+        "(did you mean 'm2'?)",
+    ),
+    (
+        "unknown attached name",
+        _set("controllers.upper.attached_motors", ["legs"]),
+        'robot.yaml: controllers.upper.attached_motors[0] = "legs": no motor or group of that name',
+    ),
+    (
+        "cyclic groups",
+        _set("motorgroups.arm", ["m1", "all"]),
+        'robot.yaml: motorgroups.arm = ["m1", "all"]: cyclic groups: arm → all → arm',
+    ),
+    (
+        "self cycle",
+        _set("motorgroups.loop", ["loop"]),
+        'robot.yaml: motorgroups.loop = ["loop"]: cyclic groups: loop → loop',
+    ),
+    (
+        "group named like motor",
+        _set("motorgroups.m1", ["m2"]),
+        "robot.yaml: motorgroups.m1 = [\"m2\"]: group name 'm1' is already a motor name",
+    ),
+    (
+        "not a mapping",
+        _set("motors", ["m1"]),
+        'robot.yaml: motors = ["m1"]: must be a valid dictionary',
+    ),
 ]
 
 
-@pytest.mark.parametrize(("mutate", "expected"), [c[1:] for c in CASES],
-                         ids=[c[0] for c in CASES])
-def test_error_message(base_config: Callable[[], Data], mutate: Callable[[Data], None],
-                       expected: str) -> None:
+@pytest.mark.parametrize(("mutate", "expected"), [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_error_message(
+    base_config: Callable[[], Data], mutate: Callable[[Data], None], expected: str
+) -> None:
     data = base_config()
     mutate(data)
     with pytest.raises(ConfigError) as info:
@@ -136,8 +200,9 @@ def test_protocol_mismatch(base_config: Callable[[], Data]) -> None:
     with pytest.raises(ConfigError) as info:
         RobotConfig.from_dict(data, source="robot.yaml")
     assert str(info.value) == (
-        'robot.yaml: motors.m1.type = "XL-320": a protocol 2 model on controller \'upper\', '
-        "which uses protocol 1 (set controllers.upper.protocol)")
+        "robot.yaml: motors.m1.type = \"XL-320\": a protocol 2 model on controller 'upper', "
+        "which uses protocol 1 (set controllers.upper.protocol)"
+    )
 
 
 def test_protocol_2_id_253_refused(base_config: Callable[[], Data]) -> None:
@@ -147,7 +212,8 @@ def test_protocol_2_id_253_refused(base_config: Callable[[], Data]) -> None:
     with pytest.raises(ConfigError) as info:
         RobotConfig.from_dict(data, source="robot.yaml")
     assert str(info.value) == (
-        "robot.yaml: motors.m3.id = 253: protocol 2 IDs are 0-252 (controller 'lower')")
+        "robot.yaml: motors.m3.id = 253: protocol 2 IDs are 0-252 (controller 'lower')"
+    )
     data["controllers"]["lower"]["protocol"] = 1
     data["motors"]["m3"]["type"] = "MX-64"
     assert RobotConfig.from_dict(data).motors["m3"].id == 253
@@ -158,11 +224,17 @@ def test_same_id_on_two_buses_is_fine(base_config: Callable[[], Data]) -> None:
     assert config.motors["m1"].id == config.motors["m3"].id == 1
 
 
-def test_unattached_motor_is_a_warning(base_config: Callable[[], Data],
-                                       caplog: pytest.LogCaptureFixture) -> None:
+def test_unattached_motor_is_a_warning(
+    base_config: Callable[[], Data], caplog: pytest.LogCaptureFixture
+) -> None:
     data = base_config()
-    data["motors"]["spare"] = {"id": 9, "type": "MX-28", "orientation": "direct",
-                               "offset": 0.0, "angle_limit": [-10, 10]}
+    data["motors"]["spare"] = {
+        "id": 9,
+        "type": "MX-28",
+        "orientation": "direct",
+        "offset": 0.0,
+        "angle_limit": [-10, 10],
+    }
     with caplog.at_level(logging.WARNING):
         config = RobotConfig.from_dict(data, source="robot.yaml")
     assert config.unattached_motors() == ["spare"]
@@ -170,8 +242,9 @@ def test_unattached_motor_is_a_warning(base_config: Callable[[], Data],
     assert "motors.spare is attached to no controller" in caplog.text
 
 
-def test_typo_in_key_is_a_warning(base_config: Callable[[], Data],
-                                  caplog: pytest.LogCaptureFixture) -> None:
+def test_typo_in_key_is_a_warning(
+    base_config: Callable[[], Data], caplog: pytest.LogCaptureFixture
+) -> None:
     data = base_config()
     data["motors"]["m1"]["max_torq"] = 50
     with caplog.at_level(logging.WARNING):
@@ -197,8 +270,9 @@ def test_file_errors_name_the_file(tmp_path: Path, base_config: Callable[[], Dat
 
 def test_yaml_syntax_error_has_line(tmp_path: Path) -> None:
     path = tmp_path / "robot.yaml"
-    path.write_text("controllers:\n  upper:\n    port: auto\n   bad: [1, 2\nmotors: {}\n",
-                    encoding="utf-8")
+    path.write_text(
+        "controllers:\n  upper:\n    port: auto\n   bad: [1, 2\nmotors: {}\n", encoding="utf-8"
+    )
     with pytest.raises(ConfigError) as info:
         load_config(path)
     message = str(info.value)
@@ -244,7 +318,10 @@ def test_every_problem_is_listed_in_one_pass(base_config: Callable[[], Data]) ->
     assert all("\n" not in line for line in lines)
     assert str(info.value).endswith("(and 3 more problems)")
     assert {p.field for p in info.value.problems} == {
-        "motors.m3.angle_limit", "controllers.upper.protocol", "motors.m2.id", "motorgroups.arm[2]"
+        "motors.m3.angle_limit",
+        "controllers.upper.protocol",
+        "motors.m2.id",
+        "motorgroups.arm[2]",
     }
 
 

@@ -14,10 +14,27 @@ from poppy_core.robot import RobotConfig, config_to_text
 
 NAMES = st.from_regex(r"[a-z][a-z0-9_]{0,7}", fullmatch=True)
 FINITE = st.floats(min_value=-360, max_value=360, allow_nan=False) | st.integers(-360, 360)
-JSON_SCALARS = (st.none() | st.booleans() | st.integers(-(2**40), 2**40)
-                | st.floats(allow_nan=False, allow_infinity=False) | st.text(max_size=12))
-SENSOR_KEYS = {"type", "fps", "freq", "resolution", "calibration", "cameras", "cards",
-               "marker_size", "families", "index", "device", "sim_camera"}
+JSON_SCALARS = (
+    st.none()
+    | st.booleans()
+    | st.integers(-(2**40), 2**40)
+    | st.floats(allow_nan=False, allow_infinity=False)
+    | st.text(max_size=12)
+)
+SENSOR_KEYS = {
+    "type",
+    "fps",
+    "freq",
+    "resolution",
+    "calibration",
+    "cameras",
+    "cards",
+    "marker_size",
+    "families",
+    "index",
+    "device",
+    "sim_camera",
+}
 JSON_VALUES = st.recursive(
     JSON_SCALARS,
     lambda inner: st.lists(inner, max_size=3) | st.dictionaries(NAMES, inner, max_size=3),
@@ -31,8 +48,7 @@ def _model_names(protocol: int) -> list[str]:
 
 @st.composite
 def motor(draw: st.DrawFn, motor_id: int, protocol: int) -> dict[str, Any]:
-    low, high = sorted(draw(st.lists(FINITE, min_size=2, max_size=2, unique_by=float)),
-                       key=float)
+    low, high = sorted(draw(st.lists(FINITE, min_size=2, max_size=2, unique_by=float)), key=float)
     data: dict[str, Any] = {
         "id": motor_id,
         "type": draw(st.sampled_from(_model_names(protocol))),
@@ -63,8 +79,9 @@ def robot_configs(draw: st.DrawFn) -> dict[str, Any]:
         protocol = draw(st.sampled_from([1, 2]))
         mine = motor_names[index::n_controllers]
         top_id = 253 if protocol == 1 else 252  # e-manual: protocol 2 reserves 253 (0xFD)
-        ids = draw(st.lists(st.integers(0, top_id), min_size=len(mine), max_size=len(mine),
-                            unique=True))
+        ids = draw(
+            st.lists(st.integers(0, top_id), min_size=len(mine), max_size=len(mine), unique=True)
+        )
         for name, motor_id in zip(mine, ids, strict=True):
             motors[name] = draw(motor(motor_id, protocol))
         attached: list[str] = list(mine)
@@ -82,8 +99,9 @@ def robot_configs(draw: st.DrawFn) -> dict[str, Any]:
             controller["protocol"] = protocol
         if draw(st.booleans()):
             controller["baudrate"] = draw(st.sampled_from([57_600, 1_000_000, 3_000_000]))
-            controller["syncloop"] = draw(st.sampled_from(["BaseDxlController",
-                                                           "LightDxlController"]))
+            controller["syncloop"] = draw(
+                st.sampled_from(["BaseDxlController", "LightDxlController"])
+            )
         controllers[cname] = controller
     data: dict[str, Any] = {"controllers": controllers, "motorgroups": groups, "motors": motors}
     if draw(st.booleans()):
@@ -116,5 +134,6 @@ def test_round_trips(data: dict[str, Any]) -> None:
         ids = [config.motors[m].id for m in config.motors_of_controller(cname)]
         assert len(ids) == len(set(ids))
         assert set(config.motors_of_controller(cname)) >= set(controller.attached_motors) - set(
-            config.motorgroups)
+            config.motorgroups
+        )
     assert config.unattached_motors() == []

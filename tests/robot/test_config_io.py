@@ -27,7 +27,9 @@ def _leftovers(directory: Path) -> list[str]:
 
 @pytest.mark.parametrize("boom_at", ["fsync", "replace"])
 def test_failed_dump_leaves_old_file_intact(
-    tmp_path: Path, base_config: Callable[[], Data], monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+    base_config: Callable[[], Data],
+    monkeypatch: pytest.MonkeyPatch,
     boom_at: str,
 ) -> None:
     target = tmp_path / "robot.yaml"
@@ -105,8 +107,12 @@ def test_pypot_json_drops_profile_header_yaml_keeps_it(
     tmp_path: Path, base_config: Callable[[], Data]
 ) -> None:
     data = base_config()
-    data["profile"] = {"name": "mine", "description": "a test robot", "kind": "arm",
-                       "source": "here"}
+    data["profile"] = {
+        "name": "mine",
+        "description": "a test robot",
+        "kind": "arm",
+        "source": "here",
+    }
     config = RobotConfig.from_dict(data)
     dump_config(config, tmp_path / "r.json")
     dump_config(config, tmp_path / "r.yaml")

@@ -91,21 +91,35 @@ def test_defaults(base_config: Any) -> None:
 
 def test_optional_motor_fields(base_config: Any) -> None:
     data = base_config()
-    data["motors"]["m1"].update(return_delay_time=0, max_torque=80, pid=[4, 0, 0.5],
-                                wheel_mode=True)
+    data["motors"]["m1"].update(
+        return_delay_time=0, max_torque=80, pid=[4, 0, 0.5], wheel_mode=True
+    )
     config = RobotConfig.from_dict(data)
     motor = config.motors["m1"]
     assert (motor.return_delay_time, motor.max_torque, motor.pid, motor.wheel_mode) == (
-        0, 80.0, (4.0, 0.0, 0.5), True)
+        0,
+        80.0,
+        (4.0, 0.0, 0.5),
+        True,
+    )
     assert config.to_pypot_dict() == data
 
 
 def test_resolve_group_flattens_in_order() -> None:
     config = load_config(Path(__file__).parent / "data" / "poppy_humanoid.json")
-    assert config.resolve_group("l_leg") == ["l_hip_x", "l_hip_z", "l_hip_y", "l_knee_y",
-                                             "l_ankle_y"]
-    assert config.resolve_group("arms")[:4] == ["l_shoulder_y", "l_shoulder_x", "l_arm_z",
-                                                "l_elbow_y"]
+    assert config.resolve_group("l_leg") == [
+        "l_hip_x",
+        "l_hip_z",
+        "l_hip_y",
+        "l_knee_y",
+        "l_ankle_y",
+    ]
+    assert config.resolve_group("arms")[:4] == [
+        "l_shoulder_y",
+        "l_shoulder_x",
+        "l_arm_z",
+        "l_elbow_y",
+    ]
     assert config.resolve_group("head_z") == ["head_z"]
     lower = config.motors_of_controller("lower_body_controller")
     upper = config.motors_of_controller("upper_body_controller")

@@ -14,10 +14,13 @@ from poppy_core.errors import ConfigError
 from poppy_core.robot import load_config
 
 # The classic "billion laughs": 9 levels of 9 aliases, 9**9 = 387 million strings once expanded.
-ALIAS_BOMB = "\n".join(
-    [f'a0: &a0 [{",".join(["lol"] * 9)}]']
-    + [f"a{i}: &a{i} [{','.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]
-) + "\n"
+ALIAS_BOMB = (
+    "\n".join(
+        [f"a0: &a0 [{','.join(['lol'] * 9)}]"]
+        + [f"a{i}: &a{i} [{','.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]
+    )
+    + "\n"
+)
 
 
 def test_the_alias_bomb_is_small() -> None:
@@ -62,8 +65,11 @@ def test_deep_json_is_one_error(document: str) -> None:
 
 @pytest.mark.parametrize(
     "document",
-    ["a: " + "[" * 100_000 + "]" * 100_000, "a:\n" + "".join(f"{' ' * i}- \n" for i in range(40)),
-     "a: " + "{b: " * 5000 + "1" + "}" * 5000],
+    [
+        "a: " + "[" * 100_000 + "]" * 100_000,
+        "a:\n" + "".join(f"{' ' * i}- \n" for i in range(40)),
+        "a: " + "{b: " * 5000 + "1" + "}" * 5000,
+    ],
     ids=["deep flow", "deep block", "deep mapping"],
 )
 def test_deep_yaml_is_one_error(document: str) -> None:

@@ -136,9 +136,10 @@ def test_eeprom_written_at_start_up_on_stiff_motors_which_stay_stiff(
         motor.table.set("torque_enable", 1)
     url = serve(served, bus)
     config = load_profile("ergo-jr")
-    with caplog.at_level("WARNING"), from_profile(
-        "ergo-jr", port=url, sensors=False, fix_return_delay=True
-    ) as robot:
+    with (
+        caplog.at_level("WARNING"),
+        from_profile("ergo-jr", port=url, sensors=False, fix_return_delay=True) as robot,
+    ):
         assert [m.compliant for m in robot.motors] == [False] * 3 + [True] * 3
     assert [r.getMessage() for r in caplog.records if r.levelname == "WARNING"] == []
     assert [m.table.get("return_delay_time") for m in bus.motors] == [0] * 6

@@ -39,8 +39,9 @@ def test_move_files() -> None:
 
 def test_the_issue_documents() -> None:
     check_config_text(ALIAS_BOMB_ISSUE)
-    check_move_bytes(b'{"framerate": 1e6, "positions": {"0.0": {"m1": [0, 0]}, '
-                     b'"100000.0": {"m1": [1, 0]}}}')
+    check_move_bytes(
+        b'{"framerate": 1e6, "positions": {"0.0": {"m1": [0, 0]}, "100000.0": {"m1": [1, 0]}}}'
+    )
 
 
 def _limits() -> None:

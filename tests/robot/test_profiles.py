@@ -47,9 +47,14 @@ def test_each_profile_loads(name: str) -> None:
     assert config.unattached_motors() == []
 
 
-@pytest.mark.parametrize(("profile", "public"), [
-    ("ergo-jr", "poppy_ergo_jr"), ("torso", "poppy_torso"), ("humanoid", "poppy_humanoid"),
-])
+@pytest.mark.parametrize(
+    ("profile", "public"),
+    [
+        ("ergo-jr", "poppy_ergo_jr"),
+        ("torso", "poppy_torso"),
+        ("humanoid", "poppy_humanoid"),
+    ],
+)
 def test_profile_matches_public_config(profile: str, public: str) -> None:
     mine = load_profile(profile)
     theirs = load_config(DATA_DIR / f"{public}.json")
@@ -58,7 +63,12 @@ def test_profile_matches_public_config(profile: str, public: str) -> None:
     for name, motor in mine.motors.items():
         other = theirs.motors[name]
         assert (motor.id, motor.type, motor.orientation, motor.offset, motor.angle_limit) == (
-            other.id, other.type, other.orientation, other.offset, other.angle_limit)
+            other.id,
+            other.type,
+            other.orientation,
+            other.offset,
+            other.angle_limit,
+        )
     for name, controller in mine.controllers.items():
         assert mine.motors_of_controller(name) == theirs.motors_of_controller(name)
         assert controller.protocol == theirs.controllers[name].protocol
@@ -78,8 +88,9 @@ def test_humanoid_on_two_buses() -> None:
     assert len(config.motors) == 25
 
 
-@pytest.mark.parametrize("spelling", ["ergo_jr", "Ergo-Jr", "poppy-ergo-jr", "poppy_ergo_jr",
-                                      "ERGOJR"])
+@pytest.mark.parametrize(
+    "spelling", ["ergo_jr", "Ergo-Jr", "poppy-ergo-jr", "poppy_ergo_jr", "ERGOJR"]
+)
 def test_name_variants(spelling: str) -> None:
     assert find_profile(spelling).name == "ergo-jr"
 
@@ -88,7 +99,8 @@ def test_unknown_profile_lists_known() -> None:
     with pytest.raises(ConfigError) as info:
         load_profile("poppy-dragster")
     assert str(info.value) == (
-        'profiles: profile = "poppy-dragster": unknown profile; known: ergo-jr, humanoid, torso')
+        'profiles: profile = "poppy-dragster": unknown profile; known: ergo-jr, humanoid, torso'
+    )
 
 
 def test_user_dir_follows_platformdirs(_isolated_user_config: Path) -> None:
@@ -128,7 +140,8 @@ def test_broken_user_profile_is_skipped_in_list_but_fails_on_load(tmp_path: Path
     (user_dir / "bad" / "profile.yaml").write_text("controllers: [\n", encoding="utf-8")
     (user_dir / "worse").mkdir()
     (user_dir / "worse" / "profile.yaml").write_text(
-        "profile: {name: worse}\ncontrollers: {}\nmotors: {m1: {id: 300}}\n", encoding="utf-8")
+        "profile: {name: worse}\ncontrollers: {}\nmotors: {m1: {id: 300}}\n", encoding="utf-8"
+    )
     names = [info.name for info in list_profiles(user_dir=user_dir)]
     assert "bad" not in names and "worse" in names
     with pytest.raises(ConfigError, match=r"profile.yaml: motors.m1.id = 300: ID must be"):

@@ -16,7 +16,6 @@ from tests.helpers.fixtures import ergo_fixture
 CONTROLLER = "my_dxl_controller"
 
 
-
 ergo = ergo_fixture()
 
 
@@ -135,12 +134,16 @@ def test_to_config_reflects_the_motors(ergo: Robot) -> None:
     assert config.motors["m1"].angle_limit == (-100, 100)
     assert config.controllers[CONTROLLER].port == "auto"
     assert ergo.to_config()["motors"]["m1"]["angle_limit"] == [-100, 100]
-    assert eventually(lambda: virtual(ergo, 1).table.get_si("max_position_limit") == pytest.approx(
-        100, abs=0.3), 2.0)
+    assert eventually(
+        lambda: virtual(ergo, 1).table.get_si("max_position_limit") == pytest.approx(100, abs=0.3),
+        2.0,
+    )
     ergo.m2.angle_limit = (-120, 80)  # user frame; m2 is indirect
     assert ergo.to_robot_config().motors["m2"].angle_limit == (-80, 120)  # configs: motor frame
-    assert eventually(lambda: virtual(ergo, 2).table.get_si("max_position_limit") == pytest.approx(
-        120, abs=0.3), 2.0)
+    assert eventually(
+        lambda: virtual(ergo, 2).table.get_si("max_position_limit") == pytest.approx(120, abs=0.3),
+        2.0,
+    )
 
 
 def test_close_stops_every_thread() -> None:

@@ -80,9 +80,7 @@ def test_a_group_name_is_its_motors(ergo: Robot) -> None:
 
 
 @pytest.mark.parametrize("motors", ["head_z", ["m1", "head_z"], ("m1", 3)])
-def test_unknown_motors_are_refused_when_the_primitive_is_built(
-    ergo: Robot, motors: Any
-) -> None:
+def test_unknown_motors_are_refused_when_the_primitive_is_built(ergo: Robot, motors: Any) -> None:
     with pytest.raises(PoppyError) as caught:
         Sinus(ergo, 50, motors)
     message = str(caught.value)

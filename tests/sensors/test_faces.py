@@ -62,7 +62,7 @@ def test_the_face_is_found_at_other_sizes_and_places(finder: FaceFinder, scale: 
     size = round(512 * scale)
     resized = cv2.resize(image, (size, size))
     canvas = np.full((max(size, 480), max(size, 640) + 100, 3), 200, dtype=np.uint8)
-    canvas[: size, 100 : 100 + size] = resized  # moved right by 100 px
+    canvas[:size, 100 : 100 + size] = resized  # moved right by 100 px
     faces = finder.find(canvas)
     box = tuple(v * scale + (100 if i % 2 == 0 else 0) for i, v in enumerate(FACE_BOX))
     assert faces and inside(faces[0].center, box), (faces, box)  # the surest first
@@ -124,7 +124,10 @@ def test_a_face_detector_on_a_video_file_from_a_config(tmp_path: Path) -> None:
     section: dict[str, Any] = {
         "camera": {"type": "OpenCVCamera", "index": str(path), "fps": 20.0},
         "face_detector": {
-            "type": "FaceDetector", "cameras": ["camera"], "freq": 4.0, "min_size": 30
+            "type": "FaceDetector",
+            "cameras": ["camera"],
+            "freq": 4.0,
+            "min_size": 30,
         },
     }
     sensors = build_sensors(checked_sensors(section), opencv_camera)

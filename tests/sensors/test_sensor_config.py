@@ -22,8 +22,12 @@ def with_sensors(sensors: dict[str, Any]) -> dict[str, Any]:
 
 @pytest.mark.parametrize(
     ("kind", "name"),
-    [("KinectSensor", "Kinect"), ("OptiTrackClient", "OptiTrack"), ("IMU", "IMU"),
-     ("ForceSensor", "force")],
+    [
+        ("KinectSensor", "Kinect"),
+        ("OptiTrackClient", "OptiTrack"),
+        ("IMU", "IMU"),
+        ("ForceSensor", "force"),
+    ],
 )
 def test_sensors_not_built_yet_are_one_line_errors(kind: str, name: str) -> None:
     with pytest.raises(ConfigError) as caught:
@@ -42,8 +46,13 @@ def test_sensors_not_built_yet_are_one_line_errors(kind: str, name: str) -> None
         ({"cam": {"type": "OpenCVCamera", "resolution": [640]}}, "resolution = [640]: must be"),
         ({"cam": {"type": "OpenCVCamera", "calibration": {"camera_matrix": [1]}}}, "calibration"),
         ({"md": {"type": "MarkerDetector", "cameras": ["cam"]}}, "'cam' is not a camera here"),
-        ({"cam": {"type": "DummyCamera"}, "md": {"type": "MarkerDetector", "cameras": ["cam"],
-          "cards": {"caribou": "x"}}}, "sensors.md.cards.caribou"),
+        (
+            {
+                "cam": {"type": "DummyCamera"},
+                "md": {"type": "MarkerDetector", "cameras": ["cam"], "cards": {"caribou": "x"}},
+            },
+            "sensors.md.cards.caribou",
+        ),
         ({"m1": {"type": "DummyCamera"}}, "sensor 'm1' has the name of a motor or group"),
         ({"cam": "OpenCVCamera"}, 'sensors.cam = "OpenCVCamera": must be a valid dictionary'),
     ],
@@ -57,8 +66,12 @@ def test_bad_sensor_entries_are_one_line_errors(sensors: dict[str, Any], words: 
 def test_pypot_sections_load_and_round_trip() -> None:
     sensors = {
         "camera": {"type": "OpenCVCamera", "index": -1, "fps": 20.0, "resolution": [640, 480]},
-        "marker_detector": {"type": "MarkerDetector", "cameras": ["camera"], "freq": 1.0,
-                            "need_robot": True},
+        "marker_detector": {
+            "type": "MarkerDetector",
+            "cameras": ["camera"],
+            "freq": 1.0,
+            "need_robot": True,
+        },
     }
     config = RobotConfig.from_dict(with_sensors(sensors))
     assert config.to_pypot_dict()["sensors"] == sensors

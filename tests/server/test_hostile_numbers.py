@@ -168,7 +168,6 @@ def zmq_property(prop: str, value: float) -> dict[str, Any]:
 # -- the table -------------------------------------------------------------------------------
 
 
-
 def goto(position: str, duration: str) -> str:
     return '{"positions": {"m1": P}, "duration_s": D}'.replace("P", position).replace("D", duration)
 

@@ -21,9 +21,7 @@ from poppy_core.server.moves import MoveService
 from tests.helpers.server import Served, serve
 
 
-def test_a_failed_save_keeps_the_recording(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_a_failed_save_keeps_the_recording(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path))
     real_save = moves_module.save_move
 
@@ -56,8 +54,12 @@ def full_library(tmp_path: Path) -> Iterator[Path]:
     folder.mkdir()
     if os.geteuid() != 0:
         pytest.skip("mounting a tmpfs needs root")
-    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=32k", "tmpfs", str(folder)],
-                      capture_output=True).returncode != 0:
+    if (
+        subprocess.run(
+            ["mount", "-t", "tmpfs", "-o", "size=32k", "tmpfs", str(folder)], capture_output=True
+        ).returncode
+        != 0
+    ):
         pytest.skip("cannot mount a tmpfs")
     (folder / "filler").write_bytes(b"\0" * 30_000)  # all 8 pages of the tmpfs
     try:

@@ -76,9 +76,10 @@ def test_v1_sensors_describe_and_report_health(client: httpx.Client) -> None:
 
 
 def test_the_mjpeg_stream_sends_jpeg_parts(served: Served) -> None:
-    with httpx.Client(base_url=served.url, timeout=10.0) as http, http.stream(
-        "GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 30}
-    ) as answer:
+    with (
+        httpx.Client(base_url=served.url, timeout=10.0) as http,
+        http.stream("GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 30}) as answer,
+    ):
         assert answer.status_code == 200
         assert answer.headers["content-type"] == "multipart/x-mixed-replace; boundary=frame"
         received = b""
@@ -110,9 +111,10 @@ def test_the_mjpeg_stream_waits_between_tries_of_a_camera_failed_for_good(
         raise SensorError("camera 'camera': unplugged for good", sensor="camera")
 
     monkeypatch.setattr(camera, "next_frame", failed_for_good)
-    with httpx.Client(base_url=served.url, timeout=10.0) as http, http.stream(
-        "GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 30}
-    ) as answer:
+    with (
+        httpx.Client(base_url=served.url, timeout=10.0) as http,
+        http.stream("GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 30}) as answer,
+    ):
         assert answer.status_code == 200
         assert eventually(lambda: len(tries) >= 2, 10.0)
         first = len(tries)

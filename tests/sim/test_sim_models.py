@@ -194,9 +194,7 @@ def test_home_pose_has_the_head_level(robot: str) -> None:
         ("r_arm_z", 30.0, 0, +1),
     ],
 )
-def test_arm_directions(
-    robot: str, joint: str, angle: float, axis: int, direction: int
-) -> None:
+def test_arm_directions(robot: str, joint: str, angle: float, axis: int, direction: int) -> None:
     bent = {"l_elbow_y": -90.0, "r_elbow_y": -90.0} if robot == "humanoid" else {}
     side = joint[0]
     before = _hands(robot, bent)[side][axis]

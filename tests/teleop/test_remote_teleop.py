@@ -139,8 +139,10 @@ def _ask(ws: Any, message: dict[str, Any]) -> dict[str, Any]:
 def test_websocket_messages_are_checked(served: Served) -> None:
     ws_url = served.url.replace("http://", "ws://") + "/api/v1/ws?rate_hz=5"
     with connect(ws_url) as ws, connect(ws_url) as other:
-        assert "send teleop.start first" in _ask(ws, {"type": "teleop.goals",
-                                                      "positions": {"m1": 1}})["error"]
+        assert (
+            "send teleop.start first"
+            in _ask(ws, {"type": "teleop.goals", "positions": {"m1": 1}})["error"]
+        )
         assert "unknown message type" in _ask(ws, {"type": "teleop.dance"})["error"]
         assert "no motor m9" in _ask(ws, {"type": "teleop.start", "motors": ["m9"]})["error"]
         assert "watchdog_s" in _ask(ws, {"type": "teleop.start", "watchdog_s": 60})["error"]

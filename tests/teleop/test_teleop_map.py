@@ -64,7 +64,8 @@ def test_yaml_file(tmp_path: Path) -> None:
     file = tmp_path / "map.yaml"
     file.write_text("r_elbow_y: m3\nr_arm_z: {leader: m4, scale: -1, offset: 5}\n")
     assert JointMap.load(file).links == (
-        JointLink("r_elbow_y", "m3"), JointLink("r_arm_z", "m4", -1.0, 5.0)
+        JointLink("r_elbow_y", "m3"),
+        JointLink("r_arm_z", "m4", -1.0, 5.0),
     )
     for text, message in [
         ("[m1, m2]", "a mapping follower: leader"),

@@ -59,8 +59,10 @@ class ScreenAnswers:
     def move(self, motors: Sequence[str], watch: RangeWatch) -> bool:
         """Show the joints' ranges live; Continue when they went through their range."""
         which = motors[0] if len(motors) == 1 else "each joint"
-        text = (f"Move {which} slowly from one end of its range to the other, back to the "
-                "posture, then Continue.")  # fmt: skip
+        text = (
+            f"Move {which} slowly from one end of its range to the other, back to the "
+            "posture, then Continue."
+        )
         return self._ask(lambda: self.screen.show_step("Ranges", text, watch))
 
     def confirm(self, question: str) -> bool:
@@ -98,14 +100,17 @@ class CalibrationScreen(ModalScreen[str | None]):
 
     def compose(self) -> ComposeResult:
         with Vertical(id="calibration"):
-            yield Static(Text(f"Calibrate → user profile {self.profile_name!r}", style="bold"),
-                         id="calibration-title")  # fmt: skip
+            yield Static(
+                Text(f"Calibrate → user profile {self.profile_name!r}", style="bold"),
+                id="calibration-title",
+            )
             yield Static(Text("starting…"), id="calibration-text")
             yield DataTable[str](id="calibration-ranges", cursor_type="none")
             yield Static(Text(""), id="calibration-event")
             with Horizontal(id="calibration-buttons"):
-                yield Button("Continue", id="calibration-continue", variant="primary",
-                             disabled=True)  # fmt: skip
+                yield Button(
+                    "Continue", id="calibration-continue", variant="primary", disabled=True
+                )
                 yield Button("Cancel", id="calibration-cancel", variant="error")
 
     def on_mount(self) -> None:
@@ -167,8 +172,13 @@ class CalibrationScreen(ModalScreen[str | None]):
 
     @staticmethod
     def _range_cells(reading: Any) -> tuple[str, ...]:
-        return (reading.motor, fixed(reading.current), fixed(reading.low),
-                fixed(reading.high), fixed(reading.span))  # fmt: skip
+        return (
+            reading.motor,
+            fixed(reading.current),
+            fixed(reading.low),
+            fixed(reading.high),
+            fixed(reading.span),
+        )
 
     def _refresh_ranges(self) -> None:
         if self._watch is None:

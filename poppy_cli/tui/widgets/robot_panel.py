@@ -271,8 +271,11 @@ class RobotPanel(Vertical):
             return
         profile = robot.config.profile if robot.config is not None else None
         if profile is None:
-            self.notify("this robot has no profile name to calibrate into: use "
-                        "`poppy calibrate --name NAME`", severity="warning")  # fmt: skip
+            self.notify(
+                "this robot has no profile name to calibrate into: use "
+                "`poppy calibrate --name NAME`",
+                severity="warning",
+            )
             return
         choice = self.query_one("#robot-group", Select).value
         motors = (

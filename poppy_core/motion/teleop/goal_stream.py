@@ -134,8 +134,9 @@ class GoalStream:
             if unknown:
                 raise UnknownMotorError(
                     f"not followed: {', '.join(unknown)} (followed: {', '.join(by_name)})",
-                    motor=str(unknown[0]), known=list(by_name),
-                )  # fmt: skip
+                    motor=str(unknown[0]),
+                    known=list(by_name),
+                )
             self._last_target_s = now
             if self.state in ("held", "idle"):
                 self._begin_ramp(targets, now)

@@ -61,9 +61,10 @@ class JointMap:
         for link in self.links:
             if link.follower in seen:
                 raise ConfigError(
-                    f"follower joint {link.follower!r} is mapped twice", field="map",
+                    f"follower joint {link.follower!r} is mapped twice",
+                    field="map",
                     value=link.follower,
-                )  # fmt: skip
+                )
             seen.add(link.follower)
             if not (math.isfinite(link.scale) and math.isfinite(link.offset)):
                 raise ConfigError(f"{link}: scale and offset must be finite", field="map")
@@ -107,9 +108,7 @@ class JointMap:
     # -- building ----------------------------------------------------------------------------
 
     @classmethod
-    def same_names(
-        cls, leader_motors: Sequence[str], follower_motors: Sequence[str]
-    ) -> JointMap:
+    def same_names(cls, leader_motors: Sequence[str], follower_motors: Sequence[str]) -> JointMap:
         """Each follower joint driven by the leader joint of the same name.
 
         Raises:
@@ -138,9 +137,10 @@ class JointMap:
             match = _ENTRY.match(part)
             if match is None:
                 raise ConfigError(
-                    f"{part.strip()!r} is not a joint link: write {SYNTAX}", field="map",
+                    f"{part.strip()!r} is not a joint link: write {SYNTAX}",
+                    field="map",
                     value=part.strip(),
-                )  # fmt: skip
+                )
             scale = float(match["scale"]) if match["scale"] else 1.0
             if match["sign"]:
                 scale = -scale
@@ -199,6 +199,7 @@ class JointMap:
             ConfigError: the file cannot be read or is not a joint map.
         """
         file = Path(path)
-        data = parse_yaml(read_limited(file, MAP_LIMITS.max_bytes, "joint map"), str(file),
-                          MAP_LIMITS)  # fmt: skip
+        data = parse_yaml(
+            read_limited(file, MAP_LIMITS.max_bytes, "joint map"), str(file), MAP_LIMITS
+        )
         return cls.from_data(data, str(file))

@@ -127,11 +127,12 @@ class Teleoperation:
         self.rate_hz = float(rate_hz)
         self.duration_s = duration_s
         self.recorder = (
-            TrajectoryRecorder(record, self.joint_map.followers, self.rate_hz,
-                               metadata=record_metadata)
+            TrajectoryRecorder(
+                record, self.joint_map.followers, self.rate_hz, metadata=record_metadata
+            )
             if record is not None
             else None
-        )  # fmt: skip
+        )
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()
@@ -295,8 +296,9 @@ class Teleoperation:
             raise _LeaderLost(f"leader read failed: {exc}") from exc
         silent = [m.name for m in self._leader_motors if not m.online]
         if silent:
-            raise _LeaderLost(f"leader motor{'s' if len(silent) > 1 else ''} "
-                              f"{', '.join(silent)} not answering")  # fmt: skip
+            raise _LeaderLost(
+                f"leader motor{'s' if len(silent) > 1 else ''} {', '.join(silent)} not answering"
+            )
         return {m.name: m.present_position for m in self._leader_motors}
 
     def _follow(self, tick: float, positions: dict[str, float]) -> None:
@@ -401,7 +403,14 @@ def teleoperate(
     """
     mapping = JointMap.parse(joint_map) if isinstance(joint_map, str) else joint_map
     teleop = Teleoperation(
-        leader, follower, mapping, rate_hz=rate_hz, ramp_s=ramp_s, duration_s=duration_s,
-        record=record, record_metadata=record_metadata, on_change=on_change,
-    )  # fmt: skip
+        leader,
+        follower,
+        mapping,
+        rate_hz=rate_hz,
+        ramp_s=ramp_s,
+        duration_s=duration_s,
+        record=record,
+        record_metadata=record_metadata,
+        on_change=on_change,
+    )
     return teleop.start()

@@ -66,10 +66,12 @@ def ip_json() -> PypotJSON:
     ip = local_ip()
     if ip is None:
         return PypotJSON(
-            {"error": "Cannot find ip of your Poppy Robot",
-             "tip": "this machine has no network route: check its connection (ip addr)"},
+            {
+                "error": "Cannot find ip of your Poppy Robot",
+                "tip": "this machine has no network route: check its connection (ip addr)",
+            },
             status_code=404,
-        )  # fmt: skip
+        )
     return PypotJSON({"ip": ip})
 
 

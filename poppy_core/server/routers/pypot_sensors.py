@@ -56,8 +56,11 @@ async def set_sensor_register(sensor: str, register: str, request: Request) -> P
     """404 unknown; 400 otherwise: the sensors' registers are read-only."""
     if register not in sensors_of(request).registers(sensor):
         await run_in_threadpool(sensors_of(request).read, sensor, register)  # raises not found
-    raise ApiError("invalid", f"register '{register}' of sensor '{sensor}' is read-only",
-                   tip="the sensors' registers can only be read")  # fmt: skip
+    raise ApiError(
+        "invalid",
+        f"register '{register}' of sensor '{sensor}' is read-only",
+        tip="the sensors' registers can only be read",
+    )
 
 
 @router.get("/sensors/{sensor}/frame.{ext}", summary="The camera's latest frame (png or jpg)")

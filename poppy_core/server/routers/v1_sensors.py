@@ -31,10 +31,14 @@ async def sensors(request: Request) -> list[dict[str, Any]]:
     """One entry per sensor, in config order."""
     service = sensors_of(request)
     return [
-        {"name": s.name, "type": s.kind, "registers": list(s.registers),
-         "health": s.health().as_dict()}
+        {
+            "name": s.name,
+            "type": s.kind,
+            "registers": list(s.registers),
+            "health": s.health().as_dict(),
+        }
         for s in service.robot.sensors
-    ]  # fmt: skip
+    ]
 
 
 @router.get("/sensors/health", summary="Sensor name -> its health")
@@ -78,8 +82,12 @@ async def mjpeg(camera: Camera, request: Request, fps: float) -> AsyncIterator[b
         number = latest.number
         jpeg = await run_in_threadpool(encode_image, latest.image, ".jpg", MJPEG_QUALITY)
         yield (
-            f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(jpeg)}\r\n\r\n"
-        ).encode() + jpeg + b"\r\n"
+            (
+                f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(jpeg)}\r\n\r\n"
+            ).encode()
+            + jpeg
+            + b"\r\n"
+        )
         await asyncio.sleep(max(0.0, period - (loop.time() - started)))
 
 

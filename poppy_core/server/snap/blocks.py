@@ -84,9 +84,11 @@ class RobotFacts:
         """The default text of an input (``@...`` keys filled from the robot)."""
         if not key.startswith("@"):
             return key
-        first_primitive = next(
-            (p for p in self.primitives if self.properties.get(p)), self.primitives[0]
-        ) if self.primitives else "dance"  # fmt: skip
+        first_primitive = (
+            next((p for p in self.primitives if self.properties.get(p)), self.primitives[0])
+            if self.primitives
+            else "dance"
+        )
         chain = next(iter(self.chains), "chain")
         tip = self.chains.get(chain, [0.0, 0.0, 0.1])
         values = {
@@ -252,9 +254,22 @@ def project(
     root = E("project", name=name, app=APP, version="1")
     sub(root, "notes", notes)
     sub(root, "thumbnail")
-    stage = sub(root, "stage", name="Stage", width="480", height="360", costume="0",
-                tempo="60", threadsafe="false", lines="round", codify="false",
-                inheritance="true", sublistIDs="false", scheduled="false", id="1")  # fmt: skip
+    stage = sub(
+        root,
+        "stage",
+        name="Stage",
+        width="480",
+        height="360",
+        costume="0",
+        tempo="60",
+        threadsafe="false",
+        lines="round",
+        codify="false",
+        inheritance="true",
+        sublistIDs="false",
+        scheduled="false",
+        id="1",
+    )
     sub(stage, "pentrails")
     sub(sub(stage, "costumes"), "list", struct="atomic")
     sub(sub(stage, "sounds"), "list", struct="atomic")
@@ -262,9 +277,24 @@ def project(
     sub(stage, "blocks")
     sub(stage, "scripts")
     sprites = sub(stage, "sprites", select="1")
-    sprite = sub(sprites, "sprite", name="Poppy", idx="1", x="0", y="0", heading="90",
-                 scale="1", volume="100", pan="0", rotation="1", draggable="true",
-                 costume="0", color="80,80,80,1", pen="tip", id="2")  # fmt: skip
+    sprite = sub(
+        sprites,
+        "sprite",
+        name="Poppy",
+        idx="1",
+        x="0",
+        y="0",
+        heading="90",
+        scale="1",
+        volume="100",
+        pan="0",
+        rotation="1",
+        draggable="true",
+        costume="0",
+        color="80,80,80,1",
+        pen="tip",
+        id="2",
+    )
     sub(sub(sprite, "costumes"), "list", struct="atomic")
     sub(sub(sprite, "sounds"), "list", struct="atomic")
     sub(sprite, "blocks")

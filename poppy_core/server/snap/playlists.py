@@ -49,9 +49,9 @@ class Playlists:
             missing = [motor for motor in move.motors if motor not in known]
             if missing:
                 raise ApiError(
-                    "invalid", f"the move {name!r} drives motors this robot lacks: "
-                    f"{', '.join(missing)}"
-                )  # fmt: skip
+                    "invalid",
+                    f"the move {name!r} drives motors this robot lacks: {', '.join(missing)}",
+                )
             total += move.duration_s
         return total
 
