@@ -218,6 +218,12 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
     "snap": (
         ("snap blocks -o poppy-blocks.xml --profile ergo-jr", "the Poppy blocks"),
         ("snap project first-steps -o . --profile ergo-jr", "an example project"),
+        ("snap download", "Snap! itself, once, for offline classes"),
+    ),
+    "snap download": (
+        ("snap download", "the pinned Snap! release, once (then `serve --snap` is offline)"),
+        ("snap download --from file:///media/usb/Snap-11.0.8.zip", "from a USB stick"),
+        ("snap download 11.0.8 --from https://mirror.example/Snap.zip --force", "a mirror"),
     ),
     "snap blocks": (
         ("snap blocks -o . --profile ergo-jr", "into this folder"),

@@ -101,6 +101,8 @@ FLAGS: dict[str, Flag] = {
     "--snap": Flag(None, None, "serve pypot's Snap! routes and the Poppy blocks"),
     "--snap-port": Flag(None, "PORT", "TCP port of the Snap! server"),
     "--snap-dir": Flag(None, "DIR", "a downloaded Snap! to serve"),
+    "--from": Flag(None, "URL", "where to download from: a URL, a file:// URL or a file"),
+    "--sha256": Flag(None, "HEX", "the digest a download must have (64 hex digits)"),
     "--open": Flag(None, None, "open it in the web browser"),
     "--token": Flag(None, "TOKEN", "token every request must carry"),
     "--cors": Flag(None, "ORIGIN", "web page origin allowed to use the robot"),

@@ -144,6 +144,10 @@ class FileError(PoppyError):
         self.errno = errno
 
 
+class DownloadError(PoppyError):
+    """A download failed or its content is not what was pinned; nothing was installed."""
+
+
 class SetupError(PoppyError):
     """A setup operation was refused or could not be verified."""
 

@@ -73,7 +73,8 @@ def serve(
     snap_dir: Path | None = typer.Option(
         None,
         "--snap-dir",
-        help="A downloaded Snap! (folder holding snap.html) to serve at /app/ on the Snap! port.",
+        help="A Snap! (folder holding snap.html) to serve at /app/ on the Snap! port "
+        "(default: the one `poppy snap download` installed).",
     ),
     open_browser: bool = typer.Option(
         False, "--open", help="Open Snap! with the Poppy blocks in the browser (with --snap)."
@@ -87,7 +88,7 @@ def serve(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
             "server streams the same state at /api/v1/ws)"
         )
-    check_snap_options(
+    snap_dir = check_snap_options(
         snap,
         snap_port,
         snap_dir,

@@ -28,26 +28,38 @@ def check_snap_options(
     snap_dir: Path | None,
     open_browser: bool,
     other_ports: Mapping[str, int],
-) -> None:
-    """Refuse Snap! options that cannot work, before the robot is built."""
+) -> Path | None:
+    """Refuse Snap! options that cannot work, before the robot is built; the Snap! copy to serve
+    at /app/ (``--snap-dir``, else the one ``poppy snap download`` installed, else None)."""
     if not snap:
         for given, name in ((snap_dir is not None, "--snap-dir"), (open_browser, "--open")):
             if given:
                 _usage(f"{name} needs --snap (it concerns the Snap! server)")
-        return
+        return None
     for option, port in other_ports.items():
         if port and port == snap_port:
             _usage(f"--snap-port {snap_port} is also the {option}: choose another port")
     if snap_dir is not None and not (snap_dir / "snap.html").is_file():
         _usage(
             f"--snap-dir {snap_dir}: no snap.html there; give the folder of a downloaded Snap! "
-            "(unzipped from https://github.com/jmoenig/Snap/releases)"
+            "(`poppy snap download` installs one)"
         )
+    if snap_dir is not None:
+        return snap_dir
+    from poppy_core.server.snap.release import installed
+
+    copy = installed()
+    return copy.path if copy is not None else None
 
 
 def announce_snap(server: SnapServer, open_browser: bool) -> None:
     """Print the Snap! server's URLs; open Snap! with the Poppy blocks when asked."""
     print(f"snap: {server.url}", flush=True)
+    if not server.local_app:
+        warn_line(
+            "no Snap! downloaded: the link opens snap.berkeley.edu (online); "
+            "`poppy snap download` once gets a copy served offline at /app/"
+        )
     print(f"Snap! with the Poppy blocks: {server.editor_url}", flush=True)
     if open_browser:
         import webbrowser

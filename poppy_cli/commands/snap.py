@@ -1,4 +1,4 @@
-"""`poppy snap`: the Poppy blocks and example projects as Snap! XML files (for an offline Snap!)."""
+"""`poppy snap`: the Poppy blocks and example projects as Snap! XML; Snap! downloaded once."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ from pathlib import Path
 
 import typer
 
+from poppy_cli.commands.snap_download import download
 from poppy_cli.options import ConfigOpt, ProfileOpt
 from poppy_cli.output import EXIT_USAGE, console, error_line
 
@@ -86,3 +87,6 @@ def project(
 ) -> None:
     """Write an example Snap! project for this robot (blocks included)."""
     _write(name, output, profile, config_file, host, snap_port, force)
+
+
+app.command("download")(download)

@@ -24,6 +24,11 @@ if TYPE_CHECKING:
 
 PROTOCOLS = ("http", "ws", "zmq", "snap")
 """pypot's attribute names of the servers (``robot.http``...), in the order they start."""
+SNAP_ONLINE_NOTE = (
+    "Snap! opens online (snap.berkeley.edu): run `poppy snap download` once on the robot "
+    "to serve Snap! offline"
+)
+"""The page's line when no Snap! copy is served at /app/."""
 DEFAULT_PORTS = {"http": 8080, "ws": 9009, "zmq": 6768, "snap": 6969}
 """pypot's default ports (``zmq``: the documentation's ZMQ example)."""
 LOOPBACK = "127.0.0.1"
@@ -223,6 +228,8 @@ def _own_pages(servers: ServerSet) -> None:
         return
     snap.bound(ports)
     if servers.app is not None:
-        from poppy_core.server.web import add_link
+        from poppy_core.server.web import add_link, add_note
 
         add_link(servers.app, "Snap! with the Poppy blocks", snap.editor_url)
+        if not snap.local_app:
+            add_note(servers.app, "snap", SNAP_ONLINE_NOTE)

@@ -13,6 +13,7 @@ import pytest
 
 from tests.helpers.bus import emulate_bus
 from tests.helpers.cli import run_poppy
+from tests.helpers.snap_release import make_release
 
 # -- a small schema language: a dict is an object with exactly these keys ("key?": optional,
 # "*": any other key with this schema); [S] a list of S; Map(S) an object whose keys are data
@@ -157,6 +158,14 @@ SCHEMAS: dict[str, Any] = {
             "firmware": Opt(int),
         }
     ],
+    "snap download": {
+        "version": str,
+        "path": str,
+        "digest": str,
+        "source": str,
+        "archive_sha256": Opt(str),
+        "downloaded": bool,
+    },
     "record": {"path": str, "frames": int, "duration_s": NUM, "framerate": NUM, "motors": [str]},
     "play": {
         "path": str,
@@ -346,9 +355,18 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
     tmp = tmp_path_factory.mktemp("json")
     saved = {
         k: os.environ.get(k)
-        for k in ("POPPY_MOVES_DIR", "XDG_CONFIG_HOME", "POPPY_PROFILE", "POPPY_PORT")
+        for k in (
+            "POPPY_MOVES_DIR",
+            "XDG_CONFIG_HOME",
+            "XDG_DATA_HOME",
+            "POPPY_PROFILE",
+            "POPPY_PORT",
+        )
     }
     os.environ.update(POPPY_MOVES_DIR=str(tmp / "moves"), XDG_CONFIG_HOME=str(tmp / "xdg"))
+    os.environ.update(XDG_DATA_HOME=str(tmp / "data"))  # `snap download` installs there
+    snap = make_release(tmp / "snap")
+    (tmp / "snap.zip").write_bytes(snap.data)
     os.environ.pop("POPPY_PROFILE", None)
     os.environ.pop("POPPY_PORT", None)
     results: dict[str, Any] = {}
@@ -403,6 +421,8 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
                 "moves import": (("moves", "import", pypot, "--name", "again"), ""),
                 "moves rm": (("moves", "rm", "again", "--yes"), ""),
                 "camera list": (("camera", "list"), ""),
+                "snap download": (("snap", "download", snap.version, "--from",
+                                   str(tmp / "snap.zip"), "--sha256", snap.digest), ""),
                 "camera detect": (("camera", "detect", "--sim", "mujoco", "--profile", "ergo-jr",
                                    "--marker", "3"), ""),
             }

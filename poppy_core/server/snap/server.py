@@ -113,6 +113,11 @@ class SnapServer:
         return f"http://{host}:{self.port}"
 
     @property
+    def local_app(self) -> bool:
+        """True when it serves a Snap! copy at ``/app/`` (the editor URL opens that copy)."""
+        return self._local_app
+
+    @property
     def blocks_url(self) -> str:
         """Where the Poppy blocks are served (with ``?token=`` when the server needs one)."""
         return f"{self.url}/snap-blocks.xml{self._query}"

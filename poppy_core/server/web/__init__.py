@@ -44,6 +44,7 @@ def add_web_page(app: FastAPI) -> None:
 
     app.state.web_started = time.monotonic()
     app.state.web_links = {"API docs": "/docs", "routes": "/routes"}
+    app.state.web_notes = {}
     app.state.web_logs = LogBuffer()
     index = f"{static_folder()}/index.html"
 
@@ -64,9 +65,14 @@ def add_link(app: FastAPI, name: str, url: str) -> None:
     app.state.web_links[name] = url
 
 
+def add_note(app: FastAPI, name: str, text: str) -> None:
+    """Show a line beside the links (how to get Snap! offline, for example)."""
+    app.state.web_notes[name] = text
+
+
 def is_public(path: str) -> bool:
     """True for the page and its assets, which need no token."""
     return path in PUBLIC_PATHS or path.startswith(STATIC_PREFIX)
 
 
-__all__ = ["LogBuffer", "add_link", "add_web_page", "is_public", "static_folder"]
+__all__ = ["LogBuffer", "add_link", "add_note", "add_web_page", "is_public", "static_folder"]

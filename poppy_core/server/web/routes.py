@@ -68,6 +68,7 @@ def about(robot: Robot, request: Request) -> dict[str, Any]:
         "sensors": {name: h.as_dict() for name, h in robot.sensor_health().items()},
         "chains": _chain_names(robot),
         "links": dict(state.web_links),
+        "notes": dict(getattr(state, "web_notes", {})),
     }
 
 

@@ -3,6 +3,7 @@ import { api, get, openStream, post } from "./api.js";
 import { showCameras, showChains } from "./extras.js";
 import { buildTable, onFrame, refresh, stats } from "./motors.js";
 import { refreshMoves, setupRecorder } from "./moves.js";
+import { notebookLink, notes } from "./notebook.js";
 import { refreshPrimitives } from "./primitives.js";
 import { count, el, every, say } from "./ui.js";
 
@@ -40,7 +41,8 @@ function showAbout(about) {
   }));
   const links = document.getElementById("links");
   links.replaceChildren(...Object.entries(about.links).map(([name, url]) =>
-    el("a", { href: url, textContent: name, target: name === "routes" ? "" : "_blank", rel: "noopener" })));
+    el("a", { href: url, textContent: name, target: name === "routes" ? "" : "_blank", rel: "noopener" })),
+    notebookLink(), ...notes(about));
 }
 
 function tickUptime() {
