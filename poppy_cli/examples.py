@@ -220,6 +220,11 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("snap project first-steps -o . --profile ergo-jr", "an example project"),
         ("snap download", "Snap! itself, once, for offline classes"),
     ),
+    "notebook": (
+        ("notebook", 'Jupyter with the "Discover your robot" notebook (robot on :8080)'),
+        ("notebook --robot http://poppy.local:8080", "notebooks driving a robot on the network"),
+        ("notebook --host 0.0.0.0 --port 8888 --no-browser", "as the robot's service runs it"),
+    ),
     "snap download": (
         ("snap download", "the pinned Snap! release, once (then `serve --snap` is offline)"),
         ("snap download --from file:///media/usb/Snap-11.0.8.zip", "from a USB stick"),

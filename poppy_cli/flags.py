@@ -32,7 +32,9 @@ FLAGS: dict[str, Flag] = {
     # -- the robot a command drives
     "--profile": Flag(None, "PROFILE", "robot profile name (`poppy config list`)"),
     "--config": Flag("-c", "FILE", "robot config file (JSON or YAML)"),
-    "--port": Flag("-p", "PORT", "serial port of the bus: a device, a pty or a URL"),
+    "--port": Flag(
+        "-p", "PORT", "serial port of the bus: a device, a pty or a URL (`notebook`: its TCP port)"
+    ),
     "--sim": Flag(None, "[mujoco]", "a virtual robot: bare for ideal servos, `mujoco` for physics"),
     "--remote": Flag(None, "URL", "drive a robot served by `poppy serve --http` at this URL"),
     "--motors": Flag("-m", "MOTORS", "which motors: names or groups (models:IDs in `emulate`)"),
@@ -101,6 +103,9 @@ FLAGS: dict[str, Flag] = {
     "--snap": Flag(None, None, "serve pypot's Snap! routes and the Poppy blocks"),
     "--snap-port": Flag(None, "PORT", "TCP port of the Snap! server"),
     "--snap-dir": Flag(None, "DIR", "a downloaded Snap! to serve"),
+    "--robot": Flag(None, "URL", "the served robot a notebook reaches (`poppy serve --http`)"),
+    "--dir": Flag(None, "DIR", "folder of the notebooks"),
+    "--no-browser": Flag(None, None, "do not open a web browser"),
     "--from": Flag(None, "URL", "where to download from: a URL, a file:// URL or a file"),
     "--sha256": Flag(None, "HEX", "the digest a download must have (64 hex digits)"),
     "--open": Flag(None, None, "open it in the web browser"),

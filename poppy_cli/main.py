@@ -12,6 +12,7 @@ from poppy_cli import state
 from poppy_cli.commands import calibrate as calibrate_cmd
 from poppy_cli.commands import camera, config, demo, emulate, motor_setup, ports, scan
 from poppy_cli.commands import moves as moves_cmd
+from poppy_cli.commands import notebook as notebook_cmd
 from poppy_cli.commands import play as play_cmd
 from poppy_cli.commands import primitive as primitive_cmd
 from poppy_cli.commands import reach as reach_cmd
@@ -130,6 +131,7 @@ app.command("play", rich_help_panel=MOVES)(play_cmd.play)
 app.add_typer(moves_cmd.app, name="moves", rich_help_panel=MOVES)
 app.command("serve", rich_help_panel=SERVE)(serve_cmd.serve)
 app.add_typer(snap_cmd.app, name="snap", rich_help_panel=SERVE)
+app.command("notebook", rich_help_panel=SERVE)(notebook_cmd.notebook)
 app.command("emulate", rich_help_panel=SIMULATE)(emulate.emulate)
 app.add_typer(sim_cmd.app, name="sim", rich_help_panel=SIMULATE)
 

@@ -22,6 +22,7 @@ EXTRAS: dict[str, str] = {
     "zmq": "pypot's ZMQ server",
     "tui": "the terminal app",
     "plot": "plots (matplotlib)",
+    "notebook": "Jupyter notebooks (`poppy notebook`)",
 }
 """Extra -> what it brings (pyproject.toml's ``[project.optional-dependencies]``)."""
 

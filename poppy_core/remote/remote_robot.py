@@ -293,7 +293,9 @@ class RemoteRobot:
             return self._by_name[name]
         if name in self.__dict__.get("_groups", {}):
             return self.group(name)
-        raise AttributeError(f"remote robot has no motor or group {name!r}")
+        if "_client" in self.__dict__ and name in self.primitive_names:
+            return RemotePrimitive(self._client, name)  # pypot's ``robot.dance.start()``
+        raise AttributeError(f"remote robot has no motor, group or primitive {name!r}")
 
     def __dir__(self) -> list[str]:
         return sorted({*super().__dir__(), *self._by_name, *self._groups})

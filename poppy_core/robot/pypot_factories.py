@@ -6,24 +6,41 @@ re-exported as ``poppy_core.robot.from_json``.
 
 from __future__ import annotations
 
+import os
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from poppy_core.remote import RemoteRobot
 
 
-def from_remote(host: str, port: int = 8080, *, token: str | None = None) -> RemoteRobot:
+ROBOT_URL_VARIABLE = "POPPY_ROBOT_URL"
+"""The robot a notebook reaches by default (``poppy notebook --robot URL`` sets it)."""
+TOKEN_VARIABLE = "POPPY_TOKEN"
+DEFAULT_ROBOT_URL = "http://127.0.0.1:8080"
+
+
+def from_remote(
+    host: str | None = None, port: int = 8080, *, token: str | None = None
+) -> RemoteRobot:
     """The robot served by ``poppy serve --http`` on ``host:port`` (pypot's ``from_remote``).
 
+    Without ``host``: the robot of ``$POPPY_ROBOT_URL`` (which ``poppy notebook`` gives its
+    notebooks), else ``http://127.0.0.1:8080``; the token then defaults to ``$POPPY_TOKEN``.
+
     Returns:
-        A ``poppy_core.remote.RemoteRobot`` (motors and groups as attributes, over HTTP).
+        A ``poppy_core.remote.RemoteRobot`` (motors, groups and primitives as attributes, over
+        HTTP).
 
     Raises:
         CommunicationError: nothing answers there, or it is not a poppy server.
     """
     from poppy_core.remote import RemoteRobot
 
-    url = host if "://" in host else f"http://{_bracketed(host)}:{int(port)}"
+    if host is None:
+        url = os.environ.get(ROBOT_URL_VARIABLE) or DEFAULT_ROBOT_URL
+        token = token if token is not None else (os.environ.get(TOKEN_VARIABLE) or None)
+    else:
+        url = host if "://" in host else f"http://{_bracketed(host)}:{int(port)}"
     return RemoteRobot(url, token=token)
 
 

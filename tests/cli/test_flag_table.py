@@ -18,7 +18,11 @@ from tests.helpers.cli_tree import options, parse, walk
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "cli.md"
 
-KIND_EXCEPTIONS = {"--protocol": "scan takes `both` besides 1 and 2"}
+KIND_EXCEPTIONS = {
+    "--protocol": "scan takes `both` besides 1 and 2",
+    # the flag COORD agreed for the Jupyter service unit (`poppy notebook --port 8888`)
+    "--port": "notebook takes the Jupyter server's TCP port, the others a serial port",
+}
 """Long flags whose value is of one kind in some commands and another elsewhere, and why."""
 
 

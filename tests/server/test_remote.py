@@ -116,3 +116,25 @@ def test_a_404_is_a_typed_unknown_name(remote: RemoteRobot) -> None:
     with pytest.raises(ConfigError) as register:  # an unknown register: not an unknown motor
         client.get(path_of("motors", "m1", "registers", "nope"))
     assert not isinstance(register.value, UnknownNameError)
+
+
+def test_primitives_are_attributes_as_in_pypot(remote: RemoteRobot, served: Served) -> None:
+    """pypot's ``robot.dance.start()`` on a served robot (the notebooks' call form)."""
+    assert "dance" in served.robot.primitive_names
+    remote.dance.start()
+    assert eventually(lambda: served.robot.dance.is_alive(), 10)
+    assert remote.dance.is_alive()
+    remote.dance.stop()
+    assert not served.robot.dance.is_alive()
+    with pytest.raises(AttributeError, match="no motor, group or primitive 'nope'"):
+        remote.nope  # noqa: B018
+
+
+def test_from_remote_without_a_host_reaches_the_robot_of_the_environment(
+    served: Served, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from poppy_core.robot import from_remote
+
+    monkeypatch.setenv("POPPY_ROBOT_URL", served.url)
+    with from_remote() as robot:
+        assert robot.url == served.url and [m.name for m in robot.motors][:1] == ["m1"]
