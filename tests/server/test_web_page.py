@@ -418,3 +418,21 @@ def test_camera_and_chain_jog(browser: Any, creature: Served) -> None:
     eventually(lambda: tab.inner_text("#chain-chain h3") == "arm", "the chain shown as arm")
     context.close()
     robot.compliant = True
+
+
+def test_the_links_offer_the_notebook_and_the_notes_of_the_server(
+    page: Any, served: Served
+) -> None:
+    from poppy_core.assembly.servers import SNAP_ONLINE_NOTE
+    from poppy_core.server.web import add_note
+
+    link = page.locator("#links a", has_text="Jupyter: discover your robot")
+    href = link.get_attribute("href")
+    assert href == "http://127.0.0.1:8888/notebooks/discover-your-robot.ipynb"
+    add_note(served.app, "snap", SNAP_ONLINE_NOTE)  # as `serve --snap` without a download
+    try:
+        page.reload()
+        page.wait_for_function(READY)
+        assert "poppy snap download" in page.inner_text("#note-snap")
+    finally:
+        served.app.state.web_notes.clear()
