@@ -3,11 +3,14 @@ digest, unpacked atomically into the user data folder, then served by `poppy ser
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import signal
+import stat
 import subprocess
 import urllib.request
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -69,7 +72,7 @@ def test_a_release_that_does_not_match_its_digest_is_refused_and_nothing_is_left
 def test_a_download_cut_short_leaves_no_half_folder(tmp_path: Path, data_home: Path) -> None:
     fake = make_release(tmp_path / "src")
     files = Files({"/snap.zip": fake.data}, cut={"/snap.zip"})
-    with release_server(files) as base, pytest.raises(DownloadError):
+    with release_server(files) as base, pytest.raises(DownloadError, match="broke off"):
         release.download(fake.version, f"{base}/snap.zip", fake.digest)
     assert _leftovers() == []
 
@@ -96,10 +99,22 @@ def test_archives_reaching_outside_their_folder_or_without_snap_html_are_refused
     fake = make_release(tmp_path / "src")
     (tmp_path / "empty" / "x").mkdir(parents=True)
     (tmp_path / "empty" / "x" / "index.html").write_text("not Snap!")
+    linked = io.BytesIO()
+    with zipfile.ZipFile(linked, "w") as zipped:
+        zipped.writestr("Snap/snap.html", "<html></html>")
+        link = zipfile.ZipInfo("Snap/passwd")
+        link.external_attr = (stat.S_IFLNK | 0o777) << 16
+        zipped.writestr(link, "/etc/passwd")
     files = Files(
-        {"/up.zip": zip_folder(fake.folder, top=".."), "/none.zip": zip_folder(tmp_path / "empty")}
+        {
+            "/up.zip": zip_folder(fake.folder, top=".."),
+            "/none.zip": zip_folder(tmp_path / "empty"),
+            "/link.zip": linked.getvalue(),
+        }
     )
     with release_server(files) as base:
+        with pytest.raises(DownloadError, match="holds a link"):
+            release.download("link", f"{base}/link.zip", fake.digest)
         with pytest.raises(DownloadError, match="outside its folder"):
             release.download("up", f"{base}/up.zip", fake.digest)
         with pytest.raises(DownloadError, match=r"no snap\.html"):

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import http.client
 import json
 import logging
 import os
@@ -216,10 +217,12 @@ def _fetch(source: str, target: Path, timeout_s: float, progress: Callable[[int]
     sha = hashlib.sha256()
     size = 0
     with _opened(source, timeout_s) as stream, target.open("wb") as out:
+        headers = getattr(stream, "headers", None)
+        announced = headers.get("Content-Length") if headers is not None else None
         while True:
             try:
                 chunk = stream.read(CHUNK)
-            except (OSError, ValueError) as exc:  # http.client.IncompleteRead is an OSError's kin
+            except (OSError, ValueError, http.client.HTTPException) as exc:
                 raise DownloadError(f"the download of {source} broke off ({exc})") from None
             if not chunk:
                 break
@@ -231,6 +234,11 @@ def _fetch(source: str, target: Path, timeout_s: float, progress: Callable[[int]
             sha.update(chunk)
             out.write(chunk)
             progress(size)
+    if announced is not None and announced.isdigit() and size != int(announced):
+        raise DownloadError(
+            f"the download of {source} broke off after {size} of {announced} bytes: "
+            "nothing installed (try again)"
+        )
     return sha.hexdigest()
 
 
