@@ -22,6 +22,7 @@ EXTRAS: dict[str, str] = {
     "zmq": "pypot's ZMQ server",
     "tui": "the terminal app",
     "plot": "plots (matplotlib)",
+    "appliance": "the robot's name on the network (mDNS/DNS-SD with zeroconf)",
 }
 """Extra -> what it brings (pyproject.toml's ``[project.optional-dependencies]``)."""
 
