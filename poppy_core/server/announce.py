@@ -31,8 +31,10 @@ POPPY_TYPE = "_poppy._tcp.local."
 HTTP_TYPE = "_http._tcp.local."
 MAX_SUFFIX = 20
 """``NAME-2`` ... ``NAME-20`` are tried when ``NAME`` is taken."""
-PROBE_MS = 750
-"""How long an address query for a candidate name waits for an answer."""
+PROBE_MS = 2000
+"""How long an address query for a candidate name waits for an answer: past the one second
+during which a responder does not multicast the same record again (RFC 6762, section 6), so
+the query's second try is answered even right after another one."""
 WILDCARD = frozenset({"", "0.0.0.0", "::"})
 
 
@@ -161,16 +163,14 @@ class Announcer:
         self._infos = []
 
     def _free_name(self, asked: str) -> str:
-        """The first candidate nobody answers for (an address or a ``_poppy`` service)."""
+        """The first candidate whose ``NAME.local`` nobody answers for (a robot announcing
+        ``_poppy._tcp`` under a name answers its address too)."""
         from zeroconf._services.info import AddressResolver  # not re-exported as typed
 
         assert self._zc is not None
         for name in candidates(asked):
-            if AddressResolver(f"{name}.local.").request(self._zc, PROBE_MS):
-                continue
-            if self._zc.get_service_info(POPPY_TYPE, f"{name}.{POPPY_TYPE}", PROBE_MS):
-                continue
-            return name
+            if not AddressResolver(f"{name}.local.").request(self._zc, PROBE_MS):
+                return name
         return asked  # every suffix taken: zeroconf renames the services themselves
 
     def _service_infos(self, name: str) -> list[ServiceInfo]:
