@@ -189,6 +189,9 @@ class Verdict(Enum):
 
     OWN = "own"
     """A page of this server (same host, one of its ports): no CORS headers needed."""
+    SIBLING = "sibling"
+    """A page the named robot serves under its name on another port (a monitor page on 2280):
+    the robot's own, answered with CORS headers (the browser sees another origin)."""
     ALLOWED = "allowed"
     """An origin the user allowed: answered with CORS headers."""
     FOREIGN = "foreign"
@@ -315,25 +318,29 @@ class OriginPolicy:
             normal = normalize_origin(origin)
         except ValueError:
             return Verdict.ALLOWED if self.any_origin else Verdict.FOREIGN
-        if normal not in (ANY, "null") and host is not None and self._own(normal, host, port):
-            return Verdict.OWN
+        if normal not in (ANY, "null") and host is not None:
+            own = self._own(normal, host, port)
+            if own is not None:
+                return own
         if self.any_origin or normal in self.origins:
             return Verdict.ALLOWED
         return Verdict.FOREIGN
 
-    def _own(self, origin: str, host: bytes, port: int | None) -> bool:
+    def _own(self, origin: str, host: bytes, port: int | None) -> Verdict | None:
         parts = urlsplit(origin)
         name = (parts.hostname or "").lower()
         origin_port = parts.port or DEFAULT_PORTS.get(parts.scheme)
         host_name, host_port = split_host(host.decode("latin-1"))
         if name == host_name and origin_port == (host_port or DEFAULT_PORTS.get(parts.scheme)):
-            return True  # same origin: a page this server served under the name it was reached by
-        if name in self.own_names and parts.scheme in ("http", "https"):
-            return True  # a page the named robot serves on another of its ports
+            return Verdict.OWN  # same origin: a page served under the name it was reached by
         ports = self.own_ports | ({port} if port is not None else set())
-        if origin_port not in ports:
-            return False
-        return name == host_name or is_loopback(name) or (name in self.hosts and not is_ip(name))
+        if origin_port in ports and (
+            name == host_name or is_loopback(name) or (name in self.hosts and not is_ip(name))
+        ):
+            return Verdict.OWN
+        if name in self.own_names:
+            return Verdict.SIBLING  # a page the named robot serves on another of its ports
+        return None
 
     # -- reports -------------------------------------------------------------------------------
 
@@ -447,7 +454,7 @@ class OriginGuard:
                 message = policy.refused_origin(origin.decode("latin-1"))
                 await refuse(scope, send, 403, message, "the server's operator can allow it")
                 return
-            if verdict is Verdict.ALLOWED and allow is None:
+            if verdict in (Verdict.ALLOWED, Verdict.SIBLING) and allow is None:
                 allow = origin
         elif fetch_site in CROSS_SITE and not policy.any_origin and self.changes_state(scope):
             message = policy.refused_cross_site()

@@ -26,11 +26,16 @@ def test_an_unnamed_loopback_server_refuses_poppy_local() -> None:
     assert not _policy().host_allowed(b"evil.example:8080")
 
 
-@pytest.mark.parametrize(
-    "origin", [b"http://poppy.local:2280", b"http://poppy.local:8080", b"http://poppy:2280"]
-)
-def test_pages_of_the_robot_on_its_other_ports_are_its_own(origin: bytes) -> None:
+@pytest.mark.parametrize("origin", [b"http://poppy.local:8080", b"http://poppy.local:9009"])
+def test_pages_of_the_robot_on_its_servers_ports_are_its_own(origin: bytes) -> None:
     assert _policy().verdict(origin, HOST, 8080) is Verdict.OWN
+
+
+@pytest.mark.parametrize(
+    "origin", [b"http://poppy.local:2280", b"https://poppy.local", b"http://poppy:2280"]
+)
+def test_pages_of_the_robots_name_on_other_ports_are_its_own_with_cors(origin: bytes) -> None:
+    assert _policy().verdict(origin, HOST, 8080) is Verdict.SIBLING
 
 
 @pytest.mark.parametrize(
@@ -57,7 +62,8 @@ def test_the_name_won_after_a_conflict_is_accepted_too() -> None:
     assert not policy.host_allowed(b"poppy-2.local:8080")
     policy.with_names(["poppy-2"])
     assert policy.host_allowed(b"poppy-2.local:8080")
-    assert policy.verdict(b"http://poppy-2.local:2280", b"poppy-2.local:8080", 8080) is Verdict.OWN
+    sibling = policy.verdict(b"http://poppy-2.local:2280", b"poppy-2.local:8080", 8080)
+    assert sibling is Verdict.SIBLING
 
 
 @pytest.mark.parametrize("text", ["", "-poppy", "poppy-", "po ppy", "poppy.example", "*", "a" * 64])

@@ -25,11 +25,31 @@ from tests.helpers.server import Served, serve
 
 TOKEN = "s3cret"
 BEARER = {"Authorization": f"Bearer {TOKEN}"}
-HOTSPOT_ADD = (
-    "nmcli connection add type wifi ifname wlan0 con-name poppy-hotspot autoconnect yes "
-    "ssid ergo-2 connection.autoconnect-priority -100 802-11-wireless.mode ap "
-    "ipv4.method shared wifi-sec.key-mgmt wpa-psk wifi-sec.psk hotspot-pw"
-).split()
+HOTSPOT_ADD = [
+    "nmcli",
+    "connection",
+    "add",
+    "type",
+    "wifi",
+    "ifname",
+    "wlan0",
+    "con-name",
+    "poppy-hotspot",
+    "autoconnect",
+    "yes",
+    "ssid",
+    "ergo-2",
+    "connection.autoconnect-priority",
+    "-100",
+    "802-11-wireless.mode",
+    "ap",
+    "ipv4.method",
+    "shared",
+    "wifi-sec.key-mgmt",
+    "wpa-psk",
+    "wifi-sec.psk",
+    "hotspot-pw",
+]
 """The fallback access point as NetworkManager is asked to make it."""
 
 
