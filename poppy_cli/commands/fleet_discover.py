@@ -4,13 +4,18 @@ from __future__ import annotations
 
 import typer
 
-from poppy_cli.options import JsonOpt
+from poppy_cli.options import JsonOpt, finite
 from poppy_cli.output import console, print_json, styled
 
 
 def discover(
     timeout: float = typer.Option(
-        3.0, "--timeout", help="Seconds to listen for announcements (0.1 to 120)."
+        3.0,
+        "--timeout",
+        min=0.1,
+        max=120.0,
+        callback=finite,
+        help="Seconds to listen for announcements (at least 2 to hear every robot).",
     ),
     interface: list[str] | None = typer.Option(
         None,

@@ -8,6 +8,7 @@ stay on loopback: ``["127.0.0.1"]``). Needs zeroconf (the ``appliance`` extra).
 
 from __future__ import annotations
 
+import ipaddress
 import threading
 import time
 from collections.abc import Sequence
@@ -15,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from poppy_core import checks
+from poppy_core.errors import ArgumentError
 from poppy_core.extras import require
 
 POPPY_TYPE = "_poppy._tcp.local."
@@ -63,9 +65,45 @@ class AnnouncedRobot:
 
 
 def _interfaces(interfaces: Sequence[str] | None) -> Any:
+    """zeroconf's interfaces: these IPv4 addresses, or every interface.
+
+    Raises:
+        ArgumentError: an interface that is not an IPv4 address.
+    """
     from zeroconf import InterfaceChoice
 
-    return list(interfaces) if interfaces else InterfaceChoice.All
+    if not interfaces:
+        return InterfaceChoice.All
+    for address in interfaces:
+        try:
+            ipaddress.IPv4Address(address)
+        except ValueError:
+            raise ArgumentError(
+                f"interface {address!r} is not an IPv4 address: give this machine's address "
+                "on that network, e.g. 192.168.1.20 (127.0.0.1: this machine only)",
+                field="interface",
+                value=address,
+            ) from None
+    return list(interfaces)
+
+
+def _zeroconf(interfaces: Sequence[str] | None) -> Any:
+    """A zeroconf instance listening on ``interfaces`` (every one by default).
+
+    Raises:
+        ArgumentError: an interface that is not an IPv4 address of this machine.
+    """
+    from zeroconf import IPVersion, Zeroconf
+
+    chosen = _interfaces(interfaces)
+    try:
+        return Zeroconf(interfaces=chosen, ip_version=IPVersion.V4Only)
+    except OSError as exc:
+        raise ArgumentError(
+            f"cannot listen for mDNS on {', '.join(interfaces or ['every interface'])}: "
+            f"{exc.strerror or exc} (give an address of this machine)",
+            field="interface",
+        ) from None
 
 
 def discover(
@@ -74,12 +112,12 @@ def discover(
     """The robots announced within ``timeout_s`` seconds, sorted by name.
 
     Raises:
-        ArgumentError: ``timeout_s`` is not 0.1 to 120 s.
+        ArgumentError: ``timeout_s`` is not 0.1 to 120 s, an interface not an IPv4 address.
         MissingExtraError: zeroconf is not installed (the ``appliance`` extra).
     """
     timeout_s = checks.in_range(timeout_s, MIN_TIMEOUT_S, MAX_TIMEOUT_S, "timeout", "s")
     require("zeroconf", extra="appliance", feature="discovering robots")
-    from zeroconf import IPVersion, ServiceBrowser, ServiceStateChange, Zeroconf
+    from zeroconf import ServiceBrowser, ServiceStateChange, Zeroconf
 
     names: set[str] = set()
     lock = threading.Lock()
@@ -91,7 +129,7 @@ def discover(
             with lock:
                 names.add(name)
 
-    zc = Zeroconf(interfaces=_interfaces(interfaces), ip_version=IPVersion.V4Only)
+    zc = _zeroconf(interfaces)
     try:
         browser = ServiceBrowser(zc, POPPY_TYPE, handlers=[changed])
         time.sleep(timeout_s)
@@ -132,15 +170,14 @@ def resolve(
     """The addresses ``host`` (``poppy.local``) answers with over mDNS; empty when none did.
 
     Raises:
-        ArgumentError: ``timeout_s`` is not 0.1 to 120 s.
+        ArgumentError: ``timeout_s`` is not 0.1 to 120 s, an interface not an IPv4 address.
         MissingExtraError: zeroconf is not installed (the ``appliance`` extra).
     """
     timeout_s = checks.in_range(timeout_s, MIN_TIMEOUT_S, MAX_TIMEOUT_S, "timeout", "s")
     require("zeroconf", extra="appliance", feature="resolving .local names")
-    from zeroconf import IPVersion, Zeroconf
     from zeroconf._services.info import AddressResolver  # not re-exported as typed
 
-    zc = Zeroconf(interfaces=_interfaces(interfaces), ip_version=IPVersion.V4Only)
+    zc = _zeroconf(interfaces)
     try:
         resolver = AddressResolver(host.rstrip(".") + ".")
         if not resolver.request(zc, int(timeout_s * 1000)):

@@ -20,6 +20,7 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
 from poppy_core.extras import require
+from poppy_core.server.errors import ListenError
 
 if TYPE_CHECKING:
     from zeroconf import ServiceInfo, Zeroconf
@@ -108,13 +109,23 @@ class Announcer:
         return f"{self.name}.local"
 
     def start(self) -> str:
-        """Take a free name, register the records; returns the name won."""
+        """Take a free name, register the records; returns the name won.
+
+        Raises:
+            ListenError: mDNS cannot be used on that interface.
+        """
         from zeroconf import InterfaceChoice, IPVersion, Zeroconf
 
         host = self.listen_host.strip("[]")
         interfaces: Any = InterfaceChoice.All if host in WILDCARD else self.addresses
         with self._lock:
-            self._zc = Zeroconf(interfaces=interfaces, ip_version=IPVersion.V4Only)
+            try:
+                self._zc = Zeroconf(interfaces=interfaces, ip_version=IPVersion.V4Only)
+            except OSError as exc:
+                raise ListenError(
+                    f"cannot announce {self.asked}.local over mDNS on {host or 'every interface'}"
+                    f": {exc.strerror or exc}"
+                ) from None
             self._register(self.asked)
         return self.name
 

@@ -295,6 +295,18 @@ SCHEMAS: dict[str, Any] = {
     "moves import": {"name": str, "path": str, "frames": int, "motors": [str]},
     "moves rm": {"deleted": str},
     "camera list": [{"device": str, "index": int, "name": str}],
+    "fleet discover": [
+        {
+            "name": str,
+            "host": str,
+            "creature": str,
+            "version": str,
+            "addresses": [str],
+            "ports": Map(int),
+            "urls": Map(str),
+            "token": bool,
+        }
+    ],
     "camera detect": [
         {
             "id": int,
@@ -403,6 +415,8 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
                 "moves import": (("moves", "import", pypot, "--name", "again"), ""),
                 "moves rm": (("moves", "rm", "again", "--yes"), ""),
                 "camera list": (("camera", "list"), ""),
+                "fleet discover": (("fleet", "discover", "--timeout", "0.5", "--interface",
+                                    "127.0.0.1"), ""),
                 "camera detect": (("camera", "detect", "--sim", "mujoco", "--profile", "ergo-jr",
                                    "--marker", "3"), ""),
             }
