@@ -69,7 +69,7 @@ def create_app(
         v1_settings,
     )
     from poppy_core.server.sensors import SensorService
-    from poppy_core.server.settings import Settings
+    from poppy_core.server.settings import RobotSettings
     from poppy_core.server.stream import add_stream_routes
 
     owns_service = service is None
@@ -99,7 +99,7 @@ def create_app(
     app.state.service = service
     app.state.sensors = SensorService(robot)
     app.state.policy = policy
-    app.state.settings = Settings()
+    app.state.settings = RobotSettings()
     app.state.settings.served.token_required = bool(token)
     app.state.settings.served.policy = policy
     app.state.stream_rate_hz = stream_rate_hz

@@ -1,6 +1,6 @@
 """The robot's settings as the page shows and changes them: name, Wi-Fi, services, token, version.
 
-``Settings`` decides who may change what and logs every change; the OS is reached through
+``RobotSettings`` decides who may change what and logs every change; the OS is reached through
 ``settings_os.SystemTools`` only. A change needs the server to have been started with
 ``--token`` (the token middleware then refuses every request without it) and a machine with
 NetworkManager and systemd; elsewhere the settings are shown read-only with the reason.
@@ -58,7 +58,7 @@ class ServedRobot:
             self.policy.with_names([name])
 
 
-class Settings:
+class RobotSettings:
     """The settings of one served robot.
 
     Args:

@@ -3,7 +3,7 @@
 Every call runs one of the OS's own tools, ``hostnamectl`` (the machine's name), ``nmcli``
 (NetworkManager: Wi-Fi networks, the robot's fallback access point) and ``systemctl`` (the
 services), found on ``PATH``, with a timeout, and fails with one line (``SystemToolError``)
-quoting the tool's own. Nothing here decides who may change what (``settings.Settings`` does).
+quoting the tool's own. Nothing here decides who may change what (``settings.RobotSettings`` does).
 Tests put a recording fake of each tool first on ``PATH`` and check the exact commands.
 """
 

@@ -2,7 +2,7 @@
 
 Reading needs what every route needs (the token when the server has one); every change also
 needs the server to have been started with ``--token`` and a machine with NetworkManager
-(``settings.Settings`` refuses otherwise) and is logged with the client's address.
+(``settings.RobotSettings`` refuses otherwise) and is logged with the client's address.
 """
 
 from collections.abc import Callable
@@ -14,7 +14,7 @@ from starlette.concurrency import run_in_threadpool
 
 from poppy_core.server.errors import ApiError
 from poppy_core.server.schemas import Problem
-from poppy_core.server.settings import Settings
+from poppy_core.server.settings import RobotSettings
 from poppy_core.server.settings_os import SystemToolError
 
 router = APIRouter(
@@ -64,9 +64,9 @@ class ServiceBody(BaseModel):
     on: bool
 
 
-def _settings(request: Request) -> Settings:
+def _settings(request: Request) -> RobotSettings:
     settings = request.app.state.settings
-    assert isinstance(settings, Settings)
+    assert isinstance(settings, RobotSettings)
     return settings
 
 
