@@ -169,7 +169,7 @@ class RobotSettings:
             logger.warning("settings: %s removed the fallback access point", who)
             return None
         assert password is not None
-        ssid = self.served.name or robot_name(self.system.hostname().split(".")[0])
+        ssid = self.served.name or _name_of(self.system.hostname())
         self.system.set_hotspot(ssid, password)
         logger.warning("settings: %s set up the fallback access point %r", who, ssid)
         return ssid
@@ -189,6 +189,14 @@ class RobotSettings:
         self.check_change()
         self.system.set_service(unit, on)
         logger.warning("settings: %s turned %s %s", who, service, "on" if on else "off")
+
+
+def _name_of(hostname: str) -> str:
+    """The robot's name from the machine's (``poppy`` when that is no DNS label)."""
+    try:
+        return robot_name(hostname.split(".")[0])
+    except ValueError:
+        return "poppy"
 
 
 def _check_ssid(ssid: str) -> None:
