@@ -206,6 +206,7 @@ def test_with_the_token_the_robot_is_renamed_and_answers_its_new_name(
 
 
 def test_wifi_and_services_from_the_routes(fake: FakeTools, with_token: Served) -> None:
+    with_token.app.state.settings.served.name = "ergo-2"  # the access point is named after it
     with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
         wifi = http.get("/api/v1/settings/wifi").json()
         assert [n["ssid"] for n in wifi["networks"]] == ["Class:room", "Home Wifi", "Cafe"]
@@ -266,3 +267,17 @@ def test_elsewhere_the_settings_are_read_only_with_the_reason(
         answer = http.put("/api/v1/settings/name", json={"name": "ergo-3"})
         assert answer.status_code == 503 and "nmcli not found" in answer.json()["detail"]
     assert fake.changes() == []
+
+
+def test_an_unnamed_robot_s_access_point_is_named_after_the_machine_or_poppy(
+    fake: FakeTools, with_token: Served, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import poppy_core.server.settings_os as settings_os
+
+    with_token.app.state.settings.served.name = None
+    body = {"on": True, "password": "hotspot-pw"}
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+        monkeypatch.setattr(settings_os.socket, "gethostname", lambda: "Ergo-9.lan")
+        assert http.put("/api/v1/settings/wifi/hotspot", json=body).json()["ssid"] == "ergo-9"
+        monkeypatch.setattr(settings_os.socket, "gethostname", lambda: "my_machine")
+        assert http.put("/api/v1/settings/wifi/hotspot", json=body).json()["ssid"] == "poppy"
