@@ -112,7 +112,7 @@ class RobotSettings:
     # -- changing ------------------------------------------------------------------------------
 
     def check_change(self) -> None:
-        """Refuse a change (403 without a token, 503 without the OS's tools)."""
+        """Refuse a change (403 without a token, 409 without the OS's tools)."""
         if not self.served.token_required:
             raise ApiError(
                 "forbidden",
@@ -124,7 +124,7 @@ class RobotSettings:
     def _check_system(self) -> None:
         reason = self.system.unavailable()
         if reason is not None:
-            raise ApiError("unavailable", reason, tip="the settings are read-only here")
+            raise ApiError("conflict", reason, tip="the settings are read-only here")
 
     def set_name(self, text: str, who: str) -> str:
         """Rename the machine and the robot's mDNS name at once; returns the name announced."""

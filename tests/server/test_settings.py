@@ -265,7 +265,7 @@ def test_elsewhere_the_settings_are_read_only_with_the_reason(
         assert shown["editable"] is False and "nmcli not found" in shown["reason"]
         assert shown["services"]["jupyter"]["on"] is None
         answer = http.put("/api/v1/settings/name", json={"name": "ergo-3"})
-        assert answer.status_code == 503 and "nmcli not found" in answer.json()["detail"]
+        assert answer.status_code == 409 and "nmcli not found" in answer.json()["detail"]
     assert fake.changes() == []
 
 

@@ -25,7 +25,6 @@ router = APIRouter(
         404: {"model": Problem},
         409: {"model": Problem},
         422: {"model": Problem},
-        503: {"model": Problem},
     },
 )
 
