@@ -218,11 +218,12 @@ def _named(servers: ServerSet, robot: Robot, spec: ServeSpec) -> None:
     from poppy_core.server.settings import ServedRobot
 
     name = spec.name or ("poppy" if spec.announce else None)
+    policies = [servers.policy] + ([servers.snap.policy] if servers.snap is not None else [])
     served = ServedRobot(
         name=name,
         protocols=tuple(servers.servers),
         token_required=bool(spec.token),
-        policy=servers.policy,
+        policies=policies,
     )
     if servers.app is not None:
         servers.app.state.settings.served = served
@@ -253,14 +254,19 @@ def _creature(robot: Robot) -> str:
 
 def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) -> None:
     from poppy_core.server.snap import create_snap_server
+    from poppy_core.server.snap.server import snap_policy
 
+    policy = snap_policy(
+        where.host, cors=spec.cors, allow_hosts=spec.allow_hosts, report=spec.report
+    )
+    if spec.name is not None:
+        policy.with_names([spec.name])  # Snap! projects call http://poppy.local:6969 too
     snap = create_snap_server(
         robot,
         where.host,
         where.port,
         service=servers.service,
-        cors=spec.cors,
-        allow_hosts=spec.allow_hosts,
+        policy=policy,
         snap_dir=spec.snap_dir,
         token=spec.token,
         report=spec.report,

@@ -101,7 +101,7 @@ def create_app(
     app.state.policy = policy
     app.state.settings = RobotSettings()
     app.state.settings.served.token_required = bool(token)
-    app.state.settings.served.policy = policy
+    app.state.settings.served.policies = [policy]
     app.state.stream_rate_hz = stream_rate_hz
     install_error_handlers(app)
     add_web_page(app)  # the home page at / (its assets and /api/v1/web)

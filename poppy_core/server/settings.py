@@ -46,7 +46,8 @@ class ServedRobot:
     name: str | None = None
     protocols: tuple[str, ...] = ()
     token_required: bool = False
-    policy: OriginPolicy | None = None
+    policies: list[OriginPolicy] = field(default_factory=list)
+    """The Host and Origin rules of every server of the robot (REST and WebSocket, Snap!)."""
     announcer: Announcer | None = None
     version: str = field(default_factory=poppy_version)
 
@@ -54,8 +55,8 @@ class ServedRobot:
         """The robot is now ``name`` (an mDNS name won, a new name set): the Host check
         accepts it from now on."""
         self.name = name
-        if self.policy is not None:
-            self.policy.with_names([name])
+        for policy in self.policies:
+            policy.with_names([name])
 
 
 class RobotSettings:

@@ -85,10 +85,12 @@ def test_a_taken_name_gets_a_suffix_and_the_server_answers_to_it(robots: list[Ro
 def test_nothing_is_announced_unless_asked(robots: list[Robot]) -> None:
     robot = from_profile("ergo-jr", sim=True)
     robots.append(robot)
-    with serve(robot, ServeSpec(http=Listen(), name="quiet")) as servers:
+    with serve(robot, ServeSpec(http=Listen(), snap=Listen(), name="quiet")) as servers:
         assert servers.announcer is None
-        assert servers.http is not None
-        port = servers.http.port
-        with httpx.Client(base_url=f"http://127.0.0.1:{port}") as http:
-            answer = http.get("/api/v1/robot", headers={"Host": f"quiet.local:{port}"})
-            assert answer.status_code == 200  # named, the Host check answers its name
+        assert servers.http is not None and servers.snap is not None
+        for port, path in ((servers.http.port, "/api/v1/robot"), (servers.snap.port, "/ip/")):
+            with httpx.Client(base_url=f"http://127.0.0.1:{port}") as http:
+                for host in ("quiet.local", "evil.example"):
+                    answer = http.get(path, headers={"Host": f"{host}:{port}"})
+                    # named, every server answers its name (Snap!'s blocks call poppy.local)
+                    assert answer.status_code == (200 if host == "quiet.local" else 400), path
