@@ -34,10 +34,10 @@ def robots() -> Iterator[list[Robot]]:
         robot.close()
 
 
-def _served(robots: list[Robot], name: str, **options: object) -> ServerSet:
+def _served(robots: list[Robot], name: str, token: str | None = None) -> ServerSet:
     robot = from_profile("ergo-jr", sim=True)
     robots.append(robot)
-    spec = ServeSpec(http=Listen(), ws=Listen(), name=name, announce=True, **options)  # type: ignore[arg-type]
+    spec = ServeSpec(http=Listen(), ws=Listen(), name=name, announce=True, token=token)
     return serve(robot, spec)
 
 
