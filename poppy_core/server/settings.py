@@ -99,11 +99,11 @@ class RobotSettings:
             return None
         return (
             "this server was started without --token: settings are changed only on a "
-            "robot whose server asks for a token (poppy service install sets one)"
+            "robot whose server asks for a token (poppy service install --token ...)"
         )
 
     def wifi(self) -> dict[str, Any]:
-        """Networks in range and saved ones (read-only: the token and NetworkManager suffice)."""
+        """Networks in range and saved ones (a read: it needs NetworkManager, not a token)."""
         self._check_system()
         return {
             "networks": [vars(n) for n in self.system.networks()],
@@ -118,7 +118,7 @@ class RobotSettings:
             raise ApiError(
                 "forbidden",
                 "settings are changed only on a server started with --token",
-                tip="restart the server with --token (poppy service install sets one)",
+                tip="restart the server with --token (poppy service install --token ...)",
             )
         self._check_system()
 
