@@ -72,6 +72,18 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("serve --http --profile ergo-jr --sim", "the REST API and web page on port 8080"),
         ("serve --snap --open --profile ergo-jr -p /dev/ttyUSB0", "Snap! with the Poppy blocks"),
         ("serve --http --http-port 9000 --ws --token s3cret --profile ergo-jr --sim", "a token"),
+        (
+            "serve --http --host 0.0.0.0 --name poppy --announce --token s3cret --profile ergo-jr",
+            "http://poppy.local:8080 on the network",
+        ),
+    ),
+    "fleet": (
+        ("fleet discover", "the robots announced on the network"),
+        ("fleet discover --json --timeout 5", "for scripts"),
+    ),
+    "fleet discover": (
+        ("fleet discover", "listen 3 s on every interface"),
+        ("fleet discover --timeout 1 --interface 127.0.0.1 --json", "this machine's only"),
     ),
     "motor": (
         ("motor info 3 -p /dev/ttyUSB0", "the whole control table"),

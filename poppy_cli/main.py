@@ -10,7 +10,7 @@ from typer import _click as click  # typer vendors Click: its exceptions live he
 
 from poppy_cli import state
 from poppy_cli.commands import calibrate as calibrate_cmd
-from poppy_cli.commands import camera, config, demo, emulate, motor_setup, ports, scan
+from poppy_cli.commands import camera, config, demo, emulate, fleet, motor_setup, ports, scan
 from poppy_cli.commands import moves as moves_cmd
 from poppy_cli.commands import notebook as notebook_cmd
 from poppy_cli.commands import play as play_cmd
@@ -132,6 +132,7 @@ app.add_typer(moves_cmd.app, name="moves", rich_help_panel=MOVES)
 app.command("serve", rich_help_panel=SERVE)(serve_cmd.serve)
 app.add_typer(snap_cmd.app, name="snap", rich_help_panel=SERVE)
 app.command("notebook", rich_help_panel=SERVE)(notebook_cmd.notebook)
+app.add_typer(fleet.app, name="fleet", rich_help_panel=SERVE)
 app.command("emulate", rich_help_panel=SIMULATE)(emulate.emulate)
 app.add_typer(sim_cmd.app, name="sim", rich_help_panel=SIMULATE)
 

@@ -23,6 +23,7 @@ EXTRAS: dict[str, str] = {
     "tui": "the terminal app",
     "plot": "plots (matplotlib)",
     "notebook": "Jupyter notebooks (`poppy notebook`)",
+    "appliance": "the robot's name on the network (mDNS/DNS-SD with zeroconf)",
 }
 """Extra -> what it brings (pyproject.toml's ``[project.optional-dependencies]``)."""
 

@@ -79,6 +79,19 @@ def serve(
     open_browser: bool = typer.Option(
         False, "--open", help="Open Snap! with the Poppy blocks in the browser (with --snap)."
     ),
+    name: str | None = typer.Option(
+        None,
+        "--name",
+        "-n",
+        help="The robot's name: NAME and NAME.local are answered, and the pages the robot "
+        "serves under them on its other ports are its own (default with --announce: poppy).",
+    ),
+    announce: bool = typer.Option(
+        False,
+        "--announce/--no-announce",
+        help="Announce NAME.local and the servers over mDNS/DNS-SD on the interfaces served "
+        "(`poppy fleet discover` lists them); off unless asked.",
+    ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
     if not (http or ws or snap or zmq):
@@ -107,6 +120,8 @@ def serve(
         allow_hosts=tuple(allow_host or ()),
         ws_rate_hz=ws_rate,
         snap_dir=snap_dir,
+        name=_robot_name(name),
+        announce=announce,
         report=_report,
     )
     any_origin = _check_origins(spec)
@@ -132,6 +147,18 @@ def serve(
     finally:
         signal.signal(signal.SIGTERM, previous)
     print("stopped", file=sys.stderr, flush=True)
+
+
+def _robot_name(name: str | None) -> str | None:
+    """The robot's name as announced, or a usage error before anything is built."""
+    if name is None:
+        return None
+    from poppy_core.server.origins import robot_name
+
+    try:
+        return robot_name(name)
+    except ValueError as exc:
+        _usage(f"--name: {exc}")
 
 
 def _check_origins(spec: ServeSpec) -> bool:
@@ -181,6 +208,9 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
         print(f"docs: http://{base}:{servers.http.port}/docs", flush=True)
     if servers.snap is not None:
         announce_snap(servers.snap, open_browser)
+    if servers.announcer is not None and servers.http is not None:
+        where = servers.announcer.host
+        print(f"announced: http://{where}:{servers.http.port}", flush=True)
 
 
 def _say_where_takes_went(saved: list[SavedTake]) -> None:

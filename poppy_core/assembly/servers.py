@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
     from poppy_core.server import OriginPolicy, RobotService
+    from poppy_core.server.announce import Announcer
     from poppy_core.server.background import BackgroundServer
     from poppy_core.server.snap import SnapServer
     from poppy_core.server.zmqserver import ZmqRobotServer
@@ -56,6 +57,10 @@ class ServeSpec:
         allow_hosts: Host names answered besides loopback names, IPs and the listening host.
         ws_rate_hz: the state stream's default rate.
         snap_dir: a downloaded Snap! served at ``/app/`` on the Snap! port.
+        name: the robot's name: ``NAME`` and ``NAME.local`` are accepted as Host names, and the
+            pages the robot serves under them on any port count as its own.
+        announce: announce ``NAME.local`` (default ``poppy``) and the robot's services over
+            mDNS/DNS-SD on the interfaces the servers listen on (``appliance`` extra).
         report: called with one line the first time an origin or Host name is refused.
     """
 
@@ -68,6 +73,8 @@ class ServeSpec:
     allow_hosts: tuple[str, ...] = ()
     ws_rate_hz: float = 30.0
     snap_dir: Path | None = None
+    name: str | None = None
+    announce: bool = False
     report: Callable[[str], None] | None = field(default=None, compare=False)
 
     def listens(self) -> dict[str, Listen]:
@@ -97,6 +104,8 @@ class ServerSet:
         self.policy = policy
         self.app = app
         self.servers: dict[str, Any] = {}
+        self.announcer: Announcer | None = None
+        """The mDNS announcement (``announce``); ``announcer.name`` is the name won."""
         self._stopped = False
 
     @property
@@ -135,6 +144,8 @@ class ServerSet:
         if self._stopped:
             return
         self._stopped = True
+        if self.announcer is not None:
+            self.announcer.stop()  # goodbye first: nobody is sent to a server that is going
         for name in reversed(PROTOCOLS):
             if name in self.servers:
                 self.servers[name].stop()
@@ -157,8 +168,8 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     Raises:
         ListenError: a port is taken or an address unusable.
         RuntimeError: a server did not start (its log says why).
-        ValueError: an origin in ``cors`` or a name in ``allow_hosts`` that is not one.
-        MissingExtraError: the ``server`` (or ``zmq``) extra is missing.
+        ValueError: an origin in ``cors``, a name in ``allow_hosts`` or ``name`` that is not one.
+        MissingExtraError: the ``server`` (or ``zmq``, ``appliance``) extra is missing.
     """
     from poppy_core.server import OriginPolicy, RobotService, ServerThread, create_app
     from poppy_core.server.background import BackgroundServer
@@ -166,7 +177,11 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
 
     listens = spec.listens()
     policy = OriginPolicy.for_server(
-        spec.host, cors=spec.cors, allow_hosts=spec.allow_hosts, report=spec.report
+        spec.host,
+        cors=spec.cors,
+        allow_hosts=spec.allow_hosts,
+        name=spec.name,
+        report=spec.report,
     )
     service = RobotService(robot)
     app = None
@@ -193,6 +208,7 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
         if "snap" in listens:
             _add_snap(servers, robot, spec, listens["snap"])
         _own_pages(servers)
+        _named(servers, robot, spec)
         if start:
             servers.start()
     except BaseException:
@@ -201,16 +217,61 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     return servers
 
 
+def _named(servers: ServerSet, robot: Robot, spec: ServeSpec) -> None:
+    """Give the page's settings the robot's name; announce it when asked (before serving, so
+    the name won is accepted by the Host check from the first request)."""
+    from poppy_core.server.settings import ServedRobot
+
+    name = spec.name or ("poppy" if spec.announce else None)
+    policies = [servers.policy] + ([servers.snap.policy] if servers.snap is not None else [])
+    served = ServedRobot(
+        name=name,
+        protocols=tuple(servers.servers),
+        token_required=bool(spec.token),
+        policies=policies,
+    )
+    if servers.app is not None:
+        servers.app.state.settings.served = served
+    if not spec.announce or name is None:
+        return
+    from poppy_core.server.announce import Announcer
+
+    ports = {p: s.port for p, s in servers.servers.items()}
+    properties = {"creature": _creature(robot), "version": served.version}
+    if spec.token:
+        properties["token"] = "1"
+    announcer = Announcer(
+        name,
+        ports,
+        listen_host=spec.host,
+        properties=properties,
+        on_name=served.named,
+    )
+    servers.announcer = announcer
+    served.announcer = announcer
+    announcer.start()
+
+
+def _creature(robot: Robot) -> str:
+    profile = robot.config.profile if robot.config is not None else None
+    return (profile.kind or profile.name) if profile is not None else "custom"
+
+
 def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) -> None:
     from poppy_core.server.snap import create_snap_server
+    from poppy_core.server.snap.server import snap_policy
 
+    policy = snap_policy(
+        where.host, cors=spec.cors, allow_hosts=spec.allow_hosts, report=spec.report
+    )
+    if spec.name is not None:
+        policy.with_names([spec.name])  # Snap! projects call http://poppy.local:6969 too
     snap = create_snap_server(
         robot,
         where.host,
         where.port,
         service=servers.service,
-        cors=spec.cors,
-        allow_hosts=spec.allow_hosts,
+        policy=policy,
         snap_dir=spec.snap_dir,
         token=spec.token,
         report=spec.report,

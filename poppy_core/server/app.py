@@ -66,8 +66,10 @@ def create_app(
         v1_motors,
         v1_robot,
         v1_sensors,
+        v1_settings,
     )
     from poppy_core.server.sensors import SensorService
+    from poppy_core.server.settings import RobotSettings
     from poppy_core.server.stream import add_stream_routes
 
     owns_service = service is None
@@ -97,6 +99,9 @@ def create_app(
     app.state.service = service
     app.state.sensors = SensorService(robot)
     app.state.policy = policy
+    app.state.settings = RobotSettings()
+    app.state.settings.served.token_required = bool(token)
+    app.state.settings.served.policies = [policy]
     app.state.stream_rate_hz = stream_rate_hz
     install_error_handlers(app)
     add_web_page(app)  # the home page at / (its assets and /api/v1/web)
@@ -114,6 +119,7 @@ def create_app(
         v1_motion.router,
         v1_chains.router,
         v1_sensors.router,
+        v1_settings.router,
     ):
         app.include_router(router, prefix="/api/v1")
     add_stream_routes(app)

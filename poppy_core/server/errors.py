@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-Kind = Literal["not_found", "invalid", "conflict", "unavailable", "storage"]
+Kind = Literal["not_found", "invalid", "conflict", "unavailable", "storage", "forbidden"]
 
 V1_PREFIX = "/api/v1"
 
@@ -46,6 +46,7 @@ V1_STATUS: dict[Kind, int] = {
     "conflict": 409,
     "unavailable": 503,
     "storage": 507,
+    "forbidden": 403,
 }
 """HTTP status of each kind of error on the v1 API."""
 
@@ -55,6 +56,7 @@ PYPOT_STATUS: dict[Kind, int] = {
     "conflict": 404,
     "unavailable": 503,
     "storage": 507,
+    "forbidden": 403,
 }
 """HTTP status of each kind on pypot's routes (pypot answers 404 for most refusals)."""
 
@@ -67,8 +69,10 @@ class ApiError(Exception):
     """A request the server refuses.
 
     Args:
-        kind: ``"not_found"``, ``"invalid"``, ``"conflict"``, ``"unavailable"`` or ``"storage"``
-            (507: the server could not save a file; what was to be saved is kept).
+        kind: ``"not_found"``, ``"invalid"``, ``"conflict"``, ``"unavailable"``, ``"storage"``
+            (507: the server could not save a file; what was to be saved is kept) or
+            ``"forbidden"`` (403: allowed on no request to this server, e.g. settings without
+            a token).
         message: what went wrong (the ``error``/``detail`` text).
         tip: how to do it right (pypot's ``tip``).
         pypot_status: the status pypot's route answers, when it differs from ``PYPOT_STATUS``.

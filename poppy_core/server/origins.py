@@ -4,12 +4,15 @@ A server on 127.0.0.1 is reachable by every web page the user opens. Two rules k
 out while scripts, pypot's clients and the server's own pages keep working:
 
 - **Host**: the ``Host`` header must name this server: a loopback name, an IP address, the name
-  given to ``--host`` (the machine's name and ``NAME.local`` when listening on every interface)
-  or a name the user allows. A DNS-rebinding page reaches the server under the attacker's name
-  and is refused (400) before any route runs.
+  given to ``--host`` (the machine's name and ``NAME.local`` when listening on every interface),
+  the robot's name (``--name NAME``: ``NAME`` and ``NAME.local``, and the name its mDNS
+  announcement won after a conflict) or a name the user allows. A DNS-rebinding page reaches
+  the server under the attacker's name and is refused (400) before any route runs.
 - **Origin**: a request a browser sends on behalf of a page of another origin carries ``Origin``
   (every cross-origin POST, ``fetch`` and WebSocket handshake). It is refused (403) unless the
-  origin is the server's own (same host, one of its ports) or one the user allowed (``--cors``);
+  origin is the server's own (same host, one of its ports; a named robot's pages from
+  ``NAME.local`` on any of the robot's ports, e.g. a monitor page on 2280) or one the user
+  allowed (``--cors``);
   a state-changing request a browser sends without ``Origin`` (a link or an image pointing at a
   GET route that moves the robot) is refused when ``Sec-Fetch-Site`` says it is cross-site.
   Allowed foreign origins get CORS headers; ``*`` allows every origin (pypot's behaviour).
@@ -145,6 +148,35 @@ def is_loopback(name: str) -> bool:
         return False
 
 
+ROBOT_NAME = re.compile(r"[a-z0-9](?:[a-z0-9-]{0,61}[a-z0-9])?")
+"""A robot's name: one DNS label (its mDNS name is ``NAME.local``)."""
+
+
+def robot_name(text: str) -> str:
+    """A robot's name as announced: ``Poppy.local`` -> ``poppy``.
+
+    Raises:
+        ValueError: not one DNS label (letters, digits and inner hyphens, at most 63).
+    """
+    name = text.strip().lower().rstrip(".").removesuffix(".local")
+    if not ROBOT_NAME.fullmatch(name):
+        raise ValueError(
+            f"{text!r} is not a robot name: give letters, digits and hyphens (at most 63, "
+            "not starting or ending with a hyphen), e.g. poppy or ergo-2"
+        )
+    return name
+
+
+def robot_names(name: str) -> set[str]:
+    """The Host names of a robot named ``name``: ``poppy`` -> ``{"poppy", "poppy.local"}``.
+
+    Raises:
+        ValueError: ``name`` is not a robot name.
+    """
+    short = robot_name(name)
+    return {short, f"{short}.local"}
+
+
 def machine_names() -> set[str]:
     """This machine's name and its mDNS name (``poppy`` and ``poppy.local``)."""
     name = socket.gethostname().lower().rstrip(".")
@@ -157,6 +189,9 @@ class Verdict(Enum):
 
     OWN = "own"
     """A page of this server (same host, one of its ports): no CORS headers needed."""
+    SIBLING = "sibling"
+    """A page the named robot serves under its name on another port (a monitor page on 2280):
+    the robot's own, answered with CORS headers (the browser sees another origin)."""
     ALLOWED = "allowed"
     """An origin the user allowed: answered with CORS headers."""
     FOREIGN = "foreign"
@@ -171,6 +206,8 @@ class OriginPolicy:
         hosts: Host names accepted besides loopback names and IP addresses (``"*"``: any).
         own_ports: ports of the sibling servers whose pages count as the server's own
             (the port a request arrives on always does).
+        own_names: the robot's own names (``NAME``, ``NAME.local``): a page served under one of
+            them on any port is the robot's own (the robot's monitor pages on their own ports).
         origin_hint: how to allow a refused origin, ``{origin}`` filled in.
         host_hint: how to allow a refused Host name, ``{host}`` filled in.
         report: called with one line the first time an origin or a Host name is refused
@@ -186,6 +223,7 @@ class OriginPolicy:
         hosts: Iterable[str] = (),
         *,
         own_ports: Iterable[int] = (),
+        own_names: Iterable[str] = (),
         origin_hint: str = "restart poppy serve with --cors {origin}",
         host_hint: str = "restart poppy serve with --allow-host {host}",
         report: Callable[[str], None] | None = None,
@@ -193,6 +231,8 @@ class OriginPolicy:
         self.origins = frozenset(normalize_origin(o) for o in origins)
         self.hosts = frozenset(normalize_host(h) for h in hosts) | LOOPBACK_NAMES
         self.own_ports = frozenset(own_ports)
+        self.own_names = frozenset(normalize_host(n) for n in own_names)
+        self.hosts |= self.own_names
         self.any_origin = ANY in self.origins
         self.any_host = ANY in self.hosts
         self.origin_hint = origin_hint
@@ -209,13 +249,18 @@ class OriginPolicy:
         *,
         cors: Iterable[str] = (),
         allow_hosts: Iterable[str] = (),
+        name: str | None = None,
         **options: Any,
     ) -> OriginPolicy:
-        """The policy of a server listening on ``host`` (``--host``, ``--cors``, ``--allow-host``).
+        """The policy of a server listening on ``host`` (``--host``, ``--cors``, ``--allow-host``,
+        ``--name``).
 
         The name given to ``--host`` is accepted; listening on every interface (``0.0.0.0``,
-        ``::``) also accepts this machine's name and ``NAME.local``.
+        ``::``) also accepts this machine's name and ``NAME.local``. A robot ``name`` is accepted
+        as ``NAME`` and ``NAME.local``, and its pages on any port count as its own.
         """
+        if name is not None:
+            options["own_names"] = robot_names(name)
         names = set(allow_hosts)
         bare = host.strip("[]").lower()
         if bare in WILDCARD_HOSTS:
@@ -227,6 +272,18 @@ class OriginPolicy:
     def with_ports(self, ports: Iterable[int]) -> OriginPolicy:
         """Count pages served on ``ports`` (sibling servers) as the server's own; returns self."""
         self.own_ports = self.own_ports | frozenset(ports)
+        self._origins_seen.clear()
+        return self
+
+    def with_names(self, names: Iterable[str]) -> OriginPolicy:
+        """Accept ``names`` as the robot's own too (the mDNS name won after a conflict, a new
+        name set from the settings); returns self."""
+        own: set[str] = set()
+        for name in names:
+            own |= robot_names(name)
+        self.own_names = self.own_names | own
+        self.hosts = self.hosts | own
+        self._hosts_seen.clear()
         self._origins_seen.clear()
         return self
 
@@ -261,23 +318,29 @@ class OriginPolicy:
             normal = normalize_origin(origin)
         except ValueError:
             return Verdict.ALLOWED if self.any_origin else Verdict.FOREIGN
-        if normal not in (ANY, "null") and host is not None and self._own(normal, host, port):
-            return Verdict.OWN
+        if normal not in (ANY, "null") and host is not None:
+            own = self._own(normal, host, port)
+            if own is not None:
+                return own
         if self.any_origin or normal in self.origins:
             return Verdict.ALLOWED
         return Verdict.FOREIGN
 
-    def _own(self, origin: str, host: bytes, port: int | None) -> bool:
+    def _own(self, origin: str, host: bytes, port: int | None) -> Verdict | None:
         parts = urlsplit(origin)
         name = (parts.hostname or "").lower()
         origin_port = parts.port or DEFAULT_PORTS.get(parts.scheme)
         host_name, host_port = split_host(host.decode("latin-1"))
         if name == host_name and origin_port == (host_port or DEFAULT_PORTS.get(parts.scheme)):
-            return True  # same origin: a page this server served under the name it was reached by
+            return Verdict.OWN  # same origin: a page served under the name it was reached by
         ports = self.own_ports | ({port} if port is not None else set())
-        if origin_port not in ports:
-            return False
-        return name == host_name or is_loopback(name) or (name in self.hosts and not is_ip(name))
+        if origin_port in ports and (
+            name == host_name or is_loopback(name) or (name in self.hosts and not is_ip(name))
+        ):
+            return Verdict.OWN
+        if name in self.own_names:
+            return Verdict.SIBLING  # a page the named robot serves on another of its ports
+        return None
 
     # -- reports -------------------------------------------------------------------------------
 
@@ -391,7 +454,7 @@ class OriginGuard:
                 message = policy.refused_origin(origin.decode("latin-1"))
                 await refuse(scope, send, 403, message, "the server's operator can allow it")
                 return
-            if verdict is Verdict.ALLOWED and allow is None:
+            if verdict in (Verdict.ALLOWED, Verdict.SIBLING) and allow is None:
                 allow = origin
         elif fetch_site in CROSS_SITE and not policy.any_origin and self.changes_state(scope):
             message = policy.refused_cross_site()

@@ -304,6 +304,18 @@ SCHEMAS: dict[str, Any] = {
     "moves import": {"name": str, "path": str, "frames": int, "motors": [str]},
     "moves rm": {"deleted": str},
     "camera list": [{"device": str, "index": int, "name": str}],
+    "fleet discover": [
+        {
+            "name": str,
+            "host": str,
+            "creature": str,
+            "version": str,
+            "addresses": [str],
+            "ports": Map(int),
+            "urls": Map(str),
+            "token": bool,
+        }
+    ],
     "camera detect": [
         {
             "id": int,
@@ -423,6 +435,8 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
                 "camera list": (("camera", "list"), ""),
                 "snap download": (("snap", "download", snap.version, "--from",
                                    str(tmp / "snap.zip"), "--sha256", snap.digest), ""),
+                "fleet discover": (("fleet", "discover", "--timeout", "0.5", "--interface",
+                                    "127.0.0.1"), ""),
                 "camera detect": (("camera", "detect", "--sim", "mujoco", "--profile", "ergo-jr",
                                    "--marker", "3"), ""),
             }

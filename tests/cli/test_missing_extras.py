@@ -37,6 +37,8 @@ CASES = [
     ("tui", "textual,textual_serve", ["tui"]),
     ("vision", "cv2", ["camera", "snapshot", "-o", "{tmp}/shot.png", "--device", "0"]),
     ("plot", "matplotlib", ["moves", "plot", "{tmp}/wave.json", "-o", "{tmp}/wave.png"]),
+    ("appliance", "zeroconf", ["fleet", "discover", "--timeout", "0.5"]),
+    ("appliance", "zeroconf", ["serve", "--http", *ROBOT, "--http-port", "0", "--announce"]),
 ]
 
 

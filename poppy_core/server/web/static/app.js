@@ -5,6 +5,7 @@ import { buildTable, onFrame, refresh, stats } from "./motors.js";
 import { refreshMoves, setupRecorder } from "./moves.js";
 import { notebookLink, notes } from "./notebook.js";
 import { refreshPrimitives } from "./primitives.js";
+import { setupSettings } from "./settings.js";
 import { count, el, every, say } from "./ui.js";
 
 const STREAM_HZ = 20;
@@ -139,6 +140,7 @@ function rateMeter() {
 async function main() {
   window.poppy = { stats };
   setupStop();
+  setupSettings();
   // the stream opens at once and every first request goes out together: first values sooner
   openStream(STREAM_HZ, onFrame, setLive);
   const [about, details] = await Promise.all([

@@ -1,0 +1,207 @@
+"""The robot's settings as the page shows and changes them: name, Wi-Fi, services, token, version.
+
+``RobotSettings`` decides who may change what and logs every change; the OS is reached through
+``settings_os.SystemTools`` only. A change needs the server to have been started with
+``--token`` (the token middleware then refuses every request without it) and a machine with
+NetworkManager and systemd; elsewhere the settings are shown read-only with the reason.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from importlib import metadata
+from typing import TYPE_CHECKING, Any
+
+from poppy_core.server.errors import ApiError
+from poppy_core.server.origins import OriginPolicy, robot_name
+from poppy_core.server.settings_os import SystemTools
+
+if TYPE_CHECKING:
+    from poppy_core.server.announce import Announcer
+
+logger = logging.getLogger(__name__)
+
+SERVICE_UNITS = {"jupyter": "poppy-jupyter.service"}
+"""Service -> its systemd unit (``poppy service install --jupyter`` writes it)."""
+SERVED_OPTIONS = {"snap": "--snap", "zmq": "--zmq"}
+"""Services served by ``poppy.service`` itself: shown, changed by reinstalling the service."""
+MIN_PSK = 8
+MAX_PSK = 63
+MAX_SSID_BYTES = 32
+
+
+def poppy_version() -> str:
+    """The installed poppy's version (``unknown`` in a source tree never installed)."""
+    try:
+        return metadata.version("poppy")
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+@dataclass
+class ServedRobot:
+    """What the composition root tells the settings about the robot it serves."""
+
+    name: str | None = None
+    protocols: tuple[str, ...] = ()
+    token_required: bool = False
+    policies: list[OriginPolicy] = field(default_factory=list)
+    """The Host and Origin rules of every server of the robot (REST and WebSocket, Snap!)."""
+    announcer: Announcer | None = None
+    version: str = field(default_factory=poppy_version)
+
+    def named(self, name: str) -> None:
+        """The robot is now ``name`` (an mDNS name won, a new name set): the Host check
+        accepts it from now on."""
+        self.name = name
+        for policy in self.policies:
+            policy.with_names([name])
+
+
+class RobotSettings:
+    """The settings of one served robot.
+
+    Args:
+        system: the OS adapter (by default the machine's own tools).
+    """
+
+    def __init__(self, system: SystemTools | None = None) -> None:
+        self.system = system or SystemTools()
+        self.served = ServedRobot()
+
+    # -- reading -------------------------------------------------------------------------------
+
+    def overview(self) -> dict[str, Any]:
+        """Everything the settings panel shows, and whether (and why not) it can change it."""
+        missing = self.system.unavailable()
+        reason = self._without_token() or missing
+        services: dict[str, Any] = {
+            name: {"on": name in self.served.protocols, "unit": None, "how": f"serve {flag}"}
+            for name, flag in SERVED_OPTIONS.items()
+        }
+        for name, unit in SERVICE_UNITS.items():
+            active = self.system.service_active(unit) if missing is None else None
+            services[name] = {"on": active, "unit": unit, "how": "systemctl"}
+        return {
+            "editable": reason is None,
+            "reason": reason,
+            "name": self.served.name,
+            "hostname": self.system.hostname(),
+            "announced": self.served.announcer is not None,
+            "services": services,
+            "token_required": self.served.token_required,
+            "version": self.served.version,
+        }
+
+    def _without_token(self) -> str | None:
+        if self.served.token_required:
+            return None
+        return (
+            "this server was started without --token: settings are changed only on a "
+            "robot whose server asks for a token (poppy service install --token ...)"
+        )
+
+    def wifi(self) -> dict[str, Any]:
+        """Networks in range and saved ones (a read: it needs NetworkManager, not a token)."""
+        self._check_system()
+        return {
+            "networks": [vars(n) for n in self.system.networks()],
+            "saved": [vars(s) for s in self.system.saved()],
+        }
+
+    # -- changing ------------------------------------------------------------------------------
+
+    def check_change(self) -> None:
+        """Refuse a change (403 without a token, 409 without the OS's tools)."""
+        if not self.served.token_required:
+            raise ApiError(
+                "forbidden",
+                "settings are changed only on a server started with --token",
+                tip="restart the server with --token (poppy service install --token ...)",
+            )
+        self._check_system()
+
+    def _check_system(self) -> None:
+        reason = self.system.unavailable()
+        if reason is not None:
+            raise ApiError("conflict", reason, tip="the settings are read-only here")
+
+    def set_name(self, text: str, who: str) -> str:
+        """Rename the machine and the robot's mDNS name at once; returns the name announced."""
+        try:
+            name = robot_name(text)
+        except ValueError as exc:
+            raise ApiError("invalid", str(exc)) from None
+        self.check_change()
+        self.system.set_hostname(name)
+        announcer = self.served.announcer
+        won = announcer.rename(name) if announcer is not None else name
+        self.served.named(won)
+        logger.warning("settings: %s renamed the robot %s (announced as %s.local)", who, name, won)
+        return won
+
+    def join(self, ssid: str, password: str | None, who: str) -> None:
+        """Join a Wi-Fi network (and remember it)."""
+        _check_ssid(ssid)
+        if password is not None and password and not MIN_PSK <= len(password) <= MAX_PSK:
+            raise ApiError("invalid", f"a Wi-Fi password has {MIN_PSK} to {MAX_PSK} characters")
+        self.check_change()
+        self.system.join(ssid, password or None)
+        logger.warning("settings: %s joined the Wi-Fi network %r", who, ssid)
+
+    def forget(self, name: str, who: str) -> None:
+        """Forget a saved Wi-Fi network."""
+        _check_ssid(name)
+        self.check_change()
+        self.system.forget(name)
+        logger.warning("settings: %s forgot the Wi-Fi network %r", who, name)
+
+    def hotspot(self, on: bool, password: str | None, who: str) -> str | None:
+        """Set up (or remove) the access point named after the robot; returns its name."""
+        if on and (password is None or not MIN_PSK <= len(password) <= MAX_PSK):
+            raise ApiError(
+                "invalid",
+                f"the access point needs a password of {MIN_PSK} to {MAX_PSK} characters",
+            )
+        self.check_change()
+        if not on:
+            self.system.remove_hotspot()
+            logger.warning("settings: %s removed the fallback access point", who)
+            return None
+        assert password is not None
+        ssid = self.served.name or _name_of(self.system.hostname())
+        self.system.set_hotspot(ssid, password)
+        logger.warning("settings: %s set up the fallback access point %r", who, ssid)
+        return ssid
+
+    def set_service(self, service: str, on: bool, who: str) -> None:
+        """Start and enable a service's unit, or stop and disable it."""
+        unit = SERVICE_UNITS.get(service)
+        if unit is None:
+            if service in SERVED_OPTIONS:
+                raise ApiError(
+                    "conflict",
+                    f"{service} is served by poppy.service itself",
+                    tip=f"reinstall the service with or without {SERVED_OPTIONS[service]}",
+                )
+            known = ", ".join([*SERVICE_UNITS, *SERVED_OPTIONS])
+            raise ApiError("not_found", f"no service {service!r} (services: {known})")
+        self.check_change()
+        self.system.set_service(unit, on)
+        logger.warning("settings: %s turned %s %s", who, service, "on" if on else "off")
+
+
+def _name_of(hostname: str) -> str:
+    """The robot's name from the machine's (``poppy`` when that is no DNS label)."""
+    try:
+        return robot_name(hostname.split(".")[0])
+    except ValueError:
+        return "poppy"
+
+
+def _check_ssid(ssid: str) -> None:
+    if not ssid or len(ssid.encode()) > MAX_SSID_BYTES or any(ord(c) < 32 for c in ssid):
+        raise ApiError(
+            "invalid", f"a Wi-Fi network name has 1 to {MAX_SSID_BYTES} bytes, no control character"
+        )

@@ -1,0 +1,91 @@
+"""The settings panel of the page in Debian's chromium (Playwright), against recording fakes of
+the OS's tools: a rename from the page runs hostnamectl with the token; without NetworkManager
+the panel is read-only and says why."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.helpers.fake_tools import FakeTools
+from tests.helpers.server import Served, serve
+from tests.helpers.waiting import eventually
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+playwright_api = pytest.importorskip(
+    "playwright.sync_api", reason="needs playwright (pip install -e '.[test]')"
+)
+pytestmark = pytest.mark.skipif(
+    CHROMIUM is None, reason="needs Debian's chromium (apt-get install chromium)"
+)
+
+TOKEN = "s3cret"
+WAIT_MS = 60_000
+
+
+@pytest.fixture(scope="module")
+def with_token(moves_folder: str) -> Iterator[Served]:
+    yield from serve(moves_folder, token=TOKEN)
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    with playwright_api.sync_playwright() as driver:
+        launched = driver.chromium.launch(
+            executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"]
+        )
+        yield launched
+        launched.close()
+
+
+@pytest.fixture
+def fake(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> FakeTools:
+    return FakeTools(tmp_path, monkeypatch)
+
+
+def _settings_page(browser: Any, served: Served) -> tuple[Any, Any]:
+    context = browser.new_context()
+    context.add_init_script(f"localStorage.setItem('poppy-token', '{TOKEN}')")
+    page = context.new_page()
+    page.set_default_timeout(WAIT_MS)
+    page.goto(served.url + "/")
+    page.wait_for_function("() => window.poppy && window.poppy.ready")
+    page.click("#settings summary")
+    page.wait_for_selector("#settings-version")
+    return context, page
+
+
+def test_renaming_from_the_page_runs_hostnamectl(
+    browser: Any, with_token: Served, fake: FakeTools
+) -> None:
+    context, page = _settings_page(browser, with_token)
+    try:
+        assert page.inner_text("#settings-version").startswith("poppy ")
+        assert page.is_hidden("#settings-reason")
+        page.fill("#settings-name", "ergo-7")
+        page.click("#settings-rename")
+        assert eventually(lambda: fake.changes() != [], 30.0)
+        assert fake.changes() == [["hostnamectl", "set-hostname", "ergo-7"]]
+        page.wait_for_function(
+            "() => document.getElementById('message').textContent.includes('ergo-7.local')"
+        )
+    finally:
+        context.close()
+
+
+def test_without_networkmanager_the_panel_is_read_only_and_says_why(
+    browser: Any, with_token: Served, fake: FakeTools, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    fake.alone(monkeypatch)
+    fake.remove("nmcli")
+    context, page = _settings_page(browser, with_token)
+    try:
+        assert "nmcli not found" in page.inner_text("#settings-reason")
+        assert page.is_disabled("#settings-rename") and page.is_disabled("#settings-name")
+    finally:
+        context.close()
+    assert fake.changes() == []
