@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 from poppy_core.bus.dxlbus import DxlBus
+from poppy_core.bus.groupread import count_answers
 from poppy_core.bus.results import FoundMotor
 from poppy_core.bus.scan import scan
 from poppy_core.bus.setup_reset import reset_motor
@@ -205,6 +206,14 @@ class GuidedSetup:
                 f"{target.name}"
             )
         motor = found[0]
+        if motor.protocol == 2:  # two motors sharing an ID both answer a broadcast ping
+            with DxlBus(self.port, motor.baudrate, 2, min_timeout_s=0.1) as bus:
+                sharing = count_answers(bus)[motor.id]
+            if sharing > 1:
+                raise SetupError(
+                    f"{sharing} motors answer on {self.port} as {_where(motor)}: unplug all "
+                    f"but {target.name}"
+                )
         if motor.model != target.model:
             what = motor.model or f"a motor of unknown model number {motor.model_number}"
             article = "" if motor.model is None else _article(motor.model)
