@@ -103,6 +103,7 @@ FLAGS: dict[str, Flag] = {
     "--snap-dir": Flag(None, "DIR", "a downloaded Snap! to serve"),
     "--open": Flag(None, None, "open it in the web browser"),
     "--token": Flag(None, "TOKEN", "token every request must carry"),
+    "--url": Flag(None, "URL", "the robot's page, checked by `poppy doctor`"),
     "--cors": Flag(None, "ORIGIN", "web page origin allowed to use the robot"),
     "--allow-host": Flag(None, "HOST", "host name the server also answers"),
     "--no-sensors": Flag(None, None, "leave the config's cameras closed"),

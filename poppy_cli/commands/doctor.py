@@ -34,11 +34,10 @@ def _render(check: Check) -> None:
 def doctor(
     profile: str | None = ProfileOpt,
     port: str | None = BusPortOpt,
-    name: str = typer.Option(
-        "poppy", "--name", help="The robot's name: its page is checked at http://NAME.local/."
-    ),
-    url: str | None = typer.Option(
-        None, "--url", help="Check the robot's page at this URL instead of http://NAME.local/."
+    url: str = typer.Option(
+        "http://poppy.local/",
+        "--url",
+        help="The robot's page, checked when poppy.service is installed (http://NAME.local/).",
     ),
     json_output: bool = JsonOpt,
 ) -> None:
@@ -62,7 +61,7 @@ def doctor(
         config,
         chosen,
         chosen_port(port),
-        page_url=url or f"http://{name}.local/",
+        page_url=url,
         probe=probe,
         progress=None if json_output else _render,
     )

@@ -75,7 +75,7 @@ def _set_up_one(flow: GuidedSetup, target: MotorTarget, json_output: bool) -> St
         if not _wait_for_enter(target):
             error_line(
                 f"input ended before {target.name} was set up; go on with "
-                f"`poppy setup motors --only {target.name},...`"
+                f"`poppy setup motors --motors {target.name},...`"
             )
             raise typer.Exit(EXIT_FAILURE)
         try:
@@ -91,7 +91,7 @@ def motors(
     profile: str | None = ProfileOpt,
     port: str | None = BusPortOpt,
     only: str | None = typer.Option(
-        None, "--only", help="Set up only these motors, e.g. m3 or m3,m4 (default: all)."
+        None, "--motors", "-m", help="Set up only these motors, e.g. m3 or m3,m4 (default: all)."
     ),
     json_output: bool = JsonOpt,
 ) -> None:

@@ -21,15 +21,18 @@ from poppy_core.bus.ports import read_ftdi_latency_ms as read_latency
 from poppy_core.errors import CorruptPacketError, PoppyError
 from poppy_core.models import ServoModel
 from poppy_core.robot.config import RobotConfig
-from poppy_core.robot.guided_setup import MotorTarget, motor_targets, read_settings
+from poppy_core.robot.guided_setup import (
+    REPLY_TIMEOUT_S,
+    MotorTarget,
+    motor_targets,
+    read_settings,
+)
 
 logger = logging.getLogger(__name__)
 
 Status = Literal["pass", "fail", "skip"]
 GOOD_LATENCY_MS = 1
 LATE_REPLIES_S = 0.1
-CHECK_TIMEOUT_S = 0.1
-"""The shortest wait for a reply: a check is not timed, and a busy machine answers late."""
 """How long the line is listened to after the broadcast ping, for replies still coming."""
 
 
@@ -104,7 +107,7 @@ def check_latency(port: str | None, sysfs_root: str = "/sys") -> Check:
 def _setup_fix(profile: str, port: str, motor: str) -> str:
     return (
         f"plug only {motor}, then: poppy setup motors --profile {profile} --port {port} "
-        f"--only {motor}"
+        f"--motors {motor}"
     )
 
 
@@ -242,7 +245,7 @@ def check_motors(config: RobotConfig, profile: str, port: str | None) -> list[Ch
         by_bus.setdefault((target.baudrate, target.protocol), []).append(target)
     for (rate, protocol), group in by_bus.items():
         try:
-            with DxlBus(port, rate, protocol, retries=2, min_timeout_s=CHECK_TIMEOUT_S) as bus:
+            with DxlBus(port, rate, protocol, retries=2, min_timeout_s=REPLY_TIMEOUT_S) as bus:
                 bus.adaptive_latency = True  # a slow adapter is learned from its late replies
                 checks.append(check_duplicates(bus, group, profile, port))
                 for target in group:

@@ -20,10 +20,11 @@ from dataclasses import dataclass, field
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.groupread import count_answers
 from poppy_core.bus.results import FoundMotor
-from poppy_core.bus.scan import scan
+from poppy_core.bus.scan import PROTOCOLS, scan
 from poppy_core.bus.setup_reset import reset_motor
 from poppy_core.errors import PoppyError, SetupError
 from poppy_core.models import ServoModel, model_by_name, standard_baudrates
+from poppy_core.protocol import protocol_for
 from poppy_core.robot.config import RobotConfig
 
 logger = logging.getLogger(__name__)
@@ -31,6 +32,8 @@ logger = logging.getLogger(__name__)
 Progress = Callable[[str], None]
 DEFAULT_RETURN_DELAY_US = 0.0
 """The return delay a Poppy robot's motors get unless the profile says another (µs)."""
+REPLY_TIMEOUT_S = 0.1
+"""The shortest wait for a reply during setup (a silent motor costs no more than that)."""
 
 
 @dataclass(frozen=True)
@@ -173,6 +176,13 @@ class GuidedSetup:
         self.port = port
         self.targets = motor_targets(config, only)
 
+    def _bus(self, rate: int, protocol: int) -> DxlBus:
+        """A bus that waits long for replies: setup is not timed, and a busy machine (or a
+        slow adapter, learned from its late replies) answers late."""
+        bus = DxlBus(self.port, rate, protocol, retries=2, min_timeout_s=REPLY_TIMEOUT_S)
+        bus.adaptive_latency = True
+        return bus
+
     def next_after(self, target: MotorTarget) -> str | None:
         """The name of the motor after ``target``, None after the last."""
         names = [t.name for t in self.targets]
@@ -191,9 +201,9 @@ class GuidedSetup:
         rates.sort(key=lambda r: r != target.baudrate)  # the profile's rate first
         found = scan(self.port, rates, [target.protocol])
         if not found:
-            other = 1 if target.protocol == 2 else 2
-            say(progress, f"nothing in protocol {target.protocol}: trying protocol {other}")
-            found = scan(self.port, None, [other])
+            others = [p for p in PROTOCOLS if p != target.protocol]
+            say(progress, f"nothing in protocol {target.protocol}: trying the other")
+            found = scan(self.port, None, others)
         if not found:
             raise SetupError(
                 f"nothing answers on {self.port} (every ID and standard rate, protocols 1 and "
@@ -206,8 +216,8 @@ class GuidedSetup:
                 f"{target.name}"
             )
         motor = found[0]
-        if motor.protocol == 2:  # two motors sharing an ID both answer a broadcast ping
-            with DxlBus(self.port, motor.baudrate, 2, min_timeout_s=0.1) as bus:
+        if protocol_for(motor.protocol).has_broadcast_ping:  # motors sharing an ID all answer
+            with self._bus(motor.baudrate, motor.protocol) as bus:
                 sharing = count_answers(bus)[motor.id]
             if sharing > 1:
                 raise SetupError(
@@ -233,7 +243,7 @@ class GuidedSetup:
         found = self.find_single(target, progress)
         model = target.servo
         outcome = StepOutcome(target.name, found, next_motor=self.next_after(target))
-        with DxlBus(self.port, found.baudrate, found.protocol) as bus:
+        with self._bus(found.baudrate, found.protocol) as bus:
             right_place = (found.id, found.baudrate) == (target.id, target.baudrate)
             if right_place and settings_match(read_settings(bus, found.id, model), target, model):
                 outcome.skipped = True
@@ -267,7 +277,7 @@ class GuidedSetup:
             SetupError: the motor does not answer there, or a setting does not read back.
         """
         model = target.servo
-        with DxlBus(self.port, target.baudrate, target.protocol) as bus:
+        with self._bus(target.baudrate, target.protocol) as bus:
             pinged = bus.ping(target.id)
             if pinged is None or pinged.model is None or pinged.model.name != model.name:
                 raise SetupError(

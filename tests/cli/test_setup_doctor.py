@@ -195,7 +195,7 @@ def test_doctor_names_a_missing_motor(robot: Callable[..., tuple[VirtualBus, str
     fixes = failures(doctor(port))
     assert list(fixes) == ["m3 (ID 3)"]
     assert "poppy setup motors --profile ergo-jr" in fixes["m3 (ID 3)"][0]
-    assert "--only m3" in fixes["m3 (ID 3)"][0]
+    assert "--motors m3" in fixes["m3 (ID 3)"][0]
 
 
 def test_doctor_names_a_wrong_model(robot: Callable[..., tuple[VirtualBus, str]]) -> None:
@@ -292,7 +292,7 @@ def setup_once(bus: VirtualBus, *places: int) -> Result:
             "ergo-jr",
             "--port",
             server.url,
-            "--only",
+            "--motors",
             "m1",
             input="\n",
         )
@@ -332,7 +332,7 @@ def test_setup_names_a_wrong_model_of_the_other_protocol() -> None:
             "ergo-jr",
             "--port",
             server.url,
-            "--only",
+            "--motors",
             "m1",
             input="\n",
         )
@@ -351,7 +351,7 @@ def test_setup_leaves_a_motor_already_right_as_it_is() -> None:
             "ergo-jr",
             "--port",
             server.url,
-            "--only",
+            "--motors",
             "m1",
             "--json",
             input="\n",
