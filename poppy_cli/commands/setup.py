@@ -55,17 +55,6 @@ def _wait_for_enter(target: MotorTarget) -> bool:
     return line != ""
 
 
-def _outcome_line(outcome: StepOutcome) -> str:
-    found = outcome.found
-    if outcome.skipped:
-        head = f"{outcome.motor}: already right (ID {found.id} at {found.baudrate} bps), left as is"
-    else:
-        changed = ", ".join(outcome.changes) or "nothing"
-        head = f"{outcome.motor}: found as ID {found.id} at {found.baudrate} bps; set {changed}"
-    tail = f"next: {outcome.next_motor}" if outcome.next_motor else "all motors done"
-    return f"{head} — {tail}"
-
-
 def _set_up_one(flow: GuidedSetup, target: MotorTarget, json_output: bool) -> StepOutcome:
     """Prompt for ``target`` until it is set up; on a terminal a failure asks again."""
     from poppy_cli.prompts import interactive
@@ -127,7 +116,7 @@ def motors(
         outcome = _set_up_one(flow, target, json_output)
         outcomes.append(outcome)
         if not json_output:
-            err_console.print(styled("[green]✓[/] {}", _outcome_line(outcome)))
+            err_console.print(styled("[green]✓[/] {}", outcome.summary()))
     if json_output:
         print_json([o.as_dict() for o in outcomes])
     else:

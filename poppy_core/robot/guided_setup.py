@@ -114,6 +114,19 @@ class StepOutcome:
     skipped: bool = False
     next_motor: str | None = None
 
+    def summary(self) -> str:
+        """One line saying what the step did and which motor is next."""
+        found = self.found
+        if self.skipped:
+            head = (
+                f"{self.motor}: already right (ID {found.id} at {found.baudrate} bps), left as is"
+            )
+        else:
+            changed = ", ".join(self.changes) or "nothing"
+            head = f"{self.motor}: found as ID {found.id} at {found.baudrate} bps; set {changed}"
+        tail = f"next: {self.next_motor}" if self.next_motor else "all motors done"
+        return f"{head} — {tail}"
+
     def as_dict(self) -> dict[str, object]:
         """The outcome as JSON-ready data (the shape of `poppy setup motors --json`)."""
         return {
