@@ -18,8 +18,9 @@ _MAX_REPEAT = 253
 _MAX_MOTOR_ID = 252
 
 
-def _parse_ids(text: str, spec: str, shared: set[int]) -> list[int]:
-    """The IDs of ``text``; IDs given as ``ID*COUNT`` are added to ``shared``."""
+def _parse_ids(text: str, spec: str, shared: set[int], plain: list[int]) -> list[int]:
+    """The IDs of ``text``; IDs given as ``ID*COUNT`` are added to ``shared``, the others to
+    ``plain``."""
     ids: list[int] = []
     for part in re.split(r"[+/ ]+", text.strip()):
         if not part:
@@ -56,6 +57,7 @@ def _parse_ids(text: str, spec: str, shared: set[int]) -> list[int]:
                 reason="bad id range",
             )
         ids.extend(range(first, last + 1))
+        plain.extend(range(first, last + 1))
     return ids
 
 
@@ -73,6 +75,7 @@ def parse_spec(spec: str) -> list[tuple[ServoModel, int]]:
     pairs: list[tuple[ServoModel, int]] = []
     model: ServoModel | None = None
     shared: set[int] = set()
+    plain: list[int] = []
     for item in spec.split(","):
         item = item.strip()
         if not item:
@@ -97,16 +100,17 @@ def parse_spec(spec: str) -> list[tuple[ServoModel, int]]:
             )
         else:
             ids_text = item
-        pairs.extend((model, motor_id) for motor_id in _parse_ids(ids_text, spec, shared))
+        pairs.extend((model, motor_id) for motor_id in _parse_ids(ids_text, spec, shared, plain))
     if not pairs:
         raise ConfigError(
             f"emulator spec {spec!r} lists no motor", field="spec", value=spec, reason="empty"
         )
     seen: set[int] = set()
-    for _, motor_id in pairs:
-        if motor_id in seen and motor_id not in shared:
+    for motor_id in [*plain, *shared]:
+        if motor_id in seen:
             raise ConfigError(
-                f"id {motor_id} appears twice in emulator spec {spec!r}",
+                f"id {motor_id} appears twice in emulator spec {spec!r} (motors sharing an ID: "
+                "ID*COUNT, e.g. XL-320:1*6)",
                 field="spec",
                 value=spec,
                 reason="duplicate id",
