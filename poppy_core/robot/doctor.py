@@ -11,13 +11,14 @@ from __future__ import annotations
 import logging
 import os
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.groupread import count_answers
 from poppy_core.bus.ports import DIALOUT_ADVICE, latency_advice, latency_timer_path
 from poppy_core.bus.ports import read_ftdi_latency_ms as read_latency
+from poppy_core.bus.scan import scan
 from poppy_core.errors import CorruptPacketError, PoppyError
 from poppy_core.models import ServoModel
 from poppy_core.robot.config import RobotConfig
@@ -254,4 +255,36 @@ def check_motors(config: RobotConfig, profile: str, port: str | None) -> list[Ch
             checks.append(
                 Check("motors", "fail", f"{port} at {rate} bps: {exc}", "`poppy ports`, then retry")
             )
+            continue
+        checks = _where_missing(checks, group, port, protocol)
     return checks
+
+
+def _where_missing(
+    checks: list[Check], group: list[MotorTarget], port: str, protocol: int
+) -> list[Check]:
+    """Say where the missing motors of ``group`` answer, if anywhere at another rate (a scan
+    of their IDs at every standard rate of the protocol)."""
+    missing = {
+        f"{t.name} (ID {t.id})": t
+        for t in group
+        if any(c.name == f"{t.name} (ID {t.id})" and c.detail.startswith("no ") for c in checks)
+    }
+    if not missing:
+        return checks
+    try:
+        found = scan(port, None, [protocol], sorted({t.id for t in missing.values()}))
+    except PoppyError as exc:
+        logger.info("could not look for the missing motors on %s: %s", port, exc)
+        return checks
+    rates: dict[int, list[int]] = {}
+    for motor in found:
+        rates.setdefault(motor.id, []).append(motor.baudrate)
+    out = []
+    for check in checks:
+        target = missing.get(check.name)
+        if target is not None and target.id in rates and check.detail.startswith("no "):
+            where = ", ".join(f"{r} bps" for r in rates[target.id])
+            check = replace(check, detail=f"{check.detail}; ID {target.id} answers at {where}")
+        out.append(check)
+    return out

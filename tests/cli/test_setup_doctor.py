@@ -198,6 +198,19 @@ def test_doctor_names_a_missing_motor(robot: Callable[..., tuple[VirtualBus, str
     assert "--motors m3" in fixes["m3 (ID 3)"][0]
 
 
+def test_doctor_says_where_a_motor_at_another_rate_answers(
+    robot: Callable[..., tuple[VirtualBus, str]],
+) -> None:
+    bus, port = robot(set_up_robot())
+    bus.motor(5).table.set("baudrate", 1)  # XL-320 code 1: 57,600 bps (e-manual)
+    result = doctor(port)
+    fixes = failures(result)
+    assert list(fixes) == ["m5 (ID 5)"]
+    detail = next(c["detail"] for c in result.json()["checks"] if c["name"] == "m5 (ID 5)")
+    assert detail.endswith("; ID 5 answers at 57600 bps")
+    assert "--motors m5" in fixes["m5 (ID 5)"][0]
+
+
 def test_doctor_names_a_wrong_model(robot: Callable[..., tuple[VirtualBus, str]]) -> None:
     _, port = robot(set_up_robot("XL-320:1-2,XL430-W250:3,XL-320:4-6"))
     result = doctor(port)
