@@ -34,10 +34,11 @@ def _render(check: Check) -> None:
 def doctor(
     profile: str | None = ProfileOpt,
     port: str | None = BusPortOpt,
-    url: str = typer.Option(
-        "http://poppy.local/",
+    url: str | None = typer.Option(
+        None,
         "--url",
-        help="The robot's page, checked when poppy.service is installed (http://NAME.local/).",
+        help="The robot's page, checked when poppy.service is installed "
+        "(default: http://NAME.local/, NAME as the service names the robot, else poppy).",
     ),
     json_output: bool = JsonOpt,
 ) -> None:

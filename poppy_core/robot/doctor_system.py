@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import shutil
 import subprocess
 import urllib.error
@@ -130,9 +131,9 @@ def service_scope(probe: SystemProbe) -> list[str] | None:
     return None
 
 
-def check_service(probe: SystemProbe) -> tuple[Check, bool]:
-    """poppy.service is running; also whether it is installed (the page is checked then)."""
-    scope = service_scope(probe)
+def check_service(probe: SystemProbe, scope: list[str] | None) -> tuple[Check, bool]:
+    """poppy.service (installed in ``scope``, see :func:`service_scope`) is running; also
+    whether it is installed (the page is checked then)."""
     if scope is None:
         return (
             Check(
@@ -157,6 +158,20 @@ def check_service(probe: SystemProbe) -> tuple[Check, bool]:
         ),
         True,
     )
+
+
+_NAME_FLAG = re.compile(r"--name[= ]+([A-Za-z0-9][A-Za-z0-9-]*)")
+DEFAULT_NAME = "poppy"
+
+
+def service_name(probe: SystemProbe, scope: list[str] | None) -> str:
+    """The robot's name the installed service gives `poppy serve` (``--name`` in its unit's
+    ExecStart), else ``poppy``, the service's default."""
+    if scope is None:
+        return DEFAULT_NAME
+    code, out = probe.run(["systemctl", *scope, "cat", SERVICE])
+    found = _NAME_FLAG.search(out) if code == 0 else None
+    return found.group(1) if found else DEFAULT_NAME
 
 
 def check_page(url: str, installed: bool, probe: SystemProbe) -> Check:
@@ -196,7 +211,7 @@ def run_doctor(
     profile: str,
     port: str | None,
     *,
-    page_url: str = "http://poppy.local/",
+    page_url: str | None = None,
     probe: SystemProbe | None = None,
     progress: Callable[[Check], None] | None = None,
 ) -> DoctorReport:
@@ -206,7 +221,8 @@ def run_doctor(
         config: the robot's profile.
         profile: its name (for the fix commands).
         port: the bus's port; None when no adapter was found.
-        page_url: where the robot's page must answer when the service is installed.
+        page_url: where the robot's page must answer when the service is installed (None:
+            ``http://NAME.local/``, NAME as the installed service names the robot).
         probe: where to look on this machine (None: the real one).
         progress: called with each check as soon as it is done.
     """
@@ -224,8 +240,10 @@ def run_doctor(
     add(check_latency(port, probe.sysfs_root))
     add(*check_motors(config, profile, port if adapter.status == "pass" else None))
     add(*check_camera(config, probe))
-    service, installed = check_service(probe)
+    scope = service_scope(probe)
+    service, installed = check_service(probe, scope)
     add(service)
-    add(check_page(page_url, installed, probe))
+    url = page_url or f"http://{service_name(probe, scope)}.local/"
+    add(check_page(url, installed, probe))
     add(check_disk(probe))
     return report

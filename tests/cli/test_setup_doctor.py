@@ -81,6 +81,8 @@ def machine(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Machine:
 
     def systemctl(argv: Sequence[str]) -> tuple[int, str]:
         calls.append(list(argv))
+        if "cat" in argv:
+            return 0, "[Service]\nExecStart=/usr/bin/poppy serve --profile ergo-jr --port auto"
         return (0, "active") if "is-active" in argv else (0, "enabled")
 
     def fetch(url: str) -> int | None:
@@ -275,6 +277,34 @@ def test_doctor_prints_one_line_per_check_with_its_fix(
     assert lines[at + 1].strip().startswith("fix: echo 1 | sudo tee")
     assert "✓ pass m1 (ID 1): XL-320 at 1000000 bps, firmware 45" in result.stdout
     assert lines[-1] == "1 check(s) failed"
+
+
+def test_doctor_checks_the_page_by_the_name_the_service_gives(
+    robot: Callable[..., tuple[VirtualBus, str]], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _, port = robot(set_up_robot())
+    probe = doctor_cmd.system_probe()
+    asked: list[str] = []
+
+    def user_unit(argv: Sequence[str]) -> tuple[int, str]:
+        if "--user" not in argv:
+            return 1, "Failed to get unit file state for poppy.service: No such file or directory"
+        if "cat" in argv:
+            return 0, "ExecStart=/usr/bin/poppy serve --profile ergo-jr --name ergo1 --announce"
+        return (0, "active") if "is-active" in argv else (0, "enabled")
+
+    def fetch(url: str) -> int | None:
+        asked.append(url)
+        return None
+
+    probe.run, probe.fetch = user_unit, fetch
+    monkeypatch.setattr(doctor_cmd, "system_probe", lambda: probe)
+    result = doctor(port)
+    assert asked == ["http://ergo1.local/"]
+    checks = {c["name"]: c for c in result.json()["checks"]}
+    assert checks["service"]["detail"] == "poppy.service active (systemctl --user)"
+    assert failures(result) == {"page": [checks["page"]["fix"]]}
+    assert checks["page"]["detail"] == "http://ergo1.local/: nothing answers"
 
 
 def test_doctor_skips_the_service_and_page_when_not_installed(
