@@ -100,7 +100,10 @@ def check_camera(config: RobotConfig, probe: SystemProbe) -> list[Check]:
         if not sensor.type.lower().endswith("camera"):
             continue
         where = sensor.device if sensor.device is not None else sensor.index
-        if where is None or isinstance(where, int):
+        if isinstance(where, int) and where < 0:  # pypot's -1: any camera
+            videos = sorted(Path(probe.dev_root).glob("video*"))
+            path = str(videos[0]) if videos else os.path.join(probe.dev_root, "video*")
+        elif where is None or isinstance(where, int):
             path = os.path.join(probe.dev_root, f"video{where or 0}")
         else:
             path = where
