@@ -240,8 +240,9 @@ def run_doctor(
 
     adapter = check_adapter(port, probe.access)
     add(adapter)
-    add(check_latency(port, probe.sysfs_root))
-    add(*check_motors(config, profile, port if adapter.status == "pass" else None))
+    reachable = port if adapter.status == "pass" else None
+    add(check_latency(reachable, probe.sysfs_root))
+    add(*check_motors(config, profile, reachable))
     add(*check_camera(config, probe))
     scope = service_scope(probe)
     service, installed = check_service(probe, scope)
