@@ -210,9 +210,7 @@ class GuidedSetup:
             SetupError: no motor, several motors, or a motor of another model.
         """
         say(progress, f"looking for {target.name} on {self.port}")
-        rates = list(standard_baudrates(target.protocol))
-        rates.sort(key=lambda r: r != target.baudrate)  # the profile's rate first
-        found = scan(self.port, rates, [target.protocol])
+        found = self._scan_protocol(target)
         if not found:
             others = [p for p in PROTOCOLS if p != target.protocol]
             say(progress, f"nothing in protocol {target.protocol}: trying the other")
@@ -245,6 +243,28 @@ class GuidedSetup:
                 f"{_article(target.model)}{target.model}: plug {target.name} instead"
             )
         return motor
+
+    def _scan_protocol(self, target: MotorTarget) -> list[FoundMotor]:
+        """The motors answering in the target's protocol: the profile's rate first, then the
+        model's factory rate, then the others.
+
+        With a broadcast ping (protocol 2) every rate is scanned (a rate costs a few
+        milliseconds). Without (protocol 1: each of the 254 IDs pinged, a second or more a
+        rate), the search stops after the first rate where a motor answers: the profile's
+        rate is always searched, so a motor there, which the new settings could collide with,
+        is seen.
+        """
+        factory = target.servo.register("baudrate").default
+        factory_bps = None if factory is None else target.servo.baudrate_bps(factory)
+        rates = list(standard_baudrates(target.protocol))
+        rates.sort(key=lambda r: (r != target.baudrate, r != factory_bps))
+        if protocol_for(target.protocol).has_broadcast_ping:
+            return scan(self.port, rates, [target.protocol])
+        for rate in rates:
+            found = scan(self.port, [rate], [target.protocol])
+            if found:
+                return found
+        return []
 
     def set_up(self, target: MotorTarget, progress: Progress | None = None) -> StepOutcome:
         """Find the one motor on the bus and give it ``target``'s settings, verified.

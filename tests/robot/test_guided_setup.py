@@ -58,3 +58,19 @@ def test_targets_keep_the_limits_the_registers_can_hold() -> None:
         2,
         0.0,
     )
+
+
+def test_a_protocol_1_kit_motor_is_found_at_its_factory_rate_and_set_up() -> None:
+    torso = load_profile("torso")
+    virtual = build_bus_from_spec("MX-28:1", protocol=1, baudrate=57_600)
+    with serve_link(virtual) as server:
+        flow = GuidedSetup(torso, server.url)
+        target = flow.targets[0]
+        outcome = flow.set_up(target)
+    assert (outcome.found.id, outcome.found.baudrate, outcome.found.protocol) == (1, 57_600, 1)
+    assert outcome.next_motor == flow.targets[1].name
+    motor = virtual.motors[0]
+    assert (motor.id, motor.baudrate_bps) == (target.id, target.baudrate)
+    assert motor.table.get_si("min_position_limit") == pytest.approx(
+        target.angle_limits[0], abs=0.1
+    )
