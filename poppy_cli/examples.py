@@ -130,6 +130,17 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("motor factory-reset 3 -p /dev/ttyUSB0", "asks first; keeps ID and baud rate"),
         ("motor factory-reset 3 --reset-id --reset-baudrate -y -p /dev/ttyUSB0", "everything"),
     ),
+    "setup": (("setup motors --profile ergo-jr -p /dev/ttyAMA0", "a kit's motors, one at a time"),),
+    "setup motors": (
+        ("setup motors --profile ergo-jr -p /dev/ttyAMA0", "each motor: plug only it, Enter"),
+        ("setup motors --profile ergo-jr -m m3 -p /dev/ttyUSB0", "set up (or fix) m3 alone"),
+        ("setup motors --profile ergo-jr -m m1 -p /dev/ttyUSB0 --json", "what was done, JSON"),
+    ),
+    "doctor": (
+        ("doctor --profile ergo-jr -p /dev/ttyAMA0", "one line per check, with its fix"),
+        ("doctor --profile ergo-jr --json", "for scripts: {ok, checks}"),
+        ("doctor --profile ergo-jr --url http://127.0.0.1:8080/", "the page on another port"),
+    ),
     "motor reset": (
         ("motor reset 1 42 -p /dev/ttyUSB0", "a new motor becomes 42, 1 Mbps, delay 0"),
         ("motor reset 1 42 --model MX-28 --angle-limits -150,150 --zero -p /dev/ttyUSB0", ""),

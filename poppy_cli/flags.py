@@ -110,6 +110,7 @@ FLAGS: dict[str, Flag] = {
     "--sha256": Flag(None, "HEX", "the digest a download must have (64 hex digits)"),
     "--open": Flag(None, None, "open it in the web browser"),
     "--token": Flag(None, "TOKEN", "token every request must carry"),
+    "--url": Flag(None, "URL", "the robot's page, checked by `poppy doctor`"),
     "--cors": Flag(None, "ORIGIN", "web page origin allowed to use the robot"),
     "--allow-host": Flag(None, "HOST", "host name the server also answers"),
     "--no-sensors": Flag(None, None, "leave the config's cameras closed"),

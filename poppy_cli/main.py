@@ -10,7 +10,17 @@ from typer import _click as click  # typer vendors Click: its exceptions live he
 
 from poppy_cli import state
 from poppy_cli.commands import calibrate as calibrate_cmd
-from poppy_cli.commands import camera, config, demo, emulate, fleet, motor_setup, ports, scan
+from poppy_cli.commands import (
+    camera,
+    config,
+    demo,
+    doctor,
+    emulate,
+    fleet,
+    motor_setup,
+    ports,
+    scan,
+)
 from poppy_cli.commands import moves as moves_cmd
 from poppy_cli.commands import notebook as notebook_cmd
 from poppy_cli.commands import play as play_cmd
@@ -18,6 +28,7 @@ from poppy_cli.commands import primitive as primitive_cmd
 from poppy_cli.commands import reach as reach_cmd
 from poppy_cli.commands import record as record_cmd
 from poppy_cli.commands import serve as serve_cmd
+from poppy_cli.commands import setup as setup_cmd
 from poppy_cli.commands import sim as sim_cmd
 from poppy_cli.commands import snap as snap_cmd
 from poppy_cli.commands import teleop as teleop_cmd
@@ -121,6 +132,8 @@ app.command("scan", rich_help_panel=SETUP)(scan.scan)
 app.add_typer(motor_setup.app, name="motor", rich_help_panel=SETUP)
 app.add_typer(config.app, name="config", rich_help_panel=SETUP)
 app.command("calibrate", rich_help_panel=SETUP)(calibrate_cmd.calibrate)
+app.add_typer(setup_cmd.app, name="setup", rich_help_panel=SETUP)
+app.command("doctor", rich_help_panel=SETUP)(doctor.doctor)
 # reach_cmd adds `reach` and `where` to the `poppy robot` group defined in commands/robot.py.
 app.add_typer(reach_cmd.app, name="robot", rich_help_panel=DRIVE)
 app.add_typer(primitive_cmd.app, name="primitive", rich_help_panel=DRIVE)

@@ -20,12 +20,13 @@ method found for the bus.
 from __future__ import annotations
 
 import logging
+from collections import Counter
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from poppy_core.bus.core import is_alarm_only, reply_fits
 from poppy_core.bus.results import PingResult
-from poppy_core.bus.timing import Deadline, status_size
+from poppy_core.bus.timing import Deadline, settle_s, status_size
 from poppy_core.errors import BusTimeout, CorruptPacketError
 from poppy_core.models import model_by_number
 from poppy_core.protocol import (
@@ -293,11 +294,23 @@ def broadcast_ping(bus: DxlBus) -> list[PingResult]:
     ``min_timeout_s`` as every other transaction (a scan's bus has none); each reply then
     extends the wait by the time one more reply needs (return delay + its bytes + latency +
     margin): motors answer one after the other, so a silence that long means the last one has
-    spoken.
+    spoken. A second reply from the same ID counts as a corrupt packet.
     """
+    found: dict[int, PingResult] = {}
+    for result in broadcast_ping_replies(bus):
+        if result.id in found:
+            bus.stats.corrupt_packets += 1
+            continue
+        found[result.id] = result
+    return [found[i] for i in sorted(found)]
+
+
+def broadcast_ping_replies(bus: DxlBus) -> list[PingResult]:
+    """Every reply to one broadcast ping (protocol 2), in the order heard, repeats included:
+    two motors sharing an ID both answer (``poppy doctor`` tells duplicated IDs this way)."""
     timing = bus.timing
     size = status_size(2, 3)
-    found: dict[int, PingResult] = {}
+    replies: list[PingResult] = []
     with bus.lock:
         bus.stats.transactions += 1
         transport = bus.transport
@@ -308,13 +321,21 @@ def broadcast_ping(bus: DxlBus) -> list[PingResult]:
             status = transport.read_packet(deadline, grace_s=timing.grace_s(size))
             if status is None:
                 break
-            if len(status.params) != 3 or status.id in found:
+            if len(status.params) != 3:
                 bus.stats.corrupt_packets += 1
                 continue
             bus.record_alarms(status)
             number = int.from_bytes(status.params[:2], "little")
-            found[status.id] = PingResult(
-                status.id, number, status.params[2], model_by_number(number)
-            )
+            replies.append(PingResult(status.id, number, status.params[2], model_by_number(number)))
             deadline.extend(timing.quiet_gap_s(size))
-    return [found[i] for i in sorted(found)]
+    return replies
+
+
+def count_answers(bus: DxlBus, late_s: float = 0.1) -> Counter[int]:
+    """How many motors answer as each ID (protocol 2): one broadcast ping, then the line is
+    listened to for ``late_s`` more (plus the adapter's settle time), so that replies still on
+    their way count too and are not taken for the answers to what follows."""
+    counts = Counter(reply.id for reply in broadcast_ping_replies(bus))
+    late = bus.listen(settle_s(bus.latency_s) + late_s)
+    counts.update(s.id for s in late if len(s.params) == bus.proto.ping_params)
+    return counts

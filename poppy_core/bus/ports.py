@@ -88,6 +88,12 @@ def recognise_adapter(vid: int | None, pid: int | None) -> str | None:
     return name
 
 
+def latency_timer_path(device: str, sysfs_root: str = "/sys") -> str:
+    """Where Linux keeps the FTDI latency timer of ``device`` (symlinks resolved)."""
+    tty = os.path.basename(os.path.realpath(device))
+    return os.path.join(sysfs_root, "bus", "usb-serial", "devices", tty, "latency_timer")
+
+
 def read_ftdi_latency_ms(device: str, *, sysfs_root: str = "/sys") -> int | None:
     """Read the FTDI latency timer of ``device`` from sysfs (Linux), in ms.
 
@@ -99,8 +105,7 @@ def read_ftdi_latency_ms(device: str, *, sysfs_root: str = "/sys") -> int | None
         The timer in ms, or None when the file does not exist (not an FTDI device, not Linux)
         or cannot be read.
     """
-    tty = os.path.basename(os.path.realpath(device))
-    path = os.path.join(sysfs_root, "bus", "usb-serial", "devices", tty, "latency_timer")
+    path = latency_timer_path(device, sysfs_root)
     try:
         with open(path, encoding="ascii") as handle:
             return int(handle.read().strip())

@@ -128,11 +128,12 @@ def reset_motor(
     baudrate: int = 1_000_000,
     angle_limits: tuple[float, float] | None = None,
     go_to_zero: bool = False,
+    return_delay_us: float = 0.0,
     progress: Progress | None = None,
 ) -> SetupResult:
     """Prepare a motor for a poppy robot (the old ``poppy-reset-motor``).
 
-    Steps, each verified: check the model, set ID ``target_id``, return delay 0, the angle
+    Steps, each verified: check the model, set ID ``target_id``, the return delay, the angle
     limits (if given), the baud rate (last: the bus follows it), then optionally torque on and
     move to 0°.
 
@@ -145,6 +146,7 @@ def reset_motor(
         baudrate: the rate it must use.
         angle_limits: ``(min_deg, max_deg)`` or None to leave them.
         go_to_zero: enable torque and send it to 0°.
+        return_delay_us: the return delay it must have (poppy: 0 µs).
         progress: called with a line per step.
 
     Raises:
@@ -156,7 +158,7 @@ def reset_motor(
         raise SetupError(f"motor {motor_id} on {bus.port} is a {actual.name}, not a {wanted.name}")
     result = new_result(bus, "reset_motor", motor_id)
     steps = [change_id(bus, motor_id, target_id, progress=progress)]
-    steps.append(set_return_delay(bus, target_id, 0, progress=progress))
+    steps.append(set_return_delay(bus, target_id, return_delay_us, progress=progress))
     if angle_limits is not None:
         steps.append(set_angle_limits(bus, target_id, *angle_limits, progress=progress))
     steps.append(change_baudrate(bus, target_id, baudrate, progress=progress))

@@ -79,6 +79,7 @@ class VirtualBus:
                 value=adapter,
             )
         self._motors = list(motors)
+        self._detached: set[int] = set()  # places (1-based) of motors taken off the line
         for motor in self._motors:
             if motor.protocol != protocol:
                 raise ConfigError(
@@ -133,6 +134,35 @@ class VirtualBus:
         """Reconnect motor ``motor_id``."""
         self.faults.plug(motor_id)
 
+    def _place(self, place: int) -> int:
+        if not 1 <= place <= len(self._motors):
+            raise KeyError(f"no motor at place {place} (places 1-{len(self._motors)})")
+        return place
+
+    def detach(self, place: int) -> None:
+        """Take the motor at ``place`` (1-based, in the order given) off the line, whatever its
+        ID: a motor in its box. Motors sharing an ID (a kit, all at the factory ID 1) are told
+        apart this way.
+
+        Raises:
+            KeyError: no motor at that place.
+        """
+        with self._lock:
+            self._detached.add(self._place(place))
+
+    def attach(self, place: int) -> None:
+        """Put the motor at ``place`` back on the line (see :meth:`detach`).
+
+        Raises:
+            KeyError: no motor at that place.
+        """
+        with self._lock:
+            self._detached.discard(self._place(place))
+
+    def is_attached(self, place: int) -> bool:
+        """Whether the motor at ``place`` (1-based) is on the line."""
+        return self._place(place) not in self._detached
+
     @property
     def corrupt_rate(self) -> float:
         """Probability that a reply byte gets a bit flipped."""
@@ -166,7 +196,10 @@ class VirtualBus:
         return self._decoder.corrupt_packets
 
     def hears(self, motor: VirtualMotor, line_bps: int) -> bool:
-        """Whether ``motor`` is plugged and its UART decodes bytes sent at ``line_bps``."""
+        """Whether ``motor`` is on the line, plugged, and its UART decodes bytes sent at
+        ``line_bps``."""
+        if self._detached and self._motors.index(motor) + 1 in self._detached:
+            return False
         return not self.faults.is_unplugged(motor.id) and baud_matches(line_bps, motor.baudrate_bps)
 
     # ------------------------------------------------------------------ plant

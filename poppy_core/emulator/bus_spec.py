@@ -12,13 +12,32 @@ from poppy_core.errors import ConfigError, RegisterError, UnknownModelError
 from poppy_core.models import ServoModel, model_by_name
 
 _IDS = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+)\s*)?$")
+# ``1*6``: six motors sharing ID 1, as a kit of new motors comes (each at its factory ID)
+_REPEAT = re.compile(r"^\s*(\d+)\s*\*\s*(\d+)\s*$")
+_MAX_REPEAT = 253
 _MAX_MOTOR_ID = 252
 
 
-def _parse_ids(text: str, spec: str) -> list[int]:
+def _parse_ids(text: str, spec: str, shared: set[int], plain: list[int]) -> list[int]:
+    """The IDs of ``text``; IDs given as ``ID*COUNT`` are added to ``shared``, the others to
+    ``plain``."""
     ids: list[int] = []
     for part in re.split(r"[+/ ]+", text.strip()):
         if not part:
+            continue
+        repeat = _REPEAT.match(part)
+        if repeat is not None:
+            motor_id, count = int(repeat.group(1)), int(repeat.group(2))
+            if motor_id > _MAX_MOTOR_ID or not 1 <= count <= _MAX_REPEAT:
+                raise ConfigError(
+                    f"bad repeat {part!r} in emulator spec {spec!r} (ID*COUNT: ID 0..."
+                    f"{_MAX_MOTOR_ID}, COUNT 1..{_MAX_REPEAT})",
+                    field="spec",
+                    value=spec,
+                    reason="bad repeat",
+                )
+            ids.extend([motor_id] * count)
+            shared.add(motor_id)
             continue
         match = _IDS.match(part)
         if match is None:
@@ -38,6 +57,7 @@ def _parse_ids(text: str, spec: str) -> list[int]:
                 reason="bad id range",
             )
         ids.extend(range(first, last + 1))
+        plain.extend(range(first, last + 1))
     return ids
 
 
@@ -45,13 +65,17 @@ def parse_spec(spec: str) -> list[tuple[ServoModel, int]]:
     """Parse ``"MODEL:IDS,MODEL:IDS"`` into ``(model, id)`` pairs.
 
     IDS is a single id or a range ``a-b``; several are joined with ``+`` or ``/``; a bare id
-    list after a comma continues the previous model (``"MX-28:1,2,5-6"``).
+    list after a comma continues the previous model (``"MX-28:1,2,5-6"``). ``ID*COUNT`` gives
+    COUNT motors sharing that ID (``"XL-320:1*6"``: a kit of new motors, all at ID 1; the
+    emulator's control tells them apart by their place, ``plug #3``).
 
     Raises:
         ConfigError: empty spec, unknown model, bad or duplicate ids.
     """
     pairs: list[tuple[ServoModel, int]] = []
     model: ServoModel | None = None
+    shared: set[int] = set()
+    plain: list[int] = []
     for item in spec.split(","):
         item = item.strip()
         if not item:
@@ -76,16 +100,17 @@ def parse_spec(spec: str) -> list[tuple[ServoModel, int]]:
             )
         else:
             ids_text = item
-        pairs.extend((model, motor_id) for motor_id in _parse_ids(ids_text, spec))
+        pairs.extend((model, motor_id) for motor_id in _parse_ids(ids_text, spec, shared, plain))
     if not pairs:
         raise ConfigError(
             f"emulator spec {spec!r} lists no motor", field="spec", value=spec, reason="empty"
         )
     seen: set[int] = set()
-    for _, motor_id in pairs:
+    for motor_id in [*plain, *shared]:
         if motor_id in seen:
             raise ConfigError(
-                f"id {motor_id} appears twice in emulator spec {spec!r}",
+                f"id {motor_id} appears twice in emulator spec {spec!r} (motors sharing an ID: "
+                "ID*COUNT, e.g. XL-320:1*6)",
                 field="spec",
                 value=spec,
                 reason="duplicate id",

@@ -6,6 +6,9 @@ Commands (case-insensitive; ``BUS`` is a bus name, every bus when left out):
 ====================  =========================================================================
 ``unplug ID [S]``     motor ID goes silent (for S seconds, then it is plugged back)
 ``plug ID``           motor ID answers again
+``unplug #N``         the N-th motor of the bus (1-based, as given) leaves the line, whatever
+                      its ID (a kit of motors all at ID 1: ``poppy emulate --motors XL-320:1*6``)
+``plug #N``           the N-th motor is back on the line
 ``corrupt P [BUS]``   each reply byte gets a bit flipped with probability P (0-1)
 ``drop P [BUS]``      each reply is lost with probability P (0-1)
 ``delay MS [BUS]``    every reply comes MS milliseconds late
@@ -35,8 +38,8 @@ logger = logging.getLogger(__name__)
 
 DEFAULT_LOSS_S = 2.0
 HELP = (
-    "commands: unplug ID [SECONDS] | plug ID | corrupt P [BUS] | drop P [BUS] | "
-    "delay MS [BUS] | lose [SECONDS] [BUS] | status | help"
+    "commands: unplug ID [SECONDS] | plug ID | unplug #N | plug #N | corrupt P [BUS] | "
+    "drop P [BUS] | delay MS [BUS] | lose [SECONDS] [BUS] | status | help"
 )
 
 
@@ -171,8 +174,33 @@ class EmulatorControl:
             raise ControlError(f"no bus {args[0]!r} (buses: {', '.join(self.servers)})")
         return [args[0]]
 
+    def _place(self, args: list[str], verb: str) -> str | None:
+        """``#N`` (with the bus name when there are several): run ``verb`` on the N-th motor.
+
+        Returns:
+            What was done, or None when the arguments are not ``#N [BUS]``.
+        """
+        if not args or not args[0].startswith("#"):
+            return None
+        usage = f"{verb} #N [BUS] (N: the motor's place on the bus, from 1)"
+        text = args[0][1:]
+        if not text.isdigit() or len(args) > 2:
+            raise ControlError(f"usage: {usage}")
+        buses = self._buses(args[1:], usage)
+        if len(buses) > 1:
+            raise ControlError(f"usage: {usage}: name the bus ({', '.join(buses)})")
+        bus = self.servers[buses[0]].bus
+        try:
+            (bus.attach if verb == "plug" else bus.detach)(int(text))
+        except KeyError as exc:
+            raise ControlError(str(exc.args[0])) from None
+        return f"motor #{text} {verb}ged"
+
     def _unplug(self, args: list[str]) -> str:
         usage = "unplug ID [SECONDS]"
+        placed = self._place(args, "unplug")
+        if placed is not None:
+            return placed
         motor_id = self._motor_id(args, usage)
         if len(args) > 2:
             raise ControlError(f"usage: {usage}")
@@ -190,6 +218,9 @@ class EmulatorControl:
         return f"motor {motor_id} unplugged for {duration:g} s"
 
     def _plug(self, args: list[str]) -> str:
+        placed = self._place(args, "plug")
+        if placed is not None:
+            return placed
         motor_id = self._motor_id(args, "plug ID")
         self._server_of_motor(motor_id).bus.plug(motor_id)
         return f"motor {motor_id} plugged"
@@ -241,12 +272,13 @@ class EmulatorControl:
     def _status(self, name: str) -> str:
         server = self.servers[name]
         bus = server.bus
-        unplugged = [m.id for m in bus.motors if bus.faults.is_unplugged(m.id)]
+        unplugged = [str(m.id) for m in bus.motors if bus.faults.is_unplugged(m.id)]
+        unplugged += [f"#{n}" for n in range(1, len(bus.motors) + 1) if not bus.is_attached(n)]
         return (
             f"{name}: {server.url} {'up' if server.connected else 'DOWN'}, "
             f"corrupt {bus.corrupt_rate:g}, drop {bus.drop_rate:g}, "
             f"delay {bus.extra_delay_s * 1000:g} ms, "
-            f"unplugged: {', '.join(map(str, unplugged)) or 'none'}"
+            f"unplugged: {', '.join(unplugged) or 'none'}"
         )
 
     # ------------------------------------------------------------------ timed actions

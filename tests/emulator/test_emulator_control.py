@@ -105,3 +105,26 @@ def test_scheduled_unplugs() -> None:
     finally:
         control.close()
         server.stop()
+
+
+def test_motors_sharing_an_id_are_plugged_by_their_place() -> None:
+    server = serve_tcp(build_bus_from_spec("XL-320:1*3", protocol=2))
+    control = EmulatorControl({"bus": server})
+    try:
+        assert [m.id for m in server.bus.motors] == [1, 1, 1]
+        for place in (1, 2, 3):
+            assert control.execute(f"unplug #{place}") == f"motor #{place} unplugged"
+        assert "unplugged: #1, #2, #3" in control.execute("status")
+        with DxlBus(server.url, protocol=2) as bus:
+            assert bus.broadcast_ping() == []
+            assert control.execute("plug #2") == "motor #2 plugged"
+            assert [p.id for p in bus.broadcast_ping()] == [1]
+            server.bus.motors[1].table.set("id", 5)
+            assert [p.id for p in bus.broadcast_ping()] == [5]
+        with pytest.raises(ControlError, match=r"no motor at place 4 \(places 1-3\)"):
+            control.execute("plug #4")
+        with pytest.raises(ControlError, match="usage: unplug #N"):
+            control.execute("unplug #x")
+    finally:
+        control.close()
+        server.stop()

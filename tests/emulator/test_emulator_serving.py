@@ -127,9 +127,26 @@ def test_parse_spec() -> None:
     ]
 
 
+def test_a_kit_spec_shares_an_id() -> None:
+    pairs = parse_spec("XL-320:1*3,4")
+    assert [(m.name, i) for m, i in pairs] == [("XL-320", 1)] * 3 + [("XL-320", 4)]
+
+
 @pytest.mark.parametrize(
     "spec",
-    ["", "MX-28", "NOPE-1:1", "MX-28:5-2", "MX-28:1,MX-28:1", "MX-28:x", "1-3", "MX-28:300"],
+    [
+        "",
+        "MX-28",
+        "NOPE-1:1",
+        "MX-28:5-2",
+        "MX-28:1,MX-28:1",
+        "MX-28:x",
+        "1-3",
+        "MX-28:300",
+        "XL-320:1*0",
+        "XL-320:300*2",
+        "XL-320:1*2,1",
+    ],
 )
 def test_bad_specs(spec: str) -> None:
     with pytest.raises(ConfigError) as info:

@@ -58,9 +58,13 @@ def run_poppy_process(
 
 
 def run_poppy(
-    *args: str, timeout: float = 60, input: str | None = None, env: Mapping[str, str] | None = None
+    *args: str,
+    timeout: float = 60,
+    input: str | io.TextIOBase | None = None,
+    env: Mapping[str, str] | None = None,
 ) -> Result:
-    """Run `poppy ARGS...` in this process (``env``: added to its environment).
+    """Run `poppy ARGS...` in this process (``env``: added to its environment; ``input``: the
+    text of stdin, or a stream whose reads the test drives, e.g. to act between prompts).
 
     ``timeout`` is kept for the callers' sake: pytest-timeout stops a command that hangs.
     """
@@ -108,7 +112,7 @@ def _as_a_process(
     args: tuple[str, ...],
     stdout: io.TextIOBase,
     stderr: io.TextIOBase,
-    input: str | None,
+    input: str | io.TextIOBase | None,
     env: Mapping[str, str],
 ) -> Iterator[None]:
     """Give the command what a fresh `poppy` process would have, and take it back after."""
@@ -124,7 +128,7 @@ def _as_a_process(
     consoles = [(c, c._width, c._color_system, c.quiet) for c in (console, err_console)]
     saved_tempdir = tempfile.tempdir
     tempfile.tempdir = None  # found again from TMPDIR, as a new process does
-    sys.stdin = io.StringIO(input or "")
+    sys.stdin = input if isinstance(input, io.TextIOBase) else io.StringIO(input or "")
     sys.stdout, sys.stderr = stdout, stderr  # type: ignore[assignment]
     sys.argv = ["poppy", *args]
     os.environ.update(env)

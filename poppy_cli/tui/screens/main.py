@@ -48,6 +48,7 @@ class MainScreen(Screen[None]):
         Binding("tab", "app.focus_next", "Next"),
         Binding("ctrl+s", "scan", "Scan", show=False),  # shown by the Bus tab (BusView)
         Binding("escape", "abort", "Abort scan", show=False),
+        Binding("f4", "setup", "Set up a kit", show=False),
     ]
 
     def __init__(self, pool: BusPool, lister: PortLister, live_period_s: float) -> None:
@@ -75,6 +76,28 @@ class MainScreen(Screen[None]):
             with TabPane("Robot F3", id="robot"):
                 yield RobotPanel(id="robot-panel")
         yield Footer(compact=True)
+
+    def action_setup(self) -> None:
+        """Set a kit's motors up, one at a time (the flow of `poppy setup motors`): the
+        robot's profile (else the user's, else ergo-jr) on the first port chosen."""
+        from poppy_cli.settings import resolve
+        from poppy_cli.tui.screens.setup import SetupScreen
+        from poppy_core.robot.guided_setup import GuidedSetup
+        from poppy_core.robot.profiles import load_profile
+
+        chosen = self.query_one(PortsPanel).selected
+        port = chosen[0] if chosen else resolve(None, None).port
+        if port is None:
+            self.notify("choose the port of the kit's bus in the Bus tab first", severity="error")
+            return
+        source = getattr(self.app, "robot_source", None)
+        profile = source or resolve(None, None).profile or "ergo-jr"
+        try:
+            flow = GuidedSetup(load_profile(profile), port)
+        except PoppyError as exc:
+            self.notify(str(exc), severity="error")
+            return
+        self.app.push_screen(SetupScreen(flow, profile))
 
     def action_tab(self, tab: str) -> None:
         """Show a tab and focus its main widget (focus left in a hidden tab would pull it back)."""
