@@ -153,6 +153,10 @@ class Worker:
         """True while the thread is alive."""
         return self._thread is not None and self._thread.is_alive()
 
+    def is_current(self) -> bool:
+        """True when called from the worker's own thread."""
+        return self._thread is not None and self._thread is threading.current_thread()
+
     def start(self) -> None:
         """Start the thread (no-op while running); a new start forgets the previous error."""
         if self.running:
