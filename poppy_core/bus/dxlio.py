@@ -12,7 +12,6 @@ from __future__ import annotations
 import glob
 import sys
 from collections.abc import Iterable, Mapping
-from types import TracebackType
 from typing import Any
 
 from poppy_core.bus import setup, setup_reset
@@ -101,9 +100,7 @@ class DxlIO(PypotCalls):
     def __enter__(self) -> DxlIO:
         return self
 
-    def __exit__(
-        self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     def __repr__(self) -> str:

@@ -30,7 +30,6 @@ import time
 from abc import ABC, abstractmethod
 from collections import deque
 from dataclasses import dataclass
-from types import TracebackType
 
 from poppy_core.emulator.bus import Reply, VirtualBus
 from poppy_core.emulator.wire_timing import SPIN_WINDOW_S, sleep_until
@@ -94,12 +93,7 @@ class EmulatorServer(ABC):
     def __enter__(self) -> EmulatorServer:
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.stop()
 
     def __repr__(self) -> str:
