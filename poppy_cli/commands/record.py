@@ -17,6 +17,7 @@ from poppy_cli.options import (
     PortOpt,
     ProfileOpt,
     SimOpt,
+    StopAfterOpt,
     finite,
 )
 from poppy_cli.output import (
@@ -29,7 +30,6 @@ from poppy_cli.output import (
 from poppy_cli.prompts import ask
 from poppy_cli.robots import robot_config, start_robot
 from poppy_core.schedule import Worker
-from poppy_core.trajectory import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -115,15 +115,7 @@ def record(
     freq: float = typer.Option(
         50.0, "--freq", min=1.0, max=1000.0, callback=finite, help="Frames per s."
     ),
-    duration: float | None = typer.Option(
-        None,
-        "--duration",
-        "-d",
-        min=0.1,
-        max=MAX_DURATION_S,
-        callback=finite,
-        help="Stop after this many seconds.",
-    ),
+    duration: float | None = StopAfterOpt,
     output: Path | None = typer.Option(
         None,
         "--output",
