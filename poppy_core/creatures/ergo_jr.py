@@ -105,41 +105,17 @@ class Dance(LoopPrimitive):
     def control(self, value: str) -> None:
         self._control = control_name(value)
 
-    @property
-    def amplitude_scale(self) -> float:
-        """Multiplier of every amplitude (>= 0)."""
-        return self._amplitude_scale
+    amplitude_scale = checks.Checked(checks.non_negative, "Multiplier of every amplitude (>= 0).")
 
-    @amplitude_scale.setter
-    def amplitude_scale(self, value: float) -> None:
-        self._amplitude_scale = checks.non_negative(value, "amplitude_scale")
+    tempo_scale = checks.Checked(checks.non_negative, "Multiplier of every frequency (>= 0).")
 
-    @property
-    def tempo_scale(self) -> float:
-        """Multiplier of every frequency (>= 0)."""
-        return self._tempo_scale
+    intro_s = checks.Checked(
+        checks.non_negative, "Seconds to reach the 0° posture before dancing (>= 0)."
+    )
 
-    @tempo_scale.setter
-    def tempo_scale(self, value: float) -> None:
-        self._tempo_scale = checks.non_negative(value, "tempo_scale")
-
-    @property
-    def intro_s(self) -> float:
-        """Seconds to reach the 0° posture before dancing (>= 0)."""
-        return self._intro_s
-
-    @intro_s.setter
-    def intro_s(self, value: float) -> None:
-        self._intro_s = checks.non_negative(value, "intro_s")
-
-    @property
-    def speed_dps(self) -> float:
-        """Moving speed while dancing, deg/s (0 = full speed)."""
-        return self._speed_dps
-
-    @speed_dps.setter
-    def speed_dps(self, value: float) -> None:
-        self._speed_dps = checks.non_negative(value, "speed_dps")
+    speed_dps = checks.Checked(
+        checks.non_negative, "Moving speed while dancing, deg/s (0 = full speed)."
+    )
 
     def _dancers(self) -> list[str]:
         known = {m.name for m in self.real_robot.motors}
@@ -279,14 +255,7 @@ class SafePowerUp(Primitive):
         self.torque_limit = torque_limit
         self.control = control
 
-    @property
-    def duration(self) -> float:
-        """Seconds to reach the idle posture (>= 0)."""
-        return self._duration
-
-    @duration.setter
-    def duration(self, value: float) -> None:
-        self._duration = checks.non_negative(value, "duration")
+    duration = checks.Checked(checks.non_negative, "Seconds to reach the idle posture (>= 0).")
 
     @property
     def control(self) -> str:
