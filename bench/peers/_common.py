@@ -4,6 +4,7 @@ command lines, JSON output, pypot configs, call timing and process status."""
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 import threading
@@ -174,3 +175,15 @@ def proc_status() -> dict[str, int]:
             if key in ("VmRSS", "Threads"):
                 out[key] = int(value.split()[0])
     return out
+
+
+def import_peer(record: dict[str, Any], *names: str) -> list[Any] | None:
+    """The modules ``names``, the first one's ``__version__`` kept in ``record["version"]``; None
+    with ``record["error"]`` saying which import failed (the peer is not installed)."""
+    try:
+        modules = [importlib.import_module(name) for name in names]
+    except ImportError as exc:
+        record["error"] = f"import failed: {exc}"
+        return None
+    record["version"] = str(modules[0].__version__)
+    return modules

@@ -14,14 +14,13 @@ line (``peer``, ``version``, ``error``, ``setup_s``). Nothing in site-packages i
 from __future__ import annotations
 
 import argparse
-import importlib
 import signal
 import sys
 import threading
 import time
 from typing import Any
 
-from _common import emit, from_config, parse_controller_port, peer_config
+from _common import emit, from_config, import_peer, parse_controller_port, peer_config
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
@@ -30,15 +29,13 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
-    try:
-        pypot = importlib.import_module("pypot")
-        pypot_robot = importlib.import_module("pypot.robot")
-        importlib.import_module("pypot.creatures")  # before poppy_torso (circular import)
-        interaction = importlib.import_module("poppy_torso.primitives.interaction")
-    except ImportError as exc:
-        record["error"] = f"import failed: {exc}"
+    # pypot.creatures before poppy_torso (a circular import)
+    modules = import_peer(
+        record, "pypot", "pypot.robot", "pypot.creatures", "poppy_torso.primitives.interaction"
+    )
+    if modules is None:
         return record
-    record["version"] = str(pypot.__version__)
+    _, pypot_robot, _, interaction = modules
     config = peer_config(args.config, args.port)
     start = time.perf_counter()
     robot = from_config(pypot_robot, config, record)

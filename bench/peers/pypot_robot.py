@@ -14,11 +14,10 @@ site-packages is patched. ``--rate-hz`` sets that loop's ``period`` to ask for a
 from __future__ import annotations
 
 import argparse
-import importlib
 import time
 from typing import Any
 
-from _common import TimedCalls, emit, from_config, parse_controller_port, peer_config
+from _common import TimedCalls, emit, from_config, import_peer, parse_controller_port, peer_config
 
 # Timestamps are rounded to the microsecond in the JSON line.
 _DIGITS = 6
@@ -32,14 +31,10 @@ def _loop_of(meta: Any, cls: type) -> Any:
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Build the pypot robot, run its loops, and return the JSON-ready record."""
     record: dict[str, Any] = {"peer": "pypot", "error": None, "rate_hz": args.rate_hz}
-    try:
-        pypot = importlib.import_module("pypot")
-        pypot_robot = importlib.import_module("pypot.robot")
-        dxl_controller = importlib.import_module("pypot.dynamixel.controller")
-    except ImportError as exc:
-        record["error"] = f"import failed: {exc}"
+    modules = import_peer(record, "pypot", "pypot.robot", "pypot.dynamixel.controller")
+    if modules is None:
         return record
-    record["version"] = str(pypot.__version__)
+    _, pypot_robot, dxl_controller = modules
     config = peer_config(args.config, args.port)
     port_to_name = {port: name for name, port in args.port}
     start = time.perf_counter()

@@ -17,14 +17,13 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib
 import sys
 import threading
 import time
 from collections.abc import Callable
 from typing import Any
 
-from _common import emit, from_config, parse_controller_port, peer_config
+from _common import emit, from_config, import_peer, parse_controller_port, peer_config
 from _common import proc_status as common_proc_status
 
 SINUS_AMPLITUDE_DEG = 10.0
@@ -65,15 +64,12 @@ class Counter:
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
     record: dict[str, Any] = {"peer": "pypot", "error": None}
-    try:
-        pypot = importlib.import_module("pypot")
-        pypot_robot = importlib.import_module("pypot.robot")
-        dxl_controller = importlib.import_module("pypot.dynamixel.controller")
-        utils = importlib.import_module("pypot.primitive.utils")
-    except ImportError as exc:
-        record["error"] = f"import failed: {exc}"
+    modules = import_peer(
+        record, "pypot", "pypot.robot", "pypot.dynamixel.controller", "pypot.primitive.utils"
+    )
+    if modules is None:
         return record
-    record["version"] = str(pypot.__version__)
+    _, pypot_robot, dxl_controller, utils = modules
     config = peer_config(args.config, args.port)
     port_to_name = {port: name for name, port in args.port}
     start = time.perf_counter()
