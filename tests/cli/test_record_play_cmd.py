@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from poppy_core.motion import Move, read_move, save_move
-from tests.helpers.cli import keyed
+from tests.helpers.cli import keyed, no_user_settings
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -23,12 +23,7 @@ POPPY = [sys.executable, "-m", "poppy_cli"]
 @pytest.fixture(autouse=True)
 def library(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """An empty move library and no user settings."""
-    folder = tmp_path / "moves"
-    monkeypatch.setenv("POPPY_MOVES_DIR", str(folder))
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
-    return folder
+    return no_user_settings(tmp_path, monkeypatch, moves=True)
 
 
 def start_recording(*args: str) -> subprocess.Popen[str]:

@@ -16,17 +16,13 @@ from poppy_core.emulator import EmulatorServer, VirtualBus, serve_pty
 from poppy_core.motion import read_move
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
-from tests.helpers.cli import POPPY, Result
+from tests.helpers.cli import POPPY, Result, no_user_settings
 
 
 @pytest.fixture(autouse=True)
 def settings(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """An empty move library, no user settings or default robot."""
-    monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
-    return tmp_path / "moves"
+    return no_user_settings(tmp_path, monkeypatch, moves=True)
 
 
 def ergo_jr_bus() -> Iterator[tuple[VirtualBus, EmulatorServer]]:
