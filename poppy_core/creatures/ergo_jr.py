@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from poppy_core import checks
 from poppy_core.creatures.postures import ERGO_JR_IDLE, clamp_to_limits
@@ -24,6 +24,12 @@ ERGO_JR_TORQUE_LIMIT_PCT = 70.0
 # poppy_ergo_jr.py setup: m.pid = (4, 2, 0) on every motor (XL-320 P = raw/8, I = raw·1000/2048,
 # D = raw·4/1000, the same units as our XL-320 registers).
 ERGO_JR_PID: tuple[float, float, float] = (4.0, 2.0, 0.0)
+
+
+def _control(value: Any, field: str) -> str:
+    """A goto control checked by ``control_name`` (``"minijerk"`` is ``"minjerk"``)."""
+    del field  # control_name names its own field
+    return control_name(value)  # it refuses what is not a control name
 
 
 @dataclass(frozen=True)
@@ -96,14 +102,7 @@ class Dance(LoopPrimitive):
         self._dance_t0 = 0.0
         self._speeds: dict[str, float] = {}
 
-    @property
-    def control(self) -> str:
-        """The goto control of the intro: ``"minjerk"`` or ``"dummy"``."""
-        return self._control
-
-    @control.setter
-    def control(self, value: str) -> None:
-        self._control = control_name(value)
+    control = checks.Checked(_control, "The goto control of the intro: 'minjerk' or 'dummy'.")
 
     amplitude_scale = checks.Checked(checks.non_negative, "Multiplier of every amplitude (>= 0).")
 
@@ -257,14 +256,7 @@ class SafePowerUp(Primitive):
 
     duration = checks.Checked(checks.non_negative, "Seconds to reach the idle posture (>= 0).")
 
-    @property
-    def control(self) -> str:
-        """The goto control: ``"minjerk"`` or ``"dummy"``."""
-        return self._control
-
-    @control.setter
-    def control(self, value: str) -> None:
-        self._control = control_name(value)
+    control = checks.Checked(_control, "The goto control: 'minjerk' or 'dummy'.")
 
     @property
     def torque_limit(self) -> float:
