@@ -14,7 +14,7 @@ import pytest
 
 from poppy_core.motion import read_move
 from tests.helpers.cli import POPPY
-from tests.helpers.processes import read_until
+from tests.helpers.processes import read_until, start
 from tests.helpers.terminal import CTRL_C, Terminal
 
 SIM = ("--sim", "--profile", "ergo-jr")
@@ -93,12 +93,7 @@ def test_two_recordings_of_one_name_at_once(
     poppy: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
-    first = subprocess.Popen(
-        [*POPPY, "record", "same", *SIM, "--duration", "20"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    first = start([*POPPY, "record", "same", *SIM, "--duration", "20"])
     try:
         assert first.stderr is not None
         line = first.stderr.readline()

@@ -1,4 +1,5 @@
-"""Child processes of the tests: read a pty until a text shows, and leave nothing running."""
+"""Child processes of the tests: start one with piped text streams, read a pty until a text
+shows, and leave nothing running."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import os
 import select
 import subprocess
 import time
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 
@@ -41,3 +43,18 @@ def reap(proc: subprocess.Popen[Any]) -> None:
     for stream in (proc.stdin, proc.stdout, proc.stderr):
         if stream is not None:
             stream.close()
+
+
+def start(
+    argv: Sequence[str], env: Mapping[str, str] | None = None, *, stdin: int | None = None
+) -> subprocess.Popen[str]:
+    """``argv`` started with its stdout and stderr piped as text (``env``: its environment,
+    None for this process's; ``stdin``: e.g. ``subprocess.DEVNULL``)."""
+    return subprocess.Popen(
+        list(argv),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=stdin,
+        text=True,
+        env=None if env is None else dict(env),
+    )
