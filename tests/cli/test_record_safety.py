@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import pty
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -14,7 +13,7 @@ import pytest
 
 from poppy_core.motion import read_move
 from tests.helpers.cli import POPPY
-from tests.helpers.processes import read_until, start
+from tests.helpers.processes import read_until, start, start_on_pty
 from tests.helpers.terminal import CTRL_C, Terminal
 
 SIM = ("--sim", "--profile", "ergo-jr")
@@ -112,15 +111,7 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
     with tmpfs(tmp_path / "full", "32k") as library:
         (library / "filler").write_bytes(b"\0" * 28_000)
         env = dict(os.environ, POPPY_MOVES_DIR=str(library), COLUMNS="200")
-        parent, child = pty.openpty()
-        proc = subprocess.Popen(
-            [*POPPY, "record", "wave", *SIM, "--duration", "6"],
-            env=env,
-            stdin=child,
-            stdout=child,
-            stderr=child,
-            close_fds=True,
-        )
+        proc, parent, child = start_on_pty([*POPPY, "record", "wave", *SIM, "--duration", "6"], env)
         os.close(child)
         try:
             shown = read_until(parent, "Save it where?")

@@ -4,6 +4,7 @@ shows, and leave nothing running."""
 from __future__ import annotations
 
 import os
+import pty
 import select
 import subprocess
 import time
@@ -58,3 +59,24 @@ def start(
         text=True,
         env=None if env is None else dict(env),
     )
+
+
+def start_on_pty(
+    argv: Sequence[str], env: Mapping[str, str] | None = None
+) -> tuple[subprocess.Popen[bytes], int, int]:
+    """``argv`` started on a new pseudo-terminal (its stdin, stdout and stderr).
+
+    Returns:
+        The process, the pty's master side (read what it prints, write what it types) and its
+        slave side, which the caller closes (at once, or after looking at the terminal's modes).
+    """
+    master, slave = pty.openpty()
+    proc = subprocess.Popen(
+        list(argv),
+        stdin=slave,
+        stdout=slave,
+        stderr=slave,
+        env=None if env is None else dict(env),
+        close_fds=True,
+    )
+    return proc, master, slave
