@@ -6,7 +6,6 @@ import os
 import select
 import subprocess
 from pathlib import Path
-from types import TracebackType
 
 from bench.procs import interrupt
 from bench.registry import POPPY_CLI
@@ -101,11 +100,6 @@ class EmulatorProcess:
         self.start()
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         """Stop the emulator."""
         self.stop()

@@ -1,11 +1,17 @@
-"""Child processes of the benchmarks: a free TCP port, and a process stopped as Ctrl-C would."""
+"""Child processes of the benchmarks: a free TCP port, a process stopped as Ctrl-C would, and
+a child run from the repository for the length of a ``with`` block."""
 
 from __future__ import annotations
 
+import os
 import signal
 import socket
 import subprocess
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from typing import Any
+
+from bench.registry import REPO_ROOT
 
 
 def free_port() -> int:
@@ -24,3 +30,30 @@ def interrupt(proc: subprocess.Popen[Any], timeout_s: float = 10.0) -> None:
     except subprocess.TimeoutExpired:
         proc.kill()
         proc.wait()
+
+
+@contextmanager
+def child(
+    args: list[str],
+    *,
+    stdout: int = subprocess.DEVNULL,
+    env: Mapping[str, str] | None = None,
+    stop_timeout_s: float = 10.0,
+) -> Iterator[subprocess.Popen[str]]:
+    """``args`` run from the repository (text, stderr piped, ``env`` added to this process's);
+    when the block ends: stopped by ``interrupt`` and its pipes closed."""
+    proc = subprocess.Popen(
+        args,
+        cwd=REPO_ROOT,
+        stdout=stdout,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, **env} if env is not None else None,
+    )
+    try:
+        yield proc
+    finally:
+        interrupt(proc, stop_timeout_s)
+        for stream in (proc.stdout, proc.stderr):
+            if stream is not None:
+                stream.close()

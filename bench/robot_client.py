@@ -17,44 +17,33 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
+from bench.peers._common import TimedCalls, parse_controller_port
+
 # Timestamps are rounded to the microsecond in the JSON line.
 _DIGITS = 6
 
 
-class _Recorder:
-    """Start times of the reads at one address on one bus (thread-safe append)."""
+class _Recorder(TimedCalls):
+    """Start times of the reads at one address on one bus."""
 
     def __init__(self, address: int) -> None:
+        super().__init__()
         self.address = address
-        self.starts: list[float] = []
-        self._lock = threading.Lock()
 
-    def wrap(self, read: Callable[..., Any]) -> Callable[..., Any]:
+    def wrap_read(self, read: Callable[..., Any]) -> Callable[..., Any]:
+        """``read``, the starts of its reads at ``address`` noted."""
+
         def timed(address: int, length: int, ids: Sequence[int]) -> Any:
             if address == self.address:
-                now = time.perf_counter()
-                with self._lock:
-                    self.starts.append(now)
+                self.note()
             return read(address, length, ids)
 
         return timed
-
-    def window(self, start_s: float, end_s: float) -> list[float]:
-        with self._lock:
-            return [t for t in self.starts if start_s <= t <= end_s]
-
-
-def _parse_port(text: str) -> tuple[str, str]:
-    name, sep, port = text.partition("=")
-    if not sep or not name or not port:
-        raise argparse.ArgumentTypeError(f"expected CONTROLLER=PORT, got {text!r}")
-    return name, port
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
@@ -85,7 +74,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
             motors = [robot.motor(n) for n in config.motors_of_controller(name)]
             address = motors[0].model.register("present_position").address
             recorder = _Recorder(address)
-            bus.sync_read = recorder.wrap(bus.sync_read)  # type: ignore[method-assign]
+            bus.sync_read = recorder.wrap_read(bus.sync_read)  # type: ignore[method-assign]
             recorders[name] = recorder
             if args.rate_hz is not None:
                 loops = [
@@ -132,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
     """Parse the command line, run the robot, print the JSON line; 0 on success, 1 on error."""
     parser = argparse.ArgumentParser(description="poppy robot sync loops (benchmark client)")
     parser.add_argument("--config", required=True, help="pypot JSON config")
-    parser.add_argument("--port", type=_parse_port, action="append", required=True)
+    parser.add_argument("--port", type=parse_controller_port, action="append", required=True)
     parser.add_argument("--rate-hz", type=float, default=None, help="present loop rate")
     parser.add_argument("--duration-s", type=float, default=5.0)
     parser.add_argument("--warmup-s", type=float, default=1.0)

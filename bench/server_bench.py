@@ -24,8 +24,8 @@ from contextlib import contextmanager
 from typing import Any
 
 from bench import side_by_side
-from bench.procs import free_port, interrupt
-from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
+from bench.procs import child, free_port
+from bench.registry import POPPY_PYTHON, BenchContext, BenchResult, Table, register
 from bench.side_by_side import measure_sides, median_cells, percentile
 
 CLIENTS = 4
@@ -78,14 +78,9 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
         args += ["--profile", "ergo-jr", "--http-port", str(port)]
     else:
         args = [str(ctx.peers_python), "-c", PYPOT_SERVER, str(port)]
-    proc = subprocess.Popen(
-        args, cwd=REPO_ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
-    )
-    try:
+    with child(args) as proc:
         _wait_listening(port, proc)
         yield port
-    finally:
-        interrupt(proc)
 
 
 def _load(port: int, method: str, path: str, body: bytes | None) -> dict[str, Any]:

@@ -14,7 +14,6 @@ import http.client
 import math
 import os
 import shutil
-import subprocess
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -23,7 +22,7 @@ from typing import Any
 
 from bench import side_by_side
 from bench.emulator_proc import EmulatorProcess
-from bench.procs import free_port, interrupt
+from bench.procs import child, free_port
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
 from bench.server_bench import CLIENTS, DURATION_S, _load, _load_wrk, _wait_listening
 from bench.side_by_side import measure_sides, median, median_cells
@@ -59,19 +58,9 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
             args = [str(ctx.peers_python), str(PYPOT_SCRIPT), "--port", emulator.port]
             args += ["--snap-port", str(port), "--moves-dir", moves]
         env = {"POPPY_MOVES_DIR": str(Path(moves) / "poppy")}
-        proc = subprocess.Popen(
-            args,
-            cwd=REPO_ROOT,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-            text=True,
-            env={**os.environ, **env},
-        )
-        try:
+        with child(args, env=env) as proc:
             _wait_listening(port, proc)
             yield port
-        finally:
-            interrupt(proc)
 
 
 def _warm_up(port: int) -> None:

@@ -26,8 +26,9 @@ import threading
 import time
 from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
-from pathlib import Path
 from typing import Any
+
+from bench.peers._common import parse_controller_port, proc_status
 
 POLL_S = 0.002
 SETUP_ATTEMPTS = 3
@@ -35,16 +36,6 @@ CHECK_PERIOD_S = 1.0
 CHECK_QUIET_S = 1.0
 SINUS_AMPLITUDE_DEG = 10.0
 SINUS_HZ = 0.5
-
-
-def proc_status() -> dict[str, int]:
-    """VmRSS (kB) and Threads of this process, from /proc/self/status."""
-    out: dict[str, int] = {}
-    for line in Path("/proc/self/status").read_text().splitlines():
-        key, _, value = line.partition(":")
-        if key in ("VmRSS", "Threads"):
-            out[key] = int(value.split()[0])
-    return out
 
 
 class Bins:
@@ -199,13 +190,6 @@ class Recorder:
             )
 
 
-def _parse_port(text: str) -> tuple[str, str]:
-    name, sep, port = text.partition("=")
-    if not sep or not name or not port:
-        raise argparse.ArgumentTypeError(f"expected CONTROLLER=PORT, got {text!r}")
-    return name, port
-
-
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Build the robot, report ready, record until ``stop``, close; the JSON-ready record."""
     import poppy_core
@@ -295,7 +279,7 @@ def main(argv: list[str] | None = None) -> int:
     """Parse the command line, run, print the JSON line; 0 on success, 1 on error."""
     parser = argparse.ArgumentParser(description="poppy robot under faults (soak client)")
     parser.add_argument("--config", required=True, help="pypot JSON config")
-    parser.add_argument("--port", type=_parse_port, action="append", required=True)
+    parser.add_argument("--port", type=parse_controller_port, action="append", required=True)
     parser.add_argument("--warmup-s", type=float, default=2.0)
     record = run(parser.parse_args(argv))
     sys.stdout.write(json.dumps(record, sort_keys=True) + "\n")

@@ -52,16 +52,38 @@ def _client(*args: str) -> list[str]:
     return [str(POPPY_PYTHON), "-m", "bench.teleop_client", *args]
 
 
+class _ErgoPair:
+    """Two emulated Ergo Jr buses, the leader moved by a hand, both probed at the wire."""
+
+    def __init__(self) -> None:
+        config = load_profile("ergo-jr")
+        mapping = JointMap.same_names(list(config.motors), list(config.motors))
+        ranges, self.follower_of, self.ids = pairing(config, config, mapping)
+        self.leader_bus, self.follower_bus = bus_of(config), bus_of(config)
+        self.leader = BusProbe(self.leader_bus, list(self.ids.values()), [])
+        follower_ids = [i for i, _ in self.follower_of.values()]
+        self.follower = BusProbe(self.follower_bus, [], follower_ids)
+        self.hand = Hand({n: self.leader_bus.motor(i) for n, i in self.ids.items()}, ranges)
+        self.hand.put(self.hand.now())
+
+    def measure(self, durations: Durations) -> dict[str, Any]:
+        """``teleop_scenarios.measure`` on this pair (XL-320s: two steps of resolution)."""
+        return measure(
+            self.hand,
+            self.leader,
+            self.follower,
+            self.follower_bus,
+            self.follower_of,
+            self.ids,
+            2 * RESOLUTION_DEG["XL-320"],
+            durations,
+        )
+
+
 def run_local(durations: Durations, rate_hz: float = 100.0) -> dict[str, Any]:
     """Ergo Jr → Ergo Jr, two buses, ``rate_hz``."""
-    config = load_profile("ergo-jr")
-    mapping = JointMap.same_names(list(config.motors), list(config.motors))
-    ranges, follower_of, ids = pairing(config, config, mapping)
-    leader_bus, follower_bus = bus_of(config), bus_of(config)
-    leader = BusProbe(leader_bus, list(ids.values()), [])
-    follower = BusProbe(follower_bus, [], [i for i, _ in follower_of.values()])
-    hand = Hand({n: leader_bus.motor(i) for n, i in ids.items()}, ranges)
-    hand.put(hand.now())
+    pair = _ErgoPair()
+    leader_bus, follower_bus = pair.leader_bus, pair.follower_bus
     with served([leader_bus, follower_bus]) as (leader_port, follower_port):
         client = Client(
             _client(
@@ -73,31 +95,13 @@ def run_local(durations: Durations, rate_hz: float = 100.0) -> dict[str, Any]:
                 f"{rate_hz:g}",
             )
         )
-        return _run(
-            client,
-            lambda: measure(
-                hand,
-                leader,
-                follower,
-                follower_bus,
-                follower_of,
-                ids,
-                2 * RESOLUTION_DEG["XL-320"],
-                durations,
-            ),
-        )
+        return _run(client, lambda: pair.measure(durations))
 
 
 def run_remote(durations: Durations, rate_hz: float = 50.0) -> dict[str, Any]:
     """Ergo Jr → Ergo Jr served by ``poppy serve``, over a loopback proxy, ``rate_hz``."""
-    config = load_profile("ergo-jr")
-    mapping = JointMap.same_names(list(config.motors), list(config.motors))
-    ranges, follower_of, ids = pairing(config, config, mapping)
-    leader_bus, follower_bus = bus_of(config), bus_of(config)
-    leader = BusProbe(leader_bus, list(ids.values()), [])
-    follower = BusProbe(follower_bus, [], [i for i, _ in follower_of.values()])
-    hand = Hand({n: leader_bus.motor(i) for n, i in ids.items()}, ranges)
-    hand.put(hand.now())
+    pair = _ErgoPair()
+    leader_bus, follower_bus = pair.leader_bus, pair.follower_bus
     with (
         served([leader_bus, follower_bus]) as (leader_port, follower_port),
         poppy_server("ergo-jr", follower_port) as url,
@@ -116,17 +120,8 @@ def run_remote(durations: Durations, rate_hz: float = 50.0) -> dict[str, Any]:
             )
 
             def phases() -> dict[str, Any]:
-                figures = measure(
-                    hand,
-                    leader,
-                    follower,
-                    follower_bus,
-                    follower_of,
-                    ids,
-                    2 * RESOLUTION_DEG["XL-320"],
-                    durations,
-                )
-                figures["stall"] = stall(hand, proxy, url, follower, durations)
+                figures = pair.measure(durations)
+                figures["stall"] = stall(pair.hand, proxy, url, pair.follower, durations)
                 return figures
 
             return _run(client, phases)

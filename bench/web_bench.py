@@ -22,8 +22,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
-from bench.procs import free_port, interrupt
-from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
+from bench.procs import child, free_port
+from bench.registry import POPPY_PYTHON, BenchContext, BenchResult, Table, register
 
 logger = logging.getLogger(__name__)
 
@@ -50,19 +50,16 @@ def served(profile: str) -> Iterator[tuple[str, int]]:
     args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", "--sim"]
     args += ["--profile", profile, "--http-port", str(port), "--no-sensors"]
     library = tempfile.TemporaryDirectory(prefix="poppy-web-bench-")  # the user's moves stay
-    env = {**os.environ, "POPPY_MOVES_DIR": library.name}
-    proc = subprocess.Popen(
-        args, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
-    )
+    env = {"POPPY_MOVES_DIR": library.name}
     try:
-        assert proc.stdout is not None
-        line = proc.stdout.readline().strip()  # the base URL once every port is bound
-        if not line.startswith("http://"):
-            why = proc.stderr.read() if proc.stderr else ""
-            raise RuntimeError(f"poppy serve did not start: {why}")
-        yield line, proc.pid
+        with child(args, stdout=subprocess.PIPE, env=env, stop_timeout_s=15) as proc:
+            assert proc.stdout is not None
+            line = proc.stdout.readline().strip()  # the base URL once every port is bound
+            if not line.startswith("http://"):
+                why = proc.stderr.read() if proc.stderr else ""
+                raise RuntimeError(f"poppy serve did not start: {why}")
+            yield line, proc.pid
     finally:
-        interrupt(proc, 15)
         library.cleanup()
 
 

@@ -17,8 +17,8 @@ from contextlib import contextmanager
 from typing import Any
 
 from bench import side_by_side
-from bench.procs import free_port, interrupt
-from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, Table, register
+from bench.procs import child, free_port
+from bench.registry import POPPY_PYTHON, BenchContext, BenchResult, Table, register
 from bench.side_by_side import measure_sides, median, median_cells, percentile
 
 DURATION_S = 1.5
@@ -61,21 +61,13 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
         args += ["--profile", "ergo-jr", "--zmq-port", str(port)]
     else:
         args = [str(ctx.peers_python), "-c", PYPOT_SERVER, str(port)]
-    proc = subprocess.Popen(
-        args, cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-    )
-    try:
+    with child(args, stdout=subprocess.PIPE) as proc:
         assert proc.stdout is not None
         line = proc.stdout.readline()  # "zmq: tcp://..." / "ready": it serves
         if not line:
             err = proc.stderr.read() if proc.stderr else ""
             raise RuntimeError(f"the {kind} server exited: {err.strip()[-300:]}")
         yield port
-    finally:
-        interrupt(proc)
-        for stream in (proc.stdout, proc.stderr):
-            if stream is not None:
-                stream.close()
 
 
 def _load(port: int, request: dict[str, Any]) -> dict[str, Any]:

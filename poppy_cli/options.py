@@ -13,6 +13,7 @@ from typer.core import TyperCommand, TyperGroup
 from poppy_cli import complete
 from poppy_core import checks
 from poppy_core.errors import ArgumentError
+from poppy_core.trajectory import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from typer import _click
@@ -179,6 +180,21 @@ def sim_option(help: str, flag: str = "--sim") -> Any:
     )
 
 
+def duration_option(default: float | None, help: str, *, minimum: float = 0.0) -> Any:
+    """``--duration/-d SECONDS``: finite, from ``minimum`` up to a day (``MAX_DURATION_S``)."""
+    return typer.Option(
+        default,
+        "--duration",
+        "-d",
+        min=minimum,
+        max=MAX_DURATION_S,
+        callback=finite,
+        help=help,
+    )
+
+
+StopAfterOpt = duration_option(None, "Stop after this many seconds.", minimum=0.1)
+"""``--duration`` of the commands that run until Ctrl-C (record, teleop)."""
 BaudOpt = typer.Option(None, "--baud", "-b", help=BAUD_HELP, min=MIN_BAUD, max=MAX_BAUD)
 ProtoOpt = typer.Option(None, "--protocol", help=PROTOCOL_HELP, min=1, max=2)
 BusPortOpt = port_option()

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from numbers import Real
+from typing import Any, Generic, TypeVar, overload
 
 from poppy_core.errors import ArgumentError
 
@@ -140,3 +142,38 @@ def count(value: object, low: int, high: int, field: str = "") -> int:
             f"{_describe(field)} must be {low}-{high}, got {value}", field=field, value=value
         )
     return value
+
+
+T = TypeVar("T")
+
+
+class Checked(Generic[T]):
+    """An attribute whose every assignment goes through ``rule(value, name)``, the attribute's
+    name naming the field of the error: ``bpm = Checked(non_negative, "Beats per minute.")``.
+
+    The value is kept in ``_<name>`` of the instance; reading it before the first assignment
+    raises AttributeError, as a property over an unset attribute would.
+    """
+
+    def __init__(self, rule: Callable[[Any, str], T], doc: str = "") -> None:
+        self._rule = rule
+        self.__doc__ = doc
+        self._name = self._slot = ""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._name, self._slot = name, f"_{name}"
+
+    @overload
+    def __get__(self, obj: None, owner: type | None = None) -> Checked[T]: ...
+
+    @overload
+    def __get__(self, obj: object, owner: type | None = None) -> T: ...
+
+    def __get__(self, obj: object | None, owner: type | None = None) -> Checked[T] | T:
+        if obj is None:
+            return self
+        value: T = getattr(obj, self._slot)
+        return value
+
+    def __set__(self, obj: object, value: Any) -> None:
+        setattr(obj, self._slot, self._rule(value, self._name))

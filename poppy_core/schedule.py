@@ -129,6 +129,8 @@ class Worker:
         body: the loop; it receives the event that asks it to stop.
         on_exit: called in the thread after ``body`` ended, whatever the way (cleanup); its
             own exception is logged, never raised.
+        quiet: exception types the owner reports itself (say, to the user as a one-line
+            error): kept and raised again like any other, but not logged.
     """
 
     def __init__(
@@ -136,10 +138,12 @@ class Worker:
         name: str,
         body: Callable[[threading.Event], None],
         on_exit: Callable[[], None] | None = None,
+        quiet: tuple[type[BaseException], ...] = (),
     ) -> None:
         self.name = name
         self._body = body
         self._on_exit = on_exit
+        self._quiet = quiet
         self.stopping = threading.Event()
         self.error: BaseException | None = None
         self._thread: threading.Thread | None = None
@@ -148,6 +152,10 @@ class Worker:
     def running(self) -> bool:
         """True while the thread is alive."""
         return self._thread is not None and self._thread.is_alive()
+
+    def is_current(self) -> bool:
+        """True when called from the worker's own thread."""
+        return self._thread is not None and self._thread is threading.current_thread()
 
     def start(self) -> None:
         """Start the thread (no-op while running); a new start forgets the previous error."""
@@ -177,6 +185,15 @@ class Worker:
             raise self.error
         return True
 
+    def wait(self, timeout_s: float | None = None) -> bool:
+        """``join`` that does not raise: False while still running after ``timeout_s`` (the
+        body's exception, if any, stays in ``error``)."""
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout_s)
+            return not thread.is_alive()
+        return True
+
     def stop(self, timeout_s: float | None = 2.0) -> bool:
         """Ask the body to stop and ``join`` it (from its own thread: only asks)."""
         self.request_stop()
@@ -186,19 +203,15 @@ class Worker:
         """``stop`` for an owner's close: the body's exception is not raised again (it was
         logged and stays in ``error``), so the close goes on freeing what it owns."""
         self.request_stop()
-        try:
-            return self.join(timeout_s)
-        except BaseException as exc:
-            if exc is not self.error:
-                raise
-            return True
+        return self.wait(timeout_s)
 
     def _run(self) -> None:
         try:
             self._body(self.stopping)
         except BaseException as exc:  # kept for join() and health, logged once
             self.error = exc
-            logger.warning("%s failed: %s", self.name, exc, exc_info=exc)
+            if not isinstance(exc, self._quiet):
+                logger.warning("%s failed: %s", self.name, exc, exc_info=exc)
         finally:
             if self._on_exit is not None:
                 try:

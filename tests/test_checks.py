@@ -82,3 +82,20 @@ def test_a_duration_is_zero_or_long_enough_to_divide_by() -> None:
     for tiny in (1e-300, 5e-324, 1e-7):
         with pytest.raises(ArgumentError, match="at least"):
             checks.duration(tiny)
+
+
+def test_a_checked_attribute_refuses_through_its_rule_and_names_itself() -> None:
+    from poppy_core.checks import Checked, non_negative
+
+    class Knob:
+        gain = Checked(non_negative, "How much (>= 0).")
+
+        def __init__(self) -> None:
+            self.gain = 2
+
+    knob = Knob()
+    assert knob.gain == 2.0 and isinstance(knob.gain, float)
+    with pytest.raises(ArgumentError) as refused:
+        knob.gain = -1.0
+    assert refused.value.field == "gain" and knob.gain == 2.0
+    assert Knob.gain.__doc__ == "How much (>= 0)."

@@ -11,8 +11,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.mark.parametrize("target", ["run", "test"])
-def test_make_says_it_is_installing_before_pip_runs(target: str, tmp_path: Path) -> None:
+def make_dry_run(target: str, tmp_path: Path) -> subprocess.CompletedProcess[str]:
+    """What ``make -n -B TARGET`` would run with a fresh virtualenv (skips without make)."""
     if shutil.which("make") is None:
         pytest.skip("no make here")
     done = subprocess.run(
@@ -24,6 +24,12 @@ def test_make_says_it_is_installing_before_pip_runs(target: str, tmp_path: Path)
         check=False,
     )
     assert done.returncode == 0, done.stderr
+    return done
+
+
+@pytest.mark.parametrize("target", ["run", "test"])
+def test_make_says_it_is_installing_before_pip_runs(target: str, tmp_path: Path) -> None:
+    done = make_dry_run(target, tmp_path)
     lines = done.stdout.splitlines()
     install = next(i for i, line in enumerate(lines) if "pip install --quiet -e" in line)
     said = [line for line in lines[:install] if line.startswith("echo ")]
@@ -35,16 +41,6 @@ def test_make_says_it_is_installing_before_pip_runs(target: str, tmp_path: Path)
 def test_make_installs_every_extra(target: str, extras: str, tmp_path: Path) -> None:
     """The bare package is the core only (a Raspberry Pi's install): a newcomer's `make run`
     and `make test` still get every room (pyproject's `all` extra)."""
-    if shutil.which("make") is None:
-        pytest.skip("no make here")
-    done = subprocess.run(
-        ["make", "-n", "-B", target, f"VENV={tmp_path / '.venv'}"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=60,
-        check=False,
-    )
-    assert done.returncode == 0, done.stderr
+    done = make_dry_run(target, tmp_path)
     install = [line for line in done.stdout.splitlines() if "pip install --quiet -e" in line]
     assert install and install[-1].endswith(f"-e '.{extras}'"), install

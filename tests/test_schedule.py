@@ -92,3 +92,41 @@ def test_worker_error_is_logged_once_kept_and_raised_to_the_joiner(
     assert worker.close() is True  # an owner's close goes on; the error stays in .error
     warnings = [r for r in caplog.records if "test breaker failed" in r.getMessage()]
     assert len(warnings) == 1 and warnings[0].levelno == logging.WARNING
+
+
+def test_worker_wait_does_not_raise_and_stop_twice_is_safe() -> None:
+    def body(stopping: threading.Event) -> None:
+        raise ValueError("bad value")
+
+    worker = Worker("test waiter", body)
+    worker.start()
+    assert worker.wait(timeout_s=5.0) is True  # the error stays in .error, not raised
+    assert isinstance(worker.error, ValueError)
+    assert worker.close() is True and worker.close() is True
+
+
+def test_worker_quiet_errors_are_kept_but_not_logged(caplog: pytest.LogCaptureFixture) -> None:
+    def body(stopping: threading.Event) -> None:
+        raise ArgumentError("the owner says this one", field="x")
+
+    worker = Worker("test quiet", body, quiet=(ArgumentError,))
+    with caplog.at_level(logging.DEBUG, logger="poppy_core.schedule"):
+        worker.start()
+        with pytest.raises(ArgumentError):
+            worker.join(timeout_s=5.0)
+    assert not [r for r in caplog.records if "test quiet" in r.getMessage()]
+
+
+def test_worker_stopped_from_its_own_body_only_asks() -> None:
+    answers: list[bool] = []
+    holder: list[Worker] = []
+
+    def body(stopping: threading.Event) -> None:
+        answers.append(holder[0].stop())  # no "cannot join current thread"
+        assert stopping.is_set()
+
+    worker = Worker("test self stop", body)
+    holder.append(worker)
+    worker.start()
+    assert worker.wait(timeout_s=5.0)
+    assert answers == [True] and worker.error is None

@@ -14,22 +14,13 @@ line (``peer``, ``version``, ``error``, ``setup_s``). Nothing in site-packages i
 from __future__ import annotations
 
 import argparse
-import importlib
-import json
 import signal
 import sys
 import threading
 import time
 from typing import Any
 
-from _common import emit
-
-
-def _parse_port(text: str) -> tuple[str, str]:
-    name, sep, port = text.partition("=")
-    if not sep or not name or not port:
-        raise argparse.ArgumentTypeError(f"expected CONTROLLER=PORT, got {text!r}")
-    return name, port
+from _common import emit, from_config, import_peer, parse_controller_port, peer_config
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
@@ -38,25 +29,17 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
-    try:
-        pypot = importlib.import_module("pypot")
-        pypot_robot = importlib.import_module("pypot.robot")
-        importlib.import_module("pypot.creatures")  # before poppy_torso (circular import)
-        interaction = importlib.import_module("poppy_torso.primitives.interaction")
-    except ImportError as exc:
-        record["error"] = f"import failed: {exc}"
+    # pypot.creatures before poppy_torso (a circular import)
+    modules = import_peer(
+        record, "pypot", "pypot.robot", "pypot.creatures", "poppy_torso.primitives.interaction"
+    )
+    if modules is None:
         return record
-    record["version"] = str(pypot.__version__)
-    with open(args.config) as f:
-        config = json.load(f)
-    config.pop("sensors", None)
-    for name, port in args.port:
-        config["controllers"][name]["port"] = port
+    _, pypot_robot, _, interaction = modules
+    config = peer_config(args.config, args.port)
     start = time.perf_counter()
-    try:
-        robot = pypot_robot.from_config(config)
-    except Exception as exc:  # pypot raises its DxlError, serial errors, KeyError...
-        record["error"] = f"from_config failed: {type(exc).__name__}: {exc}"
+    robot = from_config(pypot_robot, config, record)
+    if robot is None:
         return record
     record["setup_s"] = time.perf_counter() - start
     try:
@@ -77,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     """Parse the command line, run, print the JSON line; 0 on success."""
     parser = argparse.ArgumentParser(description="pypot arms_copy_motion (benchmark peer)")
     parser.add_argument("--config", required=True, help="pypot JSON config of a Torso")
-    parser.add_argument("--port", type=_parse_port, action="append", required=True)
+    parser.add_argument("--port", type=parse_controller_port, action="append", required=True)
     record = run(parser.parse_args(argv))
     emit(record)
     return 0 if record["error"] is None else 1

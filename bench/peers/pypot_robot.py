@@ -14,45 +14,13 @@ site-packages is patched. ``--rate-hz`` sets that loop's ``period`` to ask for a
 from __future__ import annotations
 
 import argparse
-import importlib
-import json
-import threading
 import time
-from collections.abc import Callable
 from typing import Any
 
-from _common import emit
+from _common import TimedCalls, emit, from_config, import_peer, parse_controller_port, peer_config
 
 # Timestamps are rounded to the microsecond in the JSON line.
 _DIGITS = 6
-
-
-class _Recorder:
-    """Start times of one controller's updates."""
-
-    def __init__(self) -> None:
-        self.starts: list[float] = []
-        self._lock = threading.Lock()
-
-    def wrap(self, update: Callable[[], None]) -> Callable[[], None]:
-        def timed() -> None:
-            now = time.perf_counter()
-            with self._lock:
-                self.starts.append(now)
-            update()
-
-        return timed
-
-    def window(self, start_s: float, end_s: float) -> list[float]:
-        with self._lock:
-            return [t for t in self.starts if start_s <= t <= end_s]
-
-
-def _parse_port(text: str) -> tuple[str, str]:
-    name, sep, port = text.partition("=")
-    if not sep or not name or not port:
-        raise argparse.ArgumentTypeError(f"expected CONTROLLER=PORT, got {text!r}")
-    return name, port
 
 
 def _loop_of(meta: Any, cls: type) -> Any:
@@ -63,34 +31,24 @@ def _loop_of(meta: Any, cls: type) -> Any:
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Build the pypot robot, run its loops, and return the JSON-ready record."""
     record: dict[str, Any] = {"peer": "pypot", "error": None, "rate_hz": args.rate_hz}
-    try:
-        pypot = importlib.import_module("pypot")
-        pypot_robot = importlib.import_module("pypot.robot")
-        dxl_controller = importlib.import_module("pypot.dynamixel.controller")
-    except ImportError as exc:
-        record["error"] = f"import failed: {exc}"
+    modules = import_peer(record, "pypot", "pypot.robot", "pypot.dynamixel.controller")
+    if modules is None:
         return record
-    record["version"] = str(pypot.__version__)
-    with open(args.config) as f:
-        config = json.load(f)
-    config.pop("sensors", None)
-    for name, port in args.port:
-        config["controllers"][name]["port"] = port
+    _, pypot_robot, dxl_controller = modules
+    config = peer_config(args.config, args.port)
     port_to_name = {port: name for name, port in args.port}
     start = time.perf_counter()
-    try:
-        robot = pypot_robot.from_config(config, sync=False)
-    except Exception as exc:  # pypot raises its DxlError, serial errors, KeyError...
-        record["error"] = f"from_config failed: {type(exc).__name__}: {exc}"
+    robot = from_config(pypot_robot, config, record, sync=False)
+    if robot is None:
         return record
     record["setup_s"] = time.perf_counter() - start
     try:
-        recorders: dict[str, _Recorder] = {}
+        recorders: dict[str, TimedCalls] = {}
         loops: dict[str, Any] = {}
         for meta in robot._controllers:
             name = port_to_name.get(meta.io.port, meta.io.port)
             loop = _loop_of(meta, dxl_controller.PosSpeedLoadDxlController)
-            recorder = _Recorder()
+            recorder = TimedCalls()
             loop._update = recorder.wrap(loop._update)
             if args.rate_hz is not None:
                 loop.period = 1.0 / args.rate_hz
@@ -131,7 +89,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     parser = argparse.ArgumentParser(description="pypot robot sync loops (benchmark peer)")
     parser.add_argument("--config", required=True, help="pypot JSON config")
-    parser.add_argument("--port", type=_parse_port, action="append", required=True)
+    parser.add_argument("--port", type=parse_controller_port, action="append", required=True)
     parser.add_argument("--rate-hz", type=float, default=None, help="ask this loop rate")
     parser.add_argument("--duration-s", type=float, default=5.0)
     parser.add_argument("--warmup-s", type=float, default=1.0)

@@ -6,12 +6,11 @@ Run it with the peers venv: ``bench/.venv-peers/bin/python bench/peers/pypot_sca
 
 from __future__ import annotations
 
-import importlib
 import sys
 import time
 from typing import Any
 
-from _common import ScanArgs, emit, parse_scan_args
+from _common import ScanArgs, emit, import_peer, parse_scan_args
 
 
 def run(args: ScanArgs) -> dict[str, Any]:
@@ -35,13 +34,10 @@ def run(args: ScanArgs) -> dict[str, Any]:
         "timeout_s": None,
         "error": None,
     }
-    try:
-        pypot = importlib.import_module("pypot")
-        dxl = importlib.import_module("pypot.dynamixel")
-    except ImportError as exc:
-        record["error"] = f"import failed: {exc}"
+    modules = import_peer(record, "pypot", "pypot.dynamixel")
+    if modules is None:
         return record
-    record["version"] = str(pypot.__version__)
+    _, dxl = modules
     io_cls = dxl.Dxl320IO if args.protocol == 2 else dxl.DxlIO
     record["io_class"] = io_cls.__name__
     kwargs: dict[str, Any] = {"baudrate": args.baud}

@@ -17,29 +17,22 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib
-import json
 import sys
 import threading
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
-from _common import emit
+from _common import emit, from_config, import_peer, parse_controller_port, peer_config
+from _common import proc_status as common_proc_status
 
 SINUS_AMPLITUDE_DEG = 10.0
 SINUS_HZ = 0.5
 
 
 def proc_status() -> dict[str, int]:
-    out: dict[str, int] = {}
-    for line in Path("/proc/self/status").read_text().splitlines():
-        key, _, value = line.partition(":")
-        if key in ("VmRSS", "Threads"):
-            out[key] = int(value.split()[0])
-    out["python_threads"] = threading.active_count()
-    return out
+    """``_common.proc_status`` and Python's own count of threads."""
+    return {**common_proc_status(), "python_threads": threading.active_count()}
 
 
 class Counter:
@@ -69,35 +62,19 @@ class Counter:
         return counted
 
 
-def _parse_port(text: str) -> tuple[str, str]:
-    name, sep, port = text.partition("=")
-    if not sep or not name or not port:
-        raise argparse.ArgumentTypeError(f"expected CONTROLLER=PORT, got {text!r}")
-    return name, port
-
-
 def run(args: argparse.Namespace) -> dict[str, Any]:
     record: dict[str, Any] = {"peer": "pypot", "error": None}
-    try:
-        pypot = importlib.import_module("pypot")
-        pypot_robot = importlib.import_module("pypot.robot")
-        dxl_controller = importlib.import_module("pypot.dynamixel.controller")
-        utils = importlib.import_module("pypot.primitive.utils")
-    except ImportError as exc:
-        record["error"] = f"import failed: {exc}"
+    modules = import_peer(
+        record, "pypot", "pypot.robot", "pypot.dynamixel.controller", "pypot.primitive.utils"
+    )
+    if modules is None:
         return record
-    record["version"] = str(pypot.__version__)
-    with open(args.config) as f:
-        config = json.load(f)
-    config.pop("sensors", None)
-    for name, port in args.port:
-        config["controllers"][name]["port"] = port
+    _, pypot_robot, dxl_controller, utils = modules
+    config = peer_config(args.config, args.port)
     port_to_name = {port: name for name, port in args.port}
     start = time.perf_counter()
-    try:
-        robot = pypot_robot.from_config(config, sync=False)
-    except Exception as exc:  # pypot raises its DxlError, serial errors, KeyError...
-        record["error"] = f"from_config failed: {type(exc).__name__}: {exc}"
+    robot = from_config(pypot_robot, config, record, sync=False)
+    if robot is None:
         return record
     record["setup_s"] = time.perf_counter() - start
     closed = False
@@ -157,7 +134,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--config", required=True)
-    parser.add_argument("--port", type=_parse_port, action="append", required=True)
+    parser.add_argument("--port", type=parse_controller_port, action="append", required=True)
     parser.add_argument("--warmup-s", type=float, default=2.0)
     try:
         record = run(parser.parse_args())

@@ -19,23 +19,19 @@ discards at the client's flush.
 from __future__ import annotations
 
 import argparse
-import importlib
 import time
 from typing import Any
 
-from _common import emit, parse_ids
+from _common import emit, import_peer, parse_ids
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Open the IO, toggle the torque ``args.cycles`` times, return the JSON-ready record."""
     record: dict[str, Any] = {"peer": "pypot", "error": None, "port": args.port}
-    try:
-        pypot = importlib.import_module("pypot")
-        dxl = importlib.import_module("pypot.dynamixel")
-    except ImportError as exc:
-        record["error"] = f"import failed: {exc}"
+    modules = import_peer(record, "pypot", "pypot.dynamixel")
+    if modules is None:
         return record
-    record["version"] = str(pypot.__version__)
+    _, dxl = modules
     io_class = dxl.Dxl320IO if args.protocol == 2 else dxl.DxlIO
     writes = lost = reads_failed = 0
     start = time.perf_counter()

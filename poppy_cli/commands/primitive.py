@@ -16,11 +16,10 @@ from poppy_cli.options import (
     ProfileOpt,
     RemoteOpt,
     SimOpt,
-    finite,
+    duration_option,
 )
 from poppy_cli.output import EXIT_FAILURE, console, error_line, print_json
 from poppy_cli.robots import build_robot
-from poppy_core.trajectory import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -147,14 +146,8 @@ def run(
     name: str = typer.Argument(
         ..., help="Primitive name (see `poppy primitive list`).", autocompletion=complete.primitives
     ),
-    duration: float | None = typer.Option(
-        None,
-        "--duration",
-        "-d",
-        min=0.0,
-        max=MAX_DURATION_S,
-        callback=finite,
-        help="Stop after this many seconds (default: Ctrl-C).",
+    duration: float | None = duration_option(
+        None, "Stop after this many seconds (default: Ctrl-C)."
     ),
     settings: list[str] | None = typer.Option(
         None, "--set", help="PROPERTY=VALUE before starting, e.g. --set amplitude=20 (repeat)."

@@ -13,11 +13,17 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli.commands.robot import SETTLE_S, app
-from poppy_cli.options import ConfigOpt, JsonOpt, PortOpt, ProfileOpt, SimOpt, finite
+from poppy_cli.options import (
+    ConfigOpt,
+    JsonOpt,
+    PortOpt,
+    ProfileOpt,
+    SimOpt,
+    duration_option,
+)
 from poppy_cli.output import console, print_json
 from poppy_cli.robots import build_robot
 from poppy_core import checks
-from poppy_core.checks import MAX_DURATION_S
 from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
@@ -139,15 +145,7 @@ def reach(
     rpy: str | None = typer.Option(
         None, "--rpy", help="The tip's whole orientation as roll,pitch,yaw in degrees."
     ),
-    duration: float = typer.Option(
-        2.0,
-        "--duration",
-        "-d",
-        min=0.0,
-        max=MAX_DURATION_S,
-        callback=finite,
-        help="Seconds to move.",
-    ),
+    duration: float = duration_option(2.0, "Seconds to move."),
     linear: bool = typer.Option(False, "--linear", help="Move the tip along a straight line."),
     wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),
     profile: str | None = ProfileOpt,

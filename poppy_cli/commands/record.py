@@ -17,6 +17,7 @@ from poppy_cli.options import (
     PortOpt,
     ProfileOpt,
     SimOpt,
+    StopAfterOpt,
     finite,
 )
 from poppy_cli.output import (
@@ -28,7 +29,7 @@ from poppy_cli.output import (
 )
 from poppy_cli.prompts import ask
 from poppy_cli.robots import robot_config, start_robot
-from poppy_core.trajectory import MAX_DURATION_S
+from poppy_core.schedule import Worker
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -39,7 +40,7 @@ if TYPE_CHECKING:
 REFRESH_S = 0.1
 
 
-def _install_stop(stop: threading.Event) -> threading.Thread | None:
+def _install_stop(stop: threading.Event) -> Worker | None:
     """SIGINT and SIGTERM set ``stop``; Enter does too when stdin is a terminal.
 
     Returns:
@@ -62,7 +63,7 @@ def _install_stop(stop: threading.Event) -> threading.Thread | None:
             except (OSError, ValueError):
                 return
 
-        watcher = threading.Thread(target=wait_enter, name="record enter", daemon=True)
+        watcher = Worker("record enter", lambda _: wait_enter())  # ends on ``stop``
         watcher.start()
         return watcher
     return None
@@ -114,15 +115,7 @@ def record(
     freq: float = typer.Option(
         50.0, "--freq", min=1.0, max=1000.0, callback=finite, help="Frames per s."
     ),
-    duration: float | None = typer.Option(
-        None,
-        "--duration",
-        "-d",
-        min=0.1,
-        max=MAX_DURATION_S,
-        callback=finite,
-        help="Stop after this many seconds.",
-    ),
+    duration: float | None = StopAfterOpt,
     output: Path | None = typer.Option(
         None,
         "--output",
@@ -185,7 +178,7 @@ def record(
         _wait(recorder, stop, duration)
         stop.set()
         if watcher is not None:
-            watcher.join(1.0)  # a prompt may read stdin next: the watcher must be gone
+            watcher.wait(1.0)  # a prompt may read stdin next: the watcher must be gone
         try:
             move = recorder.stop()
         except FileError as exc:

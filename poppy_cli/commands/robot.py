@@ -16,13 +16,13 @@ from poppy_cli.options import (
     ProfileOpt,
     RemoteOpt,
     SimOpt,
-    finite,
+    duration_option,
 )
 from poppy_cli.output import EXIT_INTERRUPTED, console, fmt_value, print_json, styled
 from poppy_cli.robots import build_robot, open_remote, robot_config, start_robot
 from poppy_cli.targets import TargetSyntaxError, parse_targets
 from poppy_core.errors import ArgumentError
-from poppy_core.trajectory import MAX_DURATION_S, control_name
+from poppy_core.trajectory import control_name
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -194,15 +194,7 @@ def _goals(
 @app.command("goto")
 def goto(
     targets: list[str] = typer.Argument(..., help="Targets as NAME=DEGREES, e.g. m1=30 m2=-10."),
-    duration: float = typer.Option(
-        1.0,
-        "--duration",
-        "-d",
-        min=0.0,
-        max=MAX_DURATION_S,
-        callback=finite,
-        help="Seconds to move.",
-    ),
+    duration: float = duration_option(1.0, "Seconds to move."),
     wait: bool = typer.Option(False, "--wait", help="Wait until the motors arrived."),
     control: str = typer.Option("minjerk", "--trajectory", help="minjerk or dummy."),
     profile: str | None = ProfileOpt,

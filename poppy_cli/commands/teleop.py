@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli import complete
-from poppy_cli.options import SIM_ENGINES, JsonSummaryOpt, finite
+from poppy_cli.options import SIM_ENGINES, JsonSummaryOpt, StopAfterOpt, finite
 from poppy_cli.output import (
     EXIT_FAILURE,
     EXIT_USAGE,
@@ -26,7 +26,6 @@ from poppy_cli.output import (
     print_json,
     styled,
 )
-from poppy_core.checks import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -122,15 +121,7 @@ def teleop(
         callback=finite,
         help="Start/resume ramp in s (default: by distance).",
     ),
-    duration: float | None = typer.Option(
-        None,
-        "--duration",
-        "-d",
-        min=0.1,
-        max=MAX_DURATION_S,
-        callback=finite,
-        help="Stop after this many seconds.",
-    ),
+    duration: float | None = StopAfterOpt,
     record: str | None = typer.Option(
         None, "--record", help="Save the follower's trajectory as a move of this name (or path)."
     ),

@@ -21,7 +21,6 @@ import threading
 import time
 from collections import deque
 from collections.abc import Sequence
-from types import TracebackType
 
 from poppy_core.bus.latency import ReplyClock
 from poppy_core.bus.results import BusStats
@@ -443,12 +442,7 @@ class BusCore:
             if self._owns_transport:
                 self._transport.close()
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     def __repr__(self) -> str:

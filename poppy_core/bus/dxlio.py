@@ -12,7 +12,6 @@ from __future__ import annotations
 import glob
 import sys
 from collections.abc import Iterable, Mapping
-from types import TracebackType
 from typing import Any
 
 from poppy_core.bus import setup, setup_reset
@@ -80,6 +79,7 @@ class DxlIO(PypotCalls):
             min_timeout_s=float(timeout),
         )
         self._models: dict[int, ServoModel] = {}
+        super().__init__(self)  # pypot's grouped calls read and write through this IO
 
     # -- the bus ---------------------------------------------------------------------------------
 
@@ -100,9 +100,7 @@ class DxlIO(PypotCalls):
     def __enter__(self) -> DxlIO:
         return self
 
-    def __exit__(
-        self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     def __repr__(self) -> str:
@@ -123,9 +121,15 @@ class DxlIO(PypotCalls):
 
     def get_model(self, ids: Iterable[int]) -> tuple[str, ...]:
         """The model names of the motors (``'MX-28'``...)."""
-        return tuple(self._model(i).name for i in ids)
+        return tuple(self.model_of(i).name for i in ids)
 
-    def _model(self, id: int) -> ServoModel:
+    def model_of(self, id: int) -> ServoModel:
+        """The model of motor ``id`` (asked once, then remembered).
+
+        Raises:
+            CommunicationError: the motor does not answer.
+            RegisterError: it answers with a model number poppy does not know.
+        """
         model = self._models.get(id)
         if model is None:
             found = self.bus.ping(id)
@@ -145,12 +149,12 @@ class DxlIO(PypotCalls):
 
     def get(self, register: str, ids: Iterable[int]) -> tuple[Any, ...]:
         """Register ``register`` of each motor, in SI units."""
-        return tuple(self.bus.read_register(i, self._model(i), register) for i in _ids(ids))
+        return tuple(self.bus.read_register(i, self.model_of(i), register) for i in _ids(ids))
 
     def set(self, register: str, value_for_id: Mapping[int, Any]) -> None:
         """Write ``register`` of each motor (``{id: value}``, SI units)."""
         for motor_id, value in _mapping(value_for_id).items():
-            model = self._model(motor_id)
+            model = self.model_of(motor_id)
             self.bus.write_register(motor_id, model, register, capped(model, register, value))
 
     def __getattr__(self, name: str) -> Any:
@@ -190,7 +194,7 @@ class DxlIO(PypotCalls):
             self.set("led", {motor_id: self._led_value(motor_id, on=False)})
 
     def _led_value(self, motor_id: int, *, on: bool) -> SIValue:
-        return self._model(motor_id).register("led").switched(on)
+        return self.model_of(motor_id).register("led").switched(on)
 
     def get_angle_limit(self, ids: Iterable[int]) -> tuple[tuple[float, float], ...]:
         """(min, max) position limits in degrees."""

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from typing import Any
+from typing import Any, Protocol
 
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.errors import ArgumentError
@@ -93,23 +93,40 @@ def alarm_byte(names: Iterable[str]) -> int:
     return raw
 
 
-class PypotCalls:
-    """pypot's grouped and renamed calls, for a class that reads and writes registers by name."""
+class RegisterIO(Protocol):
+    """What pypot's calls need of an IO: its bus, registers by name and each motor's model."""
 
-    bus: DxlBus
+    @property
+    def bus(self) -> DxlBus:
+        """The bus the IO speaks on."""
+        ...
 
-    # Given by the class mixing this in.
     def get(self, register: str, ids: Iterable[int]) -> tuple[Any, ...]:
-        raise NotImplementedError
+        """Register ``register`` of each motor, in SI units."""
+        ...
 
     def set(self, register: str, value_for_id: Mapping[int, Any]) -> None:
-        raise NotImplementedError
+        """Write ``register`` of each motor (``{id: value}``, SI units)."""
+        ...
 
-    def _model(self, id: int) -> ServoModel:
-        raise NotImplementedError
+    def model_of(self, id: int) -> ServoModel:
+        """The model of motor ``id``."""
+        ...
 
     def get_angle_limit(self, ids: Iterable[int]) -> tuple[tuple[float, float], ...]:
-        raise NotImplementedError
+        """(min, max) position limits in degrees."""
+        ...
+
+
+class PypotCalls:
+    """pypot's grouped and renamed calls over a ``RegisterIO`` (``DxlIO`` gives itself).
+
+    Args:
+        io: reads and writes registers by name.
+    """
+
+    def __init__(self, io: RegisterIO) -> None:
+        self._io = io
 
     # -- joint and wheel modes --------------------------------------------------------------------
 
@@ -132,9 +149,9 @@ class PypotCalls:
                 raise ArgumentError(
                     f"control mode must be 'joint' or 'wheel', got {mode!r}", field="mode"
                 )
-            model = self._model(motor_id)
+            model = self._io.model_of(motor_id)
             if model.has_register("control_mode"):
-                self.bus.write(
+                self._io.bus.write(
                     motor_id,
                     model.register("control_mode").address,
                     bytes([1 if mode == "wheel" else 2]),
@@ -142,38 +159,38 @@ class PypotCalls:
                 continue
             cw, ccw = model.register("cw_angle_limit"), model.register("ccw_angle_limit")
             top = 0 if mode == "wheel" else ccw.max_raw
-            self.bus.write(motor_id, cw.address, cw.encode(0) + ccw.encode(top))
+            self._io.bus.write(motor_id, cw.address, cw.encode(0) + ccw.encode(top))
 
     def _mode(self, motor_id: int) -> str:
-        model = self._model(motor_id)
+        model = self._io.model_of(motor_id)
         if model.has_register("control_mode"):
-            raw = self.bus.read(motor_id, model.register("control_mode").address, 1)[0]
+            raw = self._io.bus.read(motor_id, model.register("control_mode").address, 1)[0]
             return "wheel" if raw == 1 else "joint"
         cw = model.register("cw_angle_limit")
-        data = self.bus.read(motor_id, cw.address, 2 * cw.size)
+        data = self._io.bus.read(motor_id, cw.address, 2 * cw.size)
         return "wheel" if not any(data) else "joint"
 
     # -- registers pypot grouped or named its own way ---------------------------------------------
 
     def get_alarm_shutdown(self, ids: Iterable[int]) -> tuple[tuple[str, ...], ...]:
         """The alarms that turn the torque off, by name (``('Overload Error', ...)``)."""
-        return tuple(alarm_names(int(raw)) for raw in self.get("shutdown", ids))
+        return tuple(alarm_names(int(raw)) for raw in self._io.get("shutdown", ids))
 
     def set_alarm_shutdown(self, value_for_id: Mapping[int, Iterable[str]]) -> None:
         """``{id: ('Overload Error', ...)}``."""
-        self.set("shutdown", {i: alarm_byte(v) for i, v in _mapping(value_for_id).items()})
+        self._io.set("shutdown", {i: alarm_byte(v) for i, v in _mapping(value_for_id).items()})
 
     def get_alarm_LED(self, ids: Iterable[int]) -> tuple[tuple[str, ...], ...]:
         """The alarms that blink the LED, by name."""
-        return tuple(alarm_names(int(raw)) for raw in self.get("alarm_led", ids))
+        return tuple(alarm_names(int(raw)) for raw in self._io.get("alarm_led", ids))
 
     def set_alarm_LED(self, value_for_id: Mapping[int, Iterable[str]]) -> None:
         """``{id: ('Overheating Error', ...)}``."""
-        self.set("alarm_led", {i: alarm_byte(v) for i, v in _mapping(value_for_id).items()})
+        self._io.set("alarm_led", {i: alarm_byte(v) for i, v in _mapping(value_for_id).items()})
 
     def get_status_return_level(self, ids: Iterable[int]) -> tuple[str, ...]:
         """``'never'``, ``'read'`` or ``'always'``."""
-        return tuple(STATUS_LEVELS[int(raw)] for raw in self.get("status_return_level", ids))
+        return tuple(STATUS_LEVELS[int(raw)] for raw in self._io.get("status_return_level", ids))
 
     def set_status_return_level(self, value_for_id: Mapping[int, str | int]) -> None:
         """``{id: 'always'}`` (or the code 0-2)."""
@@ -185,16 +202,16 @@ class PypotCalls:
                     field="status_return_level",
                 )
             codes[motor_id] = STATUS_LEVELS.index(level) if isinstance(level, str) else level
-        self.set("status_return_level", codes)
+        self._io.set("status_return_level", codes)
 
     def get_drive_mode(self, ids: Iterable[int]) -> tuple[tuple[str, str], ...]:
         """(``'normal'``/``'reverse'``, ``'master'``/``'slave'``); a motor without dual-joint
         drive (MX-28, AX...) is always normal and master."""
         modes = []
         for motor_id in _ids(ids):
-            model = self._model(motor_id)
+            model = self._io.model_of(motor_id)
             raw = (
-                int(self.get("drive_mode", [motor_id])[0])
+                int(self._io.get("drive_mode", [motor_id])[0])
                 if model.has_register("drive_mode")
                 else 0
             )
@@ -205,7 +222,7 @@ class PypotCalls:
         """Every register pypot listed that the motor has, keyed by pypot's names."""
         tables = []
         for motor_id in _ids(ids):
-            model = self._model(motor_id)
+            model = self._io.model_of(motor_id)
             table: dict[str, Any] = {}
             for key, call in CONTROL_TABLE:
                 reader = self._reader(model, call)
@@ -218,7 +235,7 @@ class PypotCalls:
         if call == "model":
             return lambda ids: [model.name]
         if call == "angle_limit":
-            return self.get_angle_limit
+            return self._io.get_angle_limit
         registers = GROUPS.get(call, (RENAMED.get(call, call),))
         if call == "alarm_LED" or call in ("alarm_shutdown", "status_return_level"):
             return getattr(self, f"get_{call}")  # type: ignore[no-any-return]
@@ -231,8 +248,8 @@ class PypotCalls:
         registers = GROUPS.get(name)
         chosen = _ids(ids)
         if registers is None:
-            return self.get(RENAMED.get(name, name), chosen)
-        columns = [self.get(register, chosen) for register in registers]
+            return self._io.get(RENAMED.get(name, name), chosen)
+        columns = [self._io.get(register, chosen) for register in registers]
         return tuple(zip(*columns, strict=True))
 
     def set_grouped(self, name: str, value_for_id: Mapping[int, Any]) -> None:
@@ -240,7 +257,7 @@ class PypotCalls:
         registers = GROUPS.get(name)
         values = _mapping(value_for_id)
         if registers is None:
-            self.set(RENAMED.get(name, name), values)
+            self._io.set(RENAMED.get(name, name), values)
             return
         for motor_id, value in values.items():
             if (
@@ -254,7 +271,7 @@ class PypotCalls:
                     field=name,
                 )
             for register, part in zip(registers, value, strict=True):
-                self.set(register, {motor_id: part})
+                self._io.set(register, {motor_id: part})
 
 
 def _ids(ids: Iterable[int]) -> list[int]:

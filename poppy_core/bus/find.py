@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.ports import list_ports
 from poppy_core.bus.settle import answers, ping_found, settle
-from poppy_core.bus.transport import Transport
+from poppy_core.bus.transport import Transport, open_each
 from poppy_core.errors import PortError, SetupError
 from poppy_core.models import standard_baudrates
 
@@ -139,15 +139,7 @@ def find_bus(
         raise PortError("no serial port found: plug the adapter or run `poppy ports`")
     closest = _Closest()
     unopened: list[PortError] = []
-    for port in port_list:
-        try:
-            transport = Transport(port)
-        except PortError as exc:
-            if len(port_list) == 1:
-                raise
-            logger.warning("skipping %s: %s", port, exc)
-            unopened.append(exc)
-            continue
+    for port, transport in open_each(port_list, unopened):
         found = None
         try:
             found = _search(port, transport, wanted, plan, latency_s, closest)

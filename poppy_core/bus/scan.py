@@ -49,8 +49,7 @@ from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_bus, f
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
 from poppy_core.bus.settle import answers, doubt_learned, heard_in_silence, ping_found, settle
 from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, LinkTiming
-from poppy_core.bus.transport import Transport
-from poppy_core.errors import PortError
+from poppy_core.bus.transport import Transport, open_each
 from poppy_core.models import standard_baudrates
 
 __all__ = [
@@ -354,14 +353,7 @@ def scan(
     id_list = list(ids)
     total = len(port_list) * sum(len(rates[p]) for p in protocol_list) * len(id_list)
     state = _Scan(id_list, progress, should_abort, on_found, total)
-    for port in port_list:
-        try:
-            transport = Transport(port)
-        except PortError as exc:
-            if len(port_list) == 1:
-                raise
-            logger.warning("skipping %s: %s", port, exc)
-            continue
+    for port, transport in open_each(port_list):
         learned = latency_s  # a slower adapter than assumed is learned once, for every rate
         first = True  # nothing sent on this port yet: nothing can come late from elsewhere
         assumed: float | None = None  # the port's latency, before anything is learned

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import logging
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 
 from poppy_core.bus.serial_line import Line, open_line, port_error
 from poppy_core.bus.timing import Deadline
+from poppy_core.errors import PortError
 from poppy_core.protocol import PacketDecoder, StatusPacket
 
 __all__ = ["Transport", "port_error"]
@@ -191,3 +193,27 @@ class Transport:
 
     def __exit__(self, *exc_info: object) -> None:
         self.close()
+
+
+def open_each(
+    ports: Sequence[str], unopened: list[PortError] | None = None
+) -> Iterator[tuple[str, Transport]]:
+    """Each port of ``ports`` opened in turn, with its transport (the caller closes or keeps it).
+
+    A port that cannot be opened is logged and skipped (its error added to ``unopened``), unless
+    it is the only one.
+
+    Raises:
+        PortError: the only port given cannot be opened.
+    """
+    for port in ports:
+        try:
+            transport = Transport(port)
+        except PortError as exc:
+            if len(ports) == 1:
+                raise
+            logging.getLogger(__name__).warning("skipping %s: %s", port, exc)
+            if unopened is not None:
+                unopened.append(exc)
+            continue
+        yield port, transport

@@ -67,14 +67,7 @@ class SwingMotion(LoopPrimitive):
         self.amplitude_scale = amplitude_scale
         self._centre: dict[str, float] = {}
 
-    @property
-    def amplitude_scale(self) -> float:
-        """Multiplier of every amplitude (>= 0)."""
-        return self._amplitude_scale
-
-    @amplitude_scale.setter
-    def amplitude_scale(self, value: float) -> None:
-        self._amplitude_scale = checks.non_negative(value, "amplitude_scale")
+    amplitude_scale = checks.Checked(checks.non_negative, "Multiplier of every amplitude (>= 0).")
 
     def swings(self) -> Sequence[Swing]:
         """The sinusoids to add."""
@@ -138,23 +131,9 @@ class DanceBeatMotion(SwingMotion):
         self.bpm = bpm
         self.amplitude = amplitude
 
-    @property
-    def bpm(self) -> float:
-        """Beats per minute (>= 0)."""
-        return self._bpm
+    bpm = checks.Checked(checks.non_negative, "Beats per minute (>= 0).")
 
-    @bpm.setter
-    def bpm(self, value: float) -> None:
-        self._bpm = checks.non_negative(value, "bpm")
-
-    @property
-    def amplitude(self) -> float:
-        """Degrees of the largest swings (>= 0)."""
-        return self._amplitude
-
-    @amplitude.setter
-    def amplitude(self, value: float) -> None:
-        self._amplitude = checks.non_negative(value, "amplitude")
+    amplitude = checks.Checked(checks.non_negative, "Degrees of the largest swings (>= 0).")
 
     def swings(self) -> Sequence[Swing]:
         """Nod on each beat, sway over two beats."""

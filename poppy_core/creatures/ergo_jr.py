@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from poppy_core import checks
 from poppy_core.creatures.postures import ERGO_JR_IDLE, clamp_to_limits
@@ -24,6 +24,12 @@ ERGO_JR_TORQUE_LIMIT_PCT = 70.0
 # poppy_ergo_jr.py setup: m.pid = (4, 2, 0) on every motor (XL-320 P = raw/8, I = raw·1000/2048,
 # D = raw·4/1000, the same units as our XL-320 registers).
 ERGO_JR_PID: tuple[float, float, float] = (4.0, 2.0, 0.0)
+
+
+def _control(value: Any, field: str) -> str:
+    """A goto control checked by ``control_name`` (``"minijerk"`` is ``"minjerk"``)."""
+    del field  # control_name names its own field
+    return control_name(value)  # it refuses what is not a control name
 
 
 @dataclass(frozen=True)
@@ -96,50 +102,19 @@ class Dance(LoopPrimitive):
         self._dance_t0 = 0.0
         self._speeds: dict[str, float] = {}
 
-    @property
-    def control(self) -> str:
-        """The goto control of the intro: ``"minjerk"`` or ``"dummy"``."""
-        return self._control
+    control = checks.Checked(_control, "The goto control of the intro: 'minjerk' or 'dummy'.")
 
-    @control.setter
-    def control(self, value: str) -> None:
-        self._control = control_name(value)
+    amplitude_scale = checks.Checked(checks.non_negative, "Multiplier of every amplitude (>= 0).")
 
-    @property
-    def amplitude_scale(self) -> float:
-        """Multiplier of every amplitude (>= 0)."""
-        return self._amplitude_scale
+    tempo_scale = checks.Checked(checks.non_negative, "Multiplier of every frequency (>= 0).")
 
-    @amplitude_scale.setter
-    def amplitude_scale(self, value: float) -> None:
-        self._amplitude_scale = checks.non_negative(value, "amplitude_scale")
+    intro_s = checks.Checked(
+        checks.non_negative, "Seconds to reach the 0° posture before dancing (>= 0)."
+    )
 
-    @property
-    def tempo_scale(self) -> float:
-        """Multiplier of every frequency (>= 0)."""
-        return self._tempo_scale
-
-    @tempo_scale.setter
-    def tempo_scale(self, value: float) -> None:
-        self._tempo_scale = checks.non_negative(value, "tempo_scale")
-
-    @property
-    def intro_s(self) -> float:
-        """Seconds to reach the 0° posture before dancing (>= 0)."""
-        return self._intro_s
-
-    @intro_s.setter
-    def intro_s(self, value: float) -> None:
-        self._intro_s = checks.non_negative(value, "intro_s")
-
-    @property
-    def speed_dps(self) -> float:
-        """Moving speed while dancing, deg/s (0 = full speed)."""
-        return self._speed_dps
-
-    @speed_dps.setter
-    def speed_dps(self, value: float) -> None:
-        self._speed_dps = checks.non_negative(value, "speed_dps")
+    speed_dps = checks.Checked(
+        checks.non_negative, "Moving speed while dancing, deg/s (0 = full speed)."
+    )
 
     def _dancers(self) -> list[str]:
         known = {m.name for m in self.real_robot.motors}
@@ -279,23 +254,9 @@ class SafePowerUp(Primitive):
         self.torque_limit = torque_limit
         self.control = control
 
-    @property
-    def duration(self) -> float:
-        """Seconds to reach the idle posture (>= 0)."""
-        return self._duration
+    duration = checks.Checked(checks.non_negative, "Seconds to reach the idle posture (>= 0).")
 
-    @duration.setter
-    def duration(self, value: float) -> None:
-        self._duration = checks.non_negative(value, "duration")
-
-    @property
-    def control(self) -> str:
-        """The goto control: ``"minjerk"`` or ``"dummy"``."""
-        return self._control
-
-    @control.setter
-    def control(self, value: str) -> None:
-        self._control = control_name(value)
+    control = checks.Checked(_control, "The goto control: 'minjerk' or 'dummy'.")
 
     @property
     def torque_limit(self) -> float:

@@ -33,6 +33,7 @@ from functools import partial
 from poppy_core import checks
 from poppy_core.emulator.bus_servers import Endpoint
 from poppy_core.errors import ArgumentError
+from poppy_core.schedule import Worker
 
 logger = logging.getLogger(__name__)
 
@@ -122,7 +123,7 @@ class EmulatorControl:
         self._cond = threading.Condition()
         self._events: list[tuple[float, int, str, Callable[[], None]]] = []
         self._order = itertools.count()
-        self._thread: threading.Thread | None = None
+        self._worker: Worker | None = None
         self._closed = False
 
     # ------------------------------------------------------------------ commands
@@ -304,14 +305,13 @@ class EmulatorControl:
             if self._closed:
                 return
             heapq.heappush(self._events, (when, next(self._order), what, action))
-            if self._thread is None:
-                self._thread = threading.Thread(
-                    target=self._run, name="emulator control", daemon=True
-                )
-                self._thread.start()
+            if self._worker is None:
+                self._worker = Worker("emulator control", self._run)
+                self._worker.start()
             self._cond.notify()
 
-    def _run(self) -> None:
+    def _run(self, stopping: threading.Event) -> None:
+        """Runs the actions when due until ``close`` (its condition is the loop's wake-up)."""
         while True:
             with self._cond:
                 while not self._closed and (not self._events or self._events[0][0] > self._clock()):
@@ -332,5 +332,5 @@ class EmulatorControl:
             self._closed = True
             self._events.clear()
             self._cond.notify()
-        if self._thread is not None and self._thread is not threading.current_thread():
-            self._thread.join(timeout=2.0)
+        if self._worker is not None:
+            self._worker.close(2.0)  # joins (but from its own thread)

@@ -20,7 +20,6 @@ import logging
 import threading
 import time
 from collections import deque
-from types import TracebackType
 
 from poppy_core.emulator.bus import Reply, VirtualBus
 from poppy_core.errors import PortError
@@ -57,12 +56,7 @@ class LinkServer:
     def __enter__(self) -> LinkServer:
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.stop()
 
     def __repr__(self) -> str:

@@ -29,12 +29,11 @@ import threading
 import time
 from abc import ABC, abstractmethod
 from collections import deque
-from collections.abc import Callable
 from dataclasses import dataclass
-from types import TracebackType
 
 from poppy_core.emulator.bus import Reply, VirtualBus
 from poppy_core.emulator.wire_timing import SPIN_WINDOW_S, sleep_until
+from poppy_core.schedule import Worker
 
 logger = logging.getLogger(__name__)
 
@@ -86,22 +85,15 @@ class EmulatorServer(ABC):
         )  # the endpoint's descriptors: reader swaps, responder writes
         self._outage_s: float | None = None
         self._down = False
-        self._reader = threading.Thread(
-            target=self._guarded(self._read_loop), name=f"emulator reader {url}", daemon=True
-        )
-        self._thread = threading.Thread(
-            target=self._guarded(self._respond_loop), name=f"emulator {url}", daemon=True
-        )
+        # Both loops end on ``_stop`` (shared: ``stop`` wakes the reader's select and the
+        # responder's queue), not on their workers' own events.
+        self._reader = Worker(f"emulator reader {url}", lambda _: self._read_loop())
+        self._thread = Worker(f"emulator {url}", lambda _: self._respond_loop())
 
     def __enter__(self) -> EmulatorServer:
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.stop()
 
     def __repr__(self) -> str:
@@ -110,7 +102,7 @@ class EmulatorServer(ABC):
     @property
     def running(self) -> bool:
         """True while the serving threads are alive."""
-        return self._thread.is_alive() or self._reader.is_alive()
+        return self._thread.running or self._reader.running
 
     @property
     def connected(self) -> bool:
@@ -129,9 +121,8 @@ class EmulatorServer(ABC):
         self._stop.set()
         self._wake()
         self._inbox.put(None)
-        for thread in (self._reader, self._thread):
-            if thread.is_alive() and thread is not threading.current_thread():
-                thread.join(timeout=5.0)
+        for worker in (self._reader, self._thread):
+            worker.close(5.0)  # joins (but from its own thread); an error was logged once
         with self._io_lock:
             self._close_endpoint()
         os.close(self._wake_r)
@@ -150,15 +141,6 @@ class EmulatorServer(ABC):
         self._wake()
 
     # ------------------------------------------------------------------ threads
-
-    def _guarded(self, loop: Callable[[], None]) -> Callable[[], None]:
-        def run() -> None:
-            try:
-                loop()
-            except Exception:
-                logger.exception("emulator server %s crashed", self.url)
-
-        return run
 
     def _wake(self) -> None:
         with contextlib.suppress(OSError):

@@ -15,6 +15,7 @@ from poppy_core.motion.builtins import (
     Square,
     attach_builtins,
 )
+from poppy_core.motion.loop_primitive import LoopPrimitive
 from poppy_core.motion.manager import FILTERS, PrimitiveManager, primitive_manager
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import (
@@ -45,7 +46,8 @@ from poppy_core.motion.move_library import (
     save_move,
 )
 from poppy_core.motion.player import MovePlayer, PlayProgress
-from poppy_core.motion.primitive import LoopPrimitive, Primitive, PrimitiveFailure
+from poppy_core.motion.primitive import Primitive
+from poppy_core.motion.primitive_failure import PrimitiveFailure
 from poppy_core.motion.recorder import MoveRecorder
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
 from poppy_core.motion.teleop import (

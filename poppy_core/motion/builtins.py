@@ -17,7 +17,8 @@ from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.files import write_file
 from poppy_core.motion.attached import attach_primitive
-from poppy_core.motion.primitive import LoopPrimitive, Primitive
+from poppy_core.motion.loop_primitive import LoopPrimitive
+from poppy_core.motion.primitive import Primitive
 from poppy_core.motion.sandbox import MockupMotor
 
 if TYPE_CHECKING:

@@ -13,7 +13,6 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from types import TracebackType
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -22,7 +21,7 @@ from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import read_move
-from poppy_core.schedule import Periodic
+from poppy_core.schedule import Periodic, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -202,12 +201,15 @@ class MovePlayer:
             )
         played = _within_limits(move, self._motors) if self.clamped else move
         self._played = played.reversed() if backwards else played
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._worker: Worker | None = None
         self.loop_times: list[tuple[float, float]] = []
         """``(start, end)`` clock times of each loop's playing phase (ramps excluded)."""
         self.stopped = False
-        self.error: BaseException | None = None
+
+    @property
+    def error(self) -> BaseException | None:
+        """What ended the last playback early (logged once), None when it ended well."""
+        return self._worker.error if self._worker is not None else None
 
     @property
     def played(self) -> Move:
@@ -234,12 +236,12 @@ class MovePlayer:
         """
         if self.playing:
             raise RuntimeError("the move is already playing")
-        self._stop.clear()
         self.loop_times = []
         self.stopped = False
-        self.error = None
-        self._thread = threading.Thread(target=self._run, name="move player", daemon=True)
-        self._thread.start()
+        # One worker per playback: a thread that ended may still be finishing when the next
+        # playback starts.
+        self._worker = Worker("move player", self._run)
+        self._worker.start()
         return self
 
     def play(self) -> MovePlayer:
@@ -252,21 +254,19 @@ class MovePlayer:
 
     def wait(self, timeout_s: float | None = None) -> bool:
         """Block until the playback ends; False when ``timeout_s`` ran out first."""
-        thread = self._thread
-        if thread is None:
-            return True
-        thread.join(timeout_s)
-        return not thread.is_alive()
+        worker = self._worker
+        return worker.wait(timeout_s) if worker is not None else True
 
     def stop(self) -> None:
-        """Stop where the motors are (they stay stiff)."""
-        self._stop.set()
-        self.wait(5.0)
+        """Stop where the motors are (they stay stiff); joins the thread (but from itself)."""
+        worker = self._worker
+        if worker is not None:
+            worker.close(5.0)
 
     @property
     def playing(self) -> bool:
         """True while the thread runs."""
-        return self._thread is not None and self._thread.is_alive()
+        return self._worker is not None and self._worker.running
 
     # -- pypot's names (its MovePlayer is a primitive) -------------------------------------------
 
@@ -296,7 +296,7 @@ class MovePlayer:
         for motor, value in zip(self._motors, positions.tolist(), strict=True):
             motor.goal_position = value
 
-    def _ramp(self, loop: int) -> None:
+    def _ramp(self, loop: int, stopping: threading.Event) -> None:
         first = self._played.positions[0]
         distance = max(
             abs(m.present_position - float(v)) for m, v in zip(self._motors, first, strict=True)
@@ -313,19 +313,19 @@ class MovePlayer:
         handle = self.robot.goto_position(targets, duration, control="minjerk")
         while not handle.wait(0.05):
             self._report("ramp", loop, 0.0, (loop - 1) / self.loops)
-            if self._stop.is_set():
+            if stopping.is_set():
                 for motor in self._motors:
                     motor.goal_position = motor.present_position
                 return
 
-    def _play_once(self, loop: int) -> None:
+    def _play_once(self, loop: int, stopping: threading.Event) -> None:
         move = self._played
         period = 1.0 / self.rate_hz
         start = self._clock()
         schedule = Periodic(period, start)
         duration = move.duration_s
         try:
-            while not self._stop.is_set():
+            while not stopping.is_set():
                 now = self._clock()
                 move_t = (now - start) * self.speed
                 if move_t >= duration:
@@ -336,40 +336,32 @@ class MovePlayer:
                 done = (loop - 1 + move_t / duration) / self.loops if duration else 0.0
                 self._report("play", loop, shown_t, done)
                 schedule.advance(self._clock())
-                self._stop.wait(max(0.0, schedule.next_deadline - self._clock()))
+                stopping.wait(max(0.0, schedule.next_deadline - self._clock()))
         finally:
             self.loop_times.append((start, self._clock()))
 
-    def _run(self) -> None:
-        try:
-            for motor in self._motors:
-                motor.compliant = False
-            for loop in range(1, self.loops + 1):
-                if self._stop.is_set():
-                    break
-                self._ramp(loop)
-                if self._stop.is_set():
-                    break
-                self._play_once(loop)
-            self.stopped = self._stop.is_set()
-            fraction = 1.0
-            if self.stopped and self.duration_s > 0:
-                fraction = min(1.0, self.played_s / self.duration_s)
-            end_t = 0.0 if self.backwards else self.move.duration_s
-            self._report("done", self.loops, end_t, fraction)
-        except BaseException as exc:  # handed to play()/the caller through .error
-            self.error = exc
-            logger.exception("move playback failed")
+    def _run(self, stopping: threading.Event) -> None:
+        """The playback (an exception is the worker's: logged once, kept in ``error``)."""
+        for motor in self._motors:
+            motor.compliant = False
+        for loop in range(1, self.loops + 1):
+            if stopping.is_set():
+                break
+            self._ramp(loop, stopping)
+            if stopping.is_set():
+                break
+            self._play_once(loop, stopping)
+        self.stopped = stopping.is_set()
+        fraction = 1.0
+        if self.stopped and self.duration_s > 0:
+            fraction = min(1.0, self.played_s / self.duration_s)
+        end_t = 0.0 if self.backwards else self.move.duration_s
+        self._report("done", self.loops, end_t, fraction)
 
     # -- context manager -----------------------------------------------------------------------
 
     def __enter__(self) -> MovePlayer:
         return self.start()
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.stop()

@@ -1,4 +1,5 @@
-"""``Primitive`` and ``LoopPrimitive``: restartable behaviours running in their own thread.
+"""``Primitive``: a restartable behaviour running in its own thread (``LoopPrimitive``, in
+``loop_primitive``, paces one).
 
 A primitive acts on a sandboxed view of the robot (``self.robot``, see ``sandbox``): its writes
 are requests that the robot's ``PrimitiveManager`` combines with those of the other running
@@ -12,45 +13,24 @@ from __future__ import annotations
 import logging
 import threading
 import time
-import traceback
-from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar
 
-from poppy_core import checks
-from poppy_core.errors import ArgumentError, PrimitiveError, UnknownNameError
+from poppy_core.errors import PrimitiveError
+from poppy_core.motion import primitive_access
 from poppy_core.motion.manager import PrimitiveManager, primitive_manager
-from poppy_core.motion.primitive_values import convert_value
+from poppy_core.motion.primitive_failure import PrimitiveFailure, State
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
-from poppy_core.schedule import Periodic, RateMeter
+from poppy_core.schedule import Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
 
+__all__ = ["JOIN_TIMEOUT_S", "Primitive", "PrimitiveFailure", "State"]
+
 logger = logging.getLogger(__name__)
 
-State = Literal["idle", "running", "paused", "stopped", "failed"]
-_PLURALS = {"property": "properties", "method": "methods"}
 JOIN_TIMEOUT_S = 5.0
-
-
-@dataclass(frozen=True)
-class PrimitiveFailure:
-    """Why a primitive failed: the exception's type, its message and the traceback text."""
-
-    type: str
-    message: str
-    traceback: str
-
-    @property
-    def one_line(self) -> str:
-        """``"Type: message"``, for a status line."""
-        return f"{self.type}: {self.message}" if self.message else self.type
-
-    def to_dict(self) -> dict[str, str]:
-        """Plain values (for JSON)."""
-        return {"type": self.type, "message": self.message, "traceback": self.traceback}
 
 
 def _snake_case(name: str) -> str:
@@ -85,7 +65,7 @@ class Primitive:
         self._started_event = threading.Event()
         self.robot = MockupRobot(robot, self._stop_event)
         self._manager: PrimitiveManager = primitive_manager(robot)
-        self._thread: threading.Thread | None = None
+        self._worker: Worker | None = None
         self._lifecycle = threading.Lock()
         self._state: State = "idle"
         self.error: PrimitiveFailure | None = None
@@ -118,7 +98,7 @@ class Primitive:
             RobotClosedError: the robot is closed.
             RuntimeError: called from the primitive's own thread.
         """
-        if self._thread is threading.current_thread():
+        if self._worker is not None and self._worker.is_current():
             raise RuntimeError("a primitive cannot restart itself from its own thread")
         with self._lifecycle:
             if self.is_alive():
@@ -134,10 +114,10 @@ class Primitive:
             self._paused_at = None
             self._ended_at = None
             self._state = "running"
-            self._thread = threading.Thread(
-                target=self._main, name=f"primitive {type(self).__name__}", daemon=True
-            )
-            self._thread.start()
+            # One worker per run (the last one may still be finishing); ``_main`` catches the
+            # run's exceptions itself: a primitive's failure is its own story (see ``error``).
+            self._worker = Worker(f"primitive {type(self).__name__}", lambda _: self._main())
+            self._worker.start()
             self._started_event.set()
         logger.info("%s started", type(self).__name__)
 
@@ -176,11 +156,14 @@ class Primitive:
     def _stop_locked(self, wait: bool) -> None:
         self._stop_event.set()
         self._resume_event.set()
-        thread = self._thread
-        if wait and thread is not None and thread is not threading.current_thread():
-            thread.join(JOIN_TIMEOUT_S)
-            if thread.is_alive():
-                logger.warning("%s did not stop within %s s", type(self).__name__, JOIN_TIMEOUT_S)
+        worker = self._worker
+        if (
+            wait
+            and worker is not None
+            and not worker.is_current()
+            and not worker.wait(JOIN_TIMEOUT_S)
+        ):
+            logger.warning("%s did not stop within %s s", type(self).__name__, JOIN_TIMEOUT_S)
 
     def pause(self) -> None:
         """Ask the primitive to pause (``should_pause()`` turns True); its requests stay."""
@@ -228,8 +211,8 @@ class Primitive:
                     logger.info("%s stopped", name)
 
     def _fail(self, exc: BaseException) -> None:
-        text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
-        self.error = PrimitiveFailure(type(exc).__name__, str(exc), text)
+        self.error = PrimitiveFailure.of(exc)
+        text = self.error.traceback
         self._exception = exc
         self._state = "failed"
         self._stop_event.set()
@@ -271,8 +254,8 @@ class Primitive:
 
     def is_alive(self) -> bool:
         """True while the thread runs (also when paused)."""
-        thread = self._thread
-        return thread is not None and thread.is_alive()
+        worker = self._worker
+        return worker is not None and worker.running
 
     def should_stop(self) -> bool:
         """True once ``stop()`` was asked: ``run`` should return."""
@@ -292,11 +275,10 @@ class Primitive:
         Raises:
             PrimitiveError: the primitive's thread died (raised from its exception).
         """
-        thread = self._thread
-        if thread is None or thread is threading.current_thread():
+        worker = self._worker
+        if worker is None or worker.is_current():
             return not self.is_alive()
-        thread.join(timeout_s)
-        if thread.is_alive():
+        if not worker.wait(timeout_s):
             return False
         self.raise_failure()
         return True
@@ -335,52 +317,20 @@ class Primitive:
     # -- remote access -----------------------------------------------------------------------
 
     def get_property(self, name: str) -> Any:
-        """The value of declared property ``name``.
-
-        Raises:
-            UnknownNameError: ``name`` is not in ``properties`` (``kind`` ``"property"``).
-        """
-        self._check_name(name, self.properties, "property")
-        return getattr(self, name)
+        """The value of declared property ``name`` (``primitive_access.get_property``)."""
+        return primitive_access.get_property(self, name)
 
     def set_property(self, name: str, value: Any) -> None:
-        """Set declared property ``name``, converted to the type of its present value.
-
-        Text is parsed (``"0.5"``, ``"true"``, ``"m1,m2"``), so command-line and JSON values work.
-
-        Raises:
-            UnknownNameError: an unknown property (``kind`` ``"property"``).
-            ArgumentError: a value of the wrong type, or one the primitive refuses.
-        """
-        self._check_name(name, self.properties, "property")
-        converted = convert_value(name, getattr(self, name), value)
-        try:
-            setattr(self, name, converted)
-        except (TypeError, ValueError) as exc:
-            raise ArgumentError(f"property {name}: {exc}", field=name, value=value) from None
+        """Set declared property ``name``, text parsed (``primitive_access.set_property``)."""
+        primitive_access.set_property(self, name, value)
 
     def property_values(self) -> dict[str, Any]:
         """Every declared property and its value."""
-        return {name: getattr(self, name) for name in self.properties}
+        return primitive_access.property_values(self)
 
     def call_method(self, name: str, *args: Any) -> Any:
-        """Call declared method ``name`` with ``args`` and return its result.
-
-        Raises:
-            UnknownNameError: ``name`` is not in ``methods`` (``kind`` ``"method"``).
-        """
-        self._check_name(name, self.methods, "method")
-        return getattr(self, name)(*args)
-
-    def _check_name(self, name: str, known: Sequence[str], kind: str) -> None:
-        if name not in known:
-            listed = ", ".join(known) or "none"
-            raise UnknownNameError(
-                f"{type(self).__name__} has no {kind} {name!r} ({_PLURALS[kind]}: {listed})",
-                name=str(name),
-                known=list(known),
-                kind=kind,
-            )
+        """Call declared method ``name`` (``primitive_access.call_method``)."""
+        return primitive_access.call_method(self, name, *args)
 
     def describe(self) -> dict[str, Any]:
         """State, elapsed time, properties, methods and error as plain values (for JSON)."""
@@ -393,67 +343,3 @@ class Primitive:
             "methods": list(self.methods),
             "error": self.error.to_dict() if self.error is not None else None,
         }
-
-
-class LoopPrimitive(Primitive):
-    """A primitive calling ``update()`` at ``freq`` Hz, drift-free, until stopped.
-
-    Args:
-        robot: the robot to act on.
-        freq: update rate in Hz.
-    """
-
-    def __init__(self, robot: Robot, freq: float) -> None:
-        super().__init__(robot)
-        self.update_freq = freq
-        self._meter = RateMeter(window=10)
-        self._recent: deque[float] = deque(maxlen=10)
-
-    @property
-    def update_freq(self) -> float:
-        """Updates per second (takes effect at the next (re)start)."""
-        return self._freq
-
-    @update_freq.setter
-    def update_freq(self, value: float) -> None:
-        # a floor on the period (no spinning) and a ceiling (no wait too long for a timer)
-        self._freq = checks.rate(value, "update_freq")
-
-    @property
-    def period_s(self) -> float:
-        """Seconds between two updates."""
-        return 1.0 / self._freq
-
-    @property
-    def update_rate_hz(self) -> float:
-        """Measured update rate over the last updates (0 until two ran)."""
-        return self._meter.rate_hz
-
-    @property
-    def recent_update_frequencies(self) -> list[float]:
-        """The last (up to 10) instantaneous update rates, most recent first."""
-        return list(reversed(self._recent))
-
-    def update(self) -> None:
-        """One step of the behaviour, called at ``update_freq``."""
-
-    def run(self) -> None:
-        """Call ``update()`` on a drift-free schedule; late updates skip missed periods."""
-        self._meter = RateMeter(window=10)
-        self._recent.clear()
-        last: float | None = None
-        schedule = Periodic(self.period_s, time.monotonic())
-        while not self.should_stop():
-            if self.should_pause():
-                self.wait_to_resume()
-                schedule = Periodic(self.period_s, time.monotonic())
-                last = None
-                continue
-            now = time.monotonic()
-            self.update()
-            self._meter.tick(now)
-            if last is not None and now > last:
-                self._recent.append(1.0 / (now - last))
-            last = now
-            schedule.advance(time.monotonic())
-            self.sleep(schedule.next_deadline - time.monotonic())

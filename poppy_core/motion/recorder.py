@@ -21,7 +21,6 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
-from types import TracebackType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -30,7 +29,7 @@ from poppy_core.errors import ArgumentError, FileError
 from poppy_core.files import FileLock, output_path, probe_folder
 from poppy_core.motion.move import MAX_FRAMERATE_HZ, MIN_FRAMERATE_HZ, Move, resample
 from poppy_core.motion.move_format import MOVE_SUFFIX, write_move
-from poppy_core.schedule import Periodic
+from poppy_core.schedule import Periodic, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -122,8 +121,7 @@ class MoveRecorder:
         width = 1 + len(self.motors) * (2 if with_speeds else 1)
         self._samples = _Samples(width)
         self._lock = threading.Lock()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._worker: Worker | None = None
         self._t0 = 0.0
         self.checkpoints = 0
         self.checkpoint_error: Exception | None = None
@@ -151,11 +149,10 @@ class MoveRecorder:
         self.checkpoint_error = None
         self._samples = _Samples(self._samples.data.shape[1])
         self._metadata.setdefault("created", datetime.now(UTC).isoformat(timespec="seconds"))
-        self._stop.clear()
         self._t0 = self._clock()
         self._sample(self._t0)  # the take starts now, not when the thread first gets the CPU
-        self._thread = threading.Thread(target=self._run, name="move recorder", daemon=True)
-        self._thread.start()
+        self._worker = Worker("move recorder", self._run)  # one per take (see MovePlayer)
+        self._worker.start()
         return self
 
     def stop(self) -> Move:
@@ -165,11 +162,9 @@ class MoveRecorder:
             FileError: the move could not be written to ``checkpoint_path``; it is still held
                 (``move``) for ``save()`` to write elsewhere.
         """
-        thread = self._thread
-        self._stop.set()
-        if thread is not None and thread is not threading.current_thread():
-            thread.join(timeout=5.0)
-        self._thread = None
+        worker = self._worker
+        if worker is not None:
+            worker.close(5.0)  # joins (but from its own thread); an error was logged once
         move = self.move
         try:
             if self.checkpoint_path is not None and len(move):
@@ -247,9 +242,9 @@ class MoveRecorder:
 
     def wait_to_stop(self, timeout_s: float | None = None) -> bool:
         """Block until the recording thread ended (pypot's name)."""
-        thread = self._thread
-        if thread is not None and thread is not threading.current_thread():
-            thread.join(timeout_s)
+        worker = self._worker
+        if worker is not None:
+            worker.wait(timeout_s)
         return not self.recording
 
     def is_alive(self) -> bool:
@@ -259,7 +254,12 @@ class MoveRecorder:
     @property
     def recording(self) -> bool:
         """True while the thread runs."""
-        return self._thread is not None and self._thread.is_alive()
+        return self._worker is not None and self._worker.running
+
+    @property
+    def error(self) -> BaseException | None:
+        """What ended the last take's thread early (logged once), None when nothing did."""
+        return self._worker.error if self._worker is not None else None
 
     @property
     def frames_recorded(self) -> int:
@@ -327,12 +327,12 @@ class MoveRecorder:
             logger.warning("checkpoint to %s works again", self.checkpoint_path)
             self.checkpoint_error = None
 
-    def _run(self) -> None:
+    def _run(self, stopping: threading.Event) -> None:
         schedule = Periodic(1.0 / self.freq, self._t0)  # start() took the sample at t0
         next_checkpoint = self._t0 + self.checkpoint_period_s
         while True:
             schedule.advance(self._clock())
-            if self._stop.wait(max(0.0, schedule.next_deadline - self._clock())):
+            if stopping.wait(max(0.0, schedule.next_deadline - self._clock())):
                 break
             now = self._clock()
             self._sample(now)
@@ -346,12 +346,7 @@ class MoveRecorder:
     def __enter__(self) -> MoveRecorder:
         return self.start()
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.stop()
 
 

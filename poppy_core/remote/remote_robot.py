@@ -6,7 +6,6 @@ import builtins
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from types import TracebackType
 from typing import Any
 
 from poppy_core.errors import (
@@ -395,10 +394,5 @@ class RemoteRobot:
     def __enter__(self) -> RemoteRobot:
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()

@@ -24,7 +24,7 @@ from urllib.parse import urlencode, urlsplit
 
 from poppy_core.errors import CommunicationError, ConfigError
 from poppy_core.remote.client import HttpClient, path_of
-from poppy_core.schedule import Backoff
+from poppy_core.schedule import Backoff, Worker
 
 logger = logging.getLogger(__name__)
 
@@ -100,7 +100,9 @@ class RemoteFollower:
         self._outbox = threading.Condition()
         self._goals: dict[str, float] = {}
         self._messages: list[dict[str, Any]] = []
-        self._sender: threading.Thread | None = None
+        self._sender: Worker | None = None
+        self._receiver: Worker | None = None
+        self._reconnector: Worker | None = None
         self.reconnects = 0
         self.errors: list[str] = []
         """Error messages the server sent (each once)."""
@@ -133,7 +135,7 @@ class RemoteFollower:
         self._stopping.clear()
         self._connect()
         if self._sender is None:
-            self._sender = threading.Thread(target=self._send_loop, name="teleop send", daemon=True)
+            self._sender = Worker("teleop send", self._send_loop)
             self._sender.start()
 
     def send(self, targets: Mapping[str, float]) -> None:
@@ -174,13 +176,15 @@ class RemoteFollower:
         self._stopping.set()
         with self._outbox:
             self._outbox.notify()
+        if self._reconnector is not None:  # first: a link it opens meanwhile is closed below
+            self._reconnector.close(2.0)
         with self._lock:
             ws, self._ws = self._ws, None
         if ws is not None:
             ws.close()
-        sender = self._sender
-        if sender is not None and sender is not threading.current_thread():
-            sender.join(2.0)
+        for worker in (self._sender, self._receiver):
+            if worker is not None:
+                worker.close(2.0)  # joins (but from its own thread)
         self._sender = None
 
     # -- connection ------------------------------------------------------------------------------
@@ -213,7 +217,8 @@ class RemoteFollower:
             raise CommunicationError(f"cannot reach {self.ws_url}: {exc}", port=self.url) from None
         self._started.clear()
         self._last_frame = time.monotonic()
-        threading.Thread(target=self._receive, args=(ws,), name="teleop ws", daemon=True).start()
+        self._receiver = Worker("teleop ws", lambda stopping: self._receive(ws))
+        self._receiver.start()
         start = {
             "type": "teleop.start",
             "motors": self._motors,
@@ -281,7 +286,9 @@ class RemoteFollower:
             with self._lock:
                 self._positions.update(positions)
 
-    def _send_loop(self) -> None:
+    def _send_loop(self, stopping: threading.Event) -> None:
+        """Sends what ``send``/``hold``/``stop`` queued until closed (``_closed``: the outbox
+        is the loop's wake-up, ``close`` notifies it)."""
         while True:
             with self._outbox:
                 while not (self._goals or self._messages or self._closed()):
@@ -319,9 +326,10 @@ class RemoteFollower:
             self._reconnecting = True
         logger.warning("link to %s lost (%s): reconnecting", self.url, reason)
         self._changed("link lost", reason)
-        threading.Thread(target=self._reconnect, name="teleop reconnect", daemon=True).start()
+        self._reconnector = Worker("teleop reconnect", self._reconnect)
+        self._reconnector.start()
 
-    def _reconnect(self) -> None:
+    def _reconnect(self, stopping: threading.Event) -> None:
         backoff = Backoff(RECONNECT_FIRST_S, RECONNECT_MAX_S)
         try:
             while not self._stopping.wait(backoff.delay_s):

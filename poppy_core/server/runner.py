@@ -13,6 +13,7 @@ import threading
 import time
 from typing import Any
 
+from poppy_core.schedule import Worker
 from poppy_core.server.errors import ListenError
 from poppy_core.server.limits import (
     HEADER_TIMEOUT_S,
@@ -163,7 +164,7 @@ class ServerThread:
         )
         self.port = port
         self._sockets: list[socket.socket] | None = None
-        self._thread = threading.Thread(target=self._run, name="uvicorn", daemon=True)
+        self._worker = Worker("uvicorn", self._run)
 
     @property
     def url(self) -> str:
@@ -182,7 +183,8 @@ class ServerThread:
             self.port = int(self._sockets[0].getsockname()[1])
         return self
 
-    def _run(self) -> None:
+    def _run(self, stopping: threading.Event) -> None:
+        """uvicorn's loop; it ends on ``server.should_exit``, which ``stop`` sets."""
         self.server.run(sockets=self._sockets)
 
     def start(self) -> ServerThread:
@@ -193,10 +195,10 @@ class ServerThread:
             RuntimeError: the server did not start (its log says why).
         """
         self.bind()
-        self._thread.start()
+        self._worker.start()
         deadline = time.monotonic() + START_TIMEOUT_S
         while not self.server.started:
-            if not self._thread.is_alive() or time.monotonic() > deadline:
+            if not self._worker.running or time.monotonic() > deadline:
                 self.close_sockets()
                 raise RuntimeError(f"the server on {self.host}:{self.port} did not start")
             time.sleep(0.01)
@@ -205,13 +207,12 @@ class ServerThread:
     @property
     def running(self) -> bool:
         """True while the server thread runs."""
-        return self._thread.is_alive()
+        return self._worker.running
 
     def stop(self) -> None:
         """Stop serving and wait for the thread (also releases sockets bound but never served)."""
         self.server.should_exit = True
-        if self._thread.is_alive():
-            self._thread.join(timeout=10.0)
+        self._worker.close(10.0)  # an error that ended uvicorn was logged once
         self.close_sockets()
 
     def close_sockets(self) -> None:

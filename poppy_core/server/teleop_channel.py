@@ -22,7 +22,6 @@ client reconnecting with the same ``client`` id takes its motors over from its o
 
 from __future__ import annotations
 
-import logging
 import threading
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -30,9 +29,8 @@ from typing import Any
 from poppy_core import checks
 from poppy_core.motion.teleop.goal_stream import GoalStream, GoalStreamChange
 from poppy_core.robot import Robot
+from poppy_core.schedule import Worker
 from poppy_core.server.errors import ApiError
-
-logger = logging.getLogger(__name__)
 
 DEFAULT_WATCHDOG_S = 0.25
 WATCHDOG_RANGE_S = (0.05, 5.0)
@@ -115,9 +113,8 @@ class TeleopChannel:
         self._lock = threading.Lock()
         self._wake = threading.Event()
         self._newest: dict[str, float] | None = None
-        self._closing = threading.Event()
         self._close_reason = "the teleoperation ended"
-        self._thread: threading.Thread | None = None
+        self._worker: Worker | None = None
 
     # -- messages (called on the event loop: cheap, never blocks on the bus) --------------------
 
@@ -170,9 +167,9 @@ class TeleopChannel:
         with self._lock:
             self.session = session
             self._newest = None
-        self._closing.clear()
-        self._thread = threading.Thread(target=self._work, name="teleop channel", daemon=True)
-        self._thread.start()
+        # One worker per session: the last one may still be finishing.
+        self._worker = Worker("teleop channel", lambda stopping: self._work(session, stopping))
+        self._worker.start()
         return {
             "type": "teleop.started",
             "motors": list(motors),
@@ -201,13 +198,12 @@ class TeleopChannel:
 
     # -- the worker ------------------------------------------------------------------------------
 
-    def _work(self) -> None:
-        session = self.session
-        if session is None:
-            return
+    def _work(self, session: GoalStream, stopping: threading.Event) -> None:
+        """Pushes the newest goals into ``session`` until closed (an error is the worker's:
+        logged once; the session stops holding either way)."""
         try:
             session.start()
-            while not self._closing.is_set():
+            while not stopping.is_set():
                 self._wake.wait(TICK_S)
                 self._wake.clear()
                 with self._lock:
@@ -216,8 +212,6 @@ class TeleopChannel:
                     session.push(goals)
                 elif session.expired():
                     session.hold(f"no goals for {session.watchdog_s:g} s: link lost?")
-        except Exception:
-            logger.exception("teleoperation channel failed")
         finally:
             session.stop(self._close_reason)
 
@@ -227,12 +221,12 @@ class TeleopChannel:
     def close(self, reason: str) -> None:
         """End the session: the motors hold where they are (stiff). Blocks for the worker."""
         self._close_reason = reason
-        self._closing.set()
-        self._wake.set()
-        thread = self._thread
-        if thread is not None and thread is not threading.current_thread():
-            thread.join(2.0)
-        self._thread = None
+        worker = self._worker
+        if worker is not None:
+            worker.request_stop()
+            self._wake.set()
+            worker.close(2.0)  # joins (but from its own thread)
+        self._worker = None
         session = self.session
         if session is not None and session.state != "stopped":
             session.stop(reason)

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 from poppy_core import checks
 from poppy_core.errors import PoppyError
 from poppy_core.extras import require
+from poppy_core.schedule import Worker
 from poppy_core.server.errors import ApiError, ListenError, refusal_kind
 from poppy_core.server.service import RobotService
 from poppy_core.trajectory import goto_duration
@@ -230,8 +231,10 @@ class ZmqRobotServer:
                 f"cannot listen on {host}:{port}: {exc}; choose another port "
                 "(--zmq-port) or stop the program using it"
             ) from None
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._serve, name="zmq server", daemon=True)
+        self._stop = threading.Event()  # stopped for good: a stopped server does not start
+        self._released = False
+        self._release_lock = threading.Lock()
+        self._worker = Worker("zmq server", self._serve, on_exit=self._release)
         self.requests_served = 0
 
     @property
@@ -242,34 +245,36 @@ class ZmqRobotServer:
     @property
     def running(self) -> bool:
         """True while the server thread runs."""
-        return self._thread.is_alive()
+        return self._worker.running
 
     def start(self) -> ZmqRobotServer:
         """Serve in a thread (again: nothing)."""
-        if not self._thread.is_alive() and not self._stop.is_set():
-            self._thread.start()
+        if not self._worker.running and not self._stop.is_set():
+            self._worker.start()
         return self
 
     def run(self, timeout_s: float | None = None) -> None:
         """Serve and block until ``stop()`` (pypot's ``server.run()``); when it already serves in
         the background (``use_zmq=True`` started it), return at once, as pypot did."""
-        if self._thread.is_alive():
+        if self._worker.running:
             return
         self.start()
         self._stop.wait(timeout_s)
 
-    def _serve(self) -> None:
+    def _serve(self, stopping: threading.Event) -> None:
+        """Answer requests until stopped (``_release`` closes the socket after, whatever the
+        way the loop ended)."""
         import zmq
 
         socket = self._socket
         socket.setsockopt(zmq.RCVTIMEO, POLL_MS)  # wake up to see stop() without a poll per request
-        while not self._stop.is_set():
+        while not stopping.is_set():
             try:
                 raw = socket.recv()
             except zmq.Again:
                 continue
             except zmq.ZMQError as exc:
-                if self._stop.is_set():
+                if stopping.is_set():
                     break
                 logger.warning("zmq server: %s", exc)
                 continue
@@ -279,7 +284,13 @@ class ZmqRobotServer:
             except zmq.ZMQError as exc:
                 logger.warning("zmq server: reply not sent: %s", exc)
             self.requests_served += 1
-        socket.close()
+
+    def _release(self) -> None:
+        with self._release_lock:
+            if self._released:
+                return
+            self._released = True
+        self._socket.close()
         self._context.term()
 
     def reply_to(self, raw: bytes) -> bytes:
@@ -304,11 +315,10 @@ class ZmqRobotServer:
         if self._stop.is_set():
             return
         self._stop.set()
-        if self._thread.is_alive():
-            self._thread.join(timeout=5.0)
+        if self._worker.running:
+            self._worker.close(5.0)  # the thread releases the port as it ends
         else:
-            self._socket.close()
-            self._context.term()
+            self._release()
         if self._owns_service:
             self.service.close()
 

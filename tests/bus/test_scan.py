@@ -121,3 +121,15 @@ def test_find_port_without_ports(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(module, "list_ports", lambda: [])
     with pytest.raises(PortError):
         find_port([1])
+
+
+def test_find_port_skips_a_missing_port_and_says_when_none_opens(emulate: Emulate) -> None:
+    missing = ["/dev/ttyUSB_poppy_missing_3", "/dev/ttyUSB_poppy_missing_4"]
+    with emulate("MX-28:1") as (_, url):
+        assert find_port([1], ports=[missing[0], url], baudrates=[1_000_000], protocols=[1]) == (
+            url,
+            1_000_000,
+            1,
+        )
+    with pytest.raises(PortError, match="no port could be opened"):
+        find_port([1], ports=missing, baudrates=[1_000_000], protocols=[1])

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import signal
-import subprocess
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -13,6 +12,7 @@ import pytest
 from poppy_core.emulator import VirtualBus
 from tests.helpers.bus import emulate_bus
 from tests.helpers.cli import POPPY, Result, run_poppy
+from tests.helpers.processes import start
 
 __all__ = ["POPPY", "Result", "run_poppy"]
 
@@ -21,12 +21,7 @@ class Emulator:
     """A `poppy emulate` process; `url` is the first line it printed."""
 
     def __init__(self, *args: str) -> None:
-        self.proc = subprocess.Popen(
-            [*POPPY, "emulate", *args],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        self.proc = start([*POPPY, "emulate", *args])
         assert self.proc.stdout is not None
         line = self.proc.stdout.readline().strip()
         if not line:

@@ -12,16 +12,13 @@ from typing import Any
 import pytest
 import yaml
 
-from tests.helpers.cli import POPPY
+from tests.helpers.cli import POPPY, no_user_settings
 
 
 @pytest.fixture(autouse=True)
 def user_dirs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """An empty user config folder, no default robot."""
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
-    return tmp_path / "xdg" / "poppy" / "profiles"
+    return no_user_settings(tmp_path, monkeypatch) / "poppy" / "profiles"
 
 
 # Enter at the posture, Enter once m1 was "moved", yes keep its range (nothing moves a --sim

@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import os
-import pty
-import subprocess
 import termios
 from pathlib import Path
 
 from tests.helpers.cli import POPPY
-from tests.helpers.processes import read_until
+from tests.helpers.processes import read_until, start_on_pty
 
 
 def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Path) -> None:
@@ -21,14 +19,8 @@ def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Pa
         POPPY_PROFILE="",
         POPPY_PORT="",
     )
-    parent, child = pty.openpty()
-    proc = subprocess.Popen(
-        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr", "--motors", "m1"],
-        env=env,
-        stdin=child,
-        stdout=child,
-        stderr=child,
-        close_fds=True,
+    proc, parent, child = start_on_pty(
+        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr", "--motors", "m1"], env
     )
     try:
         shown = read_until(parent, "q to cancel")
@@ -59,15 +51,7 @@ def test_q_at_the_posture_cancels_at_once(tmp_path: Path) -> None:
         POPPY_PROFILE="",
         POPPY_PORT="",
     )
-    parent, child = pty.openpty()
-    proc = subprocess.Popen(
-        [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"],
-        env=env,
-        stdin=child,
-        stdout=child,
-        stderr=child,
-        close_fds=True,
-    )
+    proc, parent, child = start_on_pty([*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"], env)
     try:
         read_until(parent, "q to cancel")
         os.write(parent, b"q")

@@ -12,18 +12,14 @@ import numpy as np
 import pytest
 
 from poppy_core.motion import Move, write_move
+from tests.helpers.cli import no_user_settings
 
 SIM = ("--sim", "--profile", "ergo-jr")
 
 
 @pytest.fixture(autouse=True)
 def library(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    folder = tmp_path / "moves"
-    monkeypatch.setenv("POPPY_MOVES_DIR", str(folder))
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
-    return folder
+    return no_user_settings(tmp_path, monkeypatch, moves=True)
 
 
 def one_line(result: Any, code: int) -> str:

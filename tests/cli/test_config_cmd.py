@@ -8,15 +8,15 @@ from typing import Any
 
 import pytest
 
+from tests.helpers.cli import no_user_settings
+
 DATA = Path(__file__).resolve().parents[1] / "robot" / "data"
 ERGO_JSON = DATA / "poppy_ergo_jr.json"
 
 
 @pytest.fixture(autouse=True)
 def _isolated_settings(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
+    no_user_settings(tmp_path, monkeypatch)
 
 
 def test_validate_ok(poppy: Any) -> None:

@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from tests.helpers.cli import keyed
+from tests.helpers.cli import keyed, no_user_settings
 
 SIM = ("--sim", "--profile", "ergo-jr")
 
@@ -15,9 +15,7 @@ SIM = ("--sim", "--profile", "ergo-jr")
 @pytest.fixture(autouse=True)
 def xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """No user settings or POPPY_* variables leak into the runs."""
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
+    no_user_settings(tmp_path, monkeypatch)
 
 
 def test_list_json(poppy: Any) -> None:

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from poppy_core.motion import Move, read_move, save_move
-from tests.helpers.cli import keyed
+from tests.helpers.cli import keyed, no_user_settings
+from tests.helpers.processes import start
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -23,25 +24,13 @@ POPPY = [sys.executable, "-m", "poppy_cli"]
 @pytest.fixture(autouse=True)
 def library(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """An empty move library and no user settings."""
-    folder = tmp_path / "moves"
-    monkeypatch.setenv("POPPY_MOVES_DIR", str(folder))
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
-    return folder
+    return no_user_settings(tmp_path, monkeypatch, moves=True)
 
 
 def start_recording(*args: str) -> subprocess.Popen[str]:
     """`poppy record ARGS` in the background, returned once it says it is recording."""
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    proc = subprocess.Popen(
-        [*POPPY, "record", *args],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        stdin=subprocess.DEVNULL,
-        text=True,
-        env=env,
-    )
+    proc = start([*POPPY, "record", *args], env, stdin=subprocess.DEVNULL)
     assert proc.stderr is not None
     line = proc.stderr.readline()
     assert line.startswith("recording"), line + proc.stderr.read()
@@ -148,13 +137,10 @@ def test_play_unknown_move(poppy: Any) -> None:
 def test_a_signal_during_play_exits_130_after_the_summary(signum: int) -> None:
     save_move(ramp(["m1"], [30.0], seconds=60.0), "long")
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    proc = subprocess.Popen(
+    proc = start(
         [*POPPY, "play", "long", "--sim", "--profile", "ergo-jr", "--json"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
+        env,
         stdin=subprocess.DEVNULL,
-        text=True,
-        env=env,
     )
     assert proc.stderr is not None
     line = proc.stderr.readline()

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import pty
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -14,7 +13,7 @@ import pytest
 
 from poppy_core.motion import read_move
 from tests.helpers.cli import POPPY
-from tests.helpers.processes import read_until
+from tests.helpers.processes import read_until, start, start_on_pty
 from tests.helpers.terminal import CTRL_C, Terminal
 
 SIM = ("--sim", "--profile", "ergo-jr")
@@ -93,12 +92,7 @@ def test_two_recordings_of_one_name_at_once(
     poppy: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
-    first = subprocess.Popen(
-        [*POPPY, "record", "same", *SIM, "--duration", "20"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    first = start([*POPPY, "record", "same", *SIM, "--duration", "20"])
     try:
         assert first.stderr is not None
         line = first.stderr.readline()
@@ -117,15 +111,7 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
     with tmpfs(tmp_path / "full", "32k") as library:
         (library / "filler").write_bytes(b"\0" * 28_000)
         env = dict(os.environ, POPPY_MOVES_DIR=str(library), COLUMNS="200")
-        parent, child = pty.openpty()
-        proc = subprocess.Popen(
-            [*POPPY, "record", "wave", *SIM, "--duration", "6"],
-            env=env,
-            stdin=child,
-            stdout=child,
-            stderr=child,
-            close_fds=True,
-        )
+        proc, parent, child = start_on_pty([*POPPY, "record", "wave", *SIM, "--duration", "6"], env)
         os.close(child)
         try:
             shown = read_until(parent, "Save it where?")

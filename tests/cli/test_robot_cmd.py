@@ -8,17 +8,13 @@ from typing import Any
 
 import pytest
 
-from tests.helpers.cli import keyed
+from tests.helpers.cli import keyed, no_user_settings
 
 
 @pytest.fixture(autouse=True)
 def xdg(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """An empty user config folder (platformdirs reads XDG_CONFIG_HOME) and no POPPY_* vars."""
-    folder = tmp_path / "xdg"
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(folder))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
-    return folder
+    return no_user_settings(tmp_path, monkeypatch)
 
 
 def write_settings(xdg: Path, text: str) -> Path:

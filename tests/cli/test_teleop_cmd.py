@@ -16,17 +16,14 @@ from poppy_core.emulator import EmulatorServer, VirtualBus, serve_pty
 from poppy_core.motion import read_move
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
-from tests.helpers.cli import POPPY, Result
+from tests.helpers.cli import POPPY, Result, no_user_settings
+from tests.helpers.processes import start
 
 
 @pytest.fixture(autouse=True)
 def settings(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     """An empty move library, no user settings or default robot."""
-    monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
-    monkeypatch.delenv("POPPY_PROFILE", raising=False)
-    monkeypatch.delenv("POPPY_PORT", raising=False)
-    return tmp_path / "moves"
+    return no_user_settings(tmp_path, monkeypatch, moves=True)
 
 
 def ergo_jr_bus() -> Iterator[tuple[VirtualBus, EmulatorServer]]:
@@ -53,17 +50,10 @@ def follower_bus() -> Iterator[tuple[VirtualBus, EmulatorServer]]:
 def run_with_hand(args: list[str], hand: VirtualBus, timeout_s: float = 60.0) -> Result:
     """Run `poppy ARGS`, waving the leader's joints (motor frame) until it exits."""
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    proc = subprocess.Popen(
-        [*POPPY, *args],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        stdin=subprocess.DEVNULL,
-        text=True,
-        env=env,
-    )
-    start = time.monotonic()
-    while proc.poll() is None and time.monotonic() - start < timeout_s:
-        t = time.monotonic() - start
+    proc = start([*POPPY, *args], env, stdin=subprocess.DEVNULL)
+    began = time.monotonic()
+    while proc.poll() is None and time.monotonic() - began < timeout_s:
+        t = time.monotonic() - began
         for k, motor in enumerate(hand.motors):
             motor.move_by_hand(20.0 + 25.0 * math.sin(2.0 * t + k))
         time.sleep(0.01)

@@ -3,7 +3,6 @@ attached to an Ergo Jr whose config has a face detector."""
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -12,7 +11,7 @@ import pytest
 from poppy_core.creatures import FaceTracking, from_config, from_profile
 from poppy_core.robot import RobotConfig, load_profile
 from poppy_core.sensors import Face, FaceDetector
-from tests.creatures.test_tracking import HEIGHT, WIDTH, SeenPoint
+from tests.creatures.test_tracking import HEIGHT, WIDTH, SeenPoint, turns_to_centre
 from tests.helpers.fixtures import ergo_fixture
 from tests.helpers.waiting import eventually
 
@@ -43,24 +42,9 @@ def to_the_side(robot: Any) -> tuple[float, float, float]:
     return (float(point[0]), float(point[1]), float(point[2]))
 
 
-def off_centre_px(detector: SeenPoint) -> float:
-    seen = detector.pixel()
-    return math.inf if seen is None else math.hypot(seen[0] - WIDTH / 2, seen[1] - HEIGHT / 2)
-
-
 def test_the_head_turns_until_the_face_is_in_the_middle(ergo: Any) -> None:
     detector = SeenFaces(ergo, to_the_side(ergo))
-    tracking = FaceTracking(ergo, detector=detector, freq=10.0)
-    detector.follow = tracking
-    before = off_centre_px(detector)
-    assert 60 < before < 300, before  # in view, well off the middle
-    tracking.start()
-    try:
-        assert eventually(lambda: off_centre_px(detector) < 40, 20.0), off_centre_px(detector)
-    finally:
-        tracking.stop()
-    assert abs(ergo.m1.present_position) > 3.0  # the base turned towards the side
-    assert tracking.error is None
+    turns_to_centre(ergo, FaceTracking(ergo, detector=detector, freq=10.0), detector)
 
 
 def test_the_face_followed_is_kept_when_another_comes(ergo: Any) -> None:

@@ -89,7 +89,12 @@ def test_the_head_turns_until_the_marker_is_in_the_middle(ergo: Any) -> None:
     side = np.cross(look, [0.0, 0.0, 1.0])
     point = tip + 0.3 * look + 0.08 * side / np.linalg.norm(side) + np.array([0.0, 0.0, 0.03])
     detector = SeenPoint(ergo, tuple(point))
-    follow = MarkerFollow(ergo, detector=detector, freq=10.0)
+    turns_to_centre(ergo, MarkerFollow(ergo, detector=detector, freq=10.0), detector)
+
+
+def turns_to_centre(ergo: Any, follow: Any, detector: SeenPoint) -> None:
+    """Run ``follow`` until what ``detector`` sees is in the middle of the image: it must start
+    well off the middle, and the base must have turned towards it."""
     detector.follow = follow
     before = off_centre_px(detector)
     assert 60 < before < 300, before  # in view, well off the middle

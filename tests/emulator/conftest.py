@@ -7,7 +7,8 @@ from collections.abc import Iterator
 import pytest
 from emulator_client import RawClient
 
-from poppy_core.emulator import VirtualBus, build_bus_from_spec, serve_pty
+from poppy_core.emulator import VirtualBus, build_bus_from_spec
+from tests.helpers.bus import client_on_pty
 
 
 @pytest.fixture
@@ -18,10 +19,8 @@ def xl320_bus() -> VirtualBus:
 
 @pytest.fixture
 def xl320(xl320_bus: VirtualBus) -> Iterator[RawClient]:
-    with serve_pty(xl320_bus) as server:
-        client = RawClient(server.url, 2)
+    with client_on_pty(xl320_bus, lambda s: RawClient(s.url, 2)) as client:
         yield client
-        client.close()
 
 
 @pytest.fixture
@@ -32,10 +31,8 @@ def mx_bus() -> VirtualBus:
 
 @pytest.fixture
 def mx(mx_bus: VirtualBus) -> Iterator[RawClient]:
-    with serve_pty(mx_bus) as server:
-        client = RawClient(server.url, 1)
+    with client_on_pty(mx_bus, lambda s: RawClient(s.url, 1)) as client:
         yield client
-        client.close()
 
 
 @pytest.fixture
@@ -46,7 +43,5 @@ def x_bus() -> VirtualBus:
 
 @pytest.fixture
 def xm(x_bus: VirtualBus) -> Iterator[RawClient]:
-    with serve_pty(x_bus) as server:
-        client = RawClient(server.url, 2)
+    with client_on_pty(x_bus, lambda s: RawClient(s.url, 2)) as client:
         yield client
-        client.close()

@@ -4,9 +4,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager
-from typing import Any
+from typing import Any, Protocol, TypeVar
 
-from poppy_core.emulator import VirtualBus, build_bus_from_spec, serve_link, serve_pty, serve_tcp
+from poppy_core.emulator import (
+    EmulatorServer,
+    VirtualBus,
+    build_bus_from_spec,
+    serve_link,
+    serve_pty,
+    serve_tcp,
+)
 
 Emulate = Callable[..., AbstractContextManager[tuple[VirtualBus, str]]]
 
@@ -20,3 +27,21 @@ def emulate_bus(
     servers = {"link": serve_link, "pty": serve_pty, "tcp": serve_tcp}
     with servers[via](bus) as server:
         yield bus, server.url
+
+
+class _Closable(Protocol):
+    def close(self) -> None: ...
+
+
+C = TypeVar("C", bound=_Closable)
+
+
+@contextmanager
+def client_on_pty(bus: VirtualBus, open_client: Callable[[EmulatorServer], C]) -> Iterator[C]:
+    """Serve ``bus`` on a pty and yield the client ``open_client(server)`` opened (closed after)."""
+    with serve_pty(bus) as server:
+        client = open_client(server)
+        try:
+            yield client
+        finally:
+            client.close()

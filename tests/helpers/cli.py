@@ -21,7 +21,10 @@ import traceback
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
+
+import pytest
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 # What a `poppy` subprocess of the tests sees: a wide terminal, no colours.
@@ -154,3 +157,22 @@ def _as_a_process(
         for signum, handler in handlers.items():
             signal.signal(signum, handler)
         state.debug = False
+
+
+def no_user_settings(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, *, moves: bool = False
+) -> Path:
+    """Keep the user's settings out of a test's runs: an empty config folder (platformdirs reads
+    ``XDG_CONFIG_HOME``: ``tmp_path/xdg``), no ``POPPY_PROFILE``/``POPPY_PORT``; with ``moves``,
+    an empty move library too (``POPPY_MOVES_DIR``: ``tmp_path/moves``).
+
+    Returns:
+        The move library with ``moves``, else the config folder.
+    """
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "xdg"))
+    monkeypatch.delenv("POPPY_PROFILE", raising=False)
+    monkeypatch.delenv("POPPY_PORT", raising=False)
+    if moves:
+        monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path / "moves"))
+        return tmp_path / "moves"
+    return tmp_path / "xdg"

@@ -1,11 +1,14 @@
-"""Child processes of the tests: read a pty until a text shows, and leave nothing running."""
+"""Child processes of the tests: start one with piped text streams, read a pty until a text
+shows, and leave nothing running."""
 
 from __future__ import annotations
 
 import os
+import pty
 import select
 import subprocess
 import time
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 
@@ -41,3 +44,39 @@ def reap(proc: subprocess.Popen[Any]) -> None:
     for stream in (proc.stdin, proc.stdout, proc.stderr):
         if stream is not None:
             stream.close()
+
+
+def start(
+    argv: Sequence[str], env: Mapping[str, str] | None = None, *, stdin: int | None = None
+) -> subprocess.Popen[str]:
+    """``argv`` started with its stdout and stderr piped as text (``env``: its environment,
+    None for this process's; ``stdin``: e.g. ``subprocess.DEVNULL``)."""
+    return subprocess.Popen(
+        list(argv),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=stdin,
+        text=True,
+        env=None if env is None else dict(env),
+    )
+
+
+def start_on_pty(
+    argv: Sequence[str], env: Mapping[str, str] | None = None
+) -> tuple[subprocess.Popen[bytes], int, int]:
+    """``argv`` started on a new pseudo-terminal (its stdin, stdout and stderr).
+
+    Returns:
+        The process, the pty's master side (read what it prints, write what it types) and its
+        slave side, which the caller closes (at once, or after looking at the terminal's modes).
+    """
+    master, slave = pty.openpty()
+    proc = subprocess.Popen(
+        list(argv),
+        stdin=slave,
+        stdout=slave,
+        stderr=slave,
+        env=None if env is None else dict(env),
+        close_fds=True,
+    )
+    return proc, master, slave

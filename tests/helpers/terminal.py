@@ -8,16 +8,15 @@ The command's stdin, stdout and stderr are the pty, and the pty is its controlli
 from __future__ import annotations
 
 import os
-import pty
 import re
 import select
 import signal
-import subprocess
 import sys
 import time
 from collections.abc import Mapping
 
 from tests.helpers.cli import ENV, POPPY
+from tests.helpers.processes import start_on_pty
 
 # setsid, then the pty (stdin) becomes the controlling terminal, then poppy replaces the shim
 _SHIM = (
@@ -34,15 +33,9 @@ class Terminal:
     """`poppy ARGS...` on a pty of its own; ``shown`` is everything it printed so far."""
 
     def __init__(self, *args: str, env: Mapping[str, str] | None = None) -> None:
-        self.master, slave = pty.openpty()
         full = dict(os.environ, **ENV, **(env or {}))
-        self.proc = subprocess.Popen(
-            [sys.executable, "-c", _SHIM, *POPPY, *args],
-            stdin=slave,
-            stdout=slave,
-            stderr=slave,
-            env=full,
-            close_fds=True,
+        self.proc, self.master, slave = start_on_pty(
+            [sys.executable, "-c", _SHIM, *POPPY, *args], full
         )
         os.close(slave)
         self.shown = ""

@@ -13,6 +13,7 @@ import pytest
 
 from poppy_core.emulator import EmulatorServer, VirtualBus, build_bus_from_spec, serve_pty
 from tests.helpers import eventually
+from tests.helpers.bus import client_on_pty
 
 sdk: Any = pytest.importorskip("dynamixel_sdk")
 
@@ -45,10 +46,8 @@ def v1_bus() -> VirtualBus:
 
 @pytest.fixture
 def v1(v1_bus: VirtualBus) -> Iterator[SdkSession]:
-    with serve_pty(v1_bus) as server:
-        session = SdkSession(server, 1.0, 1_000_000)
+    with client_on_pty(v1_bus, lambda s: SdkSession(s, 1.0, 1_000_000)) as session:
         yield session
-        session.close()
 
 
 @pytest.fixture
@@ -58,10 +57,8 @@ def v2_bus() -> VirtualBus:
 
 @pytest.fixture
 def v2(v2_bus: VirtualBus) -> Iterator[SdkSession]:
-    with serve_pty(v2_bus) as server:
-        session = SdkSession(server, 2.0, 1_000_000)
+    with client_on_pty(v2_bus, lambda s: SdkSession(s, 2.0, 1_000_000)) as session:
         yield session
-        session.close()
 
 
 @pytest.fixture
@@ -71,10 +68,8 @@ def xl_bus() -> VirtualBus:
 
 @pytest.fixture
 def xl(xl_bus: VirtualBus) -> Iterator[SdkSession]:
-    with serve_pty(xl_bus) as server:
-        session = SdkSession(server, 2.0, 1_000_000)
+    with client_on_pty(xl_bus, lambda s: SdkSession(s, 2.0, 1_000_000)) as session:
         yield session
-        session.close()
 
 
 # ---------------------------------------------------------------- protocol 1

@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -13,20 +12,15 @@ import pytest
 
 from poppy_core.errors import ConfigError
 from poppy_core.motion import Move, MovePlayer, MoveRecorder, PlayProgress, read_move
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from tests.helpers import eventually
+from tests.helpers.fixtures import ergo_fixture
 
 CONTROLLER = "my_dxl_controller"
 TOLERANCE_DEG = 1.0  # the bound between playback and recording
 
 
-@pytest.fixture
-def ergo() -> Iterator[Robot]:
-    robot = from_profile("ergo-jr", sim=True)
-    try:
-        yield robot
-    finally:
-        robot.close()
+ergo = ergo_fixture()
 
 
 def virtual_position(robot: Robot, name: str) -> float:

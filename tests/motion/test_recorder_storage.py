@@ -5,7 +5,6 @@ from __future__ import annotations
 import errno
 import logging
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -13,13 +12,10 @@ import pytest
 from poppy_core.errors import ConfigError, FileError
 from poppy_core.motion import MoveRecorder, read_move
 from poppy_core.motion import recorder as recorder_module
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
+from tests.helpers.fixtures import ergo_fixture
 
-
-@pytest.fixture(scope="module")
-def ergo() -> Iterator[Robot]:
-    with from_profile("ergo-jr", sim=True) as robot:
-        yield robot
+ergo = ergo_fixture(scope="module")
 
 
 def _wait_frames(recorder: MoveRecorder, count: int) -> None:

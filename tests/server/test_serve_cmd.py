@@ -14,20 +14,14 @@ from typing import Any
 import pytest
 
 from tests.helpers.cli import keyed, run_poppy
-from tests.helpers.processes import reap
+from tests.helpers.processes import reap, start
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
 
 def _start(*args: str) -> subprocess.Popen[str]:
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    return subprocess.Popen(
-        [*POPPY, "serve", *args],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
-    )
+    return start([*POPPY, "serve", *args], env)
 
 
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT])
@@ -284,13 +278,7 @@ def test_a_signal_stops_a_remote_play_with_exit_130(served: Any, signum: int) ->
     frames = [{"m1": 10.0 * i / 2999} for i in range(3000)]  # a minute at 50 Hz
     save_move(Move.from_frames(50.0, frames), "remote_long")
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    proc = subprocess.Popen(
-        [*POPPY, "play", "remote_long", "--remote", served.url, "--json"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
-    )
+    proc = start([*POPPY, "play", "remote_long", "--remote", served.url, "--json"], env)
     try:
         moves = served.app.state.service.moves
         assert eventually(lambda: "remote_long" in moves.playing(), timeout_s=60), proc.stderr

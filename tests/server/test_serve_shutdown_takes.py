@@ -7,7 +7,6 @@ from __future__ import annotations
 import errno
 import os
 import signal
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -21,7 +20,7 @@ from poppy_core.robot import from_profile
 from poppy_core.server import moves as moves_module
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
-from tests.helpers.processes import reap
+from tests.helpers.processes import reap, start
 from tests.helpers.waiting import eventually
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -36,7 +35,7 @@ def test_sigterm_saves_the_rest_and_snap_recordings_and_says_where(tmp_path: Pat
     env = dict(
         os.environ, COLUMNS="300", NO_COLOR="1", POPPY_MOVES_DIR=str(library), TMPDIR=str(temp)
     )
-    proc = subprocess.Popen(
+    proc = start(
         [
             *POPPY,
             "serve",
@@ -50,10 +49,7 @@ def test_sigterm_saves_the_rest_and_snap_recordings_and_says_where(tmp_path: Pat
             "--profile",
             "ergo-jr",
         ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
+        env,
     )
     try:
         assert proc.stdout is not None and proc.stderr is not None

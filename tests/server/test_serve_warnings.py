@@ -10,7 +10,6 @@ import logging
 import os
 import queue
 import signal
-import subprocess
 import sys
 import threading
 from collections.abc import Iterator
@@ -21,7 +20,7 @@ from poppy_core.emulator import Endpoint, serve_tcp
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from poppy_core.server.web.logs import LogBuffer, StderrWarnings, printable
-from tests.helpers.processes import reap
+from tests.helpers.processes import reap, start
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 WAIT_S = 60.0
@@ -62,7 +61,7 @@ def served_bus() -> Iterator[Endpoint]:
 
 def test_a_lost_bus_is_a_warning_on_the_servers_stderr(served_bus: Endpoint) -> None:
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    proc = subprocess.Popen(
+    proc = start(
         [
             *POPPY,
             "serve",
@@ -75,10 +74,7 @@ def test_a_lost_bus_is_a_warning_on_the_servers_stderr(served_bus: Endpoint) -> 
             served_bus.url,
             "--no-sensors",
         ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
+        env,
     )
     try:
         assert proc.stdout is not None and proc.stderr is not None

@@ -13,27 +13,17 @@ from starlette.routing import Match
 
 from poppy_core.creatures import from_profile
 from poppy_core.motion import Move, save_move
-from poppy_core.robot import Robot
-from poppy_core.server.snap import SnapServer, robot_facts, start_snap_server
+from poppy_core.server.snap import robot_facts, start_snap_server
 from poppy_core.server.snap.catalog import BLOCKS, SnapBlock
 from poppy_core.server.snap.examples import project_names
 from poppy_core.server.snap.routing import TextRouter
-from tests.server.snap_helpers import near, wait_until
-
-Served = tuple[Robot, SnapServer, httpx.Client]
+from tests.server.snap_helpers import Served, near, served_ergo, wait_until
 
 
 @pytest.fixture(scope="module")
 def snap(moves_folder: str) -> Iterator[Served]:
     """A virtual Ergo Jr (with its behaviours and chain) served by the Snap! server."""
-    robot = from_profile("ergo-jr", sim=True)
-    server = start_snap_server(robot, port=0)
-    try:
-        with httpx.Client(base_url=f"http://127.0.0.1:{server.port}", timeout=20.0) as http:
-            yield robot, server, http
-    finally:
-        server.stop()
-        robot.close()
+    yield from served_ergo()
 
 
 def url_of(definition: ET.Element) -> str | None:

@@ -13,6 +13,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from tests.helpers.cli import run_poppy
+from tests.helpers.processes import start
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 TIMEOUT_S = 90
@@ -39,9 +40,7 @@ def test_serve_snap_with_http_prints_the_snap_urls_and_serves_both(tmp_path: Pat
     browser.write_text(f'#!/bin/sh\necho "$1" > {opened}\n')
     browser.chmod(0o755)
     env = {**_env(tmp_path / "moves"), "BROWSER": f"{browser} %s"}
-    proc = subprocess.Popen(
-        [*POPPY, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
-    )
+    proc = start([*POPPY, *args], env)
     try:
         assert proc.stdout is not None
         lines = [proc.stdout.readline().strip() for _ in range(5)]

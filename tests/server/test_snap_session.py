@@ -21,7 +21,7 @@ from poppy_core.creatures import from_profile
 from poppy_core.motion import list_moves, load_move
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, start_snap_server
-from tests.server.snap_helpers import near, wait_until
+from tests.server.snap_helpers import near, served_ergo, wait_until
 
 SESSION = json.loads((Path(__file__).parent / "data" / "snap_session.json").read_text())
 STEPS: list[dict[str, Any]] = SESSION["steps"]
@@ -30,14 +30,7 @@ STEPS: list[dict[str, Any]] = SESSION["steps"]
 @pytest.fixture(scope="module")
 def snap(moves_folder: str) -> Iterator[tuple[Robot, SnapServer, httpx.Client]]:
     """A virtual Ergo Jr (with its behaviours) served by the Snap! server on a free port."""
-    robot = from_profile("ergo-jr", sim=True)
-    server = start_snap_server(robot, port=0)
-    try:
-        with httpx.Client(base_url=f"http://127.0.0.1:{server.port}", timeout=20.0) as http:
-            yield robot, server, http
-    finally:
-        server.stop()
-        robot.close()
+    yield from served_ergo()
 
 
 def test_the_session_answers_as_pypot_and_moves_the_robot(

@@ -12,7 +12,7 @@ from poppy_core.creatures import PoppyTorso
 from poppy_core.robot import Robot
 from poppy_core.server.zmqserver import ZmqRobotServer
 from tests.creatures.helpers import wait_until
-from tests.helpers.processes import reap
+from tests.helpers.processes import reap, start
 
 zmq = pytest.importorskip("zmq")
 TIMEOUT_MS = 10_000
@@ -152,11 +152,10 @@ def test_a_taken_port_is_one_clear_line(robot: Robot) -> None:
 def test_poppy_serve_zmq() -> None:
     import os
     import signal
-    import subprocess
     import sys
 
     env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
-    proc = subprocess.Popen(
+    proc = start(
         [
             sys.executable,
             "-m",
@@ -169,10 +168,7 @@ def test_poppy_serve_zmq() -> None:
             "--zmq-port",
             "0",
         ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
+        env,
     )
     try:
         assert proc.stdout is not None

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -165,3 +166,23 @@ def test_websocket_messages_are_checked(served: Served) -> None:
         # the pypot-style register commands still work on the same socket
         ws.send(json.dumps({"m4": {"led": "green"}}))
         assert wait_for(lambda: served.robot.m4.led == "green", timeout_s=3.0)
+
+
+def test_closing_while_reconnecting_joins_every_follower_thread(
+    leader: Robot, served: Served
+) -> None:
+    follower = RemoteFollower(served.proxy.url, rate_hz=50)
+    teleop = teleoperate(leader, follower, "m1=m1", rate_hz=50)
+    try:
+        assert wait_for(lambda: served.states().get("m1") == "following", timeout_s=5.0)
+        served.proxy.cut()
+        served.proxy.close()  # nothing listens any more: the follower keeps trying
+        assert wait_for(lambda: "teleop reconnect" in _thread_names(), timeout_s=10.0)
+    finally:
+        teleop.stop()
+    left = _thread_names() & {"teleop", "teleop send", "teleop ws", "teleop reconnect"}
+    assert not left and teleop.error is None
+
+
+def _thread_names() -> set[str]:
+    return {thread.name for thread in threading.enumerate()}

@@ -10,6 +10,8 @@ import sys
 import time
 import urllib.request
 
+from tests.helpers.processes import start
+
 
 def _free_port() -> int:
     with socket.socket() as sock:
@@ -19,12 +21,9 @@ def _free_port() -> int:
 
 def test_tui_serve_answers_a_browser_on_loopback() -> None:
     port = _free_port()
-    proc = subprocess.Popen(
+    proc = start(
         [sys.executable, "-m", "poppy_cli", "tui", "--serve", "--sim", "--http-port", str(port)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=dict(os.environ, NO_COLOR="1"),
+        dict(os.environ, NO_COLOR="1"),
     )
     try:
         page = ""

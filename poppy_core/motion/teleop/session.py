@@ -21,7 +21,6 @@ import time
 from collections import deque
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from types import TracebackType
 from typing import TYPE_CHECKING, Any
 
 from poppy_core import checks
@@ -32,7 +31,7 @@ from poppy_core.motion.teleop.joint_map import JointMap
 from poppy_core.motion.teleop.recording import TrajectoryRecorder
 from poppy_core.motion.teleop.stats import TeleopReport, TeleopStatus
 from poppy_core.robot.robot import Robot
-from poppy_core.schedule import Backoff, Periodic
+from poppy_core.schedule import Backoff, Periodic, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor
@@ -133,10 +132,9 @@ class Teleoperation:
             if record is not None
             else None
         )
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._worker: Worker | None = None
         self._lock = threading.Lock()
-        self.error: BaseException | None = None
+        self._save_error: FileError | None = None
         self._t0 = 0.0
         self._first_tick: float | None = None
         self._last_tick = 0.0
@@ -162,24 +160,32 @@ class Teleoperation:
         """
         if self.running:
             raise RuntimeError("the teleoperation is already running")
-        self._stop.clear()
-        self.error = None
-        self._thread = threading.Thread(target=self._run, name="teleop", daemon=True)
-        self._thread.start()
+        self._save_error = None
+        # A PoppyError (a follower that failed) is the caller's to say: run() raises it.
+        self._worker = Worker("teleop", self._run, on_exit=self._finish, quiet=(PoppyError,))
+        self._worker.start()
         return self
 
     def stop(self) -> None:
-        """Stop: the follower holds where it is (stiff); the recorded move is saved."""
-        self._stop.set()
-        self.wait(5.0)
+        """Stop: the follower holds where it is (stiff); the recorded move is saved. Joins the
+        thread (but from itself); stopping twice is safe."""
+        worker = self._worker
+        if worker is not None:
+            worker.close(5.0)
 
     def wait(self, timeout_s: float | None = None) -> bool:
         """Block until the teleoperation ends (``duration_s`` or ``stop``); False on timeout."""
-        thread = self._thread
-        if thread is None:
-            return True
-        thread.join(timeout_s)
-        return not thread.is_alive()
+        worker = self._worker
+        return worker.wait(timeout_s) if worker is not None else True
+
+    @property
+    def error(self) -> BaseException | None:
+        """What stopped the run early (logged once unless a ``PoppyError``), or the record
+        that could not be saved; None when it ended well."""
+        worker = self._worker
+        if worker is not None and worker.error is not None:
+            return worker.error
+        return self._save_error
 
     def run(self) -> TeleopReport:
         """Run (or keep running) until ``duration_s`` or ``stop`` from another thread, then
@@ -189,7 +195,7 @@ class Teleoperation:
             PoppyError: what stopped it (a follower that failed, a record that cannot be
                 written).
         """
-        if self._thread is None:
+        if self._worker is None:
             self.start()
         self.wait()
         if self.error is not None:
@@ -199,7 +205,7 @@ class Teleoperation:
     @property
     def running(self) -> bool:
         """True while the thread runs."""
-        return self._thread is not None and self._thread.is_alive()
+        return self._worker is not None and self._worker.running
 
     # -- reports -------------------------------------------------------------------------------
 
@@ -244,27 +250,22 @@ class Teleoperation:
 
     # -- the thread ----------------------------------------------------------------------------
 
-    def _run(self) -> None:
-        try:
-            with self.leader.driving("present"):
-                for motor in self._leader_motors:
-                    motor.compliant = True
-                self._t0 = self._clock()
-                self.follower.start(self.joint_map.followers)
-                self._loop()
-        except BaseException as exc:  # handed to run()/the caller through .error
-            self.error = exc
-            if not isinstance(exc, PoppyError):
-                logger.exception("teleoperation failed")
-        finally:
-            self._finish()
+    def _run(self, stopping: threading.Event) -> None:
+        """The teleoperation (an exception is the worker's: kept in ``error``, run() raises it;
+        ``_finish`` runs after it whatever the way)."""
+        with self.leader.driving("present"):
+            for motor in self._leader_motors:
+                motor.compliant = True
+            self._t0 = self._clock()
+            self.follower.start(self.joint_map.followers)
+            self._loop(stopping)
 
-    def _loop(self) -> None:
+    def _loop(self, stopping: threading.Event) -> None:
         period = 1.0 / self.rate_hz
         schedule = Periodic(period, self._t0)
         retry_at = self._t0
         backoff = Backoff(RETRY_FIRST_S, RETRY_MAX_S)
-        while not self._stop.is_set():
+        while not stopping.is_set():
             tick = self._clock()
             if self.duration_s is not None and tick - self._t0 >= self.duration_s:
                 break
@@ -287,7 +288,7 @@ class Teleoperation:
                 self._first_tick = tick if self._first_tick is None else self._first_tick
                 self._last_tick = tick
             self._missed += schedule.advance(self._clock())
-            self._stop.wait(max(0.0, schedule.next_deadline - self._clock()))
+            stopping.wait(max(0.0, schedule.next_deadline - self._clock()))
 
     def _read_leader(self) -> dict[str, float]:
         try:
@@ -349,7 +350,7 @@ class Teleoperation:
             except (FileError, OSError) as exc:
                 if self.error is None:
                     reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
-                    self.error = FileError(
+                    self._save_error = FileError(
                         f"cannot save the recorded move to {self.recorder.path}: {reason} "
                         f"({self.recorder.samples} samples kept in memory)",
                         path=str(self.recorder.path),
@@ -360,12 +361,7 @@ class Teleoperation:
     def __enter__(self) -> Teleoperation:
         return self if self.running else self.start()
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.stop()
 
 

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 from poppy_core.errors import PoppyError
 from poppy_core.motion import MovePlayer
+from poppy_core.schedule import Worker
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 
@@ -34,7 +35,7 @@ class Playlists:
     def __init__(self, moves: MoveService) -> None:
         self.moves = moves
         self._lock = threading.Lock()
-        self._sequences: list[tuple[frozenset[str], threading.Event]] = []
+        self._sequences: list[tuple[frozenset[str], Worker]] = []
 
     def _check(self, names: Sequence[str]) -> float:
         """The total duration of ``names`` at speed 1 (each is loaded: unknown ones refused)."""
@@ -72,17 +73,15 @@ class Playlists:
         """Start the first move now and each next one when the one before ends; the total (s)."""
         total = self._check(names) / speed
         first = self.moves.play(names[0], speed)
-        cancel = threading.Event()
-        entry = (frozenset(names), cancel)
+        rest = list(names[1:])
+        worker = Worker(
+            f"snap-sequence-{names[0]}",
+            lambda stopping: self._run(stopping, rest, speed, first, entry),
+        )
+        entry = (frozenset(names), worker)
         with self._lock:
             self._sequences.append(entry)
-        thread = threading.Thread(
-            target=self._run,
-            args=(list(names[1:]), speed, first, cancel, entry),
-            name=f"snap-sequence-{names[0]}",
-            daemon=True,
-        )
-        thread.start()
+        worker.start()
         return total
 
     def sequences(self) -> list[list[str]]:
@@ -93,17 +92,17 @@ class Playlists:
     def stop(self, name: str) -> None:
         """End every sequence holding ``name`` (the move itself is stopped by the caller)."""
         with self._lock:
-            for names, cancel in self._sequences:
+            for names, worker in self._sequences:
                 if name in names:
-                    cancel.set()
+                    worker.request_stop()
 
     def _run(
         self,
+        cancel: threading.Event,
         rest: list[str],
         speed: float,
         player: MovePlayer,
-        cancel: threading.Event,
-        entry: tuple[frozenset[str], threading.Event],
+        entry: tuple[frozenset[str], Worker],
     ) -> None:
         current = ""
         try:

@@ -1,0 +1,78 @@
+"""``LoopPrimitive``: a primitive calling ``update()`` at a fixed rate, drift-free."""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from typing import TYPE_CHECKING
+
+from poppy_core import checks
+from poppy_core.motion.primitive import Primitive
+from poppy_core.schedule import Periodic, RateMeter
+
+if TYPE_CHECKING:
+    from poppy_core.robot import Robot
+
+
+class LoopPrimitive(Primitive):
+    """A primitive calling ``update()`` at ``freq`` Hz, drift-free, until stopped.
+
+    Args:
+        robot: the robot to act on.
+        freq: update rate in Hz.
+    """
+
+    def __init__(self, robot: Robot, freq: float) -> None:
+        super().__init__(robot)
+        self.update_freq = freq
+        self._meter = RateMeter(window=10)
+        self._recent: deque[float] = deque(maxlen=10)
+
+    @property
+    def update_freq(self) -> float:
+        """Updates per second (takes effect at the next (re)start)."""
+        return self._freq
+
+    @update_freq.setter
+    def update_freq(self, value: float) -> None:
+        # a floor on the period (no spinning) and a ceiling (no wait too long for a timer)
+        self._freq = checks.rate(value, "update_freq")
+
+    @property
+    def period_s(self) -> float:
+        """Seconds between two updates."""
+        return 1.0 / self._freq
+
+    @property
+    def update_rate_hz(self) -> float:
+        """Measured update rate over the last updates (0 until two ran)."""
+        return self._meter.rate_hz
+
+    @property
+    def recent_update_frequencies(self) -> list[float]:
+        """The last (up to 10) instantaneous update rates, most recent first."""
+        return list(reversed(self._recent))
+
+    def update(self) -> None:
+        """One step of the behaviour, called at ``update_freq``."""
+
+    def run(self) -> None:
+        """Call ``update()`` on a drift-free schedule; late updates skip missed periods."""
+        self._meter = RateMeter(window=10)
+        self._recent.clear()
+        last: float | None = None
+        schedule = Periodic(self.period_s, time.monotonic())
+        while not self.should_stop():
+            if self.should_pause():
+                self.wait_to_resume()
+                schedule = Periodic(self.period_s, time.monotonic())
+                last = None
+                continue
+            now = time.monotonic()
+            self.update()
+            self._meter.tick(now)
+            if last is not None and now > last:
+                self._recent.append(1.0 / (now - last))
+            last = now
+            schedule.advance(time.monotonic())
+            self.sleep(schedule.next_deadline - time.monotonic())
