@@ -26,7 +26,13 @@ LOOPBACK = ("127.0.0.1", "localhost", "::1")
 def serve(
     http: bool = typer.Option(False, "--http", help="Serve the REST API (pypot's + /api/v1)."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to listen on."),
-    http_port: int = typer.Option(8080, "--http-port", min=0, max=65535, help="HTTP port."),
+    http_ports: list[int] = typer.Option(
+        [8080],
+        "--http-port",
+        min=0,
+        max=65535,
+        help="HTTP port (repeat it to serve the same page on several ports, e.g. 80 and 8080).",
+    ),
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
@@ -82,7 +88,9 @@ def serve(
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
     if not (http or ws or snap or zmq):
         _usage("nothing to serve: pass --http, --ws, --snap and/or --zmq")
-    if http and ws and http_port == ws_port and http_port != 0:
+    http_port, *alias_ports = http_ports or [8080]
+    _check_http_ports(http_ports)
+    if http and ws and ws_port in http_ports and ws_port != 0:
         _usage(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
             "server streams the same state at /api/v1/ws)"
@@ -92,7 +100,10 @@ def serve(
         snap_port,
         snap_dir,
         open_browser,
-        {"--http-port": http_port if http else 0, "--ws-port": ws_port if ws else 0},
+        {
+            "--http-port": snap_port if http and snap_port in http_ports else 0,
+            "--ws-port": ws_port if ws else 0,
+        },
     )
     from poppy_core.assembly import Listen, ServeSpec, serve
 
@@ -106,6 +117,7 @@ def serve(
         allow_hosts=tuple(allow_host or ()),
         ws_rate_hz=ws_rate,
         snap_dir=snap_dir,
+        http_alias_ports=tuple(alias_ports),
         report=_report,
     )
     any_origin = _check_origins(spec)
@@ -131,6 +143,14 @@ def serve(
     finally:
         signal.signal(signal.SIGTERM, previous)
     print("stopped", file=sys.stderr, flush=True)
+
+
+def _check_http_ports(ports: list[int]) -> None:
+    """Refuse a port given twice to ``--http-port`` (0, a free port each, may repeat)."""
+    given = [p for p in ports if p != 0]
+    twice = sorted({p for p in given if given.count(p) > 1})
+    if twice:
+        _usage(f"--http-port {twice[0]} is given twice: give each port once")
 
 
 def _check_origins(spec: ServeSpec) -> bool:
@@ -171,7 +191,8 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
     """Print where each server serves (the tests and scripts read these lines)."""
     base = _host(host)
     if servers.http is not None:
-        print(f"http://{base}:{servers.http.port}", flush=True)
+        for http_port in servers.http.ports:
+            print(f"http://{base}:{http_port}", flush=True)
     if servers.ws is not None:
         print(f"ws://{base}:{servers.ws.port}/", flush=True)
     if servers.zmq is not None:

@@ -51,6 +51,8 @@ class ServeSpec:
         allow_hosts: Host names answered besides loopback names, IPs and the listening host.
         ws_rate_hz: the state stream's default rate.
         snap_dir: a downloaded Snap! served at ``/app/`` on the Snap! port.
+        http_alias_ports: more ports serving the REST API and page, on ``http``'s host (the
+            appliance serves port 80 and keeps 8080); their pages count as the server's own.
         report: called with one line the first time an origin or Host name is refused.
     """
 
@@ -63,6 +65,7 @@ class ServeSpec:
     allow_hosts: tuple[str, ...] = ()
     ws_rate_hz: float = 30.0
     snap_dir: Path | None = None
+    http_alias_ports: tuple[int, ...] = ()
     report: Callable[[str], None] | None = field(default=None, compare=False)
 
     def listens(self) -> dict[str, Listen]:
@@ -173,7 +176,9 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     try:
         if app is not None:
             where = listens["http"]
-            thread = ServerThread(app, where.host, where.port).bind()
+            thread = ServerThread(
+                app, where.host, where.port, alias_ports=spec.http_alias_ports
+            ).bind()
             servers.servers["http"] = BackgroundServer("http", thread, service=service)
         if "ws" in listens:
             where = listens["ws"]
@@ -216,7 +221,7 @@ def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) 
 
 def _own_pages(servers: ServerSet) -> None:
     """The pages of every port count as the servers' own; the home page links to Snap!."""
-    ports = [s.port for name, s in servers.servers.items() if name != "zmq"]
+    ports = [p for name, s in servers.servers.items() if name != "zmq" for p in _ports(s)]
     servers.policy.with_ports(ports)
     snap = servers.snap
     if snap is None:
@@ -226,3 +231,8 @@ def _own_pages(servers: ServerSet) -> None:
         from poppy_core.server.web import add_link
 
         add_link(servers.app, "Snap! with the Poppy blocks", snap.editor_url)
+
+
+def _ports(server: Any) -> list[int]:
+    """Every port a server listens on (the HTTP server's aliases too)."""
+    return list(getattr(server, "ports", [server.port]))
