@@ -106,6 +106,7 @@ FLAGS: dict[str, Flag] = {
     "--cors": Flag(None, "ORIGIN", "web page origin allowed to use the robot"),
     "--allow-host": Flag(None, "HOST", "host name the server also answers"),
     "--no-sensors": Flag(None, None, "leave the config's cameras closed"),
+    "--wait-for-motors": Flag(None, None, "serve while the port or the motors are missing"),
     "--serve": Flag(None, None, "serve the app to a web browser"),
     # -- emulators and simulation
     "--pty": Flag(None, None, "serve on a pseudo-terminal (the default)"),

@@ -69,6 +69,12 @@ def serve(
         False, "--zmq", help="Also serve pypot's ZMQ request/reply API (JSON requests)."
     ),
     zmq_port: int = typer.Option(6768, "--zmq-port", min=0, max=65535, help="ZMQ port."),
+    wait_for_motors: bool = typer.Option(
+        False,
+        "--wait-for-motors",
+        help="Serve even when the port is missing or no motor answers (the power is off): the "
+        "page says so and the robot picks the motors up when they appear (the boot service's).",
+    ),
     no_sensors: bool = typer.Option(
         False, "--no-sensors", help="Leave the config's cameras closed."
     ),
@@ -127,7 +133,14 @@ def serve(
     stop = threading.Event()
     previous = signal.signal(signal.SIGTERM, lambda signum, frame: stop.set())
     try:
-        with build_robot(profile, config_file, port, sim, sensors=not no_sensors) as robot:
+        with build_robot(
+            profile,
+            config_file,
+            port,
+            sim,
+            sensors=not no_sensors,
+            wait_for_motors=wait_for_motors,
+        ) as robot:
             servers: ServerSet | None = None
             try:
                 servers = serve(robot, spec)
