@@ -17,6 +17,7 @@ from poppy_cli.commands import primitive as primitive_cmd
 from poppy_cli.commands import reach as reach_cmd
 from poppy_cli.commands import record as record_cmd
 from poppy_cli.commands import serve as serve_cmd
+from poppy_cli.commands import service as service_cmd
 from poppy_cli.commands import sim as sim_cmd
 from poppy_cli.commands import snap as snap_cmd
 from poppy_cli.commands import teleop as teleop_cmd
@@ -130,6 +131,7 @@ app.command("play", rich_help_panel=MOVES)(play_cmd.play)
 app.add_typer(moves_cmd.app, name="moves", rich_help_panel=MOVES)
 app.command("serve", rich_help_panel=SERVE)(serve_cmd.serve)
 app.add_typer(snap_cmd.app, name="snap", rich_help_panel=SERVE)
+app.add_typer(service_cmd.app, name="service", rich_help_panel=SERVE)
 app.command("emulate", rich_help_panel=SIMULATE)(emulate.emulate)
 app.add_typer(sim_cmd.app, name="sim", rich_help_panel=SIMULATE)
 
