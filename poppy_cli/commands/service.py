@@ -110,7 +110,8 @@ def install(
         scope = "--user " if user else ""
         err_console.print(
             f"would write {', '.join(str(folder / u) for u in texts)} and run: systemctl "
-            f"{scope}daemon-reload; systemctl {scope}enable --now {' '.join(texts)}",
+            f"{scope}daemon-reload; systemctl {scope}enable {' '.join(texts)}; systemctl "
+            f"{scope}restart {' '.join(texts)}",
             soft_wrap=True,
             highlight=False,
             markup=False,
@@ -120,7 +121,8 @@ def install(
     _write_units(folder, texts)
     _remove_units(systemd, folder, [u for u in stale if (folder / u).exists()])
     systemd.systemctl("daemon-reload")
-    systemd.systemctl("enable", "--now", *texts)
+    systemd.systemctl("enable", *texts)
+    systemd.systemctl("restart", *texts)  # started, or restarted with the units just written
     where = f"http://{name}.local" + ("" if ports[0] == 80 else f":{ports[0]}")
     console.print(
         f"installed and started {', '.join(texts)} ({systemd.scope}): the page is at {where}; "

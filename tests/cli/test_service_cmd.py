@@ -80,7 +80,7 @@ def test_the_user_unit_is_one_systemd_accepts(tmp_path: Path) -> None:
     assert args[1:] == [*expected.split(), "--wait-for-motors", "--name", "poppy", "--announce"]
     assert "Restart=on-failure" in result.stdout and "WantedBy=default.target" in result.stdout
     assert "AmbientCapabilities" not in result.stdout  # a user's manager cannot grant it
-    assert "would write" in result.stderr and "enable --now poppy.service" in result.stderr
+    assert "would write" in result.stderr and "enable poppy.service; systemctl --user restart" in result.stderr
 
 
 def test_the_system_unit_serves_port_80_without_root(someone: str) -> None:
@@ -106,7 +106,8 @@ def test_install_writes_the_units_then_reloads_enables_and_starts(fake: Fake, so
     assert fake.calls() == [
         ["systemctl", "--version"],
         ["systemctl", "daemon-reload"],
-        ["systemctl", "enable", "--now", "poppy.service", "poppy-jupyter.service"],
+        ["systemctl", "enable", "poppy.service", "poppy-jupyter.service"],
+        ["systemctl", "restart", "poppy.service", "poppy-jupyter.service"],
     ]
     serve = exec_start((fake.units / "poppy.service").read_text())
     assert serve[serve.index("--port") + 1] == "/dev/ttyAMA0"
@@ -121,7 +122,8 @@ def test_install_writes_the_units_then_reloads_enables_and_starts(fake: Fake, so
         ["systemctl", "--version"],
         ["systemctl", "disable", "--now", "poppy-jupyter.service"],
         ["systemctl", "daemon-reload"],
-        ["systemctl", "enable", "--now", "poppy.service"],
+        ["systemctl", "enable", "poppy.service"],
+        ["systemctl", "restart", "poppy.service"],
     ]
     assert sorted(p.name for p in fake.units.iterdir()) == ["poppy.service"]
 
@@ -132,7 +134,8 @@ def test_a_user_install_drives_the_user_manager(fake: Fake) -> None:
     assert fake.calls() == [
         ["systemctl", "--user", "--version"],
         ["systemctl", "--user", "daemon-reload"],
-        ["systemctl", "--user", "enable", "--now", "poppy.service"],
+        ["systemctl", "--user", "enable", "poppy.service"],
+        ["systemctl", "--user", "restart", "poppy.service"],
     ]
     assert "http://ergo-2.local:8080" in result.stdout
 
