@@ -53,7 +53,20 @@ class Systemd:
         Raises:
             SystemdError: systemctl is missing, or failed with ``check`` (its message quoted).
         """
-        return self._run("systemctl", [*(["--user"] if self.user else []), *args], check)
+        done = self._run("systemctl", self._scoped(args))
+        if check and done.returncode != 0:
+            said = " ".join((done.stderr or done.stdout).split()) or f"exit {done.returncode}"
+            command = " ".join(["systemctl", *self._scoped(args)])
+            raise SystemdError(f"`{command}` failed: {said}")
+        return done.stdout
+
+    def is_active(self, unit: str) -> bool:
+        """True when ``unit`` runs (``systemctl [--user] is-active --quiet UNIT``).
+
+        Raises:
+            SystemdError: systemctl is missing.
+        """
+        return self._run("systemctl", self._scoped(("is-active", "--quiet", unit))).returncode == 0
 
     def journal(self, unit: str, lines: int, follow: bool) -> int:
         """Show the unit's log (``journalctl``) on this terminal; its exit code.
@@ -65,9 +78,13 @@ class Systemd:
         args = [*which, "--lines", str(lines), "--no-pager", *(["--follow"] if follow else [])]
         return subprocess.call([_find("journalctl"), *args])
 
-    def _run(self, command: str, args: list[str], check: bool) -> str:
+    def _scoped(self, args: tuple[str, ...]) -> list[str]:
+        return [*(["--user"] if self.user else []), *args]
+
+    @staticmethod
+    def _run(command: str, args: list[str]) -> subprocess.CompletedProcess[str]:
         try:
-            done = subprocess.run(
+            return subprocess.run(
                 [_find(command), *args],
                 capture_output=True,
                 text=True,
@@ -78,10 +95,6 @@ class Systemd:
             raise SystemdError(
                 f"`{command} {' '.join(args)}` did not answer in {TIMEOUT_S:g} s"
             ) from None
-        if check and done.returncode != 0:
-            said = " ".join((done.stderr or done.stdout).split()) or f"exit {done.returncode}"
-            raise SystemdError(f"`{command} {' '.join(args)}` failed: {said}")
-        return done.stdout
 
 
 def _find(command: str) -> str:

@@ -130,12 +130,15 @@ class BuildSteps:
                 try:
                     port = self._search_port(name, used, ports)
                 except (SetupError, PortError) as exc:
+                    problem = (
+                        f"controller {name!r} ({entry.baudrate} bps, protocol "
+                        f"{entry.protocol}): {exc}"
+                    )
                     waiting = self._port_to_wait_on(used, ports) if wait else None
                     if waiting is None:
-                        problems.append(
-                            f"controller {name!r} ({entry.baudrate} bps, protocol "
-                            f"{entry.protocol}): {exc}"
-                        )
+                        if wait:  # no port to wait on: nothing can come
+                            raise SetupError(problem) from None
+                        problems.append(problem)
                         continue
                     port = waiting
             used.add(port)

@@ -80,7 +80,10 @@ def test_the_user_unit_is_one_systemd_accepts(tmp_path: Path) -> None:
     assert args[1:] == [*expected.split(), "--wait-for-motors", "--name", "poppy", "--announce"]
     assert "Restart=on-failure" in result.stdout and "WantedBy=default.target" in result.stdout
     assert "AmbientCapabilities" not in result.stdout  # a user's manager cannot grant it
-    assert "would write" in result.stderr and "enable poppy.service; systemctl --user restart" in result.stderr
+    assert (
+        "would write" in result.stderr
+        and "enable poppy.service; systemctl --user restart" in result.stderr
+    )
 
 
 def test_the_system_unit_serves_port_80_without_root(someone: str) -> None:
@@ -290,3 +293,17 @@ def test_release_of_a_robot_not_served_is_one_line() -> None:
     assert len(result.stderr.strip().splitlines()) == 1
     bad = run_poppy("service", "take", "--remote", "ftp://robot")
     assert bad.code == 1 and "is not an http://host:port URL" in bad.stderr
+
+
+def test_is_active_asks_systemctl(fake: Fake, monkeypatch: pytest.MonkeyPatch) -> None:
+    from poppy_cli.systemd import Systemd
+
+    for name, value in fake.env().items():
+        monkeypatch.setenv(name, value)
+    assert Systemd(user=True).is_active("poppy.service")
+    monkeypatch.setenv("FAKE_COMMANDS_EXIT", "3")  # systemctl's answer for inactive
+    assert not Systemd(user=False).is_active("poppy.service")
+    assert fake.calls() == [
+        ["systemctl", "--user", "is-active", "--quiet", "poppy.service"],
+        ["systemctl", "is-active", "--quiet", "poppy.service"],
+    ]

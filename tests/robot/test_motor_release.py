@@ -106,3 +106,19 @@ def test_motors_without_power_are_waited_for(on_pty: VirtualBus, port: str) -> N
         assert eventually(lambda: all(m.online for m in robot.motors))
         # its state read when it first answered, not the defaults of a motor never seen
         assert not robot.m1.compliant and robot.m2.compliant
+
+
+def test_an_auto_port_with_no_motors_waits_on_the_port_searched(
+    on_pty: VirtualBus, port: str
+) -> None:
+    for motor in on_pty.motors:
+        on_pty.unplug(motor.id)
+    with from_profile(
+        "ergo-jr", port="auto", sensors=False, wait_for_motors=True, ports=[port]
+    ) as robot:
+        assert robot.ports == [port] and not any(m.online for m in robot.motors)
+        for motor in on_pty.motors:
+            on_pty.plug(motor.id)
+        assert eventually(lambda: all(m.online for m in robot.motors))
+    with pytest.raises(SetupError, match="no free serial port|no known motor|not found"):
+        from_profile("ergo-jr", port="auto", sensors=False, wait_for_motors=True, ports=[])
