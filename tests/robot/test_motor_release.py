@@ -120,5 +120,5 @@ def test_an_auto_port_with_no_motors_waits_on_the_port_searched(
         for motor in on_pty.motors:
             on_pty.plug(motor.id)
         assert eventually(lambda: all(m.online for m in robot.motors))
-    with pytest.raises(SetupError, match="no free serial port|no known motor|not found"):
+    with pytest.raises(SetupError, match="no free serial port to search"):
         from_profile("ergo-jr", port="auto", sensors=False, wait_for_motors=True, ports=[])
