@@ -296,8 +296,10 @@ def uninstall(user: bool = UserOpt) -> None:
 
 @app.command("release")
 def release(remote: str = RemoteOpt, json_output: bool = JsonOpt) -> None:
-    """Release the served robot's motors: everything stopped, motors compliant, the ports
-    closed so that another program (a notebook, `poppy scan`) can open them."""
+    """Release the served robot's motors: all stopped, compliant, its ports closed for others.
+
+    Another program (a notebook, `poppy scan`) can then open the ports; `poppy service take`
+    takes them back."""
     done = _post(remote, "/api/v1/motors/release")
     if json_output:
         print_json(done)
