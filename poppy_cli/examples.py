@@ -261,6 +261,35 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("snap project first-steps -o . --profile ergo-jr", "a first project"),
         ("snap project record-replay-fr -o rr.xml --profile ergo-jr -f", "in French"),
     ),
+    "service": (
+        ("service install --port /dev/ttyAMA0", "serve the Ergo Jr at boot: http://poppy.local"),
+        ("service status", "installed? running?"),
+        ("service release", "free the motors' port for a notebook"),
+    ),
+    "service install": (
+        ("service install --port /dev/ttyAMA0 --snap", "at boot, with Snap!, on a Pi"),
+        ("service install --user --dry-run", "print the unit of a desktop service"),
+        ("service install --name ergo-2 --jupyter --run-as pi", "a second robot, Jupyter too"),
+    ),
+    "service status": (
+        ("service status", "the system's service"),
+        ("service status --user --json", "your session's, for scripts"),
+    ),
+    "service logs": (
+        ("service logs", "its last 50 lines"),
+        ("service logs --lines 200 --follow", "and the new ones as they come"),
+    ),
+    "service restart": (("service restart", "after an update"),),
+    "service stop": (("service stop", "until the next boot"),),
+    "service uninstall": (("service uninstall --user", "remove your session's service"),),
+    "service release": (
+        ("service release", "the robot of this machine lets go of its motors"),
+        ("service release --remote http://poppy.local --json", "another robot's, for scripts"),
+    ),
+    "service take": (
+        ("service take", "take the motors back"),
+        ("service take --remote http://ergo-2.local", "another robot's"),
+    ),
     "camera": (
         ("camera list", "video devices"),
         ("camera snapshot -o frame.png", "one frame of /dev/video0"),

@@ -83,7 +83,9 @@ FLAGS: dict[str, Flag] = {
     "--output": Flag("-o", "PATH", "file to write, or a folder"),
     "--force": Flag("-f", None, "replace an existing file or move"),
     "--yes": Flag("-y", None, "do not ask for confirmation"),
-    "--name": Flag("-n", "NAME", "name of what the command saves (a move, a profile) or serves"),
+    "--name": Flag(
+        "-n", "NAME", "name of what the command saves (a move, a profile), or the robot's name"
+    ),
     "--prefix": Flag(None, "PREFIX", "motor name prefix (motors named PREFIX<ID>)"),
     "--format": Flag(None, "pypot|poppy", "move file format"),
     "--lang": Flag(None, "en|fr", "language"),
@@ -118,7 +120,15 @@ FLAGS: dict[str, Flag] = {
     "--no-announce": Flag(None, None, "do not announce it (see `--announce`)"),
     "--timeout": Flag(None, "SECONDS", "how long to wait, in seconds"),
     "--interface": Flag(None, "ADDRESS", "the network interface of this IPv4 address only"),
+    "--wait-for-motors": Flag(None, None, "serve while the port or the motors are missing"),
     "--serve": Flag(None, None, "serve the app to a web browser"),
+    # -- the boot service
+    "--user": Flag(None, None, "the service of your own session instead of the system's"),
+    "--run-as": Flag(None, "USER", "the user the system service runs as"),
+    "--jupyter": Flag(None, None, "also start Jupyter at boot"),
+    "--dry-run": Flag(None, None, "print what would be done, change nothing"),
+    "--lines": Flag(None, "N", "last log lines shown"),
+    "--follow": Flag(None, None, "keep showing new log lines"),
     # -- emulators and simulation
     "--pty": Flag(None, None, "serve on a pseudo-terminal (the default)"),
     "--tcp": Flag(None, "HOST:PORT", "serve on TCP instead"),

@@ -28,6 +28,7 @@ from poppy_cli.commands import primitive as primitive_cmd
 from poppy_cli.commands import reach as reach_cmd
 from poppy_cli.commands import record as record_cmd
 from poppy_cli.commands import serve as serve_cmd
+from poppy_cli.commands import service as service_cmd
 from poppy_cli.commands import setup as setup_cmd
 from poppy_cli.commands import sim as sim_cmd
 from poppy_cli.commands import snap as snap_cmd
@@ -146,6 +147,7 @@ app.command("serve", rich_help_panel=SERVE)(serve_cmd.serve)
 app.add_typer(snap_cmd.app, name="snap", rich_help_panel=SERVE)
 app.command("notebook", rich_help_panel=SERVE)(notebook_cmd.notebook)
 app.add_typer(fleet.app, name="fleet", rich_help_panel=SERVE)
+app.add_typer(service_cmd.app, name="service", rich_help_panel=SERVE)
 app.command("emulate", rich_help_panel=SIMULATE)(emulate.emulate)
 app.add_typer(sim_cmd.app, name="sim", rich_help_panel=SIMULATE)
 

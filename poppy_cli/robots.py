@@ -52,12 +52,20 @@ def build_robot(
     sim: bool | str | None,
     *,
     sensors: bool = False,
+    wait_for_motors: bool = False,
 ) -> Robot:
     """Build and start the robot the shared options describe (see :func:`start_robot`)."""
-    return start_robot(robot_config(profile, config_file, port), sim, sensors=sensors)
+    config = robot_config(profile, config_file, port)
+    return start_robot(config, sim, sensors=sensors, wait_for_motors=wait_for_motors)
 
 
-def start_robot(config: RobotConfig, sim: bool | str | None, *, sensors: bool = False) -> Robot:
+def start_robot(
+    config: RobotConfig,
+    sim: bool | str | None,
+    *,
+    sensors: bool = False,
+    wait_for_motors: bool = False,
+) -> Robot:
     """Build and start the robot of ``config``: the one way every command builds a robot.
 
     A Poppy creature (Ergo Jr, Torso, Humanoid: named by its profile, or recognised by its motor
@@ -66,10 +74,18 @@ def start_robot(config: RobotConfig, sim: bool | str | None, *, sensors: bool = 
     Motors answering after a return delay above 0 µs slow every transaction: on a terminal the
     user is asked whether to set it to 0; otherwise it is only reported (a warning).
     The config's sensors (cameras) are built only when ``sensors`` (commands that show them).
+    With ``wait_for_motors`` (a server started at boot), a missing port or silent motors are
+    waited for instead of refused.
     """
     from poppy_core.assembly import from_config
 
-    return from_config(config, sim=sim or False, fix_return_delay=ask_return_delay, sensors=sensors)
+    return from_config(
+        config,
+        sim=sim or False,
+        fix_return_delay=ask_return_delay,
+        sensors=sensors,
+        wait_for_motors=wait_for_motors,
+    )
 
 
 def open_remote(url: str) -> RemoteRobot:

@@ -26,7 +26,13 @@ LOOPBACK = ("127.0.0.1", "localhost", "::1")
 def serve(
     http: bool = typer.Option(False, "--http", help="Serve the REST API (pypot's + /api/v1)."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to listen on."),
-    http_port: int = typer.Option(8080, "--http-port", min=0, max=65535, help="HTTP port."),
+    http_ports: list[int] = typer.Option(
+        [8080],
+        "--http-port",
+        min=0,
+        max=65535,
+        help="HTTP port (repeat it to serve the same page on several ports, e.g. 80 and 8080).",
+    ),
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
     port: str | None = PortOpt,
@@ -63,6 +69,12 @@ def serve(
         False, "--zmq", help="Also serve pypot's ZMQ request/reply API (JSON requests)."
     ),
     zmq_port: int = typer.Option(6768, "--zmq-port", min=0, max=65535, help="ZMQ port."),
+    wait_for_motors: bool = typer.Option(
+        False,
+        "--wait-for-motors",
+        help="Serve even when the port is missing or no motor answers (the power is off): the "
+        "page says so and the robot picks the motors up when they appear (the boot service's).",
+    ),
     no_sensors: bool = typer.Option(
         False, "--no-sensors", help="Leave the config's cameras closed."
     ),
@@ -96,7 +108,9 @@ def serve(
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
     if not (http or ws or snap or zmq):
         _usage("nothing to serve: pass --http, --ws, --snap and/or --zmq")
-    if http and ws and http_port == ws_port and http_port != 0:
+    http_port, *alias_ports = http_ports or [8080]
+    _check_http_ports(http_ports)
+    if http and ws and ws_port in http_ports and ws_port != 0:
         _usage(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
             "server streams the same state at /api/v1/ws)"
@@ -106,7 +120,10 @@ def serve(
         snap_port,
         snap_dir,
         open_browser,
-        {"--http-port": http_port if http else 0, "--ws-port": ws_port if ws else 0},
+        {
+            "--http-port": snap_port if http and snap_port in http_ports else 0,
+            "--ws-port": ws_port if ws else 0,
+        },
     )
     from poppy_core.assembly import Listen, ServeSpec, serve
 
@@ -122,6 +139,7 @@ def serve(
         snap_dir=snap_dir,
         name=_robot_name(name),
         announce=announce,
+        http_alias_ports=tuple(alias_ports),
         report=_report,
     )
     any_origin = _check_origins(spec)
@@ -131,7 +149,14 @@ def serve(
     stop = threading.Event()
     previous = signal.signal(signal.SIGTERM, lambda signum, frame: stop.set())
     try:
-        with build_robot(profile, config_file, port, sim, sensors=not no_sensors) as robot:
+        with build_robot(
+            profile,
+            config_file,
+            port,
+            sim,
+            sensors=not no_sensors,
+            wait_for_motors=wait_for_motors,
+        ) as robot:
             servers: ServerSet | None = None
             try:
                 servers = serve(robot, spec)
@@ -159,6 +184,14 @@ def _robot_name(name: str | None) -> str | None:
         return robot_name(name)
     except ValueError as exc:
         _usage(f"--name: {exc}")
+
+
+def _check_http_ports(ports: list[int]) -> None:
+    """Refuse a port given twice to ``--http-port`` (0, a free port each, may repeat)."""
+    given = [p for p in ports if p != 0]
+    twice = sorted({p for p in given if given.count(p) > 1})
+    if twice:
+        _usage(f"--http-port {twice[0]} is given twice: give each port once")
 
 
 def _check_origins(spec: ServeSpec) -> bool:
@@ -199,7 +232,8 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
     """Print where each server serves (the tests and scripts read these lines)."""
     base = _host(host)
     if servers.http is not None:
-        print(f"http://{base}:{servers.http.port}", flush=True)
+        for http_port in servers.http.ports:
+            print(f"http://{base}:{http_port}", flush=True)
     if servers.ws is not None:
         print(f"ws://{base}:{servers.ws.port}/", flush=True)
     if servers.zmq is not None:

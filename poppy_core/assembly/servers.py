@@ -61,6 +61,8 @@ class ServeSpec:
             pages the robot serves under them on any port count as its own.
         announce: announce ``NAME.local`` (default ``poppy``) and the robot's services over
             mDNS/DNS-SD on the interfaces the servers listen on (``appliance`` extra).
+        http_alias_ports: more ports serving the REST API and page, on ``http``'s host (the
+            appliance serves port 80 and keeps 8080); their pages count as the server's own.
         report: called with one line the first time an origin or Host name is refused.
     """
 
@@ -75,6 +77,7 @@ class ServeSpec:
     snap_dir: Path | None = None
     name: str | None = None
     announce: bool = False
+    http_alias_ports: tuple[int, ...] = ()
     report: Callable[[str], None] | None = field(default=None, compare=False)
 
     def listens(self) -> dict[str, Listen]:
@@ -193,7 +196,9 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     try:
         if app is not None:
             where = listens["http"]
-            thread = ServerThread(app, where.host, where.port).bind()
+            thread = ServerThread(
+                app, where.host, where.port, alias_ports=spec.http_alias_ports
+            ).bind()
             servers.servers["http"] = BackgroundServer("http", thread, service=service)
         if "ws" in listens:
             where = listens["ws"]
@@ -282,7 +287,7 @@ def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) 
 
 def _own_pages(servers: ServerSet) -> None:
     """The pages of every port count as the servers' own; the home page links to Snap!."""
-    ports = [s.port for name, s in servers.servers.items() if name != "zmq"]
+    ports = [p for name, s in servers.servers.items() if name != "zmq" for p in _ports(s)]
     servers.policy.with_ports(ports)
     snap = servers.snap
     if snap is None:
@@ -294,3 +299,8 @@ def _own_pages(servers: ServerSet) -> None:
         add_link(servers.app, "Snap! with the Poppy blocks", snap.editor_url)
         if not snap.local_app:
             add_note(servers.app, "snap", SNAP_ONLINE_NOTE)
+
+
+def _ports(server: Any) -> list[int]:
+    """Every port a server listens on (the HTTP server's aliases too)."""
+    return list(getattr(server, "ports", [server.port]))

@@ -431,6 +431,12 @@ class BusCore:
             self._strays.clear()
             self._replies.forget()
 
+    @property
+    def is_open(self) -> bool:
+        """False while the port is closed (``close``, or a bus made ``absent``); ``reopen``
+        opens it."""
+        return self._transport.is_open
+
     def adopt_transport(self) -> None:
         """Close the transport it was given on ``close`` (a search hands on the port it opened)."""
         with self._lock:

@@ -9,12 +9,21 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 from poppy_core.bus import groupread
 from poppy_core.bus.core import BusCore
 from poppy_core.bus.results import PingResult
+from poppy_core.bus.serial_line import AbsentLine
 from poppy_core.bus.timing import MIN_REPLY_TIMEOUT_S
-from poppy_core.errors import BusTimeout, CorruptPacketError, ProtocolError, RegisterError
+from poppy_core.bus.transport import Transport
+from poppy_core.errors import (
+    BusTimeout,
+    CorruptPacketError,
+    PortError,
+    ProtocolError,
+    RegisterError,
+)
 from poppy_core.models import ServoModel, model_by_number
 from poppy_core.protocol import BROADCAST_ID, InstructionPacket
 from poppy_core.protocol import instructions as ins
@@ -36,6 +45,32 @@ class DxlBus(BusCore):
 
     def __enter__(self) -> DxlBus:
         return self
+
+    @classmethod
+    def absent(
+        cls, port: str, baudrate: int, protocol: int, reason: PortError, **options: Any
+    ) -> DxlBus:
+        """A bus whose port is not there yet (``reason`` says why it could not be opened): every
+        transaction raises ``PortError`` until ``reopen`` opens the port (a robot served at boot
+        before its adapter or its power is there).
+
+        Args:
+            port: the device path or URL.
+            baudrate: line speed in bit/s.
+            protocol: Dynamixel protocol, 1 or 2.
+            reason: the error opening the port raised.
+            **options: the other arguments of ``DxlBus``.
+        """
+        line = AbsentLine(port, baudrate, reason)
+        bus = cls(
+            port,
+            baudrate,
+            protocol,
+            transport=Transport(port, baudrate, protocol, line=line),
+            **options,
+        )
+        bus.adopt_transport()
+        return bus
 
     # -- single-motor transactions ------------------------------------------------------------
 

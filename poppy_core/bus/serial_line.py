@@ -187,3 +187,41 @@ class SerialLine:
         if self._serial.is_open:
             self._serial.close()
             logger.debug("closed %s", self.port)
+
+
+class AbsentLine:
+    """The line of a port not there yet (a robot waiting for its adapter): closed, every I/O
+    raises ``PortError`` with the reason it could not be opened; ``DxlBus.reopen`` replaces it."""
+
+    def __init__(self, port: str, baudrate: int, reason: PortError) -> None:
+        self.port = port
+        self._baudrate = baudrate
+        self.reason = reason
+
+    @property
+    def baudrate(self) -> int:
+        """The rate the port will be opened at."""
+        return self._baudrate
+
+    def set_baudrate(self, baudrate: int) -> None:
+        """Remember the rate for when the port opens."""
+        self._baudrate = baudrate
+
+    @property
+    def is_open(self) -> bool:
+        """Never."""
+        return False
+
+    def write(self, data: bytes) -> None:
+        """Raises PortError: the port is not there."""
+        raise PortError(str(self.reason), port=self.port)
+
+    def read(self, wait_s: float | None) -> bytes:
+        """Raises PortError: the port is not there."""
+        raise PortError(str(self.reason), port=self.port)
+
+    def reset_input(self) -> None:
+        """Nothing to drop."""
+
+    def close(self) -> None:
+        """Nothing to close."""

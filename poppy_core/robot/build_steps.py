@@ -106,11 +106,17 @@ class BuildSteps:
         if self.simulation is not None:
             self.simulation.start()
 
-    def open_buses(self, ports: Sequence[str] | None, strict: bool) -> None:
+    def open_buses(self, ports: Sequence[str] | None, strict: bool, wait: bool = False) -> None:
         """Open each controller's bus (searching ``"auto"`` ports) and check its motors answer.
 
+        With ``wait`` (a robot served at boot), a port that cannot be opened or motors that do
+        not answer are waited for: the bus starts closed (``DxlBus.absent``) or its motors
+        offline, and the sync loop opens it and pings them with backoff, as when a bus is lost.
+        An ``"auto"`` port whose search finds no motor waits on the first port searched.
+
         Raises:
-            SetupError: with ``strict``, one line listing every missing or mismatched motor.
+            SetupError: with ``strict`` and without ``wait``, one line listing every missing or
+                mismatched motor; with ``wait``, an ``"auto"`` port and no serial port at all.
         """
         problems: list[str] = []
         used: set[str] = set()
@@ -124,26 +130,51 @@ class BuildSteps:
                 try:
                     port = self._search_port(name, used, ports)
                 except (SetupError, PortError) as exc:
-                    problems.append(
+                    problem = (
                         f"controller {name!r} ({entry.baudrate} bps, protocol "
                         f"{entry.protocol}): {exc}"
                     )
-                    continue
+                    waiting = self._port_to_wait_on(used, ports) if wait else None
+                    if waiting is None:
+                        if wait:  # no port to wait on: nothing can come
+                            raise SetupError(problem) from None
+                        problems.append(problem)
+                        continue
+                    port = waiting
             used.add(port)
-            bus = DxlBus(
-                port, entry.baudrate, entry.protocol, sync_read=None if entry.sync_read else False
-            )
+            bus = self._open_bus(port, entry.baudrate, entry.protocol, entry.sync_read, wait)
             self.buses[name] = bus
             self.motors[name] = [
                 Motor.from_config(n, cfg.motors[n], model_by_name(cfg.motors[n].type))
                 for n in names
             ]
-            problems += startup.check_presence(bus, name, self.motors[name])
+            if bus.is_open:
+                missing = startup.check_presence(bus, name, self.motors[name])
+                if wait and missing and not any(m.online for m in self.motors[name]):
+                    logger.warning("%s", no_motors_message(port))
+                problems += missing
         if problems:
             message = "; ".join(problems)
-            if strict:
+            if strict and not wait:
                 raise SetupError(message)
             logger.warning("%s", message)
+
+    @staticmethod
+    def _open_bus(port: str, baudrate: int, protocol: int, sync_read: bool, wait: bool) -> DxlBus:
+        options: dict[str, Any] = {"sync_read": None if sync_read else False}
+        try:
+            return DxlBus(port, baudrate, protocol, **options)
+        except PortError as exc:
+            if not wait:
+                raise
+            logger.warning("%s (%s); opening it when it appears", no_motors_message(port), exc)
+            return DxlBus.absent(port, baudrate, protocol, exc, **options)
+
+    @staticmethod
+    def _port_to_wait_on(used: set[str], search: Sequence[str] | None) -> str | None:
+        candidates = list(search) if search is not None else [p.device for p in list_ports()]
+        free = [p for p in candidates if p not in used]
+        return free[0] if free else None
 
     def _search_port(self, controller: str, used: set[str], search: Sequence[str] | None) -> str:
         cfg = self.config
@@ -162,6 +193,10 @@ class BuildSteps:
         """Per bus: first state, return delays, angle limits, torque/gains; its sync loops."""
         for name, bus in self.buses.items():
             motors = self.motors[name]
+            loops = loops_for(self.config.controllers[name].syncloop)
+            if not bus.is_open:  # waited for: the sync loop opens it and reads its motors
+                self.syncs.append(BusSync(name, bus, motors, loops))
+                continue
             startup.load_state(bus, motors)
             targets = _return_delays(self.config, (m.name for m in motors))
             issues = startup.return_delay_issues(motors, targets, bus.port)
@@ -169,7 +204,6 @@ class BuildSteps:
             if write_angle_limits:
                 startup.write_angle_limits(bus, motors)
             self._apply_settings(motors)
-            loops = loops_for(self.config.controllers[name].syncloop)
             self.syncs.append(BusSync(name, bus, motors, loops))
 
     def _apply_settings(self, motors: Iterable[Motor]) -> None:
@@ -214,6 +248,11 @@ class BuildSteps:
         )
         self._handed_over = True
         return robot
+
+
+def no_motors_message(port: str) -> str:
+    """What a robot waiting for its motors says (its log, the page)."""
+    return f"no motors on {port} — is the power on?"
 
 
 def _return_delays(config: RobotConfig, names: Iterable[str]) -> dict[str, float]:

@@ -54,6 +54,7 @@ def from_config(
     ports: Sequence[str] | None = None,
     start_sync: bool = True,
     sensors: bool = True,
+    wait_for_motors: bool = False,
 ) -> Robot:
     """Build and start a plain robot from a config (a ``RobotConfig``, a dict or a JSON/YAML file).
 
@@ -73,6 +74,10 @@ def from_config(
             ``poppy_core.robot.startup``).
         ports: ports searched for controllers whose port is ``"auto"`` (None: every port).
         start_sync: start the sync loops.
+        wait_for_motors: a port that cannot be opened, or motors that do not answer, are
+            waited for instead of refused: the robot starts with them offline and its sync
+            loops open the port and find the motors when they appear (a robot served at boot,
+            before its power is on). ``strict`` then only logs.
         sensors: build the config's sensors (cameras open their device now; each starts on
             first use): OpenCV devices on hardware, the MuJoCo scene seen from the robot with
             ``sim="mujoco"``, blank frames with the ideal simulation. False: none.
@@ -90,7 +95,7 @@ def from_config(
     """
     with BuildSteps(as_config(config), sim_mode(sim)) as parts:
         parts.start_virtual_motors()
-        parts.open_buses(ports, strict)
+        parts.open_buses(ports, strict, wait_for_motors)
         parts.prepare_motors(fix_return_delay, write_angle_limits)
         if sensors:
             parts.build_sensors()

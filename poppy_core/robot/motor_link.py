@@ -156,6 +156,12 @@ class MotorLink:
             for name, raw in raw_values.items():
                 self._pending.setdefault(name, raw)
 
+    def drop_pending(self) -> None:
+        """Forget the values waiting to be written (the motors were let go: what was asked
+        before must not be sent when they are taken back)."""
+        with self.lock:
+            self._pending.clear()
+
     def has_pending(self) -> bool:
         """True when some value waits to be written."""
         with self.lock:

@@ -266,6 +266,58 @@ class Robot(PypotRobotMixin, VrepNames):
             handle.wait()
         return handle
 
+    # -- letting go of the buses ------------------------------------------------------------
+
+    @property
+    def released(self) -> bool:
+        """True while the motors are released (``release_motors``): their ports are closed."""
+        return any(sync.released for sync in self._syncs)
+
+    def release_motors(self) -> list[str]:
+        """Let go of the motors: gotos cancelled, every motor compliant, the sync loops stopped
+        and the ports closed, so that another program can open them (a notebook, `poppy
+        scan`). The motors read offline until ``take_motors``. Stop primitives and moves first
+        (``RobotService.release_motors`` does). Returns the ports closed.
+
+        Raises:
+            RobotClosedError: the robot is closed.
+        """
+        with self._close_lock:
+            if self._closed:
+                raise RobotClosedError("the robot is closed: nothing to release")
+            for motor in self._motors:
+                self._runner.cancel(motor)
+                if not self.released:
+                    motor.compliant = True
+            for sync in self._syncs:
+                if not sync.released:
+                    sync.release_port()
+        logger.warning("motors released: %s closed", ", ".join(self.ports) or "no port")
+        return self.ports
+
+    def take_motors(self) -> list[str]:
+        """Take the motors back after ``release_motors``: reopen the ports, ping and read the
+        motors, restart the sync loops. They stay compliant. Returns the ports opened.
+
+        Raises:
+            PortError: a port cannot be opened (another program still holds it): close that
+                program and take them again (the buses opened stay open).
+            RobotClosedError: the robot is closed.
+        """
+        with self._close_lock:
+            if self._closed:
+                raise RobotClosedError("the robot is closed: open it again")
+            for sync in self._syncs:
+                if sync.released:
+                    sync.take_port()
+        logger.warning("motors taken back: %s open", ", ".join(self.ports) or "no port")
+        return self.ports
+
+    @property
+    def ports(self) -> list[str]:
+        """The ports of the robot's buses, in controller order."""
+        return [bus.port for bus in self.buses.values()]
+
     # -- loops -------------------------------------------------------------------------------
 
     def start_sync(self) -> None:

@@ -110,11 +110,18 @@ class BusSync:
         self._blocks: dict[tuple[str, ServoModel], list[regs.ReadBlock]] = {}
         self._driven: set[str] = set()
         self._retry_turn = 0
-        self.connected = True
+        self.connected = bus.is_open
+        """False while the port is lost, not there yet (a bus made ``DxlBus.absent``: the
+        thread opens it with backoff) or released."""
+        self.released = False
+        """True between ``release_port`` and ``take_port``: the port is closed on purpose."""
         self.losses = 0
-        self._down_since = 0.0
+        self._down_since = 0.0 if self.connected else clock()
         self._backoff = Backoff(RECONNECT_FIRST_S, RECONNECT_MAX_S)
         self._next_reopen = 0.0
+        if not self.connected:
+            for motor in self.motors:
+                link_of(motor).mark_offline()
 
     @property
     def running(self) -> bool:
@@ -159,6 +166,41 @@ class BusSync:
                 self.bus.ping(online[0].id, retries=0)
             except PoppyError as exc:
                 logger.debug("%s: no reply after the final writes: %s", self.controller, exc)
+
+    def release_port(self) -> None:
+        """Let go of the bus: stop the thread (the writes pending, such as compliance, are sent
+        first), drop what is left, mark every motor offline and close the port, so another
+        program can open it. ``take_port`` takes it back."""
+        self.stop()
+        for motor in self.motors:
+            link = link_of(motor)
+            link.mark_offline()
+            link.drop_pending()
+        self.connected = False
+        self.released = True
+        self._down_since = self._clock()
+        self.bus.close()
+
+    def take_port(self) -> None:
+        """Take the bus back after ``release_port``: reopen the port, ping every motor, read
+        their state again, restart the thread.
+
+        Raises:
+            PortError: the port cannot be opened (another program holds it, it is gone); the
+                bus stays released.
+        """
+        self.bus.reopen()
+        self.released = False
+        self.connected = True
+        self._stop.clear()  # stopped by release_port: the pings below must run
+        try:
+            self._retry(every=True)
+        except PortError:
+            self.connected = False
+            self.released = True
+            self.bus.close()
+            raise
+        self.start()
 
     def run_once(self, name: str) -> None:
         """Run one loop now (tests and tools); errors propagate."""
@@ -237,7 +279,9 @@ class BusSync:
     def _run(self, stopping: threading.Event) -> None:
         while not stopping.is_set():
             try:
-                if self.connected:
+                if self.released:
+                    self._stop.wait(RECONNECT_MAX_S)
+                elif self.connected:
                     self._run_due_loops()
                 else:
                     self._reconnect()
@@ -360,7 +404,21 @@ class BusSync:
         link = link_of(motor)
         if link.mark_answered():
             logger.info("%s (id %d) answers again", motor.name, motor.id)
+            if link.cached("present_position") is None:
+                self._first_state(motor)
             link.resend_state()
+
+    def _first_state(self, motor: Motor) -> None:
+        """Read the control table of a motor answering for the first time (the robot started
+        without it: its bus or its power was not there yet)."""
+        try:
+            data = self.bus.read(motor.id, 0, motor.model.table_size)
+        except PortError:
+            raise
+        except BusError as exc:
+            logger.debug("%s: first state not read: %s", motor.name, exc)
+            return
+        link_of(motor).update(regs.decode_table(motor.model, data))
 
     def _missed(self, motor: Motor | None, reason: str) -> None:
         if motor is not None and link_of(motor).mark_missed(self.offline_after):

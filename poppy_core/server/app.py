@@ -61,6 +61,7 @@ def create_app(
         pypot_motion,
         pypot_motors,
         pypot_sensors,
+        v1_access,
         v1_chains,
         v1_motion,
         v1_motors,
@@ -115,6 +116,7 @@ def create_app(
         app.include_router(router)
     for router in (
         v1_robot.router,
+        v1_access.router,  # before v1_motors: /motors/access is not a motor named "access"
         v1_motors.router,
         v1_motion.router,
         v1_chains.router,

@@ -48,6 +48,11 @@ class BackgroundServer:
         return self._thread.port
 
     @property
+    def ports(self) -> list[int]:
+        """Every port it listens on: ``port``, then its aliases (the appliance's 80 and 8080)."""
+        return self._thread.ports
+
+    @property
     def url(self) -> str:
         """``http://host:port``."""
         return self._thread.url

@@ -147,6 +147,8 @@ class ServerThread:
         port: port to bind; 0 picks a free one (read ``port`` after ``bind`` or ``start``).
         header_timeout_s: see ``uvicorn_server``.
         max_connections: see ``uvicorn_server``.
+        alias_ports: more ports on ``host`` serving the same app (the appliance's 8080 beside
+            its 80); 0 picks a free one. Read them in ``ports`` after ``bind``.
     """
 
     def __init__(
@@ -157,8 +159,10 @@ class ServerThread:
         *,
         header_timeout_s: float = HEADER_TIMEOUT_S,
         max_connections: int = MAX_CONNECTIONS,
+        alias_ports: tuple[int, ...] = (),
     ) -> None:
         self.host = host
+        self.alias_ports = alias_ports
         self.server = uvicorn_server(
             app, host, port, header_timeout_s=header_timeout_s, max_connections=max_connections
         )
@@ -179,9 +183,26 @@ class ServerThread:
             ListenError: the address or port cannot be used (the message says why).
         """
         if self._sockets is None:
-            self._sockets = bind_sockets(self.host, self.port)
-            self.port = int(self._sockets[0].getsockname()[1])
+            sockets = bind_sockets(self.host, self.port)
+            try:
+                ports = [int(sockets[0].getsockname()[1])]
+                for alias in self.alias_ports:
+                    more = bind_sockets(self.host, alias)
+                    sockets += more
+                    ports.append(int(more[0].getsockname()[1]))
+            except BaseException:
+                for sock in sockets:
+                    sock.close()
+                raise
+            self._sockets = sockets
+            self.port = ports[0]
+            self.alias_ports = tuple(ports[1:])
         return self
+
+    @property
+    def ports(self) -> list[int]:
+        """Every port it listens on: ``port``, then the alias ports (known once bound)."""
+        return [self.port, *self.alias_ports]
 
     def _run(self, stopping: threading.Event) -> None:
         """uvicorn's loop; it ends on ``server.should_exit``, which ``stop`` sets."""

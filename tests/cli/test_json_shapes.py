@@ -329,6 +329,30 @@ SCHEMAS: dict[str, Any] = {
             "token": bool,
         }
     ],
+    "service status": [
+        {
+            "unit": str,
+            "scope": str,
+            "installed": bool,
+            "enabled": Opt(str),
+            "active": str,
+            "sub": str,
+            "pid": Opt(int),
+            "path": Opt(str),
+        }
+    ],
+    "service release": {
+        "released": bool,
+        "ports": [str],
+        "no_motors": [{"port": str, "message": str}],
+        "primitives": [str],
+        "moves": [str],
+    },
+    "service take": {
+        "released": bool,
+        "ports": [str],
+        "no_motors": [{"port": str, "message": str}],
+    },
     "camera detect": [
         {
             "id": int,
@@ -460,12 +484,38 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
             # fmt: on
             for name, (args, answers) in runs.items():
                 results[name] = run_poppy(*args, "--json", input=answers)
+            results.update(service_runs(tmp))
     finally:
         for key, value in saved.items():
             if value is None:
                 os.environ.pop(key, None)
             else:
                 os.environ[key] = value
+    return results
+
+
+def service_runs(tmp: Path) -> dict[str, Any]:
+    """`poppy service status` against a recording systemctl, release/take on a served robot."""
+    from poppy_core.assembly import Listen, ServeSpec, serve
+    from poppy_core.robot import from_profile
+    from tests.helpers.recording import RecordingFake
+
+    fake = RecordingFake(tmp / "systemd")
+    show = "Id=poppy.service\nLoadState=loaded\nActiveState=active\nSubState=running\n"
+    results = {
+        "service status": run_poppy(
+            "service", "status", "--json", env=fake.env(FAKE_COMMANDS_SHOW=show)
+        )
+    }
+    with (
+        from_profile("ergo-jr", sim=True) as robot,
+        serve(robot, ServeSpec(http=Listen())) as servers,
+    ):
+        assert servers.http is not None
+        for name in ("release", "take"):
+            results[f"service {name}"] = run_poppy(
+                "service", name, "--remote", servers.http.url, "--json"
+            )
     return results
 
 

@@ -17,6 +17,7 @@ from starlette.concurrency import run_in_threadpool
 from poppy_core.errors import PoppyError
 from poppy_core.robot import Motor, Robot
 from poppy_core.sensors import Camera
+from poppy_core.server.access import halt_activity
 from poppy_core.server.deps import Service
 from poppy_core.server.schemas import Problem
 from poppy_core.server.service import RobotService
@@ -107,12 +108,7 @@ def motor_details(motor: Motor) -> dict[str, Any]:
 def stop_everything(service: RobotService, then: str) -> StopResult:
     """Stop every primitive and move playing, then make the motors compliant or hold them."""
     robot = service.robot
-    stopped = service.running_primitives()
-    for name in stopped:
-        service.primitive(name).halt(wait=True)
-    moves = service.moves.playing()
-    for name in moves:
-        service.moves.stop(name)
+    stopped, moves = halt_activity(service)
     if then == "compliant":
         robot.compliant = True
     else:
