@@ -3,8 +3,10 @@
 ``poppy serve`` and the creature classes (``PoppyErgoJr(use_http=True, use_ws=True)``) both come
 here. Every protocol of one set shares one ``RobotService`` (so one teleoperation registry: a
 motor is teleoperated by one WebSocket connection, whichever port it came through), one Host and
-Origin policy (Snap!'s adds snap.berkeley.edu), one token, and one shutdown order: ZMQ, Snap!,
-WebSocket, HTTP (the reverse of starting), then the service's recordings and teleoperations.
+Origin policy (Snap!'s adds snap.berkeley.edu), one token, and one shutdown order: Zenoh, ZMQ,
+Snap!, WebSocket, HTTP (the reverse of starting), then the Zenoh session, then the service's
+recordings and teleoperations. The Zenoh session (``ServerSet.zenoh_session``) is one per set,
+opened before anything serves: every server on Zenoh (the fleet node, ROS 2) declares on it.
 Importing this module loads no server library; ``serve`` does.
 """
 
@@ -15,15 +17,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from poppy_core.zenoh_wire import ZenohSettings
+
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
     from poppy_core.server import OriginPolicy, RobotService
     from poppy_core.server.background import BackgroundServer
     from poppy_core.server.snap import SnapServer
+    from poppy_core.server.zenoh import ZenohRobotServer
     from poppy_core.server.zmqserver import ZmqRobotServer
 
-PROTOCOLS = ("http", "ws", "zmq", "snap")
-"""pypot's attribute names of the servers (``robot.http``...), in the order they start."""
+PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh")
+"""pypot's attribute names of the servers (``robot.http``...) and ``zenoh``, in the order they
+start."""
 DEFAULT_PORTS = {"http": 8080, "ws": 9009, "zmq": 6768, "snap": 6969}
 """pypot's default ports (``zmq``: the documentation's ZMQ example)."""
 LOOPBACK = "127.0.0.1"
@@ -52,6 +58,11 @@ class ServeSpec:
         ws_rate_hz: the state stream's default rate.
         snap_dir: a downloaded Snap! served at ``/app/`` on the Snap! port.
         report: called with one line the first time an origin or Host name is refused.
+        zenoh: the robot on Zenoh under ``poppy/<name>`` (``ZenohSettings``: endpoints,
+            configuration file, scouting), or None.
+        name: the robot's name (mDNS ``NAME.local``, Zenoh ``poppy/NAME``); the host's name
+            when None.
+        state_rate_hz: the Zenoh state messages per second (the sync loop's rate).
     """
 
     http: Listen | None = None
@@ -64,6 +75,9 @@ class ServeSpec:
     ws_rate_hz: float = 30.0
     snap_dir: Path | None = None
     report: Callable[[str], None] | None = field(default=None, compare=False)
+    zenoh: ZenohSettings | None = None
+    name: str | None = None
+    state_rate_hz: float = 50.0
 
     def listens(self) -> dict[str, Listen]:
         """Protocol -> where it listens, for the servers asked for, in starting order."""
@@ -92,6 +106,8 @@ class ServerSet:
         self.policy = policy
         self.app = app
         self.servers: dict[str, Any] = {}
+        self.zenoh_session: Any = None
+        """The one Zenoh session of the set (``zenoh.Session``), or None without ``zenoh``."""
         self._stopped = False
 
     @property
@@ -115,6 +131,11 @@ class ServerSet:
         return self.servers.get("snap")
 
     @property
+    def zenoh(self) -> ZenohRobotServer | None:
+        """The robot on Zenoh."""
+        return self.servers.get("zenoh")
+
+    @property
     def running(self) -> bool:
         """True while every server serves."""
         return bool(self.servers) and all(s.running for s in self.servers.values())
@@ -126,13 +147,17 @@ class ServerSet:
         return self
 
     def stop(self) -> None:
-        """Stop the servers (ZMQ, Snap!, WebSocket, HTTP), then the service (again: nothing)."""
+        """Stop the servers (Zenoh, ZMQ, Snap!, WebSocket, HTTP), the Zenoh session, then the
+        service (again: nothing)."""
         if self._stopped:
             return
         self._stopped = True
         for name in reversed(PROTOCOLS):
             if name in self.servers:
                 self.servers[name].stop()
+        if self.zenoh_session is not None:
+            self.zenoh_session.close()
+            self.zenoh_session = None
         self.service.close()
 
     def __enter__(self) -> ServerSet:
@@ -153,7 +178,8 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
         ListenError: a port is taken or an address unusable.
         RuntimeError: a server did not start (its log says why).
         ValueError: an origin in ``cors`` or a name in ``allow_hosts`` that is not one.
-        MissingExtraError: the ``server`` (or ``zmq``) extra is missing.
+        ConfigError: a Zenoh endpoint or configuration that cannot be used, a bad name.
+        MissingExtraError: the ``server`` (or ``zmq``, ``fleet``) extra is missing.
     """
     from poppy_core.server import OriginPolicy, RobotService, ServerThread, create_app
     from poppy_core.server.background import BackgroundServer
@@ -165,13 +191,13 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     )
     service = RobotService(robot)
     app = None
-    if "http" in listens:
+    if "http" in listens or spec.zenoh is not None:
         app = create_app(
             robot, service=service, token=spec.token, policy=policy, stream_rate_hz=spec.ws_rate_hz
         )
-    servers = ServerSet(service, policy, app)
+    servers = ServerSet(service, policy, app if "http" in listens else None)
     try:
-        if app is not None:
+        if "http" in listens:
             where = listens["http"]
             thread = ServerThread(app, where.host, where.port).bind()
             servers.servers["http"] = BackgroundServer("http", thread, service=service)
@@ -187,6 +213,8 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
             servers.servers["zmq"] = ZmqRobotServer(robot, where.host, where.port, service=service)
         if "snap" in listens:
             _add_snap(servers, robot, spec, listens["snap"])
+        if spec.zenoh is not None:
+            _add_zenoh(servers, spec, spec.zenoh, app)
         _own_pages(servers)
         if start:
             servers.start()
@@ -214,9 +242,26 @@ def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) 
     snap.thread.bind()
 
 
+def _add_zenoh(servers: ServerSet, spec: ServeSpec, settings: ZenohSettings, app: Any) -> None:
+    from poppy_core.server.zenoh import ZenohRobotServer
+    from poppy_core.zenoh_wire import check_name, default_name, open_session
+
+    name = check_name(spec.name) if spec.name is not None else default_name()
+    servers.zenoh_session = open_session(settings)
+    servers.servers["zenoh"] = ZenohRobotServer(
+        servers.service,
+        app,
+        servers.zenoh_session,
+        name,
+        token=spec.token,
+        state_rate_hz=spec.state_rate_hz,
+        endpoints=settings.listen,
+    )
+
+
 def _own_pages(servers: ServerSet) -> None:
     """The pages of every port count as the servers' own; the home page links to Snap!."""
-    ports = [s.port for name, s in servers.servers.items() if name != "zmq"]
+    ports = [s.port for name, s in servers.servers.items() if name not in ("zmq", "zenoh")]
     servers.policy.with_ports(ports)
     snap = servers.snap
     if snap is None:

@@ -10,10 +10,15 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from poppy_core.remote import RemoteRobot
+    from poppy_core.zenoh_wire import ZenohSettings
 
 
-def from_remote(host: str, port: int = 8080, *, token: str | None = None) -> RemoteRobot:
-    """The robot served by ``poppy serve --http`` on ``host:port`` (pypot's ``from_remote``).
+def from_remote(
+    host: str, port: int = 8080, *, token: str | None = None, zenoh: ZenohSettings | None = None
+) -> RemoteRobot:
+    """The robot served by ``poppy serve --http`` on ``host:port`` (pypot's ``from_remote``), or
+    by ``poppy serve --zenoh --name NAME`` for ``host="zenoh:NAME"`` (``zenoh``: the endpoints
+    to connect to; by default POPPY_ZENOH_CONNECT, else ``tcp/127.0.0.1:7447``).
 
     Returns:
         A ``poppy_core.remote.RemoteRobot`` (motors and groups as attributes, over HTTP).
@@ -23,6 +28,8 @@ def from_remote(host: str, port: int = 8080, *, token: str | None = None) -> Rem
     """
     from poppy_core.remote import RemoteRobot
 
+    if host.startswith("zenoh:"):
+        return RemoteRobot(host, token=token, zenoh=zenoh)
     url = host if "://" in host else f"http://{_bracketed(host)}:{int(port)}"
     return RemoteRobot(url, token=token)
 

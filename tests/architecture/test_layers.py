@@ -16,8 +16,20 @@ ROOT = Path(__file__).resolve().parents[2]
 # `documents` (bounded JSON/YAML reads), `line` (the byte-line contract and its URL schemes),
 # `trajectory` (the pure maths of a goto, shared by Motor.goto_position and the primitives'
 # sandbox), `checks` (the one rule of each kind of call argument) and `extras` (the optional
-# dependencies, with the one-line error naming a missing extra) are leaves every room may use.
-LEAVES = {"errors", "files", "documents", "line", "trajectory", "checks", "extras", "schedule"}
+# dependencies, with the one-line error naming a missing extra) are leaves every room may use;
+# so is `zenoh_wire` (the Zenoh keys, session settings and state message a served robot and its
+# clients share, as `line` is the byte-line contract of buses and emulators).
+LEAVES = {
+    "errors",
+    "files",
+    "documents",
+    "line",
+    "trajectory",
+    "checks",
+    "extras",
+    "schedule",
+    "zenoh_wire",
+}
 ALLOWED: dict[str, set[str]] = {
     "protocol": set(),
     "models": {"protocol"},
