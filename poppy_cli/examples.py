@@ -72,6 +72,35 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("serve --http --profile ergo-jr --sim", "the REST API and web page on port 8080"),
         ("serve --snap --open --profile ergo-jr -p /dev/ttyUSB0", "Snap! with the Poppy blocks"),
         ("serve --http --http-port 9000 --ws --token s3cret --profile ergo-jr --sim", "a token"),
+        (
+            "serve --zenoh --name jr1 --zenoh-connect tcp/192.168.1.10:7447 --profile ergo-jr",
+            "on Zenoh as poppy/jr1, through the teacher's router",
+        ),
+    ),
+    "fleet": (
+        ("fleet list --connect tcp/192.168.1.10:7447", "the robots on Zenoh"),
+        ("fleet play wave --all", "every robot plays a move, starting together"),
+        ("fleet stop --all", "the Stop button of every robot"),
+    ),
+    "fleet list": (
+        ("fleet list", "through a router on this computer (tcp/127.0.0.1:7447)"),
+        ("fleet list --connect tcp/192.168.1.10:7447 --json", "for scripts"),
+    ),
+    "fleet status": (
+        ("fleet status --watch", "one live table of every robot"),
+        ("fleet status --connect tcp/192.168.1.10:7447", "once"),
+    ),
+    "fleet run": (
+        ("fleet run dance --all", "every robot dances, starting together"),
+        ("fleet run dance --robots jr1,jr2", "two robots"),
+    ),
+    "fleet play": (
+        ("fleet play wave --all", "every robot plays a move of its library"),
+        ("fleet play wave --robots jr1,jr2 --token s3cret", "two robots served with a token"),
+    ),
+    "fleet stop": (
+        ("fleet stop --all", "primitives and moves stopped, motors held"),
+        ("fleet stop --robots jr3 --json", "one robot, JSON"),
     ),
     "motor": (
         ("motor info 3 -p /dev/ttyUSB0", "the whole control table"),

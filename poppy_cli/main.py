@@ -10,7 +10,7 @@ from typer import _click as click  # typer vendors Click: its exceptions live he
 
 from poppy_cli import state
 from poppy_cli.commands import calibrate as calibrate_cmd
-from poppy_cli.commands import camera, config, demo, emulate, motor_setup, ports, scan
+from poppy_cli.commands import camera, config, demo, emulate, fleet, motor_setup, ports, scan
 from poppy_cli.commands import moves as moves_cmd
 from poppy_cli.commands import play as play_cmd
 from poppy_cli.commands import primitive as primitive_cmd
@@ -130,6 +130,7 @@ app.command("play", rich_help_panel=MOVES)(play_cmd.play)
 app.add_typer(moves_cmd.app, name="moves", rich_help_panel=MOVES)
 app.command("serve", rich_help_panel=SERVE)(serve_cmd.serve)
 app.add_typer(snap_cmd.app, name="snap", rich_help_panel=SERVE)
+app.add_typer(fleet.app, name="fleet", rich_help_panel=SERVE)
 app.command("emulate", rich_help_panel=SIMULATE)(emulate.emulate)
 app.add_typer(sim_cmd.app, name="sim", rich_help_panel=SIMULATE)
 

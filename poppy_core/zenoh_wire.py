@@ -17,6 +17,8 @@ import math
 import re
 import socket
 import struct
+import threading
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -150,6 +152,32 @@ def open_session(settings: ZenohSettings) -> zenoh.Session:
             f"cannot open the Zenoh session ({exc}): check --zenoh-listen / --zenoh-connect",
             field="zenoh",
         ) from None
+
+
+def await_peers(session: zenoh.Session, settings: ZenohSettings, wait_s: float = 3.0) -> bool:
+    """Wait until ``session`` is linked to a peer or router (when ``settings`` connect to one);
+    False when none came within ``wait_s``. A session opens before its links are up: a query
+    sent at once would find no one."""
+    if not settings.connect and settings.config_file is None and not settings.scout:
+        return True
+    end = time.monotonic() + wait_s
+    while time.monotonic() < end:
+        if list(session.info.peers_zid()) or list(session.info.routers_zid()):
+            return True
+        time.sleep(0.01)
+    return False
+
+
+def await_token(session: zenoh.Session, name: str, wait_s: float = 3.0) -> bool:
+    """Wait until the liveliness token of robot ``name`` is seen; False after ``wait_s``."""
+    seen = threading.Event()
+    subscriber = session.liveliness().declare_subscriber(
+        robot_key(name), lambda sample: seen.set(), history=True
+    )
+    try:
+        return seen.wait(wait_s)
+    finally:
+        subscriber.undeclare()  # type: ignore[no-untyped-call]
 
 
 # -- the state message -------------------------------------------------------------------------

@@ -78,8 +78,12 @@ class ZenohClient(HttpClient):
         self.token = token
         self.timeout_s = timeout_s
         self._owned = session is None
-        self.session = session or zenoh_wire.open_session(settings or client_settings())
+        settings = settings or client_settings()
+        self.session = session or zenoh_wire.open_session(settings)
         self._key = zenoh_wire.robot_key(name, "api")
+        if self._owned:  # a new session: let its links come up and the robot be seen
+            zenoh_wire.await_peers(self.session, settings, timeout_s)
+            zenoh_wire.await_token(self.session, name, min(timeout_s, 3.0))
 
     def request(self, method: str, path: str, body: Any = None) -> Any:
         """Send a request; the decoded answer (as ``HttpClient.request``).
@@ -131,11 +135,11 @@ def answer_of(where: str, replies: list[Any], timeout_s: float, waited_s: float)
             "the robots seen; check the endpoints: --connect or POPPY_ZENOH_CONNECT)",
             port=where,
         )
-    if not replies:
+    errors = [r.err.payload.to_bytes().decode(errors="replace") for r in replies]
+    if not replies or errors == ["Timeout"]:  # Zenoh's own reply when the time ran out
         raise BusTimeout(
             f"{where}: no answer within {timeout_s:g} s (is the robot served with "
             "`poppy serve --zenoh` and reachable? `poppy fleet list` shows the robots seen)",
             port=where,
         )
-    message = replies[0].err.payload.to_bytes().decode(errors="replace")
-    raise CommunicationError(f"{where}: {message}", port=where)
+    raise CommunicationError(f"{where}: {'; '.join(errors)}", port=where)

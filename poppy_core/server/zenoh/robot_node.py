@@ -220,7 +220,7 @@ class ZenohRobotServer:
 
     def _on_description(self, query: zenoh.Query) -> None:
         try:
-            query.reply(query.key_expr, json.dumps(self.description()).encode())
+            query.reply(self.key("description"), json.dumps(self.description()).encode())
         except Exception:
             logger.exception("answering %s", query.key_expr)
 
@@ -232,7 +232,7 @@ class ZenohRobotServer:
 
     async def _answer(self, caller: AsgiCaller, query: zenoh.Query, payload: bytes) -> None:
         status, body = await self.api(caller, payload)
-        query.reply(query.key_expr, json.dumps({"status": status, "body": body}).encode())
+        query.reply(self.key("api"), json.dumps({"status": status, "body": body}).encode())
 
     async def api(self, caller: AsgiCaller, payload: bytes) -> tuple[int, Any]:
         """The status and answer of one ``api`` request (a refusal: REST's, or 400/413)."""
@@ -297,17 +297,17 @@ class ZenohRobotServer:
 
 
 def _start_at(value: Any) -> float | None:
+    """The wall-clock start of a command, checked as its delay from now (a clock a minute or
+    more ahead of the robot's is refused rather than waited for)."""
     if value is None:
         return None
-    when = checks.number(value, "start_at")
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        checks.number(value, "start_at")  # raises, naming the field
     now = time.time()
-    if when > now + MAX_START_DELAY_S:
-        raise ArgumentError(
-            f"start_at is {when - now:.0f} s away (at most {MAX_START_DELAY_S:g} s): "
-            "are the clocks of the robots and of this computer set (NTP)?",
-            field="start_at",
-        )
-    return when
+    delay = checks.in_range(
+        float(value) - now, -MAX_START_DELAY_S, MAX_START_DELAY_S, "start_at (from now)", "s"
+    )
+    return now + delay
 
 
 def _jsonable(value: Any) -> Any:
