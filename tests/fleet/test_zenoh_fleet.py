@@ -151,11 +151,19 @@ def test_fleet_play_starts_both_robots(two: tuple[Served, Served], fleet: Fleet)
         remote.moves.save("wave")
     finally:
         remote.close()
+    played: list[str] = []
+    for served in (a, b):
+        real = served.servers.service.moves.play
+
+        def spy(*args: Any, real: Any = real, name: str = served.name) -> Any:
+            played.append(name)
+            return real(*args)
+
+        served.servers.service.moves.play = spy  # type: ignore[method-assign]
     result = run_poppy("fleet", "play", "wave", "--all", "--token", TOKEN, *_fleet_args(a, b))
     assert result.code == 0, result.stderr
     assert "jr-a: playing wave" in result.stdout and "jr-b: playing wave" in result.stdout
-    for served in (a, b):
-        assert eventually(lambda s=served: "wave" not in s.servers.service.moves.playing() or True)
+    assert sorted(played) == ["jr-a", "jr-b"]
     result = run_poppy(
         "fleet", "run", "dance", "--robots", "jr-a,jr-b", "--token", TOKEN, *_fleet_args(a, b)
     )
@@ -174,7 +182,7 @@ def test_the_robots_of_one_command_start_at_the_shared_time(
         dance = served.servers.service.primitive("dance")
         real = dance.start
 
-        def spy(real=real, name=served.name) -> None:  # type: ignore[no-untyped-def]
+        def spy(real: Any = real, name: str = served.name) -> None:
             started[name] = time.time()
             real()
 
@@ -312,3 +320,59 @@ def test_serve_refuses_zenoh_options_without_zenoh() -> None:
     result = run_poppy("serve", "--http", "--zenoh-listen", "tcp/127.0.0.1:1", "--sim")
     assert result.code == 2
     assert "need --zenoh" in result.stderr
+
+
+def test_teleop_across_two_served_robots(two: tuple[Served, Served]) -> None:
+    """`poppy teleop --leader zenoh:A --follower zenoh:B`: B copies A moved by hand; when A's
+    state stops (the link stalls), B holds where it is and says so."""
+    from poppy_core.motion.teleop.session import Teleoperation
+    from poppy_core.remote.zenoh_teleop import ZenohFollower, ZenohLeader
+    from tests.teleop.hands import Hand
+
+    a, b = two
+    settings = Settings(connect=_connect(a, b))
+    leader = ZenohLeader("jr-a", TOKEN, settings=settings)
+    follower = ZenohFollower("jr-b", TOKEN, settings=settings, ramp_s=0.2)
+    changes: list[str] = []
+    run = Teleoperation(leader, follower, rate_hz=100, on_change=lambda s, r: changes.append(s))
+    try:
+        run.start()
+        assert eventually(lambda: a.robot.m1.compliant and not b.robot.m1.compliant, timeout_s=10)
+        Hand(a.robot).put({"m1": 30.0, "m2": -20.0})
+        assert eventually(lambda: abs(b.robot.m1.goal_position - 30.0) < 1.0, timeout_s=10)
+        assert eventually(lambda: abs(b.robot.m2.goal_position + 20.0) < 1.0, timeout_s=10)
+        node = a.servers.zenoh
+        assert node is not None
+        node._worker.close()  # the leader's state stops: the watchdog holds the follower
+        assert eventually(lambda: "leader lost" in changes, timeout_s=10)
+        held = b.robot.m1.goal_position
+        Hand(a.robot).put({"m1": -40.0})
+        time.sleep(0.3)
+        assert b.robot.m1.goal_position == held
+    finally:
+        run.stop()
+        leader.close()
+        follower.close()
+
+
+def test_poppy_teleop_takes_zenoh_robots(two: tuple[Served, Served]) -> None:
+    a, b = two
+    result = run_poppy(
+        "teleop",
+        "--leader",
+        "zenoh:jr-a",
+        "--follower",
+        "zenoh:jr-b",
+        "--duration",
+        "0.5",
+        "--connect",
+        a.endpoint,
+        "--connect",
+        b.endpoint,
+        "--json",
+        env={"POPPY_TOKEN": TOKEN},
+    )
+    assert result.code == 0, result.stderr
+    summary = result.json()
+    assert summary["follower"] == "zenoh:jr-b"
+    assert not b.robot.m1.compliant
