@@ -34,7 +34,7 @@ FLAGS: dict[str, Flag] = {
     "--config": Flag("-c", "FILE", "robot config file (JSON or YAML)"),
     "--port": Flag("-p", "PORT", "serial port of the bus: a device, a pty or a URL"),
     "--sim": Flag(None, "[mujoco]", "a virtual robot: bare for ideal servos, `mujoco` for physics"),
-    "--remote": Flag(None, "URL", "drive a robot served by `poppy serve --http` at this URL"),
+    "--remote": Flag(None, "URL", "drive a served robot: http://HOST:PORT or zenoh:NAME"),
     "--motors": Flag("-m", "MOTORS", "which motors: names or groups (models:IDs in `emulate`)"),
     "--chain": Flag(None, "NAME", "kinematic chain of the robot"),
     # -- the bus

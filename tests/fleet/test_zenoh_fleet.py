@@ -376,3 +376,14 @@ def test_poppy_teleop_takes_zenoh_robots(two: tuple[Served, Served]) -> None:
     summary = result.json()
     assert summary["follower"] == "zenoh:jr-b"
     assert not b.robot.m1.compliant
+
+
+def test_remote_zenoh_works_where_remote_url_does(two: tuple[Served, Served]) -> None:
+    a, _ = two
+    env = {"POPPY_ZENOH_CONNECT": a.endpoint, "POPPY_TOKEN": TOKEN}
+    result = run_poppy("robot", "status", "--remote", "zenoh:jr-a", "--json", env=env)
+    assert result.code == 0, result.stderr
+    assert [m["name"] for m in result.json()["motors"]] == ["m1", "m2", "m3", "m4", "m5", "m6"]
+    result = run_poppy("primitive", "list", "--remote", "zenoh:jr-a", "--json", env=env)
+    assert result.code == 0, result.stderr
+    assert "dance" in {p["name"] for p in result.json()}
