@@ -208,6 +208,10 @@ def _number(value: Any) -> float:
     return number if math.isfinite(number) else math.nan
 
 
+def _value(number: float) -> float | None:
+    return None if number != number else round(number, 3)  # NaN: not read
+
+
 def pack_state(seq: int, stamp: float, motors: Mapping[str, Mapping[str, Any]]) -> bytes:
     """Version 1: a 14-byte head, the motor names (UTF-8, ``\\n``-separated, length-prefixed),
     then 17 bytes per motor (four little-endian float32 and a flags byte)."""
@@ -241,18 +245,20 @@ def unpack_state(data: bytes) -> RobotState:
         offset += 2
         names = data[offset : offset + size].decode().split("\n") if count else []
         offset += size
+        block = data[offset : offset + count * _MOTOR.size]
         motors: dict[str, dict[str, Any]] = {}
-        for name in names:
-            *fields, flags = _MOTOR.unpack_from(data, offset)
-            offset += _MOTOR.size
-            entry: dict[str, Any] = {
-                f: (None if math.isnan(v) else round(v, 3))
-                for f, v in zip(STATE_FIELDS, fields, strict=True)
+        for name, (position, speed, load, temperature, flags) in zip(
+            names, _MOTOR.iter_unpack(block), strict=True
+        ):
+            motors[name] = {
+                "present_position": _value(position),
+                "present_speed": _value(speed),
+                "present_load": _value(load),
+                "present_temperature": _value(temperature),
+                "compliant": bool(flags & COMPLIANT),
+                "online": bool(flags & ONLINE),
             }
-            entry["compliant"] = bool(flags & COMPLIANT)
-            entry["online"] = bool(flags & ONLINE)
-            motors[name] = entry
-    except (struct.error, UnicodeDecodeError) as exc:
+    except (struct.error, UnicodeDecodeError, ValueError) as exc:
         raise ConfigError(f"not a poppy state message ({exc})", field="state") from None
     if len(motors) != count:
         raise ConfigError("not a poppy state message (motor count)", field="state")

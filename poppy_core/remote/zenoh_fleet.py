@@ -71,6 +71,8 @@ class Fleet:
         settings = settings or client_settings()
         self.session = session or zenoh_wire.open_session(settings)
         self._declared: list[Any] = []
+        self.last_start_at: float | None = None
+        """The shared start time of the last command sent ``together``."""
         if self._owned:  # a new session: let its links come up before the first query
             zenoh_wire.await_peers(self.session, settings, timeout_s)
 
@@ -126,6 +128,7 @@ class Fleet:
         answer within the timeout gets an outcome saying so (never a hang).
         """
         start_at = time.time() + START_LEAD_S if together else None
+        self.last_start_at = start_at
         timeout = self.timeout_s + (START_LEAD_S if together else 0.0)
         pending = []
         for name in names:
