@@ -216,6 +216,7 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
         if spec.zenoh is not None:
             _add_zenoh(servers, spec, spec.zenoh, app)
         _own_pages(servers)
+        _fleet_page(servers)
         if start:
             servers.start()
     except BaseException:
@@ -257,6 +258,18 @@ def _add_zenoh(servers: ServerSet, spec: ServeSpec, settings: ZenohSettings, app
         state_rate_hz=spec.state_rate_hz,
         endpoints=settings.listen,
     )
+
+
+def _fleet_page(servers: ServerSet) -> None:
+    """The page lists the robots its Zenoh session sees; the description names the page."""
+    node = servers.zenoh
+    if node is None or servers.app is None:
+        return
+    from poppy_core.server.zenoh.web_fleet import add_fleet_route
+
+    add_fleet_route(servers.app, node)
+    if servers.http is not None:
+        node.page = servers.http.url
 
 
 def _own_pages(servers: ServerSet) -> None:

@@ -387,3 +387,35 @@ def test_remote_zenoh_works_where_remote_url_does(two: tuple[Served, Served]) ->
     result = run_poppy("primitive", "list", "--remote", "zenoh:jr-a", "--json", env=env)
     assert result.code == 0, result.stderr
     assert "dance" in {p["name"] for p in result.json()}
+
+
+def test_the_page_lists_the_robots_its_fleet_sees(moves: Path) -> None:
+    """`/api/v1/web/fleet`: every robot on the network, with a link to the pages served."""
+    import httpx
+
+    from poppy_core.assembly import Listen
+
+    b = Served("jr-b", token=None)
+    endpoint = free_endpoint()
+    with from_profile("ergo-jr", sim=True) as robot:
+        spec = ServeSpec(
+            http=Listen(port=0),
+            zenoh=ZenohSettings(listen=(endpoint,), connect=(b.endpoint,)),
+            name="jr-a",
+        )
+        servers = serve(robot, spec)
+        try:
+            assert servers.http is not None
+            url = f"{servers.http.url}/api/v1/web/fleet"
+
+            def listed() -> list[dict[str, Any]]:
+                return list(httpx.get(url, timeout=5).json())
+
+            assert eventually(lambda: [r["name"] for r in listed()] == ["jr-a", "jr-b"], 10)
+            rows = {r["name"]: r for r in listed()}
+            assert rows["jr-a"]["self"] and rows["jr-a"]["page"] == servers.http.url
+            assert rows["jr-b"]["creature"] == "ergo-jr" and rows["jr-b"]["page"] is None
+            b.close()
+            assert eventually(lambda: [r["name"] for r in listed()] == ["jr-a"], 10)
+        finally:
+            servers.stop()

@@ -83,6 +83,9 @@ class ZenohRobotServer:
         self._declared: list[Any] = []
         self._publisher: Any = None
         self._health: Any = None
+        self.page: str | None = None
+        """The robot's web page (``http://...``), when it serves one, for the fleet's pages."""
+        self._seen: set[str] = set()
         self._worker = Worker(f"zenoh-state-{name}", self._publish_loop)
         self._lock = threading.Lock()
         self._last_refusal = 0.0
@@ -125,6 +128,9 @@ class ZenohRobotServer:
             session.declare_queryable(self.key("api"), self._on_api),
             session.declare_queryable(self.key("description"), self._on_description),
             session.declare_subscriber(self.key("goals"), self._on_goals),
+            session.liveliness().declare_subscriber(
+                f"{zenoh_wire.PREFIX}/*", self._on_presence, history=True
+            ),
             session.liveliness().declare_token(zenoh_wire.robot_key(self.name)),
         ]
         self._worker.start()
@@ -141,6 +147,22 @@ class ZenohRobotServer:
         if self._caller is not None:
             self._caller.close()
             self._caller = None
+
+    def seen(self) -> list[str]:
+        """The robots alive on the network, by their liveliness tokens (this one too)."""
+        with self._lock:
+            return sorted(self._seen)
+
+    def _on_presence(self, sample: zenoh.Sample) -> None:
+        import zenoh
+
+        name = zenoh_wire.name_of(str(sample.key_expr))
+        if name:
+            with self._lock:
+                if sample.kind == zenoh.SampleKind.PUT:
+                    self._seen.add(name)
+                else:
+                    self._seen.discard(name)
 
     # -- publications ------------------------------------------------------------------------
 
@@ -206,6 +228,7 @@ class ZenohRobotServer:
             "creature": profile.name if profile is not None else "",
             "host": socket.gethostname(),
             "endpoints": list(self.endpoints),
+            "page": self.page,
             "token": self.token is not None,
             "state_rate_hz": self.state_rate_hz,
             "motors": motors,
