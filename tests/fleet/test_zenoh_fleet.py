@@ -419,3 +419,19 @@ def test_the_page_lists_the_robots_its_fleet_sees(moves: Path) -> None:
             assert eventually(lambda: [r["name"] for r in listed()] == ["jr-a"], 10)
         finally:
             servers.stop()
+
+
+def test_fleet_status_shows_every_robot_and_its_motors(
+    two: tuple[Served, Served], fleet: Fleet
+) -> None:
+    result = run_poppy("fleet", "status", *_fleet_args(*two))
+    assert result.code == 0, result.stderr
+    lines = {line.split()[1]: line for line in result.stdout.splitlines() if "jr-" in line}
+    assert set(lines) == {"jr-a", "jr-b"}
+    assert all("ok" in line and "m6:" in line for line in lines.values())
+
+
+def test_fleet_commands_name_their_robots() -> None:
+    result = run_poppy("fleet", "stop", "--connect", free_endpoint())
+    assert result.code == 2
+    assert "--all, or --robots a,b" in result.stderr
