@@ -288,8 +288,15 @@ def teleop_goals() -> dict[str, Any]:
             with Fleet(Settings(connect=(endpoint,))) as fleet:
                 fleet.wait_for(["follower"])
                 send = fleet.goals("follower")
+                _paced(lambda value: send({"m1": value}), arrived, 0.0, warm_up=True)
                 out["zenoh"] = _paced(lambda value: send({"m1": value}), arrived, 0.0)
             with connect(f"ws://127.0.0.1:{servers.ws.port}/") as ws:
+                _paced(
+                    lambda value: ws.send(json.dumps({"m1": {"goal_position": value}})),
+                    arrived,
+                    50.0,
+                    warm_up=True,
+                )
                 out["ws"] = _paced(
                     lambda value: ws.send(json.dumps({"m1": {"goal_position": value}})),
                     arrived,
@@ -301,11 +308,16 @@ def teleop_goals() -> dict[str, Any]:
     return out
 
 
-def _paced(send: Any, arrived: dict[float, float], base: float) -> dict[str, Any]:
+def _paced(
+    send: Any, arrived: dict[float, float], base: float, *, warm_up: bool = False
+) -> dict[str, Any]:
+    """Send goals at ``TELEOP_HZ``; their latency to the server (``warm_up``: 0.5 s, for the
+    routes and connections to settle, with other values)."""
     sent: dict[float, float] = {}
     period = 1.0 / TELEOP_HZ
     next_at = time.perf_counter()
-    count = int(TELEOP_S * TELEOP_HZ)
+    count = int((0.5 if warm_up else TELEOP_S) * TELEOP_HZ)
+    base += 25.0 if warm_up else 0.0
     for index in range(count):
         value = round(base + (index % 400) * 0.05 + index * 1e-6, 6)
         sent[value] = time.perf_counter()
@@ -465,9 +477,9 @@ def fleet_bench(ctx: BenchContext) -> BenchResult:
         "'over idle' is what serving costs.",
         f"Load average (1 min) {raw['load_before']:.1f} before the run and "
         f"{raw['load_after']:.1f} after, on 2 cores shared with other sessions: a start waits "
-        "for the scheduler after `start_at` (a robot wakes on time, then its request crosses "
-        "three threads: Zenoh's, the robot's API loop, the route's worker), so the spread and "
-        "the teleop p99 measure the neighbours as much as poppy; to be measured again on a "
+        "for the scheduler after `start_at` (the request is routed on arrival, 0.3 s ahead; at "
+        "`start_at` the route's worker thread wakes and starts the primitive), so the spread "
+        "and the teleop p99 measure the neighbours as much as poppy; to be measured again on a "
         "quiet machine. A goal dropped (`handled < sent`) is one Zenoh dropped rather than "
         "queue (`CongestionControl.DROP`): the next one comes 10 ms later.",
     ]

@@ -19,21 +19,22 @@ from typing import Any
 from bench.procs import free_port
 from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
 from poppy_core.robot import from_profile
-from poppy_core.server.service import RobotService
 
 
 def _log_starts(path: Path) -> None:
-    real = RobotService.control_primitive
+    """Append the wall-clock time of every primitive start (when its thread is started)."""
+    from poppy_core.motion import Primitive
+
+    real = Primitive.start
     lock = threading.Lock()
 
-    def control(self: RobotService, name: str, action: str) -> Any:
-        if action == "start":
-            stamp = time.time()
-            with lock, path.open("a", encoding="utf-8") as out:
-                out.write(f"{getattr(self, 'bench_name', '?')} {stamp:.6f}\n")
-        return real(self, name, action)
+    def start(self: Primitive) -> Any:
+        stamp = time.time()
+        with lock, path.open("a", encoding="utf-8") as out:
+            out.write(f"{type(self).__name__} {stamp:.6f}\n")
+        return real(self)
 
-    RobotService.control_primitive = control  # type: ignore[method-assign]
+    Primitive.start = start  # type: ignore[method-assign]
 
 
 def main() -> None:
@@ -60,7 +61,6 @@ def main() -> None:
                 name=name,
             )
             servers = serve(robot, spec)
-            servers.service.bench_name = name  # type: ignore[attr-defined]
             sets.append(servers)
             ws_port = servers.ws.port if servers.ws is not None else 0
             print(name, endpoint or "-", ws_port, flush=True)

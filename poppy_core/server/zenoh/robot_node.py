@@ -16,6 +16,7 @@ import hmac
 import json
 import logging
 import math
+import re
 import socket
 import threading
 import time
@@ -27,6 +28,7 @@ from poppy_core.motion.chains import robot_chains
 from poppy_core.schedule import Periodic, RateMeter, Worker
 from poppy_core.server.errors import ApiError
 from poppy_core.server.middleware import MAX_BODY_BYTES
+from poppy_core.server.start_time import START_AT
 from poppy_core.server.zenoh.asgi_call import AsgiCaller
 
 if TYPE_CHECKING:
@@ -42,6 +44,9 @@ HEALTH_PERIOD_S = 1.0
 MAX_START_DELAY_S = 60.0
 """How far in the future a ``start_at`` may be (a clock that far off is refused, not waited)."""
 METHODS = ("GET", "PUT", "POST", "DELETE")
+STARTS = re.compile(r"/api/v1/(primitives/[^/?]+/start|moves/[^/?]+/play)")
+"""The requests whose action waits for ``start_at`` in its own thread (``start_time``); any
+other request with a ``start_at`` is sent to the app at that time."""
 API_SHAPE = 'send {"method": "GET|PUT|POST|DELETE", "path": "/api/v1/...", "body": {...}}'
 
 
@@ -136,14 +141,15 @@ class ZenohRobotServer:
         self._worker.start()
 
     def stop(self) -> None:
-        """Undeclare everything (the token first: the fleet sees the robot leave), stop."""
+        """Stop publishing, then undeclare everything (the token first: the fleet sees the
+        robot leave), then the API's loop."""
+        self._worker.close()
         for declared in reversed(self._declared):
             try:
                 declared.undeclare()
             except Exception as exc:  # a session already closed
                 logger.debug("undeclaring on Zenoh: %s", exc)
         self._declared = []
-        self._worker.close()
         if self._caller is not None:
             self._caller.close()
             self._caller = None
@@ -278,6 +284,13 @@ class ZenohRobotServer:
             start_at = _start_at(request.get("start_at"))
         except ArgumentError as exc:
             return 422, {"detail": str(exc)}
+        if start_at is not None and STARTS.fullmatch(path):
+            # routed now; the start itself waits for the clock in the route's thread
+            context = START_AT.set(start_at)
+            try:
+                return await caller.call(method, path, request.get("body"), token)
+            finally:
+                START_AT.reset(context)
         if start_at is not None:
             await asyncio.sleep(max(0.0, start_at - time.time()))
         return await caller.call(method, path, request.get("body"), token)
