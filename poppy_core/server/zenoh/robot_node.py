@@ -139,6 +139,14 @@ class ZenohRobotServer:
             session.liveliness().declare_token(zenoh_wire.robot_key(self.name)),
         ]
         self._worker.start()
+        self._caller.submit(self._warm_up(self._caller))
+
+    async def _warm_up(self, caller: AsgiCaller) -> None:
+        """One request through the app before any client's: its first one builds the routes'
+        models and the worker threads (a first fleet command would start late by that)."""
+        for name in list(self.service.primitives())[:1]:
+            await caller.call("GET", f"/api/v1/primitives/{name}", token=self.token)
+        await caller.call("GET", "/api/v1/moves/status", token=self.token)
 
     def stop(self) -> None:
         """Stop publishing, then undeclare everything (the token first: the fleet sees the
