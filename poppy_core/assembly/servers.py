@@ -243,16 +243,25 @@ def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) 
     snap.thread.bind()
 
 
+def _zenoh_session(servers: ServerSet, settings: ZenohSettings) -> Any:
+    """The set's one Zenoh session, opened on first use: every server on Zenoh of the set (the
+    fleet node, ROS 2) declares on it; ``ServerSet.stop`` closes it after them."""
+    if servers.zenoh_session is None:
+        from poppy_core.zenoh_wire import open_session
+
+        servers.zenoh_session = open_session(settings)
+    return servers.zenoh_session
+
+
 def _add_zenoh(servers: ServerSet, spec: ServeSpec, settings: ZenohSettings, app: Any) -> None:
     from poppy_core.server.zenoh import ZenohRobotServer
-    from poppy_core.zenoh_wire import check_name, default_name, open_session
+    from poppy_core.zenoh_wire import check_name, default_name
 
     name = check_name(spec.name) if spec.name is not None else default_name()
-    servers.zenoh_session = open_session(settings)
     servers.servers["zenoh"] = ZenohRobotServer(
         servers.service,
         app,
-        servers.zenoh_session,
+        _zenoh_session(servers, settings),
         name,
         token=spec.token,
         state_rate_hz=spec.state_rate_hz,
