@@ -149,9 +149,16 @@ def open_session(settings: ZenohSettings) -> zenoh.Session:
         return zenoh.open(config)
     except zenoh.ZError as exc:
         raise ConfigError(
-            f"cannot open the Zenoh session ({exc}): check --zenoh-listen / --zenoh-connect",
+            f"cannot open the Zenoh session ({zenoh_message(exc)}): check --zenoh-listen / "
+            "--zenoh-connect",
             field="zenoh",
         ) from None
+
+
+def zenoh_message(exc: BaseException) -> str:
+    """Zenoh's error text without the places in its Rust sources it names."""
+    text = re.sub(r"\s+at /\S+", "", str(exc)).replace("[", "").replace("]", "")
+    return " ".join(text.split()).rstrip(".")
 
 
 def await_peers(session: zenoh.Session, settings: ZenohSettings, wait_s: float = 3.0) -> bool:

@@ -435,3 +435,25 @@ def test_fleet_commands_name_their_robots() -> None:
     result = run_poppy("fleet", "stop", "--connect", free_endpoint())
     assert result.code == 2
     assert "--all, or --robots a,b" in result.stderr
+
+
+def test_a_busy_zenoh_endpoint_is_one_clear_line(moves: Path) -> None:
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        endpoint = f"tcp/127.0.0.1:{busy.getsockname()[1]}"
+        result = run_poppy(
+            "serve",
+            "--zenoh",
+            "--name",
+            "x",
+            "--zenoh-listen",
+            endpoint,
+            "--sim",
+            "--profile",
+            "ergo-jr",
+        )
+    assert result.code == 1
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Address already in use" in lines[0], lines
+    assert " at /" not in lines[0]
