@@ -19,7 +19,7 @@ from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from poppy_core.server.pypot_json import html_safe
-from poppy_core.server.start_time import wait_for_start
+from poppy_core.server.start_time import start_at_time
 from poppy_core.server.teleop_channel import TeleopRegistry
 from poppy_core.trajectory import control_name, goto_duration
 
@@ -210,8 +210,7 @@ class RobotService:
         """``start``, ``stop``, ``pause`` or ``resume`` a primitive (``stop`` joins its thread)."""
         primitive = self.primitive(name)
         if action == "start":
-            wait_for_start()  # a fleet's shared start time (none over HTTP)
-            primitive.start()
+            start_at_time(primitive.start)  # a fleet's shared start time (none over HTTP)
         elif action == "stop":
             primitive.halt(wait=True)
         elif action == "pause":

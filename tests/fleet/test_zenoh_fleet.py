@@ -457,3 +457,17 @@ def test_a_busy_zenoh_endpoint_is_one_clear_line(moves: Path) -> None:
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "Address already in use" in lines[0], lines
     assert " at /" not in lines[0]
+
+
+def test_a_start_waits_for_its_time_and_hands_back_its_result_or_error() -> None:
+    from poppy_core.server.start_time import START_AT, start_at_time
+
+    assert start_at_time(lambda: 7) == 7  # no start time: at once
+    when = time.time() + 0.1
+    context = START_AT.set(when)
+    try:
+        assert start_at_time(time.time) >= when
+        with pytest.raises(ZeroDivisionError):
+            start_at_time(lambda: 1 / 0)
+    finally:
+        START_AT.reset(context)
