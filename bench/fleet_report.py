@@ -83,7 +83,7 @@ def build_result(raw: dict[str, Any], settings: dict[str, Any]) -> BenchResult:
         f"Load average (1 min) {raw['load_before']:.1f} before the run and "
         f"{raw['load_after']:.1f} after, on 2 cores shared with other sessions: a start waits "
         "for the scheduler after `start_at` (the request is routed on arrival, 0.3 s ahead; at "
-        "`start_at` the route's worker thread wakes and starts the primitive), so the spread "
+        "`start_at` one thread per process starts the primitives due), so the spread "
         "and the teleop p99 measure the neighbours as much as poppy; to be measured again on a "
         "quiet machine. A goal dropped (`handled < sent`) is one Zenoh dropped rather than "
         "queue (`CongestionControl.DROP`): the next one comes 10 ms later.",
