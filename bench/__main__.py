@@ -9,6 +9,7 @@ from pathlib import Path
 
 from bench import (
     camera_bench,
+    fleet_bench,
     ik_bench,
     move_bench,
     robot_bench,
@@ -42,6 +43,7 @@ _MODULES = (
     snap_bench,
     web_bench,
     zmq_bench,
+    fleet_bench,
 )
 
 

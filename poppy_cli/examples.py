@@ -76,14 +76,40 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
             "serve --http --host 0.0.0.0 --name poppy --announce --token s3cret --profile ergo-jr",
             "http://poppy.local:8080 on the network",
         ),
+        (
+            "serve --zenoh --name jr1 --zenoh-connect tcp/192.168.1.10:7447 --profile ergo-jr",
+            "on Zenoh as poppy/jr1, through the teacher's router",
+        ),
     ),
     "fleet": (
-        ("fleet discover", "the robots announced on the network"),
-        ("fleet discover --json --timeout 5", "for scripts"),
+        ("fleet discover", "the robots announced on the network (mDNS)"),
+        ("fleet list --connect tcp/192.168.1.10:7447", "the robots on Zenoh"),
+        ("fleet play wave --all", "every robot plays a move, starting together"),
+        ("fleet stop --all", "the Stop button of every robot"),
     ),
     "fleet discover": (
         ("fleet discover", "listen 3 s on every interface"),
         ("fleet discover --timeout 1 --interface 127.0.0.1 --json", "this machine's only"),
+    ),
+    "fleet list": (
+        ("fleet list", "through a router on this computer (tcp/127.0.0.1:7447)"),
+        ("fleet list --connect tcp/192.168.1.10:7447 --json", "for scripts"),
+    ),
+    "fleet status": (
+        ("fleet status --watch", "one live table of every robot"),
+        ("fleet status --connect tcp/192.168.1.10:7447", "once"),
+    ),
+    "fleet run": (
+        ("fleet run dance --all", "every robot dances, starting together"),
+        ("fleet run dance --robots jr1,jr2", "two robots"),
+    ),
+    "fleet play": (
+        ("fleet play wave --all", "every robot plays a move of its library"),
+        ("fleet play wave --robots jr1,jr2 --token s3cret", "two robots served with a token"),
+    ),
+    "fleet stop": (
+        ("fleet stop --all", "primitives and moves stopped, motors held"),
+        ("fleet stop --robots jr3 --json", "one robot, JSON"),
     ),
     "motor": (
         ("motor info 3 -p /dev/ttyUSB0", "the whole control table"),

@@ -36,7 +36,7 @@ FLAGS: dict[str, Flag] = {
         "-p", "PORT", "serial port of the bus: a device, a pty or a URL (`notebook`: its TCP port)"
     ),
     "--sim": Flag(None, "[mujoco]", "a virtual robot: bare for ideal servos, `mujoco` for physics"),
-    "--remote": Flag(None, "URL", "drive a robot served by `poppy serve --http` at this URL"),
+    "--remote": Flag(None, "URL", "drive a served robot: http://HOST:PORT or zenoh:NAME"),
     "--motors": Flag("-m", "MOTORS", "which motors: names or groups (models:IDs in `emulate`)"),
     "--chain": Flag(None, "NAME", "kinematic chain of the robot"),
     # -- the bus
@@ -102,6 +102,14 @@ FLAGS: dict[str, Flag] = {
     "--ws-rate": Flag(None, "HZ", "WebSocket state frames per second"),
     "--zmq": Flag(None, None, "serve pypot's ZMQ API"),
     "--zmq-port": Flag(None, "PORT", "TCP port of the ZMQ API"),
+    "--zenoh": Flag(None, None, "serve the robot on Zenoh under poppy/NAME (fleets)"),
+    "--zenoh-listen": Flag(None, "ENDPOINT", "Zenoh endpoint to listen on, e.g. tcp/0.0.0.0:7447"),
+    "--zenoh-connect": Flag(None, "ENDPOINT", "Zenoh peer or router to connect to"),
+    "--zenoh-config": Flag(None, "FILE", "Zenoh's own JSON5 configuration (TLS, access control)"),
+    "--zenoh-scout": Flag(None, None, "find Zenoh peers by multicast scouting on the LAN"),
+    "--connect": Flag(None, "ENDPOINT", "Zenoh endpoint (peer or router) to connect to"),
+    "--all": Flag(None, None, "every robot of the fleet"),
+    "--robots": Flag(None, "NAMES", "robots of the fleet, comma-separated"),
     "--snap": Flag(None, None, "serve pypot's Snap! routes and the Poppy blocks"),
     "--snap-port": Flag(None, "PORT", "TCP port of the Snap! server"),
     "--snap-dir": Flag(None, "DIR", "a downloaded Snap! to serve"),

@@ -212,7 +212,8 @@ SimOpt = sim_option("Build a virtual robot: --sim (ideal servos) or --sim mujoco
 RemoteOpt = typer.Option(
     None,
     "--remote",
-    help="Drive a robot served by `poppy serve --http` at this URL (token: env POPPY_TOKEN).",
+    help="Drive a robot served by `poppy serve --http` at this URL, or by `poppy serve --zenoh` "
+    "as zenoh:NAME (endpoints: env POPPY_ZENOH_CONNECT; token: env POPPY_TOKEN).",
 )
 
 

@@ -20,6 +20,7 @@ EXTRAS: dict[str, str] = {
     "faces": "face detection (scikit-image)",
     "server": "the web servers (REST, WebSocket, Snap!, the web page)",
     "zmq": "pypot's ZMQ server",
+    "fleet": "Zenoh fleets (serve --zenoh, poppy fleet, zenoh: remote robots)",
     "tui": "the terminal app",
     "plot": "plots (matplotlib)",
     "notebook": "Jupyter notebooks (`poppy notebook`)",

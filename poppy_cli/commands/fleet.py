@@ -1,11 +1,16 @@
-"""`poppy fleet`: the robots on the network (this module only registers the commands)."""
+"""`poppy fleet`: many robots at once. This group only registers its commands, each in its own
+module: discover (mDNS, `fleet_discover`); list, status, run, play and stop over Zenoh
+(`fleet_zenoh`)."""
 
 from __future__ import annotations
 
 import typer
 
-from poppy_cli.commands import fleet_discover
+from poppy_cli.commands import fleet_discover, fleet_zenoh
 
-app = typer.Typer(help="Robots on the network: find the ones announced.", no_args_is_help=True)
-
+app = typer.Typer(
+    help="Many robots at once: find the ones announced, list, watch and drive a fleet.",
+    no_args_is_help=True,
+)
 app.command("discover")(fleet_discover.discover)
+fleet_zenoh.register(app)

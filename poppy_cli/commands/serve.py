@@ -1,5 +1,5 @@
-"""`poppy serve --http [--ws] [--snap] [--zmq]`: serve a robot over REST (pypot's routes +
-/api/v1), WebSocket, Snap!'s routes and pypot's ZMQ request/reply API."""
+"""`poppy serve --http [--ws] [--snap] [--zmq] [--zenoh]`: serve a robot over REST (pypot's routes
++ /api/v1), WebSocket, Snap!'s routes, pypot's ZMQ request/reply API and Zenoh (fleets)."""
 
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ from poppy_cli.robots import build_robot
 if TYPE_CHECKING:
     from poppy_core.assembly import ServerSet, ServeSpec
     from poppy_core.server.moves import SavedTake
+    from poppy_core.zenoh_wire import ZenohSettings
 
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 
@@ -91,6 +92,12 @@ def serve(
     open_browser: bool = typer.Option(
         False, "--open", help="Open Snap! with the Poppy blocks in the browser (with --snap)."
     ),
+    zenoh: bool = typer.Option(
+        False,
+        "--zenoh",
+        help="Serve the robot on Zenoh under poppy/NAME: its state, health, description and "
+        "commands, for `poppy fleet` and zenoh:NAME remote robots (see docs/fleet.md).",
+    ),
     name: str | None = typer.Option(
         None,
         "--name",
@@ -104,12 +111,35 @@ def serve(
         help="Announce NAME.local and the servers over mDNS/DNS-SD on the interfaces served "
         "(`poppy fleet discover` lists them); off unless asked.",
     ),
+    zenoh_listen: list[str] | None = typer.Option(
+        None,
+        "--zenoh-listen",
+        help="Listen for Zenoh peers here, e.g. tcp/0.0.0.0:7447 (repeat it). Default: nowhere.",
+    ),
+    zenoh_connect: list[str] | None = typer.Option(
+        None,
+        "--zenoh-connect",
+        help="Connect to this Zenoh peer or router, e.g. tcp/192.168.1.10:7447 (repeat it).",
+    ),
+    zenoh_config: Path | None = typer.Option(
+        None,
+        "--zenoh-config",
+        exists=True,
+        dir_okay=False,
+        help="Zenoh's own JSON5 configuration (router mode, TLS, access control).",
+    ),
+    zenoh_scout: bool = typer.Option(
+        False, "--zenoh-scout", help="Find Zenoh peers by multicast scouting on the LAN."
+    ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
-    if not (http or ws or snap or zmq):
-        _usage("nothing to serve: pass --http, --ws, --snap and/or --zmq")
+    if not (http or ws or snap or zmq or zenoh):
+        _usage("nothing to serve: pass --http, --ws, --snap, --zmq and/or --zenoh")
     http_port, *alias_ports = http_ports or [8080]
     _check_http_ports(http_ports)
+    zenoh_settings = _zenoh_settings(
+        zenoh, name, zenoh_listen, zenoh_connect, zenoh_config, zenoh_scout
+    )
     if http and ws and ws_port in http_ports and ws_port != 0:
         _usage(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
@@ -141,6 +171,7 @@ def serve(
         announce=announce,
         http_alias_ports=tuple(alias_ports),
         report=_report,
+        zenoh=zenoh_settings,
     )
     any_origin = _check_origins(spec)
     _warn_exposure(spec, host, any_origin)
@@ -194,6 +225,31 @@ def _check_http_ports(ports: list[int]) -> None:
         _usage(f"--http-port {twice[0]} is given twice: give each port once")
 
 
+def _zenoh_settings(
+    zenoh: bool,
+    name: str | None,
+    listen: list[str] | None,
+    connect: list[str] | None,
+    config: Path | None,
+    scout: bool,
+) -> ZenohSettings | None:
+    """The Zenoh settings asked for (None without --zenoh); a bad endpoint or name is a usage
+    error before the robot is built."""
+    from poppy_core.errors import ConfigError
+    from poppy_core.zenoh_wire import ZenohSettings, check_name
+
+    if not zenoh:
+        if listen or connect or config or scout:
+            _usage("--zenoh-listen, --zenoh-connect, --zenoh-config and --zenoh-scout need --zenoh")
+        return None
+    try:
+        if name is not None:
+            check_name(name)
+        return ZenohSettings(tuple(listen or ()), tuple(connect or ()), config, scout)
+    except ConfigError as exc:
+        _usage(str(exc))
+
+
 def _check_origins(spec: ServeSpec) -> bool:
     """Refuse a --cors or --allow-host that is not one, before the robot is built; True when
     every origin is allowed."""
@@ -245,6 +301,9 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
     if servers.announcer is not None and servers.http is not None:
         where = servers.announcer.host
         print(f"announced: http://{where}:{servers.http.port}", flush=True)
+    if servers.zenoh is not None:
+        where = ", ".join(servers.zenoh.endpoints) or "no endpoint (it connects out)"
+        print(f"zenoh: poppy/{servers.zenoh.name} listening on {where}", flush=True)
 
 
 def _say_where_takes_went(saved: list[SavedTake]) -> None:

@@ -75,7 +75,8 @@ def teleop(
     leader: str | None = typer.Option(
         None,
         "--leader",
-        help="Leader: a profile name or a config file. [default: user settings]",
+        help="Leader: a profile name, a config file, or zenoh:NAME (a robot served with "
+        "`poppy serve --zenoh`). [default: user settings]",
         autocompletion=complete.profiles,
     ),
     leader_port: str | None = typer.Option(
@@ -88,7 +89,8 @@ def teleop(
         ...,
         "--follower",
         help="Follower: a profile name, a config file, http://HOST:PORT of `poppy serve "
-        "--http`, or 'self' (the leader copies its own joints, e.g. one arm to the other).",
+        "--http`, zenoh:NAME of `poppy serve --zenoh`, or 'self' (the leader copies its own "
+        "joints, e.g. one arm to the other).",
         autocompletion=complete.profiles,
     ),
     follower_port: str | None = typer.Option(
@@ -129,6 +131,12 @@ def teleop(
         False, "--force", "-f", help="Replace an existing move of that name."
     ),
     json_output: bool = JsonSummaryOpt,
+    connect: list[str] | None = typer.Option(
+        None,
+        "--connect",
+        help="For zenoh:NAME robots: a Zenoh peer or router to connect to (repeat it). "
+        "Default: POPPY_ZENOH_CONNECT, else tcp/127.0.0.1:7447.",
+    ),
 ) -> None:
     """Teleoperate: the leader turns compliant, move it by hand; the follower copies it.
 
@@ -146,7 +154,11 @@ def teleop(
         raise typer.BadParameter(
             f"{follower_sim!r}: use ideal or mujoco", param_hint="--follower-sim"
         )
-    remote = _is_url(follower)
+    zenoh_leader = leader is not None and leader.startswith("zenoh:")
+    zenoh_follower = follower.startswith("zenoh:")
+    remote = _is_url(follower) or zenoh_follower
+    if zenoh_leader and (leader_port or follower == SELF):
+        raise typer.BadParameter("a zenoh: leader takes no --leader-port and no --follower self")
     if remote and (follower_port or follower_sim):
         raise typer.BadParameter("a served follower takes no --follower-port or --follower-sim")
     if follower == SELF and (follower_port or follower_sim):
@@ -162,14 +174,17 @@ def teleop(
 
         probe_folder(path.parent, make_folder=not is_path(record or ""))  # before anything moves
     leader_file = Path(leader).expanduser() if leader is not None else None
-    if leader_file is not None and leader_file.is_file():  # the port: option, env, settings
+    leader_config: RobotConfig | None = None
+    if zenoh_leader:
+        pass
+    elif leader_file is not None and leader_file.is_file():  # the port: option, env, settings
         leader_config = robot_config(None, leader_file, leader_port)
     else:
         leader_config = robot_config(leader, None, leader_port)
     follower_config = (
         None if remote or follower == SELF else _config(follower, follower_port, "follower")
     )
-    if follower_config is not None and follower_sim is None:
+    if leader_config is not None and follower_config is not None and follower_sim is None:
         shared = _ports_of(leader_config) & _ports_of(follower_config)
         if shared:
             error_line(
@@ -180,14 +195,28 @@ def teleop(
     with ExitStack() as stack:
         # Everything that can be refused is, before a robot is built (nothing turns compliant).
         follow: Any = None
-        if remote:
+        lead: Any = None
+        settings = _zenoh_settings(connect) if zenoh_leader or zenoh_follower else None
+        if zenoh_follower:
+            follow = _zenoh_follower(follower, settings)
+            stack.callback(follow.close)
+            follower_motors = follow.motor_names
+        elif remote:
             follow = _remote(follower, rate)
             stack.callback(follow.close)
             follower_motors = follow.motor_names
         else:
-            follower_motors = list((follower_config or leader_config).motors)
-        _check_map(mapping, list(leader_config.motors), follower_motors, follower == SELF)
-        lead = stack.enter_context(_build(leader_config, None))
+            follower_motors = list((follower_config or leader_config).motors)  # type: ignore[union-attr]
+        if leader_config is None:
+            lead = _zenoh_leader(str(leader), settings)
+            stack.callback(lead.close)
+            leader_motors = [m.name for m in lead.motors]
+        else:
+            leader_motors = list(leader_config.motors)
+        _check_map(mapping, leader_motors, follower_motors, follower == SELF)
+        if lead is None:
+            assert leader_config is not None
+            lead = stack.enter_context(_build(leader_config, None))
         if follow is None:
             follow = (
                 lead
@@ -198,8 +227,13 @@ def teleop(
         # start-up (return delays) is answered, or Ctrl-C there ends the command.
         stop = threading.Event()
         _install_stop(stop)
+        leader_name = (
+            leader_config.profile.name
+            if leader_config is not None and leader_config.profile is not None
+            else leader or "leader"
+        )
         teleop_run = _start(
-            lead, follow, mapping, rate, ramp, duration, path, leader_config, follower
+            lead, follow, mapping, rate, ramp, duration, path, leader_name, follower
         )
         _watch(teleop_run, stop, show=not json_output)
         report = teleop_run.report()
@@ -258,6 +292,28 @@ def _remote(url: str, rate: float) -> Any:
     return RemoteFollower(url, token=os.environ.get("POPPY_TOKEN") or None, rate_hz=rate)
 
 
+def _zenoh_settings(connect: list[str] | None) -> Any:
+    from poppy_core.remote.zenoh_client import client_settings
+
+    return client_settings(tuple(connect or ()))
+
+
+def _zenoh_leader(spec: str, settings: Any) -> Any:
+    from poppy_core.remote.zenoh_client import robot_name
+    from poppy_core.remote.zenoh_teleop import ZenohLeader
+
+    token = os.environ.get("POPPY_TOKEN") or None
+    return ZenohLeader(str(robot_name(spec)), token, settings=settings)
+
+
+def _zenoh_follower(spec: str, settings: Any) -> Any:
+    from poppy_core.remote.zenoh_client import robot_name
+    from poppy_core.remote.zenoh_teleop import ZenohFollower
+
+    token = os.environ.get("POPPY_TOKEN") or None
+    return ZenohFollower(str(robot_name(spec)), token, settings=settings)
+
+
 def _start(
     leader: Robot,
     follower: Any,
@@ -266,12 +322,11 @@ def _start(
     ramp: float | None,
     duration: float | None,
     path: Path | None,
-    leader_config: RobotConfig,
+    name: str,
     follower_spec: str,
 ) -> Teleoperation:
     from poppy_core.motion.teleop.session import Teleoperation
 
-    name = leader_config.profile.name if leader_config.profile is not None else "leader"
     metadata = {"description": f"teleoperated: {name} → {follower_spec}"}
     if getattr(follower, "config", None) is not None and follower.config.profile is not None:
         metadata["robot"] = follower.config.profile.name

@@ -17,6 +17,7 @@ from poppy_core.assembly.pypot_creatures import (
     PoppyTorso,
 )
 from poppy_core.assembly.servers import Listen, ServerSet, ServeSpec, serve
+from poppy_core.zenoh_wire import ZenohSettings
 
 installed_poppy_creatures = MappingProxyType(
     {"poppy-humanoid": PoppyHumanoid, "poppy-torso": PoppyTorso, "poppy-ergo-jr": PoppyErgoJr}
@@ -32,6 +33,7 @@ __all__ = [
     "PoppyTorso",
     "ServeSpec",
     "ServerSet",
+    "ZenohSettings",
     "autodetect",
     "from_config",
     "from_json",

@@ -3,8 +3,10 @@
 ``poppy serve`` and the creature classes (``PoppyErgoJr(use_http=True, use_ws=True)``) both come
 here. Every protocol of one set shares one ``RobotService`` (so one teleoperation registry: a
 motor is teleoperated by one WebSocket connection, whichever port it came through), one Host and
-Origin policy (Snap!'s adds snap.berkeley.edu), one token, and one shutdown order: ZMQ, Snap!,
-WebSocket, HTTP (the reverse of starting), then the service's recordings and teleoperations.
+Origin policy (Snap!'s adds snap.berkeley.edu), one token, and one shutdown order: Zenoh, ZMQ,
+Snap!, WebSocket, HTTP (the reverse of starting), then the Zenoh session, then the service's
+recordings and teleoperations. The Zenoh session (``ServerSet.zenoh_session``) is one per set,
+opened before anything serves: every server on Zenoh (the fleet node, ROS 2) declares on it.
 Importing this module loads no server library; ``serve`` does.
 """
 
@@ -15,16 +17,20 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from poppy_core.zenoh_wire import ZenohSettings
+
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
     from poppy_core.server import OriginPolicy, RobotService
     from poppy_core.server.announce import Announcer
     from poppy_core.server.background import BackgroundServer
     from poppy_core.server.snap import SnapServer
+    from poppy_core.server.zenoh import ZenohRobotServer
     from poppy_core.server.zmqserver import ZmqRobotServer
 
-PROTOCOLS = ("http", "ws", "zmq", "snap")
-"""pypot's attribute names of the servers (``robot.http``...), in the order they start."""
+PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh")
+"""pypot's attribute names of the servers (``robot.http``...) and ``zenoh``, in the order they
+start."""
 SNAP_ONLINE_NOTE = (
     "Snap! opens online (snap.berkeley.edu): run `poppy snap download` once on the robot "
     "to serve Snap! offline"
@@ -58,12 +64,16 @@ class ServeSpec:
         ws_rate_hz: the state stream's default rate.
         snap_dir: a downloaded Snap! served at ``/app/`` on the Snap! port.
         name: the robot's name: ``NAME`` and ``NAME.local`` are accepted as Host names, and the
-            pages the robot serves under them on any port count as its own.
+            pages the robot serves under them on any port count as its own; on Zenoh the robot
+            is ``poppy/NAME`` (the host's name when None).
         announce: announce ``NAME.local`` (default ``poppy``) and the robot's services over
             mDNS/DNS-SD on the interfaces the servers listen on (``appliance`` extra).
         http_alias_ports: more ports serving the REST API and page, on ``http``'s host (the
             appliance serves port 80 and keeps 8080); their pages count as the server's own.
         report: called with one line the first time an origin or Host name is refused.
+        zenoh: the robot on Zenoh under ``poppy/<name>`` (``ZenohSettings``: endpoints,
+            configuration file, scouting), or None.
+        state_rate_hz: the Zenoh state messages per second (the sync loop's rate).
     """
 
     http: Listen | None = None
@@ -79,6 +89,8 @@ class ServeSpec:
     announce: bool = False
     http_alias_ports: tuple[int, ...] = ()
     report: Callable[[str], None] | None = field(default=None, compare=False)
+    zenoh: ZenohSettings | None = None
+    state_rate_hz: float = 50.0
 
     def listens(self) -> dict[str, Listen]:
         """Protocol -> where it listens, for the servers asked for, in starting order."""
@@ -109,6 +121,8 @@ class ServerSet:
         self.servers: dict[str, Any] = {}
         self.announcer: Announcer | None = None
         """The mDNS announcement (``announce``); ``announcer.name`` is the name won."""
+        self.zenoh_session: Any = None
+        """The one Zenoh session of the set (``zenoh.Session``), or None without ``zenoh``."""
         self._stopped = False
 
     @property
@@ -132,6 +146,11 @@ class ServerSet:
         return self.servers.get("snap")
 
     @property
+    def zenoh(self) -> ZenohRobotServer | None:
+        """The robot on Zenoh."""
+        return self.servers.get("zenoh")
+
+    @property
     def running(self) -> bool:
         """True while every server serves."""
         return bool(self.servers) and all(s.running for s in self.servers.values())
@@ -143,7 +162,8 @@ class ServerSet:
         return self
 
     def stop(self) -> None:
-        """Stop the servers (ZMQ, Snap!, WebSocket, HTTP), then the service (again: nothing)."""
+        """Stop the servers (Zenoh, ZMQ, Snap!, WebSocket, HTTP), the Zenoh session, then the
+        service (again: nothing)."""
         if self._stopped:
             return
         self._stopped = True
@@ -152,6 +172,9 @@ class ServerSet:
         for name in reversed(PROTOCOLS):
             if name in self.servers:
                 self.servers[name].stop()
+        if self.zenoh_session is not None:
+            self.zenoh_session.close()
+            self.zenoh_session = None
         self.service.close()
 
     def __enter__(self) -> ServerSet:
@@ -172,7 +195,8 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
         ListenError: a port is taken or an address unusable.
         RuntimeError: a server did not start (its log says why).
         ValueError: an origin in ``cors``, a name in ``allow_hosts`` or ``name`` that is not one.
-        MissingExtraError: the ``server`` (or ``zmq``, ``appliance``) extra is missing.
+        ConfigError: a Zenoh endpoint or configuration that cannot be used, a bad name.
+        MissingExtraError: the ``server`` (or ``zmq``, ``appliance``, ``fleet``) extra is missing.
     """
     from poppy_core.server import OriginPolicy, RobotService, ServerThread, create_app
     from poppy_core.server.background import BackgroundServer
@@ -188,13 +212,13 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     )
     service = RobotService(robot)
     app = None
-    if "http" in listens:
+    if "http" in listens or spec.zenoh is not None:
         app = create_app(
             robot, service=service, token=spec.token, policy=policy, stream_rate_hz=spec.ws_rate_hz
         )
-    servers = ServerSet(service, policy, app)
+    servers = ServerSet(service, policy, app if "http" in listens else None)
     try:
-        if app is not None:
+        if "http" in listens:
             where = listens["http"]
             thread = ServerThread(
                 app, where.host, where.port, alias_ports=spec.http_alias_ports
@@ -212,8 +236,11 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
             servers.servers["zmq"] = ZmqRobotServer(robot, where.host, where.port, service=service)
         if "snap" in listens:
             _add_snap(servers, robot, spec, listens["snap"])
+        if spec.zenoh is not None:
+            _add_zenoh(servers, spec, spec.zenoh, app)
         _own_pages(servers)
         _named(servers, robot, spec)
+        _fleet_page(servers)
         if start:
             servers.start()
     except BaseException:
@@ -285,9 +312,49 @@ def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) 
     snap.thread.bind()
 
 
+def _zenoh_session(servers: ServerSet, settings: ZenohSettings) -> Any:
+    """The set's one Zenoh session, opened on first use: every server on Zenoh of the set (the
+    fleet node, ROS 2) declares on it; ``ServerSet.stop`` closes it after them."""
+    if servers.zenoh_session is None:
+        from poppy_core.zenoh_wire import open_session
+
+        servers.zenoh_session = open_session(settings)
+    return servers.zenoh_session
+
+
+def _add_zenoh(servers: ServerSet, spec: ServeSpec, settings: ZenohSettings, app: Any) -> None:
+    from poppy_core.server.zenoh import ZenohRobotServer
+    from poppy_core.zenoh_wire import check_name, default_name
+
+    name = check_name(spec.name) if spec.name is not None else default_name()
+    servers.servers["zenoh"] = ZenohRobotServer(
+        servers.service,
+        app,
+        _zenoh_session(servers, settings),
+        name,
+        token=spec.token,
+        state_rate_hz=spec.state_rate_hz,
+        endpoints=settings.listen,
+    )
+
+
+def _fleet_page(servers: ServerSet) -> None:
+    """The page lists the robots its Zenoh session sees; the description names the page."""
+    node = servers.zenoh
+    if node is None or servers.app is None:
+        return
+    from poppy_core.server.zenoh.web_fleet import add_fleet_route
+
+    add_fleet_route(servers.app, node)
+    if servers.http is not None:
+        node.page = servers.http.url
+
+
 def _own_pages(servers: ServerSet) -> None:
     """The pages of every port count as the servers' own; the home page links to Snap!."""
-    ports = [p for name, s in servers.servers.items() if name != "zmq" for p in _ports(s)]
+    ports = [
+        p for name, s in servers.servers.items() if name not in ("zmq", "zenoh") for p in _ports(s)
+    ]
     servers.policy.with_ports(ports)
     snap = servers.snap
     if snap is None:

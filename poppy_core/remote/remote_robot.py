@@ -16,6 +16,7 @@ from poppy_core.errors import (
     UnknownPrimitiveError,
 )
 from poppy_core.remote.client import DEFAULT_TIMEOUT_S, HttpClient, path_of
+from poppy_core.zenoh_wire import ZenohSettings
 
 _OWN = ("_client", "name", "id", "model", "registers")
 
@@ -248,9 +249,12 @@ class RemoteRobot:
     a local ``Robot``.
 
     Args:
-        url: ``http://host:port`` of the server.
+        url: ``http://host:port`` of the server, or ``zenoh:NAME`` for a robot served with
+            ``poppy serve --zenoh --name NAME`` (the same API over Zenoh).
         token: the server's token, if it has one.
         timeout_s: socket timeout of each request.
+        zenoh: how to join the Zenoh network for ``zenoh:NAME`` (default:
+            ``zenoh_client.client_settings()``: POPPY_ZENOH_CONNECT, else tcp/127.0.0.1:7447).
 
     Raises:
         CommunicationError: the server cannot be reached.
@@ -258,10 +262,15 @@ class RemoteRobot:
     """
 
     def __init__(
-        self, url: str, token: str | None = None, timeout_s: float = DEFAULT_TIMEOUT_S
+        self,
+        url: str,
+        token: str | None = None,
+        timeout_s: float = DEFAULT_TIMEOUT_S,
+        *,
+        zenoh: ZenohSettings | None = None,
     ) -> None:
         self.url = url
-        self._client = HttpClient(url, token=token, timeout_s=timeout_s)
+        self._client = _client(url, token, timeout_s, zenoh)
         try:
             infos = self._client.get(path_of("motors"))
             self._motors = [RemoteMotor(self._client, info) for info in infos]
@@ -396,3 +405,14 @@ class RemoteRobot:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _client(
+    url: str, token: str | None, timeout_s: float, zenoh: ZenohSettings | None
+) -> HttpClient:
+    from poppy_core.remote.zenoh_client import ZenohClient, robot_name
+
+    name = robot_name(url)
+    if name is None:
+        return HttpClient(url, token=token, timeout_s=timeout_s)
+    return ZenohClient(name, token=token, timeout_s=timeout_s, settings=zenoh)

@@ -36,6 +36,7 @@ from poppy_core.motion import (
 )
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
+from poppy_core.server.start_time import start_at_time
 
 logger = logging.getLogger(__name__)
 
@@ -245,7 +246,7 @@ class MoveService:
             raise ApiError("invalid", str(exc)) from None
         except ValueError as exc:
             raise ApiError("invalid", f"cannot play {name!r}: {exc}") from None
-        player.start()
+        start_at_time(player.start)  # a fleet's shared start time (none over HTTP)
         with self._lock:
             self._players[name] = player
         return player

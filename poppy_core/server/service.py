@@ -19,6 +19,7 @@ from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from poppy_core.server.pypot_json import html_safe
+from poppy_core.server.start_time import start_at_time
 from poppy_core.server.teleop_channel import TeleopRegistry
 from poppy_core.trajectory import control_name, goto_duration
 
@@ -209,7 +210,7 @@ class RobotService:
         """``start``, ``stop``, ``pause`` or ``resume`` a primitive (``stop`` joins its thread)."""
         primitive = self.primitive(name)
         if action == "start":
-            primitive.start()
+            start_at_time(primitive.start)  # a fleet's shared start time (none over HTTP)
         elif action == "stop":
             primitive.halt(wait=True)
         elif action == "pause":

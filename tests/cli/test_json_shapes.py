@@ -5,7 +5,9 @@ schema here; a command given `--json` without a schema here fails the test."""
 from __future__ import annotations
 
 import os
+import socket
 from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -133,8 +135,22 @@ PRIMITIVE = {
 }
 MS = {"p50": Opt(NUM), "p99": Opt(NUM), "max": Opt(NUM)}
 XYZ = [NUM]
+FLEET_OUTCOMES = [{"name": str, "ok": bool, "status": int, "message": str}]
 
 SCHEMAS: dict[str, Any] = {
+    "fleet list": [
+        {
+            "name": str,
+            "creature": str,
+            "motors": int,
+            "health": str,
+            "host": str,
+            "endpoints": [str],
+        }
+    ],
+    "fleet run": FLEET_OUTCOMES,
+    "fleet play": FLEET_OUTCOMES,
+    "fleet stop": FLEET_OUTCOMES,
     "ports": [
         {
             "device": str,
@@ -398,6 +414,23 @@ SIM = ("--sim", "--profile", "ergo-jr")
 ANSWERS = "\n\ny\n\ny\ny\n"  # calibrate: as tests/cli/test_calibrate_cmd.py answers
 
 
+@contextmanager
+def served_on_zenoh(name: str) -> Iterator[str]:
+    """A virtual Ergo Jr served on Zenoh as ``name``; yields the endpoint it listens on."""
+    from poppy_core.assembly import ServeSpec, ZenohSettings, serve
+    from poppy_core.robot import from_profile
+
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        endpoint = f"tcp/127.0.0.1:{sock.getsockname()[1]}"
+    with from_profile("ergo-jr", sim=True) as robot:
+        servers = serve(robot, ServeSpec(zenoh=ZenohSettings(listen=(endpoint,)), name=name))
+        try:
+            yield endpoint
+        finally:
+            servers.stop()
+
+
 @pytest.fixture(scope="module")
 def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ...]]:
     """Each command's run (once, in order: record before play...): name -> its result."""
@@ -425,7 +458,9 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
             emulate_bus("XL-320:1-6", protocol=2) as (_, follower),
             emulate_bus("MX-28:11-13", protocol=1) as (_, mx),
             emulate_bus("XL-320:1", protocol=2) as (_, kit),
+            served_on_zenoh("jr-json") as zenoh_endpoint,
         ):
+            on_zenoh = ("--connect", zenoh_endpoint)
             p2 = ("--port", jr, "--baud", "1000000", "--protocol", "2")
             p1 = ("--port", mx, "--baud", "1000000", "--protocol", "1")
             pypot = str(tmp / "wave.json")
@@ -480,6 +515,10 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
                                     "127.0.0.1"), ""),
                 "camera detect": (("camera", "detect", "--sim", "mujoco", "--profile", "ergo-jr",
                                    "--marker", "3"), ""),
+                "fleet list": (("fleet", "list", *on_zenoh), ""),
+                "fleet run": (("fleet", "run", "sinus", "--all", *on_zenoh), ""),
+                "fleet play": (("fleet", "play", "wave", "--robots", "jr-json", *on_zenoh), ""),
+                "fleet stop": (("fleet", "stop", "--all", *on_zenoh), ""),
             }
             # fmt: on
             for name, (args, answers) in runs.items():

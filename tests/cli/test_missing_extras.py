@@ -34,6 +34,8 @@ CASES = [
     ("server", "fastapi,uvicorn", ["serve", "--http", *ROBOT, "--http-port", "0"]),
     ("server", "fastapi,uvicorn", ["serve", "--snap", *ROBOT, "--snap-port", "0"]),
     ("zmq", "zmq", ["serve", "--zmq", *ROBOT, "--zmq-port", "0"]),
+    ("fleet", "zenoh", ["serve", "--zenoh", *ROBOT, "--name", "jr"]),
+    ("fleet", "zenoh", ["fleet", "list", "--connect", "tcp/127.0.0.1:9"]),
     ("tui", "textual,textual_serve", ["tui"]),
     ("vision", "cv2", ["camera", "snapshot", "-o", "{tmp}/shot.png", "--device", "0"]),
     ("plot", "matplotlib", ["moves", "plot", "{tmp}/wave.json", "-o", "{tmp}/wave.png"]),

@@ -1,6 +1,7 @@
 // The robot's home page: fetches who the robot is, builds each part, keeps them live.
 import { api, get, openStream, post } from "./api.js";
 import { showCameras, showChains } from "./extras.js";
+import { refreshFleet } from "./fleet.js";
 import { buildTable, onFrame, refresh, stats } from "./motors.js";
 import { refreshMoves, setupRecorder } from "./moves.js";
 import { notebookLink, notes } from "./notebook.js";
@@ -158,6 +159,7 @@ async function main() {
   every(1, refreshPrimitives);
   every(1.5, refreshMoves);
   every(2, refreshLogs);
+  every(5, refreshFleet);
   every(5, async () => { try { showAbout(await get("/api/v1/web/about")); } catch { /* badge */ } });
   window.poppy.ready = true;
 }

@@ -1,0 +1,79 @@
+"""``python -m bench.fleet_robots``: N virtual Ergo Jrs served in one process, for ``bench fleet``.
+
+Each robot: an ideal-servo Ergo Jr (its own 50 Hz sync loop and emulator), served on Zenoh as
+``poppy/<name>`` on its own loopback port and/or on pypot's WebSocket at 50 Hz. Prints one line
+per robot (``name zenoh-endpoint ws-port``), then ``ready``; stops on SIGINT. With ``--starts
+FILE`` every primitive start is appended to FILE as ``name wall-clock-time`` (the fleet play
+spread is measured there, at the robots).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from bench.procs import free_port
+from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
+from poppy_core.robot import from_profile
+
+
+def _log_starts(path: Path) -> None:
+    """Append the wall-clock time of every primitive start (when its thread is started)."""
+    from poppy_core.motion import Primitive
+
+    real = Primitive.start
+    lock = threading.Lock()
+
+    def start(self: Primitive) -> Any:
+        stamp = time.time()
+        with lock, path.open("a", encoding="utf-8") as out:
+            out.write(f"{type(self).__name__} {stamp:.6f}\n")
+        return real(self)
+
+    Primitive.start = start  # type: ignore[method-assign]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--count", type=int, default=10)
+    parser.add_argument("--first", type=int, default=0)
+    parser.add_argument("--zenoh", action="store_true")
+    parser.add_argument("--ws", action="store_true")
+    parser.add_argument("--starts", type=Path)
+    args = parser.parse_args()
+    if args.starts is not None:
+        _log_starts(args.starts)
+    robots, sets = [], []
+    try:
+        for index in range(args.first, args.first + args.count):
+            name = f"jr{index:02d}"
+            robot = from_profile("ergo-jr", sim=True)
+            robots.append(robot)
+            endpoint = f"tcp/127.0.0.1:{free_port()}" if args.zenoh else ""
+            spec = ServeSpec(
+                ws=Listen(port=0) if args.ws else None,
+                ws_rate_hz=50.0,
+                zenoh=ZenohSettings(listen=(endpoint,)) if args.zenoh else None,
+                name=name,
+            )
+            servers = serve(robot, spec)
+            sets.append(servers)
+            ws_port = servers.ws.port if servers.ws is not None else 0
+            print(name, endpoint or "-", ws_port, flush=True)
+        print("ready", flush=True)
+        with contextlib.suppress(KeyboardInterrupt):
+            while True:
+                time.sleep(1)
+    finally:
+        for servers in sets:
+            servers.stop()
+        for robot in robots:
+            robot.close()
+
+
+if __name__ == "__main__":
+    main()

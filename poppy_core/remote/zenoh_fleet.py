@@ -1,0 +1,232 @@
+"""``Fleet``: the robots served on Zenoh (``poppy serve --zenoh``), seen and driven together.
+
+Robots are found by their liveliness tokens ``poppy/NAME`` (a robot that goes leaves within its
+lease), described by ``poppy/NAME/description``, watched through ``poppy/*/state`` and
+``poppy/*/health``, and commanded through ``poppy/NAME/api`` with a shared wall-clock
+``start_at`` so that they start together.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from poppy_core import zenoh_wire
+from poppy_core.errors import BusTimeout, CommunicationError, ConfigError
+from poppy_core.remote.zenoh_client import answer_of, client_settings
+
+if TYPE_CHECKING:
+    import zenoh
+
+DEFAULT_TIMEOUT_S = 2.0
+START_LEAD_S = 0.3
+"""How far ahead a shared start is set: time for every robot to get the command."""
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What one robot answered to a fleet command: ``ok``, and its answer or refusal."""
+
+    name: str
+    ok: bool
+    status: int
+    answer: Any
+
+    @property
+    def message(self) -> str:
+        """The refusal's one line (REST's wording), or ``ok``."""
+        if self.ok:
+            return "ok"
+        if isinstance(self.answer, dict):
+            return str(self.answer.get("detail", self.answer.get("error", self.answer)))
+        return str(self.answer)
+
+
+class Fleet:
+    """The robots of a Zenoh network.
+
+    Args:
+        settings: how to join it (``client_settings()`` when None).
+        token: sent with every command.
+        timeout_s: how long a robot has to answer.
+        session: an open session to use (kept open on ``close``).
+    """
+
+    def __init__(
+        self,
+        settings: zenoh_wire.ZenohSettings | None = None,
+        *,
+        token: str | None = None,
+        timeout_s: float = DEFAULT_TIMEOUT_S,
+        session: zenoh.Session | None = None,
+    ) -> None:
+        self.token = token
+        self.timeout_s = timeout_s
+        self._owned = session is None
+        settings = settings or client_settings()
+        self.session = session or zenoh_wire.open_session(settings)
+        self._declared: list[Any] = []
+        self.last_start_at: float | None = None
+        """The shared start time of the last command sent ``together``."""
+        if self._owned:  # a new session: let its links come up before the first query
+            zenoh_wire.await_peers(self.session, settings, timeout_s)
+
+    def names(self) -> list[str]:
+        """The robots alive now (by their liveliness tokens), sorted."""
+        found = set()
+        for reply in self.session.liveliness().get(
+            f"{zenoh_wire.PREFIX}/*", timeout=self.timeout_s
+        ):
+            if reply.ok is not None:
+                name = zenoh_wire.name_of(str(reply.ok.key_expr))
+                if name:
+                    found.add(name)
+        return sorted(found)
+
+    def wait_for(self, names: Sequence[str], timeout_s: float = 5.0) -> list[str]:
+        """The robots of ``names`` seen within ``timeout_s`` (all of them, or fewer)."""
+        end = time.monotonic() + timeout_s
+        while True:
+            seen = [n for n in names if n in set(self.names())]
+            if len(seen) == len(names) or time.monotonic() >= end:
+                return seen
+            time.sleep(0.05)
+
+    def describe(self, names: Sequence[str] | None = None) -> dict[str, dict[str, Any]]:
+        """Name -> description of each robot alive (or of ``names``), in name order."""
+        wanted = list(names) if names is not None else self.names()
+        found: dict[str, dict[str, Any]] = {}
+        key = f"{zenoh_wire.PREFIX}/*/description"
+        for reply in self.session.get(key, timeout=self.timeout_s):
+            if reply.ok is None:
+                continue
+            name = zenoh_wire.name_of(str(reply.ok.key_expr))
+            try:
+                described = json.loads(reply.ok.payload.to_bytes())
+            except ValueError:
+                continue
+            if name in wanted and isinstance(described, dict):
+                found[name] = described
+        return {n: found[n] for n in sorted(found)}
+
+    def command(
+        self,
+        names: Sequence[str],
+        method: str,
+        path: str,
+        body: Any = None,
+        *,
+        together: bool = True,
+    ) -> list[Outcome]:
+        """Send one v1 request to every robot of ``names`` at once; with ``together`` each runs
+        it at the same wall-clock time (``START_LEAD_S`` from now). A robot that does not
+        answer within the timeout gets an outcome saying so (never a hang).
+        """
+        start_at = time.time() + START_LEAD_S if together else None
+        self.last_start_at = start_at
+        timeout = self.timeout_s + (START_LEAD_S if together else 0.0)
+        pending = []
+        for name in names:
+            payload = zenoh_wire.api_request(
+                method, path, body, token=self.token, start_at=start_at
+            )
+            key = zenoh_wire.robot_key(name, "api")
+            pending.append((name, self.session.get(key, payload=payload, timeout=timeout)))
+        began = time.monotonic()
+        outcomes = []
+        for name, handler in pending:
+            try:
+                status, answer = answer_of(
+                    f"zenoh:{name}", list(handler), timeout, time.monotonic() - began
+                )
+            except (BusTimeout, CommunicationError) as exc:
+                outcomes.append(Outcome(name, False, 0, {"detail": str(exc)}))
+                continue
+            outcomes.append(Outcome(name, status < 400, status, answer))
+        return outcomes
+
+    def on_state(
+        self, callback: Callable[[str, zenoh_wire.RobotState], None], name: str = "*"
+    ) -> None:
+        """Call ``callback(name, state)`` for each state message (of every robot by default).
+
+        It runs in Zenoh's thread: keep it short. A message that is not a state is skipped."""
+
+        def received(sample: zenoh.Sample) -> None:
+            robot = zenoh_wire.name_of(str(sample.key_expr))
+            try:
+                state = zenoh_wire.unpack_state(sample.payload.to_bytes())
+            except ConfigError:
+                return
+            if robot:
+                callback(robot, state)
+
+        key = f"{zenoh_wire.PREFIX}/{name}/state"
+        self._declared.append(self.session.declare_subscriber(key, received))
+
+    def on_health(self, callback: Callable[[str, dict[str, Any]], None]) -> None:
+        """Call ``callback(name, health)`` for each health message (every second per robot)."""
+
+        def received(sample: zenoh.Sample) -> None:
+            robot = zenoh_wire.name_of(str(sample.key_expr))
+            try:
+                health = json.loads(sample.payload.to_bytes())
+            except ValueError:
+                return
+            if robot and isinstance(health, dict):
+                callback(robot, health)
+
+        key = f"{zenoh_wire.PREFIX}/*/health"
+        self._declared.append(self.session.declare_subscriber(key, received))
+
+    def on_presence(self, callback: Callable[[str, bool], None]) -> None:
+        """Call ``callback(name, alive)`` as robots come (those already here too) and go."""
+        import zenoh
+
+        def changed(sample: zenoh.Sample) -> None:
+            robot = zenoh_wire.name_of(str(sample.key_expr))
+            if robot:
+                callback(robot, sample.kind == zenoh.SampleKind.PUT)
+
+        subscriber = self.session.liveliness().declare_subscriber(
+            f"{zenoh_wire.PREFIX}/*", changed, history=True
+        )
+        self._declared.append(subscriber)
+
+    def goals(self, name: str) -> Callable[[dict[str, float]], None]:
+        """A function sending goal positions to the robot ``name`` (its ``goals`` stream)."""
+        import zenoh
+
+        publisher = self.session.declare_publisher(
+            zenoh_wire.robot_key(name, "goals"),
+            congestion_control=zenoh.CongestionControl.DROP,
+            express=True,
+        )
+        self._declared.append(publisher)
+        lock = threading.Lock()
+
+        def send(goals: dict[str, float]) -> None:
+            with lock:
+                publisher.put(zenoh_wire.goals_message(goals, self.token))
+
+        return send
+
+    def close(self) -> None:
+        """Undeclare the subscribers; close the session if this fleet opened it."""
+        for declared in reversed(self._declared):
+            with contextlib.suppress(Exception):  # the session may be closed already
+                declared.undeclare()
+        self._declared = []
+        if self._owned:
+            self.session.close()  # type: ignore[no-untyped-call]
+
+    def __enter__(self) -> Fleet:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,362 @@
+"""``ZenohRobotServer``: a robot on Zenoh under ``poppy/NAME`` (``poppy serve --zenoh``).
+
+It declares the liveliness token ``poppy/NAME`` (seen leaving when the robot goes), publishes
+the state every sync cycle (``zenoh_wire.pack_state``) and the health every second, answers
+``poppy/NAME/description`` and ``poppy/NAME/api`` (v1 REST requests run through the REST app
+in-process: the same token, checks and refusal wording as HTTP, optionally at a shared
+wall-clock ``start_at``) and takes goal positions as a stream on ``poppy/NAME/goals``. Every
+publication drops rather than waits (Zenoh's ``CongestionControl.DROP``): a subscriber that
+cannot keep up never slows the robot.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import hmac
+import json
+import logging
+import math
+import re
+import socket
+import threading
+import time
+from typing import TYPE_CHECKING, Any
+
+from poppy_core import checks, zenoh_wire
+from poppy_core.errors import ArgumentError, PoppyError
+from poppy_core.motion.chains import robot_chains
+from poppy_core.schedule import Periodic, RateMeter, Worker
+from poppy_core.server.errors import ApiError
+from poppy_core.server.middleware import MAX_BODY_BYTES
+from poppy_core.server.start_time import START_AT
+from poppy_core.server.zenoh.asgi_call import AsgiCaller
+
+if TYPE_CHECKING:
+    import zenoh
+
+    from poppy_core.server.service import RobotService
+
+logger = logging.getLogger(__name__)
+
+DEFAULT_STATE_RATE_HZ = 50.0
+"""The sync loop's default rate: one state message per cycle."""
+HEALTH_PERIOD_S = 1.0
+MAX_START_DELAY_S = 60.0
+"""How far in the future a ``start_at`` may be (a clock that far off is refused, not waited)."""
+METHODS = ("GET", "PUT", "POST", "DELETE")
+STARTS = re.compile(r"/api/v1/(primitives/[^/?]+/start|moves/[^/?]+/play)")
+"""The requests whose action waits for ``start_at`` in its own thread (``start_time``); any
+other request with a ``start_at`` is sent to the app at that time."""
+API_SHAPE = 'send {"method": "GET|PUT|POST|DELETE", "path": "/api/v1/...", "body": {...}}'
+
+
+class ZenohRobotServer:
+    """The robot of ``service`` on the Zenoh ``session`` as ``poppy/<name>``.
+
+    Args:
+        service: the robot service shared with the other servers.
+        app: the REST app (built for this server when HTTP is not served) answering ``api``.
+        session: an open Zenoh session (the server set's, shared with other Zenoh servers).
+        name: the robot's name (one key chunk).
+        token: required in every command (``api`` and ``goals``), as on REST.
+        state_rate_hz: state messages per second (the sync loop's rate).
+        endpoints: where the session listens, for the description.
+    """
+
+    def __init__(
+        self,
+        service: RobotService,
+        app: Any,
+        session: zenoh.Session,
+        name: str,
+        *,
+        token: str | None = None,
+        state_rate_hz: float = DEFAULT_STATE_RATE_HZ,
+        endpoints: tuple[str, ...] = (),
+    ) -> None:
+        self.service = service
+        self.session = session
+        self.name = zenoh_wire.check_name(name)
+        self.token = token
+        self.state_rate_hz = checks.rate(state_rate_hz, "state_rate_hz")
+        self.endpoints = endpoints
+        self.refused_goals = 0
+        self.published = 0
+        self.rate = RateMeter()
+        self._app = app
+        self._caller: AsgiCaller | None = None
+        self._declared: list[Any] = []
+        self._publisher: Any = None
+        self._health: Any = None
+        self.page: str | None = None
+        """The robot's web page (``http://...``), when it serves one, for the fleet's pages."""
+        self._seen: set[str] = set()
+        self._worker = Worker(f"zenoh-state-{name}", self._publish_loop)
+        self._lock = threading.Lock()
+        self._last_refusal = 0.0
+
+    @property
+    def url(self) -> str:
+        """``zenoh:NAME``: what ``from_remote`` and ``--remote`` take."""
+        return f"zenoh:{self.name}"
+
+    @property
+    def port(self) -> None:
+        """No port of its own (the session's endpoints are in ``endpoints``)."""
+        return None
+
+    @property
+    def running(self) -> bool:
+        """True while the state is published."""
+        return self._worker.running
+
+    def key(self, *parts: str) -> str:
+        """``poppy/NAME/...``."""
+        return zenoh_wire.robot_key(self.name, *parts)
+
+    def start(self) -> None:
+        """Declare the queryables, the goal subscriber, then the liveliness token; publish."""
+        import zenoh
+
+        if self.running:
+            return
+        self._caller = AsgiCaller(self._app)
+        session = self.session
+        drop = zenoh.CongestionControl.DROP
+        self._publisher = session.declare_publisher(
+            self.key("state"), congestion_control=drop, express=True
+        )
+        self._health = session.declare_publisher(self.key("health"), congestion_control=drop)
+        self._declared = [
+            self._publisher,
+            self._health,
+            session.declare_queryable(self.key("api"), self._on_api),
+            session.declare_queryable(self.key("description"), self._on_description),
+            session.declare_subscriber(self.key("goals"), self._on_goals),
+            session.liveliness().declare_subscriber(
+                f"{zenoh_wire.PREFIX}/*", self._on_presence, history=True
+            ),
+            session.liveliness().declare_token(zenoh_wire.robot_key(self.name)),
+        ]
+        self._worker.start()
+        self._caller.submit(self._warm_up(self._caller))
+
+    async def _warm_up(self, caller: AsgiCaller) -> None:
+        """One request through the app before any client's: its first one builds the routes'
+        models and the worker threads (a first fleet command would start late by that)."""
+        for name in list(self.service.primitives())[:1]:
+            await caller.call("GET", f"/api/v1/primitives/{name}", token=self.token)
+        await caller.call("GET", "/api/v1/moves/status", token=self.token)
+
+    def stop(self) -> None:
+        """Stop publishing, then undeclare everything (the token first: the fleet sees the
+        robot leave), then the API's loop."""
+        self._worker.close()
+        for declared in reversed(self._declared):
+            try:
+                declared.undeclare()
+            except Exception as exc:  # a session already closed
+                logger.debug("undeclaring on Zenoh: %s", exc)
+        self._declared = []
+        if self._caller is not None:
+            self._caller.close()
+            self._caller = None
+
+    def seen(self) -> list[str]:
+        """The robots alive on the network, by their liveliness tokens (this one too)."""
+        with self._lock:
+            return sorted(self._seen)
+
+    def _on_presence(self, sample: zenoh.Sample) -> None:
+        import zenoh
+
+        name = zenoh_wire.name_of(str(sample.key_expr))
+        if name:
+            with self._lock:
+                if sample.kind == zenoh.SampleKind.PUT:
+                    self._seen.add(name)
+                else:
+                    self._seen.discard(name)
+
+    # -- publications ------------------------------------------------------------------------
+
+    def _publish_loop(self, stopping: threading.Event) -> None:
+        schedule = Periodic(1.0 / self.state_rate_hz, time.monotonic())
+        next_health = 0.0
+        while not stopping.is_set():
+            wait = schedule.next_deadline - time.monotonic()
+            if wait > 0 and stopping.wait(wait):
+                return
+            now = time.monotonic()
+            schedule.advance(now)
+            self._publisher.put(self.state_message())
+            self.published += 1
+            self.rate.tick(now)
+            if now >= next_health:
+                next_health = now + HEALTH_PERIOD_S
+                self._health.put(json.dumps(self.health()).encode())
+
+    def state_message(self) -> bytes:
+        """The state of every motor now (``zenoh_wire.pack_state``)."""
+        stamp = time.time()
+        motors: dict[str, dict[str, Any]] = {}
+        for motor in self.service.robot.motors:
+            entry = {field: getattr(motor, field, None) for field in zenoh_wire.STATE_FIELDS}
+            entry["compliant"] = motor.compliant
+            entry["online"] = motor.online
+            motors[motor.name] = entry
+        return zenoh_wire.pack_state(self.published, stamp, motors)
+
+    def health(self) -> dict[str, Any]:
+        """The buses' health, the state rate and the goals refused."""
+        buses = self.service.health()
+        offline = sorted({m for bus in buses.values() for m in bus.get("offline", [])})
+        ok = all(bus.get("connected", True) for bus in buses.values()) and not offline
+        return {
+            "name": self.name,
+            "ok": ok,
+            "offline": offline,
+            "state_hz": round(self.rate.rate_hz, 1),
+            "refused_goals": self.refused_goals,
+            "running": self.service.running_primitives(),
+            "playing": self.service.moves.playing(),
+            "buses": buses,
+        }
+
+    def description(self) -> dict[str, Any]:
+        """Creature, motors (with limits), groups, primitives, moves, chains, host, endpoints."""
+        robot = self.service.robot
+        profile = robot.config.profile if robot.config is not None else None
+        motors = [
+            {
+                "name": m.name,
+                "id": m.id,
+                "model": m.model.name,
+                "angle_limit": _jsonable(getattr(m, "angle_limit", None)),
+            }
+            for m in robot.motors
+        ]
+        return {
+            "version": zenoh_wire.STATE_VERSION,
+            "name": self.name,
+            "creature": profile.name if profile is not None else "",
+            "host": socket.gethostname(),
+            "endpoints": list(self.endpoints),
+            "page": self.page,
+            "token": self.token is not None,
+            "state_rate_hz": self.state_rate_hz,
+            "motors": motors,
+            "groups": self.service.groups(),
+            "primitives": list(self.service.primitives()),
+            "moves": self.service.moves.names(),
+            "chains": list(robot_chains(robot)),
+            "health": self.health(),
+        }
+
+    # -- queries -----------------------------------------------------------------------------
+
+    def _on_description(self, query: zenoh.Query) -> None:
+        try:
+            query.reply(self.key("description"), json.dumps(self.description()).encode())
+        except Exception:
+            logger.exception("answering %s", query.key_expr)
+
+    def _on_api(self, query: zenoh.Query) -> None:
+        payload = query.payload.to_bytes() if query.payload is not None else b""
+        caller = self._caller
+        if caller is not None:
+            caller.submit(self._answer(caller, query, payload))
+
+    async def _answer(self, caller: AsgiCaller, query: zenoh.Query, payload: bytes) -> None:
+        status, body = await self.api(caller, payload)
+        query.reply(self.key("api"), json.dumps({"status": status, "body": body}).encode())
+
+    async def api(self, caller: AsgiCaller, payload: bytes) -> tuple[int, Any]:
+        """The status and answer of one ``api`` request (a refusal: REST's, or 400/413)."""
+        if len(payload) > MAX_BODY_BYTES:
+            return 413, {"detail": f"the request is over {MAX_BODY_BYTES} bytes"}
+        try:
+            request = json.loads(payload)
+        except (ValueError, RecursionError):
+            return 400, {"detail": f"the request is not JSON: {API_SHAPE}"}
+        if not isinstance(request, dict):
+            return 400, {"detail": f"the request is not an object: {API_SHAPE}"}
+        method = request.get("method")
+        path = request.get("path")
+        if method not in METHODS or not isinstance(path, str) or not path.startswith("/"):
+            return 400, {"detail": f"bad method or path: {API_SHAPE}"}
+        token = request.get("token")
+        if token is not None and not isinstance(token, str):
+            return 400, {"detail": "the token must be a string"}
+        try:
+            start_at = _start_at(request.get("start_at"))
+        except ArgumentError as exc:
+            return 422, {"detail": str(exc)}
+        if start_at is not None and STARTS.fullmatch(path):
+            # routed now; the start itself waits for the clock in the route's thread
+            context = START_AT.set(start_at)
+            try:
+                return await caller.call(method, path, request.get("body"), token)
+            finally:
+                START_AT.reset(context)
+        if start_at is not None:
+            await asyncio.sleep(max(0.0, start_at - time.time()))
+        return await caller.call(method, path, request.get("body"), token)
+
+    # -- the goal stream ---------------------------------------------------------------------
+
+    def _on_goals(self, sample: zenoh.Sample) -> None:
+        try:
+            self.apply_goals(sample.payload.to_bytes())
+        except (ApiError, PoppyError, ValueError, TypeError, RecursionError) as exc:
+            self.refused_goals += 1
+            now = time.monotonic()
+            if now - self._last_refusal > 1.0:  # one line a second, whatever the rate
+                self._last_refusal = now
+                logger.warning("%s: goals refused: %s", self.name, exc)
+
+    def apply_goals(self, payload: bytes) -> dict[str, float]:
+        """Check every goal of a ``goals`` message, then set them all (or none).
+
+        Raises:
+            ApiError: a bad token, a bad message or a bad goal (nothing moved).
+            UnknownMotorError: an unknown motor (nothing moved).
+        """
+        if len(payload) > MAX_BODY_BYTES:
+            raise ApiError("invalid", f"the message is over {MAX_BODY_BYTES} bytes")
+        message = json.loads(payload)
+        if not isinstance(message, dict) or not isinstance(message.get("goals"), dict):
+            raise ApiError("invalid", 'expected {"goals": {motor: degrees}}')
+        if self.token is not None:
+            given = message.get("token")
+            if not isinstance(given, str) or not hmac.compare_digest(
+                given.encode(), self.token.encode()
+            ):
+                raise ApiError("invalid", "missing or wrong token")
+        targets = self.service.targets(message["goals"])
+        with self._lock:
+            for name, goal in targets.items():
+                self.service.motor(name).goal_position = goal
+        return targets
+
+
+def _start_at(value: Any) -> float | None:
+    """The wall-clock start of a command, checked as its delay from now (a clock a minute or
+    more ahead of the robot's is refused rather than waited for)."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        checks.number(value, "start_at")  # raises, naming the field
+    now = time.time()
+    delay = checks.in_range(
+        float(value) - now, -MAX_START_DELAY_S, MAX_START_DELAY_S, "start_at (from now)", "s"
+    )
+    return now + delay
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, tuple | list):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value

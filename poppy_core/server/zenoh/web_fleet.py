@@ -1,0 +1,62 @@
+"""``GET /api/v1/web/fleet``: the robots the served robot's Zenoh session sees, for its page."""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING, Any
+
+from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
+
+from poppy_core import zenoh_wire
+
+if TYPE_CHECKING:
+    from fastapi import FastAPI
+
+    from poppy_core.server.zenoh.robot_node import ZenohRobotServer
+
+ASK_TIMEOUT_S = 0.5
+router = APIRouter(prefix="/web", tags=["web page"])
+
+
+def fleet_of(node: ZenohRobotServer) -> list[dict[str, Any]]:
+    """Every robot alive on the network (this one too): name, creature, health, page."""
+    alive = set(node.seen())
+    found: dict[str, dict[str, Any]] = {}
+    key = f"{zenoh_wire.PREFIX}/*/description"
+    for reply in node.session.get(key, timeout=ASK_TIMEOUT_S):
+        if reply.ok is None:
+            continue
+        name = zenoh_wire.name_of(str(reply.ok.key_expr))
+        try:
+            described = json.loads(reply.ok.payload.to_bytes())
+        except ValueError:
+            continue
+        if name and isinstance(described, dict):
+            found[name] = described
+    robots = []
+    for name in sorted(alive | set(found)):
+        described = found.get(name, {})
+        health = described.get("health", {})
+        robots.append(
+            {
+                "name": name,
+                "self": name == node.name,
+                "creature": str(described.get("creature", "")),
+                "ok": bool(health.get("ok", False)),
+                "page": described.get("page"),
+            }
+        )
+    return robots
+
+
+@router.get("/fleet", summary="The robots on this robot's Zenoh network and their pages")
+def fleet(request: Request) -> list[dict[str, Any]]:
+    """Empty when the robot is not served on Zenoh."""
+    node = getattr(request.app.state, "zenoh", None)
+    return fleet_of(node) if node is not None else []
+
+
+def add_fleet_route(app: FastAPI, node: ZenohRobotServer) -> None:
+    """Answer ``/api/v1/web/fleet`` from ``node``'s session."""
+    app.state.zenoh = node
+    app.include_router(router, prefix="/api/v1")

@@ -1,0 +1,310 @@
+"""The Zenoh contract of a fleet: session settings, the robots' key expressions, the state message.
+
+Shared by the robot's side (``poppy_core.server.zenoh``) and the clients' (``poppy_core.remote``,
+``poppy fleet``), so both speak the same keys and bytes; a leaf: nothing of ours but the leaves.
+
+Keys (``NAME`` a robot's name, one key chunk): the liveliness token ``poppy/NAME``; the state
+``poppy/NAME/state`` (``pack_state``, every sync cycle); ``poppy/NAME/health`` (JSON, every
+second); the queryables ``poppy/NAME/description`` and ``poppy/NAME/api`` (a v1 REST request in
+JSON, answered by the robot's REST app in-process: the same checks, errors and token); the
+subscriber ``poppy/NAME/goals`` (goal positions as a stream).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import socket
+import struct
+import threading
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from poppy_core.errors import ConfigError
+from poppy_core.extras import require
+
+if TYPE_CHECKING:
+    import zenoh
+
+PREFIX = "poppy"
+STATE_VERSION = 1
+DEFAULT_LEASE_MS = 3000
+"""The transport lease of our default configuration: a robot that vanishes without closing its
+session (power cut, Wi-Fi gone) leaves ``poppy fleet list`` within it. A killed process closes
+its TCP links, which its peers see at once."""
+FLEET_PORT = 7447
+"""Zenoh's own default port (what ``zenohd`` listens on)."""
+
+_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,62}")
+_ENDPOINT = re.compile(r"[a-z0-9]+/\S+")
+
+
+def check_name(name: str) -> str:
+    """``name`` when it can be a robot's name (one key chunk: letters, digits, ``_ . -``).
+
+    Raises:
+        ConfigError: another name (with the rule).
+    """
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise ConfigError(
+            f"{name!r} is not a robot name: use 1-63 letters, digits, '_', '.' or '-' "
+            "(not starting with '.' or '-')",
+            field="name",
+        )
+    return name
+
+
+def default_name() -> str:
+    """The host's name as a robot name (its first label, other characters as ``-``)."""
+    label = socket.gethostname().split(".")[0]
+    name = re.sub(r"[^A-Za-z0-9_.-]", "-", label).strip(".-")[:63]
+    return name or "poppy"
+
+
+def robot_key(name: str, *parts: str) -> str:
+    """``poppy/NAME/part/...``."""
+    return "/".join((PREFIX, check_name(name), *parts))
+
+
+def name_of(key: str) -> str | None:
+    """The robot name of ``poppy/NAME[/...]`` (None for another key)."""
+    parts = str(key).split("/")
+    return parts[1] if len(parts) >= 2 and parts[0] == PREFIX else None
+
+
+@dataclass(frozen=True)
+class ZenohSettings:
+    """How a process joins the Zenoh network.
+
+    Attributes:
+        listen: endpoints to listen on (``tcp/127.0.0.1:7447``); none: listen nowhere.
+        connect: endpoints of peers or routers to connect to.
+        config_file: Zenoh's own JSON5 configuration (routers, TLS, access control); the
+            endpoints above, when given, replace its own.
+        scout: find peers by multicast scouting on the LAN (off unless asked).
+    """
+
+    listen: tuple[str, ...] = ()
+    connect: tuple[str, ...] = ()
+    config_file: Path | None = None
+    scout: bool = False
+
+    def __post_init__(self) -> None:
+        for endpoint in (*self.listen, *self.connect):
+            if not _ENDPOINT.fullmatch(endpoint):
+                raise ConfigError(
+                    f"{endpoint!r} is not a Zenoh endpoint: write PROTOCOL/ADDRESS, e.g. "
+                    "tcp/127.0.0.1:7447",
+                    field="endpoint",
+                )
+
+
+def session_config(settings: ZenohSettings) -> zenoh.Config:
+    """The Zenoh configuration of ``settings`` (peer mode, no scouting unless asked).
+
+    Raises:
+        ConfigError: the configuration file cannot be read or is not Zenoh's.
+        MissingExtraError: eclipse-zenoh is not installed (the ``fleet`` extra).
+    """
+    require("zenoh", extra="fleet")
+    import zenoh
+
+    try:
+        if settings.config_file is not None:
+            config = zenoh.Config.from_file(str(settings.config_file))
+        else:
+            config = zenoh.Config()
+            config.insert_json5("mode", '"peer"')
+            config.insert_json5("listen/endpoints", "[]")
+            config.insert_json5("transport/link/tx/lease", str(DEFAULT_LEASE_MS))
+        if settings.listen:
+            config.insert_json5("listen/endpoints", json.dumps(list(settings.listen)))
+        if settings.connect:
+            config.insert_json5("connect/endpoints", json.dumps(list(settings.connect)))
+        if settings.config_file is None or settings.scout:
+            scout = json.dumps(settings.scout)
+            config.insert_json5("scouting/multicast/enabled", scout)
+            config.insert_json5("scouting/gossip/enabled", scout)
+    except (zenoh.ZError, OSError, ValueError) as exc:
+        where = settings.config_file or "the Zenoh settings"
+        raise ConfigError(f"{where}: {exc}", field="zenoh") from None
+    return config
+
+
+def open_session(settings: ZenohSettings) -> zenoh.Session:
+    """A Zenoh session joined as ``settings`` say.
+
+    Raises:
+        ConfigError: a bad configuration, or an endpoint Zenoh cannot listen on or reach.
+        MissingExtraError: eclipse-zenoh is not installed (the ``fleet`` extra).
+    """
+    config = session_config(settings)
+    import zenoh
+
+    try:
+        return zenoh.open(config)
+    except zenoh.ZError as exc:
+        raise ConfigError(
+            f"cannot open the Zenoh session ({zenoh_message(exc)}): check --zenoh-listen / "
+            "--zenoh-connect",
+            field="zenoh",
+        ) from None
+
+
+def zenoh_message(exc: BaseException) -> str:
+    """Zenoh's error text without the places in its Rust sources it names."""
+    text = re.sub(r"\s+at /\S+", "", str(exc)).replace("[", "").replace("]", "")
+    return " ".join(text.split()).rstrip(".")
+
+
+def await_peers(session: zenoh.Session, settings: ZenohSettings, wait_s: float = 3.0) -> bool:
+    """Wait until ``session`` is linked to a peer or router (when ``settings`` connect to one);
+    False when none came within ``wait_s``. A session opens before its links are up: a query
+    sent at once would find no one."""
+    if not settings.connect and settings.config_file is None and not settings.scout:
+        return True
+    end = time.monotonic() + wait_s
+    while time.monotonic() < end:
+        if list(session.info.peers_zid()) or list(session.info.routers_zid()):
+            return True
+        time.sleep(0.01)
+    return False
+
+
+def await_token(session: zenoh.Session, name: str, wait_s: float = 3.0) -> bool:
+    """Wait until the liveliness token of robot ``name`` is seen; False after ``wait_s``."""
+    seen = threading.Event()
+    subscriber = session.liveliness().declare_subscriber(
+        robot_key(name), lambda sample: seen.set(), history=True
+    )
+    try:
+        return seen.wait(wait_s)
+    finally:
+        subscriber.undeclare()  # type: ignore[no-untyped-call]
+
+
+# -- the state message -------------------------------------------------------------------------
+
+STATE_FIELDS = ("present_position", "present_speed", "present_load", "present_temperature")
+"""Per motor, in this order, as float32 (NaN: not read)."""
+_HEAD = struct.Struct("<BBId")  # version, motors, sequence, wall-clock time of the read
+_MOTOR = struct.Struct("<ffffB")  # the four fields, then flags
+COMPLIANT = 1
+ONLINE = 2
+
+
+@dataclass(frozen=True)
+class RobotState:
+    """One state message: the sequence number, when it was read (``time.time()``) and per
+    motor its fields (``STATE_FIELDS`` and ``compliant``, ``online``)."""
+
+    seq: int
+    stamp: float
+    motors: dict[str, dict[str, Any]]
+
+
+def _number(value: Any) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return math.nan
+    return number if math.isfinite(number) else math.nan
+
+
+def _value(number: float) -> float | None:
+    return None if number != number else round(number, 3)  # NaN: not read
+
+
+def pack_state(seq: int, stamp: float, motors: Mapping[str, Mapping[str, Any]]) -> bytes:
+    """Version 1: a 14-byte head, the motor names (UTF-8, ``\\n``-separated, length-prefixed),
+    then 17 bytes per motor (four little-endian float32 and a flags byte)."""
+    names = "\n".join(motors).encode()
+    out = [_HEAD.pack(STATE_VERSION, len(motors), seq & 0xFFFFFFFF, stamp)]
+    out.append(struct.pack("<H", len(names)) + names)
+    for values in motors.values():
+        flags = (COMPLIANT if values.get("compliant") else 0) | (
+            ONLINE if values.get("online", True) else 0
+        )
+        out.append(_MOTOR.pack(*(_number(values.get(f)) for f in STATE_FIELDS), flags))
+    return b"".join(out)
+
+
+def unpack_state(data: bytes) -> RobotState:
+    """The message ``pack_state`` made.
+
+    Raises:
+        ConfigError: not a state message of a version this code reads.
+    """
+    try:
+        version, count, seq, stamp = _HEAD.unpack_from(data, 0)
+        if version != STATE_VERSION:
+            raise ConfigError(
+                f"state message version {version}: this poppy reads version {STATE_VERSION} "
+                "(update poppy on one side)",
+                field="state",
+            )
+        offset = _HEAD.size
+        (size,) = struct.unpack_from("<H", data, offset)
+        offset += 2
+        names = data[offset : offset + size].decode().split("\n") if count else []
+        offset += size
+        block = data[offset : offset + count * _MOTOR.size]
+        motors: dict[str, dict[str, Any]] = {}
+        for name, (position, speed, load, temperature, flags) in zip(
+            names, _MOTOR.iter_unpack(block), strict=True
+        ):
+            motors[name] = {
+                "present_position": _value(position),
+                "present_speed": _value(speed),
+                "present_load": _value(load),
+                "present_temperature": _value(temperature),
+                "compliant": bool(flags & COMPLIANT),
+                "online": bool(flags & ONLINE),
+            }
+    except (struct.error, UnicodeDecodeError, ValueError) as exc:
+        raise ConfigError(f"not a poppy state message ({exc})", field="state") from None
+    if len(motors) != count:
+        raise ConfigError("not a poppy state message (motor count)", field="state")
+    return RobotState(seq, stamp, motors)
+
+
+def state_json(seq: int, stamp: float, motors: Mapping[str, Mapping[str, Any]]) -> bytes:
+    """The same message as JSON (what ``bench fleet`` compares ``pack_state`` with)."""
+    return json.dumps({"v": STATE_VERSION, "seq": seq, "t": stamp, "motors": motors}).encode()
+
+
+def api_request(
+    method: str,
+    path: str,
+    body: Any = None,
+    *,
+    token: str | None = None,
+    start_at: float | None = None,
+) -> bytes:
+    """The payload of a query to ``poppy/NAME/api``: a v1 REST request (``start_at``: the
+    wall-clock time the robot runs it at, for commands started together)."""
+    request: dict[str, Any] = {"method": method, "path": path}
+    if body is not None:
+        request["body"] = body
+    if token:
+        request["token"] = token
+    if start_at is not None:
+        request["start_at"] = start_at
+    return json.dumps(request).encode()
+
+
+def goals_message(goals: Mapping[str, float], token: str | None = None) -> bytes:
+    """The payload of ``poppy/NAME/goals``: motor -> goal position (degrees)."""
+    message: dict[str, Any] = {"goals": dict(goals)}
+    if token:
+        message["token"] = token
+    return json.dumps(message).encode()
+
+
+def names_list(names: Sequence[str]) -> str:
+    """``a, b`` (or ``none``) for messages."""
+    return ", ".join(names) or "none"
