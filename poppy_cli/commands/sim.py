@@ -289,7 +289,10 @@ def render(
         autocompletion=complete.moves,
     ),
     camera: str | None = typer.Option(
-        "front", "--camera", help="Camera of the model ('front'); 'free' for the default view."
+        "front",
+        "--camera",
+        help="View: front, side or top (each frames the robot and all it can reach), "
+        "camera (the robot's own), or free (MuJoCo's default view).",
     ),
     width: int = typer.Option(640, "--width", min=16, max=4096, help="Image width (pixels)."),
     height: int = typer.Option(480, "--height", min=16, max=4096, help="Image height (pixels)."),
@@ -319,7 +322,9 @@ def render(
             raise _no_gl(str(exc)) from None
         raise
     except ValueError as exc:  # mujoco: unknown camera
-        error_line(f"{exc} (the models have a camera 'front'; 'free' is the default view)")
+        error_line(
+            f"{exc} (the models' cameras: front, side, top, camera; 'free' is the default view)"
+        )
         raise typer.Exit(EXIT_USAGE) from None
     if suffix != ".gif" and len(frames) > 1:
         err_console.print(f"a still image holds one frame: the last of {len(frames)} is saved")

@@ -1,7 +1,7 @@
 """``SimCamera``: the MuJoCo scene rendered offscreen from the robot's own camera.
 
 The profiles' models hold a camera named ``camera`` where the real one sits (Ergo Jr head,
-Torso/Humanoid face; see ``mjcf.CAMERAS``). The camera renders in its own thread with its own
+Torso/Humanoid face; see ``looks.CAMERAS``). The camera renders in its own thread with its own
 OpenGL context (EGL or OSMesa contexts belong to one thread): the scene is copied under the
 world's lock, drawn outside it, so physics never waits for pixels. No shadows, reflections or
 multisampling: on a software renderer they cost 30× the frame (see docs/sensors.md).

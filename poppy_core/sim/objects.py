@@ -81,9 +81,10 @@ _TYPES = {
 }
 
 
-def add_objects(xml: str, specs: list[ObjectSpec]) -> Any:
-    """Compile ``xml`` with ``specs`` added as free bodies (MjSpec); returns the MjModel."""
-    spec = mujoco.MjSpec.from_string(xml)
+def add_objects(xml: str, specs: list[ObjectSpec], assets: dict[str, bytes] | None = None) -> Any:
+    """Compile ``xml`` (its mesh files in ``assets``) with ``specs`` added as free bodies
+    (MjSpec); returns the MjModel."""
+    spec = mujoco.MjSpec.from_string(xml, assets=assets or {})
     for obj in specs:
         body = spec.worldbody.add_body(name=obj.name, pos=list(obj.position), quat=list(obj.quat))
         if not obj.fixed:

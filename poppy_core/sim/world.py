@@ -7,6 +7,7 @@ import math
 import threading
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
@@ -19,6 +20,7 @@ from poppy_core.schedule import Worker
 from poppy_core.sim.drive import Drive, Joint
 from poppy_core.sim.exchange import MotorPort
 from poppy_core.sim.gl import check_offscreen_gl
+from poppy_core.sim.model_files import read_model
 from poppy_core.sim.objects import ObjectSpec, add_objects, facing_quat
 from poppy_core.sim.plant import MotorJoint
 
@@ -50,13 +52,18 @@ class Simulation:
     Args:
         xml: the MJCF text of the robot (``profiles/<robot>/model.xml``).
         speed: how many simulated seconds pass per real second in the physics thread.
+        assets: the files the model names (its meshes), by the name it gives them
+            (``model_files.read_model``; ``Simulation.from_file`` reads them).
     """
 
-    def __init__(self, xml: str, speed: float = 1.0) -> None:
+    def __init__(
+        self, xml: str, speed: float = 1.0, *, assets: dict[str, bytes] | None = None
+    ) -> None:
         self._xml = xml
+        self._assets = dict(assets or {})
         self.speed = speed
         self._lock = threading.RLock()
-        self.model = mujoco.MjModel.from_xml_string(xml)
+        self.model = mujoco.MjModel.from_xml_string(xml, self._assets)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self._bindings: list[_Binding] = []
@@ -67,6 +74,16 @@ class Simulation:
         self._objects = _Objects()
         self._renderers: dict[tuple[int, int], Any] = {}
         self._worker = Worker("mujoco physics", self._run)
+
+    @classmethod
+    def from_file(cls, path: Path, speed: float = 1.0) -> Simulation:
+        """The world of the MJCF file at ``path``, with the mesh files it names.
+
+        Raises:
+            ConfigError: the model or one of its meshes cannot be read.
+        """
+        xml, assets = read_model(path)
+        return cls(xml, speed, assets=assets)
 
     # ------------------------------------------------------------------ motors
 
@@ -371,7 +388,7 @@ class Simulation:
                 raise ConfigError(f"an object called {name!r} exists", field=name)
             old_model, old_data = self.model, self.data
             specs = [*self._objects.specs, spec]
-            model = add_objects(self._xml, specs)
+            model = add_objects(self._xml, specs, self._assets)
             data = mujoco.MjData(model)
             for j in range(old_model.njnt):
                 joint = mujoco.mj_id2name(old_model, mujoco.mjtObj.mjOBJ_JOINT, j)
