@@ -40,7 +40,9 @@ MESH_RATIO_OK = 0.95
 def without_meshes(xml: str) -> str:
     """The model without its visual meshes (their assets and geoms): the physics unchanged."""
     kept = [
-        line for line in xml.splitlines() if "<mesh " not in line and 'class="visual"' not in line
+        line
+        for line in xml.splitlines()
+        if "<mesh " not in line and not ("<geom " in line and 'class="visual"' in line)
     ]
     return "\n".join(kept).replace(' meshdir="meshes"', "") + "\n"
 

@@ -40,6 +40,7 @@ from poppy_core.sim.looks import (
     SUPPORT_TOP_M,
     TABLE_TOP_M,
 )
+from poppy_core.sim.model_files import MESH_DIR
 from poppy_core.sim.servos import servo_params
 from poppy_core.sim.urdf import (
     Quat,
@@ -57,7 +58,6 @@ from poppy_core.sim.urdf import (
 # the free camera's distance in half-spans of the robot's reach (a ball of radius r fills a 45°
 # view from 2.6 r), from the front and a little above
 FREE_DISTANCE = 2.8
-MESH_DIR = "meshes"  # profiles/<robot>/meshes/: the URDF's visual meshes (binary STL)
 
 # profiles/<robot>/<file>: the public Poppy URDFs, kept with each profile (the chains use them too)
 ROBOTS: dict[str, str] = {
@@ -356,6 +356,9 @@ class _Writer:
             "  <default>",
             '    <geom contype="2" conaffinity="1" condim="3" friction="0.8 0.02 0.001"/>',
             '    <default class="world">',
+            '      <geom contype="1" conaffinity="3"/>',
+            "    </default>",
+            '    <default class="prop">',
             '      <geom contype="1" conaffinity="3"/>',
             "    </default>",
             '    <default class="collision">',

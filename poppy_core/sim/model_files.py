@@ -7,28 +7,41 @@ from pathlib import Path
 
 from poppy_core.errors import ConfigError
 
+MESH_DIR = "meshes"  # profiles/<robot>/meshes/: the URDF's visual meshes (binary STL)
 MAX_MODEL_BYTES = 4 * 1024 * 1024  # an MJCF text (the profiles' are ~20 kB)
 MAX_ASSETS_BYTES = 64 * 1024 * 1024  # all its mesh files together (the profiles' ~1 MB)
 
 
-def read_model(path: Path) -> tuple[str, dict[str, bytes]]:
-    """The MJCF text at ``path`` and its assets: every ``<mesh file>`` under the compiler's
-    ``meshdir`` (relative to the model's folder), keyed as MuJoCo looks them up.
+def read_model(path: Path, fallback: Path | None = None) -> tuple[str, dict[str, bytes]]:
+    """The MJCF text at ``path`` and its assets (``model_assets``).
 
     Raises:
         ConfigError: the model or a mesh file is missing, unreadable or too large.
     """
+    xml = read_xml(path)
+    return xml, model_assets(xml, path.parent, str(path), fallback)
+
+
+def read_xml(path: Path) -> str:
+    """The MJCF text at ``path``, within ``MAX_MODEL_BYTES``.
+
+    Raises:
+        ConfigError: missing, unreadable or too large.
+    """
     try:
         if path.stat().st_size > MAX_MODEL_BYTES:
             raise ConfigError("the model file is too large", file=str(path))
-        xml = path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"cannot read the simulation model: {exc}", file=str(path)) from exc
-    return xml, model_assets(xml, path.parent, str(path))
 
 
-def model_assets(xml: str, folder: Path, source: str = "model") -> dict[str, bytes]:
-    """The mesh files the MJCF ``xml`` names, read from ``folder`` (its ``meshdir`` applied)."""
+def model_assets(
+    xml: str, folder: Path, source: str = "model", fallback: Path | None = None
+) -> dict[str, bytes]:
+    """Every ``<mesh file>`` the MJCF ``xml`` names, keyed as MuJoCo looks them up: read under
+    its compiler's ``meshdir`` in ``folder``, else (a scene borrowing the robot's meshes) in
+    ``fallback``."""
     try:
         root = ET.fromstring(xml)
     except ET.ParseError as exc:
@@ -42,6 +55,8 @@ def model_assets(xml: str, folder: Path, source: str = "model") -> dict[str, byt
         if not name or name in assets:
             continue
         file = folder / meshdir / name
+        if not file.is_file() and fallback is not None and (fallback / name).is_file():
+            file = fallback / name
         try:
             data = file.read_bytes()
         except OSError as exc:

@@ -20,8 +20,9 @@ from poppy_core.schedule import Worker
 from poppy_core.sim.drive import Drive, Joint
 from poppy_core.sim.exchange import MotorPort
 from poppy_core.sim.gl import check_offscreen_gl
-from poppy_core.sim.model_files import read_model
+from poppy_core.sim.model_files import MESH_DIR, read_model
 from poppy_core.sim.objects import ObjectSpec, add_objects, facing_quat
+from poppy_core.sim.placing import Placing, carry_state
 from poppy_core.sim.plant import MotorJoint
 
 logger = logging.getLogger(__name__)
@@ -46,7 +47,7 @@ class _Objects:
     specs: list[ObjectSpec] = field(default_factory=list)
 
 
-class Simulation:
+class Simulation(Placing):
     """A MuJoCo world whose joints are driven by virtual motors (``robot.simulation``).
 
     Args:
@@ -61,6 +62,8 @@ class Simulation:
     ) -> None:
         self._xml = xml
         self._assets = dict(assets or {})
+        self.meshes_dir: Path | None = None
+        """Where a scene's missing mesh files are looked for (the profile's meshes)."""
         self.speed = speed
         self._lock = threading.RLock()
         self.model = mujoco.MjModel.from_xml_string(xml, self._assets)
@@ -83,17 +86,23 @@ class Simulation:
             ConfigError: the model or one of its meshes cannot be read.
         """
         xml, assets = read_model(path)
-        return cls(xml, speed, assets=assets)
+        simulation = cls(xml, speed, assets=assets)
+        simulation.meshes_dir = path.parent / MESH_DIR
+        return simulation
 
     # ------------------------------------------------------------------ motors
 
     def _resolve(self, joint: str) -> tuple[int, int, int]:
         """(qpos address, dof address, actuator id) of ``joint`` in the current model."""
-        index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
-        actuator = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint)
+        return self._resolve_in(self.model, joint)
+
+    @staticmethod
+    def _resolve_in(model: Any, joint: str) -> tuple[int, int, int]:
+        index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+        actuator = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint)
         if index < 0 or actuator < 0:
             raise ConfigError(f"the simulation model has no joint/actuator {joint!r}", field=joint)
-        return int(self.model.jnt_qposadr[index]), int(self.model.jnt_dofadr[index]), actuator
+        return int(model.jnt_qposadr[index]), int(model.jnt_dofadr[index]), actuator
 
     def bind(self, motor: VirtualMotor, link: MotorJoint) -> None:
         """Let ``motor`` drive joint ``link.joint``; its table starts at the joint's pose.
@@ -279,7 +288,8 @@ class Simulation:
         size: float | tuple[float, ...] = 0.02,
         mass: float = 0.05,
     ) -> None:
-        """Add a free ``"cube"``, ``"sphere"`` or ``"cylinder"`` (size: half side/radius, m).
+        """Add a free ``"cube"``, ``"sphere"``, ``"cylinder"`` or ``"cone"`` (size: half side,
+        radius, or radius and half height; m).
 
         The model is rebuilt; the robot's state and the other objects' poses are kept.
 
@@ -386,28 +396,24 @@ class Simulation:
         with self._lock:
             if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
                 raise ConfigError(f"an object called {name!r} exists", field=name)
-            old_model, old_data = self.model, self.data
             specs = [*self._objects.specs, spec]
-            model = add_objects(self._xml, specs, self._assets)
-            data = mujoco.MjData(model)
-            for j in range(old_model.njnt):
-                joint = mujoco.mj_id2name(old_model, mujoco.mjtObj.mjOBJ_JOINT, j)
-                new = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
-                size_q = 7 if old_model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE else 1
-                size_v = 6 if size_q == 7 else 1
-                qa, na = old_model.jnt_qposadr[j], model.jnt_qposadr[new]
-                va, nv = old_model.jnt_dofadr[j], model.jnt_dofadr[new]
-                data.qpos[na : na + size_q] = old_data.qpos[qa : qa + size_q]
-                data.qvel[nv : nv + size_v] = old_data.qvel[va : va + size_v]
-            data.time = old_data.time
-            for a in range(old_model.nu):
-                model.actuator_gainprm[a] = old_model.actuator_gainprm[a]
-                model.actuator_biasprm[a] = old_model.actuator_biasprm[a]
-                model.actuator_forcerange[a] = old_model.actuator_forcerange[a]
-                data.ctrl[a] = old_data.ctrl[a]
-            mujoco.mj_forward(model, data)
-            self.model, self.data = model, data
+            self._install(add_objects(self._xml, specs, self._assets))
             self._objects.specs = specs
+
+    def _install(
+        self, model: Any, xml: str | None = None, assets: dict[str, bytes] | None = None
+    ) -> None:
+        """Run ``model`` from now on (the robot's state carried over, its motors bound again);
+        ``xml`` and ``assets``, a new scene: the objects added so far are added to it again."""
+        with self._lock:
+            if xml is not None and self._objects.specs:
+                model = add_objects(xml, self._objects.specs, assets)
+            for binding in self._bindings:
+                self._resolve_in(model, binding.link.joint)
+            if xml is not None:
+                self._xml, self._assets = xml, dict(assets or {})
+            self.data = carry_state(self.model, self.data, model)
+            self.model = model
             for binding in self._bindings:
                 self._drive.relocate(binding.index, *self._resolve(binding.link.joint))
             self._drive.invalidate()
