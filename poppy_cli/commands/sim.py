@@ -53,7 +53,8 @@ def _open_viewer(simulation: Any) -> Any:
     try:
         import mujoco.viewer
 
-        return mujoco.viewer.launch_passive(simulation.model, simulation.data)
+        with simulation.lock:  # the drawn world (the robot's meshes), posed as the physics
+            return mujoco.viewer.launch_passive(simulation.view_model, simulation.view())
     except Exception as exc:  # any GL/GLFW failure: keep serving
         err_console.print(f"--view: cannot open MuJoCo's viewer ({exc}); serving without it")
         return None
@@ -114,6 +115,8 @@ def _serve(profile: str, speed: float, tcp: str | None, view: bool) -> None:
                 if not viewer.is_running():
                     viewer = None
                     continue
+                with simulation.lock:
+                    simulation.view()
                 viewer.sync()
     finally:
         if viewer is not None:

@@ -98,7 +98,7 @@ class SimCamera(Camera):
             self.fail(str(exc))
             raise SensorError(f"camera {self.name!r}: {exc}") from exc
         with sim.lock:
-            model = sim.model
+            model = sim.view_model  # the drawn world (the robot's meshes)
             samples = int(model.vis.quality.offsamples)
             model.vis.quality.offsamples = 0  # read when the GL context is made
             try:
@@ -112,12 +112,12 @@ class SimCamera(Camera):
 
     def grab(self) -> np.ndarray:
         sim = self.simulation
-        if self._renderer is None or self._model is not sim.model:  # objects were added
+        if self._renderer is None or self._model is not sim.view_model:  # objects were added
             self._close_renderer()
             self._make_renderer()
         renderer = self._renderer
         with sim.lock:
-            renderer.update_scene(sim.data, camera=self._camera)
+            renderer.update_scene(sim.view(), camera=self._camera)
         for flag in _OFF:
             renderer.scene.flags[flag] = 0
         rgb = renderer.render()

@@ -95,10 +95,24 @@ _TYPES = {
 }
 
 
-def add_objects(xml: str, specs: list[ObjectSpec], assets: dict[str, bytes] | None = None) -> Any:
+VISUAL_CLASS = "visual"  # the models' geoms that are drawn, never simulated (mjcf.py)
+
+
+def add_objects(
+    xml: str,
+    specs: list[ObjectSpec],
+    assets: dict[str, bytes] | None = None,
+    *,
+    drawn: bool = True,
+) -> Any:
     """Compile ``xml`` (its mesh files in ``assets``) with ``specs`` added as free bodies
-    (MjSpec); returns the MjModel."""
+    (MjSpec); returns the MjModel. ``drawn=False``: without the geoms of class ``visual``
+    (the meshes), the model the physics steps: the same bodies, joints and cameras."""
     spec = mujoco.MjSpec.from_string(xml, assets=assets or {})
+    if not drawn:
+        for geom in list(spec.geoms):
+            if geom.classname.name == VISUAL_CLASS:
+                spec.delete(geom)
     for obj in specs:
         body = spec.worldbody.add_body(name=obj.name, pos=list(obj.position), quat=list(obj.quat))
         if not obj.fixed:

@@ -50,6 +50,7 @@ class Placing:
     """Poses set by hand, the simulated time, and loading a scene (a ``Simulation`` mixin)."""
 
     model: Any
+    view_model: Any
     data: Any
     meshes_dir: Path | None
     _lock: threading.RLock
@@ -58,7 +59,7 @@ class Placing:
         raise NotImplementedError  # Simulation's
 
     def _install(
-        self, model: Any, xml: str | None = None, assets: dict[str, bytes] | None = None
+        self, xml: str | None = None, assets: dict[str, bytes] | None = None, specs: Any = None
     ) -> None:
         raise NotImplementedError  # Simulation's
 
@@ -104,6 +105,7 @@ class Placing:
             body, joint = self._placeable(name)
             if joint is None:
                 self.model.body_pos[body] = point
+                self.view_model.body_pos[body] = point
             else:
                 address = int(self.model.jnt_qposadr[joint])
                 self.data.qpos[address : address + 3] = point
@@ -127,6 +129,7 @@ class Placing:
             body, joint = self._placeable(name)
             if joint is None:
                 self.model.body_quat[body] = turn
+                self.view_model.body_quat[body] = turn
             else:
                 address = int(self.model.jnt_qposadr[joint])
                 self.data.qpos[address + 3 : address + 7] = turn
@@ -147,11 +150,7 @@ class Placing:
         """
         scene = Path(path)
         xml, assets = read_model(scene, meshes if meshes is not None else self.meshes_dir)
-        try:
-            model = mujoco.MjModel.from_xml_string(xml, assets)
-        except ValueError as exc:
-            raise ConfigError(f"the scene does not compile: {exc}", file=str(scene)) from exc
-        self._install(model, xml, assets)
+        self._install(xml, assets)
 
 
 def _vector(values: object, size: int, field: str) -> np.ndarray:

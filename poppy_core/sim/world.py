@@ -66,8 +66,16 @@ class Simulation(Placing):
         """Where a scene's missing mesh files are looked for (the profile's meshes)."""
         self.speed = speed
         self._lock = threading.RLock()
-        self.model = mujoco.MjModel.from_xml_string(xml, self._assets)
+        # Two compilations of one world: ``model`` steps the physics without the visual meshes
+        # (they would cost every step their poses), ``view_model`` draws them; their bodies,
+        # joints and cameras are the same, so a render copies the pose across (``view``).
+        try:
+            self.view_model = mujoco.MjModel.from_xml_string(xml, self._assets)
+            self.model = add_objects(xml, [], self._assets, drawn=False)
+        except ValueError as exc:
+            raise ConfigError(f"the simulation model does not compile: {exc}") from exc
         self.data = mujoco.MjData(self.model)
+        self._view_data = mujoco.MjData(self.view_model)
         mujoco.mj_forward(self.model, self.data)
         self._bindings: list[_Binding] = []
         self._drive = Drive()
@@ -396,30 +404,54 @@ class Simulation(Placing):
         with self._lock:
             if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
                 raise ConfigError(f"an object called {name!r} exists", field=name)
-            specs = [*self._objects.specs, spec]
-            self._install(add_objects(self._xml, specs, self._assets))
-            self._objects.specs = specs
+            self._install(specs=[*self._objects.specs, spec])
 
     def _install(
-        self, model: Any, xml: str | None = None, assets: dict[str, bytes] | None = None
+        self,
+        xml: str | None = None,
+        assets: dict[str, bytes] | None = None,
+        specs: list[ObjectSpec] | None = None,
     ) -> None:
-        """Run ``model`` from now on (the robot's state carried over, its motors bound again);
-        ``xml`` and ``assets``, a new scene: the objects added so far are added to it again."""
+        """Compile the world again and run it from now on: ``xml`` and ``assets`` (a new scene,
+        default the current one) with the objects ``specs`` (default those added so far). The
+        robot's state is carried over and its motors bound again.
+
+        Raises:
+            ConfigError: the world does not compile, or lacks a bound motor's joint.
+        """
         with self._lock:
-            if xml is not None and self._objects.specs:
-                model = add_objects(xml, self._objects.specs, assets)
+            xml = self._xml if xml is None else xml
+            assets = self._assets if assets is None else dict(assets)
+            specs = self._objects.specs if specs is None else specs
+            try:
+                view = add_objects(xml, specs, assets)
+                model = add_objects(xml, specs, assets, drawn=False)
+            except ValueError as exc:
+                raise ConfigError(f"the simulation model does not compile: {exc}") from exc
             for binding in self._bindings:
                 self._resolve_in(model, binding.link.joint)
-            if xml is not None:
-                self._xml, self._assets = xml, dict(assets or {})
+            self._xml, self._assets, self._objects.specs = xml, assets, specs
             self.data = carry_state(self.model, self.data, model)
-            self.model = model
+            self.model, self.view_model = model, view
+            self._view_data = mujoco.MjData(view)
             for binding in self._bindings:
                 self._drive.relocate(binding.index, *self._resolve(binding.link.joint))
             self._drive.invalidate()
             for renderer in self._renderers.values():
                 renderer.close()
             self._renderers.clear()
+
+    def view(self) -> Any:
+        """The drawn world's data at the physics' current pose (hold ``lock``): what a renderer
+        of ``view_model`` shows."""
+        data = self._view_data
+        data.qpos[:] = self.data.qpos
+        data.qvel[:] = self.data.qvel
+        data.time = self.data.time
+        mujoco.mj_kinematics(self.view_model, data)
+        mujoco.mj_comPos(self.view_model, data)  # the cameras that follow the centre of mass
+        mujoco.mj_camlight(self.view_model, data)
+        return data
 
     def contacts(self) -> list[tuple[str, str]]:
         """Pairs of bodies touching now (each pair once, names sorted)."""
@@ -451,9 +483,9 @@ class Simulation(Placing):
             key = (width, height)
             try:
                 if key not in self._renderers:
-                    self._renderers[key] = mujoco.Renderer(self.model, height, width)
+                    self._renderers[key] = mujoco.Renderer(self.view_model, height, width)
                 renderer = self._renderers[key]
-                renderer.update_scene(self.data, camera=camera if camera is not None else -1)
+                renderer.update_scene(self.view(), camera=camera if camera is not None else -1)
                 return renderer.render()
             except (mujoco.FatalError, AttributeError, RuntimeError) as exc:
                 raise ConfigError(

@@ -175,3 +175,32 @@ def test_the_silhouettes_match_the_reference_images(robot: str) -> None:
             reference = np.asarray(Image.open(path).convert("L")) > 127
             iou = _iou(mask, reference)
             assert iou >= MIN_IOU, f"{path.name}: {iou:.3f} of the reference"
+
+
+@pytest.mark.parametrize("robot", list(ROBOTS))
+def test_the_physics_steps_without_the_meshes_and_renders_draw_them(robot: str) -> None:
+    from poppy_core.sim.world import Simulation
+
+    sim = Simulation.from_file(PROFILES / robot / "model.xml")
+    try:
+        mesh = int(mujoco.mjtGeom.mjGEOM_MESH)
+        stepped = [int(t) for t in sim.model.geom_type]
+        drawn = [int(t) for t in sim.view_model.geom_type]
+        assert mesh not in stepped and drawn.count(mesh) >= 7
+        assert (sim.model.nbody, sim.model.njnt, sim.model.ncam) == (
+            sim.view_model.nbody,
+            sim.view_model.njnt,
+            sim.view_model.ncam,
+        )
+        sim.add_object("cube", "box", (0.3, 0.3, 0.9), size=0.02, mass=0.05)
+        assert mesh not in [int(t) for t in sim.model.geom_type]
+        sim.advance(0.2)
+        with sim.lock:
+            view = sim.view()
+            box = mujoco.mj_name2id(sim.view_model, mujoco.mjtObj.mjOBJ_BODY, "box")
+            free = mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_JOINT, "box_free")
+            address = int(sim.model.jnt_qposadr[free])
+            where = [float(v) for v in sim.data.qpos[address : address + 3]]
+            assert [float(v) for v in view.xpos[box]] == where  # drawn where the physics has it
+    finally:
+        sim.close()
