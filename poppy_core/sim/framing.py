@@ -129,12 +129,20 @@ def camera_axes(eye: Vec3, target: Vec3) -> tuple[Vec3, Vec3]:
 
 
 def pose_cloud(
-    xml: str, assets: dict[str, bytes], floor_z: float, seed: int = 0, poses: int = 300
+    xml: str,
+    assets: dict[str, bytes],
+    floor_z: float,
+    seed: int = 0,
+    poses: int = 300,
+    *,
+    follow_com: bool = False,
 ) -> np.ndarray:
-    """Points (n, 3) bounding the robot over its joints' range: the corners of every robot
-    geom's box at the zero pose, each joint at 90% and 100% of its limits each way (all
-    together) and ``poses`` random poses (seeded), lifted to ``floor_z`` where they dip below
-    (the table or the floor stops the limbs). The robot's root stays where the model puts it."""
+    """Points (n, 3) bounding the robot over its joints' range: every robot geom's bounding
+    ball at the model's pose, at the zero pose, each joint at 90% and 100% of its limits each
+    way (all together) and ``poses`` random poses (seeded), lifted to ``floor_z`` where they
+    dip below (the table or the floor stops the limbs). The root stays where the model puts it.
+    ``follow_com``: for cameras that follow the centre of mass (``trackcom``), each pose's
+    points are moved back by how far its centre of mass moved from the zero pose's."""
     import mujoco
 
     model = mujoco.MjModel.from_xml_string(xml, assets)
@@ -147,18 +155,25 @@ def pose_cloud(
         angles += [share * ranges[:, 0], share * ranges[:, 1]]
     angles += list(rng.uniform(ranges[:, 0], ranges[:, 1], size=(poses, len(hinges))))
     geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] != 0]
+    # each geom's bounding ball (``geom_rbound`` around its centre), by 14 points on it: the
+    # axes' ends and the cube's corners
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    boxes = [(model.geom_aabb[g][:3], model.geom_aabb[g][3:]) for g in geoms]
-    corners = np.stack([centre + signs * half for centre, half in boxes])  # (geoms, 8, 3)
+    directions = np.concatenate([np.eye(3), -np.eye(3), signs / math.sqrt(3)])
+    radii = np.array([float(model.geom_rbound[g]) for g in geoms])
+    offsets = radii[:, None, None] * directions[None, :, :]  # (geoms, 14, 3), world axes
+    mujoco.mj_resetData(model, data)  # the model's own pose (qpos0): where the cameras start
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_comPos(model, data)
+    start_com = np.array(data.subtree_com[0])
     clouds = []
-    for pose in angles:
+    for pose in [None, *angles]:
         mujoco.mj_resetData(model, data)
-        for joint, angle in zip(hinges, pose, strict=True):
+        for joint, angle in zip(hinges, pose if pose is not None else [], strict=False):
             data.qpos[model.jnt_qposadr[joint]] = angle
         mujoco.mj_kinematics(model, data)
-        xmat = data.geom_xmat[geoms].reshape(-1, 3, 3)
-        world = np.einsum("gij,gkj->gki", xmat, corners) + data.geom_xpos[geoms][:, None, :]
-        clouds.append(world.reshape(-1, 3))
-    cloud = np.concatenate(clouds)
-    cloud[:, 2] = np.maximum(cloud[:, 2], floor_z)
-    return cloud
+        mujoco.mj_comPos(model, data)
+        points = (data.geom_xpos[geoms][:, None, :] + offsets).reshape(-1, 3)
+        points[:, 2] = np.maximum(points[:, 2], floor_z)
+        com = np.array(data.subtree_com[0])
+        clouds.append(points - (com - start_com) if follow_com else points)
+    return np.concatenate(clouds)

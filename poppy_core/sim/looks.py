@@ -31,7 +31,7 @@ def _views(front_rise: float, side_rise: float) -> tuple[View, ...]:
 
 
 STYLES: dict[str, Style] = {
-    "ergo-jr": Style(0.012, "0.95 0.95 0.95 1", "table", _views(0.6, 0.35), "0.93 0.93 0.95 1"),
+    "ergo-jr": Style(0.012, "0.95 0.95 0.95 1", "table", _views(0.45, 0.35), "0.93 0.93 0.95 1"),
     "torso": Style(0.022, "0.92 0.92 0.9 1", "support", _views(0.3, 0.15), "0.9 0.9 0.88 1"),
     "humanoid": Style(0.025, "0.92 0.92 0.9 1", "floor", _views(0.25, 0.1), "0.9 0.9 0.88 1"),
 }

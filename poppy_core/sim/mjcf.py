@@ -322,7 +322,9 @@ class _Writer:
         poses = self.world_frames()
         floor_z = self.mount(poses)[2]
         bare = self.text(poses, [])
-        return self.text(poses, self.cameras(pose_cloud(bare, assets, floor_z)))
+        follow = self.style.mount == "floor"  # its cameras follow the centre of mass
+        cloud = pose_cloud(bare, assets, floor_z, follow_com=follow)
+        return self.text(poses, self.cameras(cloud))
 
     def text(self, poses: dict[str, tuple[Vec3, Quat]], cameras: list[str]) -> str:
         style = self.style
