@@ -112,11 +112,12 @@ class SimCamera(Camera):
 
     def grab(self) -> np.ndarray:
         sim = self.simulation
-        if self._renderer is None or self._model is not sim.view_model:  # objects were added
-            self._close_renderer()
-            self._make_renderer()
-        renderer = self._renderer
-        with sim.lock:
+        with sim.lock:  # the model checked and posed at once: an object added between the two
+            # would give the old model's renderer the new model's data
+            if self._renderer is None or self._model is not sim.view_model:  # objects added
+                self._close_renderer()
+                self._make_renderer()
+            renderer = self._renderer
             renderer.update_scene(sim.view(), camera=self._camera)
         for flag in _OFF:
             renderer.scene.flags[flag] = 0
