@@ -262,6 +262,7 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
     "sim render": (
         ("sim render --profile humanoid -o humanoid.png", "a still"),
         ("sim render --profile ergo-jr --move wave -o wave.gif -f", "a move, as a GIF"),
+        ("sim render --profile torso --camera side -o torso-side.png", "from its left"),
         ("sim render --profile ergo-jr --camera free --width 320 --height 240 -o .", ""),
     ),
     "snap": (

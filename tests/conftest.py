@@ -35,6 +35,7 @@ SLOW_MODULES = {
 # (it happened when mujoco was imported before MUJOCO_GL was set; see docs/simulation.md).
 GL_MODULES = {
     "sim/test_sim_camera.py",
+    "sim/test_sim_meshes.py",
     "sim/test_sim_plant.py",
     "sim/test_sim_tracking.py",
 }

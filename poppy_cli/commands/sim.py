@@ -53,7 +53,8 @@ def _open_viewer(simulation: Any) -> Any:
     try:
         import mujoco.viewer
 
-        return mujoco.viewer.launch_passive(simulation.model, simulation.data)
+        with simulation.lock:  # the drawn world (the robot's meshes), posed as the physics
+            return mujoco.viewer.launch_passive(simulation.view_model, simulation.view())
     except Exception as exc:  # any GL/GLFW failure: keep serving
         err_console.print(f"--view: cannot open MuJoCo's viewer ({exc}); serving without it")
         return None
@@ -114,6 +115,8 @@ def _serve(profile: str, speed: float, tcp: str | None, view: bool) -> None:
                 if not viewer.is_running():
                     viewer = None
                     continue
+                with simulation.lock:
+                    simulation.view()
                 viewer.sync()
     finally:
         if viewer is not None:
@@ -289,7 +292,10 @@ def render(
         autocompletion=complete.moves,
     ),
     camera: str | None = typer.Option(
-        "front", "--camera", help="Camera of the model ('front'); 'free' for the default view."
+        "front",
+        "--camera",
+        help="View: front, side or top (each frames the robot and all it can reach), "
+        "camera (the robot's own), or free (MuJoCo's default view).",
     ),
     width: int = typer.Option(640, "--width", min=16, max=4096, help="Image width (pixels)."),
     height: int = typer.Option(480, "--height", min=16, max=4096, help="Image height (pixels)."),
@@ -319,7 +325,9 @@ def render(
             raise _no_gl(str(exc)) from None
         raise
     except ValueError as exc:  # mujoco: unknown camera
-        error_line(f"{exc} (the models have a camera 'front'; 'free' is the default view)")
+        error_line(
+            f"{exc} (the models' cameras: front, side, top, camera; 'free' is the default view)"
+        )
         raise typer.Exit(EXIT_USAGE) from None
     if suffix != ".gif" and len(frames) > 1:
         err_console.print(f"a still image holds one frame: the last of {len(frames)} is saved")

@@ -12,6 +12,7 @@ saying what to use instead.
 from __future__ import annotations
 
 import logging
+import os
 from collections.abc import Mapping
 from os import PathLike
 from typing import Any, ClassVar
@@ -57,7 +58,11 @@ class AbstractPoppyCreature:
         config: a config (dict, or JSON/YAML file) instead of the creature's profile.
         simulator: None (hardware), ``'dummy'`` (virtual servos, ideal plant), ``'mujoco'``
             (virtual servos in MuJoCo physics; ``robot.simulation``); ``'vrep'`` is refused.
-        scene: refused unless None (MuJoCo uses the profile's ``model.xml``).
+        scene: with ``simulator='mujoco'``, an MJCF scene file holding the robot and its props
+            (``robot.load_scene``); None: the profile's ``model.xml``.
+        tracked_objects, tracked_collisions: with ``simulator='mujoco'``, bodies read as
+            ``robot.<name>.position``/``.orientation`` and ``robot.<name>.colliding`` (pypot's
+            ``from_vrep`` arguments).
         use_http, http_host, http_port: the REST server (``robot.http``).
         use_ws, ws_host, ws_port: the state stream WebSocket (``robot.ws``).
         use_zmq, zmq_host, zmq_port: pypot's ZMQ request/reply server (``robot.zmq``).
@@ -116,7 +121,8 @@ class AbstractPoppyCreature:
         sim = _simulator(simulator)
         if simulator == "poppy-simu":
             use_http = True  # pypot: poppy-simu is the dummy robot served over HTTP
-        _refuse_vrep_options(base_path, scene, port, id, shared_vrep_io, use_remote)
+        _refuse_vrep_options(base_path, port, id, shared_vrep_io, use_remote)
+        scene_calls = _scene_options(sim, scene, extra)  # MuJoCo's scene and trackers
         sensors = _sensor_switches(extra)
         spec = ServeSpec(
             http=Listen(http_host, http_port) if use_http else None,
@@ -134,6 +140,7 @@ class AbstractPoppyCreature:
             robot = from_config(_config_source(config), sim, **options)
         try:
             cls.setup(robot)
+            scene_calls(robot)
             if sim:
                 hold_start_pose(robot)
             if spec.listens():
@@ -198,20 +205,13 @@ def _config_source(config: object) -> Any:
 
 
 def _refuse_vrep_options(
-    base_path: object, scene: object, port: object, id: object, shared: object, remote: bool
+    base_path: object, port: object, id: object, shared: object, remote: bool
 ) -> None:
     if base_path is not None:
         raise ConfigError(
             "base_path is not supported: the creature's files are poppy profiles; "
             "give config= a config file instead",
             field="base_path",
-        )
-    if scene is not None:
-        raise ConfigError(
-            "scene= is a V-REP option: with simulator='mujoco' the scene is the "
-            "profile's model.xml",
-            field="scene",
-            value=scene,
         )
     if port is not None and not isinstance(port, str):
         raise ConfigError(
@@ -227,6 +227,47 @@ def _refuse_vrep_options(
             "use_zmq=True (pypot's ZMQ server) or use_http=True",
             field="use_remote",
         )
+
+
+def _scene_options(sim: bool | str, scene: object, extra: dict[str, Any]) -> Any:
+    """What the robot gets once built from pypot's V-REP scene arguments, on MuJoCo: the scene
+    file loaded, objects and collisions tracked (taken out of ``extra``)."""
+    tracked = extra.pop("tracked_objects", None) or []
+    collisions = extra.pop("tracked_collisions", None) or []
+    if sim != "mujoco" and (scene is not None or tracked or collisions):
+        raise ConfigError(
+            "scene=, tracked_objects= and tracked_collisions= need simulator='mujoco' "
+            "(the scene is an MJCF file holding the robot and its props)",
+            field="scene" if scene is not None else "tracked_objects",
+            value=scene,
+        )
+    path = None
+    if scene is not None:
+        if not isinstance(scene, (str, os.PathLike)) or os.fspath(scene) == "keep-existing":
+            raise ConfigError(
+                f"scene={scene!r}: give the path of an MJCF scene file (start from a copy of "
+                "the profile's model.xml and add props), or leave it out",
+                field="scene",
+                value=scene,
+            )
+        path = os.fspath(scene)
+        if str(path).lower().endswith(".ttt"):
+            raise ConfigError(
+                f"scene={scene!r} is a V-REP scene: MuJoCo reads an MJCF file (start from a "
+                "copy of the profile's model.xml and add props)",
+                field="scene",
+                value=scene,
+            )
+
+    def apply(robot: Robot) -> None:
+        if path is not None:
+            robot.load_scene(path)
+        if tracked:
+            robot.track_objects(tracked)
+        if collisions:
+            robot.track_collisions(collisions)
+
+    return apply
 
 
 def _sensor_switches(extra: Mapping[str, Any]) -> bool:

@@ -5,7 +5,7 @@ and ``face_tracking`` share.
 ``tracking_feedback`` is poppy-ergo-jr's behaviour of that name: the tip motors' LEDs are green
 while a marker was seen in any of the last six updates, off otherwise. ``marker_follow`` is the
 "head follows a marker" the Poppy lessons show, built on the arm's kinematic chain: the camera
-looks along the tip's -z (see ``sim.mjcf.CAMERAS``), so the marker's pixel gives a direction in
+looks along the tip's -z (see ``sim.looks.CAMERAS``), so the marker's pixel gives a direction in
 the chain's base frame, and a damped least-squares step of the chosen joints turns the camera's
 axis towards it. It works the same on the real robot and in MuJoCo (``SimCamera``).
 """

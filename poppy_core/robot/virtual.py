@@ -34,7 +34,7 @@ def start_simulation(config: RobotConfig) -> Any:
     for directory in profile_dirs():
         path = directory / kind / "model.xml"
         if kind and path.is_file():
-            return Simulation(path.read_text(encoding="utf-8"))
+            return Simulation.from_file(path)
     raise ConfigError(
         f"no simulation model for robot kind {kind!r} (profiles/<kind>/model.xml)",
         field="profile.kind",

@@ -1,7 +1,7 @@
 """``SimCamera``: the MuJoCo scene rendered offscreen from the robot's own camera.
 
 The profiles' models hold a camera named ``camera`` where the real one sits (Ergo Jr head,
-Torso/Humanoid face; see ``mjcf.CAMERAS``). The camera renders in its own thread with its own
+Torso/Humanoid face; see ``looks.CAMERAS``). The camera renders in its own thread with its own
 OpenGL context (EGL or OSMesa contexts belong to one thread): the scene is copied under the
 world's lock, drawn outside it, so physics never waits for pixels. No shadows, reflections or
 multisampling: on a software renderer they cost 30× the frame (see docs/sensors.md).
@@ -98,7 +98,7 @@ class SimCamera(Camera):
             self.fail(str(exc))
             raise SensorError(f"camera {self.name!r}: {exc}") from exc
         with sim.lock:
-            model = sim.model
+            model = sim.view_model  # the drawn world (the robot's meshes)
             samples = int(model.vis.quality.offsamples)
             model.vis.quality.offsamples = 0  # read when the GL context is made
             try:
@@ -112,12 +112,13 @@ class SimCamera(Camera):
 
     def grab(self) -> np.ndarray:
         sim = self.simulation
-        if self._renderer is None or self._model is not sim.model:  # objects were added
-            self._close_renderer()
-            self._make_renderer()
-        renderer = self._renderer
-        with sim.lock:
-            renderer.update_scene(sim.data, camera=self._camera)
+        with sim.lock:  # the model checked and posed at once: an object added between the two
+            # would give the old model's renderer the new model's data
+            if self._renderer is None or self._model is not sim.view_model:  # objects added
+                self._close_renderer()
+                self._make_renderer()
+            renderer = self._renderer
+            renderer.update_scene(sim.view(), camera=self._camera)
         for flag in _OFF:
             renderer.scene.flags[flag] = 0
         rgb = renderer.render()

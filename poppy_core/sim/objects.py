@@ -1,4 +1,4 @@
-"""Objects added to a simulation (cube, sphere, cylinder): their spec and the model rebuild."""
+"""Objects added to a simulation (cube, sphere, cylinder, cone): their spec, the model rebuild."""
 
 from __future__ import annotations
 
@@ -10,13 +10,15 @@ import numpy as np
 
 from poppy_core.errors import ConfigError
 
-KINDS = ("cube", "sphere", "cylinder")
+KINDS = ("cube", "sphere", "cylinder", "cone")
+CONE_SIDES = 24  # a cone is a mesh (MuJoCo has no cone shape): a pyramid of this many sides
 CARD_HALF_THICKNESS_M = 0.001
 _COLORS = {
     "cube": [0.85, 0.2, 0.2, 1.0],
     "sphere": [0.2, 0.5, 0.85, 1.0],
     "card": [1.0] * 4,
     "cylinder": [0.2, 0.7, 0.3, 1.0],
+    "cone": [0.9, 0.6, 0.1, 1.0],
 }
 
 
@@ -72,18 +74,45 @@ class ObjectSpec:
             return [s[0], 0.0, 0.0]
         return [s[0], s[1] if len(s) > 1 else s[0], 0.0]
 
+    def cone_vertices(self) -> list[float]:
+        """A cone's mesh (radius ``size[0]``, half height ``size[1]``, centred, tip up): its
+        base circle's points and its tip, flattened."""
+        radius = self.size[0]
+        half = self.size[1] if len(self.size) > 1 else radius
+        points: list[float] = []
+        for k in range(CONE_SIDES):
+            angle = 2 * np.pi * k / CONE_SIDES
+            points += [radius * float(np.cos(angle)), radius * float(np.sin(angle)), -half]
+        return [*points, 0.0, 0.0, half]
+
 
 _TYPES = {
     "card": mujoco.mjtGeom.mjGEOM_BOX,
     "cube": mujoco.mjtGeom.mjGEOM_BOX,
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
     "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
+    "cone": mujoco.mjtGeom.mjGEOM_MESH,
 }
 
 
-def add_objects(xml: str, specs: list[ObjectSpec]) -> Any:
-    """Compile ``xml`` with ``specs`` added as free bodies (MjSpec); returns the MjModel."""
-    spec = mujoco.MjSpec.from_string(xml)
+VISUAL_CLASS = "visual"  # the models' geoms that are drawn, never simulated (mjcf.py)
+
+
+def add_objects(
+    xml: str,
+    specs: list[ObjectSpec],
+    assets: dict[str, bytes] | None = None,
+    *,
+    drawn: bool = True,
+) -> Any:
+    """Compile ``xml`` (its mesh files in ``assets``) with ``specs`` added as free bodies
+    (MjSpec); returns the MjModel. ``drawn=False``: without the geoms of class ``visual``
+    (the meshes), the model the physics steps: the same bodies, joints and cameras."""
+    spec = mujoco.MjSpec.from_string(xml, assets=assets or {})
+    if not drawn:
+        for geom in list(spec.geoms):
+            if geom.classname.name == VISUAL_CLASS:
+                spec.delete(geom)
     for obj in specs:
         body = spec.worldbody.add_body(name=obj.name, pos=list(obj.position), quat=list(obj.quat))
         if not obj.fixed:
@@ -97,6 +126,9 @@ def add_objects(xml: str, specs: list[ObjectSpec]) -> Any:
             contype=1,
             conaffinity=3,
         )
+        if obj.kind == "cone":
+            spec.add_mesh(name=f"{obj.name}_cone", uservert=obj.cone_vertices())
+            geom.meshname = f"{obj.name}_cone"
         if obj.texture is not None:
             geom.material = _textured(spec, obj.name, obj.texture)
             geom.rgba = [1.0, 1.0, 1.0, 1.0]

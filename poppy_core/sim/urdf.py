@@ -1,10 +1,10 @@
-"""Read the kinematic facts of a URDF (links, joints, origins, axes, inertias) with xml.etree."""
+"""Read the facts of a URDF (links, joints, origins, axes, inertias, meshes) with xml.etree."""
 
 from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from poppy_core.errors import ConfigError
@@ -20,6 +20,16 @@ class Inertial:
     mass_kg: float
     com: Vec3
     inertia: tuple[float, float, float, float, float, float]  # ixx iyy izz ixy ixz iyz
+
+
+@dataclass(frozen=True)
+class Visual:
+    """A link's visual mesh: the file name (the last part of ``<mesh filename>``) and its origin
+    in the link frame."""
+
+    mesh: str
+    xyz: Vec3
+    rpy: Vec3
 
 
 @dataclass(frozen=True)
@@ -42,6 +52,7 @@ class Urdf:
     name: str
     links: dict[str, Inertial | None]
     joints: list[UrdfJoint]
+    visuals: dict[str, Visual] = field(default_factory=dict)
 
     @property
     def root(self) -> str:
@@ -81,6 +92,19 @@ def _inertial(link: ET.Element) -> Inertial | None:
     )
 
 
+def _visual(link: ET.Element) -> Visual | None:
+    mesh = link.find("visual/geometry/mesh")
+    if mesh is None or not mesh.get("filename"):
+        return None
+    origin = link.find("visual/origin")
+    name = str(mesh.get("filename")).replace("\\", "/").rsplit("/", 1)[-1]
+    return Visual(
+        name,
+        _vec(origin.get("xyz") if origin is not None else None),
+        _vec(origin.get("rpy") if origin is not None else None),
+    )
+
+
 def parse_urdf(path: Path) -> Urdf:
     """Parse the URDF at ``path``.
 
@@ -110,7 +134,12 @@ def parse_urdf(path: Path) -> Urdf:
                 axis=_vec(axis.get("xyz") if axis is not None else None, (1.0, 0.0, 0.0)),
             )
         )
-    return Urdf(root.attrib.get("name", path.stem), links, joints)
+    visuals = {}
+    for link in root.findall("link"):
+        visual = _visual(link)
+        if visual is not None:
+            visuals[link.attrib["name"]] = visual
+    return Urdf(root.attrib.get("name", path.stem), links, joints, visuals)
 
 
 # ---------------------------------------------------------------------- rotations (w, x, y, z)

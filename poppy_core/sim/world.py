@@ -7,6 +7,7 @@ import math
 import threading
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
@@ -19,7 +20,9 @@ from poppy_core.schedule import Worker
 from poppy_core.sim.drive import Drive, Joint
 from poppy_core.sim.exchange import MotorPort
 from poppy_core.sim.gl import check_offscreen_gl
+from poppy_core.sim.model_files import MESH_DIR, read_model
 from poppy_core.sim.objects import ObjectSpec, add_objects, facing_quat
+from poppy_core.sim.placing import Placing, carry_state
 from poppy_core.sim.plant import MotorJoint
 
 logger = logging.getLogger(__name__)
@@ -44,20 +47,35 @@ class _Objects:
     specs: list[ObjectSpec] = field(default_factory=list)
 
 
-class Simulation:
+class Simulation(Placing):
     """A MuJoCo world whose joints are driven by virtual motors (``robot.simulation``).
 
     Args:
         xml: the MJCF text of the robot (``profiles/<robot>/model.xml``).
         speed: how many simulated seconds pass per real second in the physics thread.
+        assets: the files the model names (its meshes), by the name it gives them
+            (``model_files.read_model``; ``Simulation.from_file`` reads them).
     """
 
-    def __init__(self, xml: str, speed: float = 1.0) -> None:
+    def __init__(
+        self, xml: str, speed: float = 1.0, *, assets: dict[str, bytes] | None = None
+    ) -> None:
         self._xml = xml
+        self._assets = dict(assets or {})
+        self.meshes_dir: Path | None = None
+        """Where a scene's missing mesh files are looked for (the profile's meshes)."""
         self.speed = speed
         self._lock = threading.RLock()
-        self.model = mujoco.MjModel.from_xml_string(xml)
+        # Two compilations of one world: ``model`` steps the physics without the visual meshes
+        # (they would cost every step their poses), ``view_model`` draws them; their bodies,
+        # joints and cameras are the same, so a render copies the pose across (``view``).
+        try:
+            self.view_model = mujoco.MjModel.from_xml_string(xml, self._assets)
+            self.model = add_objects(xml, [], self._assets, drawn=False)
+        except ValueError as exc:
+            raise ConfigError(f"the simulation model does not compile: {exc}") from exc
         self.data = mujoco.MjData(self.model)
+        self._view_data = mujoco.MjData(self.view_model)
         mujoco.mj_forward(self.model, self.data)
         self._bindings: list[_Binding] = []
         self._drive = Drive()
@@ -68,15 +86,31 @@ class Simulation:
         self._renderers: dict[tuple[int, int], Any] = {}
         self._worker = Worker("mujoco physics", self._run)
 
+    @classmethod
+    def from_file(cls, path: Path, speed: float = 1.0) -> Simulation:
+        """The world of the MJCF file at ``path``, with the mesh files it names.
+
+        Raises:
+            ConfigError: the model or one of its meshes cannot be read.
+        """
+        xml, assets = read_model(path)
+        simulation = cls(xml, speed, assets=assets)
+        simulation.meshes_dir = path.parent / MESH_DIR
+        return simulation
+
     # ------------------------------------------------------------------ motors
 
     def _resolve(self, joint: str) -> tuple[int, int, int]:
         """(qpos address, dof address, actuator id) of ``joint`` in the current model."""
-        index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, joint)
-        actuator = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint)
+        return self._resolve_in(self.model, joint)
+
+    @staticmethod
+    def _resolve_in(model: Any, joint: str) -> tuple[int, int, int]:
+        index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+        actuator = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, joint)
         if index < 0 or actuator < 0:
             raise ConfigError(f"the simulation model has no joint/actuator {joint!r}", field=joint)
-        return int(self.model.jnt_qposadr[index]), int(self.model.jnt_dofadr[index]), actuator
+        return int(model.jnt_qposadr[index]), int(model.jnt_dofadr[index]), actuator
 
     def bind(self, motor: VirtualMotor, link: MotorJoint) -> None:
         """Let ``motor`` drive joint ``link.joint``; its table starts at the joint's pose.
@@ -262,7 +296,8 @@ class Simulation:
         size: float | tuple[float, ...] = 0.02,
         mass: float = 0.05,
     ) -> None:
-        """Add a free ``"cube"``, ``"sphere"`` or ``"cylinder"`` (size: half side/radius, m).
+        """Add a free ``"cube"``, ``"sphere"``, ``"cylinder"`` or ``"cone"`` (size: half side,
+        radius, or radius and half height; m).
 
         The model is rebuilt; the robot's state and the other objects' poses are kept.
 
@@ -369,34 +404,54 @@ class Simulation:
         with self._lock:
             if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
                 raise ConfigError(f"an object called {name!r} exists", field=name)
-            old_model, old_data = self.model, self.data
-            specs = [*self._objects.specs, spec]
-            model = add_objects(self._xml, specs)
-            data = mujoco.MjData(model)
-            for j in range(old_model.njnt):
-                joint = mujoco.mj_id2name(old_model, mujoco.mjtObj.mjOBJ_JOINT, j)
-                new = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
-                size_q = 7 if old_model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE else 1
-                size_v = 6 if size_q == 7 else 1
-                qa, na = old_model.jnt_qposadr[j], model.jnt_qposadr[new]
-                va, nv = old_model.jnt_dofadr[j], model.jnt_dofadr[new]
-                data.qpos[na : na + size_q] = old_data.qpos[qa : qa + size_q]
-                data.qvel[nv : nv + size_v] = old_data.qvel[va : va + size_v]
-            data.time = old_data.time
-            for a in range(old_model.nu):
-                model.actuator_gainprm[a] = old_model.actuator_gainprm[a]
-                model.actuator_biasprm[a] = old_model.actuator_biasprm[a]
-                model.actuator_forcerange[a] = old_model.actuator_forcerange[a]
-                data.ctrl[a] = old_data.ctrl[a]
-            mujoco.mj_forward(model, data)
-            self.model, self.data = model, data
-            self._objects.specs = specs
+            self._install(specs=[*self._objects.specs, spec])
+
+    def _install(
+        self,
+        xml: str | None = None,
+        assets: dict[str, bytes] | None = None,
+        specs: list[ObjectSpec] | None = None,
+    ) -> None:
+        """Compile the world again and run it from now on: ``xml`` and ``assets`` (a new scene,
+        default the current one) with the objects ``specs`` (default those added so far). The
+        robot's state is carried over and its motors bound again.
+
+        Raises:
+            ConfigError: the world does not compile, or lacks a bound motor's joint.
+        """
+        with self._lock:
+            xml = self._xml if xml is None else xml
+            assets = self._assets if assets is None else dict(assets)
+            specs = self._objects.specs if specs is None else specs
+            try:
+                view = add_objects(xml, specs, assets)
+                model = add_objects(xml, specs, assets, drawn=False)
+            except ValueError as exc:
+                raise ConfigError(f"the simulation model does not compile: {exc}") from exc
+            for binding in self._bindings:
+                self._resolve_in(model, binding.link.joint)
+            self._xml, self._assets, self._objects.specs = xml, assets, specs
+            self.data = carry_state(self.model, self.data, model)
+            self.model, self.view_model = model, view
+            self._view_data = mujoco.MjData(view)
             for binding in self._bindings:
                 self._drive.relocate(binding.index, *self._resolve(binding.link.joint))
             self._drive.invalidate()
             for renderer in self._renderers.values():
                 renderer.close()
             self._renderers.clear()
+
+    def view(self) -> Any:
+        """The drawn world's data at the physics' current pose (hold ``lock``): what a renderer
+        of ``view_model`` shows."""
+        data = self._view_data
+        data.qpos[:] = self.data.qpos
+        data.qvel[:] = self.data.qvel
+        data.time = self.data.time
+        mujoco.mj_kinematics(self.view_model, data)
+        mujoco.mj_comPos(self.view_model, data)  # the cameras that follow the centre of mass
+        mujoco.mj_camlight(self.view_model, data)
+        return data
 
     def contacts(self) -> list[tuple[str, str]]:
         """Pairs of bodies touching now (each pair once, names sorted)."""
@@ -428,9 +483,9 @@ class Simulation:
             key = (width, height)
             try:
                 if key not in self._renderers:
-                    self._renderers[key] = mujoco.Renderer(self.model, height, width)
+                    self._renderers[key] = mujoco.Renderer(self.view_model, height, width)
                 renderer = self._renderers[key]
-                renderer.update_scene(self.data, camera=camera if camera is not None else -1)
+                renderer.update_scene(self.view(), camera=camera if camera is not None else -1)
                 return renderer.render()
             except (mujoco.FatalError, AttributeError, RuntimeError) as exc:
                 raise ConfigError(

@@ -144,8 +144,10 @@ def test_use_snap_serves_the_snap_routes_until_close() -> None:
 
 
 def test_refused_pypot_options_name_what_to_do() -> None:
-    with pytest.raises(ConfigError, match=r"model\.xml"):
+    with pytest.raises(ConfigError, match=r"V-REP scene: MuJoCo reads an MJCF file"):
         PoppyErgoJr(simulator="mujoco", scene="poppy_ergo_jr.ttt")
+    with pytest.raises(ConfigError, match="need simulator='mujoco'"):
+        PoppyErgoJr(simulator="dummy", scene="scene.xml")
     with pytest.raises(ConfigError, match="serial port"):
         PoppyErgoJr(simulator="dummy", port=19997)
     with pytest.raises(ConfigError, match="'mujoco'"):

@@ -47,7 +47,7 @@ class World:
 def make_world(robot: str) -> World:
     """The robot's model with one virtual bus per controller attached (physics not running)."""
     config = load_profile(robot)
-    sim = Simulation((PROFILES / robot / "model.xml").read_text(encoding="utf-8"))
+    sim = Simulation.from_file(PROFILES / robot / "model.xml")
     motors: dict[str, VirtualMotor] = {}
     for controller, entry in config.controllers.items():
         ids: dict[int, MotorJoint] = {}

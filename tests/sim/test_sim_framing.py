@@ -19,14 +19,14 @@ ROOT = Path(__file__).resolve().parents[2]
 ASPECT = 640 / 480  # the default render size
 
 
-def _outside(robot: str, seed: int) -> list[str]:
-    """Geoms of ``robot`` (not the world's) that leave the `front` camera's 4:3 frame, over
+def _outside(robot: str, seed: int, view: str = "front") -> list[str]:
+    """Geoms of ``robot`` (not the world's) that leave the camera ``view``'s 4:3 frame, over
     its zero pose, its joints at 90% of their limits each way and random poses."""
     import mujoco
 
     model = mujoco.MjModel.from_xml_path(str(ROOT / "profiles" / robot / "model.xml"))
     data = mujoco.MjData(model)
-    camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "front")
+    camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, view)
     tan_v = math.tan(math.radians(float(model.cam_fovy[camera])) / 2)
     hinges = [j for j in range(model.njnt) if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]
     rng = np.random.default_rng(seed)
@@ -58,8 +58,9 @@ def _outside(robot: str, seed: int) -> list[str]:
 
 
 @pytest.mark.parametrize("robot", ["ergo-jr", "torso", "humanoid"])
-def test_the_front_camera_frames_the_robot_in_every_pose(robot: str) -> None:
-    assert _outside(robot, seed=7) == []
+@pytest.mark.parametrize("view", ["front", "side", "top"])
+def test_the_cameras_frame_the_robot_in_every_pose(robot: str, view: str) -> None:
+    assert _outside(robot, seed=7, view=view) == []
 
 
 def test_the_front_camera_sees_the_ergo_jr_large_enough() -> None:

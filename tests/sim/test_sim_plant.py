@@ -153,7 +153,7 @@ def test_objects_keep_the_robot_state_and_names_are_checked(ergo: World) -> None
     with pytest.raises(ConfigError):
         ergo.sim.add_object("sphere", "ball", (0.0, 0.0, 0.5))
     with pytest.raises(ConfigError):
-        ergo.sim.add_object("cone", "c", (0.0, 0.0, 0.5))
+        ergo.sim.add_object("pyramid", "c", (0.0, 0.0, 0.5))  # a cone is a kind now
     with pytest.raises(ConfigError):
         ergo.sim.get_object_position("nothing")
 
