@@ -5,6 +5,7 @@ import { buildTable, onFrame, refresh, stats } from "./motors.js";
 import { refreshMoves, setupRecorder } from "./moves.js";
 import { refreshPrimitives } from "./primitives.js";
 import { count, el, every, say } from "./ui.js";
+import { setupView, viewFrame } from "./view-panel.js";
 
 const STREAM_HZ = 20;
 let uptimeBase = null;
@@ -138,11 +139,12 @@ async function main() {
   window.poppy = { stats };
   setupStop();
   // the stream opens at once and every first request goes out together: first values sooner
-  openStream(STREAM_HZ, onFrame, setLive);
+  openStream(STREAM_HZ, (frame) => { onFrame(frame); viewFrame(frame); }, setLive);
   const [about, details] = await Promise.all([
     get("/api/v1/web/about"), get("/api/v1/web/motors?leds=true"),
   ]);
   showAbout(about);
+  setupView(about);
   const motors = Object.keys(details.motors); // in the robot's order
   buildTable(motors, details);
   setupRecorder(motors);
