@@ -152,7 +152,7 @@ export async function startView(container, about) {
   scene.add(grid);
   const { tips, targets } = markers(robot, model.chains, size);
 
-  const stats = { ready: true, frames: 0, updates: 0, missing: [...missing], meshes: 0, continuous: false };
+  const stats = { ready: true, frames: 0, updates: 0, missing: [...missing], meshes: 0, continuous: false, ghost: false, targets: 0 };
   robot.traverse((o) => { if (o.isMesh && o.material === bodyMaterial && o.geometry.type === "BufferGeometry") stats.meshes += 1; });
   window.poppy.view = stats;
   let dirty = true, visible = true;
@@ -205,6 +205,7 @@ export async function startView(container, about) {
       }
       if (away) pose(ghost, goals);
       if (ghost.visible !== away) { ghost.visible = away; dirty = true; }
+      stats.ghost = away;
       if (Object.keys(targets).length) {
         const aims = await get("/api/v1/model/targets");
         for (const [name, marker] of Object.entries(targets)) {
@@ -214,6 +215,7 @@ export async function startView(container, about) {
           if (show || marker.visible) dirty = true;
           marker.visible = show;
         }
+        stats.targets = Object.values(targets).filter((m) => m.visible).length;
       }
     } catch { /* the page's badge says when the robot is away */ }
   }

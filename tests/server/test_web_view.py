@@ -1,0 +1,187 @@
+"""The page's 3D view in a real browser: Debian's chromium (WebGL 2 by its software renderer).
+
+The view draws the virtual robot from its URDF and meshes and moves with the state stream: the
+canvas is not blank, and its pixels change when a motor moves. Also the model's routes (URDF,
+meshes, cache headers) and the line shown where the browser has no WebGL.
+"""
+
+from __future__ import annotations
+
+import io
+import shutil
+from collections.abc import Iterator
+from typing import Any
+
+import httpx
+import numpy as np
+import pytest
+
+from poppy_core.robot import from_profile
+from poppy_core.server import ServerThread, create_app
+from tests.helpers.waiting import eventually
+from tests.server.conftest import Served
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+playwright_api = pytest.importorskip(
+    "playwright.sync_api", reason="needs playwright (pip install -e '.[test]')"
+)
+Image = pytest.importorskip("PIL.Image", reason="needs pillow to read the screenshots")
+pytestmark = pytest.mark.skipif(
+    CHROMIUM is None, reason="needs Debian's chromium (apt-get install chromium)"
+)
+
+WAIT_S = 60.0
+WEBGL_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+DRAWN = "() => window.poppy && window.poppy.view && window.poppy.view.frames > 0"
+
+
+@pytest.fixture(scope="module")
+def driver() -> Iterator[Any]:
+    with playwright_api.sync_playwright() as running:
+        yield running
+
+
+@pytest.fixture(scope="module")
+def browser(driver: Any) -> Iterator[Any]:
+    launched = driver.chromium.launch(executable_path=CHROMIUM, args=WEBGL_ARGS)
+    yield launched
+    launched.close()
+
+
+@pytest.fixture(scope="module")
+def humanoid(moves_folder: str) -> Iterator[Served]:
+    """A virtual Humanoid served on 127.0.0.1."""
+    robot = from_profile("humanoid", sim=True)
+    app = create_app(robot)
+    server = ServerThread(app).start()
+    try:
+        yield Served(server.url, robot, app)
+    finally:
+        server.stop()
+        robot.close()
+
+
+def open_view(browser: Any, url: str, errors: list[str]) -> Any:
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    page = context.new_page()
+    page.set_default_timeout(WAIT_S * 1000)
+    page.on("pageerror", lambda error: errors.append(str(error)))
+    page.on(
+        "console",
+        lambda m: errors.append(m.text) if "Content Security Policy" in m.text else None,
+    )
+    page.goto(url + "/")
+    page.wait_for_function(DRAWN)
+    return page
+
+
+def pixels(page: Any) -> np.ndarray:
+    png = page.locator("#view3d canvas").screenshot()
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
+
+
+def changed(before: np.ndarray, after: np.ndarray) -> int:
+    """How many pixels differ clearly between two shots."""
+    return int((np.abs(before - after).max(axis=2) > 24).sum())
+
+
+def not_blank(shot: np.ndarray) -> bool:
+    """More than a background: some pixels far from the most common colour."""
+    flat = shot.reshape(-1, 3)
+    colours, counts = np.unique(flat, axis=0, return_counts=True)
+    background = colours[counts.argmax()]
+    return int((np.abs(flat - background).max(axis=1) > 40).sum()) > 200
+
+
+def move_and_compare(page: Any, robot: Any, motor: str, by_deg: float) -> int:
+    before = pixels(page)
+    assert not_blank(before), "the 3D canvas is blank"
+    robot.compliant = False
+    start = robot.motor(motor).present_position
+    robot.goto_position({motor: start + by_deg}, 0.8, wait=True)
+    assert eventually(
+        lambda: abs(robot.motor(motor).present_position - (start + by_deg)) < 2, timeout_s=WAIT_S
+    ), f"{motor} did not arrive"
+    drawn = page.evaluate("() => window.poppy.view.updates")
+    page.wait_for_function(f"() => window.poppy.view.updates > {drawn + 3}")  # frames after it
+    page.wait_for_function("() => new Promise(r => requestAnimationFrame(() => r(true)))")
+    after = pixels(page)
+    robot.goto_position({motor: start}, 0.5, wait=True)
+    robot.compliant = True
+    return changed(before, after)
+
+
+def test_the_ergo_jr_is_drawn_and_m1_turning_30_degrees_changes_it(
+    browser: Any, served: Served
+) -> None:
+    errors: list[str] = []
+    page = open_view(browser, served.url, errors)
+    assert move_and_compare(page, served.robot, "m1", 30.0) > 300
+    page.context.close()
+    assert not errors, errors
+
+
+def test_the_humanoid_is_drawn_and_its_l_shoulder_y_moves_it(
+    browser: Any, humanoid: Served
+) -> None:
+    errors: list[str] = []
+    page = open_view(browser, humanoid.url, errors)
+    assert move_and_compare(page, humanoid.robot, "l_shoulder_y", -60.0) > 150
+    page.context.close()
+    assert not errors, errors
+
+
+def test_a_goto_shows_its_goal_as_a_ghost_and_a_cartesian_goto_its_target(
+    browser: Any, served: Served
+) -> None:
+    errors: list[str] = []
+    page = open_view(browser, served.url, errors)
+    robot = served.robot
+    robot.compliant = False
+    handle = robot.goto_position({"m2": 40.0}, 4.0)
+    page.wait_for_function("() => window.poppy.view.ghost === true")
+    handle.wait()
+    page.wait_for_function("() => window.poppy.view.ghost === false")
+    robot.goto_position({"m2": 0.0}, 0.5, wait=True)
+    tip = robot.chain.position
+    robot.chain.goto([tip[0], tip[1], tip[2] - 0.02], duration=4.0)
+    page.wait_for_function("() => window.poppy.view.targets === 1")
+    robot.compliant = True
+    page.context.close()
+    assert not errors, errors
+
+
+def test_without_webgl_the_page_says_so_in_one_line(driver: Any, served: Served) -> None:
+    launched = driver.chromium.launch(
+        executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu", "--disable-webgl"]
+    )
+    try:
+        page = launched.new_page()
+        page.goto(served.url + "/")
+        page.wait_for_function("() => window.poppy && window.poppy.view")
+        assert "no WebGL" in page.inner_text("#view3d .view-note")
+        assert page.locator("#view3d canvas").count() == 0
+        assert page.is_visible("#motor-table")  # the rest of the page works
+    finally:
+        launched.close()
+
+
+def test_the_model_routes_hand_out_the_urdf_and_its_meshes(client: httpx.Client) -> None:
+    model = client.get("/api/v1/model").json()
+    assert model["urdf"] == "/api/v1/model/robot.urdf"
+    assert set(model["joints"]) == {f"m{i}" for i in range(1, 7)}
+    assert model["joints"]["m2"] == {"scale": -1.0, "offset_deg": 0.0}  # indirect
+    assert model["chains"]["chain"]["tip_joint"] == "m6"
+    urdf = client.get(model["urdf"])
+    assert urdf.status_code == 200 and b"<robot" in urdf.content
+    assert "max-age" in urdf.headers["cache-control"]
+    again = client.get(model["urdf"], headers={"If-None-Match": urdf.headers["etag"]})
+    assert again.status_code == 304
+    for name in model["mesh_files"][:1]:  # the meshes in the profile, when it has them
+        mesh = client.get(model["meshes"] + name)
+        assert mesh.status_code == 200 and mesh.headers["content-type"] == "model/stl"
+    assert client.get(model["meshes"] + "..%2Fprofile.yaml").status_code == 404
+    for bad in ("nothere.STL", "profile.yaml"):
+        answer = client.get(model["meshes"] + bad)
+        assert answer.status_code == 404, bad
+        assert "mesh" in answer.json()["detail"]
