@@ -41,9 +41,16 @@ app = typer.Typer(
 )
 
 
+# The profiles' meshes are the Poppy project's hardware (profiles/<robot>/meshes/LICENSE).
+MESHES_NOTICE = (
+    "Robot meshes: Poppy project (poppy-humanoid, poppy-torso, poppy-ergo-jr), CC BY-SA 4.0, "
+    "decimated; see profiles/<robot>/meshes/LICENSE"
+)
+
+
 def version_text() -> str:
-    """``poppy X.Y.Z`` and, on a second line, what it runs on (from package metadata: nothing
-    is imported)."""
+    """``poppy X.Y.Z``, on a second line what it runs on (from package metadata: nothing is
+    imported), and on a third the notice of the robots' meshes it ships."""
     import platform
     from importlib import metadata
 
@@ -58,7 +65,8 @@ def version_text() -> str:
     )
     return (
         f"poppy {version_of('poppy')}\n"
-        f"Python {platform.python_version()} on {platform.system() or 'unknown'}; {libraries}"
+        f"Python {platform.python_version()} on {platform.system() or 'unknown'}; {libraries}\n"
+        f"{MESHES_NOTICE}"
     )
 
 

@@ -17,9 +17,10 @@ from tests.helpers.cli import run_poppy
 def test_version(flag: str) -> None:
     result = run_poppy(flag)
     assert result.code == 0 and result.stderr == ""
-    first, second = result.stdout.splitlines()
+    first, second, notice = result.stdout.splitlines()
     assert first == f"poppy {metadata.version('poppy')}"
     assert second.startswith("Python ") and "typer " in second
+    assert "Poppy project" in notice and "CC BY-SA 4.0" in notice and "meshes/LICENSE" in notice
 
 
 def _options(command: Any, path: str = "poppy") -> Iterator[tuple[str, str]]:
