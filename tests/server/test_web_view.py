@@ -75,6 +75,15 @@ def open_view(browser: Any, url: str, errors: list[str]) -> Any:
     return page
 
 
+def wait(page: Any, condition: str, what: str) -> None:
+    """Wait for a condition of the page, saying what was awaited if it never comes."""
+    try:
+        page.wait_for_function(condition)
+    except playwright_api.TimeoutError:
+        state = page.evaluate("() => JSON.stringify(window.poppy && window.poppy.view)")
+        raise AssertionError(f"timed out waiting for {what}; the view: {state}") from None
+
+
 def pixels(page: Any) -> np.ndarray:
     png = page.locator("#view3d canvas").screenshot()
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
@@ -138,14 +147,14 @@ def test_a_goto_shows_its_goal_as_a_ghost_and_a_cartesian_goto_its_target(
     page = open_view(browser, served.url, errors)
     robot = served.robot
     robot.compliant = False
-    handle = robot.goto_position({"m2": 40.0}, 4.0)
-    page.wait_for_function("() => window.poppy.view.ghost === true")
+    handle = robot.goto_position({"m2": 40.0}, 6.0)
+    wait(page, "() => window.poppy.view.ghost === true", "the ghost during the goto")
     handle.wait()
-    page.wait_for_function("() => window.poppy.view.ghost === false")
+    wait(page, "() => window.poppy.view.ghost === false", "no ghost once the goto is over")
     robot.goto_position({"m2": 0.0}, 0.5, wait=True)
     tip = robot.chain.position
-    robot.chain.goto([tip[0], tip[1], tip[2] - 0.02], duration=4.0)
-    page.wait_for_function("() => window.poppy.view.targets === 1")
+    robot.chain.goto([tip[0], tip[1], tip[2] - 0.02], duration=6.0)
+    wait(page, "() => window.poppy.view.targets === 1", "the target during the goto")
     robot.compliant = True
     page.context.close()
     assert not errors, errors
