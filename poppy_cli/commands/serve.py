@@ -180,6 +180,8 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
         print(f"docs: http://{base}:{servers.http.port}/docs", flush=True)
     if servers.snap is not None:
         announce_snap(servers.snap, open_browser)
+    if servers.http is not None:  # last: scripts read the lines above by their order
+        print(f"page: http://{base}:{servers.http.port}/ (with the 3D view)", flush=True)
 
 
 def _say_where_takes_went(saved: list[SavedTake]) -> None:
