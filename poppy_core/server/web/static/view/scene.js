@@ -152,7 +152,7 @@ export async function startView(container, about) {
   scene.add(grid);
   const { tips, targets } = markers(robot, model.chains, size);
 
-  const stats = { ready: true, frames: 0, updates: 0, missing: [...missing], meshes: 0, continuous: false, ghost: false, targets: 0 };
+  const stats = { ready: true, frames: 0, updates: 0, missing: [...missing], meshes: 0, continuous: false, ghost: false, targets: 0, firstDrawAt: null };
   robot.traverse((o) => { if (o.isMesh && o.material === bodyMaterial && o.geometry.type === "BufferGeometry") stats.meshes += 1; });
   window.poppy.view = stats;
   let dirty = true, visible = true;
@@ -174,6 +174,7 @@ export async function startView(container, about) {
     if (!visible || !(dirty || stats.continuous)) return;
     dirty = false;
     renderer.render(scene, camera);
+    if (stats.frames === 0) stats.firstDrawAt = performance.now();
     stats.frames += 1;
   }
   loop();
