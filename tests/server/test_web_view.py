@@ -175,6 +175,22 @@ def test_without_webgl_the_page_says_so_in_one_line(driver: Any, served: Served)
         launched.close()
 
 
+def test_the_goals_route_says_where_the_gotos_under_way_go(
+    client: httpx.Client, served: Served
+) -> None:
+    robot = served.robot
+    robot.compliant = False
+    idle = {"goals": {}, "targets": {"chain": None}}  # once an earlier test's gotos are over
+    assert eventually(lambda: client.get("/api/v1/model/goals").json() == idle, timeout_s=WAIT_S)
+    handle = robot.goto_position({"m3": 25.0}, 5.0)
+    live = client.get("/api/v1/model/goals").json()
+    assert live["goals"] == {"m3": 25.0}
+    handle.wait()
+    assert client.get("/api/v1/model/goals").json()["goals"] == {}
+    robot.goto_position({"m3": 0.0}, 0.3, wait=True)
+    robot.compliant = True
+
+
 def test_the_model_routes_hand_out_the_urdf_and_its_meshes(client: httpx.Client) -> None:
     model = client.get("/api/v1/model").json()
     assert model["urdf"] == "/api/v1/model/robot.urdf"

@@ -129,12 +129,18 @@ async def model_route(request: Request, service: Service) -> dict[str, Any]:
     }
 
 
-@router.get("/targets", summary="Where each chain's cartesian goto sends its tip, while it runs")
-async def targets_route(service: Service) -> dict[str, Any]:
-    """Chain name -> its target (metres, in the chain's base frame) or null."""
+@router.get("/goals", summary="Where the gotos under way go: motors' goals, chains' targets")
+async def goals_route(service: Service) -> dict[str, Any]:
+    """``goals``: each motor moving under a goto -> its goal (degrees); ``targets``: each chain
+    -> where its cartesian goto sends the tip (metres, in the chain's base frame) or null."""
     from poppy_core.motion.chains import robot_chains
+    from poppy_core.robot.goto import running_goals
 
-    return {name: chain.target for name, chain in robot_chains(service.robot).items()}
+    robot = service.robot
+    return {
+        "goals": running_goals(robot.motors),
+        "targets": {name: chain.target for name, chain in robot_chains(robot).items()},
+    }
 
 
 @router.get("/robot.urdf", summary="The robot's URDF", response_class=Response)

@@ -5,9 +5,12 @@ import { el } from "./ui.js";
 let scene = null; // the loaded view: { frame(data), setVisible(on) }
 let lastFrame = null;
 let started = false;
+let firstFrame = null; // resolves with the page's first state frame
+const framed = new Promise((resolve) => { firstFrame = resolve; });
 
 export function viewFrame(data) {
   lastFrame = data;
+  firstFrame(data);
   if (scene) scene.frame(data);
 }
 
@@ -31,6 +34,9 @@ async function start(panel, about) {
     return;
   }
   line(panel, "Loading the 3D model…");
+  // the table's first live values go first: three.js is parsed once they are shown
+  await framed;
+  await new Promise((resolve) => setTimeout(resolve, 50));
   try {
     const { startView } = await import("./view/scene.js");
     scene = await startView(panel.querySelector(".view-canvas"), about);

@@ -118,8 +118,9 @@ export async function startView(container, about) {
   const missing = new Set();
   const mesh = meshSource(model.meshes, new Set(model.mesh_files), missing);
   const pending = [];
-  const bodyMaterial = new THREE.MeshStandardMaterial({ color: BODY, roughness: 0.65, metalness: 0.05 });
-  const ghostMaterial = new THREE.MeshStandardMaterial({ color: GHOST, transparent: true, opacity: 0.28, depthWrite: false });
+  // Lambert shading and no multisampling: cheap enough for a software renderer (bench web)
+  const bodyMaterial = new THREE.MeshLambertMaterial({ color: BODY });
+  const ghostMaterial = new THREE.MeshLambertMaterial({ color: GHOST, transparent: true, opacity: 0.28, depthWrite: false });
   const robot = parseRobot(text, mesh, bodyMaterial, pending);
   const ghost = parseRobot(text, mesh, ghostMaterial, pending);
   ghost.visible = false;
@@ -130,8 +131,8 @@ export async function startView(container, about) {
     skeleton(robot, bodyMaterial, size);
   }
 
-  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+  const renderer = new THREE.WebGLRenderer({ antialias: false, powerPreference: "low-power" });
+  renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 1.5));
   const canvas = renderer.domElement;
   canvas.setAttribute("role", "img");
   canvas.setAttribute("aria-label", `3D view of ${about.name}`);
@@ -192,32 +193,23 @@ export async function startView(container, about) {
     }
   }
 
-  // goals (ghost) and cartesian targets: read while the view shows
+  // the gotos under way (their goals as a ghost) and cartesian targets: read while it shows
   async function poll() {
     if (!visible) return;
     try {
-      const details = await get("/api/v1/web/motors");
-      const goals = {};
-      let away = false;
-      for (const [name, motor] of Object.entries(details.motors)) {
-        if (typeof motor.goal_position !== "number") continue;
-        goals[name] = motor.goal_position;
-        if (!motor.compliant && name in present && Math.abs(motor.goal_position - present[name]) > GHOST_DEG) away = true;
-      }
-      if (away) pose(ghost, goals);
-      if (ghost.visible !== away) { ghost.visible = away; dirty = true; }
+      const live = await get("/api/v1/model/goals");
+      const away = Object.entries(live.goals).some(([name, goal]) => name in present && Math.abs(goal - present[name]) > GHOST_DEG);
+      if (away) pose(ghost, { ...present, ...live.goals });
+      if (ghost.visible !== away || away) { ghost.visible = away; dirty = true; }
       stats.ghost = away;
-      if (Object.keys(targets).length) {
-        const aims = await get("/api/v1/model/targets");
-        for (const [name, marker] of Object.entries(targets)) {
-          const aim = aims[name];
-          const show = Array.isArray(aim);
-          if (show) marker.position.fromArray(aim);
-          if (show || marker.visible) dirty = true;
-          marker.visible = show;
-        }
-        stats.targets = Object.values(targets).filter((m) => m.visible).length;
+      for (const [name, marker] of Object.entries(targets)) {
+        const aim = live.targets[name];
+        const show = Array.isArray(aim);
+        if (show) marker.position.fromArray(aim);
+        if (show || marker.visible) dirty = true;
+        marker.visible = show;
       }
+      stats.targets = Object.values(targets).filter((m) => m.visible).length;
     } catch { /* the page's badge says when the robot is away */ }
   }
   setInterval(poll, POLL_S * 1000);
