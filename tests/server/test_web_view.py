@@ -160,6 +160,19 @@ def test_a_goto_shows_its_goal_as_a_ghost_and_a_cartesian_goto_its_target(
     assert not errors, errors
 
 
+def test_what_a_running_marker_detector_sees_is_said_under_the_view(
+    browser: Any, served: Served, client: httpx.Client
+) -> None:
+    errors: list[str] = []
+    page = open_view(browser, served.url, errors)
+    assert page.evaluate("() => window.poppy.view.seen") is None  # idle: not started by the view
+    assert client.get("/api/v1/sensors/marker_detector").status_code == 200  # someone uses it
+    wait(page, "() => window.poppy.view.seen === 'marker_detector sees no marker'", "the line")
+    assert page.inner_text("#view3d .view-seen") == "marker_detector sees no marker"
+    page.context.close()
+    assert not errors, errors
+
+
 def test_without_webgl_the_page_says_so_in_one_line(driver: Any, served: Served) -> None:
     launched = driver.chromium.launch(
         executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu", "--disable-webgl"]

@@ -1,6 +1,7 @@
 // The robot in 3D: its URDF and meshes (from /api/v1/model) drawn with three.js, moved by the
 // state stream's present positions; the goal as a ghost while a goto runs; each chain's tip and
-// its cartesian target as dots. Renders only when something changed (a frame, the mouse).
+// its cartesian target as dots; what a marker detector sees, under it. Renders only when
+// something changed (a frame, the mouse).
 import * as THREE from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
 import { STLLoader } from "three/examples/jsm/loaders/STLLoader.js";
@@ -213,6 +214,29 @@ export async function startView(container, about) {
     } catch { /* the page's badge says when the robot is away */ }
   }
   setInterval(poll, POLL_S * 1000);
+
+  // what the robot's marker detector sees, under the view; read only while the detector runs
+  // (someone uses it): reading it would start it, camera and all
+  const detectors = Object.entries(about.sensors ?? {}).filter(([, s]) => s.kind === "MarkerDetector").map(([name]) => name);
+  const seen = document.createElement("p");
+  seen.className = "view-seen muted";
+  container.append(seen);
+  async function look() {
+    if (!visible) return;
+    try {
+      const health = await get("/api/v1/sensors/health");
+      const lines = [];
+      for (const name of detectors.filter((n) => health[n]?.running)) {
+        const { registers } = await get(`/api/v1/sensors/${name}`);
+        const cards = registers.cards ?? [], markers = registers.markers ?? [];
+        const what = cards.length ? cards.join(", ") : markers.map((m) => `marker ${m.id}`).join(", ");
+        lines.push(`${name} sees ${what || "no marker"}`);
+      }
+      seen.textContent = lines.join("; ");
+      stats.seen = seen.textContent;
+    } catch { /* the badge says */ }
+  }
+  if (detectors.length) setInterval(look, 1000);
   void tips;
 
   return {
