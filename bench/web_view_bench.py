@@ -54,6 +54,33 @@ def _fps(chrome: Any, url: str, seconds: float) -> tuple[float, int]:
     return rate, meshes
 
 
+CEILING = """() => new Promise((done) => {
+  const canvas = document.createElement("canvas");
+  canvas.width = 542; canvas.height = 336;
+  document.body.append(canvas);
+  const gl = canvas.getContext("webgl2");
+  let frames = 0;
+  const start = performance.now();
+  function tick() {
+    gl.clearColor(frames % 2, 0.5, 0.5, 1);
+    gl.clear(gl.COLOR_BUFFER_BIT);
+    frames += 1;
+    if (performance.now() - start < SECONDS * 1000) requestAnimationFrame(tick);
+    else done(frames / ((performance.now() - start) / 1000));
+  }
+  requestAnimationFrame(tick);
+})"""
+"""The browser's own ceiling: a canvas of the view's size cleared at every animation frame."""
+
+
+def _ceiling(chrome: Any, seconds: float) -> float:
+    context = chrome.new_context(viewport=VIEWPORT)
+    page = context.new_page()
+    rate = float(page.evaluate(CEILING.replace("SECONDS", str(seconds))))
+    context.close()
+    return rate
+
+
 def measure_view(
     served: Callable[[str], AbstractContextManager[tuple[str, int]]],
     browser: Callable[[], AbstractContextManager[Any]],
@@ -76,7 +103,8 @@ def measure_view(
                 http.post(f"/api/v1/primitives/{primitive}/start")
             paints = [_paint(chrome, url + "/") for _ in range(repeat + 1)]
             rate, meshes = _fps(chrome, url + "/", seconds)
-        figures[profile] = {"paints_ms": paints, "fps": rate, "meshes": meshes}
+            ceiling = _ceiling(chrome, seconds)
+        figures[profile] = {"paints_ms": paints, "fps": rate, "meshes": meshes, "ceiling": ceiling}
     return figures
 
 
@@ -99,6 +127,15 @@ def view_table(figures: dict[str, Any]) -> tuple[Table, bool]:
                 f"{raw['fps']:.1f}",
                 f"≥ {GOAL_FPS[profile]:.0f}",
                 "yes" if ok else "**no**",
+            ]
+        )
+        rows.append(
+            [
+                name,
+                "the browser's ceiling: a blank canvas of that size, cleared every frame",
+                f"{raw['ceiling']:.1f}",
+                "",
+                "",
             ]
         )
     table = Table("3D view", ["robot", "measure", "value", "goal", "met"], rows)
