@@ -140,3 +140,48 @@ def view_table(figures: dict[str, Any]) -> tuple[Table, bool]:
         )
     table = Table("3D view", ["robot", "measure", "value", "goal", "met"], rows)
     return table, met
+
+
+def screenshots(
+    served: Callable[[str], AbstractContextManager[tuple[str, int]]],
+    browser: Callable[[], AbstractContextManager[Any]],
+    folder: str,
+) -> list[str]:
+    """The 3D view's panel of a served Ergo Jr and Humanoid, an arm raised (PNG files)."""
+    import httpx
+
+    poses = {"ergo-jr": {"m1": 30.0, "m2": -20.0, "m3": 30.0}, "humanoid": {"l_shoulder_y": -70.0}}
+    written = []
+    for profile, pose in poses.items():
+        with (
+            served(profile) as (url, _pid),
+            browser() as chrome,
+            httpx.Client(base_url=url, timeout=10.0) as http,
+        ):
+            http.put("/api/v1/robot/compliant", json={"compliant": False})
+            body = {"positions": pose, "duration_s": 1.0, "wait": True}
+            http.post("/api/v1/gotos", json=body)
+            context = chrome.new_context(viewport=VIEWPORT, device_scale_factor=1)
+            page = context.new_page()
+            page.goto(url + "/")
+            page.wait_for_function(DRAWN, timeout=60_000)
+            time.sleep(1.0)
+            path = f"{folder}/web-3d-{profile}.png"
+            page.locator("#view3d").screenshot(path=path)
+            written.append(path)
+            context.close()
+    return written
+
+
+def main() -> None:
+    """``python -m bench.web_view_bench [FOLDER]``: the 3D view's figures for docs/web.md."""
+    import sys
+
+    from bench.web_bench import browser, served
+
+    for path in screenshots(served, browser, sys.argv[1] if len(sys.argv) > 1 else "docs/img"):
+        print(path)
+
+
+if __name__ == "__main__":
+    main()

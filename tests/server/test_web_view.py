@@ -1,7 +1,9 @@
 """The page's 3D view in a real browser: Debian's chromium (WebGL 2 by its software renderer).
 
 The view draws the virtual robot from its URDF and meshes and moves with the state stream: the
-canvas is not blank, and its pixels change when a motor moves. Also the model's routes (URDF,
+canvas is not blank, its pixels change when a motor moves, and each chain's tip is drawn where
+the server's kinematics put it (the motors' angles turn the URDF's joints as the chains read
+them). Also the model's routes (URDF,
 meshes, cache headers) and the line shown where the browser has no WebGL.
 """
 
@@ -120,12 +122,33 @@ def move_and_compare(page: Any, robot: Any, motor: str, by_deg: float) -> int:
     return changed(before, after)
 
 
+def tips_match_the_chains(page: Any, served: Served) -> None:
+    """Each chain's tip as the view draws it is where the server's kinematics put it (1 mm)."""
+    with httpx.Client(base_url=served.url, timeout=10.0) as client:
+
+        def apart() -> float:
+            drawn = page.evaluate("() => window.poppy.view.tips()")
+            assert drawn, "no chain tip drawn"
+            told = {name: client.get(f"/api/v1/chains/{name}").json() for name in drawn}
+            return max(
+                float(np.linalg.norm(np.subtract(drawn[name], told[name]["position"])))
+                for name in drawn
+            )
+
+        assert eventually(lambda: apart() < 0.001, timeout_s=WAIT_S), f"{apart() * 1000:.1f} mm"
+
+
 def test_the_ergo_jr_is_drawn_and_m1_turning_30_degrees_changes_it(
     browser: Any, served: Served
 ) -> None:
     errors: list[str] = []
     page = open_view(browser, served.url, errors)
     assert move_and_compare(page, served.robot, "m1", 30.0) > 300
+    served.robot.compliant = False
+    served.robot.goto_position({"m1": 20.0, "m2": -30.0, "m3": 40.0, "m5": 25.0}, 0.5, wait=True)
+    tips_match_the_chains(page, served)
+    served.robot.goto_position({m.name: 0.0 for m in served.robot.motors}, 0.5, wait=True)
+    served.robot.compliant = True
     page.context.close()
     assert not errors, errors
 
@@ -136,6 +159,9 @@ def test_the_humanoid_is_drawn_and_its_l_shoulder_y_moves_it(
     errors: list[str] = []
     page = open_view(browser, humanoid.url, errors)
     assert move_and_compare(page, humanoid.robot, "l_shoulder_y", -60.0) > 150
+    humanoid.robot.compliant = False
+    humanoid.robot.goto_position({"l_shoulder_x": 40.0, "r_elbow_y": -50.0}, 0.5, wait=True)
+    tips_match_the_chains(page, humanoid)
     page.context.close()
     assert not errors, errors
 

@@ -157,6 +157,12 @@ export async function startView(container, about) {
   const stats = { ready: true, frames: 0, updates: 0, missing: [...missing], meshes: 0, continuous: false, ghost: false, targets: 0, firstDrawAt: null };
   robot.traverse((o) => { if (o.isMesh && o.material === bodyMaterial && o.geometry.type === "BufferGeometry") stats.meshes += 1; });
   window.poppy.view = stats;
+  // each chain's tip as drawn, in the chain's base frame (m): what /api/v1/chains/<chain> says
+  stats.tips = () => Object.fromEntries(Object.entries(tips).map(([name, tip]) => {
+    const base = robot.links[model.chains[name].base];
+    robot.updateMatrixWorld(true);
+    return [name, base.worldToLocal(tip.getWorldPosition(new THREE.Vector3())).toArray()];
+  }));
   let dirty = true, visible = true;
 
   function resize() {
@@ -237,7 +243,6 @@ export async function startView(container, about) {
     } catch { /* the badge says */ }
   }
   if (detectors.length) setInterval(look, 1000);
-  void tips;
 
   return {
     frame(data) {
