@@ -199,6 +199,31 @@ def test_what_a_running_marker_detector_sees_is_said_under_the_view(
     assert not errors, errors
 
 
+def test_with_a_token_the_view_reads_the_model_and_meshes_with_it(
+    browser: Any, moves_folder: str
+) -> None:
+    from tests.helpers.server import serve
+
+    served = serve(moves_folder, token="s3cret-view")
+    robot = next(served)
+    try:
+        context = browser.new_context(viewport={"width": 1280, "height": 900})
+        page = context.new_page()
+        urls: list[str] = []
+        page.on("request", lambda request: urls.append(request.url))
+        page.goto(robot.url + "/")
+        page.wait_for_selector("#token-dialog[open]")
+        page.fill("#token-input", "s3cret-view")
+        page.click("#token-ok")
+        wait(page, DRAWN, "the view drawn with the token")
+        assert page.evaluate("() => window.poppy.view.missing") == []
+        assert page.evaluate("() => window.poppy.view.meshes") == 7  # every mesh read
+        assert not [u for u in urls if "s3cret" in u], "the token went into a URL"
+        context.close()
+    finally:
+        served.close()
+
+
 def test_without_webgl_the_page_says_so_in_one_line(driver: Any, served: Served) -> None:
     launched = driver.chromium.launch(
         executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu", "--disable-webgl"]
