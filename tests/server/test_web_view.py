@@ -255,12 +255,20 @@ def test_the_goals_route_says_where_the_gotos_under_way_go(
     robot.compliant = True
 
 
-def test_the_model_routes_hand_out_the_urdf_and_its_meshes(client: httpx.Client) -> None:
+def test_the_model_routes_hand_out_the_urdf_and_its_meshes(
+    client: httpx.Client, served: Served
+) -> None:
     model = client.get("/api/v1/model").json()
     assert model["urdf"] == "/api/v1/model/robot.urdf"
     assert set(model["joints"]) == {f"m{i}" for i in range(1, 7)}
     assert model["joints"]["m2"] == {"scale": -1.0, "offset_deg": 0.0}  # indirect
     assert model["chains"]["chain"]["tip_joint"] == "m6"
+    served.robot.m3.offset = 4.0  # a calibration: the view turns the joints as the robot is now
+    try:
+        joint = client.get("/api/v1/model").json()["joints"]["m3"]
+        assert joint == {"scale": -1.0, "offset_deg": 4.0}
+    finally:
+        served.robot.m3.offset = 0.0
     urdf = client.get(model["urdf"])
     assert urdf.status_code == 200 and b"<robot" in urdf.content
     assert "max-age" in urdf.headers["cache-control"]

@@ -37,12 +37,23 @@ MESH_TYPES = {".stl": "model/stl"}
 
 @dataclass(frozen=True)
 class ModelFiles:
-    """Where a robot's URDF and meshes are, and how its motors turn its joints."""
+    """Where a robot's URDF and meshes are, and the motors the model turns the other way."""
 
     urdf: Path
     meshes: Path
-    joints: dict[str, dict[str, float]]
     reversed: tuple[str, ...]
+
+    def joints(self, robot: Robot) -> dict[str, dict[str, float]]:
+        """How each motor's angle turns its URDF joint: ``radians(scale * (deg + offset_deg))``
+        (the motors' orientations and offsets as they are now: a calibration changes them)."""
+        joints = {}
+        for motor in robot.motors:
+            sign = 1.0 if motor.direct else -1.0
+            joints[motor.name] = {
+                "scale": -sign if motor.name in self.reversed else sign,
+                "offset_deg": float(motor.offset),
+            }
+        return joints
 
 
 def model_files(robot: Robot) -> ModelFiles | None:
@@ -62,15 +73,7 @@ def model_files(robot: Robot) -> ModelFiles | None:
     if found is None or found[1].suffix.lower() != ".urdf":
         return None
     spec, path = found
-    reversed_ = tuple(spec.reversed)
-    joints = {}
-    for motor in robot.motors:
-        sign = 1.0 if motor.direct else -1.0
-        joints[motor.name] = {
-            "scale": -sign if motor.name in reversed_ else sign,
-            "offset_deg": float(motor.offset),
-        }
-    return ModelFiles(path, path.parent / "meshes", joints, reversed_)
+    return ModelFiles(path, path.parent / "meshes", tuple(spec.reversed))
 
 
 def _files(request: Request, service: Any) -> ModelFiles:
@@ -124,7 +127,7 @@ async def model_route(request: Request, service: Service) -> dict[str, Any]:
         "urdf": "/api/v1/model/robot.urdf",
         "meshes": "/api/v1/model/meshes/",
         "mesh_files": meshes,
-        "joints": files.joints,
+        "joints": files.joints(service.robot),
         "chains": chain_marks(service.robot),
     }
 
