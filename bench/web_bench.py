@@ -190,18 +190,18 @@ def web_benchmark(ctx: BenchContext) -> BenchResult:
             "`--use-angle=swiftshader`) at 1280x900; first paint is the page's first contentful "
             "paint and the view's first frame from navigation start (median of the warm "
             "loads); the frame rate is the view drawing every animation frame (it otherwise "
-            f"draws only when something changed) over {seconds:.0f} s, beside the ceiling of "
-            "the same browser at that moment: a blank WebGL canvas of the view's size cleared "
-            "at every animation frame, on a page of its own."
+            f"draws only when something changed) over {seconds:.0f} s, beside the ceiling: "
+            "the same page's animation frame rate with the view hidden, right after."
         ),
         tables=[Table("Home page", ["measure", "value", "goal", "met"], rows), view],
         notes=[
             "pypot has no dashboard to compare with (its `/` lists the routes), so no peer runs.",
             f"Machine load when the run started (1 and 5 min averages): {load}; the two cores "
             "were shared with other programs, and chromium runs on the same machine.",
-            "The 3D view's frame rate is bounded by the browser's own: when the ceiling is low "
-            "(a loaded machine: chromium's renderer, GPU and browser processes wait for the "
-            "cores), the view's rate is low too, whatever it draws.",
+            "The 3D view's frame rate is bounded by the page's own (the motor table updated "
+            "at 20 Hz, the polls): when that ceiling is low (a loaded machine: chromium's "
+            "renderer, GPU and browser processes wait for the cores), the view's rate is low "
+            "too, whatever it draws.",
         ],
         passed=all(checks) and view_met,
         raw=raw,
