@@ -191,7 +191,7 @@ export async function startView(container, about) {
     const j = model.joints[name];
     return j ? (j.scale * (degrees + j.offset_deg) * Math.PI) / 180 : null;
   };
-  const present = {};
+  const present = {}, drawn = {}; // the angles the stream gives, and those last drawn
   function pose(target, values) {
     for (const [name, degrees] of Object.entries(values)) {
       const joint = target.joints[name];
@@ -246,11 +246,17 @@ export async function startView(container, about) {
 
   return {
     frame(data) {
+      let moved = false; // a still robot is not drawn again (a tenth of a degree is nothing to see)
       for (const [name, state] of Object.entries(data)) {
-        if (state && typeof state.present_position === "number") present[name] = state.present_position;
+        const degrees = state?.present_position;
+        if (typeof degrees !== "number") continue;
+        if (!(name in drawn) || Math.abs(degrees - drawn[name]) > 0.1) moved = true;
+        present[name] = degrees;
       }
-      pose(robot, present);
       stats.updates += 1;
+      if (!moved) return;
+      pose(robot, present);
+      Object.assign(drawn, present);
       dirty = true;
     },
     setVisible(on) { visible = on; dirty = true; },
