@@ -1,7 +1,7 @@
 // The robot in 3D: its URDF and meshes (from /api/v1/model) drawn with three.js, moved by the
 // state stream's present positions; the goal as a ghost while a goto runs; each chain's tip and
 // its cartesian target as dots; what a marker detector sees, under it. Renders only when
-// something changed (a frame, the mouse).
+// something changed (a motor moved, the mouse).
 import * as THREE from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
 import { STLLoader } from "three/examples/jsm/loaders/STLLoader.js";
