@@ -46,6 +46,7 @@ BROWSER_MODULES = {
     "server/test_browser.py",
     "server/test_snap_browser.py",
     "server/test_web_page.py",
+    "server/test_web_view.py",
 }
 # pytest-timeout (120 s, by signal) stops a test that waits in Python. A thread stuck inside a
 # C library (an OpenGL driver, a serial ioctl) never sees the signal; this watchdog then prints
