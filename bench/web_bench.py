@@ -199,9 +199,10 @@ def web_benchmark(ctx: BenchContext) -> BenchResult:
             f"Machine load when the run started (1 and 5 min averages): {load}; the two cores "
             "were shared with other programs, and chromium runs on the same machine.",
             "The 3D view's frame rate is bounded by the page's own (the motor table updated "
-            "at 20 Hz, the polls): when that ceiling is low (a loaded machine: chromium's "
-            "renderer, GPU and browser processes wait for the cores), the view's rate is low "
-            "too, whatever it draws.",
+            "at 20 Hz, the polls) and by what a WebGL frame costs chromium's software path "
+            "whatever it holds (the row 'an empty scene': SwiftShader, then compositing, on "
+            "the same two cores): the robot itself costs the difference between that row and "
+            "the frame rate. On a loaded machine both bounds drop.",
         ],
         passed=all(checks) and view_met,
         raw=raw,

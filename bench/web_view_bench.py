@@ -39,7 +39,7 @@ def _paint(chrome: Any, url: str) -> tuple[float, float]:
     return first
 
 
-def _fps(chrome: Any, url: str, seconds: float) -> tuple[float, int, float]:
+def _fps(chrome: Any, url: str, seconds: float) -> tuple[float, int, float, float]:
     context = chrome.new_context(viewport=VIEWPORT)
     page = context.new_page()
     page.goto(url)
@@ -50,10 +50,14 @@ def _fps(chrome: Any, url: str, seconds: float) -> tuple[float, int, float]:
     before, start = page.evaluate("window.poppy.view.frames"), time.monotonic()
     time.sleep(seconds)
     rate = (page.evaluate("window.poppy.view.frames") - before) / (time.monotonic() - start)
+    page.evaluate("window.poppy.view.empty = true")  # the same view drawing an empty scene
+    before, start = page.evaluate("window.poppy.view.frames"), time.monotonic()
+    time.sleep(seconds)
+    empty = (page.evaluate("window.poppy.view.frames") - before) / (time.monotonic() - start)
     page.click("#view3d h2 button")  # hide: the same page, the view drawing nothing
     ceiling = float(page.evaluate(PAGE_RATE.replace("SECONDS", str(seconds))))
     context.close()
-    return rate, meshes, ceiling
+    return rate, meshes, empty, ceiling
 
 
 PAGE_RATE = """() => new Promise((done) => {
@@ -90,8 +94,14 @@ def measure_view(
             if primitive:
                 http.post(f"/api/v1/primitives/{primitive}/start")
             paints = [_paint(chrome, url + "/") for _ in range(repeat + 1)]
-            rate, meshes, ceiling = _fps(chrome, url + "/", seconds)
-        figures[profile] = {"paints_ms": paints, "fps": rate, "meshes": meshes, "ceiling": ceiling}
+            rate, meshes, empty, ceiling = _fps(chrome, url + "/", seconds)
+        figures[profile] = {
+            "paints_ms": paints,
+            "fps": rate,
+            "meshes": meshes,
+            "empty_fps": empty,
+            "ceiling": ceiling,
+        }
     return figures
 
 
@@ -114,6 +124,15 @@ def view_table(figures: dict[str, Any]) -> tuple[Table, bool]:
                 f"{raw['fps']:.1f}",
                 f"≥ {GOAL_FPS[profile]:.0f}",
                 "yes" if ok else "**no**",
+            ]
+        )
+        rows.append(
+            [
+                name,
+                "the same view drawing an empty scene (a WebGL frame's own cost)",
+                f"{raw['empty_fps']:.1f}",
+                "",
+                "",
             ]
         )
         rows.append(
