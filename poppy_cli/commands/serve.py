@@ -304,6 +304,8 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
     if servers.zenoh is not None:
         where = ", ".join(servers.zenoh.endpoints) or "no endpoint (it connects out)"
         print(f"zenoh: poppy/{servers.zenoh.name} listening on {where}", flush=True)
+    if servers.http is not None:  # last: scripts read the lines above by their order
+        print(f"page: http://{base}:{servers.http.port}/ (with the 3D view)", flush=True)
 
 
 def _say_where_takes_went(saved: list[SavedTake]) -> None:

@@ -25,9 +25,18 @@ from poppy_core.robot import Robot
 
 logger = logging.getLogger(__name__)
 
-SIMULATORS: dict[str | None, bool | str] = {None: False, "dummy": True, "mujoco": "mujoco"}
+SIMULATORS: dict[str | None, bool | str] = {
+    None: False,
+    "dummy": True,
+    "mujoco": "mujoco",
+    "threejs": True,
+    "poppy-simu": True,
+}
 """pypot's ``simulator=`` values -> the factory's ``sim``: virtual servos with the ideal plant
-(``'dummy'``), with MuJoCo physics (``'mujoco'``), or hardware (None)."""
+(``'dummy'``; ``'threejs'`` and ``'poppy-simu'`` also serve the page with its 3D view), with
+MuJoCo physics (``'mujoco'``), or hardware (None)."""
+PAGE_SIMULATORS = ("threejs", "poppy-simu")
+"""The simulators that serve the robot's page over HTTP (pypot's threejs and poppy-simu)."""
 LOOPBACK = "127.0.0.1"
 
 
@@ -39,11 +48,9 @@ def _simulator(value: object) -> bool | str:
             field="simulator",
             value=value,
         )
-    if value == "poppy-simu":
-        return True
     if value not in SIMULATORS:
         raise ConfigError(
-            f"unknown simulator {value!r}: use None (hardware), 'dummy' or 'mujoco'",
+            f"unknown simulator {value!r}: use None (hardware), 'dummy', 'mujoco' or 'threejs'",
             field="simulator",
             value=value,
         )
@@ -57,7 +64,9 @@ class AbstractPoppyCreature:
         base_path: refused (the creature's files are poppy's profiles).
         config: a config (dict, or JSON/YAML file) instead of the creature's profile.
         simulator: None (hardware), ``'dummy'`` (virtual servos, ideal plant), ``'mujoco'``
-            (virtual servos in MuJoCo physics; ``robot.simulation``); ``'vrep'`` is refused.
+            (virtual servos in MuJoCo physics; ``robot.simulation``), ``'threejs'`` (the
+            ideal virtual robot with its page and 3D view served over HTTP, the URL printed);
+            ``'vrep'`` is refused.
         scene: with ``simulator='mujoco'``, an MJCF scene file holding the robot and its props
             (``robot.load_scene``); None: the profile's ``model.xml``.
         tracked_objects, tracked_collisions: with ``simulator='mujoco'``, bodies read as
@@ -119,8 +128,8 @@ class AbstractPoppyCreature:
                 field="kind",
             )
         sim = _simulator(simulator)
-        if simulator == "poppy-simu":
-            use_http = True  # pypot: poppy-simu is the dummy robot served over HTTP
+        if simulator in PAGE_SIMULATORS:
+            use_http = True  # pypot: the virtual robot served over HTTP for the browser's view
         _refuse_vrep_options(base_path, port, id, shared_vrep_io, use_remote)
         scene_calls = _scene_options(sim, scene, extra)  # MuJoCo's scene and trackers
         sensors = _sensor_switches(extra)
@@ -145,6 +154,8 @@ class AbstractPoppyCreature:
                 hold_start_pose(robot)
             if spec.listens():
                 start_services(robot, spec, start_background_services)
+            if simulator in PAGE_SIMULATORS:
+                announce_page(robot, http_host)
         except BaseException:
             robot.close()
             raise
@@ -177,6 +188,21 @@ def start_services(robot: Robot, spec: ServeSpec, start: bool) -> None:
     robot.on_close(servers.stop)
     for name, server in servers.servers.items():
         robot.attach(name, server)
+
+
+def announce_page(robot: Robot, host: str) -> None:
+    """Log and print where the robot's page with its 3D view is (pypot's threejs simulator
+    had the browser page of poppy-simu draw the robot)."""
+    server = robot.extensions.get("http")
+    port = getattr(server, "port", None)
+    if port is None:
+        return
+    shown = "127.0.0.1" if host in ("0.0.0.0", "::", "") else host
+    if ":" in shown:
+        shown = f"[{shown}]"
+    url = f"http://{shown}:{port}/"
+    logger.info("the robot's page with its 3D view: %s", url)
+    print(f"The robot's page with its 3D view: {url}", flush=True)
 
 
 def hold_start_pose(robot: Robot) -> None:

@@ -80,6 +80,7 @@ class RobotChain:
         self._lock = threading.Lock()
         self._signature: tuple[Any, ...] = ()
         self._chain = self._build()
+        self._target: tuple[tuple[float, ...], float] | None = None
 
     def __repr__(self) -> str:
         return f"<RobotChain {self.name} motors={[m.name for m in self.motors]}>"
@@ -258,7 +259,19 @@ class RobotChain:
         """
         del accurate
         angles = self.solve(position, orientation)
+        self._aim(position, duration)
         return self.robot.goto_position(angles, duration, control or self.control, wait)
+
+    def _aim(self, position: Vector, duration: float) -> None:
+        self._target = (tuple(float(v) for v in position), time.monotonic() + duration)
+
+    @property
+    def target(self) -> list[float] | None:
+        """Where the last cartesian goto sends the tip, while it runs (None after it)."""
+        aimed = self._target
+        if aimed is None or time.monotonic() > aimed[1]:
+            return None
+        return list(aimed[0])
 
     def goto_linear(
         self,
@@ -285,6 +298,7 @@ class RobotChain:
             ) from None
         waypoints = plan_line(self, position, orientation, max(2, math.ceil(duration * rate_hz)))
         move = LinearMove(self.robot, waypoints, duration / len(waypoints), self.name)
+        self._aim(position, duration)
         if wait:
             move.wait()
         return move

@@ -44,6 +44,19 @@ def kinematics_of(
     Raises:
         ConfigError: a malformed section or a model that cannot be found or read.
     """
+    found = model_file(config, kind)
+    if found is None:
+        return None
+    spec, path = found
+    return spec, load_description(path)
+
+
+def model_file(config: RobotConfig, kind: str | None = None) -> tuple[KinematicsSpec, Path] | None:
+    """The config's kinematics section and the path of the model file it names (unread).
+
+    Raises:
+        ConfigError: a malformed section or a model file that cannot be found.
+    """
     section = config.kinematics
     folders: list[Path] = [config.folder] if config.folder is not None else []
     if section is None and kind is not None:
@@ -59,7 +72,7 @@ def kinematics_of(
     if kind is not None:  # a config given as a dict (pypot's JSON) names the creature's model
         folders += profile_folders(kind)
     spec = kinematics_spec(section)
-    return spec, load_description(find_model(spec.model, folders))
+    return spec, find_model(spec.model, folders)
 
 
 def kinematics_spec(section: KinematicsSection) -> KinematicsSpec:

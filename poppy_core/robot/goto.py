@@ -9,7 +9,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -131,6 +131,11 @@ class GotoRunner:
                 self._thread.start()
         return handle
 
+    def goals(self) -> dict[str, float]:
+        """Each motor moving under a goto -> the goal it goes to (degrees, user frame)."""
+        with self._lock:
+            return {move.motor.name: move.goal for move in self._moves.values()}
+
     def cancel(self, motor: Motor) -> None:
         """Stop the goto of ``motor`` where it is (its goal stays the last one sent)."""
         with self._lock:
@@ -183,3 +188,13 @@ class GotoRunner:
                 return
             schedule.advance(now)
             self._wake.wait(max(0.0, schedule.next_deadline - self._clock()))
+
+
+def running_goals(motors: Iterable[Motor]) -> dict[str, float]:
+    """Each of ``motors`` moving under a goto -> the goal it goes to (the page's 3D ghost)."""
+    names = {motor.name for motor in motors}
+    runners = {id(link_of(m).runner): link_of(m).runner for m in motors}
+    goals: dict[str, float] = {}
+    for runner in runners.values():
+        goals.update((name, goal) for name, goal in runner.goals().items() if name in names)
+    return goals

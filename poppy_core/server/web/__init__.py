@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import base64
+import hashlib
+import re
 import time
 from importlib.resources import files
 from typing import TYPE_CHECKING
@@ -13,11 +16,24 @@ if TYPE_CHECKING:
 
 STATIC_PREFIX = "/web/"
 """Where the page's assets are served (public: they hold no robot data)."""
+
+
+def _import_map_hash() -> str:
+    """The CSP source of index.html's import map (the 3D view's vendored three.js modules)."""
+    page = (files("poppy_core.server.web") / "static" / "index.html").read_text("utf-8")
+    found = re.search(r'<script type="importmap">(.*?)</script>', page, re.S)
+    if found is None:
+        return ""
+    digest = base64.b64encode(hashlib.sha256(found.group(1).encode()).digest()).decode()
+    return f" 'sha256-{digest}'"
+
+
 PAGE_HEADERS = {
     # its own files only; no other site may frame it (a framed Stop or slider could be clicked
-    # through a decoy page)
+    # through a decoy page); the one inline script is the import map, allowed by its hash
     "Content-Security-Policy": (
-        "default-src 'self'; img-src 'self' blob: data:; connect-src 'self'; "
+        f"default-src 'self'; script-src 'self'{_import_map_hash()}; "
+        "img-src 'self' blob: data:; connect-src 'self'; "
         "frame-ancestors 'none'; base-uri 'none'; form-action 'self'"
     ),
     "X-Frame-Options": "DENY",
@@ -40,6 +56,7 @@ def add_web_page(app: FastAPI) -> None:
     from starlette.responses import FileResponse, Response
     from starlette.staticfiles import StaticFiles
 
+    from poppy_core.server.web.model import router as model_router
     from poppy_core.server.web.routes import router
 
     app.state.web_started = time.monotonic()
@@ -58,6 +75,7 @@ def add_web_page(app: FastAPI) -> None:
     app.add_api_route("/favicon.ico", favicon, include_in_schema=False, methods=["GET"])
     app.mount(STATIC_PREFIX, StaticFiles(directory=static_folder()), name="web")
     app.include_router(router, prefix="/api/v1")
+    app.include_router(model_router, prefix="/api/v1")  # the 3D view's URDF and meshes
 
 
 def add_link(app: FastAPI, name: str, url: str) -> None:

@@ -8,6 +8,7 @@ import { notebookLink, notes } from "./notebook.js";
 import { refreshPrimitives } from "./primitives.js";
 import { setupSettings } from "./settings.js";
 import { count, el, every, say } from "./ui.js";
+import { setupView, viewFrame } from "./view-panel.js";
 
 const STREAM_HZ = 20;
 let uptimeBase = null;
@@ -143,11 +144,12 @@ async function main() {
   setupStop();
   setupSettings();
   // the stream opens at once and every first request goes out together: first values sooner
-  openStream(STREAM_HZ, onFrame, setLive);
+  openStream(STREAM_HZ, (frame) => { onFrame(frame); viewFrame(frame); }, setLive);
   const [about, details] = await Promise.all([
     get("/api/v1/web/about"), get("/api/v1/web/motors?leds=true"),
   ]);
   showAbout(about);
+  setupView(about);
   const motors = Object.keys(details.motors); // in the robot's order
   buildTable(motors, details);
   setupRecorder(motors);
