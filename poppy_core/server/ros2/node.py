@@ -78,6 +78,7 @@ class Ros2Node:
         *,
         state_rate_hz: float = 50.0,
     ) -> None:
+        types.typestore()  # a missing rosbags (the ros2 extra) is one line, before serving
         self.service = service
         self.robot = service.robot
         self.session = session
