@@ -29,6 +29,16 @@ HASHES = {
     "trajectory_msgs/msg/JointTrajectory": (
         "RIHS01_179b33eba59d676f6d967ac71fe35e7ca2f64b2f3928f4a018cec115e213796e"
     ),
+    # rosbags' hashes of the Jazzy definitions (it gives JointState's published one above)
+    "tf2_msgs/msg/TFMessage": (
+        "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087"
+    ),
+    "diagnostic_msgs/msg/DiagnosticArray": (
+        "RIHS01_5a8a36efb05fb25070fa0fb3810290c0e6cd4862b54a8fb975a1ee8dc55a333e"
+    ),
+    "sensor_msgs/msg/CompressedImage": (
+        "RIHS01_15640771531571185e2efc8a100baf923961a4d15d5569652e6cb6691e8e371a"
+    ),
     "std_srvs/srv/SetBool": (
         "RIHS01_abe9e4bb6b41b40e6789712c00ec8871923e089af3f667a79992a428cff2da0a"
     ),
