@@ -395,3 +395,31 @@ def test_a_joint_command_sets_the_goals(node: Node) -> None:
     )
     assert eventually(lambda: abs(node.robot.motor("m1").goal_position - 10) < 0.01, 10.0)
     assert node.robot.motor("m2").goal_position == pytest.approx(-10.0, abs=0.01)  # indirect
+
+
+def test_stop_ends_the_trajectory_and_the_primitives(node: Node) -> None:
+    _stiff(node)
+    request = rmw.msg(f"{TRIGGER}_Request")
+    node.client.call("/jr1/sinus/start", TRIGGER, request)
+    node.client.publish(
+        "/joint_trajectory", TRAJECTORY, _trajectory(["m2"], [(30.0, [math.radians(-30)])])
+    )
+    assert eventually(lambda: node.servers.ros2.commands.following, 10.0)
+    response, _ = node.client.call("/jr1/stop", TRIGGER, request)
+    assert response.success and "sinus" in response.message
+    assert not node.servers.ros2.commands.following
+    assert node.servers.service.running_primitives() == []
+
+
+def test_a_request_that_is_not_the_services_type_gets_an_error_reply(node: Node) -> None:
+    replies = list(
+        node.session.get(
+            rmw.key(0, "/jr1/set_compliant", SET_BOOL),
+            payload=b"\x07\x07",
+            attachment=rmw.attachment(1),
+            timeout=10.0,
+        )
+    )
+    assert len(replies) == 1 and replies[0].err is not None
+    assert b"bad request" in replies[0].err.payload.to_bytes()
+    assert not any(m.compliant is False for m in node.robot.motors)  # nothing done

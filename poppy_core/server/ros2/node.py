@@ -25,6 +25,7 @@ from poppy_core import ros2_wire as wire
 from poppy_core.errors import PoppyError
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.schedule import Periodic, RateMeter, Worker
+from poppy_core.server.errors import ApiError
 from poppy_core.server.ros2 import messages, types
 from poppy_core.server.ros2.commands import CommandRefused, Commands
 from poppy_core.server.ros2.joints import UrdfJoints
@@ -229,7 +230,7 @@ class Ros2Node:
                 return
             try:
                 handle(message)
-            except (CommandRefused, PoppyError, ValueError) as exc:
+            except (CommandRefused, PoppyError, ApiError, ValueError) as exc:
                 self._refused(name, str(exc))
 
         self._declared.append(self.session.declare_subscriber(self._key(name, typ), on_sample))
@@ -250,6 +251,12 @@ class Ros2Node:
 
     def _answer(self, query: zenoh.Query, key: str, typename: str, handle: Any) -> None:
         try:
+            self._reply(query, key, typename, handle)
+        finally:
+            query.drop()  # type: ignore[no-untyped-call]  # the client stops waiting
+
+    def _reply(self, query: zenoh.Query, key: str, typename: str, handle: Any) -> None:
+        try:
             asked = wire.read_attachment(query.attachment.to_bytes()) if query.attachment else None
             payload = query.payload.to_bytes() if query.payload is not None else b""
             request = types.deserialize(payload, f"{typename}_Request")
@@ -259,8 +266,11 @@ class Ros2Node:
             return
         try:
             success, text = handle(request)
-        except (PoppyError, ValueError) as exc:
+        except (PoppyError, ApiError, ValueError) as exc:
             success, text = False, str(exc)
+        except Exception as exc:  # a reply still goes out: a client never waits in vain
+            logger.exception("ROS 2: %s failed", key)
+            success, text = False, f"failed: {exc}"
         if not success:
             logger.warning("ROS 2: %s refused: %s", key, text)
         response = types.message(f"{typename}_Response", success=success, message=text)
