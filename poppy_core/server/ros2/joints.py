@@ -52,7 +52,7 @@ class UrdfJoints:
         config = robot.config
         if config is None:
             return
-        from poppy_core.motion.chains import kinematics_of
+        from poppy_core.motion.chains import group_expander, kinematics_of
 
         profile = config.profile
         kind = (profile.kind or profile.name) if profile is not None else ""
@@ -66,7 +66,8 @@ class UrdfJoints:
         spec, description = found
         self.description = description
         if (spec.joint_frame or description.joint_frame) == "motor":
-            reversed_ = set(spec.reversed)
+            expand = group_expander(config)
+            reversed_ = {m for name in spec.reversed for m in expand(name)}
             for name, entry in config.motors.items():
                 sign = 1.0 if entry.orientation == "direct" else -1.0
                 self.frames[name] = JointFrame(
