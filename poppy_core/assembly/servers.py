@@ -278,7 +278,7 @@ def _add_zenoh(servers: ServerSet, spec: ServeSpec, settings: ZenohSettings, app
 
 def _ros2_session(servers: ServerSet, spec: ServeSpec, settings: Ros2Settings) -> None:
     """The set's session, with timestamps (the fleet's settings when it is served too)."""
-    from poppy_core.server.ros2.session import open_ros2_session
+    from poppy_core.server.ros2.ros2_session import open_ros2_session
 
     servers.zenoh_session = open_ros2_session(spec.zenoh or settings.zenoh)
 
