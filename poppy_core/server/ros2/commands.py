@@ -4,7 +4,8 @@ A command names joints (the motors) with URDF angles in radians. It is refused w
 nothing, when a joint is unknown, a value is not a finite number, a target lies outside the
 motor's angle limits, or a motor is compliant (the refusal says to call ``set_compliant``).
 A trajectory's points are followed at their ``time_from_start`` by a worker that sets the
-goals every sync period, interpolating between points; the next trajectory replaces it.
+goals every sync period, interpolating between points and setting each point itself (at most
+one period late); the next trajectory replaces it.
 """
 
 from __future__ import annotations
@@ -58,6 +59,17 @@ class Plan:
         share = 1.0 if t1 <= t0 else (elapsed - t0) / (t1 - t0)
         a, b = points[index - 1], points[index]
         return tuple(x + (y - x) * share for x, y in zip(a, b, strict=True))
+
+    def step(
+        self, elapsed: float, first: Sequence[float], reached: int
+    ) -> tuple[tuple[float, ...], int]:
+        """The goals of one sync period and the points reached after it: the first point whose
+        time has come and that no period set yet, else the position at ``elapsed``. Every
+        point is set once, at most one period late (a point between two periods would
+        otherwise be cut short); ``reached`` counts the points set before."""
+        if reached < len(self.times) and self.times[reached] <= elapsed:
+            return self.points[reached], reached + 1
+        return self.at(elapsed, first), reached
 
 
 def _duration(value: Any, field: str) -> float:
@@ -190,9 +202,13 @@ class Commands:
 
     def _follow(self, stopping: threading.Event) -> None:
         schedule = Periodic(self.period_s, time.monotonic())
+        following: Plan | None = None
+        reached = 0
         while not stopping.is_set():
             with self._lock:
                 plan, first = self._plan, self._first
+            if plan is not following:
+                following, reached = plan, 0
             if plan is None:
                 self._wake.wait(0.5)
                 self._wake.clear()
@@ -206,7 +222,7 @@ class Commands:
             elapsed = now - plan.start
             if elapsed < 0:
                 continue
-            degrees = plan.at(elapsed, first)
+            degrees, reached = plan.step(elapsed, first, reached)
             with self._lock:
                 if self._plan is not plan:
                     continue
@@ -218,5 +234,5 @@ class Commands:
                         break
                     motor.goal_position = value
                 else:
-                    if elapsed >= plan.times[-1]:
+                    if reached == len(plan.times):
                         self._plan = None
