@@ -149,3 +149,13 @@ def test_wire_rules() -> None:
         wire.check_namespace("/a b")
     with pytest.raises(ConfigError, match="attachment"):
         wire.read_attachment(b"\x00" * 5)
+
+
+def test_the_node_leaves_the_graph_when_served_no_more() -> None:
+    served = Node()
+    try:
+        assert eventually(lambda: any("/NN/" in t for t in served.client.tokens()), 10.0)
+        served.servers.stop()
+        assert eventually(lambda: served.client.tokens() == [], 10.0)
+    finally:
+        served.close()
