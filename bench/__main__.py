@@ -13,6 +13,7 @@ from bench import (
     ik_bench,
     move_bench,
     robot_bench,
+    ros2_bench,
     scan_bench,
     server_bench,
     sim_bench,
@@ -44,6 +45,7 @@ _MODULES = (
     web_bench,
     zmq_bench,
     fleet_bench,
+    ros2_bench,
 )
 
 

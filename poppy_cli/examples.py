@@ -80,6 +80,10 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
             "serve --zenoh --name jr1 --zenoh-connect tcp/192.168.1.10:7447 --profile ergo-jr",
             "on Zenoh as poppy/jr1, through the teacher's router",
         ),
+        (
+            "serve --ros2 --name jr1 --ros-namespace /lab --profile ergo-jr",
+            "a ROS 2 node /lab/jr1, through the zenohd router on this computer",
+        ),
     ),
     "fleet": (
         ("fleet discover", "the robots announced on the network (mDNS)"),

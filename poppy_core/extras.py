@@ -21,6 +21,7 @@ EXTRAS: dict[str, str] = {
     "server": "the web servers (REST, WebSocket, Snap!, the web page)",
     "zmq": "pypot's ZMQ server",
     "fleet": "Zenoh fleets (serve --zenoh, poppy fleet, zenoh: remote robots)",
+    "ros2": "ROS 2 over rmw_zenoh (serve --ros2)",
     "tui": "the terminal app",
     "plot": "plots (matplotlib)",
     "notebook": "Jupyter notebooks (`poppy notebook`)",

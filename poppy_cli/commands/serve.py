@@ -1,5 +1,6 @@
-"""`poppy serve --http [--ws] [--snap] [--zmq] [--zenoh]`: serve a robot over REST (pypot's routes
-+ /api/v1), WebSocket, Snap!'s routes, pypot's ZMQ request/reply API and Zenoh (fleets)."""
+"""`poppy serve --http [--ws] [--snap] [--zmq] [--zenoh] [--ros2]`: serve a robot over REST
+(pypot's routes + /api/v1), WebSocket, Snap!'s routes, pypot's ZMQ request/reply API, Zenoh
+(fleets) and ROS 2 (rmw_zenoh's wire)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import typer
 
+from poppy_cli.commands.serve_ros2 import announce_ros2, ros2_settings
 from poppy_cli.commands.serve_snap import announce_snap, check_snap_options
 from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, finite
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, warn_line
@@ -131,15 +133,42 @@ def serve(
     zenoh_scout: bool = typer.Option(
         False, "--zenoh-scout", help="Find Zenoh peers by multicast scouting on the LAN."
     ),
+    ros2: bool = typer.Option(
+        False,
+        "--ros2",
+        help="Serve the robot as a ROS 2 node over rmw_zenoh (no ROS needed): joint_states, "
+        "tf, robot_description, joint_trajectory, services (see docs/ros2.md).",
+    ),
+    ros_domain: int | None = typer.Option(
+        None,
+        "--ros-domain",
+        min=0,
+        max=232,
+        envvar="ROS_DOMAIN_ID",
+        help="The ROS 2 domain ID (default 0, or ROS_DOMAIN_ID).",
+    ),
+    ros_namespace: str | None = typer.Option(
+        None, "--ros-namespace", help="The node's ROS 2 namespace, e.g. /lab (default /)."
+    ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
-    if not (http or ws or snap or zmq or zenoh):
-        _usage("nothing to serve: pass --http, --ws, --snap, --zmq and/or --zenoh")
+    from poppy_core.errors import ConfigError
+
+    if not (http or ws or snap or zmq or zenoh or ros2):
+        _usage("nothing to serve: pass --http, --ws, --snap, --zmq, --zenoh and/or --ros2")
     http_port, *alias_ports = http_ports or [8080]
     _check_http_ports(http_ports)
     zenoh_settings = _zenoh_settings(
-        zenoh, name, zenoh_listen, zenoh_connect, zenoh_config, zenoh_scout
+        zenoh or ros2, name, zenoh_listen, zenoh_connect, zenoh_config, zenoh_scout
     )
+    if not zenoh:
+        zenoh_settings = None  # the endpoints are the ROS 2 node's
+    try:
+        ros2_spec = ros2_settings(
+            ros2, ros_domain, ros_namespace, zenoh_listen, zenoh_connect, zenoh_config, zenoh_scout
+        )
+    except (ValueError, ConfigError) as exc:
+        _usage(str(exc))
     if http and ws and ws_port in http_ports and ws_port != 0:
         _usage(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
@@ -172,6 +201,7 @@ def serve(
         http_alias_ports=tuple(alias_ports),
         report=_report,
         zenoh=zenoh_settings,
+        ros2=ros2_spec,
     )
     any_origin = _check_origins(spec)
     _warn_exposure(spec, host, any_origin)
@@ -240,7 +270,10 @@ def _zenoh_settings(
 
     if not zenoh:
         if listen or connect or config or scout:
-            _usage("--zenoh-listen, --zenoh-connect, --zenoh-config and --zenoh-scout need --zenoh")
+            _usage(
+                "--zenoh-listen, --zenoh-connect, --zenoh-config and --zenoh-scout need --zenoh "
+                "or --ros2"
+            )
         return None
     try:
         if name is not None:
@@ -304,6 +337,7 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
     if servers.zenoh is not None:
         where = ", ".join(servers.zenoh.endpoints) or "no endpoint (it connects out)"
         print(f"zenoh: poppy/{servers.zenoh.name} listening on {where}", flush=True)
+    announce_ros2(servers)
     if servers.http is not None:  # last: scripts read the lines above by their order
         print(f"page: http://{base}:{servers.http.port}/ (with the 3D view)", flush=True)
 

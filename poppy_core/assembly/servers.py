@@ -5,8 +5,9 @@ here. Every protocol of one set shares one ``RobotService`` (so one teleoperatio
 motor is teleoperated by one WebSocket connection, whichever port it came through), one Host and
 Origin policy (Snap!'s adds snap.berkeley.edu), one token, and one shutdown order: Zenoh, ZMQ,
 Snap!, WebSocket, HTTP (the reverse of starting), then the Zenoh session, then the service's
-recordings and teleoperations. The Zenoh session (``ServerSet.zenoh_session``) is one per set,
-opened before anything serves: every server on Zenoh (the fleet node, ROS 2) declares on it.
+recordings and teleoperations (the ROS 2 node stops first). The Zenoh session
+(``ServerSet.zenoh_session``) is one per set, opened before anything serves: every server on
+Zenoh (the fleet node, the ROS 2 node) declares on it.
 Importing this module loads no server library; ``serve`` does.
 """
 
@@ -17,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.zenoh_wire import ZenohSettings
 
 if TYPE_CHECKING:
@@ -24,13 +26,14 @@ if TYPE_CHECKING:
     from poppy_core.server import OriginPolicy, RobotService
     from poppy_core.server.announce import Announcer
     from poppy_core.server.background import BackgroundServer
+    from poppy_core.server.ros2 import Ros2Node
     from poppy_core.server.snap import SnapServer
     from poppy_core.server.zenoh import ZenohRobotServer
     from poppy_core.server.zmqserver import ZmqRobotServer
 
-PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh")
-"""pypot's attribute names of the servers (``robot.http``...) and ``zenoh``, in the order they
-start."""
+PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh", "ros2")
+"""pypot's attribute names of the servers (``robot.http``...), ``zenoh`` and ``ros2``, in the
+order they start."""
 SNAP_ONLINE_NOTE = (
     "Snap! opens online (snap.berkeley.edu): run `poppy snap download` once on the robot "
     "to serve Snap! offline"
@@ -74,6 +77,8 @@ class ServeSpec:
         zenoh: the robot on Zenoh under ``poppy/<name>`` (``ZenohSettings``: endpoints,
             configuration file, scouting), or None.
         state_rate_hz: the Zenoh state messages per second (the sync loop's rate).
+        ros2: the robot as a ROS 2 node on rmw_zenoh's wire (``Ros2Settings``: domain,
+            namespace, node; its Zenoh settings serve when ``zenoh`` is None), or None.
     """
 
     http: Listen | None = None
@@ -91,6 +96,7 @@ class ServeSpec:
     report: Callable[[str], None] | None = field(default=None, compare=False)
     zenoh: ZenohSettings | None = None
     state_rate_hz: float = 50.0
+    ros2: Ros2Settings | None = None
 
     def listens(self) -> dict[str, Listen]:
         """Protocol -> where it listens, for the servers asked for, in starting order."""
@@ -151,6 +157,11 @@ class ServerSet:
         return self.servers.get("zenoh")
 
     @property
+    def ros2(self) -> Ros2Node | None:
+        """The robot as a ROS 2 node."""
+        return self.servers.get("ros2")
+
+    @property
     def running(self) -> bool:
         """True while every server serves."""
         return bool(self.servers) and all(s.running for s in self.servers.values())
@@ -196,7 +207,8 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
         RuntimeError: a server did not start (its log says why).
         ValueError: an origin in ``cors``, a name in ``allow_hosts`` or ``name`` that is not one.
         ConfigError: a Zenoh endpoint or configuration that cannot be used, a bad name.
-        MissingExtraError: the ``server`` (or ``zmq``, ``appliance``, ``fleet``) extra is missing.
+        MissingExtraError: the ``server`` (or ``zmq``, ``appliance``, ``fleet``, ``ros2``) extra
+            is missing.
     """
     from poppy_core.server import OriginPolicy, RobotService, ServerThread, create_app
     from poppy_core.server.background import BackgroundServer
@@ -236,8 +248,12 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
             servers.servers["zmq"] = ZmqRobotServer(robot, where.host, where.port, service=service)
         if "snap" in listens:
             _add_snap(servers, robot, spec, listens["snap"])
+        if spec.ros2 is not None:  # first: its session stamps samples, for both nodes
+            _ros2_session(servers, spec, spec.ros2)
         if spec.zenoh is not None:
             _add_zenoh(servers, spec, spec.zenoh, app)
+        if spec.ros2 is not None:
+            _add_ros2(servers, spec, spec.ros2)
         _own_pages(servers)
         _named(servers, robot, spec)
         _fleet_page(servers)
@@ -338,6 +354,28 @@ def _add_zenoh(servers: ServerSet, spec: ServeSpec, settings: ZenohSettings, app
     )
 
 
+def _ros2_session(servers: ServerSet, spec: ServeSpec, settings: Ros2Settings) -> None:
+    """The set's session, with timestamps (the fleet's settings when it is served too)."""
+    from poppy_core.server.ros2.ros2_session import open_ros2_session
+
+    servers.zenoh_session = open_ros2_session(spec.zenoh or settings.zenoh)
+
+
+def _add_ros2(servers: ServerSet, spec: ServeSpec, settings: Ros2Settings) -> None:
+    """The ROS 2 node, on the set's Zenoh session."""
+    from poppy_core.server.ros2 import Ros2Node
+    from poppy_core.zenoh_wire import check_name, default_name
+
+    name = check_name(spec.name) if spec.name is not None else default_name()
+    servers.servers["ros2"] = Ros2Node(
+        servers.service,
+        servers.zenoh_session,
+        settings,
+        name,
+        state_rate_hz=spec.state_rate_hz,
+    )
+
+
 def _fleet_page(servers: ServerSet) -> None:
     """The page lists the robots its Zenoh session sees; the description names the page."""
     node = servers.zenoh
@@ -353,7 +391,10 @@ def _fleet_page(servers: ServerSet) -> None:
 def _own_pages(servers: ServerSet) -> None:
     """The pages of every port count as the servers' own; the home page links to Snap!."""
     ports = [
-        p for name, s in servers.servers.items() if name not in ("zmq", "zenoh") for p in _ports(s)
+        p
+        for name, s in servers.servers.items()
+        if name not in ("zmq", "zenoh", "ros2")
+        for p in _ports(s)
     ]
     servers.policy.with_ports(ports)
     snap = servers.snap

@@ -18,7 +18,8 @@ ROOT = Path(__file__).resolve().parents[2]
 # sandbox), `checks` (the one rule of each kind of call argument) and `extras` (the optional
 # dependencies, with the one-line error naming a missing extra) are leaves every room may use;
 # so is `zenoh_wire` (the Zenoh keys, session settings and state message a served robot and its
-# clients share, as `line` is the byte-line contract of buses and emulators).
+# clients share, as `line` is the byte-line contract of buses and emulators), and `ros2_wire`
+# (rmw_zenoh's keys, liveliness tokens and attachments, on top of `zenoh_wire`'s settings).
 LEAVES = {
     "errors",
     "files",
@@ -29,6 +30,7 @@ LEAVES = {
     "extras",
     "schedule",
     "zenoh_wire",
+    "ros2_wire",
 }
 ALLOWED: dict[str, set[str]] = {
     "protocol": set(),
@@ -227,6 +229,8 @@ def test_leaves_import_only_errors_and_checks() -> None:
         below = {"poppy_core.errors"} if leaf == "checks" else {"poppy_core.errors", "poppy_core"}
         if leaf == "zenoh_wire":  # its session needs the optional zenoh: the one-line error
             below |= {"poppy_core.extras"}
+        if leaf == "ros2_wire":  # the node's Zenoh session settings are the fleet's
+            below |= {"poppy_core.zenoh_wire"}
         # `from poppy_core import checks` is recorded as its package
         assert ours <= below, (leaf, ours)
         if "poppy_core" in ours:

@@ -36,6 +36,7 @@ CASES = [
     ("zmq", "zmq", ["serve", "--zmq", *ROBOT, "--zmq-port", "0"]),
     ("fleet", "zenoh", ["serve", "--zenoh", *ROBOT, "--name", "jr"]),
     ("fleet", "zenoh", ["fleet", "list", "--connect", "tcp/127.0.0.1:9"]),
+    ("ros2", "rosbags", ["serve", "--ros2", *ROBOT, "--zenoh-listen", "tcp/127.0.0.1:0"]),
     ("tui", "textual,textual_serve", ["tui"]),
     ("vision", "cv2", ["camera", "snapshot", "-o", "{tmp}/shot.png", "--device", "0"]),
     ("plot", "matplotlib", ["moves", "plot", "{tmp}/wave.json", "-o", "{tmp}/wave.png"]),
