@@ -56,7 +56,7 @@ def add_web_page(app: FastAPI) -> None:
     from starlette.responses import FileResponse, Response
     from starlette.staticfiles import StaticFiles
 
-    from poppy_core.server.web.model import router as model_router
+    from poppy_core.server.web.robot_model import router as model_router
     from poppy_core.server.web.routes import router
 
     app.state.web_started = time.monotonic()
