@@ -40,7 +40,21 @@ def report(robot):
             uses[name] = {"extra": exc.extra, "message": str(exc)}
     robot.m1.goal_position = 10.0  # the motors work meanwhile
     prims = [p.name for p in robot.primitives]
-    print(json.dumps({"health": health, "uses": uses, "primitives": prims}))
+    print(json.dumps({"health": health, "uses": uses, "primitives": prims, "rest": rest(robot)}))
+
+def rest(robot):
+    import httpx
+    from poppy_core.server import ServerThread, create_app
+
+    server = ServerThread(create_app(robot)).start()
+    try:
+        with httpx.Client(base_url=server.url, timeout=20.0) as http:
+            path = "/sensors/marker_detector/registers/markers/value.json"
+            markers = http.get(path)
+            health = http.get("/api/v1/sensors/health").json()["marker_detector"]
+        return {"status": markers.status_code, "body": markers.json(), "health": health}
+    finally:
+        server.stop()
 
 if sys.argv[1] == "dummy":
     robot = PoppyErgoJr(simulator="dummy")
@@ -85,3 +99,7 @@ def test_an_ergo_jr_builds_without_opencv_and_its_detector_says_why(
         assert "\n" not in failure["message"]
         assert "pip install 'poppy[vision]'" in failure["message"]
     assert "marker_follow" in result["primitives"]
+    served = result["rest"]  # a served robot: unavailable (503), one line naming the extra
+    assert served["status"] == 503, served
+    assert "pip install 'poppy[vision]'" in served["body"]["error"]
+    assert served["health"]["ok"] is False and "cv2" in served["health"]["last_error"]
