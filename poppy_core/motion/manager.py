@@ -5,6 +5,8 @@ robot. Its thread starts with the first running primitive and ends when none is 
 ``freq`` Hz (drift-free) it gathers every primitive's requests per motor and register, combines
 numeric ones with ``filter`` (mean by default, ``"sum"`` or any function of a list of floats) and
 lets the most recently started primitive win on on/off registers (``compliant``, ``led``).
+A primitive whose requests cannot be applied (a motor the robot does not have) is stopped as
+failed, one WARNING line; the others and the manager go on.
 """
 
 from __future__ import annotations
@@ -125,16 +127,28 @@ class PrimitiveManager:
         """Stop combining ``primitive`` after applying its last requests (its thread calls it)."""
         with self._lock:
             if primitive in self._primitives:
-                self.update()
+                self.update()  # may reject it (a request it cannot have applied)
+            if primitive in self._primitives:
                 self._primitives.remove(primitive)
 
     # -- combining ---------------------------------------------------------------------------
 
     def combine(self, now: float | None = None) -> dict[str, dict[str, Any]]:
-        """Motor name -> register -> the combined value of every primitive's request."""
+        """Motor name -> register -> the combined value of every primitive's request.
+
+        A primitive whose requests cannot be had or name a motor the robot does not have is
+        stopped as failed (``Primitive.fail``) and left out.
+        """
         gathered: dict[str, dict[str, list[Any]]] = {}
         for primitive in self.primitives:
-            for motor, requested in primitive.robot.requests(now).items():
+            try:
+                requests = primitive.robot.requests(now)
+                for motor in requests:
+                    self._robot.motor(motor)  # UnknownMotorError: not this robot's motor
+            except Exception as exc:
+                self._reject(primitive, exc)
+                continue
+            for motor, requested in requests.items():
                 per_motor = gathered.setdefault(motor, {})
                 for register, value in requested.items():
                     per_motor.setdefault(register, []).append(value)
@@ -176,11 +190,29 @@ class PrimitiveManager:
                         continue
                     self._applied[key] = value
 
+    def _reject(self, primitive: Primitive, exc: Exception) -> None:
+        """Stop ``primitive`` as failed (its requests cannot be applied); the others go on."""
+        with self._lock:
+            if primitive in self._primitives:
+                self._primitives.remove(primitive)
+        self._note_error(f"{primitive.name}: {type(exc).__name__}: {exc}")
+        primitive.fail(exc)
+
     def _note_error(self, message: str) -> None:
         self.errors += 1
         self.last_error = message
 
     def _loop(self, stopping: threading.Event) -> None:  # ends itself; close sets _wake
+        try:
+            self._combine_while_running()
+        except BaseException:  # the worker logs why; the next add starts another thread
+            with self._lock:
+                if self._thread is not None and self._thread.is_current():
+                    self._thread = None
+                self._applied.clear()
+            raise
+
+    def _combine_while_running(self) -> None:
         schedule = Periodic(1.0 / self.freq, time.monotonic())
         while True:
             with self._lock:

@@ -218,6 +218,17 @@ class Primitive:
         self._stop_event.set()
         logger.warning("primitive %s died:\n%s", self.name, text.rstrip())
 
+    def fail(self, exc: Exception) -> None:
+        """Stop it as failed because of ``exc``, found outside its thread (its manager: a request
+        for a motor the robot does not have); one WARNING line, ``state`` ``"failed"``, ``error``
+        kept, and ``stop``/``wait_to_stop`` raise ``PrimitiveError`` as after a death."""
+        self.error = PrimitiveFailure.of(exc)
+        self._exception = exc
+        self._state = "failed"
+        self._stop_event.set()
+        self._resume_event.set()
+        logger.warning("primitive %s stopped by its manager: %s", self.name, self.error.one_line)
+
     # -- state -------------------------------------------------------------------------------
 
     @property

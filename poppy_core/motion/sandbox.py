@@ -14,7 +14,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
-from poppy_core.errors import ConfigError, RegisterError
+from poppy_core.errors import RegisterError, UnknownMotorError
 from poppy_core.trajectory import MinimumJerk, check_goto, plan_goto
 
 if TYPE_CHECKING:
@@ -290,11 +290,13 @@ class MockupRobot:
         """The mockup of motor ``name``.
 
         Raises:
-            ConfigError: no such motor.
+            UnknownMotorError: no such motor (a ``ConfigError``).
         """
         if name not in self._motors:
-            known = ", ".join(self._motors)
-            raise ConfigError(f"no motor {name!r} (motors: {known})", field=name, value=name)
+            known = list(self._motors)
+            raise UnknownMotorError(
+                f"no motor {name!r} (motors: {', '.join(known)})", motor=str(name), known=known
+            )
         return self._motors[name]
 
     def mockup(self, motor: Motor | MockupMotor | str) -> MockupMotor:
@@ -322,7 +324,7 @@ class MockupRobot:
         """Request several motors to move so that they arrive together.
 
         Raises:
-            ConfigError: an unknown motor name.
+            UnknownMotorError: an unknown motor name (a ``ConfigError``).
         """
         targets = [(self.motor(name), pos) for name, pos in position_for_motors.items()]
         for motor, position in targets:

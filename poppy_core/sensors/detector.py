@@ -9,13 +9,15 @@ the library call behind Snap!'s ``/detect/<card>`` block.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import ClassVar, Generic, TypeVar
 
 import numpy as np
 
 from poppy_core.errors import SensorError, UnknownCardError
-from poppy_core.sensors.base import FIRST_VALUE_TIMEOUT_S, Sensor
+from poppy_core.sensors.base import FIRST_VALUE_TIMEOUT_S, Sensor, SensorHealth
 from poppy_core.sensors.camera import Camera
 from poppy_core.sensors.markers import (
     DEFAULT_DICTIONARY,
@@ -24,6 +26,8 @@ from poppy_core.sensors.markers import (
     Marker,
     MarkerFinder,
 )
+
+logger = logging.getLogger(__name__)
 
 DEFAULT_FREQ_HZ = 5.0
 STALE_FRAME_S = 2.0
@@ -73,6 +77,23 @@ class FrameDetector(Sensor, Generic[T]):
             found.extend(self._in(camera))
         self._found = found
 
+    def health(self) -> SensorHealth:
+        """Its own health, lost while a camera it looks through is lost (that camera's reason)."""
+        own = super().health()
+        if not own.connected:
+            return own
+        lost = [(camera.name, camera.health()) for camera in self.cameras]
+        lost = [(name, health) for name, health in lost if not health.connected]
+        if not lost:
+            return own
+        reason = "; ".join(f"camera {name!r} lost: {h.last_error}" for name, h in lost)
+        return replace(
+            own,
+            connected=False,
+            down_s=max(h.down_s for _, h in lost),
+            last_error=reason,
+        )
+
     def found(self) -> list[T]:
         """What the latest frames hold (the first call starts the detector and waits).
 
@@ -118,6 +139,23 @@ class MarkerDetector(FrameDetector[Marker]):
         super().__init__(name, cameras, freq)
         self.finder = MarkerFinder(dictionary, marker_size, tuple(families))
         self.card_ids: dict[str, list[int]] = {k: list(v) for k, v in (cards or {}).items()}
+        if self.finder.missing is not None:  # no OpenCV: the robot builds, health says why
+            logger.warning("%s %s is not available: %s", self.kind, name, self.finder.missing)
+            self.fail(str(self.finder.missing))
+
+    def start(self) -> None:
+        """Start detecting (the first read does it).
+
+        Raises:
+            MissingExtraError: OpenCV (the ``vision`` extra) is not installed, in one line.
+            SensorError: the detector was closed.
+        """
+        self.finder.ready()
+        super().start()
+
+    def detect(self, camera: Camera | None = None) -> list[Marker]:
+        self.finder.ready()
+        return super().detect(camera)
 
     def find(self, image: np.ndarray, camera: Camera) -> list[Marker]:
         return self.finder.find(image, camera.calibration, camera.name)

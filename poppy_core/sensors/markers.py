@@ -12,7 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from poppy_core.errors import SensorError
+from poppy_core.errors import MissingExtraError, SensorError
+from poppy_core.extras import require
 from poppy_core.sensors import hamming
 from poppy_core.sensors.camera import CameraCalibration
 from poppy_core.sensors.opencv import cv
@@ -156,6 +157,9 @@ class MarkerFinder:
         marker_size_m: side of the printed markers (black square), for poses.
         families: ``"aruco"``, ``"hamming"`` or both.
 
+    OpenCV is needed only to find markers: without the ``vision`` extra the finder is made,
+    ``missing`` says why it cannot work, and ``find`` raises ``MissingExtraError``.
+
     Raises:
         SensorError: unknown dictionary or family, or a size that is not positive.
     """
@@ -171,23 +175,47 @@ class MarkerFinder:
             raise SensorError(f"marker families are {', '.join(FAMILIES)}, got {families!r}")
         if not marker_size_m > 0:
             raise SensorError(f"marker size must be a positive length in m, got {marker_size_m}")
-        cv2 = cv()
         self.dictionary = dictionary
         self.marker_size_m = float(marker_size_m)
         self.families = tuple(families)
-        self._detector = cv2.aruco.ArucoDetector(
-            aruco_dictionary(dictionary), cv2.aruco.DetectorParameters()
-        )
+        self._detector: Any = None
+        self.missing: MissingExtraError | None = None
+        """Why the finder cannot work (OpenCV is not installed), None when it can."""
         half = self.marker_size_m / 2
         self._object_points = np.array(
             [[-half, half, 0], [half, half, 0], [half, -half, 0], [-half, -half, 0]],
             dtype=np.float32,
         )
+        try:
+            self.ready()
+        except MissingExtraError as exc:
+            self.missing = exc
+
+    def ready(self) -> None:
+        """Make OpenCV's ArUco detector if not yet made (``find`` does it first).
+
+        Raises:
+            MissingExtraError: OpenCV (the ``vision`` extra) is not installed, in one line.
+            SensorError: an unknown dictionary.
+        """
+        if self._detector is not None:
+            return
+        require("cv2", extra="vision", feature="marker detection")
+        cv2 = cv()
+        self._detector = cv2.aruco.ArucoDetector(
+            aruco_dictionary(self.dictionary), cv2.aruco.DetectorParameters()
+        )
+        self.missing = None
 
     def find(
         self, frame: np.ndarray, calibration: CameraCalibration | None = None, camera: str = ""
     ) -> list[Marker]:
-        """Every marker in ``frame`` (BGR or grey), with poses when ``calibration`` is given."""
+        """Every marker in ``frame`` (BGR or grey), with poses when ``calibration`` is given.
+
+        Raises:
+            MissingExtraError: OpenCV (the ``vision`` extra) is not installed.
+        """
+        self.ready()
         cv2 = cv()
         grey = frame if frame.ndim == 2 else cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
         corners, ids, _ = self._detector.detectMarkers(grey)

@@ -21,6 +21,7 @@ from poppy_core.errors import (
     BusTimeout,
     ConfigError,
     FileError,
+    MissingExtraError,
     MotorError,
     PoppyError,
     RegisterError,
@@ -117,7 +118,8 @@ def from_poppy_error(exc: PoppyError) -> ApiError:
 
     ``UnknownNameError`` (motor, group, primitive, move, card) is ``not_found``; an
     ``ArgumentError``, ``RegisterError`` or other ``ConfigError`` is ``invalid``; bus trouble,
-    a closed robot or a sensor that does not answer is ``unavailable``; a file is ``storage``.
+    a closed robot, a sensor that does not answer or a feature whose extra is not installed is
+    ``unavailable``; a file is ``storage``.
     """
     if isinstance(exc, UnknownNameError):
         return ApiError("not_found", str(exc), tip=NAME_TIPS.get(exc.kind, ""))
@@ -125,7 +127,7 @@ def from_poppy_error(exc: PoppyError) -> ApiError:
         return ApiError("invalid", str(exc))
     if isinstance(exc, BusTimeout | BusError | MotorError):
         return ApiError("unavailable", f"the robot did not answer: {exc}")
-    if isinstance(exc, SensorError):
+    if isinstance(exc, SensorError | MissingExtraError):  # a sensor without its extra too
         return ApiError("unavailable", str(exc))
     if isinstance(exc, RobotClosedError):
         return ApiError("unavailable", str(exc))

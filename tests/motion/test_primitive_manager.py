@@ -2,20 +2,27 @@
 
 from __future__ import annotations
 
+import logging
 import time
 
 import pytest
 
-from poppy_core.errors import ArgumentError, ConfigError, RegisterError
+from poppy_core.errors import (
+    ArgumentError,
+    PrimitiveError,
+    RegisterError,
+    UnknownMotorError,
+)
 from poppy_core.motion import (
     FILTERS,
+    LoopPrimitive,
     MockupMotor,
     MockupRobot,
     PrimitiveManager,
     Sinus,
     primitive_manager,
 )
-from poppy_core.robot import Robot
+from poppy_core.robot import Robot, from_profile
 from tests.helpers import eventually
 from tests.helpers.fixtures import ergo_fixture
 
@@ -104,7 +111,7 @@ def test_mockup_robot_groups_and_passthrough(ergo: Robot) -> None:
     sandbox.compliant = True
     assert all(v == {"compliant": True} for v in sandbox.requests().values())
     assert not ergo.compliant  # still only requests
-    with pytest.raises(ConfigError, match="no motor"):
+    with pytest.raises(UnknownMotorError, match="no motor"):
         sandbox.motor("m9")
 
 
@@ -180,3 +187,46 @@ def test_bad_filter_result_is_counted_not_applied(ergo: Robot) -> None:
     manager.close()
     with pytest.raises(ArgumentError, match="manager frequency"):
         PrimitiveManager(ergo, freq=0)
+
+
+class Mirror(LoopPrimitive):
+    """Writes a goal to ``head_z``, a motor the robot does not have: its sandbox is another
+    robot's (a primitive pointed at the wrong robot)."""
+
+    def __init__(self, robot: Robot, other: Robot) -> None:
+        super().__init__(robot, 50)
+        self.robot = MockupRobot(other, self._stop_event)
+
+    def update(self) -> None:
+        self.robot.head_z.goal_position = 5.0
+
+
+def test_a_primitive_requesting_an_unknown_motor_is_stopped_and_the_manager_goes_on(
+    ergo: Robot, caplog: pytest.LogCaptureFixture
+) -> None:
+    manager = primitive_manager(ergo)
+    with from_profile("torso", sim=True, creature=False) as torso:
+        before = constant(ergo, "m2", 15.0)
+        before.start()
+        assert eventually(lambda: abs(ergo.m2.goal_position - 15.0) < 0.5)
+        stray = Mirror(ergo, torso)
+        with caplog.at_level(logging.WARNING):
+            stray.start()
+            assert eventually(lambda: stray.state == "failed" and not stray.is_alive())
+            assert stray.error is not None and stray.error.type == "UnknownMotorError"
+            assert "'head_z'" in stray.error.message and "\n" not in stray.error.one_line
+            assert stray.describe()["error"]["type"] == "UnknownMotorError"
+            after = constant(ergo, "m3", -12.0)  # the manager still combines requests
+            after.start()
+            assert eventually(lambda: abs(ergo.m3.goal_position + 12.0) < 0.5)
+            assert manager.running and stray not in manager.primitives
+            assert manager.last_error is not None and "head_z" in manager.last_error
+            with pytest.raises(PrimitiveError, match=r"UnknownMotorError: .*'head_z'"):
+                stray.stop()
+            before.stop()
+            after.stop()
+        warned = [r for r in caplog.records if "head_z" in r.getMessage()]
+        assert len(warned) == 1 and warned[0].levelno == logging.WARNING
+        assert "\n" not in warned[0].getMessage()
+        assert before.error is None and after.error is None
+    assert eventually(lambda: not manager.running)

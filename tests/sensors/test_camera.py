@@ -11,9 +11,10 @@ from typing import Any
 import pytest
 
 from poppy_core.errors import SensorError
-from poppy_core.sensors import DummyCamera, build_sensors, opencv_camera
+from poppy_core.sensors import DummyCamera, MarkerDetector, build_sensors, opencv_camera
 from poppy_core.sensors.opencv_camera import OpenCVCamera, list_devices
 from tests.helpers.configs import checked_sensors
+from tests.helpers.waiting import eventually
 
 cv2 = pytest.importorskip("cv2")
 
@@ -132,6 +133,27 @@ def test_a_lost_camera_warns_once_shows_in_health_and_resumes(
         assert health.connected and health.losses == 1 and health.as_dict()["ok"] is True
         assert any("is back" in r.getMessage() for r in caplog.records)
         assert cable.opened >= 2
+
+
+def test_a_marker_detector_is_lost_while_its_camera_is_and_back_with_it(
+    video_file: Path,
+) -> None:
+    cable = Unpluggable(video_file)
+    with (
+        OpenCVCamera("camera", "/dev/video0", fps=50.0, opener=cable) as camera,
+        MarkerDetector("marker_detector", [camera], 20.0) as detector,
+    ):
+        assert detector.markers == [] and detector.health().ok
+        cable.plugged.clear()
+        assert eventually(lambda: not camera.health().connected, timeout_s=10)
+        health = detector.health()
+        assert not health.connected and not health.ok and health.running
+        assert health.last_error.startswith("camera 'camera' lost: ")
+        assert "gave no frame" in health.last_error
+        assert health.as_dict()["ok"] is False
+        cable.plugged.set()
+        assert eventually(lambda: detector.health().ok, timeout_s=10)
+        assert camera.health().connected and detector.markers == []
 
 
 def test_dummy_camera_gives_black_frames() -> None:

@@ -62,12 +62,16 @@ def test_a_robot_whose_camera_is_missing_starts_and_opens_it_when_plugged(
         health = robot.sensor_health()["camera"]
         assert not health.connected and not health.ok
         assert f"{device} does not exist" in health.last_error
-        assert robot.sensor_health()["marker_detector"].ok  # not started: nothing to say yet
+        detector = robot.sensor_health()["marker_detector"]  # blind while its camera is lost
+        assert not detector.ok and f"camera 'camera' lost: {device} does not exist" in (
+            detector.last_error
+        )
         robot.m1.compliant = False  # the motors work meanwhile
         (warning,) = camera_warnings(caplog)
         assert "is not available" in warning and str(device) in warning
         plug_in(video_file, device)
         assert eventually(lambda: robot.sensor_health()["camera"].connected, timeout_s=20)
+        assert robot.sensor_health()["marker_detector"].ok  # back with its camera
         camera = robot.sensor("camera")
         assert isinstance(camera, Camera)
         first = camera.latest()
@@ -140,9 +144,11 @@ def test_poppy_serve_starts_without_its_camera_and_the_page_says_so(tmp_path: Pa
             http_url = proc.stdout.readline().strip()
             assert http_url.startswith("http://127.0.0.1:"), proc.communicate(timeout=30)
             with urllib.request.urlopen(f"{http_url}/api/v1/web/about", timeout=20) as answer:
-                camera = json.load(answer)["sensors"]["camera"]
+                sensors = json.load(answer)["sensors"]
+            camera, detector = sensors["camera"], sensors["marker_detector"]
             assert camera["connected"] is False and camera["ok"] is False
             assert "/dev/video0 does not exist" in camera["last_error"]
+            assert detector["ok"] is False and "camera 'camera' lost" in detector["last_error"]
             with urllib.request.urlopen(f"{http_url}/motors/list.json", timeout=20) as answer:
                 assert json.load(answer)["motors"] == [f"m{i}" for i in range(1, 7)]
         finally:
