@@ -206,7 +206,9 @@ def quat_from_euler(angles: list[float]) -> Quat:
     qx = (math.cos(a), math.sin(a), 0.0, 0.0)
     qy = (math.cos(b), 0.0, math.sin(b), 0.0)
     qz = (math.cos(c), 0.0, 0.0, math.sin(c))
-    return _mul(_mul(qx, qy), qz)
+    from poppy_core.kinematics.transforms import quat_mul  # numpy: only when a sim call asks
+
+    return quat_mul(quat_mul(qx, qy), qz)
 
 
 def euler_from_quat(q: Quat) -> list[float]:
@@ -219,14 +221,3 @@ def euler_from_quat(q: Quat) -> list[float]:
     r22 = 1 - 2 * (x * x + y * y)
     beta = math.asin(max(-1.0, min(1.0, r02)))
     return [math.atan2(-r12, r22), beta, math.atan2(-r01, r00)]
-
-
-def _mul(a: Quat, b: Quat) -> Quat:
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    )
