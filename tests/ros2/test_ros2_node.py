@@ -73,15 +73,20 @@ class Node:
         self.robot.close()
 
 
+def _header() -> Any:
+    """A std_msgs/Header stamped 0, of no frame."""
+    return rmw.msg(
+        "std_msgs/msg/Header",
+        stamp=rmw.msg("builtin_interfaces/msg/Time", sec=0, nanosec=0),
+        frame_id="",
+    )
+
+
 def _joint_command(names: list[str], positions: Any) -> Any:
     """A sensor_msgs/JointState of ``names`` at ``positions`` (rad), stamped 0."""
     return rmw.msg(
         JOINT_STATE,
-        header=rmw.msg(
-            "std_msgs/msg/Header",
-            stamp=rmw.msg("builtin_interfaces/msg/Time", sec=0, nanosec=0),
-            frame_id="",
-        ),
+        header=_header(),
         name=names,
         position=positions,
         velocity=np.array([], dtype=float),
@@ -248,11 +253,7 @@ def test_trigger_starts_and_stops_a_primitive(node: Node) -> None:
 def _trajectory(names: list[str], points: list[tuple[float, list[float]]]) -> object:
     return rmw.msg(
         TRAJECTORY,
-        header=rmw.msg(
-            "std_msgs/msg/Header",
-            stamp=rmw.msg("builtin_interfaces/msg/Time", sec=0, nanosec=0),
-            frame_id="",
-        ),
+        header=_header(),
         joint_names=names,
         points=[
             rmw.msg(
