@@ -11,7 +11,7 @@ from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from typing import Any
 
-from bench.registry import REPO_ROOT
+from bench.registry import POPPY_PYTHON, REPO_ROOT
 
 
 def free_port() -> int:
@@ -19,6 +19,12 @@ def free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return int(sock.getsockname()[1])
+
+
+def poppy_serve_ergo(*flags: str) -> list[str]:
+    """``poppy serve --sim --profile ergo-jr FLAGS`` run by poppy's interpreter (a served
+    virtual Ergo Jr, as each server benchmark measures it)."""
+    return [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--sim", "--profile", "ergo-jr", *flags]
 
 
 def interrupt(proc: subprocess.Popen[Any], timeout_s: float = 10.0) -> None:
