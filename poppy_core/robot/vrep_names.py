@@ -101,17 +101,13 @@ class VrepNames:
         self, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
     ) -> None:
         """A free upright cylinder of diameter ``sizes[0]`` and height ``sizes[2]`` (m)."""
-        sides = _three(sizes, "sizes")
-        size = (positive(sides[0], "sizes") / 2, positive(sides[2], "sizes") / 2)
-        self._add("add_cylinder", "cylinder", name, position, size, mass)
+        self._add("add_cylinder", "cylinder", name, position, _upright(sizes), mass)
 
     def add_cone(
         self, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
     ) -> None:
         """A free upright cone (tip up) of base diameter ``sizes[0]`` and height ``sizes[2]``."""
-        sides = _three(sizes, "sizes")
-        size = (positive(sides[0], "sizes") / 2, positive(sides[2], "sizes") / 2)
-        self._add("add_cone", "cone", name, position, size, mass)
+        self._add("add_cone", "cone", name, position, _upright(sizes), mass)
 
     def get_collision_state(self, collision_name: str) -> bool:
         """Whether body ``collision_name`` touches another body or the world now."""
@@ -198,6 +194,12 @@ def _three(values: Any, field: str) -> list[Any]:
     if len(items) != 3:
         raise ConfigError(f"{field} must be 3 numbers, not {values!r}", field=field)
     return items
+
+
+def _upright(sizes: Any) -> tuple[float, float]:
+    """(radius, half height) of an upright solid of V-REP's ``sizes`` (diameter, _, height)."""
+    sides = _three(sizes, "sizes")
+    return (positive(sides[0], "sizes") / 2, positive(sides[2], "sizes") / 2)
 
 
 def quat_from_euler(angles: list[float]) -> Quat:

@@ -30,3 +30,11 @@ def launched(*args: str) -> Iterator[Any]:
         browser = driver.chromium.launch(executable_path=CHROMIUM, args=[*HEADLESS_ARGS, *args])
         yield browser
         browser.close()
+
+
+def new_tab(browser: Any, timeout_ms: float) -> tuple[Any, Any]:
+    """A fresh context (a 1280x900 window) and its page, waiting up to ``timeout_ms``."""
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    tab = context.new_page()
+    tab.set_default_timeout(timeout_ms)
+    return context, tab

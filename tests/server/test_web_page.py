@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from tests.helpers.chromium import launched, needs_chromium
+from tests.helpers.chromium import launched, needs_chromium, new_tab
 from tests.helpers.server import serve_robot
 from tests.server.conftest import Served, serve
 
@@ -46,9 +46,7 @@ def browser() -> Iterator[Any]:
 
 @pytest.fixture
 def page(browser: Any, served: Served) -> Iterator[Any]:
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    opened = context.new_page()
-    opened.set_default_timeout(WAIT_S * 1000)
+    context, opened = new_tab(browser, WAIT_S * 1000)
     errors: list[str] = []
     opened.on("pageerror", lambda error: errors.append(str(error)))
     opened.on(
@@ -372,9 +370,7 @@ def creature(moves_folder: str) -> Iterator[Served]:
 
 
 def test_camera_and_chain_jog(browser: Any, creature: Served) -> None:
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    tab = context.new_page()
-    tab.set_default_timeout(WAIT_S * 1000)
+    context, tab = new_tab(browser, WAIT_S * 1000)
     tab.goto(creature.url + "/")
     tab.wait_for_function(READY)
     tab.click("#camera-views button")

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from poppy_core.robot import from_profile
-from tests.helpers.chromium import CHROMIUM, HEADLESS_ARGS, needs_chromium, playwright_api
+from tests.helpers.chromium import CHROMIUM, HEADLESS_ARGS, needs_chromium, new_tab, playwright_api
 from tests.helpers.server import serve_robot
 from tests.helpers.waiting import eventually
 from tests.server.conftest import Served
@@ -51,9 +51,7 @@ def humanoid(moves_folder: str) -> Iterator[Served]:
 
 
 def open_view(browser: Any, url: str, errors: list[str]) -> Any:
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    page = context.new_page()
-    page.set_default_timeout(WAIT_S * 1000)
+    _, page = new_tab(browser, WAIT_S * 1000)
     page.on("pageerror", lambda error: errors.append(str(error)))
     page.on(
         "console",
