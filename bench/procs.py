@@ -11,7 +11,7 @@ from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from typing import Any
 
-from bench.registry import POPPY_PYTHON, REPO_ROOT
+from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext
 
 
 def free_port() -> int:
@@ -21,10 +21,24 @@ def free_port() -> int:
         return int(sock.getsockname()[1])
 
 
-def poppy_serve_ergo(*flags: str) -> list[str]:
-    """``poppy serve --sim --profile ergo-jr FLAGS`` run by poppy's interpreter (a served
-    virtual Ergo Jr, as each server benchmark measures it)."""
-    return [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--sim", "--profile", "ergo-jr", *flags]
+def served_ergo(
+    kind: str, ctx: BenchContext, pypot_program: str, port: int, *flags: str
+) -> list[str]:
+    """The command line of a virtual Ergo Jr served on ``port``: ``poppy serve --sim --profile
+    ergo-jr FLAGS`` (``kind`` "poppy"), else ``pypot_program`` (Python source taking the port)
+    run by the peers' interpreter."""
+    if kind == "poppy":
+        return [
+            str(POPPY_PYTHON),
+            "-m",
+            "poppy_cli",
+            "serve",
+            "--sim",
+            "--profile",
+            "ergo-jr",
+            *flags,
+        ]
+    return [str(ctx.peers_python), "-c", pypot_program, str(port)]
 
 
 def interrupt(proc: subprocess.Popen[Any], timeout_s: float = 10.0) -> None:
