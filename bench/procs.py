@@ -13,6 +13,9 @@ from typing import Any
 
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext
 
+SERVE_ERGO_JR = ("-m", "poppy_cli", "serve", "--sim", "--profile", "ergo-jr")
+"""poppy's arguments serving a virtual Ergo Jr (after its interpreter)."""
+
 
 def free_port() -> int:
     """A TCP port on 127.0.0.1 that nothing listens on now."""
@@ -28,16 +31,7 @@ def served_ergo(
     ergo-jr FLAGS`` (``kind`` "poppy"), else ``pypot_program`` (Python source taking the port)
     run by the peers' interpreter."""
     if kind == "poppy":
-        return [
-            str(POPPY_PYTHON),
-            "-m",
-            "poppy_cli",
-            "serve",
-            "--sim",
-            "--profile",
-            "ergo-jr",
-            *flags,
-        ]
+        return [str(POPPY_PYTHON), *SERVE_ERGO_JR, *flags]
     return [str(ctx.peers_python), "-c", pypot_program, str(port)]
 
 
