@@ -11,7 +11,10 @@ from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from typing import Any
 
-from bench.registry import REPO_ROOT
+from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext
+
+SERVE_ERGO_JR = ("-m", "poppy_cli", "serve", "--sim", "--profile", "ergo-jr")
+"""poppy's arguments serving a virtual Ergo Jr (after its interpreter)."""
 
 
 def free_port() -> int:
@@ -19,6 +22,17 @@ def free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         return int(sock.getsockname()[1])
+
+
+def served_ergo(
+    kind: str, ctx: BenchContext, pypot_program: str, port: int, *flags: str
+) -> list[str]:
+    """The command line of a virtual Ergo Jr served on ``port``: ``poppy serve --sim --profile
+    ergo-jr FLAGS`` (``kind`` "poppy"), else ``pypot_program`` (Python source taking the port)
+    run by the peers' interpreter."""
+    if kind == "poppy":
+        return [str(POPPY_PYTHON), *SERVE_ERGO_JR, *flags]
+    return [str(ctx.peers_python), "-c", pypot_program, str(port)]
 
 
 def interrupt(proc: subprocess.Popen[Any], timeout_s: float = 10.0) -> None:

@@ -24,8 +24,8 @@ from contextlib import contextmanager
 from typing import Any
 
 from bench import side_by_side
-from bench.procs import child, free_port
-from bench.registry import POPPY_PYTHON, BenchContext, BenchResult, Table, register
+from bench.procs import child, free_port, served_ergo
+from bench.registry import BenchContext, BenchResult, Table, register
 from bench.side_by_side import measure_sides, median_cells, percentile
 
 CLIENTS = 4
@@ -73,11 +73,7 @@ def _wait_listening(port: int, proc: subprocess.Popen[str]) -> None:
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
     port = free_port()
-    if kind == "poppy":
-        args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", "--sim"]
-        args += ["--profile", "ergo-jr", "--http-port", str(port)]
-    else:
-        args = [str(ctx.peers_python), "-c", PYPOT_SERVER, str(port)]
+    args = served_ergo(kind, ctx, PYPOT_SERVER, port, "--http", "--http-port", str(port))
     with child(args) as proc:
         _wait_listening(port, proc)
         yield port

@@ -17,8 +17,8 @@ from contextlib import contextmanager
 from typing import Any
 
 from bench import side_by_side
-from bench.procs import child, free_port
-from bench.registry import POPPY_PYTHON, BenchContext, BenchResult, Table, register
+from bench.procs import child, free_port, served_ergo
+from bench.registry import BenchContext, BenchResult, Table, register
 from bench.side_by_side import measure_sides, median, median_cells, percentile
 
 DURATION_S = 1.5
@@ -56,11 +56,7 @@ SCENARIOS: dict[str, dict[str, Any]] = {
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
     port = free_port()
-    if kind == "poppy":
-        args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--zmq", "--sim"]
-        args += ["--profile", "ergo-jr", "--zmq-port", str(port)]
-    else:
-        args = [str(ctx.peers_python), "-c", PYPOT_SERVER, str(port)]
+    args = served_ergo(kind, ctx, PYPOT_SERVER, port, "--zmq", "--zmq-port", str(port))
     with child(args, stdout=subprocess.PIPE) as proc:
         assert proc.stdout is not None
         line = proc.stdout.readline()  # "zmq: tcp://..." / "ready": it serves

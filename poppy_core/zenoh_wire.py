@@ -207,7 +207,8 @@ class RobotState:
     motors: dict[str, dict[str, Any]]
 
 
-def _number(value: Any) -> float:
+def finite_or_nan(value: Any) -> float:
+    """``value`` as a float; NaN for anything not a finite number (a value not read yet)."""
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -229,7 +230,7 @@ def pack_state(seq: int, stamp: float, motors: Mapping[str, Mapping[str, Any]]) 
         flags = (COMPLIANT if values.get("compliant") else 0) | (
             ONLINE if values.get("online", True) else 0
         )
-        out.append(_MOTOR.pack(*(_number(values.get(f)) for f in STATE_FIELDS), flags))
+        out.append(_MOTOR.pack(*(finite_or_nan(values.get(f)) for f in STATE_FIELDS), flags))
     return b"".join(out)
 
 

@@ -77,6 +77,16 @@ def unlock_eeprom(bus: DxlBus, motor_id: int, model: ServoModel) -> None:
         bus.write_register(motor_id, model, "torque_enable", False)
 
 
+def _write_unanswered(bus: DxlBus, motor_id: int, model: ServoModel, name: str, value: int) -> None:
+    """Write the ID or the baud rate, the EEPROM unlocked: the motor may answer at its new ID or
+    rate, or not at all (some firmwares), so a missing acknowledgement is only logged."""
+    unlock_eeprom(bus, motor_id, model)
+    try:
+        bus.write_register(motor_id, model, name, value)
+    except CommunicationError as exc:
+        logger.debug("%s write not acknowledged (expected from some firmwares): %s", name, exc)
+
+
 @contextmanager
 def eeprom_unlocked(bus: DxlBus, motor_id: int, model: ServoModel) -> Iterator[None]:
     """EEPROM writes allowed in the block: a stiff motor whose protocol locks its EEPROM while
@@ -139,11 +149,7 @@ def change_id(
     if bus.ping(new_id) is not None:
         raise SetupError(f"ID {new_id} is already taken on {bus.port}")
     say(progress, f"motor {old_id}: setting ID {new_id}")
-    unlock_eeprom(bus, old_id, model)
-    try:
-        bus.write_register(old_id, model, "id", new_id)
-    except CommunicationError as exc:
-        logger.debug("ID write not acknowledged (expected from some firmwares): %s", exc)
+    _write_unanswered(bus, old_id, model, "id", new_id)
     if not wait_for_answer(bus, new_id):
         still_old = bus.ping(old_id) is not None
         hint = f"it still answers as {old_id}" if still_old else "run `poppy scan` to find it"
@@ -217,11 +223,7 @@ def change_baudrate(
     model.baudrate_code(baudrate)
     if baudrate != old:
         say(progress, f"motor {motor_id}: setting {baudrate} bps")
-        unlock_eeprom(bus, motor_id, model)
-        try:
-            bus.write_register(motor_id, model, "baudrate", baudrate)
-        except CommunicationError as exc:
-            logger.debug("baud rate write not acknowledged: %s", exc)
+        _write_unanswered(bus, motor_id, model, "baudrate", baudrate)
         bus.baudrate = baudrate
         if not wait_for_answer(bus, motor_id):
             found = locate(bus, motor_id)

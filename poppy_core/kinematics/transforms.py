@@ -57,6 +57,20 @@ def axis_angle_matrix(axis: Sequence[float] | Matrix, angle_rad: float) -> Matri
     return np.eye(3) + math.sin(angle_rad) * k + (1.0 - math.cos(angle_rad)) * (k @ k)
 
 
+def quat_mul(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float]
+) -> tuple[float, float, float, float]:
+    """Hamilton product ``a * b`` of quaternions ``(w, x, y, z)`` (plain floats, no numpy)."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
+
+
 def quat_matrix(quat: Sequence[float]) -> Matrix:
     """Rotation matrix of a quaternion ``(w, x, y, z)`` (normalised here)."""
     w, x, y, z = np.asarray(quat, dtype=float) / np.linalg.norm(quat)

@@ -101,17 +101,13 @@ class VrepNames:
         self, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
     ) -> None:
         """A free upright cylinder of diameter ``sizes[0]`` and height ``sizes[2]`` (m)."""
-        sides = _three(sizes, "sizes")
-        size = (positive(sides[0], "sizes") / 2, positive(sides[2], "sizes") / 2)
-        self._add("add_cylinder", "cylinder", name, position, size, mass)
+        self._add("add_cylinder", "cylinder", name, position, _upright(sizes), mass)
 
     def add_cone(
         self, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
     ) -> None:
         """A free upright cone (tip up) of base diameter ``sizes[0]`` and height ``sizes[2]``."""
-        sides = _three(sizes, "sizes")
-        size = (positive(sides[0], "sizes") / 2, positive(sides[2], "sizes") / 2)
-        self._add("add_cone", "cone", name, position, size, mass)
+        self._add("add_cone", "cone", name, position, _upright(sizes), mass)
 
     def get_collision_state(self, collision_name: str) -> bool:
         """Whether body ``collision_name`` touches another body or the world now."""
@@ -200,13 +196,21 @@ def _three(values: Any, field: str) -> list[Any]:
     return items
 
 
+def _upright(sizes: Any) -> tuple[float, float]:
+    """(radius, half height) of an upright solid of V-REP's ``sizes`` (diameter, _, height)."""
+    sides = _three(sizes, "sizes")
+    return (positive(sides[0], "sizes") / 2, positive(sides[2], "sizes") / 2)
+
+
 def quat_from_euler(angles: list[float]) -> Quat:
     """V-REP's Euler angles (alpha, beta, gamma: ``Rx @ Ry @ Rz``) as a quaternion (w, x, y, z)."""
     a, b, c = (x / 2 for x in angles)
     qx = (math.cos(a), math.sin(a), 0.0, 0.0)
     qy = (math.cos(b), 0.0, math.sin(b), 0.0)
     qz = (math.cos(c), 0.0, 0.0, math.sin(c))
-    return _mul(_mul(qx, qy), qz)
+    from poppy_core.kinematics.transforms import quat_mul  # numpy: only when a sim call asks
+
+    return quat_mul(quat_mul(qx, qy), qz)
 
 
 def euler_from_quat(q: Quat) -> list[float]:
@@ -219,14 +223,3 @@ def euler_from_quat(q: Quat) -> list[float]:
     r22 = 1 - 2 * (x * x + y * y)
     beta = math.asin(max(-1.0, min(1.0, r02)))
     return [math.atan2(-r12, r22), beta, math.atan2(-r01, r00)]
-
-
-def _mul(a: Quat, b: Quat) -> Quat:
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    )

@@ -22,6 +22,7 @@ import numpy as np
 
 from poppy_core.documents import CONFIG_LIMITS, parse_yaml, read_limited
 from poppy_core.files import write_file
+from poppy_core.kinematics.transforms import quat_mul
 from poppy_core.models import model_by_name
 from poppy_core.sim.framing import (
     FRONT_FOVY_DEG,
@@ -51,7 +52,6 @@ from poppy_core.sim.urdf import (
     parse_urdf,
     quat_from_axis_angle,
     quat_from_rpy,
-    quat_mul,
     rotate,
 )
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from poppy_core.errors import ConfigError
+from poppy_core.kinematics.transforms import quat_mul
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]  # (w, x, y, z), MuJoCo's order
@@ -143,18 +144,6 @@ def parse_urdf(path: Path) -> Urdf:
 
 
 # ---------------------------------------------------------------------- rotations (w, x, y, z)
-
-
-def quat_mul(a: Quat, b: Quat) -> Quat:
-    """Hamilton product ``a * b``."""
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    )
 
 
 def quat_from_axis_angle(axis: Vec3, angle_rad: float) -> Quat:

@@ -42,9 +42,9 @@ ALLOWED: dict[str, set[str]] = {
     # the MuJoCo plant of the emulator, in a room of its own (ARCHITECTURE: "poppy_core/sim/ if it
     # needs a room"); the robot factory builds it, as it builds emulators
     # sim's camera is a Sensor; its marker cards are drawn by sensors.markers
-    "sim": {"emulator", "models", "protocol", "sensors"},
+    "sim": {"emulator", "models", "protocol", "sensors", "kinematics"},
     # remote imports nothing of ours: pypot's from_remote is a robot factory returning its client
-    "robot": {"bus", "models", "emulator", "sim", "protocol", "sensors", "remote"},
+    "robot": {"bus", "models", "emulator", "sim", "protocol", "sensors", "remote", "kinematics"},
     # kinematics is a leaf (numpy only, nothing of ours but errors): rooms that need chains
     # import it, whatever their place in the plan's table
     "motion": {"robot", "models", "kinematics"},

@@ -10,8 +10,9 @@ from tests.helpers.cli import POPPY
 from tests.helpers.processes import read_until, start_on_pty
 
 
-def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Path) -> None:
-    env = dict(
+def _env(tmp_path: Path) -> dict[str, str]:
+    """A terminal of 120 columns, no colour, no user profile or port, config under tmp_path."""
+    return dict(
         os.environ,
         COLUMNS="120",
         NO_COLOR="1",
@@ -19,6 +20,10 @@ def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Pa
         POPPY_PROFILE="",
         POPPY_PORT="",
     )
+
+
+def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Path) -> None:
+    env = _env(tmp_path)
     proc, parent, child = start_on_pty(
         [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr", "--motors", "m1"], env
     )
@@ -43,14 +48,7 @@ def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Pa
 
 
 def test_q_at_the_posture_cancels_at_once(tmp_path: Path) -> None:
-    env = dict(
-        os.environ,
-        COLUMNS="120",
-        NO_COLOR="1",
-        XDG_CONFIG_HOME=str(tmp_path / "xdg"),
-        POPPY_PROFILE="",
-        POPPY_PORT="",
-    )
+    env = _env(tmp_path)
     proc, parent, child = start_on_pty([*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"], env)
     try:
         read_until(parent, "q to cancel")

@@ -115,22 +115,28 @@ def test_generate_from_emulator_then_validate(poppy: Any, ergo_jr: Any, tmp_path
     assert "--force" in again.stderr
 
 
+def _validate_refused(poppy: Any, tmp_path: Path, data: Any) -> tuple[Path, list[str]]:
+    """``poppy config validate`` of ``data`` saved as bad.json: refused in three lines, no trace."""
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    result = poppy("config", "validate", str(bad))
+    assert result.code == 1
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 3, result.stderr
+    return bad, lines
+
+
 def test_validate_lists_every_problem_one_line_each(poppy: Any, tmp_path: Path) -> None:
     data = json.loads(ERGO_JSON.read_text())
     data["motors"]["m2"]["id"] = data["motors"]["m1"]["id"]
     data["motors"]["m3"]["angle_limit"] = [90, -90]
     data["motors"]["m4"]["type"] = "XL-3200"
-    bad = tmp_path / "bad.json"
-    bad.write_text(json.dumps(data))
-    result = poppy("config", "validate", str(bad))
-    assert result.code == 1
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 3, result.stderr
+    bad, lines = _validate_refused(poppy, tmp_path, data)
     assert all(line.startswith(f"error: {bad}: motors.m") for line in lines)
     assert any("motors.m2.id = 1: duplicate ID" in line for line in lines)
     assert any("motors.m3.angle_limit = [90, -90]: min must be below max" in line for line in lines)
     assert any("motors.m4.type" in line for line in lines)
-    assert "Traceback" not in result.stderr
 
 
 def test_validate_lists_chains_and_sensors_problems_one_line_each(
@@ -142,14 +148,8 @@ def test_validate_lists_chains_and_sensors_problems_one_line_each(
         "camera": {"type": "OpenCVCamera", "resolution": [640]},
         "imu": {"type": "IMU"},
     }
-    bad = tmp_path / "bad.json"
-    bad.write_text(json.dumps(data))
-    result = poppy("config", "validate", str(bad))
-    assert result.code == 1
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 3, result.stderr
+    bad, lines = _validate_refused(poppy, tmp_path, data)
     assert any("sensors.camera.resolution = [640]: must be [width, " in line for line in lines)
     assert any("sensors.imu.type" in line and "not supported yet" in line for line in lines)
     assert any('kinematics.model = "": must not be empty' in line for line in lines)
     assert all(line.startswith(f"error: {bad}: ") for line in lines)
-    assert "Traceback" not in result.stderr

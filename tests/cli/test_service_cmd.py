@@ -17,7 +17,7 @@ from poppy_core.emulator import serve_pty
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.cli import Result, run_poppy
-from tests.helpers.processes import reap
+from tests.helpers.processes import reap, served_urls
 from tests.helpers.recording import RecordingFake
 
 SHOW = (
@@ -263,12 +263,7 @@ def test_the_units_exec_start_run_as_is_serves_the_page(tmp_path: Path) -> None:
         )
         try:
             assert proc.stdout is not None
-            urls: list[str] = []
-            for line in proc.stdout:
-                if line.startswith("docs: "):
-                    break
-                if line.startswith("http://"):
-                    urls.append(line.strip())
+            urls = served_urls(proc.stdout)
             assert len(urls) == 2, proc.stderr.read() if proc.stderr else ""
             for url in urls:
                 page = httpx.get(url + "/", timeout=30)

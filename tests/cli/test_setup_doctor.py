@@ -324,7 +324,8 @@ def test_doctor_skips_the_service_and_page_when_not_installed(
 # -- setup's refusals: one line saying what to do, exit 1, nothing written ---------------------
 
 
-def setup_once(bus: VirtualBus, *places: int) -> Result:
+def setup_once(bus: VirtualBus, *places: int, options: tuple[str, ...] = ()) -> Result:
+    """``poppy setup motors --motors m1`` on ``bus`` (its motors at ``places`` plugged first)."""
     for place in places:
         bus.attach(place)
     with serve_link(bus) as server:
@@ -337,6 +338,7 @@ def setup_once(bus: VirtualBus, *places: int) -> Result:
             server.url,
             "--motors",
             "m1",
+            *options,
             input="\n",
         )
 
@@ -366,19 +368,7 @@ def test_setup_names_a_wrong_model() -> None:
 
 
 def test_setup_names_a_wrong_model_of_the_other_protocol() -> None:
-    bus = build_bus_from_spec("MX-28:1", protocol=1)
-    with serve_link(bus) as server:
-        result = run_poppy(
-            "setup",
-            "motors",
-            "--profile",
-            "ergo-jr",
-            "--port",
-            server.url,
-            "--motors",
-            "m1",
-            input="\n",
-        )
+    result = setup_once(build_bus_from_spec("MX-28:1", protocol=1))
     assert result.code == 1
     assert "found an MX-28 at ID 1 at 1000000 bps, protocol 1, m1 is an XL-320" in result.stderr
 
@@ -386,19 +376,7 @@ def test_setup_names_a_wrong_model_of_the_other_protocol() -> None:
 def test_setup_leaves_a_motor_already_right_as_it_is() -> None:
     bus = set_up_robot("XL-320:1")
     before = bytes(bus.motors[0].table.data)
-    with serve_link(bus) as server:
-        result = run_poppy(
-            "setup",
-            "motors",
-            "--profile",
-            "ergo-jr",
-            "--port",
-            server.url,
-            "--motors",
-            "m1",
-            "--json",
-            input="\n",
-        )
+    result = setup_once(bus, options=("--json",))
     assert result.code == 0, result.stderr
     assert result.json() == [
         {

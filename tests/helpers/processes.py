@@ -8,7 +8,7 @@ import pty
 import select
 import subprocess
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 
@@ -80,3 +80,14 @@ def start_on_pty(
         close_fds=True,
     )
     return proc, master, slave
+
+
+def served_urls(lines: Iterable[str]) -> list[str]:
+    """The ``http://`` URLs ``poppy serve`` prints, read up to its ``docs:`` line."""
+    urls: list[str] = []
+    for line in lines:
+        if line.startswith("docs: "):
+            break
+        if line.startswith("http://"):
+            urls.append(line.strip())
+    return urls

@@ -21,7 +21,11 @@ class Served:
 
 def serve(moves_folder: str, **options: Any) -> Iterator[Served]:
     """Serve a fresh virtual Ergo Jr until the generator is closed."""
-    robot = from_profile("ergo-jr", sim=True)
+    yield from serve_robot(from_profile("ergo-jr", sim=True), **options)
+
+
+def serve_robot(robot: Robot, **options: Any) -> Iterator[Served]:
+    """Serve ``robot`` (``create_app``'s ``options``) until the generator is closed; close it."""
     app = create_app(robot, **options)
     server = ServerThread(app).start()
     try:

@@ -10,7 +10,7 @@ import re
 import socket
 import threading
 import time
-from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 import pytest
@@ -73,13 +73,25 @@ class Node:
         self.robot.close()
 
 
-@pytest.fixture
-def node() -> Iterator[Node]:
-    served = Node()
-    try:
-        yield served
-    finally:
-        served.close()
+def _header() -> Any:
+    """A std_msgs/Header stamped 0, of no frame."""
+    return rmw.msg(
+        "std_msgs/msg/Header",
+        stamp=rmw.msg("builtin_interfaces/msg/Time", sec=0, nanosec=0),
+        frame_id="",
+    )
+
+
+def _joint_command(names: list[str], positions: Any) -> Any:
+    """A sensor_msgs/JointState of ``names`` at ``positions`` (rad), stamped 0."""
+    return rmw.msg(
+        JOINT_STATE,
+        header=_header(),
+        name=names,
+        position=positions,
+        velocity=np.array([], dtype=float),
+        effort=np.array([], dtype=float),
+    )
 
 
 def _stiff(node: Node) -> None:
@@ -241,11 +253,7 @@ def test_trigger_starts_and_stops_a_primitive(node: Node) -> None:
 def _trajectory(names: list[str], points: list[tuple[float, list[float]]]) -> object:
     return rmw.msg(
         TRAJECTORY,
-        header=rmw.msg(
-            "std_msgs/msg/Header",
-            stamp=rmw.msg("builtin_interfaces/msg/Time", sec=0, nanosec=0),
-            frame_id="",
-        ),
+        header=_header(),
         joint_names=names,
         points=[
             rmw.msg(
@@ -337,18 +345,7 @@ def test_bad_commands_move_nothing(node: Node, caplog: pytest.LogCaptureFixture)
         node.client.publish(
             "/joint_command",
             JOINT_STATE,
-            rmw.msg(
-                JOINT_STATE,
-                header=rmw.msg(
-                    "std_msgs/msg/Header",
-                    stamp=rmw.msg("builtin_interfaces/msg/Time", sec=0, nanosec=0),
-                    frame_id="",
-                ),
-                name=names,
-                position=np.array(positions, dtype=float),
-                velocity=np.array([], dtype=float),
-                effort=np.array([], dtype=float),
-            ),
+            _joint_command(names, np.array(positions, dtype=float)),
         )
         assert eventually(lambda n=count: _refusals(node) == n, 10.0)  # type: ignore[misc]
     assert any("refused, nothing moved: no joint 'm9'" in r.getMessage() for r in caplog.records)
@@ -380,18 +377,7 @@ def test_a_joint_command_sets_the_goals(node: Node) -> None:
     node.client.publish(
         "/joint_command",
         JOINT_STATE,
-        rmw.msg(
-            JOINT_STATE,
-            header=rmw.msg(
-                "std_msgs/msg/Header",
-                stamp=rmw.msg("builtin_interfaces/msg/Time", sec=0, nanosec=0),
-                frame_id="",
-            ),
-            name=["m1", "m2"],
-            position=np.array([math.radians(10), math.radians(10)]),
-            velocity=np.array([], dtype=float),
-            effort=np.array([], dtype=float),
-        ),
+        _joint_command(["m1", "m2"], np.array([math.radians(10), math.radians(10)])),
     )
     assert eventually(lambda: abs(node.robot.motor("m1").goal_position - 10) < 0.01, 10.0)
     assert node.robot.motor("m2").goal_position == pytest.approx(-10.0, abs=0.01)  # indirect

@@ -4,7 +4,6 @@ beside the ROS 2 node on one session, and rmw_zenoh's wire rules as poppy writes
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -25,15 +24,6 @@ from tests.ros2.test_ros2_node import Node, client_session, free_endpoint
 TF = "tf2_msgs/msg/TFMessage"
 DIAGNOSTICS = "diagnostic_msgs/msg/DiagnosticArray"
 IMAGE = "sensor_msgs/msg/CompressedImage"
-
-
-@pytest.fixture
-def node() -> Iterator[Node]:
-    served = Node()
-    try:
-        yield served
-    finally:
-        served.close()
 
 
 def _hashed(name: str) -> str:

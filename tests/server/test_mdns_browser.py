@@ -7,7 +7,6 @@ drives it, and the same page from another site is refused."""
 from __future__ import annotations
 
 import os
-import shutil
 import threading
 import uuid
 from collections.abc import Iterator
@@ -19,15 +18,10 @@ import pytest
 from poppy_core.assembly import Listen, ServerSet, ServeSpec, serve
 from poppy_core.remote.discovery import resolve
 from poppy_core.robot import from_profile
+from tests.helpers.chromium import launched, needs_chromium
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-playwright_api = pytest.importorskip(
-    "playwright.sync_api", reason="needs playwright (pip install -e '.[test]')"
-)
 pytest.importorskip("zeroconf")
-pytestmark = pytest.mark.skipif(
-    CHROMIUM is None, reason="needs Debian's chromium (apt-get install chromium)"
-)
+pytestmark = needs_chromium
 
 WAIT_MS = 60_000
 MONITOR = """<!doctype html><title>monitor</title><script>
@@ -98,13 +92,7 @@ def browser(announced: tuple[str, ServerSet]) -> Iterator[Any]:
     addresses = resolve(f"{name}.local", 5.0, interfaces=["127.0.0.1"])  # python-zeroconf
     assert addresses == ["127.0.0.1"]
     rules = f"MAP {name}.local {addresses[0]}, MAP evil.test 127.0.0.1"
-    with playwright_api.sync_playwright() as driver:
-        launched = driver.chromium.launch(
-            executable_path=CHROMIUM,
-            args=["--no-sandbox", "--disable-gpu", f"--host-resolver-rules={rules}"],
-        )
-        yield launched
-        launched.close()
+    yield from launched(f"--host-resolver-rules={rules}")
 
 
 def _open(browser: Any, url: str) -> tuple[Any, Any]:
@@ -129,36 +117,32 @@ def test_the_page_is_reached_by_the_announced_name(
         context.close()
 
 
-def test_a_page_of_the_robots_name_on_another_port_drives_it(
-    browser: Any, announced: tuple[str, ServerSet], monitor: MonitorPages
+@pytest.mark.parametrize(
+    ("site", "expected", "moved"),
+    [
+        ("NAME.local", {"read": 200, "put": 200, "ws": "message"}, True),
+        ("evil.test", {"read": "blocked", "put": "blocked", "ws": "error"}, False),
+    ],
+    ids=["a page of the robot's name on another port drives it", "another site is refused"],
+)
+def test_a_page_on_another_port_drives_the_robot_only_from_its_name(
+    browser: Any,
+    announced: tuple[str, ServerSet],
+    monitor: MonitorPages,
+    site: str,
+    expected: dict[str, Any],
+    moved: bool,
 ) -> None:
     name, servers = announced
     assert servers.http is not None
     robot = servers.service.robot
     robot.compliant = True
     monitor.page = (MONITOR % {"host": f"{name}.local", "port": servers.http.port}).encode()
-    context, page = _open(browser, f"http://{name}.local:{monitor.port}/")
+    context, page = _open(browser, f"http://{site.replace('NAME', name)}:{monitor.port}/")
     try:
         seen = page.wait_for_function("() => window.result").json_value()
     finally:
         context.close()
-    assert seen == {"read": 200, "put": 200, "ws": "message"}
-    assert robot.compliant is False
+    assert seen == expected
+    assert robot.compliant is not moved
     robot.compliant = True
-
-
-def test_the_same_page_from_another_site_is_refused(
-    browser: Any, announced: tuple[str, ServerSet], monitor: MonitorPages
-) -> None:
-    name, servers = announced
-    assert servers.http is not None
-    robot = servers.service.robot
-    robot.compliant = True
-    monitor.page = (MONITOR % {"host": f"{name}.local", "port": servers.http.port}).encode()
-    context, page = _open(browser, f"http://evil.test:{monitor.port}/")
-    try:
-        seen = page.wait_for_function("() => window.result").json_value()
-    finally:
-        context.close()
-    assert seen == {"read": "blocked", "put": "blocked", "ws": "error"}
-    assert robot.compliant is True

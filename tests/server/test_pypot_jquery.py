@@ -9,7 +9,6 @@ port of 127.0.0.1 and allowed by the robot's origin rules, as ``poppy serve --co
 
 from __future__ import annotations
 
-import shutil
 import threading
 from collections.abc import Iterator
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -19,16 +18,11 @@ from typing import Any
 import pytest
 
 from poppy_core.server import OriginPolicy
+from tests.helpers.chromium import launched, needs_chromium
 from tests.helpers.server import Served, serve
 from tests.helpers.waiting import eventually
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-playwright_api = pytest.importorskip(
-    "playwright.sync_api", reason="needs playwright (pip install -e '.[test]')"
-)
-pytestmark = pytest.mark.skipif(
-    CHROMIUM is None, reason="needs Debian's chromium (apt-get install chromium)"
-)
+pytestmark = needs_chromium
 
 DATA = Path(__file__).parent / "data"
 FILES = {
@@ -74,17 +68,13 @@ def robot_server(moves_folder: str, page_server: str) -> Iterator[Served]:
 
 @pytest.fixture
 def page(page_server: str, robot_server: Served) -> Iterator[Any]:
-    with playwright_api.sync_playwright() as driver:
-        browser = driver.chromium.launch(
-            executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"]
-        )
+    errors: list[str] = []
+    for browser in launched():
         opened = browser.new_page()
         opened.set_default_timeout(WAIT_S * 1000)
-        errors: list[str] = []
         opened.on("pageerror", lambda error: errors.append(str(error)))
         opened.goto(f"{page_server}/?api={robot_server.url}")
         yield opened
-        browser.close()
     assert not errors, errors  # JSON.parse of an object throws here
 
 

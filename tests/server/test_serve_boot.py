@@ -16,7 +16,7 @@ import pytest
 from poppy_core.emulator import serve_pty
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
-from tests.helpers.processes import reap
+from tests.helpers.processes import reap, served_urls
 from tests.helpers.waiting import eventually
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -29,13 +29,7 @@ def start_serving(*args: str) -> tuple[subprocess.Popen[str], list[str]]:
         [*POPPY, "serve", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
     )
     assert proc.stdout is not None
-    urls: list[str] = []
-    for line in proc.stdout:
-        if line.startswith("docs: "):
-            break
-        if line.startswith("http://"):
-            urls.append(line.strip())
-    return proc, urls
+    return proc, served_urls(proc.stdout)
 
 
 def stop(proc: subprocess.Popen[str]) -> str:

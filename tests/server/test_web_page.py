@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import shutil
 import time
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -16,15 +15,11 @@ from typing import Any
 import numpy as np
 import pytest
 
+from tests.helpers.chromium import launched, needs_chromium, new_tab
+from tests.helpers.server import serve_robot
 from tests.server.conftest import Served, serve
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-playwright_api = pytest.importorskip(
-    "playwright.sync_api", reason="needs playwright (pip install -e '.[test]')"
-)
-pytestmark = pytest.mark.skipif(
-    CHROMIUM is None, reason="needs Debian's chromium (apt-get install chromium)"
-)
+pytestmark = needs_chromium
 
 WAIT_S = 30.0
 # arrow functions: Playwright evaluates a bare expression string with eval, which the page's
@@ -46,19 +41,12 @@ def eventually(check: Callable[[], Any], what: str, timeout_s: float = WAIT_S) -
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[Any]:
-    with playwright_api.sync_playwright() as driver:
-        launched = driver.chromium.launch(
-            executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"]
-        )
-        yield launched
-        launched.close()
+    yield from launched()
 
 
 @pytest.fixture
 def page(browser: Any, served: Served) -> Iterator[Any]:
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    opened = context.new_page()
-    opened.set_default_timeout(WAIT_S * 1000)
+    context, opened = new_tab(browser, WAIT_S * 1000)
     errors: list[str] = []
     opened.on("pageerror", lambda error: errors.append(str(error)))
     opened.on(
@@ -377,22 +365,12 @@ def test_with_a_token_the_page_works_after_it_is_entered(browser: Any, with_toke
 def creature(moves_folder: str) -> Iterator[Served]:
     """A virtual Ergo Jr as ``poppy serve`` builds it: its chain and camera attached."""
     from poppy_core.creatures import from_profile
-    from poppy_core.server import ServerThread, create_app
 
-    robot = from_profile("ergo-jr", sim=True)
-    app = create_app(robot)
-    server = ServerThread(app).start()
-    try:
-        yield Served(server.url, robot, app)
-    finally:
-        server.stop()
-        robot.close()
+    yield from serve_robot(from_profile("ergo-jr", sim=True))
 
 
 def test_camera_and_chain_jog(browser: Any, creature: Served) -> None:
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    tab = context.new_page()
-    tab.set_default_timeout(WAIT_S * 1000)
+    context, tab = new_tab(browser, WAIT_S * 1000)
     tab.goto(creature.url + "/")
     tab.wait_for_function(READY)
     tab.click("#camera-views button")

@@ -16,6 +16,7 @@ import pytest
 
 from poppy_core.robot import Robot, from_profile
 from poppy_core.server import ServerThread, create_app
+from tests.helpers.chromium import new_tab
 from tests.server.test_web_page import (  # noqa: F401 (browser is a fixture)
     LIVE,
     WAIT_S,
@@ -66,9 +67,7 @@ def test_the_page_greys_out_while_the_server_is_gone_and_comes_back(
 ) -> None:
     first = ServerThread(create_app(robot)).start()
     port = first.port
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    tab = context.new_page()
-    tab.set_default_timeout(WAIT_S * 1000)
+    context, tab = new_tab(browser, WAIT_S * 1000)
     try:
         tab.goto(first.url + "/")
         tab.wait_for_function(LIVE)
@@ -117,9 +116,7 @@ def test_one_update_a_second_is_said_in_the_singular(
 ) -> None:
     """The stream thinned to one frame a second on its way to the page: "1 update/s"."""
     server = ServerThread(create_app(robot)).start()
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    tab = context.new_page()
-    tab.set_default_timeout(WAIT_S * 1000)
+    context, tab = new_tab(browser, WAIT_S * 1000)
     last = [0.0]
 
     def thin(socket: Any) -> None:
@@ -156,9 +153,7 @@ def test_a_stream_gone_silent_counts_as_lost(
 ) -> None:
     """A server that stops sending without closing (a network down): greyed out, then back."""
     server = ServerThread(create_app(robot)).start()
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    tab = context.new_page()
-    tab.set_default_timeout(WAIT_S * 1000)
+    context, tab = new_tab(browser, WAIT_S * 1000)
     silent = [False]
     sockets: list[Any] = []
 

@@ -3,7 +3,6 @@ in Debian's chromium (issue 26, items 1 and 4). The robot is an emulated Ergo Jr
 
 from __future__ import annotations
 
-import shutil
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -16,27 +15,17 @@ from poppy_core.emulator import Endpoint, VirtualBus, serve_pty
 from poppy_core.errors import PortError
 from poppy_core.robot import Robot, from_profile, load_profile
 from poppy_core.robot.factory import virtual_buses
+from tests.helpers.chromium import launched, needs_chromium
 from tests.helpers.waiting import eventually
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-playwright_api = pytest.importorskip(
-    "playwright.sync_api", reason="needs playwright (pip install -e '.[test]')"
-)
-pytestmark = pytest.mark.skipif(
-    CHROMIUM is None, reason="needs Debian's chromium (apt-get install chromium)"
-)
+pytestmark = needs_chromium
 WAIT_MS = 30_000
 READY = "() => window.poppy && window.poppy.ready"
 
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[Any]:
-    with playwright_api.sync_playwright() as driver:
-        launched = driver.chromium.launch(
-            executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"]
-        )
-        yield launched
-        launched.close()
+    yield from launched()
 
 
 @pytest.fixture

@@ -10,7 +10,6 @@ meshes, cache headers) and the line shown where the browser has no WebGL.
 from __future__ import annotations
 
 import io
-import shutil
 from collections.abc import Iterator
 from typing import Any
 
@@ -19,18 +18,13 @@ import numpy as np
 import pytest
 
 from poppy_core.robot import from_profile
-from poppy_core.server import ServerThread, create_app
+from tests.helpers.chromium import CHROMIUM, HEADLESS_ARGS, needs_chromium, new_tab, playwright_api
+from tests.helpers.server import serve_robot
 from tests.helpers.waiting import eventually
 from tests.server.conftest import Served
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-playwright_api = pytest.importorskip(
-    "playwright.sync_api", reason="needs playwright (pip install -e '.[test]')"
-)
 Image = pytest.importorskip("PIL.Image", reason="needs pillow to read the screenshots")
-pytestmark = pytest.mark.skipif(
-    CHROMIUM is None, reason="needs Debian's chromium (apt-get install chromium)"
-)
+pytestmark = needs_chromium
 
 WAIT_S = 60.0
 WEBGL_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
@@ -53,20 +47,11 @@ def browser(driver: Any) -> Iterator[Any]:
 @pytest.fixture(scope="module")
 def humanoid(moves_folder: str) -> Iterator[Served]:
     """A virtual Humanoid served on 127.0.0.1."""
-    robot = from_profile("humanoid", sim=True)
-    app = create_app(robot)
-    server = ServerThread(app).start()
-    try:
-        yield Served(server.url, robot, app)
-    finally:
-        server.stop()
-        robot.close()
+    yield from serve_robot(from_profile("humanoid", sim=True))
 
 
 def open_view(browser: Any, url: str, errors: list[str]) -> Any:
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    page = context.new_page()
-    page.set_default_timeout(WAIT_S * 1000)
+    _, page = new_tab(browser, WAIT_S * 1000)
     page.on("pageerror", lambda error: errors.append(str(error)))
     page.on(
         "console",
@@ -226,7 +211,7 @@ def test_with_a_token_the_view_reads_the_model_and_meshes_with_it(
 
 def test_without_webgl_the_page_says_so_in_one_line(driver: Any, served: Served) -> None:
     launched = driver.chromium.launch(
-        executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu", "--disable-webgl"]
+        executable_path=CHROMIUM, args=[*HEADLESS_ARGS, "--disable-webgl"]
     )
     try:
         page = launched.new_page()

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
 
 from poppy_core.emulator import VirtualBus, VirtualMotor
+from poppy_core.errors import ConfigError, SensorError
 from poppy_core.models import model_by_name
 from poppy_core.robot.config import MotorConfig
 from poppy_core.robot.frames import to_motor, to_user
@@ -59,3 +65,27 @@ def make_world(robot: str) -> World:
             bus_motors.append(motors[name])
         VirtualBus(bus_motors, entry.protocol, plant=MujocoPlant(sim, ids), auto_step=False)
     return World(sim, motors, dict(config.motors))
+
+
+def ready_to_look(robot: Any) -> Any:
+    """``robot`` once its camera gave a frame (skips without OpenGL), stiff, every motor at 0°."""
+    try:
+        robot.camera.latest(timeout_s=30)
+    except (SensorError, ConfigError) as exc:
+        pytest.skip(f"no OpenGL for offscreen rendering here ({exc}); `make sim-deps`")
+    robot.compliant = False
+    robot.goto_position({m.name: 0.0 for m in robot.motors}, 0.5, wait=True)
+    time.sleep(0.5)
+    return robot
+
+
+def ahead_of_camera(sim: Any, ahead_m: float, right_m: float) -> tuple[float, float, float]:
+    """The point ``ahead_m`` in front of the scene's camera and ``right_m`` to its right."""
+    import mujoco
+
+    with sim.lock:
+        camera = mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, "camera")
+        axes = np.asarray(sim.data.cam_xmat[camera]).reshape(3, 3)
+        where = np.asarray(sim.data.cam_xpos[camera])
+    point = where + ahead_m * -axes[:, 2] + right_m * axes[:, 0]
+    return (float(point[0]), float(point[1]), float(point[2]))

@@ -7,13 +7,13 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-import numpy as np
 import pytest
-
-from poppy_core.errors import ConfigError, SensorError
 
 pytest.importorskip("mujoco")
 pytest.importorskip("cv2")
+
+from sim_helpers import ahead_of_camera, ready_to_look
+
 skimage_data = pytest.importorskip("skimage.data")
 
 pytestmark = [pytest.mark.slow, pytest.mark.gl]  # renders with OpenGL in the test process
@@ -27,14 +27,7 @@ def ergo() -> Iterator[Any]:
     data = load_profile("ergo-jr").to_dict()
     data["sensors"]["face_detector"] = {"type": "FaceDetector", "cameras": ["camera"]}
     with from_config(RobotConfig.from_dict(data, source="test"), sim="mujoco") as robot:
-        try:
-            robot.camera.latest(timeout_s=30)
-        except (SensorError, ConfigError) as exc:
-            pytest.skip(f"no OpenGL for offscreen rendering here ({exc}); `make sim-deps`")
-        robot.compliant = False
-        robot.goto_position({m.name: 0.0 for m in robot.motors}, 0.5, wait=True)
-        time.sleep(0.5)
-        yield robot
+        yield ready_to_look(robot)
 
 
 def faces_now(robot: Any) -> list[Any]:
@@ -46,20 +39,10 @@ def faces_now(robot: Any) -> list[Any]:
 
 
 def test_a_face_in_the_scene_is_found_then_followed_to_the_middle(ergo: Any) -> None:
-    import mujoco
-
     sim = ergo.simulation
-    with sim.lock:
-        camera = mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, "camera")
-        axes = np.asarray(sim.data.cam_xmat[camera]).reshape(3, 3)
-        where = np.asarray(sim.data.cam_xpos[camera])
-    look, right = -axes[:, 2], axes[:, 0]
     assert faces_now(ergo) == []  # the empty scene: no face
     picture = skimage_data.astronaut()[0:256, 100:356]  # her head and shoulders
-    centre = where + 0.3 * look + 0.06 * right
-    sim.add_picture(
-        "astronaut", picture, (float(centre[0]), float(centre[1]), float(centre[2])), size=0.14
-    )
+    sim.add_picture("astronaut", picture, ahead_of_camera(sim, 0.3, 0.06), size=0.14)
     (face,) = faces_now(ergo)
     assert face.position[0] > 0.2 and abs(face.position[1]) < 0.3, face  # right of the middle
     assert 80 <= face.size <= 170

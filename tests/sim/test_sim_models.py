@@ -10,6 +10,7 @@ import pytest
 from sim_helpers import PROFILES, ROBOTS
 
 from poppy_core.creatures.postures import humanoid_sit
+from poppy_core.kinematics.transforms import quat_mul
 from poppy_core.robot.frames import to_motor
 from poppy_core.robot.profiles import load_profile
 from poppy_core.sim.mjcf import ROBOTS as URDF_FILES
@@ -20,7 +21,6 @@ from poppy_core.sim.urdf import (
     parse_urdf,
     quat_from_axis_angle,
     quat_from_rpy,
-    quat_mul,
     rotate,
 )
 

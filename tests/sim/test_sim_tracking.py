@@ -6,13 +6,12 @@ import time
 from collections.abc import Iterator
 from typing import Any
 
-import numpy as np
 import pytest
 
 pytest.importorskip("mujoco")
 pytest.importorskip("cv2")
 
-from poppy_core.errors import ConfigError, SensorError
+from sim_helpers import ahead_of_camera, ready_to_look
 
 pytestmark = pytest.mark.slow
 
@@ -22,14 +21,7 @@ def ergo() -> Iterator[Any]:
     from poppy_core.creatures import from_profile
 
     with from_profile("ergo-jr", sim="mujoco") as robot:
-        try:
-            robot.camera.latest(timeout_s=30)
-        except (SensorError, ConfigError) as exc:
-            pytest.skip(f"no OpenGL for offscreen rendering here ({exc}); `make sim-deps`")
-        robot.compliant = False
-        robot.goto_position({m.name: 0.0 for m in robot.motors}, 0.5, wait=True)
-        time.sleep(0.5)
-        yield robot
+        yield ready_to_look(robot)
 
 
 def seen(robot: Any) -> tuple[float, float] | None:
@@ -38,16 +30,8 @@ def seen(robot: Any) -> tuple[float, float] | None:
 
 
 def test_marker_follow_brings_the_card_to_the_middle(ergo: Any) -> None:
-    import mujoco
-
     sim = ergo.simulation
-    with sim.lock:
-        camera = mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_CAMERA, "camera")
-        axes = np.asarray(sim.data.cam_xmat[camera]).reshape(3, 3)
-        where = np.asarray(sim.data.cam_xpos[camera])
-    look, right = -axes[:, 2], axes[:, 0]
-    card = where + 0.3 * look + 0.07 * right
-    sim.add_marker("card", 7, (float(card[0]), float(card[1]), float(card[2])), size=0.05)
+    sim.add_marker("card", 7, ahead_of_camera(sim, 0.3, 0.07), size=0.05)
     deadline = time.monotonic() + 20
     while seen(ergo) is None and time.monotonic() < deadline:
         time.sleep(0.1)

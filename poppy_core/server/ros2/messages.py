@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 from poppy_core.server.ros2 import types
 from poppy_core.server.ros2.joints import UrdfJoints, joint_transform, matrix_quaternion
+from poppy_core.zenoh_wire import finite_or_nan
 
 if TYPE_CHECKING:
     from poppy_core.kinematics import JointDescription
@@ -31,14 +32,6 @@ def header(frame: str = "", now: float | None = None) -> Any:
     return types.message("std_msgs/msg/Header", stamp=stamp(now), frame_id=frame)
 
 
-def _number(value: Any) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        return math.nan
-    return number if math.isfinite(number) else math.nan
-
-
 def joint_state(robot: Robot, joints: UrdfJoints, now: float | None = None) -> Any:
     """Every motor: its joint's position (rad), speed (rad/s) and effort (N·m, from the load
     as a fraction of the servo's stall torque); NaN where a value is not read."""
@@ -48,10 +41,10 @@ def joint_state(robot: Robot, joints: UrdfJoints, now: float | None = None) -> A
     for motor in robot.motors:
         frame = joints.frames[motor.name]
         names.append(motor.name)
-        positions.append(frame.to_joint(_number(motor.present_position)))
-        velocities.append(math.radians(frame.scale * _number(motor.present_speed)))
+        positions.append(frame.to_joint(finite_or_nan(motor.present_position)))
+        velocities.append(math.radians(frame.scale * finite_or_nan(motor.present_speed)))
         stall = getattr(motor.model, "stall_torque_nm", None)
-        load = _number(motor.present_load)
+        load = finite_or_nan(motor.present_load)
         efforts.append(frame.scale * load / 100.0 * stall if stall else math.nan)
     return types.message(
         types.JOINT_STATE,
@@ -93,7 +86,7 @@ def tf_message(robot: Robot, joints: UrdfJoints, now: float | None = None) -> An
         motor = motors.get(joint.name)
         angle = 0.0
         if motor is not None:
-            degrees = _number(motor.present_position)
+            degrees = finite_or_nan(motor.present_position)
             angle = joints.to_joint(joint.name, degrees) if math.isfinite(degrees) else 0.0
         out.append(transform(joint, angle, now))
     return types.message(types.TF_MESSAGE, transforms=out)
