@@ -4,7 +4,8 @@ The Zenoh ``api`` queryable runs a request with ``start_at`` (wall clock) at onc
 ``START_AT`` set. The actions that start something (a primitive, a move) do all their work on
 arrival: the move is loaded and checked, the player or primitive and its thread are made; that
 thread then waits at a ``Gate`` (``start_gate``). At ``start_at`` one thread per process, woken
-by a precise wait (a sleep to ``SPIN_S`` before, then short sleeps), opens every gate due: the
+by a precise wait (a sleep to ``SPIN_S`` before, then one for the rest, so that a long sleep's
+drift is made up), opens every gate due: the
 start itself is only a thread released, so the robots of one process fire within a fraction of
 a millisecond of each other and of ``start_at``. A refusal is still immediate (the checks ran on
 arrival); a stop before ``start_at`` cancels the gate and nothing starts. The request's reply
@@ -24,9 +25,9 @@ START_AT: ContextVar[float | None] = ContextVar("start_at", default=None)
 """The wall-clock time (``time.time()``) the current request's action starts at, or None."""
 
 SPIN_S = 0.002
-"""How long before the start time the firing thread stops sleeping and waits in short steps."""
-STEP_S = 0.0001
-"""The short step of the last ``SPIN_S`` (a sleep: the GIL is left to the other threads)."""
+"""How long before the start time the firing thread's first sleep ends; the rest is slept again
+from a fresh reading of the clock. Not a spin nor short steps: each wake-up of a thread has to
+take the GIL back, which on a busy process can wait for another thread's switch interval."""
 
 
 @dataclass
@@ -70,13 +71,13 @@ def wait_started(gate: Gate | None) -> None:
 
 
 def wait_until(when: float) -> None:
-    """Return at wall-clock ``when``, a few tenths of a millisecond late at most on an idle
-    machine: one sleep to ``SPIN_S`` before, then short sleeps."""
+    """Return at wall-clock ``when`` (never before), a fraction of a millisecond late on an idle
+    machine: one sleep to ``SPIN_S`` before, then one for the rest."""
     while True:
         left = when - time.time()
         if left <= 0:
             return
-        time.sleep(left - SPIN_S if left > SPIN_S else min(left, STEP_S))
+        time.sleep(left - SPIN_S if left > SPIN_S else left)
 
 
 def _fire(when: float, due: _Due) -> None:
