@@ -17,6 +17,7 @@ import pytest
 from poppy_core import zenoh_wire
 from poppy_core.motion import Primitive
 from poppy_core.motion.move import Move
+from poppy_core.motion.move_library import save_move
 from poppy_core.motion.player import MovePlayer
 from poppy_core.remote.zenoh_client import answer_of
 from poppy_core.remote.zenoh_fleet import Fleet
@@ -125,8 +126,8 @@ def test_a_gate_opens_or_is_cancelled_whichever_comes_first() -> None:
     assert results == [True]
 
 
-def _send(fleet: Fleet, name: str, path: str, start_at: float | None) -> Any:
-    payload = zenoh_wire.api_request("POST", path, token=TOKEN, start_at=start_at)
+def _send(fleet: Fleet, name: str, path: str, start_at: float | None, body: Any = None) -> Any:
+    payload = zenoh_wire.api_request("POST", path, body, token=TOKEN, start_at=start_at)
     key = zenoh_wire.robot_key(name, "api")
     return fleet.session.get(key, payload=payload, timeout=10.0)
 
@@ -167,3 +168,37 @@ def test_a_refused_fleet_play_moves_nothing(two: tuple[Served, Served], fleet: F
     wait_until(fleet.last_start_at + 0.1)
     assert a.servers.service.moves.playing() == []
     assert {m.name: m.goal_position for m in a.robot.motors} == before
+
+
+def test_the_fleet_stop_before_the_start_time_cancels_an_armed_move(
+    two: tuple[Served, Served], fleet: Fleet, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    played_from: list[MovePlayer] = []  # the players whose playback (their thread's body) ran
+    real_run = MovePlayer._run
+
+    def run(self: MovePlayer, stopping: threading.Event) -> None:
+        played_from.append(self)
+        real_run(self, stopping)
+
+    monkeypatch.setattr(MovePlayer, "_run", run)
+    wave = Move.from_frames(10.0, [{"m1": 30.0 + i} for i in range(5)])
+    save_move(wave, "wave")
+    before = {}
+    for served in two:
+        served.robot.compliant = False
+        before[served.name] = {m.name: m.goal_position for m in served.robot.motors}
+    start_at = time.time() + 2.0
+    body = {"speed": 1.0, "backwards": False}
+    played = [_send(fleet, s.name, "/api/v1/moves/wave/play", start_at, body) for s in two]
+    assert eventually(lambda: all(s.servers.service.moves.playing() == ["wave"] for s in two))
+    stopped = fleet.command(
+        ["jr-a", "jr-b"], "POST", "/api/v1/web/stop", {"then": "hold"}, together=False
+    )
+    assert [o.ok for o in stopped] == [True, True], [o.message for o in stopped]
+    for handler in played:
+        answer_of("zenoh", list(handler), 10.0, 0.0)
+    wait_until(start_at + 0.1)
+    assert played_from == []
+    for served in two:
+        assert served.servers.service.moves.playing() == []
+        assert {m.name: m.goal_position for m in served.robot.motors} == before[served.name]
