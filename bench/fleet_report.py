@@ -99,6 +99,13 @@ def build_result(raw: dict[str, Any], settings: dict[str, Any]) -> BenchResult:
         "poppy on a loaded machine. A start is stamped when the primitive's thread begins "
         "(its `setup`). A goal dropped (`handled < sent`) is one Zenoh dropped rather than "
         "queue (`CongestionControl.DROP`): the next one comes 10 ms later.",
+        "Arm then fire against the start it replaced (the start itself run at `start_at`, one "
+        "thread per process, one start after the other), measured back to back with this "
+        "bench's `play_spread` on 2026-11-28 at load average 17 on the 2 cores: spread p50 "
+        "45.5 → 13.8 ms, p90 86.5 → 35.4 ms, after `start_at` p50 17.4 → 3.5 ms, p99 110 → "
+        "37 ms (100 and 50 trials); the max (160 and 277 ms) is a robot process that got no "
+        "core for a while. Earlier, on an idle machine, the replaced start gave spread p50 "
+        "16.4 ms, max 22.4 ms (10 trials): to be measured again on a quiet machine.",
         f"The start spread leaves out a first command ({play['first']['spread_ms']:.1f} ms "
         f"spread, the last robot {play['first']['late_max_ms']:.1f} ms after `start_at`), "
         "sent just after the robots came up.",
