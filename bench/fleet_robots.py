@@ -3,18 +3,18 @@
 Each robot: an ideal-servo Ergo Jr (its own 50 Hz sync loop and emulator), served on Zenoh as
 ``poppy/<name>`` on its own loopback port and/or on pypot's WebSocket at 50 Hz. Prints one line
 per robot (``name zenoh-endpoint ws-port``), then ``ready``; stops on SIGINT. With ``--starts
-FILE`` every primitive start is appended to FILE as ``name wall-clock-time`` (the fleet play
-spread is measured there, at the robots).
+FILE`` the time every ``Sinus`` primitive began is appended to FILE as ``pid wall-clock-time``
+(the fleet play spread is measured there, at the robots).
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import threading
 import time
 from pathlib import Path
-from typing import Any
 
 from bench.procs import free_port
 from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
@@ -22,19 +22,20 @@ from poppy_core.robot import from_profile
 
 
 def _log_starts(path: Path) -> None:
-    """Append the wall-clock time of every primitive start (when its thread is started)."""
-    from poppy_core.motion import Primitive
+    """Append the wall-clock time every ``Sinus`` primitive began (its ``setup``, the first step
+    of its thread once started: when a start really happens, armed or not)."""
+    from poppy_core.motion.builtins import Sinus
 
-    real = Primitive.start
+    real = Sinus.setup
     lock = threading.Lock()
 
-    def start(self: Primitive) -> Any:
+    def setup(self: Sinus) -> None:
         stamp = time.time()
         with lock, path.open("a", encoding="utf-8") as out:
-            out.write(f"{type(self).__name__} {stamp:.6f}\n")
-        return real(self)
+            out.write(f"{os.getpid()} {stamp:.6f}\n")
+        real(self)
 
-    Primitive.start = start  # type: ignore[method-assign]
+    Sinus.setup = setup  # type: ignore[method-assign]
 
 
 def main() -> None:

@@ -1,4 +1,5 @@
-"""Loop machinery: drift-free deadlines, a rate meter, a doubling backoff and a worker thread."""
+"""Loop machinery: drift-free deadlines, a rate meter, a doubling backoff, a worker thread and
+the gate an armed start waits at."""
 
 from __future__ import annotations
 
@@ -218,3 +219,38 @@ class Worker:
                     self._on_exit()
                 except Exception:
                     logger.exception("%s: cleaning up its thread", self.name)
+
+
+class Gate:
+    """What an armed start waits at: its thread is made ahead and held here until the gate
+    opens (go) or is cancelled (a stop came first: the start never happens).
+
+    The owner (a fleet's shared start time) ``open``s it at the start time; whoever stops the
+    armed start ``cancel``s it. Only the first of the two counts.
+    """
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+        self._lock = threading.Lock()
+        self._cancelled = False
+
+    def open(self) -> None:
+        """Let the held start go (no-op once cancelled)."""
+        with self._lock:
+            self._event.set()
+
+    def cancel(self) -> None:
+        """Call the start off (no-op once open): its thread ends without starting."""
+        with self._lock:
+            if not self._event.is_set():
+                self._cancelled = True
+                self._event.set()
+
+    @property
+    def cancelled(self) -> bool:
+        """True when the start was called off before the gate opened."""
+        return self._cancelled
+
+    def wait(self, timeout_s: float | None = None) -> bool:
+        """Block until the gate opens (True) or is cancelled (False); False also on timeout."""
+        return self._event.wait(timeout_s) and not self._cancelled

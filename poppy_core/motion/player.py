@@ -21,7 +21,7 @@ from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import read_move
-from poppy_core.schedule import Periodic, Worker
+from poppy_core.schedule import Gate, Periodic, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -202,6 +202,7 @@ class MovePlayer:
         played = _within_limits(move, self._motors) if self.clamped else move
         self._played = played.reversed() if backwards else played
         self._worker: Worker | None = None
+        self._gate: Gate | None = None
         self.loop_times: list[tuple[float, float]] = []
         """``(start, end)`` clock times of each loop's playing phase (ramps excluded)."""
         self.stopped = False
@@ -228,8 +229,11 @@ class MovePlayer:
 
     # -- control -----------------------------------------------------------------------------
 
-    def start(self) -> MovePlayer:
+    def start(self, gate: Gate | None = None) -> MovePlayer:
         """Start playing in a thread.
+
+        With a ``gate``, the start is armed: the thread is made now and plays once the gate
+        opens; a ``stop()`` before that cancels the gate and nothing is played.
 
         Raises:
             RuntimeError: already playing.
@@ -240,7 +244,9 @@ class MovePlayer:
         self.stopped = False
         # One worker per playback: a thread that ended may still be finishing when the next
         # playback starts.
-        self._worker = Worker("move player", self._run)
+        self._gate = gate
+        body = self._run if gate is None else lambda stopping: self._run_at(gate, stopping)
+        self._worker = Worker("move player", body)
         self._worker.start()
         return self
 
@@ -259,6 +265,8 @@ class MovePlayer:
 
     def stop(self) -> None:
         """Stop where the motors are (they stay stiff); joins the thread (but from itself)."""
+        if self._gate is not None:
+            self._gate.cancel()  # an armed start that has not fired never will
         worker = self._worker
         if worker is not None:
             worker.close(5.0)
@@ -339,6 +347,13 @@ class MovePlayer:
                 stopping.wait(max(0.0, schedule.next_deadline - self._clock()))
         finally:
             self.loop_times.append((start, self._clock()))
+
+    def _run_at(self, gate: Gate, stopping: threading.Event) -> None:
+        """``_run`` once ``gate`` opens (nothing when it was cancelled)."""
+        if gate.wait() and not stopping.is_set():
+            self._run(stopping)
+        else:
+            self.stopped = True
 
     def _run(self, stopping: threading.Event) -> None:
         """The playback (an exception is the worker's: logged once, kept in ``error``)."""

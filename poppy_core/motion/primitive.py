@@ -21,7 +21,7 @@ from poppy_core.motion import primitive_access
 from poppy_core.motion.manager import PrimitiveManager, primitive_manager
 from poppy_core.motion.primitive_failure import PrimitiveFailure, State
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
-from poppy_core.schedule import Worker
+from poppy_core.schedule import Gate, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -66,6 +66,7 @@ class Primitive:
         self.robot = MockupRobot(robot, self._stop_event)
         self._manager: PrimitiveManager = primitive_manager(robot)
         self._worker: Worker | None = None
+        self._gate: Gate | None = None
         self._lifecycle = threading.Lock()
         self._state: State = "idle"
         self.error: PrimitiveFailure | None = None
@@ -91,8 +92,12 @@ class Primitive:
 
     # -- lifecycle ---------------------------------------------------------------------------
 
-    def start(self) -> None:
+    def start(self, gate: Gate | None = None) -> None:
         """Start the primitive, or restart it (a running one is stopped first).
+
+        With a ``gate``, the start is armed: everything is made now (its thread too), and
+        ``setup`` and ``run`` begin when the gate opens; a stop before that cancels the gate and
+        the primitive ends without having run.
 
         Raises:
             RobotClosedError: the robot is closed.
@@ -116,7 +121,8 @@ class Primitive:
             self._state = "running"
             # One worker per run (the last one may still be finishing); ``_main`` catches the
             # run's exceptions itself: a primitive's failure is its own story (see ``error``).
-            self._worker = Worker(f"primitive {type(self).__name__}", lambda _: self._main())
+            self._gate = gate
+            self._worker = Worker(f"primitive {type(self).__name__}", lambda _: self._main(gate))
             self._worker.start()
             self._started_event.set()
         logger.info("%s started", type(self).__name__)
@@ -154,6 +160,8 @@ class Primitive:
         raise error from exception
 
     def _stop_locked(self, wait: bool) -> None:
+        if self._gate is not None:
+            self._gate.cancel()  # an armed start that has not fired never will
         self._stop_event.set()
         self._resume_event.set()
         worker = self._worker
@@ -183,8 +191,13 @@ class Primitive:
             self._resume_event.set()
             logger.info("%s resumed", type(self).__name__)
 
-    def _main(self) -> None:
+    def _main(self, gate: Gate | None = None) -> None:
         name = type(self).__name__
+        if gate is not None and not gate.wait():
+            self._end_armed()
+            return
+        if gate is not None:
+            self._t0 = time.monotonic()  # it began now, not when it was armed
         try:
             self.setup()
             if not self._stop_event.is_set():
@@ -209,6 +222,15 @@ class Primitive:
                 if self._state != "failed":
                     self._state = "stopped"
                     logger.info("%s stopped", name)
+
+    def _end_armed(self) -> None:
+        """An armed start called off before its gate opened: it ends without having run."""
+        try:
+            self._manager.remove(self)
+        finally:
+            self._ended_at = time.monotonic()
+            self._state = "stopped"
+            logger.info("%s: its start was called off before its start time", type(self).__name__)
 
     def _fail(self, exc: BaseException) -> None:
         self.error = PrimitiveFailure.of(exc)

@@ -36,7 +36,7 @@ from poppy_core.motion import (
 )
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
-from poppy_core.server.start_time import start_at_time
+from poppy_core.server.start_time import start_gate, wait_started
 
 logger = logging.getLogger(__name__)
 
@@ -246,9 +246,11 @@ class MoveService:
             raise ApiError("invalid", str(exc)) from None
         except ValueError as exc:
             raise ApiError("invalid", f"cannot play {name!r}: {exc}") from None
-        start_at_time(player.start)  # a fleet's shared start time (none over HTTP)
+        gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
+        player.start(gate)
         with self._lock:
-            self._players[name] = player
+            self._players[name] = player  # a stop before the start time finds it, and cancels it
+        wait_started(gate)
         return player
 
     def playing(self) -> list[str]:

@@ -19,7 +19,7 @@ from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from poppy_core.server.pypot_json import html_safe
-from poppy_core.server.start_time import start_at_time
+from poppy_core.server.start_time import start_gate, wait_started
 from poppy_core.server.teleop_channel import TeleopRegistry
 from poppy_core.trajectory import control_name, goto_duration
 
@@ -210,7 +210,9 @@ class RobotService:
         """``start``, ``stop``, ``pause`` or ``resume`` a primitive (``stop`` joins its thread)."""
         primitive = self.primitive(name)
         if action == "start":
-            start_at_time(primitive.start)  # a fleet's shared start time (none over HTTP)
+            gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
+            primitive.start(gate)
+            wait_started(gate)
         elif action == "stop":
             primitive.halt(wait=True)
         elif action == "pause":

@@ -1,62 +1,90 @@
-"""A request's shared start time: the robots of a fleet command start together.
+"""A request's shared start time: the robots of a fleet command start together, armed then fired.
 
 The Zenoh ``api`` queryable runs a request with ``start_at`` (wall clock) at once, with
-``START_AT`` set; the actions that start something (a primitive, a move) go through
-``start_at_time``, so the request is parsed, checked and routed ahead of time and only the
-start itself waits for the clock. Every start due at one time in a process is run by one
-thread, one after the other: one thread wakes for them all (robots served together in one
-process would otherwise wake as many threads at once, each waiting for the others).
+``START_AT`` set. The actions that start something (a primitive, a move) do all their work on
+arrival: the move is loaded and checked, the player or primitive and its thread are made; that
+thread then waits at a ``Gate`` (``start_gate``). At ``start_at`` one thread per process, woken
+by a precise wait (a sleep to ``SPIN_S`` before, then one for the rest, so that a long sleep's
+drift is made up), opens every gate due: the
+start itself is only a thread released, so the robots of one process fire within a fraction of
+a millisecond of each other and of ``start_at``. A refusal is still immediate (the checks ran on
+arrival); a stop before ``start_at`` cancels the gate and nothing starts. The request's reply
+comes once the gates opened (``wait_started``), as it did when the start ran at ``start_at``.
 """
 
 from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable
 from contextvars import ContextVar
-from typing import TypeVar
+from dataclasses import dataclass, field
+
+from poppy_core.schedule import Gate
 
 START_AT: ContextVar[float | None] = ContextVar("start_at", default=None)
 """The wall-clock time (``time.time()``) the current request's action starts at, or None."""
 
-T = TypeVar("T")
+SPIN_S = 0.002
+"""How long before the start time the firing thread's first sleep ends; the rest is slept again
+from a fresh reading of the clock. Not a spin nor short steps: each wake-up of a thread has to
+take the GIL back, which on a busy process can wait for another thread's switch interval."""
+
+
+@dataclass
+class _Due:
+    gates: list[Gate] = field(default_factory=list)
+    fired: threading.Event = field(default_factory=threading.Event)
+
+
 _lock = threading.Lock()
-_due: dict[float, list[Callable[[], None]]] = {}
+_due: dict[float, _Due] = {}
 
 
-def start_at_time(start: Callable[[], T]) -> T:
-    """``start()`` now, or at the current request's ``START_AT`` (its result, its error)."""
+def start_gate() -> Gate | None:
+    """The gate an armed start of the current request waits at, or None: start at once (no
+    ``START_AT``, or one already past). The gate opens at ``START_AT``; cancel it to call the
+    start off."""
     when = START_AT.get()
     if when is None or when <= time.time():
-        return start()
-    done = threading.Event()
-    outcome: list[T] = []
-    failure: list[BaseException] = []
-
-    def run() -> None:
-        try:
-            outcome.append(start())
-        except BaseException as exc:  # handed back to the request's thread
-            failure.append(exc)
-        finally:
-            done.set()
-
+        return None
+    gate = Gate()
     with _lock:
-        first = when not in _due
-        _due.setdefault(when, []).append(run)
+        due = _due.get(when)
+        first = due is None
+        if due is None:
+            due = _due[when] = _Due()
+        due.gates.append(gate)
     if first:
-        threading.Thread(target=_starter, args=(when,), name="fleet-start", daemon=True).start()
-    done.wait()
-    if failure:
-        raise failure[0]
-    return outcome[0]
+        threading.Thread(target=_fire, args=(when, due), name="fleet-start", daemon=True).start()
+    return gate
 
 
-def _starter(when: float) -> None:
-    delay = when - time.time()
-    if delay > 0:
-        time.sleep(delay)
+def wait_started(gate: Gate | None) -> None:
+    """Block until ``gate``'s start time came and its gates were opened (None: at once)."""
+    if gate is None:
+        return
+    when = START_AT.get()
     with _lock:
-        due = _due.pop(when, [])
-    for run in due:
-        run()
+        due = _due.get(when) if when is not None else None
+    if due is not None:
+        due.fired.wait()
+
+
+def wait_until(when: float) -> None:
+    """Return at wall-clock ``when`` (never before), a fraction of a millisecond late on an idle
+    machine: one sleep to ``SPIN_S`` before, then one for the rest."""
+    while True:
+        left = when - time.time()
+        if left <= 0:
+            return
+        time.sleep(left - SPIN_S if left > SPIN_S else left)
+
+
+def _fire(when: float, due: _Due) -> None:
+    wait_until(when)
+    with _lock:
+        _due.pop(when, None)
+        gates = list(due.gates)
+    for gate in gates:
+        gate.open()
+    due.fired.set()

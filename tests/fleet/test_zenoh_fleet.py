@@ -10,74 +10,24 @@ import json
 import socket
 import subprocess
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from poppy_core.assembly import ServerSet, ServeSpec, ZenohSettings, serve
+from poppy_core.assembly import ServeSpec, ZenohSettings, serve
 from poppy_core.errors import BusTimeout, CommunicationError, UnknownMotorError
 from poppy_core.remote import RemoteRobot
 from poppy_core.remote.zenoh_fleet import Fleet
-from poppy_core.robot import Robot, from_profile, from_remote
+from poppy_core.robot import from_profile, from_remote
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from poppy_core.zenoh_wire import check_name, pack_state, session_config, unpack_state
 from tests.helpers.cli import ENV, POPPY, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.waiting import eventually
+from tests.helpers.zenoh_served import TOKEN, Served, connect_to, free_endpoint
 
 pytest.importorskip("zenoh")
-
-TOKEN = "s3cret"
-
-
-def free_endpoint() -> str:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{sock.getsockname()[1]}"
-
-
-class Served:
-    """A virtual Ergo Jr served on Zenoh as ``poppy/NAME``, listening on ``endpoint``."""
-
-    def __init__(self, name: str, token: str | None = TOKEN) -> None:
-        self.name = name
-        self.endpoint = free_endpoint()
-        self.robot: Robot = from_profile("ergo-jr", sim=True)
-        spec = ServeSpec(zenoh=ZenohSettings(listen=(self.endpoint,)), name=name, token=token)
-        self.servers: ServerSet = serve(self.robot, spec)
-
-    def close(self) -> None:
-        self.servers.stop()
-        self.robot.close()
-
-
-@pytest.fixture
-def moves(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path))
-    return tmp_path
-
-
-@pytest.fixture
-def two(moves: Path) -> Iterator[tuple[Served, Served]]:
-    a, b = Served("jr-a"), Served("jr-b")
-    try:
-        yield a, b
-    finally:
-        a.close()
-        b.close()
-
-
-def _connect(*served: Served) -> tuple[str, ...]:
-    return tuple(s.endpoint for s in served)
-
-
-@pytest.fixture
-def fleet(two: tuple[Served, Served]) -> Iterator[Fleet]:
-    with Fleet(Settings(connect=_connect(*two)), token=TOKEN) as client:
-        assert client.wait_for(["jr-a", "jr-b"]) == ["jr-a", "jr-b"]
-        yield client
 
 
 def _fleet_args(*served: Served) -> list[str]:
@@ -144,7 +94,7 @@ def test_the_state_message_round_trips_and_its_version_is_checked() -> None:
 
 def test_fleet_play_starts_both_robots(two: tuple[Served, Served], fleet: Fleet) -> None:
     a, b = two
-    remote = RemoteRobot("zenoh:jr-a", token=TOKEN, zenoh=Settings(connect=_connect(a)))
+    remote = RemoteRobot("zenoh:jr-a", token=TOKEN, zenoh=Settings(connect=connect_to(a)))
     try:
         remote.moves.record("wave")
         time.sleep(0.3)
@@ -180,18 +130,20 @@ def test_the_robots_of_one_command_start_at_the_shared_time(
     started: dict[str, float] = {}
     for served in two:
         dance = served.servers.service.primitive("dance")
-        real = dance.start
+        real = dance.setup
 
         def spy(real: Any = real, name: str = served.name) -> None:
             started[name] = time.time()
             real()
 
-        dance.start = spy  # type: ignore[method-assign]
-    before = time.time()
+        dance.setup = spy  # type: ignore[method-assign]
     outcomes = fleet.command(["jr-a", "jr-b"], "POST", "/api/v1/primitives/dance/start")
     assert [o.ok for o in outcomes] == [True, True]
-    assert set(started) == {"jr-a", "jr-b"}
-    assert all(t >= before + 0.25 for t in started.values())  # at start_at, not on arrival
+    assert eventually(lambda: set(started) == {"jr-a", "jr-b"})
+    start_at = fleet.last_start_at
+    assert start_at is not None
+    # armed on arrival, fired at start_at (less a float rounding of the robot's check)
+    assert all(t >= start_at - 1e-6 for t in started.values())
 
 
 def test_bad_commands_are_refused_with_the_rest_wording_and_move_nothing(
@@ -217,7 +169,7 @@ def test_bad_commands_are_refused_with_the_rest_wording_and_move_nothing(
         together=False,
     )[0]
     assert nan.status == 422
-    with Fleet(Settings(connect=_connect(a))) as no_token:
+    with Fleet(Settings(connect=connect_to(a))) as no_token:
         refused = no_token.command(
             ["jr-a"], "POST", "/api/v1/robot/compliant", {"compliant": True}, together=False
         )[0]
@@ -330,7 +282,7 @@ def test_teleop_across_two_served_robots(two: tuple[Served, Served]) -> None:
     from tests.teleop.hands import Hand
 
     a, b = two
-    settings = Settings(connect=_connect(a, b))
+    settings = Settings(connect=connect_to(a, b))
     leader = ZenohLeader("jr-a", TOKEN, settings=settings)
     follower = ZenohFollower("jr-b", TOKEN, settings=settings, ramp_s=0.2)
     changes: list[str] = []
@@ -457,21 +409,3 @@ def test_a_busy_zenoh_endpoint_is_one_clear_line(moves: Path) -> None:
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "Address already in use" in lines[0], lines
     assert " at /" not in lines[0]
-
-
-def test_a_start_waits_for_its_time_and_hands_back_its_result_or_error() -> None:
-    from poppy_core.server.start_time import START_AT, start_at_time
-
-    assert start_at_time(lambda: 7) == 7  # no start time: at once
-    when = time.time() + 0.1
-    context = START_AT.set(when)
-    try:
-        assert start_at_time(time.time) >= when
-    finally:
-        START_AT.reset(context)
-    context = START_AT.set(time.time() + 0.1)
-    try:
-        with pytest.raises(ZeroDivisionError):  # raised in the starter's thread, handed back
-            start_at_time(lambda: 1 / 0)
-    finally:
-        START_AT.reset(context)

@@ -1,0 +1,36 @@
+"""Fixtures of the fleet tests: two robots served on Zenoh and a fleet client of both."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from poppy_core.remote.zenoh_fleet import Fleet
+from poppy_core.zenoh_wire import ZenohSettings as Settings
+from tests.helpers.zenoh_served import TOKEN, Served, connect_to
+
+
+@pytest.fixture
+def moves(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path))
+    return tmp_path
+
+
+@pytest.fixture
+def two(moves: Path) -> Iterator[tuple[Served, Served]]:
+    pytest.importorskip("zenoh")
+    a, b = Served("jr-a"), Served("jr-b")
+    try:
+        yield a, b
+    finally:
+        a.close()
+        b.close()
+
+
+@pytest.fixture
+def fleet(two: tuple[Served, Served]) -> Iterator[Fleet]:
+    with Fleet(Settings(connect=connect_to(*two)), token=TOKEN) as client:
+        assert client.wait_for(["jr-a", "jr-b"]) == ["jr-a", "jr-b"]
+        yield client

@@ -1,0 +1,204 @@
+"""A fleet's shared start time: starts are armed on arrival and fired at ``start_at``.
+
+Order and arrival only (the machine is shared): an armed start runs after its start time, never
+before; every armed start fires; a stop before the start time means nothing starts; a refused
+command moves nothing.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from poppy_core import zenoh_wire
+from poppy_core.motion import Primitive
+from poppy_core.motion.move import Move
+from poppy_core.motion.move_library import save_move
+from poppy_core.motion.player import MovePlayer
+from poppy_core.remote.zenoh_client import answer_of
+from poppy_core.remote.zenoh_fleet import Fleet
+from poppy_core.robot import Robot, from_profile
+from poppy_core.schedule import Gate
+from poppy_core.server.start_time import START_AT, start_gate, wait_started, wait_until
+from tests.helpers.waiting import eventually
+from tests.helpers.zenoh_served import TOKEN, Served
+
+LEAD_S = 0.3
+
+
+class Stamp(Primitive):
+    """Notes when it began running."""
+
+    def __init__(self, robot: Robot) -> None:
+        super().__init__(robot)
+        self.began: list[float] = []
+
+    def run(self) -> None:
+        self.began.append(time.time())
+
+
+@pytest.fixture
+def robot() -> Iterator[Robot]:
+    with from_profile("ergo-jr", sim=True) as jr:
+        yield jr
+
+
+def _at(when: float) -> Any:
+    return START_AT.set(when)
+
+
+def test_without_a_start_time_there_is_no_gate() -> None:
+    assert start_gate() is None
+    context = _at(time.time() - 1.0)  # a start time already past: at once
+    try:
+        assert start_gate() is None
+    finally:
+        START_AT.reset(context)
+
+
+def test_armed_primitives_all_fire_after_their_start_time(robot: Robot) -> None:
+    stamps = [Stamp(robot) for _ in range(5)]
+    when = time.time() + LEAD_S
+    context = _at(when)
+    try:
+        gates = [start_gate() for _ in stamps]
+        for stamp, gate in zip(stamps, gates, strict=True):
+            stamp.start(gate)  # armed: its thread is made, held at the gate
+        assert not any(s.began for s in stamps) or time.time() >= when
+        wait_started(gates[0])
+    finally:
+        START_AT.reset(context)
+    assert eventually(lambda: all(s.began for s in stamps))
+    assert all(s.began[0] >= when for s in stamps)  # fired at the start time, not on arrival
+    assert all(len(s.began) == 1 for s in stamps)
+
+
+def test_a_stop_before_the_start_time_means_the_primitive_never_runs(robot: Robot) -> None:
+    stamp = Stamp(robot)
+    when = time.time() + LEAD_S
+    context = _at(when)
+    try:
+        gate = start_gate()
+        assert gate is not None
+        stamp.start(gate)
+        stamp.stop()  # before the start time
+        assert gate.cancelled and stamp.state == "stopped" and not stamp.is_alive()
+        wait_started(gate)
+    finally:
+        START_AT.reset(context)
+    wait_until(when + 0.05)
+    assert stamp.began == []
+    stamp.start()  # it can still be started again, now
+    assert eventually(lambda: len(stamp.began) == 1)
+
+
+def test_a_stopped_armed_move_plays_nothing(robot: Robot) -> None:
+    robot.compliant = False
+    before = {m.name: m.goal_position for m in robot.motors}
+    move = Move.from_frames(10.0, [{"m1": 30.0}, {"m1": 35.0}, {"m1": 40.0}])
+    player = MovePlayer(robot, move)
+    gate = Gate()
+    player.start(gate)
+    player.stop()
+    gate.open()  # too late: the stop called it off
+    assert player.wait(5.0) and player.stopped and player.loop_times == []
+    assert {m.name: m.goal_position for m in robot.motors} == before
+
+
+def test_a_gate_opens_or_is_cancelled_whichever_comes_first() -> None:
+    opened, cancelled = Gate(), Gate()
+    opened.open()
+    opened.cancel()
+    cancelled.cancel()
+    cancelled.open()
+    assert opened.wait(0) and not opened.cancelled
+    assert not cancelled.wait(0) and cancelled.cancelled
+    held = Gate()
+    results: list[bool] = []
+    thread = threading.Thread(target=lambda: results.append(held.wait()))
+    thread.start()
+    held.open()
+    thread.join(5.0)
+    assert results == [True]
+
+
+def _send(fleet: Fleet, name: str, path: str, start_at: float | None, body: Any = None) -> Any:
+    payload = zenoh_wire.api_request("POST", path, body, token=TOKEN, start_at=start_at)
+    key = zenoh_wire.robot_key(name, "api")
+    return fleet.session.get(key, payload=payload, timeout=10.0)
+
+
+def test_a_fleet_stop_before_the_start_time_means_nothing_starts(
+    two: tuple[Served, Served], fleet: Fleet
+) -> None:
+    ran: list[str] = []  # the primitives whose setup (their first step) ran
+    for served in two:
+        dance = served.servers.service.primitive("dance")
+        dance.setup = lambda name=served.name: ran.append(name)  # type: ignore[method-assign]
+    start_at = time.time() + 2.0
+    started = [_send(fleet, s.name, "/api/v1/primitives/dance/start", start_at) for s in two]
+    assert eventually(
+        lambda: all("dance" in s.servers.service.running_primitives() for s in two)
+    )  # armed on arrival
+    stopped = fleet.command(
+        ["jr-a", "jr-b"], "POST", "/api/v1/primitives/dance/stop", together=False
+    )
+    assert [o.ok for o in stopped] == [True, True]
+    for handler in started:  # their replies come at the start time
+        status, _ = answer_of("zenoh", list(handler), 10.0, 0.0)
+        assert status < 400
+    wait_until(start_at + 0.1)
+    assert ran == []
+    assert not any(s.servers.service.running_primitives() for s in two)
+
+
+def test_a_refused_fleet_play_moves_nothing(two: tuple[Served, Served], fleet: Fleet) -> None:
+    a, _ = two
+    a.robot.compliant = False
+    before = {m.name: m.goal_position for m in a.robot.motors}
+    body = {"speed": 1.0, "backwards": False}
+    outcomes = fleet.command(["jr-a", "jr-b"], "POST", "/api/v1/moves/nowhere/play", body)
+    assert [o.ok for o in outcomes] == [False, False]
+    assert all(o.status == 404 for o in outcomes), [(o.status, o.message) for o in outcomes]
+    assert fleet.last_start_at is not None
+    wait_until(fleet.last_start_at + 0.1)
+    assert a.servers.service.moves.playing() == []
+    assert {m.name: m.goal_position for m in a.robot.motors} == before
+
+
+def test_the_fleet_stop_before_the_start_time_cancels_an_armed_move(
+    two: tuple[Served, Served], fleet: Fleet, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    played_from: list[MovePlayer] = []  # the players whose playback (their thread's body) ran
+    real_run = MovePlayer._run
+
+    def run(self: MovePlayer, stopping: threading.Event) -> None:
+        played_from.append(self)
+        real_run(self, stopping)
+
+    monkeypatch.setattr(MovePlayer, "_run", run)
+    wave = Move.from_frames(10.0, [{"m1": 30.0 + i} for i in range(5)])
+    save_move(wave, "wave")
+    before = {}
+    for served in two:
+        served.robot.compliant = False
+        before[served.name] = {m.name: m.goal_position for m in served.robot.motors}
+    start_at = time.time() + 2.0
+    body = {"speed": 1.0, "backwards": False}
+    played = [_send(fleet, s.name, "/api/v1/moves/wave/play", start_at, body) for s in two]
+    assert eventually(lambda: all(s.servers.service.moves.playing() == ["wave"] for s in two))
+    stopped = fleet.command(
+        ["jr-a", "jr-b"], "POST", "/api/v1/web/stop", {"then": "hold"}, together=False
+    )
+    assert [o.ok for o in stopped] == [True, True], [o.message for o in stopped]
+    for handler in played:
+        answer_of("zenoh", list(handler), 10.0, 0.0)
+    wait_until(start_at + 0.1)
+    assert played_from == []
+    for served in two:
+        assert served.servers.service.moves.playing() == []
+        assert {m.name: m.goal_position for m in served.robot.motors} == before[served.name]

@@ -1,0 +1,37 @@
+"""Virtual Ergo Jrs served on Zenoh on loopback (explicit endpoints, scouting off), for tests."""
+
+from __future__ import annotations
+
+import socket
+
+from poppy_core.assembly import ServerSet, ServeSpec, ZenohSettings, serve
+from poppy_core.robot import Robot, from_profile
+
+TOKEN = "s3cret"
+
+
+def free_endpoint() -> str:
+    """A Zenoh endpoint on a free loopback port."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return f"tcp/127.0.0.1:{sock.getsockname()[1]}"
+
+
+class Served:
+    """A virtual Ergo Jr served on Zenoh as ``poppy/NAME``, listening on ``endpoint``."""
+
+    def __init__(self, name: str, token: str | None = TOKEN) -> None:
+        self.name = name
+        self.endpoint = free_endpoint()
+        self.robot: Robot = from_profile("ergo-jr", sim=True)
+        spec = ServeSpec(zenoh=ZenohSettings(listen=(self.endpoint,)), name=name, token=token)
+        self.servers: ServerSet = serve(self.robot, spec)
+
+    def close(self) -> None:
+        self.servers.stop()
+        self.robot.close()
+
+
+def connect_to(*served: Served) -> tuple[str, ...]:
+    """The endpoints a client connects to, to reach ``served``."""
+    return tuple(s.endpoint for s in served)
