@@ -207,6 +207,23 @@ class RobotState:
     motors: dict[str, dict[str, Any]]
 
 
+def descriptions(session: zenoh.Session, timeout_s: float) -> dict[str, dict[str, Any]]:
+    """Name -> description of every robot that answers ``poppy/*/description`` within
+    ``timeout_s``; a reply that is not a JSON object is skipped."""
+    found: dict[str, dict[str, Any]] = {}
+    for reply in session.get(f"{PREFIX}/*/description", timeout=timeout_s):
+        if reply.ok is None:
+            continue
+        name = name_of(str(reply.ok.key_expr))
+        try:
+            described = json.loads(reply.ok.payload.to_bytes())
+        except ValueError:
+            continue
+        if name and isinstance(described, dict):
+            found[name] = described
+    return found
+
+
 def finite_or_nan(value: Any) -> float:
     """``value`` as a float; NaN for anything not a finite number (a value not read yet)."""
     try:

@@ -14,7 +14,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from poppy_core import zenoh_wire
 from poppy_core.errors import BusTimeout, CommunicationError, ConfigError
@@ -22,6 +22,8 @@ from poppy_core.remote.zenoh_client import answer_of, client_settings
 
 if TYPE_CHECKING:
     import zenoh
+
+T = TypeVar("T")
 
 DEFAULT_TIMEOUT_S = 2.0
 START_LEAD_S = 0.3
@@ -100,18 +102,11 @@ class Fleet:
     def describe(self, names: Sequence[str] | None = None) -> dict[str, dict[str, Any]]:
         """Name -> description of each robot alive (or of ``names``), in name order."""
         wanted = list(names) if names is not None else self.names()
-        found: dict[str, dict[str, Any]] = {}
-        key = f"{zenoh_wire.PREFIX}/*/description"
-        for reply in self.session.get(key, timeout=self.timeout_s):
-            if reply.ok is None:
-                continue
-            name = zenoh_wire.name_of(str(reply.ok.key_expr))
-            try:
-                described = json.loads(reply.ok.payload.to_bytes())
-            except ValueError:
-                continue
-            if name in wanted and isinstance(described, dict):
-                found[name] = described
+        found = {
+            name: described
+            for name, described in zenoh_wire.descriptions(self.session, self.timeout_s).items()
+            if name in wanted
+        }
         return {n: found[n] for n in sorted(found)}
 
     def command(
@@ -156,32 +151,27 @@ class Fleet:
         """Call ``callback(name, state)`` for each state message (of every robot by default).
 
         It runs in Zenoh's thread: keep it short. A message that is not a state is skipped."""
-
-        def received(sample: zenoh.Sample) -> None:
-            robot = zenoh_wire.name_of(str(sample.key_expr))
-            try:
-                state = zenoh_wire.unpack_state(sample.payload.to_bytes())
-            except ConfigError:
-                return
-            if robot:
-                callback(robot, state)
-
-        key = f"{zenoh_wire.PREFIX}/{name}/state"
-        self._declared.append(self.session.declare_subscriber(key, received))
+        self._subscribe(f"{zenoh_wire.PREFIX}/{name}/state", zenoh_wire.unpack_state, callback)
 
     def on_health(self, callback: Callable[[str, dict[str, Any]], None]) -> None:
         """Call ``callback(name, health)`` for each health message (every second per robot)."""
+        self._subscribe(f"{zenoh_wire.PREFIX}/*/health", _health_of, callback)
+
+    def _subscribe(
+        self, key: str, decode: Callable[[bytes], T], callback: Callable[[str, T], None]
+    ) -> None:
+        """Call ``callback(robot, decode(payload))`` for each sample on ``key``; a payload
+        ``decode`` refuses (ConfigError) is skipped."""
 
         def received(sample: zenoh.Sample) -> None:
             robot = zenoh_wire.name_of(str(sample.key_expr))
             try:
-                health = json.loads(sample.payload.to_bytes())
-            except ValueError:
+                message = decode(sample.payload.to_bytes())
+            except ConfigError:
                 return
-            if robot and isinstance(health, dict):
-                callback(robot, health)
+            if robot:
+                callback(robot, message)
 
-        key = f"{zenoh_wire.PREFIX}/*/health"
         self._declared.append(self.session.declare_subscriber(key, received))
 
     def on_presence(self, callback: Callable[[str, bool], None]) -> None:
@@ -230,3 +220,14 @@ class Fleet:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _health_of(payload: bytes) -> dict[str, Any]:
+    """A health message's JSON object (ConfigError: not one)."""
+    try:
+        health = json.loads(payload)
+    except ValueError as exc:
+        raise ConfigError(f"not a health message: {exc}") from exc
+    if not isinstance(health, dict):
+        raise ConfigError("not a health message: not a JSON object")
+    return health

@@ -24,18 +24,10 @@ from poppy_core.protocol import (
     sync_write,
     write,
 )
+from tests.helpers.waiting import eventually, within
 
 XL320_TORQUE_ENABLE = 24
 XL320_PRESENT_POSITION = 37
-
-
-def _wait_for(check: Callable[[], bool], timeout_s: float) -> bool:
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        if check():
-            return True
-        time.sleep(0.005)
-    return False
 
 
 def test_a_write_is_heard_while_an_earlier_reply_is_held_back() -> None:
@@ -47,7 +39,7 @@ def test_a_write_is_heard_while_an_earlier_reply_is_held_back() -> None:
         client = RawClient(server.url, 2)
         client.send(read(2, 1, XL320_PRESENT_POSITION, 2))
         client.port.write(encode_instruction(2, write(2, 2, XL320_TORQUE_ENABLE, b"\x01")))
-        heard = _wait_for(lambda: bus.motor(2).table.get("torque_enable") == 1, 1.0)
+        heard = within(lambda: bus.motor(2).table.get("torque_enable") == 1, 1.5)
         client.close()
     assert heard
 
@@ -80,7 +72,7 @@ def _lose_the_line(server: Any, dxl: DxlBus) -> None:
     """Motor 1 answers; the line goes for 0.5 s: the server says so and the bus fails."""
     assert dxl.ping(1) is not None
     server.lose(0.5)
-    assert _wait_for(lambda: not server.connected, 1.0)
+    assert eventually(lambda: not server.connected)
     with pytest.raises(PortError):
         for _ in range(3):
             dxl.ping(1)
@@ -95,7 +87,7 @@ def test_pty_line_lost_and_back_under_its_link(tmp_path: Path) -> None:
         with DxlBus(str(link), 1_000_000, 2) as dxl:
             _lose_the_line(server, dxl)
             assert not link.exists()
-        assert _wait_for(lambda: server.connected and link.exists(), 3.0)
+        assert eventually(lambda: server.connected and link.exists())
         assert os.readlink(link) == server.url
         with DxlBus(str(link), 1_000_000, 2) as dxl:
             assert dxl.ping(1) is not None
@@ -110,7 +102,7 @@ def test_tcp_line_lost_and_back_on_the_same_port() -> None:
             _lose_the_line(server, dxl)
         with pytest.raises(PortError):
             DxlBus(url, 1_000_000, 2)
-        assert _wait_for(lambda: server.connected, 3.0)
+        assert eventually(lambda: server.connected)
         assert server.url == url
         with DxlBus(url, 1_000_000, 2) as dxl:
             assert dxl.ping(1) is not None
@@ -139,7 +131,7 @@ class FlushingClient:
     def write_no_reply(self, data: bytes) -> None:
         before = self.received()
         self.send(data)
-        _wait_for(lambda: self.received() > before, 2.0)
+        within(lambda: self.received() > before, 2.0)
 
     def read(self, motor_id: int, address: int, length: int) -> bytes | None:
         self.send(encode_instruction(2, read(2, motor_id, address, length)))

@@ -24,3 +24,15 @@ def eventually(check: Callable[[], bool], timeout_s: float = 3.0, interval_s: fl
             return True
         time.sleep(interval_s)
     return check()
+
+
+def within(check: Callable[[], bool], timeout_s: float, interval_s: float = 0.005) -> bool:
+    """Poll ``check`` for at most ``timeout_s`` (no floor): for the few waits whose window is
+    what the test checks (a write heard before a held-back reply is due), or that may run out
+    by design (a step that gives no sign it was taken). Any other wait is ``eventually``."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if check():
+            return True
+        time.sleep(interval_s)
+    return check()

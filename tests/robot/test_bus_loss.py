@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -12,17 +12,7 @@ import pytest
 from poppy_core.emulator import Endpoint, VirtualBus, serve_link, serve_pty, serve_tcp
 from poppy_core.robot import Robot, from_profile, load_profile
 from poppy_core.robot.factory import virtual_buses
-
-WAIT_S = 10.0  # generous: a loaded machine may be slow, the goals are measured in bench soak
-
-
-def until(check: Callable[[], bool], timeout_s: float = WAIT_S) -> bool:
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        if check():
-            return True
-        time.sleep(0.01)
-    return False
+from tests.helpers.waiting import eventually
 
 
 def ergo_jr_virtual() -> VirtualBus:
@@ -58,7 +48,7 @@ def sync_warnings(caplog: pytest.LogCaptureFixture, text: str) -> list[str]:
 def test_health_of_a_healthy_robot(served: tuple[Endpoint, str]) -> None:
     _, port = served
     with from_profile("ergo-jr", port=port, sensors=False) as robot:
-        assert until(lambda: robot.health()["my_dxl_controller"].loop_hz["present"] > 0)
+        assert eventually(lambda: robot.health()["my_dxl_controller"].loop_hz["present"] > 0)
         health = robot.health()["my_dxl_controller"]
         assert health.connected and health.running and health.ok
         assert health.offline == [] and health.losses == 0 and health.down_s == 0
@@ -73,22 +63,24 @@ def test_a_lost_bus_is_loud_then_comes_back(
     server, port = served
     caplog.set_level(logging.WARNING, logger="poppy_core.robot.sync")
     with from_profile("ergo-jr", port=port, sensors=False) as robot:
-        assert until(lambda: all(m.online for m in robot.motors))
+        assert eventually(lambda: all(m.online for m in robot.motors))
         server.lose(1.0)
-        assert until(lambda: not any(m.online for m in robot.motors))
+        assert eventually(lambda: not any(m.online for m in robot.motors))
         health = robot.health()["my_dxl_controller"]
         assert not health.connected and health.losses == 1
         assert sorted(health.offline) == sorted(m.name for m in robot.motors)
-        assert until(lambda: robot.health()["my_dxl_controller"].loop_hz["present"] == 0)
+        assert eventually(lambda: robot.health()["my_dxl_controller"].loop_hz["present"] == 0)
         # back: reopened by the sync thread, motors answer again, writes reach them
-        assert until(lambda: all(m.online for m in robot.motors))
+        assert eventually(lambda: all(m.online for m in robot.motors))
         assert robot.health()["my_dxl_controller"].connected
         robot.m3.compliant = False
         robot.m3.goal_position = 20.0
         motor = server.bus.motor(robot.m3.id)
         wanted = robot.m3.to_motor(20.0)
-        assert until(lambda: motor.torque_enabled and abs(motor.goal_position_deg - wanted) < 1)
-        assert until(lambda: abs(robot.m3.present_position - 20.0) < 2)
+        assert eventually(
+            lambda: motor.torque_enabled and abs(motor.goal_position_deg - wanted) < 1
+        )
+        assert eventually(lambda: abs(robot.m3.present_position - 20.0) < 2)
     # the bus named by what it is (its port), not by pypot's placeholder controller name
     shown = port if "://" in port else port.rsplit("/", 1)[-1]  # ttyDXL, emu://1
     assert len(sync_warnings(caplog, f"bus {shown}: lost {port} ")) == 1
@@ -106,7 +98,7 @@ def test_a_bus_that_never_comes_back_is_retried_quietly(
     robot: Robot = from_profile("ergo-jr", port=server.url, sensors=False)
     try:
         server.stop()  # gone for good
-        assert until(lambda: not robot.health()["my_dxl_controller"].connected)
+        assert eventually(lambda: not robot.health()["my_dxl_controller"].connected)
         time.sleep(1.5)  # a few reopen attempts
         assert robot.health()["my_dxl_controller"].running
         assert len(sync_warnings(caplog, ": lost ")) == 1

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from typing import TYPE_CHECKING, Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
@@ -21,18 +20,7 @@ router = APIRouter(prefix="/web", tags=["web page"])
 def fleet_of(node: ZenohRobotServer) -> list[dict[str, Any]]:
     """Every robot alive on the network (this one too): name, creature, health, page."""
     alive = set(node.seen())
-    found: dict[str, dict[str, Any]] = {}
-    key = f"{zenoh_wire.PREFIX}/*/description"
-    for reply in node.session.get(key, timeout=ASK_TIMEOUT_S):
-        if reply.ok is None:
-            continue
-        name = zenoh_wire.name_of(str(reply.ok.key_expr))
-        try:
-            described = json.loads(reply.ok.payload.to_bytes())
-        except ValueError:
-            continue
-        if name and isinstance(described, dict):
-            found[name] = described
+    found = zenoh_wire.descriptions(node.session, ASK_TIMEOUT_S)
     robots = []
     for name in sorted(alive | set(found)):
         described = found.get(name, {})
