@@ -75,6 +75,7 @@ class PrimitiveManager:
         self._meter = RateMeter()
         self.errors = 0
         self.last_error: str | None = None
+        self._refused: set[tuple[str, str]] = set()  # writes failing now: logged once each
 
     def __repr__(self) -> str:
         return f"<PrimitiveManager {self.freq:g} Hz primitives={self._primitives}>"
@@ -183,11 +184,19 @@ class PrimitiveManager:
                     try:
                         setattr(motor, register, value)
                     except Exception as exc:
-                        logger.exception(
-                            "primitive manager: %s.%s = %r", motor_name, register, value
-                        )
+                        if key not in self._refused:  # once until it is taken again
+                            self._refused.add(key)
+                            logger.warning(
+                                "primitive manager: %s.%s = %r refused: %s: %s",
+                                motor_name,
+                                register,
+                                value,
+                                type(exc).__name__,
+                                exc,
+                            )
                         self._note_error(f"{motor_name}.{register}: {exc}")
                         continue
+                    self._refused.discard(key)
                     self._applied[key] = value
 
     def _reject(self, primitive: Primitive, exc: Exception) -> None:

@@ -230,3 +230,38 @@ def test_a_primitive_requesting_an_unknown_motor_is_stopped_and_the_manager_goes
         assert "\n" not in warned[0].getMessage()
         assert before.error is None and after.error is None
     assert eventually(lambda: not manager.running)
+
+
+class _Refusing:
+    """A motor that refuses every write while ``refusing`` is set."""
+
+    refusing = True
+
+    def __setattr__(self, name: str, value: object) -> None:
+        if type(self).refusing:
+            raise ValueError(f"{name} refused")
+
+
+def test_a_refused_write_is_logged_once_until_it_is_taken_again(
+    ergo: Robot, caplog: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    manager = PrimitiveManager(ergo)
+    posture = constant(ergo, "m1", 5.0)
+    posture.robot.m1.goal_position = 5.0
+    manager.add(posture)
+    refusing = _Refusing()
+    monkeypatch.setattr(ergo, "motor", lambda name: refusing)
+    with caplog.at_level(logging.WARNING, logger="poppy_core.motion.manager"):
+        for _ in range(5):
+            manager.update()
+        _Refusing.refusing = False
+        manager.update()  # taken: the next refusal is news again
+        _Refusing.refusing = True
+        posture.robot.m1.goal_position = 6.0
+        manager.update()
+        manager.update()
+    refused = [r for r in caplog.records if "m1.goal_position" in r.getMessage()]
+    assert [r.levelno for r in refused] == [logging.WARNING, logging.WARNING]
+    assert all("\n" not in r.getMessage() for r in refused)
+    assert manager.errors >= 7  # the manager's own loop may update too
+    manager.close()
