@@ -52,7 +52,7 @@ def install(
     zmq: bool = typer.Option(False, "--zmq", help="Also serve pypot's ZMQ API (it has no token)."),
     token: bool = typer.Option(
         False,
-        "--token",
+        "--require-token",
         help="Require a token: a random one in a file only the service's user reads (kept on "
         "reinstall); the page's settings change it.",
     ),

@@ -113,7 +113,7 @@ class RobotSettings:
             return None
         return (
             "this server was started without --token: settings are changed only on a "
-            "robot whose server asks for a token (poppy service install --token ...)"
+            "robot whose server asks for a token (poppy service install --require-token)"
         )
 
     def wifi(self) -> dict[str, Any]:
@@ -136,7 +136,7 @@ class RobotSettings:
             raise ApiError(
                 "forbidden",
                 "settings are changed only on a server started with --token",
-                tip="restart the server with --token (poppy service install --token ...)",
+                tip="restart the server with --token (poppy service install --require-token)",
             )
 
     def _check_system(self) -> None:
@@ -241,7 +241,7 @@ class RobotSettings:
             raise ApiError(
                 "conflict",
                 "this server's token was given on its command line (--token), not in a file",
-                tip="install the service (poppy service install --token) to change it here",
+                tip="install the service (poppy service install --require-token) to change it here",
             )
         try:
             serve_options.write_token(path, token)

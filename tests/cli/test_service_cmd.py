@@ -71,7 +71,7 @@ def exec_start(unit: str) -> list[str]:
 def test_the_user_unit_is_one_systemd_accepts(tmp_path: Path) -> None:
     if shutil.which("systemd-analyze") is None:
         pytest.skip("systemd-analyze is not installed (.ci/run installs Debian's systemd)")
-    result = run_poppy("service", "install", "--user", "--dry-run", "--token")
+    result = run_poppy("service", "install", "--user", "--dry-run", "--require-token")
     assert result.code == 0, result.stderr
     unit = tmp_path / "poppy.service"
     unit.write_text(result.stdout)
@@ -141,7 +141,7 @@ def test_install_writes_the_units_then_reloads_enables_and_starts(fake: Fake, so
 def test_install_writes_the_settings_file_and_a_token_only_its_user_reads(
     fake: Fake, someone: str
 ) -> None:
-    result = fake.run("install", "--run-as", someone, "--snap", "--token")
+    result = fake.run("install", "--run-as", someone, "--snap", "--require-token")
     assert result.code == 0, result.stderr
     settings, token = fake.files / "serve.json", fake.files / "token"
     assert json.loads(settings.read_text()) == {"snap": True, "zmq": False}
@@ -155,12 +155,12 @@ def test_install_writes_the_settings_file_and_a_token_only_its_user_reads(
 
     # installed again: the options as its flags say, the token (maybe changed by the page) kept
     token.write_text("set-from-the-page\n")
-    again = fake.run("install", "--run-as", someone, "--zmq", "--token")
+    again = fake.run("install", "--run-as", someone, "--zmq", "--require-token")
     assert again.code == 0, again.stderr
     assert json.loads(settings.read_text()) == {"snap": False, "zmq": True}
     assert token.read_text() == "set-from-the-page\n" and "token" not in again.stdout
     assert "--token-file" in exec_start((fake.units / "poppy.service").read_text())
-    assert fake.run("install", "--run-as", someone).code == 0  # without --token: none asked
+    assert fake.run("install", "--run-as", someone).code == 0  # no --require-token: none
     assert "--token-file" not in exec_start((fake.units / "poppy.service").read_text())
 
 
@@ -347,7 +347,7 @@ def test_the_installed_service_reads_its_token_and_options_from_its_files(
 ) -> None:
     (virtual,) = virtual_buses(load_profile("ergo-jr")).values()
     port = str(tmp_path / "ttyDXL")
-    install = ("install", "--user", "--token", "--host", "127.0.0.1", "--port", port)
+    install = ("install", "--user", "--require-token", "--host", "127.0.0.1", "--port", port)
     assert fake.run(*install, "--http-port", "0").code == 0
     token = (fake.files / "token").read_text().strip()
     env = dict(os.environ, POPPY_MOVES_DIR=str(tmp_path / "moves"), NO_COLOR="1")
