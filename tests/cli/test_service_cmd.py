@@ -283,7 +283,15 @@ def test_the_units_exec_start_run_as_is_serves_the_page(tmp_path: Path) -> None:
     (virtual,) = virtual_buses(load_profile("ergo-jr")).values()
     port = str(tmp_path / "ttyDXL")
     install = ("install", "--user", "--dry-run", "--host", "127.0.0.1", "--port", port)
-    result = run_poppy("service", *install, "--http-port", "0", "--http-port", "0")
+    result = run_poppy(
+        "service",
+        *install,
+        "--http-port",
+        "0",
+        "--http-port",
+        "0",
+        env={"POPPY_SERVICE_DIR": str(tmp_path / "service")},  # none: Snap! and ZMQ off
+    )
     assert result.code == 0, result.stderr
     env = dict(os.environ, POPPY_MOVES_DIR=str(tmp_path / "moves"), NO_COLOR="1")
     with serve_pty(virtual, link=port):
