@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import threading
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
@@ -80,6 +81,8 @@ class RobotSettings:
     def __init__(self, system: SystemTools | None = None) -> None:
         self.system = system or SystemTools()
         self.served = ServedRobot()
+        self._files = threading.Lock()
+        """One change of the service's files at a time (two pages: neither undoes the other)."""
 
     # -- reading -------------------------------------------------------------------------------
 
@@ -218,9 +221,10 @@ class RobotSettings:
             )
         self._check_token()
         try:
-            options = serve_options.read_options(path)
-            changed = dataclasses.replace(options, **{service: on})
-            serve_options.write_options(path, changed)
+            with self._files:
+                options = serve_options.read_options(path)
+                changed = dataclasses.replace(options, **{service: on})
+                serve_options.write_options(path, changed)
         except (ConfigError, FileError) as exc:
             raise ApiError(
                 "conflict", str(exc), tip="the settings file could not be changed"
