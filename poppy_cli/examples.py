@@ -84,6 +84,10 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
             "serve --ros2 --name jr1 --ros-namespace /lab --profile ergo-jr",
             "a ROS 2 node /lab/jr1, through the zenohd router on this computer",
         ),
+        (
+            "serve --http --settings serve.json --token-file token --profile ergo-jr --sim",
+            "options and token from files, as the installed service (not in `ps`)",
+        ),
     ),
     "fleet": (
         ("fleet discover", "the robots announced on the network (mDNS)"),
@@ -301,6 +305,7 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("service install --port /dev/ttyAMA0 --snap", "at boot, with Snap!, on a Pi"),
         ("service install --user --dry-run", "print the unit of a desktop service"),
         ("service install --name ergo-2 --jupyter --run-as pi", "a second robot, Jupyter too"),
+        ("service install --port /dev/ttyAMA0 --require-token", "with a token the page changes"),
     ),
     "service status": (
         ("service status", "the system's service"),

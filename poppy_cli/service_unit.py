@@ -33,8 +33,11 @@ class ServiceSpec:
         run_as: the user a system unit runs as (None for a user unit).
         host: the address the page is served on.
         http_ports: the page's ports (the first one, then its aliases).
-        snap: serve Snap! too.
+        snap: serve Snap! too (the initial settings file).
+        zmq: serve pypot's ZMQ API too (the initial settings file).
         jupyter: also write `poppy-jupyter.service`.
+        settings_file: the serve options file the unit reads (``--settings``), or None.
+        token_file: the token file the unit reads (``--token-file``), or None: no token.
     """
 
     poppy: tuple[str, ...]
@@ -46,7 +49,10 @@ class ServiceSpec:
     host: str = "0.0.0.0"
     http_ports: tuple[int, ...] = field(default=SYSTEM_PORTS)
     snap: bool = False
+    zmq: bool = False
     jupyter: bool = False
+    settings_file: Path | None = None
+    token_file: Path | None = None
 
     @property
     def robot_url(self) -> str:
@@ -73,8 +79,12 @@ def serve_command(spec: ServiceSpec) -> list[str]:
         args += ["--http-port", str(port)]
     args += ["--profile", spec.profile, "--port", spec.port, "--wait-for-motors"]
     args += ["--name", spec.name, "--announce"]
-    if spec.snap:
-        args.append("--snap")
+    if spec.settings_file is not None:  # Snap! and ZMQ: as the file says, the page switches them
+        args += ["--settings", str(spec.settings_file)]
+    else:
+        args += [flag for flag, on in (("--snap", spec.snap), ("--zmq", spec.zmq)) if on]
+    if spec.token_file is not None:
+        args += ["--token-file", str(spec.token_file)]
     return args
 
 

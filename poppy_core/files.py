@@ -187,6 +187,7 @@ def write_file(
     *,
     replace: bool = False,
     make_folder: bool = False,
+    mode: int | None = None,
 ) -> Path:
     """Write ``data`` to ``path`` atomically (see the module docstring for the rules).
 
@@ -195,6 +196,8 @@ def write_file(
         data: its whole content (text is written as UTF-8).
         replace: replace an existing regular file (else it is refused).
         make_folder: create missing parent folders (only for folders poppy owns).
+        mode: the file's permission bits from its creation on, whatever the umask and the
+            replaced file's (``0o600`` for a secret only its owner reads).
 
     Returns:
         The path written.
@@ -211,15 +214,21 @@ def write_file(
     payload = data.encode("utf-8") if isinstance(data, str) else data
     temp = folder / f".{target.name[:200]}.{secrets.token_hex(6)}.tmp"
     try:
-        fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, NEW_FILE_MODE)
+        fd = os.open(
+            temp,
+            os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW,
+            NEW_FILE_MODE if mode is None else mode,
+        )
     except OSError as exc:
         raise file_error(exc, target, "write") from None
     try:
         try:
+            if mode is not None:
+                os.fchmod(fd, mode)  # before any byte is written
             view = memoryview(payload)
             while view:
                 view = view[os.write(fd, view) :]
-            if existing is not None:
+            if existing is not None and mode is None:
                 os.fchmod(fd, stat.S_IMODE(existing.st_mode))
             os.fsync(fd)
         finally:

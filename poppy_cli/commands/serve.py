@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import typer
 
+from poppy_cli.commands.serve_files import read_served_files
 from poppy_cli.commands.serve_ros2 import announce_ros2, ros2_settings
 from poppy_cli.commands.serve_snap import announce_snap, check_snap_options
 from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, finite
@@ -55,6 +56,18 @@ def serve(
         "--token",
         envvar="POPPY_TOKEN",
         help="Require this token (Authorization: Bearer … or ?token=) on every route.",
+    ),
+    token_file: Path | None = typer.Option(
+        None,
+        "--token-file",
+        help="Require the token held in this file (kept out of `ps`; the page's settings "
+        "change it there).",
+    ),
+    settings: Path | None = typer.Option(
+        None,
+        "--settings",
+        help="Serve Snap! and ZMQ as this JSON file says (the installed service's; the page's "
+        "settings switch them there).",
     ),
     cors: list[str] | None = typer.Option(
         None,
@@ -154,6 +167,7 @@ def serve(
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
     from poppy_core.errors import ConfigError
 
+    snap, zmq, token = read_served_files(settings, token_file, token, snap, zmq)
     if not (http or ws or snap or zmq or zenoh or ros2):
         _usage("nothing to serve: pass --http, --ws, --snap, --zmq, --zenoh and/or --ros2")
     http_port, *alias_ports = http_ports or [8080]
@@ -202,6 +216,8 @@ def serve(
         report=_report,
         zenoh=zenoh_settings,
         ros2=ros2_spec,
+        settings_file=settings,
+        token_file=token_file,
     )
     any_origin = _check_origins(spec)
     _warn_exposure(spec, host, any_origin)

@@ -49,6 +49,13 @@ def install(
         "poppy", "--name", "-n", help="The robot's name: its page is http://NAME.local."
     ),
     snap: bool = typer.Option(False, "--snap", help="Also serve Snap! with the Poppy blocks."),
+    zmq: bool = typer.Option(False, "--zmq", help="Also serve pypot's ZMQ API (it has no token)."),
+    token: bool = typer.Option(
+        False,
+        "--require-token",
+        help="Require a token: a random one in a file only the service's user reads (kept on "
+        "reinstall); the page's settings change it.",
+    ),
     jupyter: bool = typer.Option(
         False, "--jupyter", help="Also start Jupyter (poppy-jupyter.service) on port 8888."
     ),
@@ -72,8 +79,10 @@ def install(
 ) -> None:
     """Write poppy.service (and poppy-jupyter.service), reload systemd, enable and start it."""
     from poppy_cli import service_unit as units
+    from poppy_cli.service_files import files_of, write_files
     from poppy_cli.systemd import Systemd, unit_dir
     from poppy_core.robot import load_profile
+    from poppy_core.server.serve_options import ServeOptions
 
     if not NAME.fullmatch(name):
         _usage(
@@ -86,17 +95,22 @@ def install(
         _usage("--run-as is for the system service: a --user service runs as you")
     load_profile(profile)  # an unknown profile: one line naming the known ones
     ports = tuple(http_ports or (units.USER_PORTS if user else units.SYSTEM_PORTS))
+    run_as = None if user else _service_user(run_as)
+    files = files_of(run_as)
     spec = units.ServiceSpec(
         poppy=units.poppy_command(),
         profile=profile,
         port=port,
         name=name,
         user=user,
-        run_as=None if user else _service_user(run_as),
+        run_as=run_as,
         host=host,
         http_ports=ports,
         snap=snap,
+        zmq=zmq,
         jupyter=jupyter,
+        settings_file=files.settings,
+        token_file=files.token if token else None,
     )
     texts = units.units(spec)
     systemd = Systemd(user)
@@ -108,8 +122,11 @@ def install(
                 print(f"# {folder / unit}")
             print(text)
         scope = "--user " if user else ""
+        written = [str(folder / u) for u in texts] + [str(files.settings)]
+        if token:
+            written.append(f"{files.token} (a random token, unless it holds one)")
         err_console.print(
-            f"would write {', '.join(str(folder / u) for u in texts)} and run: systemctl "
+            f"would write {', '.join(written)} and run: systemctl "
             f"{scope}daemon-reload; systemctl {scope}enable {' '.join(texts)}; systemctl "
             f"{scope}restart {' '.join(texts)}",
             soft_wrap=True,
@@ -118,6 +135,7 @@ def install(
         )
         return
     systemd.systemctl("--version")  # no systemd: one line before anything is written
+    made = write_files(files, ServeOptions(snap=snap, zmq=zmq), token, run_as)
     _write_units(folder, texts)
     _remove_units(systemd, folder, [u for u in stale if (folder / u).exists()])
     systemd.systemctl("daemon-reload")
@@ -131,6 +149,14 @@ def install(
         highlight=False,
         markup=False,
     )
+    if made is not None:
+        console.print(
+            f"the robot's token (the page asks for it once): {made}; it is kept in "
+            f"{files.token}, readable by the service's user only",
+            soft_wrap=True,
+            highlight=False,
+            markup=False,
+        )
 
 
 def _service_user(run_as: str | None) -> str:

@@ -79,6 +79,10 @@ class ServeSpec:
         state_rate_hz: the Zenoh state messages per second (the sync loop's rate).
         ros2: the robot as a ROS 2 node on rmw_zenoh's wire (``Ros2Settings``: domain,
             namespace, node; its Zenoh settings serve when ``zenoh`` is None), or None.
+        settings_file: the appliance's serve options file (``poppy serve --settings``): the
+            page's settings switch Snap! and ZMQ there.
+        token_file: the file ``token`` was read from (``--token-file``): the page's settings
+            change the token there.
     """
 
     http: Listen | None = None
@@ -97,6 +101,8 @@ class ServeSpec:
     zenoh: ZenohSettings | None = None
     state_rate_hz: float = 50.0
     ros2: Ros2Settings | None = None
+    settings_file: Path | None = None
+    token_file: Path | None = None
 
     def listens(self) -> dict[str, Listen]:
         """Protocol -> where it listens, for the servers asked for, in starting order."""
@@ -277,6 +283,8 @@ def _named(servers: ServerSet, robot: Robot, spec: ServeSpec) -> None:
         protocols=tuple(servers.servers),
         token_required=bool(spec.token),
         policies=policies,
+        settings_file=spec.settings_file,
+        token_file=spec.token_file,
     )
     if servers.app is not None:
         servers.app.state.settings.served = served

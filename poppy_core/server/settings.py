@@ -8,14 +8,19 @@ NetworkManager and systemd; elsewhere the settings are shown read-only with the 
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+import threading
 from dataclasses import dataclass, field
 from importlib import metadata
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from poppy_core.errors import ConfigError, FileError
+from poppy_core.server import serve_options
 from poppy_core.server.errors import ApiError
 from poppy_core.server.origins import OriginPolicy, robot_name
-from poppy_core.server.settings_os import SystemTools
+from poppy_core.server.settings_os import SystemToolError, SystemTools
 
 if TYPE_CHECKING:
     from poppy_core.server.announce import Announcer
@@ -25,7 +30,10 @@ logger = logging.getLogger(__name__)
 SERVICE_UNITS = {"jupyter": "poppy-jupyter.service"}
 """Service -> its systemd unit (``poppy service install --jupyter`` writes it)."""
 SERVED_OPTIONS = {"snap": "--snap", "zmq": "--zmq"}
-"""Services served by ``poppy.service`` itself: shown, changed by reinstalling the service."""
+"""Services served by ``poppy.service`` itself: changed in its settings file (``poppy serve
+--settings``), then the service restarts."""
+SERVICE_UNIT = "poppy.service"
+"""The installed service (``poppy service install``), restarted after a change of its files."""
 MIN_PSK = 8
 MAX_PSK = 63
 MAX_SSID_BYTES = 32
@@ -50,6 +58,10 @@ class ServedRobot:
     """The Host and Origin rules of every server of the robot (REST and WebSocket, Snap!)."""
     announcer: Announcer | None = None
     version: str = field(default_factory=poppy_version)
+    settings_file: Path | None = None
+    """The serve options file (``poppy serve --settings``): Snap! and ZMQ are switched there."""
+    token_file: Path | None = None
+    """The token file (``poppy serve --token-file``): the token is changed there."""
 
     def named(self, name: str) -> None:
         """The robot is now ``name`` (an mDNS name won, a new name set): the Host check
@@ -69,6 +81,8 @@ class RobotSettings:
     def __init__(self, system: SystemTools | None = None) -> None:
         self.system = system or SystemTools()
         self.served = ServedRobot()
+        self._files = threading.Lock()
+        """One change of the service's files at a time (two pages: neither undoes the other)."""
 
     # -- reading -------------------------------------------------------------------------------
 
@@ -76,8 +90,9 @@ class RobotSettings:
         """Everything the settings panel shows, and whether (and why not) it can change it."""
         missing = self.system.unavailable()
         reason = self._without_token() or missing
+        how = "settings" if self.served.settings_file is not None else None
         services: dict[str, Any] = {
-            name: {"on": name in self.served.protocols, "unit": None, "how": f"serve {flag}"}
+            name: {"on": name in self.served.protocols, "unit": None, "how": how or f"serve {flag}"}
             for name, flag in SERVED_OPTIONS.items()
         }
         for name, unit in SERVICE_UNITS.items():
@@ -91,6 +106,8 @@ class RobotSettings:
             "announced": self.served.announcer is not None,
             "services": services,
             "token_required": self.served.token_required,
+            "token_changeable": self.served.token_required and self.served.token_file is not None,
+            "restarts": self.system.own_unit == SERVICE_UNIT,
             "version": self.served.version,
         }
 
@@ -99,7 +116,7 @@ class RobotSettings:
             return None
         return (
             "this server was started without --token: settings are changed only on a "
-            "robot whose server asks for a token (poppy service install --token ...)"
+            "robot whose server asks for a token (poppy service install --require-token)"
         )
 
     def wifi(self) -> dict[str, Any]:
@@ -114,13 +131,16 @@ class RobotSettings:
 
     def check_change(self) -> None:
         """Refuse a change (403 without a token, 409 without the OS's tools)."""
+        self._check_token()
+        self._check_system()
+
+    def _check_token(self) -> None:
         if not self.served.token_required:
             raise ApiError(
                 "forbidden",
                 "settings are changed only on a server started with --token",
-                tip="restart the server with --token (poppy service install --token ...)",
+                tip="restart the server with --token (poppy service install --require-token)",
             )
-        self._check_system()
 
     def _check_system(self) -> None:
         reason = self.system.unavailable()
@@ -175,21 +195,82 @@ class RobotSettings:
         logger.warning("settings: %s set up the fallback access point %r", who, ssid)
         return ssid
 
-    def set_service(self, service: str, on: bool, who: str) -> None:
-        """Start and enable a service's unit, or stop and disable it."""
+    def set_service(self, service: str, on: bool, who: str) -> bool:
+        """Start and enable a service's unit, or stop and disable it; Snap! and ZMQ are
+        switched in the settings file and ``poppy.service`` restarts. Returns True when the
+        server restarts now."""
         unit = SERVICE_UNITS.get(service)
         if unit is None:
             if service in SERVED_OPTIONS:
-                raise ApiError(
-                    "conflict",
-                    f"{service} is served by poppy.service itself",
-                    tip=f"reinstall the service with or without {SERVED_OPTIONS[service]}",
-                )
+                return self._set_option(service, on, who)
             known = ", ".join([*SERVICE_UNITS, *SERVED_OPTIONS])
             raise ApiError("not_found", f"no service {service!r} (services: {known})")
         self.check_change()
         self.system.set_service(unit, on)
         logger.warning("settings: %s turned %s %s", who, service, "on" if on else "off")
+        return False
+
+    def _set_option(self, service: str, on: bool, who: str) -> bool:
+        path = self.served.settings_file
+        if path is None:
+            raise ApiError(
+                "conflict",
+                f"{service} is an option of this server's command line ({SERVED_OPTIONS[service]}):"
+                " it was started without --settings",
+                tip="install the service (poppy service install) to switch it from the page",
+            )
+        self._check_token()
+        try:
+            with self._files:
+                options = serve_options.read_options(path)
+                changed = dataclasses.replace(options, **{service: on})
+                serve_options.write_options(path, changed)
+        except (ConfigError, FileError) as exc:
+            raise ApiError(
+                "conflict", str(exc), tip="the settings file could not be changed"
+            ) from None
+        logger.warning("settings: %s turned %s %s (%s)", who, service, "on" if on else "off", path)
+        return self._restart(path)
+
+    def set_token(self, token: str, who: str) -> bool:
+        """Write a new token in the token file; the server restarts with it (True), or takes
+        it at its next start (False)."""
+        try:
+            serve_options.check_token(token)
+        except ValueError as exc:
+            raise ApiError("invalid", str(exc)) from None
+        self._check_token()
+        path = self.served.token_file
+        if path is None:
+            raise ApiError(
+                "conflict",
+                "this server's token was given on its command line (--token), not in a file",
+                tip="install the service (poppy service install --require-token) to change it here",
+            )
+        try:
+            serve_options.write_token(path, token)
+        except FileError as exc:
+            raise ApiError(
+                "conflict", str(exc), tip="the token file could not be changed"
+            ) from None
+        logger.warning("settings: %s changed the token (%s)", who, path)
+        return self._restart(path)
+
+    def _restart(self, path: Path) -> bool:
+        """Restart ``poppy.service`` when this server is it; False when it is not."""
+        if self.system.own_unit != SERVICE_UNIT:
+            logger.warning("settings: %s changed; it applies when this server starts again", path)
+            return False
+        try:
+            self.system.restart_later(SERVICE_UNIT)
+        except SystemToolError as exc:
+            raise ApiError(
+                "conflict",
+                f"saved in {path}, but {exc}",
+                tip="it applies at the next start (`poppy service restart` restarts it now)",
+            ) from None
+        logger.warning("settings: %s restarts to apply it", SERVICE_UNIT)
+        return True
 
 
 def _name_of(hostname: str) -> str:

@@ -81,6 +81,16 @@ def user_manager(cgroup: str) -> bool:
     return "/user@" in cgroup
 
 
+def unit_of(cgroup: str) -> str | None:
+    """The systemd service running this process, from ``/proc/self/cgroup``'s text (None
+    outside one: a terminal's session or scope)."""
+    for line in cgroup.splitlines():
+        last = line.rsplit("/", 1)[-1].strip()
+        if last.endswith(".service") and not last.startswith("user@"):
+            return last
+    return None
+
+
 def _own_cgroup() -> str:
     try:
         return Path("/proc/self/cgroup").read_text(encoding="utf-8", errors="replace")
@@ -104,10 +114,20 @@ class SystemTools:
         user_units: reach the services with ``systemctl --user``; by default when this process
             runs under a user's systemd.
         timeout_s: the longest a command may take.
+        cgroup: ``/proc/self/cgroup``'s text (read when None): which systemd service, of the
+            system or of a user, runs this process.
     """
 
-    def __init__(self, user_units: bool | None = None, timeout_s: float = TIMEOUT_S) -> None:
-        self.user_units = user_manager(_own_cgroup()) if user_units is None else user_units
+    def __init__(
+        self,
+        user_units: bool | None = None,
+        timeout_s: float = TIMEOUT_S,
+        cgroup: str | None = None,
+    ) -> None:
+        cgroup = _own_cgroup() if cgroup is None else cgroup
+        self.user_units = user_manager(cgroup) if user_units is None else user_units
+        self.own_unit = unit_of(cgroup)
+        """The service running this server (``poppy.service`` under the installed service)."""
         self.timeout_s = timeout_s
 
     # -- running -------------------------------------------------------------------------------
@@ -270,3 +290,8 @@ class SystemTools:
         """Start and enable ``unit``, or stop and disable it (``systemctl enable|disable
         --now``)."""
         self.run(*self._systemctl("enable" if on else "disable", "--now", unit))
+
+    def restart_later(self, unit: str) -> None:
+        """Ask systemd to restart ``unit`` and return at once (``systemctl restart --no-block``):
+        the unit may be the one running this server, which answers before it is stopped."""
+        self.run(*self._systemctl("restart", "--no-block", unit))

@@ -3,10 +3,12 @@ by a recording fake put first on PATH (issue 26.1). Release/take are tested on a
 
 from __future__ import annotations
 
+import json
 import os
 import shlex
 import shutil
 import signal
+import stat
 import subprocess
 from pathlib import Path
 
@@ -34,9 +36,12 @@ class Fake(RecordingFake):
     def __init__(self, root: Path) -> None:
         super().__init__(root)
         self.units = root / "units"
+        self.files = root / "service"
 
     def env(self, **more: str) -> dict[str, str]:
-        return super().env(POPPY_UNIT_DIR=str(self.units), **more)
+        return super().env(
+            POPPY_UNIT_DIR=str(self.units), POPPY_SERVICE_DIR=str(self.files), **more
+        )
 
     def run(self, *args: str, **env: str) -> Result:
         return run_poppy("service", *args, env=self.env(**env))
@@ -66,7 +71,7 @@ def exec_start(unit: str) -> list[str]:
 def test_the_user_unit_is_one_systemd_accepts(tmp_path: Path) -> None:
     if shutil.which("systemd-analyze") is None:
         pytest.skip("systemd-analyze is not installed (.ci/run installs Debian's systemd)")
-    result = run_poppy("service", "install", "--user", "--dry-run")
+    result = run_poppy("service", "install", "--user", "--dry-run", "--require-token")
     assert result.code == 0, result.stderr
     unit = tmp_path / "poppy.service"
     unit.write_text(result.stdout)
@@ -77,7 +82,9 @@ def test_the_user_unit_is_one_systemd_accepts(tmp_path: Path) -> None:
     args = exec_start(result.stdout)
     assert Path(args[0]).is_absolute() and Path(args[0]).name == "poppy"
     expected = "serve --http --host 0.0.0.0 --http-port 8080 --profile ergo-jr --port auto"
-    assert args[1:] == [*expected.split(), "--wait-for-motors", "--name", "poppy", "--announce"]
+    assert args[1:-4] == [*expected.split(), "--wait-for-motors", "--name", "poppy", "--announce"]
+    assert args[-4] == "--settings" and args[-2] == "--token-file"  # the token not in the unit
+    assert Path(args[-3]).name == "serve.json" and Path(args[-1]).name == "token"
     assert "Restart=on-failure" in result.stdout and "WantedBy=default.target" in result.stdout
     assert "AmbientCapabilities" not in result.stdout  # a user's manager cannot grant it
     assert (
@@ -92,7 +99,7 @@ def test_the_system_unit_serves_port_80_without_root(someone: str) -> None:
     unit = result.stdout
     args = exec_start(unit)
     assert args[args.index("--http-port") + 1] == "80" and args.count("--http-port") == 2
-    assert "8080" in args and args[-1] == "--snap"
+    assert "8080" in args and "--snap" not in args and args[-2] == "--settings"
     for line in (
         "AmbientCapabilities=CAP_NET_BIND_SERVICE",
         f"User={someone}",
@@ -129,6 +136,32 @@ def test_install_writes_the_units_then_reloads_enables_and_starts(fake: Fake, so
         ["systemctl", "restart", "poppy.service"],
     ]
     assert sorted(p.name for p in fake.units.iterdir()) == ["poppy.service"]
+
+
+def test_install_writes_the_settings_file_and_a_token_only_its_user_reads(
+    fake: Fake, someone: str
+) -> None:
+    result = fake.run("install", "--run-as", someone, "--snap", "--require-token")
+    assert result.code == 0, result.stderr
+    settings, token = fake.files / "serve.json", fake.files / "token"
+    assert json.loads(settings.read_text()) == {"snap": True, "zmq": False}
+    assert stat.S_IMODE(token.stat().st_mode) == 0o600
+    secret = token.read_text().strip()
+    assert len(secret) >= 16 and secret in result.stdout  # told once, at install
+    unit = (fake.units / "poppy.service").read_text()
+    assert secret not in unit
+    args = exec_start(unit)
+    assert args[-4:] == ["--settings", str(settings), "--token-file", str(token)]
+
+    # installed again: the options as its flags say, the token (maybe changed by the page) kept
+    token.write_text("set-from-the-page\n")
+    again = fake.run("install", "--run-as", someone, "--zmq", "--require-token")
+    assert again.code == 0, again.stderr
+    assert json.loads(settings.read_text()) == {"snap": False, "zmq": True}
+    assert token.read_text() == "set-from-the-page\n" and "token" not in again.stdout
+    assert "--token-file" in exec_start((fake.units / "poppy.service").read_text())
+    assert fake.run("install", "--run-as", someone).code == 0  # no --require-token: none
+    assert "--token-file" not in exec_start((fake.units / "poppy.service").read_text())
 
 
 def test_a_user_install_drives_the_user_manager(fake: Fake) -> None:
@@ -250,7 +283,15 @@ def test_the_units_exec_start_run_as_is_serves_the_page(tmp_path: Path) -> None:
     (virtual,) = virtual_buses(load_profile("ergo-jr")).values()
     port = str(tmp_path / "ttyDXL")
     install = ("install", "--user", "--dry-run", "--host", "127.0.0.1", "--port", port)
-    result = run_poppy("service", *install, "--http-port", "0", "--http-port", "0")
+    result = run_poppy(
+        "service",
+        *install,
+        "--http-port",
+        "0",
+        "--http-port",
+        "0",
+        env={"POPPY_SERVICE_DIR": str(tmp_path / "service")},  # none: Snap! and ZMQ off
+    )
     assert result.code == 0, result.stderr
     env = dict(os.environ, POPPY_MOVES_DIR=str(tmp_path / "moves"), NO_COLOR="1")
     with serve_pty(virtual, link=port):
@@ -302,3 +343,57 @@ def test_is_active_asks_systemctl(fake: Fake, monkeypatch: pytest.MonkeyPatch) -
         ["systemctl", "--user", "is-active", "--quiet", "poppy.service"],
         ["systemctl", "is-active", "--quiet", "poppy.service"],
     ]
+
+
+def test_the_installed_service_reads_its_token_and_options_from_its_files(
+    fake: Fake, tmp_path: Path
+) -> None:
+    (virtual,) = virtual_buses(load_profile("ergo-jr")).values()
+    port = str(tmp_path / "ttyDXL")
+    install = ("install", "--user", "--require-token", "--host", "127.0.0.1", "--port", port)
+    assert fake.run(*install, "--http-port", "0").code == 0
+    token = (fake.files / "token").read_text().strip()
+    env = dict(os.environ, POPPY_MOVES_DIR=str(tmp_path / "moves"), NO_COLOR="1")
+    env.pop("POPPY_TOKEN", None)
+    with serve_pty(virtual, link=port):
+        proc = subprocess.Popen(
+            exec_start((fake.units / "poppy.service").read_text()),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        try:
+            assert proc.stdout is not None
+            url = next(line.strip() for line in proc.stdout if line.startswith("http://"))
+            assert httpx.get(url + "/api/v1/motors", timeout=30).status_code == 401
+            bearer = {"Authorization": f"Bearer {token}"}
+            shown = httpx.get(url + "/api/v1/settings", headers=bearer, timeout=30).json()
+            assert shown["token_required"] and shown["token_changeable"]
+            assert shown["services"]["snap"] == {"on": False, "unit": None, "how": "settings"}
+            assert shown["restarts"] is False  # run by hand, not by systemd
+        finally:
+            proc.send_signal(signal.SIGTERM)
+            assert proc.wait(timeout=30) == 0
+            reap(proc)
+
+
+@pytest.mark.parametrize(
+    ("args", "says", "code"),
+    [
+        (("--settings", "s.json", "--snap"), "leave --snap and --zmq out", 2),
+        (("--token-file", "t", "--token", "x" * 16), "not both", 2),
+        (("--token-file", "missing-token"), "missing-token does not exist", 1),
+        (("--settings", "bad.json"), "is not JSON", 1),
+    ],
+)
+def test_serve_s_files_refused_in_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, args: tuple[str, ...], says: str, code: int
+) -> None:
+    (tmp_path / "bad.json").write_text("{")
+    monkeypatch.delenv("POPPY_TOKEN", raising=False)
+    given = [a if a.startswith(("-", "x")) else str(tmp_path / a) for a in args]
+    result = run_poppy("serve", "--http", "--sim", "--profile", "ergo-jr", *given)
+    assert result.code == code, result.stderr
+    assert says in result.stderr and "Traceback" not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr

@@ -184,3 +184,17 @@ def test_a_lock_file_removed_under_a_waiting_writer_does_not_let_two_in(
     third = FileLock(target).acquire()  # free again once B is done
     third.release()
     assert not (tmp_path / ".take.move.lock").exists()
+
+
+def test_a_secret_is_its_owner_s_alone_from_its_creation(tmp_path: Path) -> None:
+    old = os.umask(0)  # the loosest umask: the mode asked for still holds
+    try:
+        secret = write_file(tmp_path / "token", "s3cret\n", mode=0o600)
+        assert stat.S_IMODE(secret.stat().st_mode) == 0o600
+        shared = tmp_path / "shared"
+        shared.write_text("old")
+        shared.chmod(0o644)
+        write_file(shared, "new", replace=True, mode=0o600)  # not the replaced file's bits
+        assert stat.S_IMODE(shared.stat().st_mode) == 0o600 and shared.read_text() == "new"
+    finally:
+        os.umask(old)

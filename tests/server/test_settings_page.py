@@ -78,3 +78,39 @@ def test_without_networkmanager_the_panel_is_read_only_and_says_why(
     finally:
         context.close()
     assert fake.changes() == []
+
+
+def test_zmq_and_the_token_from_the_page_write_the_files_and_restart_the_service(
+    browser: Any,
+    with_token: Served,
+    fake: FakeTools,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from poppy_core.server import serve_options
+    from poppy_core.server.settings_os import SystemTools
+
+    folder = tmp_path / "service"
+    serve_options.write_options(folder / "serve.json", serve_options.ServeOptions())
+    serve_options.write_token(folder / "token", "an-old-token-1")
+    settings = with_token.app.state.settings
+    monkeypatch.setattr(settings.served, "settings_file", folder / "serve.json")
+    monkeypatch.setattr(settings.served, "token_file", folder / "token")
+    monkeypatch.setattr(settings, "system", SystemTools(cgroup="0::/system.slice/poppy.service"))
+    restart = ["systemctl", "restart", "--no-block", "poppy.service"]
+    context, page = _settings_page(browser, with_token)
+    try:
+        page.check("#settings-zmq")
+        assert eventually(lambda: fake.changes() == [restart], 30.0)
+        assert serve_options.read_options(folder / "serve.json").zmq
+        page.wait_for_function(
+            "() => document.getElementById('message').textContent.includes('Reconnected')"
+        )
+        page.fill("#settings-new-token", "a-new-token-42")
+        page.click("#settings-change-token")
+        assert eventually(lambda: fake.changes() == [restart, restart], 30.0)
+        assert serve_options.read_token(folder / "token") == "a-new-token-42"
+        # the page sends the new token once the service is back
+        page.wait_for_function("() => localStorage.getItem('poppy-token') === 'a-new-token-42'")
+    finally:
+        context.close()

@@ -63,6 +63,12 @@ class ServiceBody(BaseModel):
     on: bool
 
 
+class TokenBody(BaseModel):
+    """The new token (the request itself carries the current one)."""
+
+    token: str = Field(..., max_length=128, description="12 to 128 visible ASCII characters")
+
+
 def _settings(request: Request) -> RobotSettings:
     settings = request.app.state.settings
     assert isinstance(settings, RobotSettings)
@@ -123,6 +129,14 @@ async def hotspot(body: HotspotBody, request: Request) -> dict[str, Any]:
 
 @router.put("/services/{service}", summary="Start and enable a service, or stop and disable it")
 async def set_service(service: str, body: ServiceBody, request: Request) -> dict[str, Any]:
-    """``jupyter`` (poppy-jupyter.service); Snap! and ZMQ are options of poppy.service."""
-    await _os(_settings(request).set_service, service, body.on, _who(request))
-    return {"service": service, "on": body.on}
+    """``jupyter`` (poppy-jupyter.service); ``snap`` and ``zmq`` are written in the settings
+    file of poppy.service, which restarts (``restarting``: the page reconnects)."""
+    restarting = await _os(_settings(request).set_service, service, body.on, _who(request))
+    return {"service": service, "on": body.on, "restarting": restarting}
+
+
+@router.put("/token", summary="Change the token (written in the token file; the server restarts)")
+async def set_token(body: TokenBody, request: Request) -> dict[str, Any]:
+    """``restarting``: poppy.service restarts with the new token now (else at its next start)."""
+    restarting = await _os(_settings(request).set_token, body.token, _who(request))
+    return {"changed": True, "restarting": restarting}

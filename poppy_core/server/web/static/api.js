@@ -10,6 +10,11 @@ export function token() {
   return localStorage.getItem(TOKEN_KEY) || "";
 }
 
+// The token the page sends from now on (the settings changed it).
+export function setToken(value) {
+  localStorage.setItem(TOKEN_KEY, value);
+}
+
 function hex(text) {
   return [...new TextEncoder().encode(text)].map((b) => b.toString(16).padStart(2, "0")).join("");
 }

@@ -1,7 +1,7 @@
 // The settings panel: the robot's name, Wi-Fi, services, token and version (/api/v1/settings).
 // Read-only, with the reason, where the server cannot change them (no --token, no
 // NetworkManager); every change goes through the API with the token, and the server logs it.
-import { api, get } from "./api.js";
+import { api, get, setToken } from "./api.js";
 import { button, el, say } from "./ui.js";
 
 let loaded = false;
@@ -13,9 +13,26 @@ function row(label, ...content) {
 async function change(method, path, body, done) {
   try {
     const answer = await api(method, path, body);
-    say(done(answer));
+    say(done(answer) + (answer.restarting ? " · poppy.service restarts: reconnecting…" : ""));
+    if (answer.restarting) { await backAgain(); return; }
   } catch (error) {
     say(`Settings: ${error.message}`, true);
+  }
+  await showSettings();
+}
+
+// After a change that restarts the service: wait until the server answers again.
+async function backAgain() {
+  await new Promise((resolve) => setTimeout(resolve, 2000));
+  for (let tries = 0; tries < 60; tries += 1) {
+    try {
+      await get("/api/v1/settings");
+      await showSettings();
+      say("Reconnected: the change is applied");
+      return;
+    } catch (error) {
+      await new Promise((resolve) => setTimeout(resolve, 1000));
+    }
   }
   await showSettings();
 }
@@ -73,6 +90,13 @@ function wifiRow(settings) {
 
 function servicesRow(settings) {
   const items = Object.entries(settings.services).map(([name, service]) => {
+    if (service.how === "settings") { // Snap!, ZMQ: the service's settings file, then it restarts
+      const box = el("input", { id: `settings-${name}`, type: "checkbox", checked: Boolean(service.on), disabled: !settings.token_required });
+      box.setAttribute("aria-label", `${name} on`);
+      box.addEventListener("change", () => change("PUT", `/api/v1/settings/services/${name}`, { on: box.checked },
+        (answer) => `${name} ${box.checked ? "on" : "off"}${answer.restarting ? "" : " at the next start"}`));
+      return el("li", {}, el("label", {}, box, ` ${name} (poppy.service)`));
+    }
     if (service.how !== "systemctl") {
       return el("li", { textContent: `${name}: ${service.on ? "on" : "off"} (poppy serve ${service.how.replace("serve ", "")})` });
     }
@@ -85,6 +109,24 @@ function servicesRow(settings) {
   return row("Services", el("ul", { className: "buses" }, ...items));
 }
 
+function tokenRow(settings) {
+  if (!settings.token_changeable) {
+    const shown = settings.token_required ? "required (given on the server's command line)" : "none";
+    return row("Token", el("span", { id: "settings-token", textContent: shown }));
+  }
+  const input = el("input", { id: "settings-new-token", type: "password", size: 16, placeholder: "12+ characters" });
+  input.setAttribute("aria-label", "new token");
+  const apply = button("Change the token", () => {
+    const chosen = input.value;
+    return change("PUT", "/api/v1/settings/token", { token: chosen }, (answer) => {
+      if (answer.restarting) setToken(chosen); // the server keeps the old one until it starts again
+      return `Token changed${answer.restarting ? "" : " (it applies at the next start)"}`;
+    });
+  });
+  apply.id = "settings-change-token";
+  return row("Token", el("span", { textContent: "required " }), input, " ", apply);
+}
+
 export async function showSettings() {
   const body = document.getElementById("settings-body");
   let settings;
@@ -92,7 +134,7 @@ export async function showSettings() {
   const reason = el("p", { id: "settings-reason", className: "muted", hidden: settings.editable,
     textContent: settings.editable ? "" : `Read-only here: ${settings.reason}` });
   body.replaceChildren(reason, nameRow(settings), wifiRow(settings), servicesRow(settings),
-    row("Token", el("span", { textContent: settings.token_required ? "required (set when the service was installed)" : "none" })),
+    tokenRow(settings),
     row("Version", el("span", { id: "settings-version", textContent: `poppy ${settings.version}` })));
 }
 
