@@ -27,6 +27,8 @@ def _custom(tmp_path: Path, kinematics: dict[str, Any], model: str = "poppy_ergo
     data["profile"] = {"name": "my-arm", "kind": "my-arm"}
     data["kinematics"] = kinematics
     shutil.copy(PROFILES / "ergo-jr" / model, tmp_path / model)
+    if model.endswith(".xml"):  # an MJCF model names its meshes (meshdir="meshes")
+        shutil.copytree(PROFILES / "ergo-jr" / "meshes", tmp_path / "meshes")
     path = tmp_path / "my-arm.yaml"
     path.write_text(yaml.safe_dump(data), encoding="utf-8")
     return path
