@@ -8,6 +8,7 @@ import time
 from poppy_core.bus import DxlBus
 from poppy_core.emulator import FaultInjector, build_bus_from_spec, serve_pty
 from poppy_core.protocol import ping
+from tests.helpers.bus import LOADED_REPLY_FLOOR_S
 
 MX_PRESENT = 36  # MX-28 present position (e-manual), 2 bytes
 XL_PRESENT = 37  # XL-320 present position (e-manual), 2 bytes
@@ -34,7 +35,10 @@ def test_a_garbled_usb2ax_reply_keeps_the_sync_read() -> None:
     faults = GarbleReplies(set())
     virtual = build_bus_from_spec("MX-28:1-6", adapter="usb2ax", faults=faults)
     ids = [1, 2, 3, 4, 5, 6]
-    with serve_pty(virtual) as server, DxlBus(server.url) as bus:
+    with (
+        serve_pty(virtual) as server,
+        DxlBus(server.url, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus,
+    ):
         expected = {i: bus.read(i, MX_PRESENT, 2) for i in ids}
         assert bus.sync_read(MX_PRESENT, 2, ids) == expected
         assert (bus.sync_read_mode, bus.usb2ax) == ("sync", True)
@@ -46,7 +50,10 @@ def test_a_garbled_usb2ax_reply_keeps_the_sync_read() -> None:
 def test_a_motor_garbled_in_every_group_reply_is_read_on_its_own() -> None:
     faults = GarbleReplies(set())
     virtual = build_bus_from_spec("XL-320:1-3", protocol=2, faults=faults)
-    with serve_pty(virtual) as server, DxlBus(server.url, protocol=2) as bus:
+    with (
+        serve_pty(virtual) as server,
+        DxlBus(server.url, protocol=2, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus,
+    ):
         expected = {i: bus.read(i, XL_PRESENT, 2) for i in (1, 2, 3)}
         # the sync read: replies 1-3; its retry asks motor 2 alone: reply 4
         faults.which = {faults.count + 2, faults.count + 4}

@@ -8,6 +8,7 @@ scan at 1 Mbps 37 % slower). These tests check the deadlines given, never a dura
 
 from __future__ import annotations
 
+import importlib
 from collections import defaultdict
 from collections.abc import Sequence
 from typing import Any
@@ -28,6 +29,8 @@ from poppy_core.bus.timing import (
 from poppy_core.emulator import FaultInjector, VirtualBus, VirtualMotor, serve_link
 from poppy_core.models import model_by_name
 from poppy_core.protocol import Instruction, InstructionPacket, StatusPacket
+
+scan_module = importlib.import_module("poppy_core.bus.scan")  # the package's `scan` is the function
 
 
 class LateOnce(FaultInjector):
@@ -172,23 +175,38 @@ def test_a_reply_late_once_does_not_lengthen_the_quiet_time(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     # The latency a late reply taught is doubted before the line is left quiet: motor 9, found
-    # on time in the pass, answers on time again, so the quiet time is an on-time adapter's.
-    listened: list[float] = []
+    # late in the pass, answers on time when asked again, so the quiet time is the latency's of
+    # that answer, not the late reply's. (On an idle machine, an on-time adapter's 1 ms; a busy
+    # machine may run the emulator a few ms late for that answer too: the quiet time follows
+    # the latency in force, which is the claim; comparing it with 1 ms's failed at load 8.)
+    listened: list[tuple[float, float]] = []
+    doubted: list[tuple[float, float]] = []
     real_listen = bus_core.BusCore.listen
+    real_doubt = scan_module.doubt_learned
 
     def listen(self: bus_core.BusCore, duration_s: float) -> list[StatusPacket]:
-        listened.append(duration_s)
+        listened.append((duration_s, self.latency_s))
         return real_listen(self, duration_s)
 
+    def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> None:
+        learned = bus.latency_s
+        real_doubt(bus, before_s, motor_id)
+        doubted.append((learned, bus.latency_s))
+
     monkeypatch.setattr(bus_core.BusCore, "listen", listen)
+    monkeypatch.setattr(scan_module, "doubt_learned", doubt_learned)
+    late_s = 0.015
     motors = [VirtualMotor(model_by_name("MX-28"), i, 1_000_000) for i in (3, 9)]
     virtual = VirtualBus(
-        motors, 1, wire_timing=True, latency_s=0.001, faults=LateOnce(3, 0.015)
+        motors, 1, wire_timing=True, latency_s=0.001, faults=LateOnce(3, late_s)
     )  # the 3rd reply: motor 9's ping (motor 3's ping and model read came first)
     with serve_link(virtual) as server:
         found = scan(server.url, [1_000_000], [1], ids=range(30), latency_s=0.001)
     assert sorted(f.id for f in found) == [3, 9]
-    assert listened and max(listened) <= settle_s(0.001)
+    # the late reply taught a latency, which was doubted (a busy machine may teach more)
+    assert any(learned >= late_s and kept < learned for learned, kept in doubted)
+    quiet_s, latency_s = listened[-1]  # the quiet time before the next rate
+    assert latency_s < late_s and quiet_s <= settle_s(latency_s)  # not the late reply's
 
 
 def test_a_slow_adapters_silent_ids_wait_the_ports_deadline(

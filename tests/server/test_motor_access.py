@@ -19,6 +19,7 @@ from poppy_core.assembly import Listen, ServeSpec, serve
 from poppy_core.emulator import Endpoint, serve_pty
 from poppy_core.robot import Robot, from_profile, load_profile
 from poppy_core.robot.factory import virtual_buses
+from tests.helpers.bus import LOADED_REPLY_FLOOR_S
 from tests.helpers.waiting import eventually
 
 TOKEN = "s3cret"
@@ -31,7 +32,7 @@ from poppy_core.errors import PoppyError
 from poppy_core.models import model_by_name
 xl320 = model_by_name("XL-320")
 try:
-    with DxlBus(sys.argv[1], 1_000_000, 2) as bus:
+    with DxlBus(sys.argv[1], 1_000_000, 2, min_timeout_s=float(sys.argv[2])) as bus:
         found = {i: bus.read_register(i, xl320, "present_position") for i in range(1, 7)}
 except PoppyError as exc:
     print(json.dumps({"error": str(exc)}))
@@ -42,7 +43,10 @@ else:
 
 def read_from_another_process(port: str) -> dict[str, object]:
     done = subprocess.run(
-        [sys.executable, "-c", READER, port], capture_output=True, text=True, timeout=60
+        [sys.executable, "-c", READER, port, str(LOADED_REPLY_FLOOR_S)],
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert done.returncode == 0, done.stderr
     answer: dict[str, object] = json.loads(done.stdout)

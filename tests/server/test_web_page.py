@@ -414,3 +414,49 @@ def test_the_links_offer_the_notebook_and_the_notes_of_the_server(
         assert "poppy snap download" in page.inner_text("#note-snap")
     finally:
         served.app.state.web_notes.clear()
+
+
+def test_a_refusal_of_a_token_replaced_meanwhile_asks_nothing(
+    browser: Any, with_token: Served
+) -> None:
+    # A call sent with a wrong token whose 401 comes back after the right token was entered (a
+    # busy server answers late) tries the new token; it used to ask for the token again, and
+    # the page then waited on that dialog.
+    context = browser.new_context()
+    tab = context.new_page()
+    tab.set_default_timeout(WAIT_S * 1000)
+    held: list[Any] = []
+    answered: list[tuple[str, str | None, int]] = []
+
+    def hold_one(route: Any) -> None:
+        if not held and route.request.headers.get("authorization") == "Bearer wrong":
+            held.append(route)  # let through once the right token is in
+        else:
+            route.continue_()
+
+    tab.route("**/api/v1/**", hold_one)
+    tab.on(
+        "response",
+        lambda r: answered.append((r.url, r.request.headers.get("authorization"), r.status)),
+    )
+    tab.goto(with_token.url + "/")
+    tab.wait_for_selector("#token-dialog[open]")
+    tab.fill("#token-input", "wrong")
+    tab.click("#token-ok")
+    tab.wait_for_selector("#token-dialog[open]")  # the other calls were refused
+    assert held, "no call was sent with the wrong token"
+    tab.fill("#token-input", "s3cret-page")
+    tab.click("#token-ok")
+    tab.wait_for_selector("#token-dialog", state="hidden")
+    url = held[0].request.url
+    held[0].continue_()
+
+    def retried() -> bool:
+        tab.wait_for_timeout(20)  # lets Playwright deliver its events
+        return (url, "Bearer s3cret-page", 200) in answered
+
+    eventually(retried, "the refused call tried again with the right token")
+    assert (url, "Bearer wrong", 401) in answered
+    tab.wait_for_function(LIVE, timeout=2 * WAIT_S * 1000)
+    assert not tab.is_visible("#token-dialog")
+    context.close()

@@ -61,13 +61,17 @@ async function problem(response) {
 export async function api(method, path, body) {
   for (;;) {
     const headers = {};
-    if (token()) headers.Authorization = `Bearer ${token()}`;
+    const sent = token();
+    if (sent) headers.Authorization = `Bearer ${sent}`;
     if (body !== undefined) headers["Content-Type"] = "application/json";
     const response = await fetch(path, {
       method, headers, body: body === undefined ? undefined : JSON.stringify(body),
     });
     if (response.status === 401) {
-      await askToken(Boolean(token()));
+      // A token entered while this call was out (its 401 came late) is tried first: asking
+      // again would open the dialog over a page that works.
+      if (token() !== sent) continue;
+      await askToken(Boolean(sent));
       continue;
     }
     if (!response.ok) throw new ApiError(response.status, await problem(response));
