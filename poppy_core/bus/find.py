@@ -19,6 +19,13 @@ DEFAULT_SEARCH_FIRST_BPS = 1_000_000
 FACTORY_BPS = 57_600
 """The factory rate of MX and X-series motors: searched second, so a new motor is found early."""
 PROTOCOLS = (1, 2)
+PATIENT_LATENCY_S = 0.15
+"""The adapter latency assumed by the last, patient look of a search that found nothing: a
+machine too busy to run the motors' replies on time (a loaded Pi, an emulator under load) is
+then found at the common rates, for a few seconds more before a search that must fail."""
+PATIENT_RATES = 1
+"""How many of the first rates of the plan the patient look tries again: 1 Mbps, the rate of
+Poppy robots (each rate more costs about a second before a search that must fail)."""
 
 
 def _answering(bus: DxlBus, wanted: list[int]) -> tuple[list[int], set[int]]:
@@ -97,6 +104,14 @@ def _search(
                     return again
             previous[protocol] = rate
             closest.offer(bus, answered)
+    if closest.count:  # some motors answered in time: the others are absent, not late
+        return None
+    patient = max(learned or 0.0, PATIENT_LATENCY_S)
+    for rate, protocols in plan[:PATIENT_RATES]:
+        for protocol in protocols:
+            bus = _search_bus(port, rate, protocol, transport, patient)
+            if len(_answering(bus, wanted)[0]) == len(wanted):
+                return bus
     return None
 
 
@@ -124,7 +139,9 @@ def find_bus(
 
     A motor that answers is asked again once the line has settled, so that a late reply (a
     slow adapter) is not taken for a motor at the next rate tried; a slower adapter than
-    assumed is learned from its replies (see ``poppy_core.bus.latency``).
+    assumed is learned from its replies (see ``poppy_core.bus.latency``). When nothing at all
+    answered, the first rates are tried once more with a patient wait (``PATIENT_LATENCY_S``):
+    replies a busy machine made late are not taken for an empty bus.
 
     Raises:
         PortError: no serial port at all; the only port given (or every one) cannot be opened.

@@ -110,6 +110,17 @@ def test_find_bus_closes_the_port_when_nothing_answers(counts: Counts) -> None:
     assert not counts.lines[0].is_open
 
 
+@pytest.mark.parametrize("late_s", [0.05, 0.1])
+def test_a_motor_whose_replies_a_busy_machine_makes_late_is_still_found(late_s: float) -> None:
+    # Every reply is late (an emulator, or a Pi, too busy to answer on time): the quick search
+    # hears nothing in time, and the patient last look at 1 Mbps finds the motor rather than
+    # calling an empty bus.
+    with emulate_bus("XL-320:1-6", protocol=2) as (bus, url):
+        bus.extra_delay_s = late_s
+        with find_bus([3], [url]) as found:
+            assert (found.baudrate, found.protocol) == (1_000_000, 2)
+
+
 def test_a_named_port_that_cannot_open_is_a_port_error() -> None:
     with pytest.raises(PortError, match="no such port"):
         find_bus([3], ["/dev/ttyUSB_poppy_missing_6"])
