@@ -80,7 +80,9 @@ def install(
     """Write poppy.service (and poppy-jupyter.service), reload systemd, enable and start it."""
     from poppy_cli import service_unit as units
     from poppy_cli.service_files import files_of, write_files
+    from poppy_cli.service_polkit import RULE_FILE, polkit_dir, rule_text
     from poppy_cli.systemd import Systemd, unit_dir
+    from poppy_core.files import write_file
     from poppy_core.robot import load_profile
     from poppy_core.server.serve_options import ServeOptions
 
@@ -123,6 +125,8 @@ def install(
             print(text)
         scope = "--user " if user else ""
         written = [str(folder / u) for u in texts] + [str(files.settings)]
+        if run_as is not None:
+            written.append(str(polkit_dir() / RULE_FILE))
         if token:
             written.append(f"{files.token} (a random token, unless it holds one)")
         err_console.print(
@@ -137,6 +141,13 @@ def install(
     systemd.systemctl("--version")  # no systemd: one line before anything is written
     made = write_files(files, ServeOptions(snap=snap, zmq=zmq), token, run_as)
     _write_units(folder, texts)
+    if run_as is not None:  # the page's restarts and settings, for the service's user
+        write_file(
+            polkit_dir() / RULE_FILE,
+            rule_text(run_as, (units.UNIT, units.JUPYTER_UNIT)),
+            replace=True,
+            make_folder=True,
+        )
     _remove_units(systemd, folder, [u for u in stale if (folder / u).exists()])
     systemd.systemctl("daemon-reload")
     systemd.systemctl("enable", *texts)
@@ -316,6 +327,10 @@ def uninstall(user: bool = UserOpt) -> None:
         return
     systemd.systemctl("--version")
     _remove_units(systemd, unit_dir(user), list(reversed(names)))
+    if not user:
+        from poppy_cli.service_polkit import RULE_FILE, polkit_dir
+
+        (polkit_dir() / RULE_FILE).unlink(missing_ok=True)
     systemd.systemctl("daemon-reload")
     console.print(f"removed {', '.join(names)}", highlight=False, markup=False)
 

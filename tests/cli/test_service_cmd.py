@@ -37,10 +37,14 @@ class Fake(RecordingFake):
         super().__init__(root)
         self.units = root / "units"
         self.files = root / "service"
+        self.polkit = root / "polkit"
 
     def env(self, **more: str) -> dict[str, str]:
         return super().env(
-            POPPY_UNIT_DIR=str(self.units), POPPY_SERVICE_DIR=str(self.files), **more
+            POPPY_UNIT_DIR=str(self.units),
+            POPPY_SERVICE_DIR=str(self.files),
+            POPPY_POLKIT_DIR=str(self.polkit),
+            **more,
         )
 
     def run(self, *args: str, **env: str) -> Result:
@@ -397,3 +401,57 @@ def test_serve_s_files_refused_in_one_line(
     assert result.code == code, result.stderr
     assert says in result.stderr and "Traceback" not in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+
+
+def test_a_system_install_lets_its_user_restart_its_units_and_nothing_more(
+    fake: Fake, someone: str
+) -> None:
+    # The page's settings restart poppy.service and change the name and Wi-Fi as the service's
+    # user: a polkit rule allows exactly that, and goes with the service.
+    assert fake.run("install", "--run-as", someone).code == 0
+    rule = (fake.polkit / "50-poppy.rules").read_text()
+    assert f'subject.user != "{someone}"' in rule
+    assert '["poppy.service", "poppy-jupyter.service"]' in rule
+    assert '["start", "stop", "restart"]' in rule
+    assert "org.freedesktop.hostname1.set-static-hostname" in rule
+    assert "org.freedesktop.NetworkManager.settings.modify.system" in rule
+    assert "polkit.Result.YES" in rule and '"enable"' not in rule  # never enable other units
+    assert fake.run("uninstall").code == 0
+    assert not (fake.polkit / "50-poppy.rules").exists()
+    assert fake.run("install", "--user").code == 0  # a user's manager needs no rule
+    assert not (fake.polkit / "50-poppy.rules").exists()
+
+
+def test_the_polkit_rule_answers_as_polkit_would_ask(tmp_path: Path) -> None:
+    # polkit runs the rule as JavaScript: Node.js stands in for its interpreter, with a
+    # polkit object that records the rule and actions that answer lookup("unit"/"verb").
+    import shutil
+    import subprocess
+
+    from poppy_cli.service_polkit import rule_text
+
+    node = shutil.which("node")
+    if node is None:
+        pytest.skip("Node.js is not installed: the rule's JavaScript is not run")
+    probe = tmp_path / "rule.js"
+    probe.write_text(
+        "var rules = [];\n"
+        'var polkit = {Result: {YES: "yes", NOT_HANDLED: "no"}, '
+        "addRule: function (f) { rules.push(f); }};\n"
+        + rule_text("pi", ("poppy.service", "poppy-jupyter.service"))
+        + "function ask(id, unit, verb, user) {\n"
+        '  var action = {id: id, lookup: function (k) { return k == "unit" ? unit : verb; }};\n'
+        "  return rules[0](action, {user: user});\n"
+        "}\n"
+        'var units = "org.freedesktop.systemd1.manage-units";\n'
+        "console.log([\n"
+        '  ask(units, "poppy.service", "restart", "pi"),\n'
+        '  ask(units, "poppy-jupyter.service", "stop", "pi"),\n'
+        '  ask(units, "ssh.service", "restart", "pi"),\n'
+        '  ask(units, "poppy.service", "restart", "bob"),\n'
+        '  ask("org.freedesktop.hostname1.set-static-hostname", "", "", "pi"),\n'
+        '  ask("org.freedesktop.login1.reboot", "", "", "pi"),\n'
+        '].join(" "));\n'
+    )
+    out = subprocess.run([node, str(probe)], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["yes", "yes", "no", "no", "yes", "no"]
