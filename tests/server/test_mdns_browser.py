@@ -146,3 +146,101 @@ def test_a_page_on_another_port_drives_the_robot_only_from_its_name(
     assert seen == expected
     assert robot.compliant is not moved
     robot.compliant = True
+
+
+# The requests of poppy-monitor (github poppy-project/poppy-monitor a90d302: lib/ajax.js posts
+# JSON with "Content-Type: application/json; charset=UTF-8", js/poppy-object.js polls
+# /robot.json and uses pypot's singular /motor/ and /primitive/ paths) and of puppet-master's
+# move recorder (poppy-project/puppet-master, templates/EN/move-recorder.html: jQuery's $.post
+# of a JSON string, sent form-encoded, and $.get), replayed from a page of the robot's name on
+# another port with each client's own request form: the paths, methods, bodies and headers as
+# those clients send them (their code is not copied).
+CLIENTS = """<!doctype html><title>clients</title><script>
+const base = "http://%(host)s:%(port)d";
+const JSON_TYPE = "application/json; charset=UTF-8";
+const FORM_TYPE = "application/x-www-form-urlencoded; charset=UTF-8";
+function xhr(method, path, body, type) {
+  return new Promise(resolve => {
+    const req = new XMLHttpRequest();
+    req.open(method, base + path, true);
+    req.onreadystatechange = () => { if (req.readyState == 4) resolve(req.status || "blocked"); };
+    if (type) req.setRequestHeader("Content-Type", type);
+    req.send(body);
+  });
+}
+const pause = ms => new Promise(resolve => setTimeout(resolve, ms));
+async function main() {
+  const out = [];
+  const step = async (name, run) => out.push([name, await run()]);
+  // poppy-monitor
+  await step("monitor robot.json", () => xhr("GET", "/robot.json", null));
+  await step("monitor compliant", () => xhr("POST",
+    "/motor/m1/register/compliant/value.json", JSON.stringify(false), JSON_TYPE));
+  await step("monitor goal", () => xhr("POST",
+    "/motor/m1/register/goal_position/value.json", JSON.stringify(10), JSON_TYPE));
+  await step("monitor start", () => xhr("POST",
+    "/primitive/%(primitive)s/method/start/args.json", JSON.stringify({}), JSON_TYPE));
+  await step("monitor stop", () => xhr("POST",
+    "/primitive/%(primitive)s/method/stop/args.json", JSON.stringify({}), JSON_TYPE));
+  // puppet-master's move recorder
+  await step("recorder aliases", () => xhr("GET", "/motors/aliases/list.json", null));
+  await step("recorder alias", () => xhr("GET", "/motors/base/list.json", null));
+  await step("recorder compliant", () => xhr("POST",
+    "/motors/m2/registers/compliant/value.json", JSON.stringify(true), FORM_TYPE));
+  await step("recorder record", () => xhr("POST", "/records/%(move)s/record.json",
+    '{"motors": "m2,m3"}', FORM_TYPE));
+  await pause(300);
+  await step("recorder save", () => xhr("POST", "/records/%(move)s/save.json", '{}', FORM_TYPE));
+  await step("recorder list", () => xhr("GET", "/records/list.json", null));
+  await step("recorder play", () => xhr("POST", "/records/%(move)s/play.json",
+    '{"speed": "1"}', FORM_TYPE));
+  await step("recorder stop", () => xhr("POST", "/records/%(move)s/stop.json", '{}', FORM_TYPE));
+  await step("recorder running", () => xhr("GET", "/primitives/running/list.json", null));
+  window.result = out;
+}
+main();
+</script>"""
+
+
+@pytest.mark.parametrize(
+    ("site", "answered"),
+    [("NAME.local", "answered"), ("evil.test", "blocked")],
+    ids=["from the robot's name", "from another site"],
+)
+def test_poppy_monitor_and_puppet_master_requests_work_from_the_robots_name_only(
+    browser: Any,
+    announced: tuple[str, ServerSet],
+    monitor: MonitorPages,
+    site: str,
+    answered: Any,
+) -> None:
+    name, servers = announced
+    assert servers.http is not None
+    robot = servers.service.robot
+    robot.compliant = True
+    move = f"replayed-{uuid.uuid4().hex[:6]}"
+    monitor.page = (
+        CLIENTS
+        % {
+            "host": f"{name}.local",
+            "port": servers.http.port,
+            "primitive": "dance",
+            "move": move,
+        }
+    ).encode()
+    context, page = _open(browser, f"http://{site.replace('NAME', name)}:{monitor.port}/")
+    try:
+        seen = page.wait_for_function("() => window.result").json_value()
+    finally:
+        context.close()
+    statuses = {step: status for step, status in seen}
+    if answered == "blocked":
+        # a simple GET may reach the server but the page never reads it; nothing moves
+        assert all(status == "blocked" for status in statuses.values()), statuses
+        assert robot.m1.compliant and robot.m2.compliant
+    else:
+        # pypot 5 answers its writes 202 and its reads 200 (pypot/server/httpserver.py): so do we
+        assert all(status in (200, 202) for status in statuses.values()), statuses
+        assert statuses["monitor robot.json"] == statuses["recorder list"] == 200
+        assert not robot.m1.compliant
+    robot.compliant = True
