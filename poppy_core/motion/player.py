@@ -229,7 +229,7 @@ class MovePlayer:
 
     # -- control -----------------------------------------------------------------------------
 
-    def start(self, gate: Gate | None = None) -> MovePlayer:
+    def start(self, *, gate: Gate | None = None) -> MovePlayer:
         """Start playing in a thread.
 
         With a ``gate``, the start is armed: the thread is made now and plays once the gate

@@ -92,7 +92,7 @@ class Primitive:
 
     # -- lifecycle ---------------------------------------------------------------------------
 
-    def start(self, gate: Gate | None = None) -> None:
+    def start(self, *, gate: Gate | None = None) -> None:
         """Start the primitive, or restart it (a running one is stopped first).
 
         With a ``gate``, the start is armed: everything is made now (its thread too), and

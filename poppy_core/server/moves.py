@@ -247,7 +247,7 @@ class MoveService:
         except ValueError as exc:
             raise ApiError("invalid", f"cannot play {name!r}: {exc}") from None
         gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
-        player.start(gate)
+        player.start(gate=gate)
         with self._lock:
             self._players[name] = player  # a stop before the start time finds it, and cancels it
         wait_started(gate)

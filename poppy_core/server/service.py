@@ -211,7 +211,7 @@ class RobotService:
         primitive = self.primitive(name)
         if action == "start":
             gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
-            primitive.start(gate)
+            primitive.start(gate=gate)
             wait_started(gate)
         elif action == "stop":
             primitive.halt(wait=True)

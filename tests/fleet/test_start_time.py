@@ -67,7 +67,7 @@ def test_armed_primitives_all_fire_after_their_start_time(robot: Robot) -> None:
     try:
         gates = [start_gate() for _ in stamps]
         for stamp, gate in zip(stamps, gates, strict=True):
-            stamp.start(gate)  # armed: its thread is made, held at the gate
+            stamp.start(gate=gate)  # armed: its thread is made, held at the gate
         assert not any(s.began for s in stamps) or time.time() >= when
         wait_started(gates[0])
     finally:
@@ -84,7 +84,7 @@ def test_a_stop_before_the_start_time_means_the_primitive_never_runs(robot: Robo
     try:
         gate = start_gate()
         assert gate is not None
-        stamp.start(gate)
+        stamp.start(gate=gate)
         stamp.stop()  # before the start time
         assert gate.cancelled and stamp.state == "stopped" and not stamp.is_alive()
         wait_started(gate)
@@ -102,7 +102,7 @@ def test_a_stopped_armed_move_plays_nothing(robot: Robot) -> None:
     move = Move.from_frames(10.0, [{"m1": 30.0}, {"m1": 35.0}, {"m1": 40.0}])
     player = MovePlayer(robot, move)
     gate = Gate()
-    player.start(gate)
+    player.start(gate=gate)
     player.stop()
     gate.open()  # too late: the stop called it off
     assert player.wait(5.0) and player.stopped and player.loop_times == []
