@@ -34,6 +34,9 @@ def served(moves_folder: str) -> Iterator[Served]:
 
 @pytest.fixture
 def client(served: Served) -> Iterator[httpx.Client]:
-    """An HTTP client of ``served``."""
-    with httpx.Client(base_url=served.url, timeout=10.0) as http:
+    """An HTTP client of ``served``. It lets an idle connection go after 2 s, before uvicorn's
+    keep-alive timeout (5 s) closes it: a request sent on a connection the server is closing at
+    that moment is reset (seen after a test's 5 s goto)."""
+    limits = httpx.Limits(keepalive_expiry=2.0)
+    with httpx.Client(base_url=served.url, timeout=10.0, limits=limits) as http:
         yield http
