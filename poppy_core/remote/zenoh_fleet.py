@@ -119,7 +119,8 @@ class Fleet:
         together: bool = True,
     ) -> list[Outcome]:
         """Send one v1 request to every robot of ``names`` at once; with ``together`` each runs
-        it at the same wall-clock time (``START_LEAD_S`` from now). A robot that does not
+        it at the same wall-clock time (``START_LEAD_S`` from now) and this returns once that
+        time has come (a start is answered when armed, before it). A robot that does not
         answer within the timeout gets an outcome saying so (never a hang).
         """
         start_at = time.time() + START_LEAD_S if together else None
@@ -143,6 +144,8 @@ class Fleet:
                 outcomes.append(Outcome(name, False, 0, {"detail": str(exc)}))
                 continue
             outcomes.append(Outcome(name, status < 400, status, answer))
+        if start_at is not None:
+            time.sleep(max(0.0, start_at - time.time()))
         return outcomes
 
     def on_state(

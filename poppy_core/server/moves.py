@@ -36,7 +36,7 @@ from poppy_core.motion import (
 )
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
-from poppy_core.server.start_time import start_gate, wait_started
+from poppy_core.server.start_time import start_gate
 
 logger = logging.getLogger(__name__)
 
@@ -250,7 +250,6 @@ class MoveService:
         player.start(gate=gate)
         with self._lock:
             self._players[name] = player  # a stop before the start time finds it, and cancels it
-        wait_started(gate)
         return player
 
     def playing(self) -> list[str]:

@@ -19,7 +19,7 @@ from poppy_core.server import values
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from poppy_core.server.pypot_json import html_safe
-from poppy_core.server.start_time import start_gate, wait_started
+from poppy_core.server.start_time import start_gate
 from poppy_core.server.teleop_channel import TeleopRegistry
 from poppy_core.trajectory import control_name, goto_duration
 
@@ -212,7 +212,6 @@ class RobotService:
         if action == "start":
             gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
             primitive.start(gate=gate)
-            wait_started(gate)
         elif action == "stop":
             primitive.halt(wait=True)
         elif action == "pause":

@@ -3,13 +3,13 @@
 The Zenoh ``api`` queryable runs a request with ``start_at`` (wall clock) at once, with
 ``START_AT`` set. The actions that start something (a primitive, a move) do all their work on
 arrival: the move is loaded and checked, the player or primitive and its thread are made; that
-thread then waits at a ``Gate`` (``start_gate``). At ``start_at`` one thread per process, woken
-by a precise wait (a sleep to ``SPIN_S`` before, then one for the rest, so that a long sleep's
-drift is made up), opens every gate due: the
-start itself is only a thread released, so the robots of one process fire within a fraction of
-a millisecond of each other and of ``start_at``. A refusal is still immediate (the checks ran on
-arrival); a stop before ``start_at`` cancels the gate and nothing starts. The request's reply
-comes once the gates opened (``wait_started``), as it did when the start ran at ``start_at``.
+thread then waits at a ``Gate`` (``start_gate``), and the request is answered (a refusal too:
+the checks ran on arrival). At ``start_at`` one thread per process, woken by a precise wait (a
+sleep to ``SPIN_S`` before, then one for the rest, so that a long sleep's drift is made up),
+opens every gate due: the start itself is only a thread released. Nothing else wakes then (the
+replies went out on arrival), so the robots of one process fire within a fraction of a
+millisecond of each other and of ``start_at`` on an idle machine. A stop before ``start_at``
+cancels the gate and nothing starts.
 """
 
 from __future__ import annotations
@@ -33,7 +33,6 @@ take the GIL back, which on a busy process can wait for another thread's switch 
 @dataclass
 class _Due:
     gates: list[Gate] = field(default_factory=list)
-    fired: threading.Event = field(default_factory=threading.Event)
 
 
 _lock = threading.Lock()
@@ -59,17 +58,6 @@ def start_gate() -> Gate | None:
     return gate
 
 
-def wait_started(gate: Gate | None) -> None:
-    """Block until ``gate``'s start time came and its gates were opened (None: at once)."""
-    if gate is None:
-        return
-    when = START_AT.get()
-    with _lock:
-        due = _due.get(when) if when is not None else None
-    if due is not None:
-        due.fired.wait()
-
-
 def wait_until(when: float) -> None:
     """Return at wall-clock ``when`` (never before), a fraction of a millisecond late on an idle
     machine: one sleep to ``SPIN_S`` before, then one for the rest."""
@@ -87,4 +75,3 @@ def _fire(when: float, due: _Due) -> None:
         gates = list(due.gates)
     for gate in gates:
         gate.open()
-    due.fired.set()

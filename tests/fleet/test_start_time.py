@@ -7,6 +7,7 @@ command moves nothing.
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 from collections.abc import Iterator
@@ -23,7 +24,7 @@ from poppy_core.remote.zenoh_client import answer_of
 from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import Robot, from_profile
 from poppy_core.schedule import Gate
-from poppy_core.server.start_time import START_AT, start_gate, wait_started, wait_until
+from poppy_core.server.start_time import START_AT, start_gate, wait_until
 from tests.helpers.waiting import eventually
 from tests.helpers.zenoh_served import TOKEN, Served
 
@@ -69,7 +70,6 @@ def test_armed_primitives_all_fire_after_their_start_time(robot: Robot) -> None:
         for stamp, gate in zip(stamps, gates, strict=True):
             stamp.start(gate=gate)  # armed: its thread is made, held at the gate
         assert not any(s.began for s in stamps) or time.time() >= when
-        wait_started(gates[0])
     finally:
         START_AT.reset(context)
     assert eventually(lambda: all(s.began for s in stamps))
@@ -87,7 +87,6 @@ def test_a_stop_before_the_start_time_means_the_primitive_never_runs(robot: Robo
         stamp.start(gate=gate)
         stamp.stop()  # before the start time
         assert gate.cancelled and stamp.state == "stopped" and not stamp.is_alive()
-        wait_started(gate)
     finally:
         START_AT.reset(context)
     wait_until(when + 0.05)
@@ -148,7 +147,7 @@ def test_a_fleet_stop_before_the_start_time_means_nothing_starts(
         ["jr-a", "jr-b"], "POST", "/api/v1/primitives/dance/stop", together=False
     )
     assert [o.ok for o in stopped] == [True, True]
-    for handler in started:  # their replies come at the start time
+    for handler in started:  # answered when armed
         status, _ = answer_of("zenoh", list(handler), 10.0, 0.0)
         assert status < 400
     wait_until(start_at + 0.1)
@@ -202,3 +201,37 @@ def test_the_fleet_stop_before_the_start_time_cancels_an_armed_move(
     for served in two:
         assert served.servers.service.moves.playing() == []
         assert {m.name: m.goal_position for m in served.robot.motors} == before[served.name]
+
+
+def test_an_armed_start_is_answered_on_arrival_and_says_when_it_starts(
+    two: tuple[Served, Served], fleet: Fleet
+) -> None:
+    a, _ = two
+    began: list[float] = []
+    dance = a.servers.service.primitive("dance")
+    dance.setup = lambda: began.append(time.time())  # type: ignore[method-assign]
+    start_at = time.time() + 30.0  # far enough that no loaded machine reaches it first
+    handler = _send(fleet, a.name, "/api/v1/primitives/dance/start", start_at)
+    replies = list(handler)  # the reply, before the start time
+    assert time.time() < start_at
+    answer = json.loads(replies[0].ok.payload.to_bytes())
+    assert answer["status"] == 200 and answer["start_at"] == pytest.approx(start_at)
+    assert began == [] and "dance" in a.servers.service.running_primitives()  # armed
+    fleet.command([a.name], "POST", "/api/v1/primitives/dance/stop", together=False)
+    assert began == []
+
+
+def test_a_refused_armed_start_has_no_start_time(two: tuple[Served, Served], fleet: Fleet) -> None:
+    a, _ = two
+    handler = _send(fleet, a.name, "/api/v1/primitives/nowhere/start", time.time() + 30.0)
+    answer = json.loads(next(iter(handler)).ok.payload.to_bytes())
+    assert answer["status"] == 404 and "start_at" not in answer
+
+
+def test_a_together_command_returns_once_its_start_time_came(
+    two: tuple[Served, Served], fleet: Fleet
+) -> None:
+    outcomes = fleet.command(["jr-a", "jr-b"], "POST", "/api/v1/primitives/dance/start")
+    assert [o.ok for o in outcomes] == [True, True]
+    assert fleet.last_start_at is not None and time.time() >= fleet.last_start_at
+    fleet.command(["jr-a", "jr-b"], "POST", "/api/v1/primitives/dance/stop", together=False)

@@ -268,40 +268,35 @@ class ZenohRobotServer:
             caller.submit(self._answer(caller, query, payload))
 
     async def _answer(self, caller: AsgiCaller, query: zenoh.Query, payload: bytes) -> None:
-        status, body = await self.api(caller, payload)
-        query.reply(self.key("api"), json.dumps({"status": status, "body": body}).encode())
+        query.reply(self.key("api"), json.dumps(await self.api(caller, payload)).encode())
 
-    async def api(self, caller: AsgiCaller, payload: bytes) -> tuple[int, Any]:
-        """The status and answer of one ``api`` request (a refusal: REST's, or 400/413)."""
-        if len(payload) > MAX_BODY_BYTES:
-            return 413, {"detail": f"the request is over {MAX_BODY_BYTES} bytes"}
-        try:
-            request = json.loads(payload)
-        except (ValueError, RecursionError):
-            return 400, {"detail": f"the request is not JSON: {API_SHAPE}"}
-        if not isinstance(request, dict):
-            return 400, {"detail": f"the request is not an object: {API_SHAPE}"}
-        method = request.get("method")
-        path = request.get("path")
-        if method not in METHODS or not isinstance(path, str) or not path.startswith("/"):
-            return 400, {"detail": f"bad method or path: {API_SHAPE}"}
-        token = request.get("token")
-        if token is not None and not isinstance(token, str):
-            return 400, {"detail": "the token must be a string"}
+    async def api(self, caller: AsgiCaller, payload: bytes) -> dict[str, Any]:
+        """The reply to one ``api`` request: ``{"status", "body"}`` (a refusal: REST's, or
+        400/413), plus ``start_at`` when a start was armed for that time (answered on arrival:
+        the start itself happens at ``start_at``)."""
+        request = _request(payload)
+        if isinstance(request, tuple):
+            status, body = request
+            return {"status": status, "body": body}
         try:
             start_at = _start_at(request.get("start_at"))
         except ArgumentError as exc:
-            return 422, {"detail": str(exc)}
+            return {"status": 422, "body": {"detail": str(exc)}}
+        method, path = request["method"], request["path"]
+        body, token = request.get("body"), request.get("token")
         if start_at is not None and STARTS.fullmatch(path):
-            # routed now; the start itself waits for the clock in the route's thread
+            # armed now (checked, its thread made, held at a gate); the gate opens at start_at
             context = START_AT.set(start_at)
             try:
-                return await caller.call(method, path, request.get("body"), token)
+                status, answer = await caller.call(method, path, body, token)
             finally:
                 START_AT.reset(context)
+            reply = {"status": status, "body": answer}
+            return {**reply, "start_at": start_at} if status < 400 else reply
         if start_at is not None:
             await asyncio.sleep(max(0.0, start_at - time.time()))
-        return await caller.call(method, path, request.get("body"), token)
+        status, answer = await caller.call(method, path, body, token)
+        return {"status": status, "body": answer}
 
     # -- the goal stream ---------------------------------------------------------------------
 
@@ -338,6 +333,26 @@ class ZenohRobotServer:
             for name, goal in targets.items():
                 self.service.motor(name).goal_position = goal
         return targets
+
+
+def _request(payload: bytes) -> dict[str, Any] | tuple[int, Any]:
+    """The ``api`` request in ``payload`` (method, path, token checked), or the refusal."""
+    if len(payload) > MAX_BODY_BYTES:
+        return 413, {"detail": f"the request is over {MAX_BODY_BYTES} bytes"}
+    try:
+        request = json.loads(payload)
+    except (ValueError, RecursionError):
+        return 400, {"detail": f"the request is not JSON: {API_SHAPE}"}
+    if not isinstance(request, dict):
+        return 400, {"detail": f"the request is not an object: {API_SHAPE}"}
+    method = request.get("method")
+    path = request.get("path")
+    if method not in METHODS or not isinstance(path, str) or not path.startswith("/"):
+        return 400, {"detail": f"bad method or path: {API_SHAPE}"}
+    token = request.get("token")
+    if token is not None and not isinstance(token, str):
+        return 400, {"detail": "the token must be a string"}
+    return request
 
 
 def _start_at(value: Any) -> float | None:
