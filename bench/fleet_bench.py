@@ -18,6 +18,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import subprocess
@@ -46,27 +47,33 @@ TRIALS = 50
 TELEOP_HZ = 100.0
 TELEOP_S = 4.0
 SLOW_S = 0.02
+SLOW_SUBSCRIBERS = 20
 SLOW_SUBSCRIBER = """
-import sys, time
+import os, sys, time
 from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.zenoh_wire import ZenohSettings
-fleet = Fleet(ZenohSettings(connect=tuple(sys.argv[2:])))
-fleet.on_state(lambda name, state: time.sleep(float(sys.argv[1])))
+count, delay, endpoints = int(sys.argv[1]), float(sys.argv[2]), tuple(sys.argv[3:])
+fleets = [Fleet(ZenohSettings(connect=endpoints)) for _ in range(count)]
+for fleet in fleets:
+    fleet.on_state(lambda name, state: time.sleep(delay))
 print("ready", flush=True)
 try:
     while True:
         time.sleep(1)
 except KeyboardInterrupt:
-    fleet.close()
+    os._exit(0)  # a session sleeping in its callback would not close in time: the sockets go
 """
+"""COUNT Zenoh sessions (each its own client, as COUNT `fleet status` would be), each on every
+robot's state, each sleeping DELAY s per message: subscribers that cannot keep up."""
 TICK = os.sysconf("SC_CLK_TCK")
 
 
 @contextmanager
 def _robots(
-    zenoh: bool, ws: bool, starts: Path | None = None
+    zenoh: bool, ws: bool, starts: Path | None = None, env: dict[str, str] | None = None
 ) -> Iterator[tuple[list[Any], list[dict[str, Any]]]]:
-    """Start the robot processes; yields them and one record per robot (name, endpoint, ws)."""
+    """Start the robot processes (``env``: more environment); yields them and one record per
+    robot (name, endpoint, ws)."""
     procs, robots = [], []
     python = str(POPPY_PYTHON) if POPPY_PYTHON.exists() else sys.executable
     try:
@@ -84,9 +91,9 @@ def _robots(
             args += ["--zenoh"] if zenoh else []
             args += ["--ws"] if ws else []
             args += ["--starts", str(starts)] if starts is not None else []
-            env = {**os.environ, "PYTHONPATH": str(REPO_ROOT)}
+            full = {**os.environ, **(env or {}), "PYTHONPATH": str(REPO_ROOT)}
             procs.append(
-                subprocess.Popen(args, cwd=REPO_ROOT, stdout=subprocess.PIPE, text=True, env=env)
+                subprocess.Popen(args, cwd=REPO_ROOT, stdout=subprocess.PIPE, text=True, env=full)
             )
         for proc in procs:
             assert proc.stdout is not None
@@ -142,28 +149,13 @@ def fanout_zenoh() -> dict[str, Any]:
                     if hz is not None:
                         loops[name].append(float(hz))
 
-        endpoints = [r["endpoint"] for r in robots]
-        slow = subprocess.Popen(
-            [sys.executable, "-c", SLOW_SUBSCRIBER, str(SLOW_S), *endpoints],
-            cwd=REPO_ROOT,
-            stdout=subprocess.PIPE,
-            text=True,
-            env={**os.environ, "PYTHONPATH": str(REPO_ROOT)},
-        )
-        try:
-            assert slow.stdout is not None
-            slow.stdout.readline()  # ready
-            with Fleet(settings) as fleet:
-                fleet.on_state(state)
-                fleet.on_health(health)
-                time.sleep(WARMUP_S)
-                measuring.set()
-                cpu = _cpu_per_robot(procs, WINDOW_S)
-                measuring.clear()
-        finally:
-            interrupt(slow)
-            if slow.stdout is not None:
-                slow.stdout.close()
+        with _slow_subscribers(1, [r["endpoint"] for r in robots]), Fleet(settings) as fleet:
+            fleet.on_state(state)
+            fleet.on_health(health)
+            time.sleep(WARMUP_S)
+            measuring.set()
+            cpu = _cpu_per_robot(procs, WINDOW_S)
+            measuring.clear()
         ages.sort()
         rates = sorted(counts.get(r["name"], 0) / WINDOW_S for r in robots)
         sync = sorted(hz for values in loops.values() for hz in values)
@@ -177,6 +169,62 @@ def fanout_zenoh() -> dict[str, Any]:
             "sync_hz_min": sync[0] if sync else None,
             "sync_hz_median": sync[len(sync) // 2] if sync else None,
         }
+
+
+@contextmanager
+def _slow_subscribers(count: int, endpoints: list[str]) -> Iterator[None]:
+    """``count`` slow subscribers (``SLOW_SUBSCRIBER``) in a process of their own."""
+    slow = subprocess.Popen(
+        [sys.executable, "-c", SLOW_SUBSCRIBER, str(count), str(SLOW_S), *endpoints],
+        cwd=REPO_ROOT,
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(REPO_ROOT)},
+    )
+    try:
+        assert slow.stdout is not None
+        if slow.stdout.readline().strip() != "ready":
+            raise RuntimeError("the slow subscribers did not start")
+        yield
+    finally:
+        interrupt(slow)
+        if slow.stdout is not None:
+            slow.stdout.close()
+
+
+def sync_under_slow_subscribers() -> dict[str, Any]:
+    """The robots' ``present`` sync loop rates (their health), without and then with
+    ``SLOW_SUBSCRIBERS`` slow subscribers on every robot's state."""
+    from poppy_core.remote.zenoh_fleet import Fleet
+    from poppy_core.zenoh_wire import ZenohSettings
+
+    with _robots(zenoh=True, ws=False) as (procs, robots):
+        endpoints = [r["endpoint"] for r in robots]
+        rates: list[float] = []
+
+        def health(name: str, data: dict[str, Any]) -> None:
+            for bus in data.get("buses", {}).values():
+                hz = bus.get("loop_hz", {}).get("present")
+                if hz is not None:
+                    rates.append(float(hz))
+
+        found: dict[str, Any] = {}
+        with Fleet(ZenohSettings(connect=tuple(endpoints))) as fleet:
+            fleet.on_health(health)
+            for label, count in (("none", 0), ("slow", SLOW_SUBSCRIBERS)):
+                with _slow_subscribers(count, endpoints) if count else contextlib.nullcontext():
+                    time.sleep(WARMUP_S)
+                    rates.clear()
+                    cpu = _cpu_per_robot(procs, WINDOW_S)
+                    seen = sorted(rates)
+                found[label] = {
+                    "subscribers": count,
+                    "sync_hz_min": seen[0] if seen else None,
+                    "sync_hz_median": seen[len(seen) // 2] if seen else None,
+                    "samples": len(seen),
+                    "cpu_per_robot_pct": cpu,
+                }
+    return found
 
 
 def fanout_ws() -> dict[str, Any]:
@@ -222,35 +270,65 @@ def idle_cpu() -> float:
         return _cpu_per_robot(procs, WINDOW_S)
 
 
+STARTS = {
+    "run": ("/api/v1/primitives/sinus/start", None, "/api/v1/primitives/sinus/stop"),
+    "play": ("/api/v1/moves/wave/play", {"speed": 1.0}, "/api/v1/moves/wave/stop"),
+}
+"""What each start measures: ``fleet run sinus`` and ``fleet play wave`` (start, body, stop)."""
+
+
+def _wave(moves: Path) -> dict[str, str]:
+    """Save the move ``fleet play`` plays in ``moves`` (1 s of ``m1`` from its rest pose and
+    back); the robots' environment that makes it their library."""
+    from poppy_core.motion.move import Move
+    from poppy_core.motion.move_library import MOVES_DIR_ENV, save_move
+
+    moves.mkdir(parents=True, exist_ok=True)
+    frames = [{"m1": 10.0 * (1 - abs(1 - i / 25))} for i in range(51)]
+    save_move(Move.from_frames(50.0, frames), moves / "wave.move")
+    return {MOVES_DIR_ENV: str(moves)}
+
+
 def play_spread(tmp: Path) -> dict[str, Any]:
     from poppy_core.remote.zenoh_fleet import Fleet
     from poppy_core.zenoh_wire import ZenohSettings
 
     starts = tmp / "starts.txt"
-    spreads, offsets, within = [], [], []
-    first: dict[str, float] = {}
-    with _robots(zenoh=True, ws=False, starts=starts) as (_, robots):
+    env = _wave(tmp / "moves")
+    found: dict[str, Any] = {}
+    with _robots(zenoh=True, ws=False, starts=starts, env=env) as (_, robots):
         names = [r["name"] for r in robots]
         settings = ZenohSettings(connect=tuple(r["endpoint"] for r in robots))
         with Fleet(settings, timeout_s=5.0) as fleet:
             fleet.wait_for(names, 10.0)
-            for trial in range(TRIALS + 1):  # the first, a warm-up, is kept apart
-                starts.write_text("")
-                outcomes = fleet.command(names, "POST", "/api/v1/primitives/sinus/start")
-                assert all(o.ok for o in outcomes), [o.message for o in outcomes if not o.ok]
-                stamps = _stamps(starts, len(names))
-                times = [t for _, t in stamps]
-                late = [t - (fleet.last_start_at or 0) for t in times]
-                if trial == 0:
-                    first = {
-                        "spread_ms": (max(times) - min(times)) * 1000,
-                        "late_max_ms": max(late) * 1000,
-                    }
-                else:
-                    spreads.append(max(times) - min(times))
-                    offsets.extend(late)
-                    within.append(_within_process(stamps))
-                fleet.command(names, "POST", "/api/v1/primitives/sinus/stop", together=False)
+            for what, (path, body, stop) in STARTS.items():
+                found[what] = _spread(fleet, names, starts, path, body, stop)
+    return found
+
+
+def _spread(
+    fleet: Any, names: list[str], starts: Path, path: str, body: Any, stop: str
+) -> dict[str, Any]:
+    """``TRIALS`` starts of ``path`` on every robot together (after a first one kept apart)."""
+    spreads, offsets, within = [], [], []
+    first: dict[str, float] = {}
+    for trial in range(TRIALS + 1):
+        starts.write_text("")
+        outcomes = fleet.command(names, "POST", path, body)
+        assert all(o.ok for o in outcomes), [o.message for o in outcomes if not o.ok]
+        stamps = _stamps(starts, len(names))
+        times = [t for _, t in stamps]
+        late = [t - (fleet.last_start_at or 0) for t in times]
+        if trial == 0:
+            first = {
+                "spread_ms": (max(times) - min(times)) * 1000,
+                "late_max_ms": max(late) * 1000,
+            }
+        else:
+            spreads.append(max(times) - min(times))
+            offsets.extend(late)
+            within.append(_within_process(stamps))
+        fleet.command(names, "POST", stop, together=False)
     spreads.sort()
     offsets.sort()
     within.sort()
@@ -258,6 +336,7 @@ def play_spread(tmp: Path) -> dict[str, Any]:
         "trials": len(spreads),
         "spread_p50_ms": (percentile(spreads, 0.5) or 0) * 1000,
         "spread_p90_ms": (percentile(spreads, 0.9) or 0) * 1000,
+        "spread_p99_ms": (percentile(spreads, 0.99) or 0) * 1000,
         "spread_max_ms": spreads[-1] * 1000,
         "late_p50_ms": (percentile(offsets, 0.5) or 0) * 1000,
         "late_p99_ms": (percentile(offsets, 0.99) or 0) * 1000,
@@ -417,6 +496,7 @@ def fleet_bench(ctx: BenchContext) -> BenchResult:
     raw: dict[str, Any] = {"robots": ROBOTS, "processes": PROCESSES, "window_s": WINDOW_S}
     raw["load_before"] = os.getloadavg()[0]
     raw["zenoh"] = fanout_zenoh()
+    raw["slow"] = sync_under_slow_subscribers()
     raw["ws"] = fanout_ws()
     raw["idle_cpu_per_robot_pct"] = idle_cpu()
     with tempfile.TemporaryDirectory() as tmp:
@@ -430,6 +510,7 @@ def fleet_bench(ctx: BenchContext) -> BenchResult:
         "WINDOW_S": WINDOW_S,
         "WARMUP_S": WARMUP_S,
         "SLOW_S": SLOW_S,
+        "SLOW_SUBSCRIBERS": SLOW_SUBSCRIBERS,
         "TELEOP_HZ": TELEOP_HZ,
     }
     return build_result(raw, settings)

@@ -3,8 +3,8 @@
 Each robot: an ideal-servo Ergo Jr (its own 50 Hz sync loop and emulator), served on Zenoh as
 ``poppy/<name>`` on its own loopback port and/or on pypot's WebSocket at 50 Hz. Prints one line
 per robot (``name zenoh-endpoint ws-port``), then ``ready``; stops on SIGINT. With ``--starts
-FILE`` the time every ``Sinus`` primitive began is appended to FILE as ``pid wall-clock-time``
-(the fleet play spread is measured there, at the robots).
+FILE`` the time every ``Sinus`` primitive or move playback began is appended to FILE as ``pid
+wall-clock-time`` (the fleet run/play spread is measured there, at the robots).
 """
 
 from __future__ import annotations
@@ -22,20 +22,31 @@ from poppy_core.robot import from_profile
 
 
 def _log_starts(path: Path) -> None:
-    """Append the wall-clock time every ``Sinus`` primitive began (its ``setup``, the first step
-    of its thread once started: when a start really happens, armed or not)."""
+    """Append the wall-clock time every start really began, armed or not: a ``Sinus``
+    primitive's ``setup`` and a move player's playback (``_run``), the first step of their
+    thread once started."""
     from poppy_core.motion.builtins import Sinus
+    from poppy_core.motion.player import MovePlayer
 
-    real = Sinus.setup
     lock = threading.Lock()
 
-    def setup(self: Sinus) -> None:
-        stamp = time.time()
+    def stamp() -> None:
+        now = time.time()
         with lock, path.open("a", encoding="utf-8") as out:
-            out.write(f"{os.getpid()} {stamp:.6f}\n")
-        real(self)
+            out.write(f"{os.getpid()} {now:.6f}\n")
+
+    real_setup, real_run = Sinus.setup, MovePlayer._run
+
+    def setup(self: Sinus) -> None:
+        stamp()
+        real_setup(self)
+
+    def run(self: MovePlayer, stopping: threading.Event) -> None:
+        stamp()
+        real_run(self, stopping)
 
     Sinus.setup = setup  # type: ignore[method-assign]
+    MovePlayer._run = run  # type: ignore[method-assign]
 
 
 def main() -> None:
