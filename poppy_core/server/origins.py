@@ -35,6 +35,7 @@ from urllib.parse import urlsplit
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from poppy_core.checks import robot_name
 from poppy_core.server.refusals import refuse
 
 logger = logging.getLogger(__name__)
@@ -146,25 +147,6 @@ def is_loopback(name: str) -> bool:
         return ipaddress.ip_address(name).is_loopback
     except ValueError:
         return False
-
-
-ROBOT_NAME = re.compile(r"[a-z0-9](?:[a-z0-9-]{0,61}[a-z0-9])?")
-"""A robot's name: one DNS label (its mDNS name is ``NAME.local``)."""
-
-
-def robot_name(text: str) -> str:
-    """A robot's name as announced: ``Poppy.local`` -> ``poppy``.
-
-    Raises:
-        ValueError: not one DNS label (letters, digits and inner hyphens, at most 63).
-    """
-    name = text.strip().lower().rstrip(".").removesuffix(".local")
-    if not ROBOT_NAME.fullmatch(name):
-        raise ValueError(
-            f"{text!r} is not a robot name: give letters, digits and hyphens (at most 63, "
-            "not starting or ending with a hyphen), e.g. poppy or ergo-2"
-        )
-    return name
 
 
 def robot_names(name: str) -> set[str]:
