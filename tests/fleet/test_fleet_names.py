@@ -12,7 +12,7 @@ from poppy_core import zenoh_wire
 from poppy_core.assembly import ServeSpec
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.remote.zenoh_client import robot_name as zenoh_url_name
-from poppy_core.server.origins import robot_names
+from poppy_core.server.host_names import robot_names
 from tests.helpers.cli import run_poppy
 from tests.helpers.zenoh_served import Served, connect_to, free_endpoint
 
