@@ -1,8 +1,10 @@
-"""Checks of call arguments (finite, positive, a duration, a rate): one rule each, ArgumentError."""
+"""Checks of call arguments (finite, positive, a duration, a rate, a robot's name): one rule
+each, ArgumentError."""
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from numbers import Real
 from typing import Any, Generic, TypeVar, overload
@@ -142,6 +144,35 @@ def count(value: object, low: int, high: int, field: str = "") -> int:
             f"{_describe(field)} must be {low}-{high}, got {value}", field=field, value=value
         )
     return value
+
+
+ROBOT_NAME = re.compile(r"[a-z0-9](?:[a-z0-9-]{0,61}[a-z0-9])?")
+"""A robot's name: one DNS label, lower case (its mDNS name ``NAME.local``, its Zenoh key
+``poppy/NAME``, its ROS 2 node)."""
+
+
+def robot_name(value: object, field: str = "name") -> str:
+    """``value`` as a robot's name: ``Poppy``, ``poppy.local`` -> ``poppy``.
+
+    One rule for every place a robot is named (``poppy serve --name``, mDNS, Zenoh, the
+    settings page, ``zenoh:NAME``): a DNS label (letters, digits and inner hyphens, at most
+    63), so that ``NAME.local`` and ``poppy/NAME`` name the same robot. DNS names ignore case,
+    so the name is lower-cased; a ``.local`` suffix (mDNS's domain) is dropped.
+
+    Raises:
+        ArgumentError: (a ValueError) any other name, with ``field`` and the rule named.
+    """
+    text = value if isinstance(value, str) else ""
+    name = text.strip().lower().rstrip(".").removesuffix(".local")
+    if not ROBOT_NAME.fullmatch(name):
+        raise ArgumentError(
+            f"{_describe(field)} {value!r} is not a robot name: give 1-63 letters, digits and "
+            "hyphens, not starting or ending with a hyphen (no '_', '.' or space: it is the "
+            "robot's NAME.local), e.g. poppy or ergo-2",
+            field=field,
+            value=value,
+        )
+    return name
 
 
 T = TypeVar("T")

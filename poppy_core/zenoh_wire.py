@@ -3,11 +3,12 @@
 Shared by the robot's side (``poppy_core.server.zenoh``) and the clients' (``poppy_core.remote``,
 ``poppy fleet``), so both speak the same keys and bytes; a leaf: nothing of ours but the leaves.
 
-Keys (``NAME`` a robot's name, one key chunk): the liveliness token ``poppy/NAME``; the state
-``poppy/NAME/state`` (``pack_state``, every sync cycle); ``poppy/NAME/health`` (JSON, every
-second); the queryables ``poppy/NAME/description`` and ``poppy/NAME/api`` (a v1 REST request in
-JSON, answered by the robot's REST app in-process: the same checks, errors and token); the
-subscriber ``poppy/NAME/goals`` (goal positions as a stream).
+Keys (``NAME`` a robot's name: ``checks.robot_name``, the rule of its mDNS name too): the
+liveliness token ``poppy/NAME``; the state ``poppy/NAME/state`` (``pack_state``, every sync
+cycle); ``poppy/NAME/health`` (JSON, every second); the queryables ``poppy/NAME/description``
+and ``poppy/NAME/api`` (a v1 REST request in JSON, answered by the robot's REST app in-process:
+the same checks, errors and token); the subscriber ``poppy/NAME/goals`` (goal positions as a
+stream).
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from poppy_core.errors import ConfigError
+from poppy_core import checks
+from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.extras import require
 
 if TYPE_CHECKING:
@@ -39,29 +41,27 @@ its TCP links, which its peers see at once."""
 FLEET_PORT = 7447
 """Zenoh's own default port (what ``zenohd`` listens on)."""
 
-_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,62}")
 _ENDPOINT = re.compile(r"[a-z0-9]+/\S+")
 
 
 def check_name(name: str) -> str:
-    """``name`` when it can be a robot's name (one key chunk: letters, digits, ``_ . -``).
+    """``name`` as a robot's name (``checks.robot_name``: one DNS label, lower case, so that
+    ``poppy/NAME`` and ``NAME.local`` name the same robot): ``Poppy`` -> ``poppy``.
 
     Raises:
         ConfigError: another name (with the rule).
     """
-    if not isinstance(name, str) or not _NAME.fullmatch(name):
-        raise ConfigError(
-            f"{name!r} is not a robot name: use 1-63 letters, digits, '_', '.' or '-' "
-            "(not starting with '.' or '-')",
-            field="name",
-        )
-    return name
+    try:
+        return checks.robot_name(name)
+    except ArgumentError as exc:
+        raise ConfigError(str(exc), field="name", value=name) from None
 
 
 def default_name() -> str:
-    """The host's name as a robot name (its first label, other characters as ``-``)."""
-    label = socket.gethostname().split(".")[0]
-    name = re.sub(r"[^A-Za-z0-9_.-]", "-", label).strip(".-")[:63]
+    """The host's name as a robot name (its first label lower-cased, other characters as
+    ``-``; ``poppy`` when nothing is left)."""
+    label = socket.gethostname().split(".")[0].lower()
+    name = re.sub(r"[^a-z0-9-]", "-", label)[:63].strip("-")
     return name or "poppy"
 
 

@@ -99,3 +99,23 @@ def test_a_checked_attribute_refuses_through_its_rule_and_names_itself() -> None
         knob.gain = -1.0
     assert refused.value.field == "gain" and knob.gain == 2.0
     assert Knob.gain.__doc__ == "How much (>= 0)."
+
+
+@pytest.mark.parametrize(
+    ("given", "name"),
+    [("poppy", "poppy"), ("Ergo-2", "ergo-2"), ("POPPY.local.", "poppy"), (" jr1 ", "jr1")],
+)
+def test_a_robot_name_is_one_lower_case_dns_label(given: str, name: str) -> None:
+    assert checks.robot_name(given) == name
+
+
+@pytest.mark.parametrize(
+    "given", ["", "jr_01", "jr.1", "poppy.example", "-jr", "jr-", "a b", "a/b", "a" * 64, None, 3]
+)
+def test_a_robot_name_refused_names_the_field_the_rule_and_an_example(given: object) -> None:
+    with pytest.raises(ArgumentError) as refused:
+        checks.robot_name(given, "--name")
+    message = str(refused.value)
+    assert message.startswith(f"--name {given!r} is not a robot name: ")
+    assert "e.g. poppy or ergo-2" in message and "\n" not in message
+    assert refused.value.field == "--name"

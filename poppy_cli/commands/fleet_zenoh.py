@@ -168,17 +168,38 @@ def _status_table(
     return table
 
 
-def _targets(fleet: Fleet, all_robots: bool, robots: str | None) -> list[str]:
+def _wanted(all_robots: bool, robots: str | None) -> list[str] | None:
+    """The robots of ``--robots a,b`` (None for ``--all``), checked before connecting: a usage
+    error when neither or both are given, or a name is no robot name (``checks.robot_name``:
+    ``Poppy`` is ``poppy``)."""
+    from poppy_core.checks import robot_name
+    from poppy_core.errors import ArgumentError
+
     if all_robots == bool(robots):
         error_line("name the robots: --all, or --robots a,b")
         raise typer.Exit(EXIT_USAGE)
     if all_robots:
-        names = fleet.names()
-        if not names:
-            error_line("no robot on Zenoh (check --connect; robots need `poppy serve --zenoh`)")
-            raise typer.Exit(EXIT_FAILURE)
-        return names
-    return [n.strip() for n in (robots or "").split(",") if n.strip()]
+        return None
+    try:
+        names = [robot_name(n, "--robots") for n in (robots or "").split(",") if n.strip()]
+    except ArgumentError as exc:
+        error_line(str(exc))
+        raise typer.Exit(EXIT_USAGE) from None
+    if not names:
+        error_line("name the robots: --all, or --robots a,b")
+        raise typer.Exit(EXIT_USAGE)
+    return names
+
+
+def _targets(fleet: Fleet, wanted: list[str] | None) -> list[str]:
+    """``wanted``, or every robot on Zenoh for ``--all`` (an error when there is none)."""
+    if wanted is not None:
+        return wanted
+    names = fleet.names()
+    if not names:
+        error_line("no robot on Zenoh (check --connect; robots need `poppy serve --zenoh`)")
+        raise typer.Exit(EXIT_FAILURE)
+    return names
 
 
 def _report(outcomes: list[Outcome], what: str, json_output: bool) -> None:
@@ -210,8 +231,9 @@ def fleet_run(
     json_output: bool = JsonOpt,
 ) -> None:
     """Start a primitive on the robots, all at the same time."""
+    wanted = _wanted(all_robots, robots)
     with _fleet(connect, zenoh_config, zenoh_scout, token) as fleet:
-        names = _targets(fleet, all_robots, robots)
+        names = _targets(fleet, wanted)
         path = f"/api/v1/primitives/{_quoted(primitive)}/start"
         outcomes = fleet.command(names, "POST", path)
     _report(outcomes, f"{primitive} started", json_output)
@@ -228,8 +250,9 @@ def fleet_play(
     json_output: bool = JsonOpt,
 ) -> None:
     """Play a move on the robots, all starting at the same time."""
+    wanted = _wanted(all_robots, robots)
     with _fleet(connect, zenoh_config, zenoh_scout, token) as fleet:
-        names = _targets(fleet, all_robots, robots)
+        names = _targets(fleet, wanted)
         path = f"/api/v1/moves/{_quoted(move)}/play"
         outcomes = fleet.command(names, "POST", path, {"speed": 1.0, "backwards": False})
     _report(outcomes, f"playing {move}", json_output)
@@ -245,8 +268,9 @@ def fleet_stop(
     json_output: bool = JsonOpt,
 ) -> None:
     """The Stop button of every robot named: primitives and moves stopped, motors held."""
+    wanted = _wanted(all_robots, robots)
     with _fleet(connect, zenoh_config, zenoh_scout, token) as fleet:
-        names = _targets(fleet, all_robots, robots)
+        names = _targets(fleet, wanted)
         outcomes = fleet.command(
             names, "POST", "/api/v1/web/stop", {"then": "hold"}, together=False
         )

@@ -172,8 +172,9 @@ def serve(
         _usage("nothing to serve: pass --http, --ws, --snap, --zmq, --zenoh and/or --ros2")
     http_port, *alias_ports = http_ports or [8080]
     _check_http_ports(http_ports)
+    robot_name = _robot_name(name)
     zenoh_settings = _zenoh_settings(
-        zenoh or ros2, name, zenoh_listen, zenoh_connect, zenoh_config, zenoh_scout
+        zenoh or ros2, zenoh_listen, zenoh_connect, zenoh_config, zenoh_scout
     )
     if not zenoh:
         zenoh_settings = None  # the endpoints are the ROS 2 node's
@@ -210,7 +211,7 @@ def serve(
         allow_hosts=tuple(allow_host or ()),
         ws_rate_hz=ws_rate,
         snap_dir=snap_dir,
-        name=_robot_name(name),
+        name=robot_name,
         announce=announce,
         http_alias_ports=tuple(alias_ports),
         report=_report,
@@ -252,15 +253,17 @@ def serve(
 
 
 def _robot_name(name: str | None) -> str | None:
-    """The robot's name as announced, or a usage error before anything is built."""
+    """The robot's name as announced on mDNS and Zenoh (``checks.robot_name``), or a usage
+    error before anything is built."""
     if name is None:
         return None
-    from poppy_core.server.origins import robot_name
+    from poppy_core.checks import robot_name
+    from poppy_core.errors import ArgumentError
 
     try:
-        return robot_name(name)
-    except ValueError as exc:
-        _usage(f"--name: {exc}")
+        return robot_name(name, "--name")
+    except ArgumentError as exc:
+        _usage(str(exc))
 
 
 def _check_http_ports(ports: list[int]) -> None:
@@ -273,16 +276,15 @@ def _check_http_ports(ports: list[int]) -> None:
 
 def _zenoh_settings(
     zenoh: bool,
-    name: str | None,
     listen: list[str] | None,
     connect: list[str] | None,
     config: Path | None,
     scout: bool,
 ) -> ZenohSettings | None:
-    """The Zenoh settings asked for (None without --zenoh); a bad endpoint or name is a usage
-    error before the robot is built."""
+    """The Zenoh settings asked for (None without --zenoh); a bad endpoint is a usage error
+    before the robot is built."""
     from poppy_core.errors import ConfigError
-    from poppy_core.zenoh_wire import ZenohSettings, check_name
+    from poppy_core.zenoh_wire import ZenohSettings
 
     if not zenoh:
         if listen or connect or config or scout:
@@ -292,8 +294,6 @@ def _zenoh_settings(
             )
         return None
     try:
-        if name is not None:
-            check_name(name)
         return ZenohSettings(tuple(listen or ()), tuple(connect or ()), config, scout)
     except ConfigError as exc:
         _usage(str(exc))

@@ -4,7 +4,6 @@ another program or taken back (release, take)."""
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -19,8 +18,6 @@ app = typer.Typer(
     no_args_is_help=True,
 )
 
-NAME = re.compile(r"[a-z0-9]([a-z0-9-]{0,61}[a-z0-9])?")
-"""A robot's name: one DNS label (``NAME.local``)."""
 DEFAULT_REMOTE = "http://127.0.0.1:8080"
 SHOWN = ("Id", "LoadState", "ActiveState", "SubState", "UnitFileState", "MainPID", "FragmentPath")
 
@@ -82,15 +79,16 @@ def install(
     from poppy_cli.service_files import files_of, write_files
     from poppy_cli.service_polkit import RULE_FILE, polkit_dir, rule_text
     from poppy_cli.systemd import Systemd, unit_dir
+    from poppy_core.checks import robot_name
+    from poppy_core.errors import ArgumentError
     from poppy_core.files import write_file
     from poppy_core.robot import load_profile
     from poppy_core.server.serve_options import ServeOptions
 
-    if not NAME.fullmatch(name):
-        _usage(
-            f"--name {name!r}: give a host name of lowercase letters, digits and dashes "
-            "(e.g. poppy, ergo-2), at most 63"
-        )
+    try:
+        name = robot_name(name, "--name")  # the rule `poppy serve --name` applies
+    except ArgumentError as exc:
+        _usage(str(exc))
     if not port.strip():
         _usage("--port is empty: give the serial port (e.g. /dev/ttyAMA0) or auto")
     if user and run_as is not None:

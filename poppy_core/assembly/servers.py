@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from poppy_core.checks import robot_name
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.zenoh_wire import ZenohSettings
 
@@ -66,9 +67,10 @@ class ServeSpec:
         allow_hosts: Host names answered besides loopback names, IPs and the listening host.
         ws_rate_hz: the state stream's default rate.
         snap_dir: a downloaded Snap! served at ``/app/`` on the Snap! port.
-        name: the robot's name: ``NAME`` and ``NAME.local`` are accepted as Host names, and the
-            pages the robot serves under them on any port count as its own; on Zenoh the robot
-            is ``poppy/NAME`` (the host's name when None).
+        name: the robot's name (``checks.robot_name``: one DNS label, kept lower case; a bad
+            one is an ArgumentError here): ``NAME`` and ``NAME.local`` are accepted as Host
+            names, and the pages the robot serves under them on any port count as its own; on
+            Zenoh the robot is ``poppy/NAME`` (the host's name when None).
         announce: announce ``NAME.local`` (default ``poppy``) and the robot's services over
             mDNS/DNS-SD on the interfaces the servers listen on (``appliance`` extra).
         http_alias_ports: more ports serving the REST API and page, on ``http``'s host (the
@@ -103,6 +105,12 @@ class ServeSpec:
     ros2: Ros2Settings | None = None
     settings_file: Path | None = None
     token_file: Path | None = None
+
+    def __post_init__(self) -> None:
+        """``name`` as the robot's one name on mDNS and Zenoh (``checks.robot_name``:
+        ``Poppy.local`` -> ``poppy``; ArgumentError, a ValueError, for another name)."""
+        if self.name is not None:
+            object.__setattr__(self, "name", robot_name(self.name, "name"))
 
     def listens(self) -> dict[str, Listen]:
         """Protocol -> where it listens, for the servers asked for, in starting order."""
@@ -211,8 +219,8 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     Raises:
         ListenError: a port is taken or an address unusable.
         RuntimeError: a server did not start (its log says why).
-        ValueError: an origin in ``cors``, a name in ``allow_hosts`` or ``name`` that is not one.
-        ConfigError: a Zenoh endpoint or configuration that cannot be used, a bad name.
+        ValueError: an origin in ``cors`` or a name in ``allow_hosts`` that is not one.
+        ConfigError: a Zenoh endpoint or configuration that cannot be used.
         MissingExtraError: the ``server`` (or ``zmq``, ``appliance``, ``fleet``, ``ros2``) extra
             is missing.
     """

@@ -74,7 +74,7 @@ class ZenohClient(HttpClient):
         session: zenoh.Session | None = None,
     ) -> None:
         self.name = zenoh_wire.check_name(name)
-        self.base_url = f"{SCHEME}{name}"
+        self.base_url = f"{SCHEME}{self.name}"
         self.token = token
         self.timeout_s = timeout_s
         self._owned = session is None

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from poppy_core.checks import positive
 from poppy_core.errors import ConfigError
@@ -27,25 +27,37 @@ VREP_VISUAL_SUFFIX = "_visual"
 Quat = tuple[float, float, float, float]
 
 
-class VrepNames:
-    """The V-REP robot's methods, for a ``Robot`` whose ``simulation`` is a MuJoCo world."""
+class VrepHost(Protocol):
+    """What ``VrepNames`` needs of the robot it is mixed into (``Robot`` gives it)."""
 
-    simulation: Any
+    @property
+    def simulation(self) -> Any:
+        """The MuJoCo world (``poppy_core.sim.world.Simulation``), or None for a real robot."""
+        ...
 
     def attach(self, name: str, obj: object) -> None:
-        raise NotImplementedError  # Robot's
+        """Make ``obj`` reachable as ``robot.<name>``."""
+        ...
 
-    def reset_simulation(self) -> None:
+
+class VrepNames:
+    """The V-REP robot's methods, for a ``VrepHost`` (a ``Robot``) whose ``simulation`` is a
+    MuJoCo world."""
+
+    def reset_simulation(self: VrepHost) -> None:
         """pypot's name for ``robot.simulation.reset()``: the world back to its start pose."""
-        self._simulation("reset_simulation").reset()
+        _world(self, "reset_simulation").reset()
 
     def get_object_position(
-        self, name: str, relative_to: str | None = None, relative_to_object: str | None = None
+        self: VrepHost,
+        name: str,
+        relative_to: str | None = None,
+        relative_to_object: str | None = None,
     ) -> list[float]:
         """Body ``name``'s position (m) in the world, or in body ``relative_to``'s frame
         (pypot's keyword ``relative_to_object`` too; ``l_forearm_visual`` reads as
         ``l_forearm``)."""
-        simulation = self._simulation("get_object_position")
+        simulation = _world(self, "get_object_position")
         frame = relative_to if relative_to is not None else relative_to_object
         body = _body_name(simulation, name)
         base = None if frame is None else _body_name(simulation, frame)
@@ -53,101 +65,113 @@ class VrepNames:
         return position
 
     def get_object_orientation(
-        self, name: str, relative_to: str | None = None, relative_to_object: str | None = None
+        self: VrepHost,
+        name: str,
+        relative_to: str | None = None,
+        relative_to_object: str | None = None,
     ) -> list[float]:
         """Body ``name``'s orientation as V-REP's Euler angles (rad), in the world or in body
         ``relative_to``'s frame."""
-        simulation = self._simulation("get_object_orientation")
+        simulation = _world(self, "get_object_orientation")
         frame = relative_to if relative_to is not None else relative_to_object
         base = None if frame is None else _body_name(simulation, frame)
         w, x, y, z = simulation.get_object_orientation(_body_name(simulation, name), base)
         return euler_from_quat((w, x, y, z))
 
-    def set_object_position(self, name: str, position: Any = (0.0, 0.0, 0.0)) -> None:
+    def set_object_position(self: VrepHost, name: str, position: Any = (0.0, 0.0, 0.0)) -> None:
         """Put object ``name`` at ``position`` (m, world frame), at rest."""
-        simulation = self._simulation("set_object_position")
+        simulation = _world(self, "set_object_position")
         simulation.set_object_position(_body_name(simulation, name), position)
 
-    def set_object_orientation(self, name: str, orientation: Any) -> None:
+    def set_object_orientation(self: VrepHost, name: str, orientation: Any) -> None:
         """Turn object ``name`` to V-REP's Euler angles ``orientation`` (rad, world frame)."""
-        simulation = self._simulation("set_object_orientation")
+        simulation = _world(self, "set_object_orientation")
         angles = [float(a) for a in _three(orientation, "orientation")]
         simulation.set_object_orientation(_body_name(simulation, name), quat_from_euler(angles))
 
-    def get_simulation_current_time(self, timer: str = "CurrentTime") -> float:
+    def get_simulation_current_time(self: VrepHost, timer: str = "CurrentTime") -> float:
         """The simulated time (s) since the world was built (``timer``: V-REP's signal name,
         unused)."""
-        return float(self._simulation("get_simulation_current_time").time)
+        return float(_world(self, "get_simulation_current_time").time)
 
     @property
-    def current_simulation_time(self) -> float:
+    def current_simulation_time(self: VrepHost) -> float:
         """pypot's ``robot.current_simulation_time``: the simulated time (s)."""
-        return self.get_simulation_current_time()
+        return float(_world(self, "current_simulation_time").time)
 
-    def add_cube(self, name: str, position: Any, sizes: Any, mass: float) -> None:
+    def add_cube(self: VrepHost, name: str, position: Any, sizes: Any, mass: float) -> None:
         """A free box of sides ``sizes`` (x, y, z; m) and ``mass`` (kg) at ``position``."""
         x, y, z = (positive(s, "sizes") / 2 for s in _three(sizes, "sizes"))
-        self._add("add_cube", "cube", name, position, (x, y, z), mass)
+        _add(self, "add_cube", "cube", name, position, (x, y, z), mass)
 
     def add_sphere(
-        self, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
+        self: VrepHost, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
     ) -> None:
         """A free ball of diameter ``sizes[0]`` (m) and ``mass`` (kg) (``precision``: V-REP's
         faceting, unused: MuJoCo's ball is round)."""
         radius = positive(_three(sizes, "sizes")[0], "sizes") / 2
-        self._add("add_sphere", "sphere", name, position, (radius,), mass)
+        _add(self, "add_sphere", "sphere", name, position, (radius,), mass)
 
     def add_cylinder(
-        self, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
+        self: VrepHost, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
     ) -> None:
         """A free upright cylinder of diameter ``sizes[0]`` and height ``sizes[2]`` (m)."""
-        self._add("add_cylinder", "cylinder", name, position, _upright(sizes), mass)
+        _add(self, "add_cylinder", "cylinder", name, position, _upright(sizes), mass)
 
     def add_cone(
-        self, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
+        self: VrepHost, name: str, position: Any, sizes: Any, mass: float, precision: Any = (10, 10)
     ) -> None:
         """A free upright cone (tip up) of base diameter ``sizes[0]`` and height ``sizes[2]``."""
-        self._add("add_cone", "cone", name, position, _upright(sizes), mass)
+        _add(self, "add_cone", "cone", name, position, _upright(sizes), mass)
 
-    def get_collision_state(self, collision_name: str) -> bool:
+    def get_collision_state(self: VrepHost, collision_name: str) -> bool:
         """Whether body ``collision_name`` touches another body or the world now."""
-        simulation = self._simulation("get_collision_state")
+        simulation = _world(self, "get_collision_state")
         return bool(simulation.colliding(_body_name(simulation, collision_name)))
 
-    def load_scene(self, scene_path: str | Path, start: bool = False) -> None:
+    def load_scene(self: VrepHost, scene_path: str | Path, start: bool = False) -> None:
         """Replace the world by the MJCF scene at ``scene_path`` (the robot and its props; see
         ``Simulation.load_scene``); ``start``: V-REP's, the physics already runs."""
-        self._simulation("load_scene").load_scene(scene_path)
+        _world(self, "load_scene").load_scene(scene_path)
 
-    def track_objects(self, names: Any) -> None:
+    def track_objects(self: VrepHost, names: Any) -> None:
         """pypot's ``tracked_objects``: ``robot.<name>.position`` and ``.orientation`` of each
         body (and ``.colliding``)."""
-        simulation = self._simulation("track_objects")
+        simulation = _world(self, "track_objects")
         for name in _names(names):
             simulation.get_object_position(_body_name(simulation, name))  # known, or an error
             self.attach(name, TrackedObject(simulation, _body_name(simulation, name)))
 
-    def track_collisions(self, names: Any) -> None:
+    def track_collisions(self: VrepHost, names: Any) -> None:
         """pypot's ``tracked_collisions``: ``robot.<name>.colliding`` of each body (a body
         both tracked and a collision is one ``robot.<name>``)."""
-        simulation = self._simulation("track_collisions")
+        simulation = _world(self, "track_collisions")
         for name in _names(names):
             simulation.get_object_position(_body_name(simulation, name))
             self.attach(name, TrackedObject(simulation, _body_name(simulation, name)))
 
-    def _add(self, call: str, kind: str, name: str, position: Any, size: Any, mass: float) -> None:
-        simulation = self._simulation(call)
-        place = tuple(float(v) for v in _three(position, "position"))
-        simulation.add_object(kind, name, place, size=size, mass=positive(mass, "mass"))
 
-    def _simulation(self, call: str) -> Any:
-        if self.simulation is None:
-            raise ConfigError(
-                f"{call}() needs a simulated robot: build it with simulator='mujoco' "
-                "(PoppyHumanoid(simulator='mujoco'), from_profile(..., sim='mujoco'))",
-                field=call,
-            )
-        return self.simulation
+def _add(
+    host: VrepHost, call: str, kind: str, name: str, position: Any, size: Any, mass: float
+) -> None:
+    simulation = _world(host, call)
+    place = tuple(float(v) for v in _three(position, "position"))
+    simulation.add_object(kind, name, place, size=size, mass=positive(mass, "mass"))
+
+
+def _world(host: VrepHost, call: str) -> Any:
+    """``host``'s MuJoCo world, for pypot's call ``call``.
+
+    Raises:
+        ConfigError: a real robot (no simulation).
+    """
+    if host.simulation is None:
+        raise ConfigError(
+            f"{call}() needs a simulated robot: build it with simulator='mujoco' "
+            "(PoppyHumanoid(simulator='mujoco'), from_profile(..., sim='mujoco'))",
+            field=call,
+        )
+    return host.simulation
 
 
 class TrackedObject:

@@ -7,7 +7,8 @@ the ``server`` extra, importing it raises ``MissingExtraError`` naming the extra
 from poppy_core.server import needs  # noqa: F401  (checks the server extra, before the rest)
 from poppy_core.server.app import create_app
 from poppy_core.server.errors import ListenError
-from poppy_core.server.origins import OriginGuard, OriginPolicy
+from poppy_core.server.origin_guard import OriginGuard
+from poppy_core.server.origins import OriginPolicy
 from poppy_core.server.runner import ServerThread, bind_sockets, uvicorn_server
 from poppy_core.server.service import RobotService
 from poppy_core.server.stream import create_stream_app

@@ -14,7 +14,8 @@ from poppy_core.server.errors import install_error_handlers
 from poppy_core.server.fastpath import RegisterFastPath
 from poppy_core.server.legacy_paths import LegacyPaths
 from poppy_core.server.middleware import MAX_BODY_BYTES, BodyLimitMiddleware, TokenMiddleware
-from poppy_core.server.origins import OriginGuard, OriginPolicy
+from poppy_core.server.origin_guard import OriginGuard
+from poppy_core.server.origins import OriginPolicy
 from poppy_core.server.service import RobotService
 from poppy_core.server.state_routes import changes_state_as_routed
 from poppy_core.server.web import add_web_page, is_public

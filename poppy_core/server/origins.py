@@ -17,171 +17,39 @@ out while scripts, pypot's clients and the server's own pages keep working:
   GET route that moves the robot) is refused when ``Sec-Fetch-Site`` says it is cross-site.
   Allowed foreign origins get CORS headers; ``*`` allows every origin (pypot's behaviour).
 
-``OriginPolicy`` holds the rules and is shared by every server of one ``poppy serve`` (REST,
-pypot's WebSocket port, and any other server added later), so a refused origin is reported once
-with the option that allows it. ``OriginGuard`` applies a policy to an ASGI app.
+``OriginPolicy`` (here) holds the rules and is shared by every server of one ``poppy serve``
+(REST, pypot's WebSocket port, and any other server added later), so a refused origin is
+reported once with the option that allows it; ``origin_guard.OriginGuard`` applies a policy to
+an ASGI app; ``host_names`` reads the names and origins the headers carry.
 """
 
 from __future__ import annotations
 
-import ipaddress
 import logging
-import re
-import socket
 from collections.abc import Callable, Iterable
 from enum import Enum
 from typing import Any
 from urllib.parse import urlsplit
 
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
-
-from poppy_core.server.refusals import refuse
+from poppy_core.server.host_names import (
+    ANY,
+    DEFAULT_PORTS,
+    LOOPBACK_NAMES,
+    WILDCARD_HOSTS,
+    is_ip,
+    is_loopback,
+    machine_names,
+    normalize_host,
+    normalize_origin,
+    robot_names,
+    split_host,
+)
 
 logger = logging.getLogger(__name__)
 
-ANY = "*"
-LOOPBACK_NAMES = frozenset({"localhost", "127.0.0.1", "::1"})
-WILDCARD_HOSTS = frozenset({"", "0.0.0.0", "::"})
-DEFAULT_PORTS = {"http": 80, "https": 443, "ws": 80, "wss": 443}
 MAX_REPORTED = 64
 """Distinct refused origins/hosts reported (a page cycling names cannot flood the terminal)."""
 MAX_CACHED = 256
-
-SAFE_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
-PORT = re.compile(r"[0-9]{1,5}")
-
-ALLOW_HEADERS = b"Origin, Accept, Content-Type, X-Requested-With, X-CSRF-Token, Authorization"
-ALLOW_METHODS = b"GET, POST, PUT, PATCH, DELETE, OPTIONS"
-PREFLIGHT_MAX_AGE = b"600"
-NO_STORE = (b"cache-control", b"no-store")
-PYPOT_OPEN_HEADERS = [
-    NO_STORE,
-    (b"access-control-allow-origin", b"*"),
-    (b"access-control-allow-headers", ALLOW_HEADERS),
-    (b"access-control-allow-methods", ALLOW_METHODS),
-]
-"""pypot's headers on every answer, kept for ``--cors '*'``."""
-CROSS_SITE = (b"cross-site", b"same-site")
-
-
-def normalize_origin(text: str) -> str:
-    """An origin as browsers send it: ``HTTPS://Snap.Berkeley.edu:443/`` -> ``https://snap.berkeley.edu``.
-
-    ``*`` (any origin) and ``null`` (file:// pages, sandboxed frames) are kept as they are.
-
-    Raises:
-        ValueError: ``text`` is not ``scheme://host[:port]`` with scheme http or https.
-    """
-    text = text.strip()
-    if text in (ANY, "null"):
-        return text
-    parts = urlsplit(text)
-    if (
-        parts.scheme.lower() not in ("http", "https")
-        or not parts.hostname
-        or parts.path not in ("", "/")
-        or parts.query
-        or parts.fragment
-        or parts.username is not None
-    ):
-        raise ValueError(
-            f"{text!r} is not an origin: give scheme://host[:port], e.g. https://snap.berkeley.edu"
-        )
-    scheme = parts.scheme.lower()
-    port = parts.port  # ValueError when out of range
-    host = parts.hostname.lower()
-    if ":" in host:
-        host = f"[{host}]"
-    suffix = f":{port}" if port is not None and port != DEFAULT_PORTS[scheme] else ""
-    return f"{scheme}://{host}{suffix}"
-
-
-def normalize_host(text: str) -> str:
-    """A host name as the Host header carries it, without port: ``Poppy.local.`` -> ``poppy.local``.
-
-    Raises:
-        ValueError: ``text`` holds a scheme, a path or spaces.
-    """
-    name = text.strip().lower().rstrip(".")
-    if name.startswith("[") and name.endswith("]"):
-        name = name[1:-1]
-    if name == ANY:
-        return name
-    if not name or "/" in name or " " in name or "@" in name:
-        raise ValueError(f"{text!r} is not a host name: give a name such as poppy.local")
-    return name
-
-
-def split_host(value: str) -> tuple[str, int | None]:
-    """``"[::1]:8080"`` -> ``("::1", 8080)``; ``"Localhost"`` -> ``("localhost", None)``."""
-    value = value.strip().lower()
-    port: int | None = None
-    if value.startswith("[") and "]" in value:
-        end = value.index("]")
-        name, rest = value[1:end], value[end + 1 :]
-        if PORT.fullmatch(rest[1:]) and rest.startswith(":"):
-            port = int(rest[1:])
-    elif value.count(":") == 1:
-        name, _, text = value.partition(":")
-        port = int(text) if PORT.fullmatch(text) else None
-    else:
-        name = value  # a bare IPv6 address or a name without port
-    return name.rstrip("."), port
-
-
-def is_ip(name: str) -> bool:
-    """True for an IPv4 or IPv6 address literal."""
-    try:
-        ipaddress.ip_address(name)
-    except ValueError:
-        return False
-    return True
-
-
-def is_loopback(name: str) -> bool:
-    """True for ``localhost``, ``*.localhost`` (loopback in every browser) and loopback IPs."""
-    if name == "localhost" or name.endswith(".localhost"):
-        return True
-    try:
-        return ipaddress.ip_address(name).is_loopback
-    except ValueError:
-        return False
-
-
-ROBOT_NAME = re.compile(r"[a-z0-9](?:[a-z0-9-]{0,61}[a-z0-9])?")
-"""A robot's name: one DNS label (its mDNS name is ``NAME.local``)."""
-
-
-def robot_name(text: str) -> str:
-    """A robot's name as announced: ``Poppy.local`` -> ``poppy``.
-
-    Raises:
-        ValueError: not one DNS label (letters, digits and inner hyphens, at most 63).
-    """
-    name = text.strip().lower().rstrip(".").removesuffix(".local")
-    if not ROBOT_NAME.fullmatch(name):
-        raise ValueError(
-            f"{text!r} is not a robot name: give letters, digits and hyphens (at most 63, "
-            "not starting or ending with a hyphen), e.g. poppy or ergo-2"
-        )
-    return name
-
-
-def robot_names(name: str) -> set[str]:
-    """The Host names of a robot named ``name``: ``poppy`` -> ``{"poppy", "poppy.local"}``.
-
-    Raises:
-        ValueError: ``name`` is not a robot name.
-    """
-    short = robot_name(name)
-    return {short, f"{short}.local"}
-
-
-def machine_names() -> set[str]:
-    """This machine's name and its mDNS name (``poppy`` and ``poppy.local``)."""
-    name = socket.gethostname().lower().rstrip(".")
-    short = name.split(".")[0]
-    return {n for n in (name, short, f"{short}.local") if n}
 
 
 class Verdict(Enum):
@@ -389,112 +257,3 @@ def _quoted(value: str) -> str:
     """``value`` for a suggested command line: as Python quotes it, without the quotes, so a
     control character a client sent (``\x9b``) is shown escaped, never written raw."""
     return repr(value)[1:-1]
-
-
-def default_changes_state(scope: Scope) -> bool:
-    """True for what may change the robot: a WebSocket, any method but GET/HEAD/OPTIONS.
-
-    An app with GET routes that change the robot passes its own rule, decided on the route a
-    request reaches (the REST app: ``state_routes.changes_state_as_routed``).
-    """
-    return scope["type"] == "websocket" or scope["method"] not in SAFE_METHODS
-
-
-class OriginGuard:
-    """Apply an ``OriginPolicy`` to every HTTP request and WebSocket handshake of ``app``.
-
-    Refuses foreign Host names (400) and origins (403) before the app sees them, answers
-    ``OPTIONS`` preflights (204), and adds ``Cache-Control: no-store`` and, for allowed foreign
-    origins, the CORS headers to every answer.
-
-    Args:
-        app: the wrapped app.
-        policy: the rules (shared by the servers of one ``poppy serve``).
-        changes_state: which requests may change the robot (cross-site ones without ``Origin``
-            are refused); every WebSocket and non-GET request by default.
-    """
-
-    def __init__(
-        self,
-        app: ASGIApp,
-        policy: OriginPolicy,
-        changes_state: Callable[[Scope], bool] = default_changes_state,
-    ) -> None:
-        self.app = app
-        self.policy = policy
-        self.changes_state = changes_state
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] not in ("http", "websocket"):
-            await self.app(scope, receive, send)
-            return
-        host = origin = fetch_site = None
-        repeated = False
-        for name, value in scope["headers"]:
-            if name == b"host":
-                repeated = repeated or host is not None
-                host = value
-            elif name == b"origin":
-                repeated = repeated or origin is not None
-                origin = value
-            elif name == b"sec-fetch-site":
-                fetch_site = value
-        policy = self.policy
-        if repeated or not policy.host_allowed(host):
-            text = (host or b"").decode("latin-1")
-            message = policy.refused_host(text) if not repeated else "repeated Host or Origin"
-            tip = "open the robot by its address or a name the server allows"
-            await refuse(scope, send, 400, message, tip)
-            return
-        allow: bytes | None = b"*" if policy.any_origin else None
-        if origin is not None:
-            server = scope.get("server")
-            verdict = policy.verdict(origin, host, server[1] if server else None)
-            if verdict is Verdict.FOREIGN:
-                message = policy.refused_origin(origin.decode("latin-1"))
-                await refuse(scope, send, 403, message, "the server's operator can allow it")
-                return
-            if verdict in (Verdict.ALLOWED, Verdict.SIBLING) and allow is None:
-                allow = origin
-        elif fetch_site in CROSS_SITE and not policy.any_origin and self.changes_state(scope):
-            message = policy.refused_cross_site()
-            await refuse(scope, send, 403, message, "use fetch() from an allowed origin")
-            return
-        if scope["type"] == "websocket":
-            await self.app(scope, receive, send)
-            return
-        if allow is None:
-            extra = [NO_STORE]
-        elif allow == b"*":
-            extra = PYPOT_OPEN_HEADERS
-        else:
-            extra = [NO_STORE, (b"access-control-allow-origin", allow), (b"vary", b"Origin")]
-        if scope["method"] == "OPTIONS":
-            await self._preflight(scope, send, extra, allow is not None)
-            return
-
-        async def send_with_headers(message: Message) -> None:
-            if message["type"] == "http.response.start":
-                message = {**message, "headers": [*message.get("headers", []), *extra]}
-            await send(message)
-
-        await self.app(scope, receive, send_with_headers)
-
-    @staticmethod
-    async def _preflight(
-        scope: Scope, send: Send, extra: list[tuple[bytes, bytes]], cors: bool
-    ) -> None:
-        listed = (b"access-control-allow-headers", b"access-control-allow-methods")
-        headers = [h for h in extra if h[0] not in listed]
-        if cors:
-            headers += [
-                (b"access-control-allow-headers", ALLOW_HEADERS),
-                (b"access-control-allow-methods", ALLOW_METHODS),
-                (b"access-control-max-age", PREFLIGHT_MAX_AGE),
-            ]
-            if (b"access-control-request-private-network", b"true") in scope["headers"]:
-                # Chrome asks before a public page reaches a loopback server (Private Network
-                # Access): the origin is allowed, so is this.
-                headers.append((b"access-control-allow-private-network", b"true"))
-        await send({"type": "http.response.start", "status": 204, "headers": headers})
-        await send({"type": "http.response.body", "body": b""})

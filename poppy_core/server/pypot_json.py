@@ -27,7 +27,7 @@ PYPOT_HEADERS: dict[str, str] = {
     "Content-Security-Policy": "default-src 'none'; sandbox",
 }
 """Sent with every answer of pypot's routes (besides the content type); pypot's
-``Cache-control: no-store`` is added to every answer by ``origins.OriginGuard``."""
+``Cache-control: no-store`` is added to every answer by ``origin_guard.OriginGuard``."""
 
 
 ENCODER = json.JSONEncoder(ensure_ascii=False, allow_nan=False, separators=(",", ":"))

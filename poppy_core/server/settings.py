@@ -16,10 +16,11 @@ from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from poppy_core.checks import robot_name
 from poppy_core.errors import ConfigError, FileError
 from poppy_core.server import serve_options
 from poppy_core.server.errors import ApiError
-from poppy_core.server.origins import OriginPolicy, robot_name
+from poppy_core.server.origins import OriginPolicy
 from poppy_core.server.settings_os import SystemToolError, SystemTools
 
 if TYPE_CHECKING:

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from starlette.types import Scope
 
 from poppy_core.server.legacy_paths import current_path
-from poppy_core.server.origins import SAFE_METHODS
+from poppy_core.server.origin_guard import SAFE_METHODS
 from poppy_core.server.routers.common import CHANGES_STATE
 
 if TYPE_CHECKING:

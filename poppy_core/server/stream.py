@@ -26,7 +26,8 @@ from poppy_core.schedule import Periodic
 from poppy_core.server.errors import ApiError, refusal_kind
 from poppy_core.server.jsonio import parse_json
 from poppy_core.server.middleware import TokenMiddleware, token_protocol
-from poppy_core.server.origins import OriginGuard, OriginPolicy
+from poppy_core.server.origin_guard import OriginGuard
+from poppy_core.server.origins import OriginPolicy
 from poppy_core.server.refusals import one_line
 from poppy_core.server.service import RobotService
 from poppy_core.server.teleop_channel import TeleopChannel

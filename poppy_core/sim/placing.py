@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import threading
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import mujoco  # noqa: TID253 (this room is imported lazily, by the factory)
 import numpy as np
@@ -46,54 +46,56 @@ def carry_state(old_model: Any, old_data: Any, model: Any) -> Any:
     return data
 
 
-class Placing:
-    """Poses set by hand, the simulated time, and loading a scene (a ``Simulation`` mixin)."""
-
-    model: Any
-    view_model: Any
-    data: Any
-    meshes_dir: Path | None
-    _lock: threading.RLock
-
-    def _body(self, name: str) -> int:
-        raise NotImplementedError  # Simulation's
-
-    def _install(
-        self, xml: str | None = None, assets: dict[str, bytes] | None = None, specs: Any = None
-    ) -> None:
-        raise NotImplementedError  # Simulation's
+class PlacingHost(Protocol):
+    """What ``Placing`` needs of the world it is mixed into (``Simulation`` gives it)."""
 
     @property
-    def time(self) -> float:
+    def model(self) -> Any:
+        """The stepped ``MjModel`` (without the visual meshes)."""
+        ...
+
+    @property
+    def view_model(self) -> Any:
+        """The drawn ``MjModel`` (same bodies, with the visual meshes)."""
+        ...
+
+    @property
+    def data(self) -> Any:
+        """The world's ``MjData``."""
+        ...
+
+    @property
+    def meshes_dir(self) -> Path | None:
+        """Where a scene's missing mesh files are looked for."""
+        ...
+
+    @property
+    def lock(self) -> threading.RLock:
+        """Held to read or change ``model``/``data``."""
+        ...
+
+    def _body(self, name: str) -> int:
+        """Body ``name``'s index (``ConfigError`` if there is none)."""
+        ...
+
+    def _install(self, xml: str | None = None, assets: dict[str, bytes] | None = None) -> None:
+        """Compile the world again from ``xml`` and ``assets``, carrying the robot's state."""
+        ...
+
+
+class Placing:
+    """Poses set by hand, the simulated time, and loading a scene (a mixin of a ``PlacingHost``,
+    the ``Simulation``)."""
+
+    @property
+    def time(self: PlacingHost) -> float:
         """The simulated time (s) since the world was built."""
-        with self._lock:
+        with self.lock:
             return float(self.data.time)
 
-    def _free_joint(self, body: int) -> int | None:
-        """The free joint that moves ``body`` on its own, if any."""
-        for j in range(int(self.model.body_jntnum[body])):
-            joint = int(self.model.body_jntadr[body]) + j
-            if self.model.jnt_type[joint] == mujoco.mjtJoint.mjJNT_FREE:
-                return joint
-        return None
-
-    def _placeable(self, name: str) -> tuple[int, int | None]:
-        """(body, its free joint or None for a body fixed in the world).
-
-        Raises:
-            ConfigError: ``name`` is a link moved by the robot's joints.
-        """
-        body = self._body(name)
-        joint = self._free_joint(body)
-        if joint is None and (self.model.body_parentid[body] != 0 or self.model.body_jntnum[body]):
-            raise ConfigError(
-                f"{name!r} moves with the robot's joints: set its motors' goal positions, or "
-                "place an object or the robot's free root",
-                field=name,
-            )
-        return body, joint
-
-    def set_object_position(self, name: str, position: tuple[float, float, float]) -> None:
+    def set_object_position(
+        self: PlacingHost, name: str, position: tuple[float, float, float]
+    ) -> None:
         """Put body ``name`` (an object, a scene's prop, the Humanoid's root) at ``position``
         (m, world frame), at rest; its orientation is kept.
 
@@ -101,8 +103,8 @@ class Placing:
             ConfigError: no such body, a robot link, or a position that is not 3 numbers.
         """
         point = _vector(position, 3, "position")
-        with self._lock:
-            body, joint = self._placeable(name)
+        with self.lock:
+            body, joint = _placeable(self, name)
             if joint is None:
                 self.model.body_pos[body] = point
                 self.view_model.body_pos[body] = point
@@ -113,7 +115,9 @@ class Placing:
                 self.data.qvel[dof : dof + 6] = 0.0
             mujoco.mj_forward(self.model, self.data)
 
-    def set_object_orientation(self, name: str, quat: tuple[float, float, float, float]) -> None:
+    def set_object_orientation(
+        self: PlacingHost, name: str, quat: tuple[float, float, float, float]
+    ) -> None:
         """Turn body ``name`` (as ``set_object_position`` places) to the quaternion ``quat``
         (w, x, y, z; normalised here), at rest; its position is kept.
 
@@ -125,8 +129,8 @@ class Placing:
         if length < 1e-9:
             raise ConfigError("an orientation quaternion cannot be zero", field="orientation")
         turn = turn / length
-        with self._lock:
-            body, joint = self._placeable(name)
+        with self.lock:
+            body, joint = _placeable(self, name)
             if joint is None:
                 self.model.body_quat[body] = turn
                 self.view_model.body_quat[body] = turn
@@ -137,7 +141,7 @@ class Placing:
                 self.data.qvel[dof : dof + 6] = 0.0
             mujoco.mj_forward(self.model, self.data)
 
-    def load_scene(self, path: str | Path, meshes: Path | None = None) -> None:
+    def load_scene(self: PlacingHost, path: str | Path, meshes: Path | None = None) -> None:
         """Replace the world by the MJCF scene at ``path``: the robot and its props.
 
         The scene names the robot's joints and actuators like the profile's model (start
@@ -151,6 +155,34 @@ class Placing:
         scene = Path(path)
         xml, assets = read_model(scene, meshes if meshes is not None else self.meshes_dir)
         self._install(xml, assets)
+
+
+def _free_joint(host: PlacingHost, body: int) -> int | None:
+    """The free joint that moves ``body`` on its own, if any."""
+    model = host.model
+    for j in range(int(model.body_jntnum[body])):
+        joint = int(model.body_jntadr[body]) + j
+        if model.jnt_type[joint] == mujoco.mjtJoint.mjJNT_FREE:
+            return joint
+    return None
+
+
+def _placeable(host: PlacingHost, name: str) -> tuple[int, int | None]:
+    """(body, its free joint or None for a body fixed in the world).
+
+    Raises:
+        ConfigError: ``name`` is a link moved by the robot's joints.
+    """
+    body = host._body(name)
+    joint = _free_joint(host, body)
+    model = host.model
+    if joint is None and (model.body_parentid[body] != 0 or model.body_jntnum[body]):
+        raise ConfigError(
+            f"{name!r} moves with the robot's joints: set its motors' goal positions, or "
+            "place an object or the robot's free root",
+            field=name,
+        )
+    return body, joint
 
 
 def _vector(values: object, size: int, field: str) -> np.ndarray:

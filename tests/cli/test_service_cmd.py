@@ -249,8 +249,8 @@ def test_a_failing_systemctl_is_one_line(fake: Fake, someone: str) -> None:
 @pytest.mark.parametrize(
     ("args", "says", "code"),
     [
-        (("--name", "Poppy_1"), "--name 'Poppy_1': give a host name", 2),
-        (("--name", "-poppy"), "give a host name", 2),
+        (("--name", "Poppy_1"), "--name 'Poppy_1' is not a robot name", 2),
+        (("--name", "-poppy"), "is not a robot name", 2),
         (("--port", " "), "--port is empty", 2),
         (("--run-as", "root"), "must not run as root: pass --run-as USER", 2),
         (("--run-as", "no-such-user-here"), "no such user on this machine", 2),

@@ -165,6 +165,13 @@ def test_simulated_creatures_hold_their_start_pose_as_pypot_simulators() -> None
             robot.reset_simulation()
         with pytest.raises(ConfigError, match="simulator='mujoco'"):
             robot.get_object_position("head")
+        # each V-REP call names itself: pypot's property, not the method behind it
+        with pytest.raises(ConfigError, match=r"^current_simulation_time\(\) needs"):
+            robot.current_simulation_time  # noqa: B018 (the read is the call)
+        with pytest.raises(ConfigError, match=r"^add_cube\(\) needs"):
+            robot.add_cube("box", [0, 0, 0.1], [0.02, 0.02, 0.02], 0.01)
+        with pytest.raises(ConfigError, match=r"^track_objects\(\) needs"):
+            robot.track_objects(["head"])
 
 
 def test_a_pypot_config_dict_finds_its_simulation_model() -> None:

@@ -19,7 +19,8 @@ from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
 from poppy_core.server import OriginPolicy
-from poppy_core.server.origins import Verdict, is_ip, is_loopback, normalize_origin, split_host
+from poppy_core.server.host_names import is_ip, is_loopback, normalize_origin, split_host
+from poppy_core.server.origins import Verdict
 from tests.helpers.server import Served, serve
 
 EVIL = "https://evil.example"

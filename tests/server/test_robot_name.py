@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import pytest
 
+from poppy_core.checks import robot_name
 from poppy_core.server import OriginPolicy
-from poppy_core.server.origins import Verdict, robot_name
+from poppy_core.server.origins import Verdict
 
 HOST = b"poppy.local:8080"
 

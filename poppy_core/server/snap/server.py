@@ -19,7 +19,8 @@ from starlette.types import Scope
 from poppy_core.motion.chains import robot_chains
 from poppy_core.robot import Robot
 from poppy_core.sensors import MarkerDetector
-from poppy_core.server.origins import OriginGuard, OriginPolicy
+from poppy_core.server.origin_guard import OriginGuard
+from poppy_core.server.origins import OriginPolicy
 from poppy_core.server.runner import ServerThread
 from poppy_core.server.service import RobotService
 from poppy_core.server.snap.app import APP_PREFIX, create_snap_app
