@@ -175,6 +175,14 @@ def robot_name(value: object, field: str = "name") -> str:
     return name
 
 
+def robot_name_of_host(hostname: str) -> str:
+    """A machine's robot name: its first label lower-cased, other characters as ``-``
+    (``My_Pi.lan`` -> ``my-pi``), ``poppy`` when nothing is left (the default of ``--name``)."""
+    label = hostname.split(".")[0].lower()
+    name = re.sub(r"[^a-z0-9-]", "-", label)[:63].strip("-")
+    return name or "poppy"
+
+
 T = TypeVar("T")
 
 

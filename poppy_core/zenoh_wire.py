@@ -60,9 +60,7 @@ def check_name(name: str) -> str:
 def default_name() -> str:
     """The host's name as a robot name (its first label lower-cased, other characters as
     ``-``; ``poppy`` when nothing is left)."""
-    label = socket.gethostname().split(".")[0].lower()
-    name = re.sub(r"[^a-z0-9-]", "-", label)[:63].strip("-")
-    return name or "poppy"
+    return checks.robot_name_of_host(socket.gethostname())
 
 
 def robot_key(name: str, *parts: str) -> str:

@@ -16,7 +16,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from poppy_core.checks import robot_name
+from poppy_core.checks import robot_name, robot_name_of_host
 from poppy_core.errors import ConfigError, FileError
 from poppy_core.server import serve_options
 from poppy_core.server.errors import ApiError
@@ -191,7 +191,7 @@ class RobotSettings:
             logger.warning("settings: %s removed the fallback access point", who)
             return None
         assert password is not None
-        ssid = self.served.name or _name_of(self.system.hostname())
+        ssid = self.served.name or robot_name_of_host(self.system.hostname())
         self.system.set_hotspot(ssid, password)
         logger.warning("settings: %s set up the fallback access point %r", who, ssid)
         return ssid
@@ -272,14 +272,6 @@ class RobotSettings:
             ) from None
         logger.warning("settings: %s restarts to apply it", SERVICE_UNIT)
         return True
-
-
-def _name_of(hostname: str) -> str:
-    """The robot's name from the machine's (``poppy`` when that is no DNS label)."""
-    try:
-        return robot_name(hostname.split(".")[0])
-    except ValueError:
-        return "poppy"
 
 
 def _check_ssid(ssid: str) -> None:

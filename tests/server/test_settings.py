@@ -273,11 +273,17 @@ def test_an_unnamed_robot_s_access_point_is_named_after_the_machine_or_poppy(
     fake: FakeTools, with_token: Served, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     import poppy_core.server.settings_os as settings_os
+    from poppy_core import zenoh_wire
 
     with_token.app.state.settings.served.name = None
     body = {"on": True, "password": "hotspot-pw"}
     with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
         monkeypatch.setattr(settings_os.socket, "gethostname", lambda: "Ergo-9.lan")
         assert http.put("/api/v1/settings/wifi/hotspot", json=body).json()["ssid"] == "ergo-9"
+        # the machine's robot name, as Zenoh's default name makes it (one rule)
         monkeypatch.setattr(settings_os.socket, "gethostname", lambda: "my_machine")
+        assert http.put("/api/v1/settings/wifi/hotspot", json=body).json()["ssid"] == "my-machine"
+        monkeypatch.setattr(zenoh_wire.socket, "gethostname", lambda: "my_machine")
+        assert zenoh_wire.default_name() == "my-machine"
+        monkeypatch.setattr(settings_os.socket, "gethostname", lambda: "__")
         assert http.put("/api/v1/settings/wifi/hotspot", json=body).json()["ssid"] == "poppy"
