@@ -22,8 +22,7 @@ from poppy_cli.output import EXIT_USAGE, console, error_line, fmt_value, print_j
 
 if TYPE_CHECKING:
     from poppy_core.bus.results import SetupResult
-    from poppy_core.models import Register
-    from poppy_core.models.register import SIValue
+    from poppy_core.models import Register, SIValue
 
 app = typer.Typer(
     help="Read, write and set up motors: IDs, baud rates, limits, torque, LED, reset.",

@@ -1,6 +1,5 @@
 """Bus layer: transports, ``DxlBus`` transactions, port listing, scanning and motor setup."""
 
-from poppy_core.bus.core import is_alarm_only
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.dxlio import Dxl320IO, DxlIO, get_available_ports
 from poppy_core.bus.ports import (
@@ -13,6 +12,7 @@ from poppy_core.bus.ports import (
     read_ftdi_latency_ms,
     recognise_adapter,
 )
+from poppy_core.bus.replies import is_alarm_only
 from poppy_core.bus.results import BusStats, FoundMotor, PingResult, ScanProgress, SetupResult
 from poppy_core.bus.scan import find_bus, find_port, scan
 from poppy_core.bus.serial_line import Line, LineOpener, SerialLine, open_line, register_scheme

@@ -1,14 +1,9 @@
 """The transaction engine under ``DxlBus``: lock, physical deadlines, retries, error bits, counters.
 
-Error bits policy (decided here, relied upon above):
-
-* *Alarm* bits report the motor's state, not a refused instruction: protocol 1 input voltage,
-  overheating and overload; protocol 2 the hardware alert bit (bit 7) with no error number. The
-  instruction was executed, so the data is returned (or the write counted as done); the alarm is
-  logged once when it appears, counted in ``stats.alarms`` and kept in ``bus.alarms[id]``.
-* Any other bit (protocol 1 angle limit, range, checksum, instruction; protocol 2 error numbers)
-  means the instruction was refused: ``MotorError`` is raised, naming the motor and the bits.
-* ``ping`` never raises ``MotorError``: any valid reply proves the motor is there.
+One instruction is one ``exchange``: the bus sends it and sets the first reply's deadline, and
+``poppy_core.bus.replies`` collects the replies. Error bits follow the policy written there
+(``ErrorBits``: a refusal raises ``MotorError``, an alarm is recorded in ``bus.alarms``); ``ping``
+never raises ``MotorError``: any valid reply proves the motor is there.
 
 Retries: a timeout or a corrupt reply is retried ``retries`` times (``MotorError`` never is).
 """
@@ -23,6 +18,7 @@ from collections import deque
 from collections.abc import Sequence
 
 from poppy_core.bus.latency import ReplyClock
+from poppy_core.bus.replies import ErrorBits, collect_replies
 from poppy_core.bus.results import BusStats
 from poppy_core.bus.timing import (
     DEFAULT_RETURN_DELAY_S,
@@ -32,7 +28,7 @@ from poppy_core.bus.timing import (
     default_latency_s,
 )
 from poppy_core.bus.transport import Transport
-from poppy_core.errors import BusTimeout, CorruptPacketError, MotorError, PortError, ProtocolError
+from poppy_core.errors import BusTimeout, CorruptPacketError, PortError, ProtocolError
 from poppy_core.protocol import (
     BROADCAST_ID,
     DxlProtocol,
@@ -43,23 +39,6 @@ from poppy_core.protocol import (
 )
 
 logger = logging.getLogger(__name__)
-
-
-def is_alarm_only(protocol: int | DxlProtocol, error: int) -> bool:
-    """True when ``error`` carries only alarm bits (the instruction was still executed)."""
-    return protocol_for(protocol).is_alarm_only(error)
-
-
-def reply_fits(protocol: int | DxlProtocol, status: StatusPacket, n_params: int) -> bool:
-    """A reply to keep: ``n_params`` bytes of data, or a refusal (which carries none and is
-    checked later).
-
-    A status of another size is a late answer to an earlier instruction (for instance a write
-    sent with ``reply=False`` that was answered all the same): it is kept aside.
-    """
-    if len(status.params) == n_params:
-        return True
-    return bool(status.error) and not is_alarm_only(protocol, status.error)
 
 
 class BusCore:
@@ -140,7 +119,8 @@ class BusCore:
         self.timeout_s = timeout_s
         self.min_timeout_s = min_timeout_s
         self.stats = BusStats()
-        self.alarms: dict[int, list[str]] = {}
+        self._errors = ErrorBits(self._proto, port, self.stats)
+        self.alarms = self._errors.alarms
         self._strays: deque[StatusPacket] = deque(maxlen=256)
         self.sync_read_enabled = sync_read
         self.sync_read_mode: str | None = None
@@ -251,7 +231,6 @@ class BusCore:
         for stray in transport.drain():
             self._observe(stray, drained_at)
             self._strays.append(stray)
-        corrupt_before, skipped_before = transport.corrupt_packets, transport.skipped_bytes
         data = self._proto.encode_instruction(packet)
         transport.write(data)
         if packet.id != BROADCAST_ID:
@@ -260,49 +239,21 @@ class BusCore:
             self._replies.sent_to_all(time.monotonic(), len(data))
         if not expected:
             return {}
-        sizes = [self._proto.status_size(n) for _, n in expected]
         first = timeout_s if timeout_s is not None else self.timeout_s
         if first is None:
-            first = self._timing.reply_timeout_s(len(data), sizes[0])
+            first = self._timing.reply_timeout_s(len(data), self._proto.status_size(expected[0][1]))
         floor = self.min_timeout_s if min_timeout_s is None else min_timeout_s
-        deadline = Deadline(max(first, floor))
-        grace = self._timing.grace_s(max(sizes))
-        wanted = {motor_id for motor_id, _ in expected}
-        sizes_by_id = dict(expected)
-        got: dict[int, StatusPacket] = {}
-        expected_bytes = sum(sizes)
-        received_before = transport.bytes_received
-        stray_bytes = 0
-
-        def all_came() -> bool:
-            """As many bytes as the replies came, some garbled: no point waiting out the
-            deadline (the retry goes out at once)."""
-            if len(got) + transport.corrupt_packets - corrupt_before >= len(wanted):
-                return True
-            return transport.bytes_received - received_before - stray_bytes >= expected_bytes
-
-        while len(got) < len(wanted):
-            status = transport.read_packet(deadline, grace_s=grace, give_up=all_came)
-            if status is None:
-                break
-            self._observe(status, time.monotonic())
-            if (
-                status.id in wanted
-                and status.id not in got
-                and reply_fits(self._protocol, status, sizes_by_id[status.id])
-            ):
-                got[status.id] = status
-                deadline.extend(self._timing.quiet_gap_s(max(sizes)))
-            else:
-                logger.debug("%s: stray status from ID %d kept aside", self._port, status.id)
-                self._strays.append(status)
-                stray_bytes += self._proto.status_size(len(status.params))
-        corrupt = transport.corrupt_packets - corrupt_before
-        if len(got) < len(wanted) and not corrupt and transport.skipped_bytes > skipped_before:
-            corrupt = 1  # bytes came back but no packet could be found in them: garbage
-        self.stats.corrupt_packets += corrupt
-        self.stats.timeouts += len(wanted) - len(got)
-        return got
+        return collect_replies(
+            transport,
+            self._proto,
+            expected,
+            Deadline(max(first, floor)),
+            self._timing,
+            self.stats,
+            observe=self._observe,
+            set_aside=self._strays.append,
+            port=self._port,
+        )
 
     def listen(self, duration_s: float) -> list[StatusPacket]:
         """Wait ``duration_s`` for late replies; return them with the strays kept aside.
@@ -370,34 +321,12 @@ class BusCore:
         )
 
     def check_status(self, status: StatusPacket, *, register: str | None = None) -> None:
-        """Raise ``MotorError`` for refusal bits; log and record alarm bits (see module doc)."""
-        if status.error == 0 or self._proto.is_alarm_only(status.error):
-            self.record_alarms(status)
-            return
-        self.stats.motor_errors += 1
-        names = self._proto.decode_errors(status.error)
-        where = f" ({register})" if register else ""
-        raise MotorError(
-            f"motor {status.id} on {self._port}{where} reported: {', '.join(names)}",
-            motor_id=status.id,
-            errors=names,
-            register=register,
-            port=self._port,
-        )
+        """Raise ``MotorError`` for refusal bits; log and record alarm bits (``ErrorBits``)."""
+        self._errors.check(status, register=register)
 
     def record_alarms(self, status: StatusPacket) -> None:
         """Keep the alarm bits of ``status`` in ``alarms`` and log when they change."""
-        names = self._proto.decode_errors(status.error) if status.error else []
-        if names != self.alarms.get(status.id, []):
-            if names:
-                logger.warning(
-                    "motor %d on %s reports: %s", status.id, self._port, ", ".join(names)
-                )
-            else:
-                logger.info("motor %d on %s: alarm cleared", status.id, self._port)
-        if names:
-            self.stats.alarms += 1
-        self.alarms[status.id] = names
+        self._errors.record(status)
 
     def _send(self, packet: InstructionPacket) -> None:
         with self._lock:

@@ -19,8 +19,7 @@ from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.dxlio_pypot import GROUPS, RENAMED, PypotCalls, _ids, _mapping, capped
 from poppy_core.bus.ports import list_ports
 from poppy_core.errors import ArgumentError, CommunicationError, RegisterError
-from poppy_core.models import ServoModel
-from poppy_core.models.register import SIValue
+from poppy_core.models import ServoModel, SIValue
 
 # pypot's getters named is_<flag> and their registers.
 FLAGS = {"is_led_on": "led", "is_moving": "moving", "is_torque_enabled": "torque_enable"}

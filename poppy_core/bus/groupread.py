@@ -24,7 +24,7 @@ from collections import Counter
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from poppy_core.bus.core import is_alarm_only, reply_fits
+from poppy_core.bus.replies import is_alarm_only, reply_fits
 from poppy_core.bus.results import PingResult
 from poppy_core.bus.timing import Deadline, settle_s, status_size
 from poppy_core.errors import BusTimeout, CorruptPacketError

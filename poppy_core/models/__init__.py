@@ -8,9 +8,7 @@ from poppy_core.models.catalog import (
     model_by_number,
     standard_baudrates,
 )
-from poppy_core.models.model import COMMON_NAMES, ServoModel
-from poppy_core.models.mx import MX_12W, MX_28, MX_64, MX_106
-from poppy_core.models.register import (
+from poppy_core.models.converters import (
     Baudrate,
     Boolean,
     Choice,
@@ -18,9 +16,11 @@ from poppy_core.models.register import (
     DirectionBit,
     Linear,
     Raw,
-    Register,
     SIValue,
 )
+from poppy_core.models.model import COMMON_NAMES, ServoModel
+from poppy_core.models.mx import MX_12W, MX_28, MX_64, MX_106
+from poppy_core.models.register import Register
 from poppy_core.models.xl320 import XL_320, XL320LEDColors
 from poppy_core.models.xseries import XL330_M288, XL430_W250, XM430_W350
 

@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from poppy_core.models.model import ServoModel, aliases_for
-from poppy_core.models.register import (
+from poppy_core.models.converters import (
     BOOL,
     LOAD_PERCENT,
     RAW,
@@ -13,10 +12,10 @@ from poppy_core.models.register import (
     VOLTAGE,
     Baudrate,
     DirectionBit,
-    Row,
-    build_table,
     position,
 )
+from poppy_core.models.model import ServoModel, aliases_for
+from poppy_core.models.register import Row, build_table
 
 # e-manual (AX-12A, "Baud Rate (4)"): bps = 2,000,000 / (code + 1); the listed codes with the
 # nominal rates a PC opens its port at (code 16 → 117,647 bps, nominal 115,200: -2.1 %). The AX

@@ -8,7 +8,8 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from poppy_core.errors import RegisterError
-from poppy_core.models.register import Baudrate, Register, SIValue
+from poppy_core.models.converters import Baudrate, SIValue
+from poppy_core.models.register import Register
 
 # The names every model resolves, directly or through an alias (docs/internals.md).
 COMMON_NAMES: tuple[str, ...] = (

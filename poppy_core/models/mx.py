@@ -7,8 +7,7 @@ from poppy_core.models.ax import (
     PROTOCOL1_LISTED_BAUDRATES,
     PROTOCOL1_RAM_START,
 )
-from poppy_core.models.model import ServoModel, aliases_for
-from poppy_core.models.register import (
+from poppy_core.models.converters import (
     BOOL,
     LOAD_PERCENT,
     MILLISECONDS,
@@ -20,11 +19,11 @@ from poppy_core.models.register import (
     Baudrate,
     DirectionBit,
     Linear,
-    Row,
-    build_table,
     gain,
     position,
 )
+from poppy_core.models.model import ServoModel, aliases_for
+from poppy_core.models.register import Row, build_table
 
 # e-manual (MX-28, "Baud Rate (4)"): codes 250-252 give 2.25, 2.5 and 3 Mbps; the rest follow
 # 2,000,000 / (code + 1) like the AX.

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 from enum import Enum
 
-from poppy_core.models.model import ServoModel, aliases_for
-from poppy_core.models.register import (
+from poppy_core.models.converters import (
     BOOL,
     LOAD_PERCENT,
     RAW,
@@ -16,10 +15,11 @@ from poppy_core.models.register import (
     Baudrate,
     Choice,
     DirectionBit,
-    build_table,
     gain,
     position,
 )
+from poppy_core.models.model import ServoModel, aliases_for
+from poppy_core.models.register import build_table
 
 # e-manual (XL-320, "Baud Rate (4)").
 XL320_BAUDRATES: dict[int, int] = {0: 9_600, 1: 57_600, 2: 115_200, 3: 1_000_000}

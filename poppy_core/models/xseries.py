@@ -8,8 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from poppy_core.models.model import ServoModel, aliases_for
-from poppy_core.models.register import (
+from poppy_core.models.converters import (
     BOOL,
     MILLISECONDS,
     RAW,
@@ -18,12 +17,12 @@ from poppy_core.models.register import (
     VOLTAGE,
     Baudrate,
     Linear,
-    Row,
-    build_table,
     gain,
     position,
     rpm,
 )
+from poppy_core.models.model import ServoModel, aliases_for
+from poppy_core.models.register import Row, build_table
 
 # e-manual (X-series "Baud Rate (8)", control_table_baudrate_2).
 X_BAUDRATES: dict[int, int] = {

@@ -12,7 +12,8 @@ bus offers), one transaction per group of motors sharing a register layout. A mo
 offline motor per ``retry_period_s``, in turn) until it answers again. Deadlines are drift-free
 (``Periodic``); a run that overran its period is followed at once by the next one, so a loop
 whose runs are sometimes long keeps its rate. Reads are stored into, writes taken from and
-misses counted on each motor's ``MotorLink`` (``link_of(motor)``), the robot side of a ``Motor``.
+misses counted on each motor's ``MotorLink`` (``link_of(motor)``), the robot side of a ``Motor``;
+a run's transactions are ``SyncTransfers``' (``robot.sync_transfers``).
 
 A lost port (adapter unplugged, emulator gone: a ``PortError``) is logged once at WARNING, every
 motor of the bus goes offline at once, and the thread reopens the port with backoff
@@ -28,23 +29,17 @@ import time
 from collections.abc import Callable, Sequence
 
 from poppy_core.bus import DxlBus
-from poppy_core.errors import BusError, MotorError, PoppyError, PortError
-from poppy_core.models import ServoModel
-from poppy_core.robot import registers as regs
+from poppy_core.errors import PoppyError, PortError
 from poppy_core.robot.health import BusHealth, LoopStats, SyncStats, bus_label
 from poppy_core.robot.loops import BASE_LOOPS, LIGHT_LOOPS, LoopSpec, loops_for
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.motor_link import link_of
+from poppy_core.robot.sync_transfers import RETRY, SyncTransfers
 from poppy_core.schedule import Backoff, Periodic, RateMeter, Worker
 
 logger = logging.getLogger(__name__)
 
 
-RETRY = "retry"
-# Offline motors are pinged RETRY_BATCH at a time, in turn, every ``retry_period_s`` (0.2 s): a
-# motor plugged back answers within a fraction of a second, and a bus full of silent motors
-# costs its live ones one ping per run.
-RETRY_BATCH = 1
 # Reopening a lost port: first attempt after RECONNECT_FIRST_S, then twice as long each time.
 RECONNECT_FIRST_S = 0.1
 RECONNECT_MAX_S = 1.0
@@ -83,7 +78,7 @@ class BusSync:
         loops: the register groups (``BASE_LOOPS``, ``LIGHT_LOOPS`` or your own).
         offline_after: consecutive missed reads before a motor is marked offline.
         retry_period_s: time between two pings of offline motors (one motor per ping, in
-            turn; see ``RETRY_BATCH``).
+            turn; see ``sync_transfers.RETRY_BATCH``).
         clock: monotonic clock in seconds.
     """
 
@@ -101,15 +96,13 @@ class BusSync:
         self.controller = controller
         self.bus = bus
         self.motors = list(motors)
-        self.offline_after = offline_after
         self._clock = clock
         self._specs = [*loops, LoopSpec(RETRY, (), False, 1.0 / retry_period_s)]
         self._loops: list[_Loop] = []
         self._worker = Worker(f"sync {controller}", self._run)
         self._stop = self._worker.stopping
-        self._blocks: dict[tuple[str, ServoModel], list[regs.ReadBlock]] = {}
+        self._transfers = SyncTransfers(bus, self.motors, offline_after, self._stop)
         self._driven: set[str] = set()
-        self._retry_turn = 0
         self.connected = bus.is_open
         """False while the port is lost, not there yet (a bus made ``DxlBus.absent``: the
         thread opens it with backoff) or released."""
@@ -122,6 +115,11 @@ class BusSync:
         if not self.connected:
             for motor in self.motors:
                 link_of(motor).mark_offline()
+
+    @property
+    def offline_after(self) -> int:
+        """Consecutive missed reads before a motor is marked offline."""
+        return self._transfers.offline_after
 
     @property
     def running(self) -> bool:
@@ -157,7 +155,7 @@ class BusSync:
         for spec in self._specs:
             if spec.write:
                 try:
-                    self._write(spec)
+                    self._transfers.write(spec)
                 except PoppyError as exc:
                     logger.warning("%s: final writes failed: %s", self.controller, exc)
         online = [m for m in self.motors if m.online]
@@ -194,7 +192,7 @@ class BusSync:
         self.connected = True
         self._stop.clear()  # stopped by release_port: the pings below must run
         try:
-            self._retry(every=True)
+            self._transfers.retry(every=True)
         except PortError:
             self.connected = False
             self.released = True
@@ -205,7 +203,7 @@ class BusSync:
     def run_once(self, name: str) -> None:
         """Run one loop now (tests and tools); errors propagate."""
         spec = next(s for s in self._specs if s.name == name)
-        self._execute(spec)
+        self._transfers.run(spec)
 
     def has_loop(self, name: str) -> bool:
         """True when this bus has a loop called ``name``."""
@@ -302,7 +300,7 @@ class BusSync:
             loop.meter.tick(now)
             started = self._clock()
             try:
-                self._execute(loop.spec)
+                self._transfers.run(loop.spec)
             except PortError as exc:
                 loop.errors += 1
                 self._lost(exc)
@@ -356,121 +354,6 @@ class BusSync:
         for loop in self._loops:
             loop.schedule = Periodic(loop.schedule.period_s, now, catch_up=1)
         try:
-            self._retry(every=True)
+            self._transfers.retry(every=True)
         except PortError as exc:
             self._lost(exc)
-
-    def _execute(self, spec: LoopSpec) -> None:
-        if spec.name == RETRY:
-            self._retry()
-        elif spec.write:
-            self._write(spec)
-        else:
-            self._read(spec)
-
-    def _blocks_for(self, spec: LoopSpec, model: ServoModel) -> list[regs.ReadBlock]:
-        key = (spec.name, model)
-        if key not in self._blocks:
-            self._blocks[key] = regs.read_blocks(model, spec.registers)
-        return self._blocks[key]
-
-    def _read(self, spec: LoopSpec) -> None:
-        # Motors whose blocks share address and length go in one transaction, whatever their
-        # model (AX and MX have the same layout); each decodes with its own registers.
-        batches: dict[tuple[int, int], list[tuple[Motor, regs.ReadBlock]]] = {}
-        for motor in self.motors:
-            if motor.online:
-                for block in self._blocks_for(spec, motor.model):
-                    batches.setdefault((block.address, block.length), []).append((motor, block))
-        for (address, length), members in batches.items():
-            by_id = {motor.id: (motor, block) for motor, block in members}
-            try:
-                data = self.bus.sync_read(address, length, list(by_id))
-            except MotorError as exc:
-                member = by_id.get(exc.motor_id)
-                self._missed(None if member is None else member[0], str(exc))
-                raise
-            for motor_id, payload in data.items():
-                if motor_id not in by_id:
-                    continue
-                motor, block = by_id[motor_id]
-                if payload is None or len(payload) != length:
-                    self._missed(motor, f"no reply to the {spec.name} read")
-                    continue
-                link_of(motor).update(block.decode(payload))
-                self._answered(motor)
-
-    def _answered(self, motor: Motor) -> None:
-        link = link_of(motor)
-        if link.mark_answered():
-            logger.info("%s (id %d) answers again", motor.name, motor.id)
-            if link.cached("present_position") is None:
-                self._first_state(motor)
-            link.resend_state()
-
-    def _first_state(self, motor: Motor) -> None:
-        """Read the control table of a motor answering for the first time (the robot started
-        without it: its bus or its power was not there yet)."""
-        try:
-            data = self.bus.read(motor.id, 0, motor.model.table_size)
-        except PortError:
-            raise
-        except BusError as exc:
-            logger.debug("%s: first state not read: %s", motor.name, exc)
-            return
-        link_of(motor).update(regs.decode_table(motor.model, data))
-
-    def _missed(self, motor: Motor | None, reason: str) -> None:
-        if motor is not None and link_of(motor).mark_missed(self.offline_after):
-            logger.warning(
-                "%s (id %d) on %s stopped answering (%s); pinging it until it answers",
-                motor.name,
-                motor.id,
-                self.bus.port,
-                reason,
-            )
-
-    def _write(self, spec: LoopSpec) -> None:
-        taken: list[tuple[Motor, dict[str, int]]] = []
-        for motor in self.motors:
-            if motor.online:
-                values = link_of(motor).take_pending(spec.registers)
-                if values:
-                    taken.append((motor, values))
-        if not taken:
-            return
-        try:
-            for name in spec.registers:
-                groups: dict[tuple[int, int], dict[int, bytes]] = {}
-                for motor, values in taken:
-                    if name in values:
-                        register = motor.model.register(name)
-                        key = (register.address, register.size)
-                        groups.setdefault(key, {})[motor.id] = register.encode(values[name])
-                for (address, _), data in groups.items():
-                    self.bus.sync_write(address, data)
-        except BusError:
-            for motor, values in taken:
-                link_of(motor).restore_pending(values)
-            raise
-
-    def _retry(self, every: bool = False) -> None:
-        """Ping offline motors: the next ``RETRY_BATCH`` in turn, or ``every`` one of them."""
-        offline = [m for m in self.motors if not m.online]
-        if not offline:
-            return
-        if not every:
-            start = self._retry_turn % len(offline)
-            offline = (offline[start:] + offline[:start])[:RETRY_BATCH]
-            self._retry_turn += len(offline)
-        for motor in offline:
-            if self._stop.is_set():
-                return
-            try:
-                answered = self.bus.ping(motor.id, identify=False) is not None
-            except PortError:
-                raise
-            except BusError:
-                answered = False
-            if answered:
-                self._answered(motor)

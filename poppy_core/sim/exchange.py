@@ -26,7 +26,8 @@ from operator import itemgetter
 from typing import NamedTuple
 
 from poppy_core.emulator.motor import VirtualMotor
-from poppy_core.models.register import Boolean, DirectionBit, Linear, Register
+from poppy_core.models.converters import Boolean, DirectionBit, Linear
+from poppy_core.models.register import Register
 
 # The registers a command is made of, and the sensed ones (names resolved through the model's
 # aliases, e.g. cw_angle_limit for min_position_limit on protocol-1 models).

@@ -1,4 +1,4 @@
-"""Objects added to a simulation (cube, sphere, cylinder, cone): their spec, the model rebuild."""
+"""Objects added to a simulation (cube, sphere, cylinder, cone, card): their spec, the rebuild."""
 
 from __future__ import annotations
 
@@ -62,6 +62,32 @@ class ObjectSpec:
             raise ConfigError("object size and mass must be positive", field="size", value=size)
         x, y, z = position
         return cls(kind, name, (float(x), float(y), float(z)), sizes, float(mass))
+
+    @classmethod
+    def card(
+        cls,
+        name: str,
+        pixels: np.ndarray,
+        position: tuple[float, float, float],
+        side: float,
+        facing: tuple[float, float, float],
+    ) -> ObjectSpec:
+        """A square card of side ``side`` (m) showing ``pixels`` (``picture_pixels``), held at
+        ``position`` with its front looking along ``facing``.
+
+        Raises:
+            ConfigError: no direction to face.
+        """
+        return cls(
+            "card",
+            name,
+            tuple(float(v) for v in position),  # type: ignore[arg-type]
+            (side / 2,),
+            0.01,
+            facing_quat(facing),
+            True,
+            pixels,
+        )
 
     def geom_size(self) -> list[float]:
         """MuJoCo geom size: box half sides, sphere radius, cylinder radius and half height."""
@@ -169,3 +195,37 @@ def facing_quat(facing: tuple[float, float, float]) -> tuple[float, float, float
     mujoco.mju_mat2Quat(quat, np.column_stack([x, y, z]).ravel())
     w, qx, qy, qz = (float(v) for v in quat)
     return (w, qx, qy, qz)
+
+
+def picture_pixels(image: object) -> np.ndarray:
+    """``image`` as the pixels a card shows.
+
+    Raises:
+        ConfigError: not an (height, width, 3) uint8 RGB image.
+    """
+    pixels = np.asarray(image)
+    if pixels.ndim != 3 or pixels.shape[2] < 3 or pixels.dtype != np.uint8:
+        raise ConfigError(
+            "a picture is an (height, width, 3) uint8 RGB image",
+            field="image",
+            value=getattr(pixels, "shape", None),
+        )
+    return pixels
+
+
+def marker_picture(
+    marker_id: int, size: float, family: str, dictionary: str
+) -> tuple[np.ndarray, float]:
+    """The RGB picture of a marker's card and the card's side (m): the marker's black square
+    is ``size`` (m) wide, with a white margin of one cell around it.
+
+    Raises:
+        SensorError: unknown family, dictionary or id.
+    """
+    from poppy_core.sensors.markers import marker_image
+
+    grey = np.asarray(marker_image(marker_id, family, dictionary, size_px=240))
+    image = np.repeat(grey[:, :, None], 3, axis=2)
+    dark = np.nonzero(grey.min(axis=0) < 128)[0]  # columns of the black square
+    card_half = size / 2 * grey.shape[1] / float(dark[-1] - dark[0] + 1)
+    return image, 2 * card_half

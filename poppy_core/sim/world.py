@@ -19,9 +19,9 @@ from poppy_core.errors import ConfigError
 from poppy_core.schedule import Worker
 from poppy_core.sim.drive import Drive, Joint
 from poppy_core.sim.exchange import MotorPort
-from poppy_core.sim.gl import check_offscreen_gl
 from poppy_core.sim.model_files import MESH_DIR, read_model
-from poppy_core.sim.objects import ObjectSpec, add_objects, facing_quat
+from poppy_core.sim.objects import ObjectSpec, add_objects, marker_picture, picture_pixels
+from poppy_core.sim.observing import Observing
 from poppy_core.sim.placing import Placing, carry_state
 from poppy_core.sim.plant import MotorJoint
 
@@ -47,7 +47,7 @@ class _Objects:
     specs: list[ObjectSpec] = field(default_factory=list)
 
 
-class Simulation(Placing):
+class Simulation(Observing, Placing):
     """A MuJoCo world whose joints are driven by virtual motors (``robot.simulation``).
 
     Args:
@@ -230,9 +230,7 @@ class Simulation(Placing):
         """Stop the thread and free the renderers."""
         self.stop()
         with self._lock:
-            for renderer in self._renderers.values():
-                renderer.close()
-            self._renderers.clear()
+            self._close_renderers()
 
     # ------------------------------------------------------------------ handle
 
@@ -250,43 +248,6 @@ class Simulation(Placing):
             with binding.motor.lock:
                 binding.motor.table.set_si("goal_position", position)
                 binding.motor.set_state(position, 0.0, 0.0, False)
-
-    def _body(self, name: str) -> int:
-        index = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
-        if index < 0:
-            known = ", ".join(self.body_names())
-            raise ConfigError(f"no object {name!r} in the simulation ({known})", field=name)
-        return int(index)
-
-    def body_names(self) -> list[str]:
-        """Names of the bodies (robot links and added objects)."""
-        names = (
-            mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, i)
-            for i in range(1, self.model.nbody)
-        )
-        return [n for n in names if n]
-
-    def get_object_position(self, name: str, relative_to: str | None = None) -> list[float]:
-        """Position (m) of body ``name`` in the world, or in body ``relative_to``'s frame."""
-        with self._lock:
-            pos = np.array(self.data.xpos[self._body(name)])
-            if relative_to is not None:
-                ref = self._body(relative_to)
-                rot = np.array(self.data.xmat[ref]).reshape(3, 3)
-                pos = rot.T @ (pos - self.data.xpos[ref])
-            return [float(v) for v in pos]
-
-    def get_object_orientation(self, name: str, relative_to: str | None = None) -> list[float]:
-        """Orientation quaternion (w, x, y, z) of body ``name`` (world or ``relative_to``)."""
-        with self._lock:
-            quat = np.array(self.data.xquat[self._body(name)])
-            if relative_to is not None:
-                inverse = np.zeros(4)
-                mujoco.mju_negQuat(inverse, self.data.xquat[self._body(relative_to)])
-                out = np.zeros(4)
-                mujoco.mju_mulQuat(out, inverse, quat)
-                quat = out
-            return [float(v) for v in quat]
 
     def add_object(
         self,
@@ -333,13 +294,8 @@ class Simulation(Placing):
             ConfigError: the name is used, or no direction to face.
             SensorError: unknown family, dictionary or id.
         """
-        from poppy_core.sensors.markers import marker_image
-
-        grey = np.asarray(marker_image(marker_id, family, dictionary, size_px=240))
-        image = np.repeat(grey[:, :, None], 3, axis=2)
-        dark = np.nonzero(grey.min(axis=0) < 128)[0]  # columns of the black square
-        card_half = size / 2 * grey.shape[1] / float(dark[-1] - dark[0] + 1)
-        self.add_picture(name, image, position, 2 * card_half, facing=facing)
+        image, side = marker_picture(marker_id, size, family, dictionary)
+        self.add_picture(name, image, position, side, facing=facing)
 
     def add_picture(
         self,
@@ -364,27 +320,11 @@ class Simulation(Placing):
             ConfigError: the name is used, no direction to face, a bad image.
             ArgumentError: a size that is not a positive length.
         """
-        pixels = np.asarray(image)
-        if pixels.ndim != 3 or pixels.shape[2] < 3 or pixels.dtype != np.uint8:
-            raise ConfigError(
-                "a picture is an (height, width, 3) uint8 RGB image",
-                field="image",
-                value=getattr(pixels, "shape", None),
-            )
+        pixels = picture_pixels(image)
         side = positive(size, "size")
         if facing is None:
             facing = self._toward_camera(position)
-        spec = ObjectSpec(
-            "card",
-            name,
-            tuple(float(v) for v in position),  # type: ignore[arg-type]
-            (side / 2,),
-            0.01,
-            facing_quat(facing),
-            True,
-            pixels,
-        )
-        self._add(spec)
+        self._add(ObjectSpec.card(name, pixels, position, side, facing))
 
     def _toward_camera(self, position: tuple[float, float, float]) -> tuple[float, float, float]:
         with self._lock:
@@ -437,57 +377,4 @@ class Simulation(Placing):
             for binding in self._bindings:
                 self._drive.relocate(binding.index, *self._resolve(binding.link.joint))
             self._drive.invalidate()
-            for renderer in self._renderers.values():
-                renderer.close()
-            self._renderers.clear()
-
-    def view(self) -> Any:
-        """The drawn world's data at the physics' current pose (hold ``lock``): what a renderer
-        of ``view_model`` shows."""
-        data = self._view_data
-        data.qpos[:] = self.data.qpos
-        data.qvel[:] = self.data.qvel
-        data.time = self.data.time
-        mujoco.mj_kinematics(self.view_model, data)
-        mujoco.mj_comPos(self.view_model, data)  # the cameras that follow the centre of mass
-        mujoco.mj_camlight(self.view_model, data)
-        return data
-
-    def contacts(self) -> list[tuple[str, str]]:
-        """Pairs of bodies touching now (each pair once, names sorted)."""
-        with self._lock:
-            pairs = set()
-            for i in range(self.data.ncon):
-                contact = self.data.contact[i]
-                a = self.model.geom_bodyid[contact.geom[0]]
-                b = self.model.geom_bodyid[contact.geom[1]]
-                names = sorted(
-                    mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, int(x)) or "world"
-                    for x in (a, b)
-                )
-                pairs.add((names[0], names[1]))
-            return sorted(pairs)
-
-    def colliding(self, name: str, other: str | None = None) -> bool:
-        """Whether body ``name`` touches ``other`` (any body when None; "world" is the floor)."""
-        return any(name in pair and (other is None or other in pair) for pair in self.contacts())
-
-    def render(self, camera: str | None = None, width: int = 640, height: int = 480) -> Any:
-        """An RGB image (numpy array height × width × 3) from ``camera`` (default: free view).
-
-        Raises:
-            ConfigError: no OpenGL backend (set MUJOCO_GL to egl or osmesa).
-        """
-        check_offscreen_gl()
-        with self._lock:
-            key = (width, height)
-            try:
-                if key not in self._renderers:
-                    self._renderers[key] = mujoco.Renderer(self.view_model, height, width)
-                renderer = self._renderers[key]
-                renderer.update_scene(self.view(), camera=camera if camera is not None else -1)
-                return renderer.render()
-            except (mujoco.FatalError, AttributeError, RuntimeError) as exc:
-                raise ConfigError(
-                    f"cannot render ({exc}): set MUJOCO_GL to egl or osmesa", field="MUJOCO_GL"
-                ) from exc
+            self._close_renderers()

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from poppy_core.bus.core import reply_fits
+from poppy_core.bus.replies import reply_fits
 from poppy_core.protocol import StatusPacket
 
 OVERHEAT_P1 = 0x04  # protocol 1 alarm bit: the instruction still ran
