@@ -175,9 +175,9 @@ def test_the_fleet_stop_before_the_start_time_cancels_an_armed_move(
     played_from: list[MovePlayer] = []  # the players whose playback (their thread's body) ran
     real_run = MovePlayer._run
 
-    def run(self: MovePlayer, stopping: threading.Event) -> None:
+    def run(self: MovePlayer, stopping: threading.Event, at: float | None = None) -> None:
         played_from.append(self)
-        real_run(self, stopping)
+        real_run(self, stopping, at)
 
     monkeypatch.setattr(MovePlayer, "_run", run)
     wave = Move.from_frames(10.0, [{"m1": 30.0 + i} for i in range(5)])

@@ -1,5 +1,5 @@
 """A shared start is the motion's time origin: a gate's ``at`` is where a gated primitive's
-elapsed time and a LoopPrimitive's update grid count from.
+elapsed time, a LoopPrimitive's update grid and a MovePlayer's frames count from.
 
 A robot whose thread wakes late (a loaded machine) catches up with what is due instead of
 playing from the beginning, late: robots started together stay in phase. The gates here are
@@ -12,7 +12,11 @@ import math
 import statistics
 import time
 
+import numpy as np
+
 from poppy_core.motion import PositionWatcher, Sinus
+from poppy_core.motion.move import Move
+from poppy_core.motion.player import RAMP_SKIP_DEG, MovePlayer, PlayProgress
 from poppy_core.robot import Robot
 from poppy_core.schedule import Gate
 from tests.helpers import eventually
@@ -136,3 +140,62 @@ def test_a_gate_opened_before_its_start_time_holds_the_first_update(ergo: Robot)
     watcher.stop()
     assert watcher.woke[0] < at  # it woke early, and did its first update at its start time
     assert watcher.updated[0] >= at
+
+
+def wave(frames: int = 41, rate: float = 10.0, base: float = 0.0) -> Move:
+    """m1 climbs one degree a frame from ``base``."""
+    return Move.from_frames(rate, [{"m1": base + i} for i in range(frames)])
+
+
+class Noted(MovePlayer):
+    """A player noting each goal of m1 it writes, and its progress."""
+
+    def __init__(self, robot: Robot, move: Move, ramp_s: float | None = None) -> None:
+        self.progress: list[PlayProgress] = []
+        super().__init__(robot, move, ramp_s=ramp_s, on_progress=self.progress.append)
+        self.goals: list[float] = []
+
+    def playing_phase(self) -> bool:
+        return any(p.phase == "play" for p in self.progress)
+
+    def _set_goals(self, positions: np.ndarray[tuple[int], np.dtype[np.float64]]) -> None:
+        self.goals.append(float(positions[0]))
+        super()._set_goals(positions)
+
+
+def test_a_late_gated_move_plays_the_frame_due_not_frame_0(ergo: Robot) -> None:
+    assert abs(ergo.motor("m1").present_position) < RAMP_SKIP_DEG  # at the first frame: no ramp
+    player = Noted(ergo, wave())
+    gate = Gate(at=time.monotonic())
+    player.start(gate=gate)
+    open_late(gate, LATE_S)
+    assert eventually(lambda: len(player.goals) >= 2)
+    player.stop()
+    assert player.goals[0] >= 10.0 * LATE_S - 1e-6  # the frame due 0.3 s in, at 10 frames/s
+    first_play = next(p for p in player.progress if p.phase == "play")
+    assert first_play.move_t_s >= LATE_S
+    assert player.loop_times[0][0] == gate.at  # the playback counted from the shared start
+
+
+def test_a_given_ramp_ends_at_the_same_time_on_every_robot(ergo: Robot) -> None:
+    player = Noted(ergo, wave(base=20.0), ramp_s=0.6)  # 20° away: a ramp comes first
+    gate = Gate(at=time.monotonic())
+    player.start(gate=gate)
+    open_late(gate, LATE_S)
+    assert eventually(player.playing_phase)
+    player.stop()
+    assert gate.at is not None
+    assert player.loop_times[0][0] == gate.at + 0.6  # frames count from the shared ramp's end
+
+
+def test_an_automatic_ramp_plays_from_frame_0_after_it(ergo: Robot) -> None:
+    player = Noted(ergo, wave(base=20.0))  # 20° away, no ramp_s: a ramp of its own length
+    gate = Gate(at=time.monotonic())
+    player.start(gate=gate)
+    open_late(gate, LATE_S)
+    assert eventually(player.playing_phase)
+    player.stop()
+    assert gate.at is not None
+    assert player.loop_times[0][0] > gate.at + LATE_S  # after its ramp, not at the shared start
+    first_play = next(p for p in player.progress if p.phase == "play")
+    assert first_play.move_t_s < LATE_S  # from the start of the move, not the frame due
