@@ -227,9 +227,17 @@ class Gate:
 
     The owner (a fleet's shared start time) ``open``s it at the start time; whoever stops the
     armed start ``cancel``s it. Only the first of the two counts.
+
+    Attributes:
+        at: when the gate is due to open, on the ``time.monotonic()`` clock, or None. A motion
+            started through a gate with ``at`` counts its time from ``at``, not from when its
+            thread woke (``Primitive.elapsed_time``, ``LoopPrimitive``'s updates, a
+            ``MovePlayer``'s frames): robots started by one shared start stay in phase, a late
+            thread catching up with what is due. Without it, the time counts from the wake-up.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, at: float | None = None) -> None:
+        self.at = at
         self._event = threading.Event()
         self._lock = threading.Lock()
         self._cancelled = False

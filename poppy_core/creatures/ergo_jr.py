@@ -69,6 +69,9 @@ SAFE_POWER_UP_S = 3.0  # postures.py SafePowerUp: IdlePosture(robot, 3.0)
 class Dance(LoopPrimitive):
     """Ergo Jr's dance: sums of sinusoids on its joints, after going to 0° (looping).
 
+    Started through a fleet's gate (``shared_start``), the intro ends ``intro_s`` after the
+    shared start on every robot and the dance counts from there: the robots dance in phase.
+
     Args:
         robot: an Ergo Jr.
         amplitude_scale: multiplies every sinusoid's amplitude (1 = pypot's dance).
@@ -126,12 +129,16 @@ class Dance(LoopPrimitive):
         self._speeds = {n: self.real_robot.motor(n).moving_speed for n in names}
         for name in names:
             self.robot.motor(name).compliant = False
-        self.robot.goto_position({n: 0.0 for n in names}, self.intro_s, self.control, wait=True)
+        # A fleet's shared start: the intro ends at shared_start + intro_s on every robot (a
+        # thread that woke late has a shorter one) and the dance counts from there, in phase.
+        shared = self.shared_start is not None
+        intro_s = max(0.0, self.intro_s - self.elapsed_time) if shared else self.intro_s
+        self.robot.goto_position({n: 0.0 for n in names}, intro_s, self.control, wait=True)
         for name in names:
             motor = self.robot.motor(name)
             motor.moving_speed = self.speed_dps
             motor.led = "green"
-        self._dance_t0 = self.elapsed_time
+        self._dance_t0 = self.intro_s if shared else self.elapsed_time
 
     def positions(self, t_s: float) -> dict[str, float]:
         """Motor name -> the dance's goal (degrees) ``t_s`` seconds into the dance."""

@@ -17,6 +17,11 @@ if TYPE_CHECKING:
 class LoopPrimitive(Primitive):
     """A primitive calling ``update()`` at ``freq`` Hz, drift-free, until stopped.
 
+    Its updates fall at ``t0 + k * period``: ``t0`` is when ``run`` begins, or the
+    ``shared_start`` of a start through a gate with a start time (a fleet's robots then update
+    on one grid; a thread that woke late updates at once, with the value due now, and goes on
+    on the grid). After a pause the grid starts again at the resume.
+
     Args:
         robot: the robot to act on.
         freq: update rate in Hz.
@@ -61,7 +66,10 @@ class LoopPrimitive(Primitive):
         self._meter = RateMeter(window=10)
         self._recent.clear()
         last: float | None = None
-        schedule = Periodic(self.period_s, time.monotonic())
+        origin = self.shared_start
+        schedule = Periodic(self.period_s, time.monotonic() if origin is None else origin)
+        if origin is not None and self.sleep(origin - time.monotonic()):  # a gate opened early
+            return
         while not self.should_stop():
             if self.should_pause():
                 self.wait_to_resume()

@@ -235,6 +235,20 @@ class MovePlayer:
         With a ``gate``, the start is armed: the thread is made now and plays once the gate
         opens; a ``stop()`` before that cancels the gate and nothing is played.
 
+        A gate with a start time (``Gate.at``, a fleet's shared start) is the first loop's time
+        origin, so that robots started together play in phase whenever their thread wakes (a
+        late one plays the frame due now, not frame 0), when the ramp allows it:
+
+        - the robot is already at the first frame (within ``RAMP_SKIP_DEG``): no ramp, frame
+          ``k`` is played at ``at + k / (framerate * speed)``;
+        - ``ramp_s`` is given: the ramp ends at ``at + ramp_s`` (a late thread's ramp is that
+          much shorter) and the frames count from there;
+        - otherwise the robot needs a ramp whose length depends on how far it is: it ramps,
+          then plays from frame 0 as an un-gated start does, out of phase with the others
+          (logged at INFO; give ``ramp_s`` to keep it in phase).
+
+        The next loops and an un-gated start count from when their ramp ends.
+
         Raises:
             RuntimeError: already playing.
         """
@@ -304,7 +318,16 @@ class MovePlayer:
         for motor, value in zip(self._motors, positions.tolist(), strict=True):
             motor.goal_position = value
 
-    def _ramp(self, loop: int, stopping: threading.Event) -> None:
+    def _on_clock(self, at: float) -> float:
+        """``at`` (a ``time.monotonic()`` time) on the player's clock."""
+        if self._clock is time.monotonic:
+            return at
+        return self._clock() - (time.monotonic() - at)
+
+    def _ramp(self, loop: int, stopping: threading.Event, shared: float | None) -> float | None:
+        """Go to the first frame; returns when (player's clock) the frames count from, None for
+        when the ramp ended. ``shared``: the shared start (player's clock), None when there is
+        none."""
         first = self._played.positions[0]
         distance = max(
             abs(m.present_position - float(v)) for m, v in zip(self._motors, first, strict=True)
@@ -314,9 +337,21 @@ class MovePlayer:
             duration = (
                 0.0 if distance < RAMP_SKIP_DEG else max(MIN_RAMP_S, distance / self.ramp_speed_dps)
             )
+            if shared is not None and duration > 0:
+                logger.info(
+                    "%.1f° from the move's first frame: the playback starts after a %.1f s ramp, "
+                    "not in phase with the shared start (give ramp_s to keep it)",
+                    distance,
+                    duration,
+                )
+                shared = None
+        elif shared is not None:
+            shared += duration  # a ramp of a given length ends at the same time on every robot
+            duration = shared - self._clock()  # the rest of it, for a thread that woke late
         if duration <= 0:
-            self._set_goals(first)
-            return
+            if shared is None:  # else the playback writes the frame due at once
+                self._set_goals(first)
+            return shared
         targets = {m.name: float(v) for m, v in zip(self._motors, first, strict=True)}
         handle = self.robot.goto_position(targets, duration, control="minjerk")
         while not handle.wait(0.05):
@@ -324,14 +359,18 @@ class MovePlayer:
             if stopping.is_set():
                 for motor in self._motors:
                     motor.goal_position = motor.present_position
-                return
+                return None
+        return shared
 
-    def _play_once(self, loop: int, stopping: threading.Event) -> None:
+    def _play_once(self, loop: int, stopping: threading.Event, origin: float | None) -> None:
+        """Play the frames, counted from ``origin`` (player's clock; None: from now)."""
         move = self._played
         period = 1.0 / self.rate_hz
-        start = self._clock()
+        start = self._clock() if origin is None else origin
         schedule = Periodic(period, start)
         duration = move.duration_s
+        if origin is not None:  # a gate opened before its time: the first frame is due then
+            stopping.wait(max(0.0, start - self._clock()))
         try:
             while not stopping.is_set():
                 now = self._clock()
@@ -351,21 +390,23 @@ class MovePlayer:
     def _run_at(self, gate: Gate, stopping: threading.Event) -> None:
         """``_run`` once ``gate`` opens (nothing when it was cancelled)."""
         if gate.wait() and not stopping.is_set():
-            self._run(stopping)
+            self._run(stopping, gate.at)
         else:
             self.stopped = True
 
-    def _run(self, stopping: threading.Event) -> None:
-        """The playback (an exception is the worker's: logged once, kept in ``error``)."""
+    def _run(self, stopping: threading.Event, at: float | None = None) -> None:
+        """The playback (an exception is the worker's: logged once, kept in ``error``); ``at``:
+        the shared start (``time.monotonic()``) the first loop counts from, if any."""
+        shared = None if at is None else self._on_clock(at)
         for motor in self._motors:
             motor.compliant = False
         for loop in range(1, self.loops + 1):
             if stopping.is_set():
                 break
-            self._ramp(loop, stopping)
+            origin = self._ramp(loop, stopping, shared if loop == 1 else None)
             if stopping.is_set():
                 break
-            self._play_once(loop, stopping)
+            self._play_once(loop, stopping, origin)
         self.stopped = stopping.is_set()
         fraction = 1.0
         if self.stopped and self.duration_s > 0:

@@ -72,6 +72,7 @@ class Primitive:
         self.error: PrimitiveFailure | None = None
         self._exception: BaseException | None = None
         self._t0: float | None = None
+        self._origin: float | None = None
         self._paused_at: float | None = None
         self._paused_s = 0.0
         self._ended_at: float | None = None
@@ -97,7 +98,9 @@ class Primitive:
 
         With a ``gate``, the start is armed: everything is made now (its thread too), and
         ``setup`` and ``run`` begin when the gate opens; a stop before that cancels the gate and
-        the primitive ends without having run.
+        the primitive ends without having run. A gate with a start time (``Gate.at``) is the
+        time origin: ``elapsed_time`` counts from it (see ``shared_start``), whenever the
+        thread wakes.
 
         Raises:
             RobotClosedError: the robot is closed.
@@ -114,7 +117,8 @@ class Primitive:
             self._resume_event.set()
             self.error = None
             self._exception = None
-            self._t0 = time.monotonic()
+            self._origin = gate.at if gate is not None else None
+            self._t0 = time.monotonic() if self._origin is None else self._origin
             self._paused_s = 0.0
             self._paused_at = None
             self._ended_at = None
@@ -177,7 +181,8 @@ class Primitive:
         """Ask the primitive to pause (``should_pause()`` turns True); its requests stay."""
         if self._state == "running":
             self._resume_event.clear()
-            self._paused_at = time.monotonic()
+            # armed with a shared start: a pause before it takes nothing off the elapsed time
+            self._paused_at = max(time.monotonic(), self._t0 or 0.0)
             self._state = "paused"
             logger.info("%s paused", type(self).__name__)
 
@@ -185,7 +190,7 @@ class Primitive:
         """Let a paused primitive go on."""
         if self._state == "paused":
             if self._paused_at is not None:
-                self._paused_s += time.monotonic() - self._paused_at
+                self._paused_s += max(0.0, time.monotonic() - self._paused_at)
             self._paused_at = None
             self._state = "running"
             self._resume_event.set()
@@ -196,7 +201,7 @@ class Primitive:
         if gate is not None and not gate.wait():
             self._end_armed()
             return
-        if gate is not None:
+        if gate is not None and gate.at is None:
             self._t0 = time.monotonic()  # it began now, not when it was armed
         try:
             self.setup()
@@ -217,7 +222,7 @@ class Primitive:
             finally:
                 self._ended_at = time.monotonic()
                 if self._paused_at is not None:
-                    self._paused_s += self._ended_at - self._paused_at
+                    self._paused_s += max(0.0, self._ended_at - self._paused_at)
                     self._paused_at = None
                 if self._state != "failed":
                     self._state = "stopped"
@@ -321,14 +326,29 @@ class Primitive:
         return self._stop_event.wait(max(0.0, seconds))
 
     @property
+    def shared_start(self) -> float | None:
+        """The shared start this run counts its time from: its gate's ``at`` (on the
+        ``time.monotonic()`` clock), or None (started at once, or through a gate without one).
+
+        A fleet's robots started together stay in phase: a thread that woke late computes what
+        is due now (``elapsed_time`` counts from here, ``LoopPrimitive`` updates on the grid
+        ``shared_start + k * period``) instead of playing from the beginning, late.
+        """
+        return self._origin
+
+    @property
     def elapsed_time(self) -> float:
-        """Seconds since the (re)start, pauses left out; frozen once stopped; 0 before."""
+        """Seconds since the (re)start, pauses left out; frozen once stopped; 0 before.
+
+        The start is ``shared_start`` when there is one (a thread that woke late reads the time
+        since then), else when it was started (or, armed, when its gate opened).
+        """
         if self._t0 is None:
             return 0.0
         end = self._ended_at if self._ended_at is not None else time.monotonic()
         paused = self._paused_s
         if self._paused_at is not None:
-            paused += end - self._paused_at
+            paused += max(0.0, end - self._paused_at)
         return max(0.0, end - self._t0 - paused)
 
     def get_mockup_motor(self, motor: Motor | MockupMotor | str) -> MockupMotor:

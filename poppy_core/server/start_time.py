@@ -46,7 +46,7 @@ def start_gate() -> Gate | None:
     when = START_AT.get()
     if when is None or when <= time.time():
         return None
-    gate = Gate()
+    gate = Gate(at=time.monotonic() + (when - time.time()))  # the start, on the motion's clock
     with _lock:
         due = _due.get(when)
         first = due is None

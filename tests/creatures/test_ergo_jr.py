@@ -13,7 +13,9 @@ from poppy_core.creatures.postures import ERGO_JR_CURIOUS, ERGO_JR_IDLE, ERGO_JR
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import primitive_manager
 from poppy_core.robot import Robot
+from poppy_core.schedule import Gate
 from tests.creatures.helpers import positions, reached, virtual, wait_until
+from tests.helpers import eventually
 
 ERGO_JR_PRIMITIVES = [
     "safe_power_up",
@@ -155,3 +157,32 @@ def test_jump_folds_unfolds_and_gives_the_gains_back(ergo: Robot) -> None:
     assert all(m.pid == pytest.approx(ERGO_JR_PID, abs=0.02) for m in ergo.motors)
     with pytest.raises(ArgumentError):
         jump.set_property("jumps", "-2")
+
+
+class TracedDance(Dance):
+    """A dance noting the dance time of each update."""
+
+    def __init__(self, robot: Robot, intro_s: float) -> None:
+        super().__init__(robot, intro_s=intro_s)
+        self.dance_times: list[float] = []
+
+    def positions(self, t_s: float) -> dict[str, float]:
+        self.dance_times.append(t_s)
+        return super().positions(t_s)
+
+
+def test_a_late_gated_dance_dances_in_phase_with_the_shared_start(ergo: Robot) -> None:
+    intro_s, late_s = 0.2, 0.5
+    dance = TracedDance(ergo, intro_s)
+    at = time.monotonic()
+    gate = Gate(at=at)
+    dance.start(gate=gate)
+    while time.monotonic() < at + late_s:
+        time.sleep(0.05)
+    gate.open()  # its thread wakes later than the shared start plus the intro
+    try:
+        assert eventually(lambda: len(dance.dance_times) >= 2)
+    finally:
+        dance.stop()
+    # the dance counts from shared start + intro, not from when this robot's intro ended
+    assert dance.dance_times[0] >= late_s - intro_s

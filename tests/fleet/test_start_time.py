@@ -175,9 +175,9 @@ def test_the_fleet_stop_before_the_start_time_cancels_an_armed_move(
     played_from: list[MovePlayer] = []  # the players whose playback (their thread's body) ran
     real_run = MovePlayer._run
 
-    def run(self: MovePlayer, stopping: threading.Event) -> None:
+    def run(self: MovePlayer, stopping: threading.Event, at: float | None = None) -> None:
         played_from.append(self)
-        real_run(self, stopping)
+        real_run(self, stopping, at)
 
     monkeypatch.setattr(MovePlayer, "_run", run)
     wave = Move.from_frames(10.0, [{"m1": 30.0 + i} for i in range(5)])
@@ -235,3 +235,19 @@ def test_a_together_command_returns_once_its_start_time_came(
     assert [o.ok for o in outcomes] == [True, True]
     assert fleet.last_start_at is not None and time.time() >= fleet.last_start_at
     fleet.command(["jr-a", "jr-b"], "POST", "/api/v1/primitives/dance/stop", together=False)
+
+
+def test_the_gate_of_a_shared_start_carries_its_start_time(robot: Robot) -> None:
+    when = time.time() + LEAD_S
+    context = _at(when)
+    try:
+        gate = start_gate()
+    finally:
+        START_AT.reset(context)
+    assert gate is not None and gate.at is not None
+    # start_at on the motion's clock (time.monotonic()); the two clocks read a moment apart
+    assert gate.at - time.monotonic() == pytest.approx(when - time.time(), abs=0.05)
+    stamp = Stamp(robot)
+    stamp.start(gate=gate)
+    assert stamp.shared_start == gate.at  # the primitive's time counts from the start time
+    assert eventually(lambda: stamp.began != [])
