@@ -4,11 +4,9 @@ Run ``python -m poppy_core.sim.mjcf [profiles_dir]`` to regenerate ``profiles/<r
 
 Each URDF joint becomes a hinge named like the profile's motor; links get capsules between the
 joint origins (no meshes) and the URDF's mass and inertia. A MuJoCo joint angle is the motor's
-own angle (the one its control table holds), as pypot reads the Poppy URDFs: the URDF angle,
-turned the other way for the motors the profile's ``kinematics.reversed`` lists (a URDF axis
-against the servo's). The bodies are drawn at the robot's home pose (every motor at 0° in the
-user frame) and each joint's ``ref`` is the motor's angle there, so the model starts at home.
-See docs/simulation.md for the evidence.
+own angle (the one its control table holds) and the bodies are drawn at the robot's home pose
+(``sim/home_pose.py``); each joint's ``ref`` is the motor's angle there, so the model starts at
+home. See docs/simulation.md for the evidence.
 """
 
 from __future__ import annotations
@@ -16,13 +14,10 @@ from __future__ import annotations
 import math
 import sys
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from poppy_core.documents import CONFIG_LIMITS, parse_yaml, read_limited
 from poppy_core.files import write_file
-from poppy_core.kinematics.transforms import quat_mul
 from poppy_core.models import model_by_name
 from poppy_core.sim.framing import (
     FRONT_FOVY_DEG,
@@ -33,6 +28,7 @@ from poppy_core.sim.framing import (
     norm,
     pose_cloud,
 )
+from poppy_core.sim.home_pose import Frames, HomePose, load_profile_motors, reversed_joints
 from poppy_core.sim.looks import (
     BLOBS,
     CAMERA_NAME,
@@ -45,12 +41,10 @@ from poppy_core.sim.model_files import MESH_DIR
 from poppy_core.sim.servos import servo_params
 from poppy_core.sim.urdf import (
     Quat,
-    Urdf,
     UrdfJoint,
     Vec3,
     conjugate,
     parse_urdf,
-    quat_from_axis_angle,
     quat_from_rpy,
     rotate,
 )
@@ -76,76 +70,16 @@ def _v(values: tuple[float, ...]) -> str:
     return " ".join(_f(v) for v in values)
 
 
-def load_profile_data(profiles_dir: Path, robot: str) -> dict[str, Any]:
-    """``profiles/<robot>/profile.yaml``, read and parsed within a config's bounds."""
-    path = profiles_dir / robot / "profile.yaml"
-    text = read_limited(path, CONFIG_LIMITS.max_bytes, "profile")
-    data: dict[str, Any] = parse_yaml(text, str(path), CONFIG_LIMITS)
-    return data
-
-
-def load_profile_motors(profiles_dir: Path, robot: str) -> dict[str, dict[str, Any]]:
-    """The ``motors`` section of ``profiles/<robot>/profile.yaml``."""
-    motors: dict[str, dict[str, Any]] = load_profile_data(profiles_dir, robot)["motors"]
-    return motors
-
-
-def reversed_joints(profiles_dir: Path, robot: str) -> frozenset[str]:
-    """The motors whose URDF axis turns against the servo (``kinematics.reversed``)."""
-    section = load_profile_data(profiles_dir, robot).get("kinematics") or {}
-    return frozenset(section.get("reversed") or ())
-
-
 class _Writer:
-    def __init__(
-        self,
-        robot: str,
-        urdf: Urdf,
-        motors: dict[str, dict[str, Any]],
-        reversed_: frozenset[str] = frozenset(),
-        meshes: frozenset[str] = frozenset(),
-    ) -> None:
+    def __init__(self, robot: str, home: HomePose, meshes: frozenset[str] = frozenset()) -> None:
         self.robot = robot
         self.mesh_links = meshes  # the links whose visual mesh the profile ships
-        self.urdf = urdf
-        self.motors = motors
-        self.reversed = reversed_
+        self.home = home
+        self.urdf = home.urdf
+        self.motors = home.motors
         self.style = STYLES[robot]
         self.lines: list[str] = []
         self.statistic = ""
-
-    def axis(self, joint: UrdfJoint) -> Vec3:
-        """The hinge axis: the URDF's, the other way round for a reversed motor."""
-        k = -1.0 if joint.name in self.reversed else 1.0
-        return (k * joint.axis[0], k * joint.axis[1], k * joint.axis[2])
-
-    def home_deg(self, joint: UrdfJoint) -> float:
-        """The motor's own angle at the home pose (user 0°): ``sign * offset``."""
-        motor = self.motors.get(joint.name)
-        if motor is None or joint.kind not in ("revolute", "continuous"):
-            return 0.0
-        sign = 1.0 if motor.get("orientation", "direct") == "direct" else -1.0
-        return sign * float(motor.get("offset", 0.0))
-
-    def joint_quat(self, joint: UrdfJoint) -> Quat:
-        """The child body's frame at the home pose (the joint turned to its home angle)."""
-        base = quat_from_rpy(joint.rpy)
-        turn = quat_from_axis_angle(self.axis(joint), math.radians(self.home_deg(joint)))
-        return quat_mul(base, turn)
-
-    def world_frames(self) -> dict[str, tuple[Vec3, Quat]]:
-        """World pose of every link at poppy's zero pose (root at the origin)."""
-        poses: dict[str, tuple[Vec3, Quat]] = {self.urdf.root: ((0.0, 0.0, 0.0), (1, 0, 0, 0))}
-        pending = [self.urdf.root]
-        while pending:
-            link = pending.pop()
-            pos, quat = poses[link]
-            for joint in self.urdf.children(link):
-                offset = rotate(quat, joint.xyz)
-                child_pos = (pos[0] + offset[0], pos[1] + offset[1], pos[2] + offset[2])
-                poses[joint.child] = (child_pos, quat_mul(quat, self.joint_quat(joint)))
-                pending.append(joint.child)
-        return poses
 
     def cameras(self, cloud: np.ndarray) -> list[str]:
         """The views' cameras, each framing ``cloud`` (the robot over its joints' range, see
@@ -255,9 +189,9 @@ class _Writer:
             f'fullinertia="{_v((ixx, iyy, izz, ixy, ixz, iyz))}"/>'
         )
 
-    def body(self, joint: UrdfJoint, depth: int, poses: dict[str, tuple[Vec3, Quat]]) -> None:
+    def body(self, joint: UrdfJoint, depth: int, poses: Frames) -> None:
         indent = "  " * depth
-        quat = self.joint_quat(joint)
+        quat = self.home.joint_quat(joint)
         self.lines.append(
             f'{indent}<body name="{joint.child}" pos="{_v(joint.xyz)}" quat="{_v(quat)}">'
         )
@@ -266,10 +200,10 @@ class _Writer:
             motor = self.motors.get(joint.name, {})
             low, high = motor.get("angle_limit", (-150.0, 150.0))  # motor frame, as pypot's
             servo = servo_params(model_by_name(motor.get("type", "MX-28")))
-            home = self.home_deg(joint)
+            home = self.home.home_deg(joint)
             ref = f' ref="{_f(math.radians(home))}"' if home else ""
             self.lines.append(
-                f'{indent}  <joint name="{joint.name}" axis="{_v(self.axis(joint))}"{ref} '
+                f'{indent}  <joint name="{joint.name}" axis="{_v(self.home.axis(joint))}"{ref} '
                 f'range="{_f(math.radians(low))} {_f(math.radians(high))}" '
                 f'armature="{_f(servo.armature_kgm2)}" frictionloss="{_f(servo.friction_nm)}"/>'
             )
@@ -279,7 +213,7 @@ class _Writer:
             self.body(child, depth + 1, poses)
         self.lines.append(f"{indent}</body>")
 
-    def lowest_point(self, poses: dict[str, tuple[Vec3, Quat]]) -> float:
+    def lowest_point(self, poses: Frames) -> float:
         """Height of the lowest sole below the root at the zero pose (Humanoid)."""
         lows = []
         for link, (pos, _) in poses.items():
@@ -289,7 +223,7 @@ class _Writer:
                 lows.append(pos[2] + com[2] - 0.025)
         return min(lows) if lows else 0.0
 
-    def mount(self, poses: dict[str, tuple[Vec3, Quat]]) -> tuple[list[str], Vec3, float]:
+    def mount(self, poses: Frames) -> tuple[list[str], Vec3, float]:
         """What the robot stands on (world geoms), where its root sits and the lowest height
         its limbs can reach (the table's top or the floor)."""
         if self.style.mount == "table":
@@ -319,14 +253,14 @@ class _Writer:
     def write(self, assets: dict[str, bytes]) -> str:
         """The MJCF text; its cameras frame the robot over its joints' range, found on the
         model compiled once without them (``assets``: the mesh files)."""
-        poses = self.world_frames()
+        poses = self.home.world_frames()
         floor_z = self.mount(poses)[2]
         bare = self.text(poses, [])
         follow = self.style.mount == "floor"  # its cameras follow the centre of mass
         cloud = pose_cloud(bare, assets, floor_z, follow_com=follow)
         return self.text(poses, self.cameras(cloud))
 
-    def text(self, poses: dict[str, tuple[Vec3, Quat]], cameras: list[str]) -> str:
+    def text(self, poses: Frames, cameras: list[str]) -> str:
         style = self.style
         root = self.urdf.root
         stand, root_pos, _ = self.mount(poses)
@@ -411,7 +345,8 @@ def generate(robot: str, profiles_dir: Path) -> str:
     motors = load_profile_motors(profiles_dir, robot)
     folder = profiles_dir / robot / MESH_DIR
     shipped = frozenset(link for link, v in urdf.visuals.items() if (folder / v.mesh).is_file())
-    writer = _Writer(robot, urdf, motors, reversed_joints(profiles_dir, robot), shipped)
+    home = HomePose(urdf, motors, reversed_joints(profiles_dir, robot))
+    writer = _Writer(robot, home, shipped)
     assets = {
         urdf.visuals[link].mesh: (folder / urdf.visuals[link].mesh).read_bytes() for link in shipped
     }

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from poppy_core.errors import ConfigError
-from poppy_core.sim.mjcf import ROBOTS, reversed_joints
+from poppy_core.sim.home_pose import reversed_joints
+from poppy_core.sim.mjcf import ROBOTS
 from poppy_core.sim.urdf import parse_urdf
 
 mujoco = pytest.importorskip("mujoco")

@@ -13,8 +13,9 @@ from poppy_core.creatures.postures import humanoid_sit
 from poppy_core.kinematics.transforms import quat_mul
 from poppy_core.robot.frames import to_motor
 from poppy_core.robot.profiles import load_profile
+from poppy_core.sim.home_pose import reversed_joints
 from poppy_core.sim.mjcf import ROBOTS as URDF_FILES
-from poppy_core.sim.mjcf import generate, reversed_joints
+from poppy_core.sim.mjcf import generate
 from poppy_core.sim.urdf import (
     Quat,
     Vec3,
