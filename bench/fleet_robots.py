@@ -41,9 +41,9 @@ def _log_starts(path: Path) -> None:
         stamp()
         real_setup(self)
 
-    def run(self: MovePlayer, stopping: threading.Event) -> None:
+    def run(self: MovePlayer, stopping: threading.Event, at: float | None = None) -> None:
         stamp()
-        real_run(self, stopping)
+        real_run(self, stopping, at)
 
     Sinus.setup = setup  # type: ignore[method-assign]
     MovePlayer._run = run  # type: ignore[method-assign]
