@@ -114,6 +114,7 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
     "fleet play": (
         ("fleet play wave --all", "every robot plays a move of its library"),
         ("fleet play wave --robots jr1,jr2 --token s3cret", "two robots served with a token"),
+        ("fleet play wave --all --ramp 2", "each robot reaches the first frame in 2 s: in phase"),
     ),
     "fleet stop": (
         ("fleet stop --all", "primitives and moves stopped, motors held"),

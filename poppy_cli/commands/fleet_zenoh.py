@@ -13,8 +13,9 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from poppy_cli.options import JsonOpt
+from poppy_cli.options import JsonOpt, finite
 from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, console, error_line, print_json
+from poppy_core.checks import MAX_DURATION_S
 
 if TYPE_CHECKING:
     from poppy_core.remote.zenoh_fleet import Fleet, Outcome
@@ -247,14 +248,26 @@ def fleet_play(
     zenoh_config: Path | None = ConfigOpt,
     zenoh_scout: bool = ScoutOpt,
     token: str | None = TokenOpt,
+    ramp: float | None = typer.Option(
+        None,
+        "--ramp",
+        min=0.0,
+        max=MAX_DURATION_S,
+        callback=finite,
+        help="Seconds to reach the first frame, the same on every robot: they play in phase "
+        "wherever each one is (default: each its own, from its distance).",
+    ),
     json_output: bool = JsonOpt,
 ) -> None:
     """Play a move on the robots, all starting at the same time."""
     wanted = _wanted(all_robots, robots)
+    body: dict[str, Any] = {"speed": 1.0, "backwards": False}
+    if ramp is not None:
+        body["ramp_s"] = ramp
     with _fleet(connect, zenoh_config, zenoh_scout, token) as fleet:
         names = _targets(fleet, wanted)
         path = f"/api/v1/moves/{_quoted(move)}/play"
-        outcomes = fleet.command(names, "POST", path, {"speed": 1.0, "backwards": False})
+        outcomes = fleet.command(names, "POST", path, body)
     _report(outcomes, f"playing {move}", json_output)
 
 

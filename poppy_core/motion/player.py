@@ -185,7 +185,7 @@ class MovePlayer:
         self.speed = float(speed)
         self.backwards = backwards
         self.loops = int(loops)
-        self.ramp_s = ramp_s
+        self.ramp_s = None if ramp_s is None else checks.duration(ramp_s, "ramp_s")
         self.ramp_speed_dps = ramp_speed_dps
         self.rate_hz = rate_hz if rate_hz is not None else write_rate_hz(robot)
         self.on_progress = on_progress

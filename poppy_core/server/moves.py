@@ -232,8 +232,12 @@ class MoveService:
 
     # -- playing -------------------------------------------------------------------------------
 
-    def play(self, name: str, speed: float = 1.0, backwards: bool = False) -> MovePlayer:
-        """Play a library move (a playback of it already running is left alone)."""
+    def play(
+        self, name: str, speed: float = 1.0, backwards: bool = False, ramp_s: float | None = None
+    ) -> MovePlayer:
+        """Play a library move (a playback of it already running is left alone); ``ramp_s``:
+        the ramp to its first frame (None: from the distance; give it to a fleet's robots so
+        that, wherever each one is, they play in phase from the shared start)."""
         check_move_name(name)
         with self._lock:
             running = self._players.get(name)
@@ -241,7 +245,7 @@ class MoveService:
             return running
         move = self.load(name)
         try:
-            player = MovePlayer(self.robot, move, speed=speed, backwards=backwards)
+            player = MovePlayer(self.robot, move, speed=speed, backwards=backwards, ramp_s=ramp_s)
         except ConfigError as exc:
             raise ApiError("invalid", str(exc)) from None
         except ValueError as exc:

@@ -179,6 +179,13 @@ class PlayRequest(BaseModel):
         1.0, ge=MIN_SPEED, le=MAX_SPEED, description="2.0 plays twice as fast (the player's range)"
     )
     backwards: bool = False
+    ramp_s: Finite | None = Field(
+        None,
+        ge=0,
+        le=checks.MAX_DURATION_S,
+        description="seconds of the ramp to the first frame (null: from the distance); the "
+        "same on every robot of a fleet keeps them in phase",
+    )
 
 
 class MovesStatus(BaseModel):

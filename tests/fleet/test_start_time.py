@@ -25,6 +25,7 @@ from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import Robot, from_profile
 from poppy_core.schedule import Gate
 from poppy_core.server.start_time import START_AT, start_gate, wait_until
+from tests.helpers.cli import run_poppy
 from tests.helpers.waiting import eventually
 from tests.helpers.zenoh_served import TOKEN, Served
 
@@ -251,3 +252,27 @@ def test_the_gate_of_a_shared_start_carries_its_start_time(robot: Robot) -> None
     stamp.start(gate=gate)
     assert stamp.shared_start == gate.at  # the primitive's time counts from the start time
     assert eventually(lambda: stamp.began != [])
+
+
+def test_fleet_play_with_a_ramp_gives_every_robot_that_ramp(
+    two: tuple[Served, Served], fleet: Fleet
+) -> None:
+    save_move(Move.from_frames(10.0, [{"m1": 30.0 + i} for i in range(5)]), "wave")
+    args = [arg for s in two for arg in ("--connect", s.endpoint)]
+    result = run_poppy("fleet", "play", "wave", "--all", "--ramp", "1.5", "--token", TOKEN, *args)
+    assert result.code == 0, result.stderr
+    for served in two:
+        player = served.servers.service.moves._players["wave"]
+        assert player.ramp_s == 1.5
+        player.stop()
+
+
+def test_a_bad_ramp_is_refused_and_plays_nothing(two: tuple[Served, Served], fleet: Fleet) -> None:
+    save_move(Move.from_frames(10.0, [{"m1": 30.0 + i} for i in range(5)]), "wave")
+    args = [arg for s in two for arg in ("--connect", s.endpoint)]
+    result = run_poppy("fleet", "play", "wave", "--all", "--ramp", "-1", "--token", TOKEN, *args)
+    assert result.code == 2 and "--ramp" in result.stderr and "Traceback" not in result.stderr
+    body = {"speed": 1.0, "ramp_s": -1}
+    outcomes = fleet.command(["jr-a"], "POST", "/api/v1/moves/wave/play", body, together=False)
+    assert outcomes[0].status == 422 and "ramp_s" in outcomes[0].message
+    assert all(s.servers.service.moves.playing() == [] for s in two)
