@@ -1,17 +1,17 @@
 """``python -m bench fleet``: 20 virtual Ergo Jrs on Zenoh against today's WebSocket stream.
 
-1. **Fan-out**: 20 robots in ``PROCESSES`` processes (``bench.fleet_robots``), each publishing
+1. **Fan-out**: 20 robots in ``PROCESSES`` processes (``bench.fleet_procs``), each publishing
    its state at 50 Hz; one subscriber in this process (a ``Fleet`` on every robot's endpoint, as
    ``poppy fleet status`` is) counts the messages of each robot and their age (the robot's read
    time in the message against this clock: one machine, one clock). A second, slow subscriber
-   (20 ms per message) runs beside it: the robots' sync loops must not notice. The same robots
-   then stream over pypot's WebSocket at 50 Hz to 20 clients (their frames carry no time: rate
-   only). CPU per robot is the robot processes' CPU time over the window, divided by 20,
-   against the same robots serving nothing.
-2. **fleet play spread**: ``Fleet.command`` starts a primitive on the 20 robots with a shared
-   start time; each robot logs when it started it (``--starts``); the spread is the latest
-   minus the earliest, over ``TRIALS`` commands.
-3. **Teleop goals at 100 Hz**: a follower served in this process gets 100 goals/s over Zenoh
+   (20 ms per message) runs beside it. The same robots then stream over pypot's WebSocket at
+   50 Hz to 20 clients (their frames carry no time: rate only). CPU per robot is the robot
+   processes' CPU time over the window, divided by 20, against the same robots serving nothing.
+2. **Sync loops under slow subscribers**: the robots' own sync loop rates (their health) with
+   no subscriber, then with ``SLOW_SUBSCRIBERS`` Zenoh sessions that cannot keep up.
+3. **Start spread** (``bench.fleet_spread``): ``fleet run`` and ``fleet play`` on the 20
+   robots with a shared start time, over ``TRIALS`` commands each.
+4. **Teleop goals at 100 Hz**: a follower served in this process gets 100 goals/s over Zenoh
    (its ``goals`` stream) and over the WebSocket (``{motor: {goal_position}}`` frames); the
    latency is from the send to the server's handling of that goal (matched by its value).
 """
@@ -21,116 +21,38 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import subprocess
-import sys
 import threading
 import time
 from collections import defaultdict
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from bench.fleet_procs import (
+    PROCESSES,
+    ROBOTS,
+    SLOW_S,
+    SLOW_SUBSCRIBERS,
+    cpu_per_robot,
+    robot_processes,
+    slow_subscribers,
+)
 from bench.fleet_report import build_result
-from bench.procs import interrupt
-from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext, BenchResult, register
+from bench.fleet_spread import play_spread
+from bench.registry import BenchContext, BenchResult, register
 from bench.side_by_side import percentile
 
-ROBOTS = 20
-PROCESSES = 4
 RATE_HZ = 50.0
 WINDOW_S = 5.0
 WARMUP_S = 2.0
-TRIALS = 50
-"""Fleet play commands timed (after one warm-up): enough for a p90 and a max that mean something
-(the goal is checked on the max, a bound over every trial)."""
 TELEOP_HZ = 100.0
 TELEOP_S = 4.0
-SLOW_S = 0.02
-SLOW_SUBSCRIBERS = 20
-SLOW_SUBSCRIBER = """
-import os, sys, time
-from poppy_core.remote.zenoh_fleet import Fleet
-from poppy_core.zenoh_wire import ZenohSettings
-count, delay, endpoints = int(sys.argv[1]), float(sys.argv[2]), tuple(sys.argv[3:])
-fleets = [Fleet(ZenohSettings(connect=endpoints)) for _ in range(count)]
-for fleet in fleets:
-    fleet.on_state(lambda name, state: time.sleep(delay))
-print("ready", flush=True)
-try:
-    while True:
-        time.sleep(1)
-except KeyboardInterrupt:
-    os._exit(0)  # a session sleeping in its callback would not close in time: the sockets go
-"""
-"""COUNT Zenoh sessions (each its own client, as COUNT `fleet status` would be), each on every
-robot's state, each sleeping DELAY s per message: subscribers that cannot keep up."""
-TICK = os.sysconf("SC_CLK_TCK")
-
-
-@contextmanager
-def _robots(
-    zenoh: bool, ws: bool, starts: Path | None = None, env: dict[str, str] | None = None
-) -> Iterator[tuple[list[Any], list[dict[str, Any]]]]:
-    """Start the robot processes (``env``: more environment); yields them and one record per
-    robot (name, endpoint, ws)."""
-    procs, robots = [], []
-    python = str(POPPY_PYTHON) if POPPY_PYTHON.exists() else sys.executable
-    try:
-        per = ROBOTS // PROCESSES
-        for index in range(PROCESSES):
-            args = [
-                python,
-                "-m",
-                "bench.fleet_robots",
-                "--count",
-                str(per),
-                "--first",
-                str(index * per),
-            ]
-            args += ["--zenoh"] if zenoh else []
-            args += ["--ws"] if ws else []
-            args += ["--starts", str(starts)] if starts is not None else []
-            full = {**os.environ, **(env or {}), "PYTHONPATH": str(REPO_ROOT)}
-            procs.append(
-                subprocess.Popen(args, cwd=REPO_ROOT, stdout=subprocess.PIPE, text=True, env=full)
-            )
-        for proc in procs:
-            assert proc.stdout is not None
-            for line in proc.stdout:
-                if line.strip() == "ready":
-                    break
-                name, endpoint, ws_port = line.split()
-                robots.append({"name": name, "endpoint": endpoint, "ws": int(ws_port)})
-            else:
-                raise RuntimeError("a robot process ended before it served")
-        yield procs, robots
-    finally:
-        for proc in procs:
-            interrupt(proc)
-            if proc.stdout is not None:
-                proc.stdout.close()
-
-
-def _cpu_s(procs: list[Any]) -> float:
-    total = 0
-    for proc in procs:
-        fields = Path(f"/proc/{proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
-        total += int(fields[11]) + int(fields[12])  # utime, stime
-    return total / TICK
-
-
-def _cpu_per_robot(procs: list[Any], window_s: float) -> float:
-    before = _cpu_s(procs)
-    time.sleep(window_s)
-    return (_cpu_s(procs) - before) / window_s / ROBOTS * 100.0
 
 
 def fanout_zenoh() -> dict[str, Any]:
     from poppy_core.remote.zenoh_fleet import Fleet
     from poppy_core.zenoh_wire import ZenohSettings
 
-    with _robots(zenoh=True, ws=False) as (procs, robots):
+    with robot_processes(zenoh=True, ws=False) as (procs, robots):
         settings = ZenohSettings(connect=tuple(r["endpoint"] for r in robots))
         counts: dict[str, int] = defaultdict(int)
         ages: list[float] = []
@@ -149,12 +71,12 @@ def fanout_zenoh() -> dict[str, Any]:
                     if hz is not None:
                         loops[name].append(float(hz))
 
-        with _slow_subscribers(1, [r["endpoint"] for r in robots]), Fleet(settings) as fleet:
+        with slow_subscribers(1, [r["endpoint"] for r in robots]), Fleet(settings) as fleet:
             fleet.on_state(state)
             fleet.on_health(health)
             time.sleep(WARMUP_S)
             measuring.set()
-            cpu = _cpu_per_robot(procs, WINDOW_S)
+            cpu = cpu_per_robot(procs, WINDOW_S)
             measuring.clear()
         ages.sort()
         rates = sorted(counts.get(r["name"], 0) / WINDOW_S for r in robots)
@@ -171,34 +93,13 @@ def fanout_zenoh() -> dict[str, Any]:
         }
 
 
-@contextmanager
-def _slow_subscribers(count: int, endpoints: list[str]) -> Iterator[None]:
-    """``count`` slow subscribers (``SLOW_SUBSCRIBER``) in a process of their own."""
-    slow = subprocess.Popen(
-        [sys.executable, "-c", SLOW_SUBSCRIBER, str(count), str(SLOW_S), *endpoints],
-        cwd=REPO_ROOT,
-        stdout=subprocess.PIPE,
-        text=True,
-        env={**os.environ, "PYTHONPATH": str(REPO_ROOT)},
-    )
-    try:
-        assert slow.stdout is not None
-        if slow.stdout.readline().strip() != "ready":
-            raise RuntimeError("the slow subscribers did not start")
-        yield
-    finally:
-        interrupt(slow)
-        if slow.stdout is not None:
-            slow.stdout.close()
-
-
-def sync_under_slow_subscribers() -> dict[str, Any]:
+def sync_underslow_subscribers() -> dict[str, Any]:
     """The robots' ``present`` sync loop rates (their health), without and then with
     ``SLOW_SUBSCRIBERS`` slow subscribers on every robot's state."""
     from poppy_core.remote.zenoh_fleet import Fleet
     from poppy_core.zenoh_wire import ZenohSettings
 
-    with _robots(zenoh=True, ws=False) as (procs, robots):
+    with robot_processes(zenoh=True, ws=False) as (procs, robots):
         endpoints = [r["endpoint"] for r in robots]
         rates: list[float] = []
 
@@ -212,10 +113,10 @@ def sync_under_slow_subscribers() -> dict[str, Any]:
         with Fleet(ZenohSettings(connect=tuple(endpoints))) as fleet:
             fleet.on_health(health)
             for label, count in (("none", 0), ("slow", SLOW_SUBSCRIBERS)):
-                with _slow_subscribers(count, endpoints) if count else contextlib.nullcontext():
+                with slow_subscribers(count, endpoints) if count else contextlib.nullcontext():
                     time.sleep(WARMUP_S)
                     rates.clear()
-                    cpu = _cpu_per_robot(procs, WINDOW_S)
+                    cpu = cpu_per_robot(procs, WINDOW_S)
                     seen = sorted(rates)
                 found[label] = {
                     "subscribers": count,
@@ -230,7 +131,7 @@ def sync_under_slow_subscribers() -> dict[str, Any]:
 def fanout_ws() -> dict[str, Any]:
     from websockets.sync.client import connect
 
-    with _robots(zenoh=False, ws=True) as (procs, robots):
+    with robot_processes(zenoh=False, ws=True) as (procs, robots):
         counts: dict[str, int] = defaultdict(int)
         measuring = threading.Event()
         stop = threading.Event()
@@ -250,7 +151,7 @@ def fanout_ws() -> dict[str, Any]:
             thread.start()
         time.sleep(WARMUP_S)
         measuring.set()
-        cpu = _cpu_per_robot(procs, WINDOW_S)
+        cpu = cpu_per_robot(procs, WINDOW_S)
         measuring.clear()
         stop.set()
         for thread in threads:
@@ -265,105 +166,9 @@ def fanout_ws() -> dict[str, Any]:
 
 
 def idle_cpu() -> float:
-    with _robots(zenoh=False, ws=False) as (procs, _):
+    with robot_processes(zenoh=False, ws=False) as (procs, _):
         time.sleep(WARMUP_S)
-        return _cpu_per_robot(procs, WINDOW_S)
-
-
-STARTS = {
-    "run": ("/api/v1/primitives/sinus/start", None, "/api/v1/primitives/sinus/stop"),
-    "play": ("/api/v1/moves/wave/play", {"speed": 1.0}, "/api/v1/moves/wave/stop"),
-}
-"""What each start measures: ``fleet run sinus`` and ``fleet play wave`` (start, body, stop)."""
-
-
-def _wave(moves: Path) -> dict[str, str]:
-    """Save the move ``fleet play`` plays in ``moves`` (1 s of ``m1`` from its rest pose and
-    back); the robots' environment that makes it their library."""
-    from poppy_core.motion.move import Move
-    from poppy_core.motion.move_library import MOVES_DIR_ENV, save_move
-
-    moves.mkdir(parents=True, exist_ok=True)
-    frames = [{"m1": 10.0 * (1 - abs(1 - i / 25))} for i in range(51)]
-    save_move(Move.from_frames(50.0, frames), moves / "wave.move")
-    return {MOVES_DIR_ENV: str(moves)}
-
-
-def play_spread(tmp: Path) -> dict[str, Any]:
-    from poppy_core.remote.zenoh_fleet import Fleet
-    from poppy_core.zenoh_wire import ZenohSettings
-
-    starts = tmp / "starts.txt"
-    env = _wave(tmp / "moves")
-    found: dict[str, Any] = {}
-    with _robots(zenoh=True, ws=False, starts=starts, env=env) as (_, robots):
-        names = [r["name"] for r in robots]
-        settings = ZenohSettings(connect=tuple(r["endpoint"] for r in robots))
-        with Fleet(settings, timeout_s=5.0) as fleet:
-            fleet.wait_for(names, 10.0)
-            for what, (path, body, stop) in STARTS.items():
-                found[what] = _spread(fleet, names, starts, path, body, stop)
-    return found
-
-
-def _spread(
-    fleet: Any, names: list[str], starts: Path, path: str, body: Any, stop: str
-) -> dict[str, Any]:
-    """``TRIALS`` starts of ``path`` on every robot together (after a first one kept apart)."""
-    spreads, offsets, within = [], [], []
-    first: dict[str, float] = {}
-    for trial in range(TRIALS + 1):
-        starts.write_text("")
-        outcomes = fleet.command(names, "POST", path, body)
-        assert all(o.ok for o in outcomes), [o.message for o in outcomes if not o.ok]
-        stamps = _stamps(starts, len(names))
-        times = [t for _, t in stamps]
-        late = [t - (fleet.last_start_at or 0) for t in times]
-        if trial == 0:
-            first = {
-                "spread_ms": (max(times) - min(times)) * 1000,
-                "late_max_ms": max(late) * 1000,
-            }
-        else:
-            spreads.append(max(times) - min(times))
-            offsets.extend(late)
-            within.append(_within_process(stamps))
-        fleet.command(names, "POST", stop, together=False)
-    spreads.sort()
-    offsets.sort()
-    within.sort()
-    return {
-        "trials": len(spreads),
-        "spread_p50_ms": (percentile(spreads, 0.5) or 0) * 1000,
-        "spread_p90_ms": (percentile(spreads, 0.9) or 0) * 1000,
-        "spread_p99_ms": (percentile(spreads, 0.99) or 0) * 1000,
-        "spread_max_ms": spreads[-1] * 1000,
-        "late_p50_ms": (percentile(offsets, 0.5) or 0) * 1000,
-        "late_p99_ms": (percentile(offsets, 0.99) or 0) * 1000,
-        "late_min_ms": offsets[0] * 1000,
-        "within_p50_ms": (percentile(within, 0.5) or 0) * 1000,
-        "within_max_ms": within[-1] * 1000,
-        "first": first,
-    }
-
-
-def _stamps(path: Path, count: int, timeout_s: float = 5.0) -> list[tuple[str, float]]:
-    """The ``count`` (process, start time) the robots logged (a robot's primitive begins in its
-    own thread, maybe just after the command's reply)."""
-    deadline = time.monotonic() + timeout_s
-    while True:
-        lines = path.read_text().splitlines()
-        if len(lines) >= count or time.monotonic() > deadline:
-            return [(line.split()[0], float(line.split()[1])) for line in lines]
-        time.sleep(0.01)
-
-
-def _within_process(stamps: list[tuple[str, float]]) -> float:
-    """The largest spread of the starts of the robots served by one process."""
-    by_process: dict[str, list[float]] = defaultdict(list)
-    for pid, stamp in stamps:
-        by_process[pid].append(stamp)
-    return max(max(times) - min(times) for times in by_process.values())
+        return cpu_per_robot(procs, WINDOW_S)
 
 
 def teleop_goals() -> dict[str, Any]:
@@ -496,7 +301,7 @@ def fleet_bench(ctx: BenchContext) -> BenchResult:
     raw: dict[str, Any] = {"robots": ROBOTS, "processes": PROCESSES, "window_s": WINDOW_S}
     raw["load_before"] = os.getloadavg()[0]
     raw["zenoh"] = fanout_zenoh()
-    raw["slow"] = sync_under_slow_subscribers()
+    raw["slow"] = sync_underslow_subscribers()
     raw["ws"] = fanout_ws()
     raw["idle_cpu_per_robot_pct"] = idle_cpu()
     with tempfile.TemporaryDirectory() as tmp:
