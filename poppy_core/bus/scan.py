@@ -34,6 +34,12 @@ a few latencies and they are asked again: a reply that came late from the rate t
 was taken for an answer at this one) does not answer twice, and is dropped. At the first rate
 tried on a port there is no rate before, and nothing to ask again.
 
+When nothing at all answered on a port, its first rates are scanned once more with a patient
+wait (``find.patient_steps``, as ``find_bus`` looks: 1 Mbps, 0.15 s a reply), so that replies a
+busy machine made late are not taken for an empty bus. Its pass over every ID keeps the port's
+deadline (late replies come as strays, asked again patiently); an empty bus at 1 Mbps, both
+protocols, costs about 3 s more (1.1 s before).
+
 A scan opens each port once and switches rates on it. On an abort (``should_abort()`` true) it
 returns what it has found so far.
 """
@@ -44,7 +50,14 @@ import logging
 from collections.abc import Callable, Iterable, Sequence
 
 from poppy_core.bus.dxlbus import DxlBus
-from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_bus, find_port
+from poppy_core.bus.find import (
+    DEFAULT_SEARCH_FIRST_BPS,
+    PROTOCOLS,
+    find_bus,
+    find_port,
+    patient_steps,
+    search_order,
+)
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
 from poppy_core.bus.scan_state import ScanState, found_motor
 from poppy_core.bus.settle import answers, doubt_learned, heard_in_silence, ping_found, settle
@@ -249,6 +262,34 @@ def _confirm(
     return set(candidates) - again
 
 
+def _patient_look(
+    state: ScanState,
+    port: str,
+    transport: Transport,
+    plan: list[tuple[int, list[int]]],
+    timing: tuple[float | None, float],
+    broadcast: bool,
+    pass_latency_s: float | None,
+) -> None:
+    """Nothing answered on ``port``: its first rates once more, with a patient wait.
+
+    ``find.patient_steps`` says which rates and how patient (``find_bus`` looks the same way);
+    ``timing`` is the latency learned and the return delay. The pass over every ID keeps the
+    port's deadline (``pass_latency_s``): its late replies are caught as strays and asked again
+    with the patient wait, so a silent ID costs no more than before.
+    """
+    steps = patient_steps(plan, timing[0])
+    if steps:
+        logger.info("%s: nothing answered: looking again, patient (a busy machine?)", port)
+    state.total += len(steps) * len(state.ids)
+    for rate, protocol, patient_s in steps:
+        if state.abort_requested():
+            return
+        bus = _scan_bus(port, rate, protocol, transport, patient_s, timing[1])
+        last = (rate, protocol) == steps[-1][:2]
+        _scan_rate(state, port, bus, broadcast, last=last, pass_latency_s=pass_latency_s)
+
+
 def scan(
     ports: str | Sequence[str],
     baudrates: Iterable[int] | None = None,
@@ -278,7 +319,8 @@ def scan(
         return_delay_s: return delay assumed in timeouts.
 
     Returns:
-        The motors found, in the order found. Unknown model numbers give ``model=None``.
+        The motors found, in the order found. Unknown model numbers give ``model=None``. A
+        port where nothing answered was looked at again, patiently (module docstring).
 
     Raises:
         PortError: the only port given cannot be opened (with several ports, one that cannot
@@ -315,6 +357,10 @@ def scan(
                         earlier = _scan_bus(port, previous, protocol, transport, learned, timing[1])
                         _revisit(state, port, earlier, heard_late)
                     previous = rate
+            if not state.aborted and not any(f.port == port for f in state.found):
+                plan = search_order(protocol_list, fixed)
+                timing = (learned, return_delay_s)
+                _patient_look(state, port, transport, plan, timing, broadcast, assumed)
         finally:
             transport.close()
     return state.found
