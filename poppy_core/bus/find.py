@@ -20,12 +20,14 @@ FACTORY_BPS = 57_600
 """The factory rate of MX and X-series motors: searched second, so a new motor is found early."""
 PROTOCOLS = (1, 2)
 PATIENT_LATENCY_S = 0.15
-"""The adapter latency assumed by the last, patient look of a search that found nothing: a
-machine too busy to run the motors' replies on time (a loaded Pi, an emulator under load) is
-then found at the common rates, for a few seconds more before a search that must fail."""
+"""The adapter latency assumed by the last, patient look of a search (``find_bus``) or a scan
+(``scan``) that found nothing (``patient_steps``): a machine too busy to run the motors' replies
+on time (a loaded Pi, an emulator under load) is then found at the common rates, for a few
+seconds more before a search that must fail."""
 PATIENT_RATES = 1
 """How many of the first rates of the plan the patient look tries again: 1 Mbps, the rate of
-Poppy robots (each rate more costs about a second before a search that must fail)."""
+Poppy robots (each rate more costs about a second before a search that must fail, and a
+scan's pass over every ID again)."""
 
 
 def _answering(bus: DxlBus, wanted: list[int]) -> tuple[list[int], set[int]]:
