@@ -20,12 +20,14 @@ FACTORY_BPS = 57_600
 """The factory rate of MX and X-series motors: searched second, so a new motor is found early."""
 PROTOCOLS = (1, 2)
 PATIENT_LATENCY_S = 0.15
-"""The adapter latency assumed by the last, patient look of a search that found nothing: a
-machine too busy to run the motors' replies on time (a loaded Pi, an emulator under load) is
-then found at the common rates, for a few seconds more before a search that must fail."""
+"""The adapter latency assumed by the last, patient look of a search (``find_bus``) or a scan
+(``scan``) that found nothing (``patient_steps``): a machine too busy to run the motors' replies
+on time (a loaded Pi, an emulator under load) is then found at the common rates, for a few
+seconds more before a search that must fail."""
 PATIENT_RATES = 1
 """How many of the first rates of the plan the patient look tries again: 1 Mbps, the rate of
-Poppy robots (each rate more costs about a second before a search that must fail)."""
+Poppy robots (each rate more costs about a second before a search that must fail, and a
+scan's pass over every ID again)."""
 
 
 def _answering(bus: DxlBus, wanted: list[int]) -> tuple[list[int], set[int]]:
@@ -56,7 +58,7 @@ class _Closest:
             )
 
 
-def _search_order(protocols: list[int], fixed: list[int] | None) -> list[tuple[int, list[int]]]:
+def search_order(protocols: list[int], fixed: list[int] | None) -> list[tuple[int, list[int]]]:
     """The rates to try, each with the protocols to try at it: 1 Mbps first, then 57,600 bps.
 
     1 Mbps is the rate of Poppy robots and of most set-up buses, so the common case is found
@@ -69,6 +71,24 @@ def _search_order(protocols: list[int], fixed: list[int] | None) -> list[tuple[i
             order.setdefault(rate, []).append(protocol)
     first = (DEFAULT_SEARCH_FIRST_BPS, FACTORY_BPS)
     return sorted(order.items(), key=lambda item: first.index(item[0]) if item[0] in first else 2)
+
+
+def patient_steps(
+    plan: list[tuple[int, list[int]]], learned_s: float | None
+) -> list[tuple[int, int, float]]:
+    """The last, patient look of a search where nothing at all answered (``find_bus``, ``scan``).
+
+    Args:
+        plan: the search's rates, each with its protocols, first rates first (``search_order``).
+        learned_s: the adapter latency learned by the search (None: nothing learned).
+
+    Returns:
+        ``(rate, protocol, latency_s)`` to try again: the first ``PATIENT_RATES`` rates of the
+        plan, in each of their protocols, with a latency of ``PATIENT_LATENCY_S`` at least, so
+        that replies a busy machine made late are not taken for an empty bus.
+    """
+    patient_s = max(learned_s or 0.0, PATIENT_LATENCY_S)
+    return [(rate, p, patient_s) for rate, protocols in plan[:PATIENT_RATES] for p in protocols]
 
 
 def _search_bus(
@@ -106,12 +126,10 @@ def _search(
             closest.offer(bus, answered)
     if closest.count:  # some motors answered in time: the others are absent, not late
         return None
-    patient = max(learned or 0.0, PATIENT_LATENCY_S)
-    for rate, protocols in plan[:PATIENT_RATES]:
-        for protocol in protocols:
-            bus = _search_bus(port, rate, protocol, transport, patient)
-            if len(_answering(bus, wanted)[0]) == len(wanted):
-                return bus
+    for rate, protocol, patient_s in patient_steps(plan, learned):
+        bus = _search_bus(port, rate, protocol, transport, patient_s)
+        if len(_answering(bus, wanted)[0]) == len(wanted):
+            return bus
     return None
 
 
@@ -150,7 +168,7 @@ def find_bus(
     wanted = list(ids)
     protocols = list(protocols)
     fixed = None if baudrates is None else list(baudrates)
-    plan = _search_order(protocols, fixed)
+    plan = search_order(protocols, fixed)
     port_list = list(ports) if ports is not None else [p.device for p in list_ports()]
     if not port_list:
         raise PortError("no serial port found: plug the adapter or run `poppy ports`")

@@ -34,6 +34,12 @@ a few latencies and they are asked again: a reply that came late from the rate t
 was taken for an answer at this one) does not answer twice, and is dropped. At the first rate
 tried on a port there is no rate before, and nothing to ask again.
 
+When nothing at all answered on a port, its first rates are scanned once more with a patient
+wait (``find.patient_steps``, as ``find_bus`` looks: 1 Mbps, 0.15 s a reply), so that replies a
+busy machine made late are not taken for an empty bus. Its pass over every ID keeps the port's
+deadline (late replies come as strays, asked again patiently); an empty bus at 1 Mbps, both
+protocols, costs about 3 s more (1.1 s before).
+
 A scan opens each port once and switches rates on it. On an abort (``should_abort()`` true) it
 returns what it has found so far.
 """
@@ -42,11 +48,18 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
 
 from poppy_core.bus.dxlbus import DxlBus
-from poppy_core.bus.find import DEFAULT_SEARCH_FIRST_BPS, PROTOCOLS, find_bus, find_port
+from poppy_core.bus.find import (
+    DEFAULT_SEARCH_FIRST_BPS,
+    PROTOCOLS,
+    find_bus,
+    find_port,
+    patient_steps,
+    search_order,
+)
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
+from poppy_core.bus.scan_state import ScanState, found_motor
 from poppy_core.bus.settle import answers, doubt_learned, heard_in_silence, ping_found, settle
 from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, LinkTiming
 from poppy_core.bus.transport import Transport, open_each
@@ -68,70 +81,8 @@ logger = logging.getLogger(__name__)
 SCAN_IDS = range(254)
 
 
-def _found(port: str, bus: DxlBus, result: PingResult) -> FoundMotor:
-    return FoundMotor(
-        port=port,
-        baudrate=bus.baudrate,
-        protocol=bus.protocol,
-        id=result.id,
-        model_number=result.model_number,
-        model=result.model_name,
-        firmware=result.firmware,
-    )
-
-
-@dataclass
-class _Scan:
-    """State of one scan run."""
-
-    ids: list[int]
-    progress: Callable[[ScanProgress], None] | None
-    should_abort: Callable[[], bool] | None
-    on_found: Callable[[FoundMotor], None] | None
-    total: int
-    done: int = 0
-    found: list[FoundMotor] = field(default_factory=list)
-    unconfirmed: int = 0  # motors that answered at the rate being scanned, not yet confirmed
-    aborted: bool = False
-
-    def abort_requested(self) -> bool:
-        if not self.aborted and self.should_abort is not None and self.should_abort():
-            logger.info("scan aborted after %d ping(s)", self.done)
-            self.aborted = True
-        return self.aborted
-
-    def report(self, port: str, bus: DxlBus, step: str, motor_id: int | None, count: int) -> None:
-        self.done += count
-        if self.progress is not None:
-            self.progress(
-                ScanProgress(
-                    port,
-                    bus.baudrate,
-                    bus.protocol,
-                    step,
-                    motor_id,
-                    self.done,
-                    self.total,
-                    len(self.found) + self.unconfirmed,
-                )
-            )
-
-    def add(self, motor: FoundMotor) -> None:
-        self.found.append(motor)
-        logger.info(
-            "found motor %d (%s) on %s at %d bps, protocol %d",
-            motor.id,
-            motor.model or f"model {motor.model_number}",
-            motor.port,
-            motor.baudrate,
-            motor.protocol,
-        )
-        if self.on_found is not None:
-            self.on_found(motor)
-
-
 def _scan_rate(
-    state: _Scan,
+    state: ScanState,
     port: str,
     bus: DxlBus,
     broadcast: bool,
@@ -211,7 +162,7 @@ def _scan_rate(
             candidates[motor_id] = result
     if first:
         for result in candidates.values():
-            state.add(_found(port, bus, result))
+            state.add(found_motor(port, bus, result))
         state.unconfirmed = 0
         unconfirmed: set[int] = set()
     else:
@@ -253,7 +204,7 @@ def _scan_bus(
     return bus
 
 
-def _revisit(state: _Scan, port: str, bus: DxlBus, ids: set[int]) -> None:
+def _revisit(state: ScanState, port: str, bus: DxlBus, ids: set[int]) -> None:
     """Look again at the rate before for motors whose replies came late into the next one.
 
     ``bus`` is at that earlier rate, with the latency learned since; a motor found there is
@@ -279,7 +230,7 @@ def _revisit(state: _Scan, port: str, bus: DxlBus, ids: set[int]) -> None:
 
 
 def _confirm(
-    state: _Scan, port: str, bus: DxlBus, candidates: dict[int, PingResult], by_broadcast: bool
+    state: ScanState, port: str, bus: DxlBus, candidates: dict[int, PingResult], by_broadcast: bool
 ) -> set[int]:
     """Report the candidates that answer again, now that the line has settled.
 
@@ -299,7 +250,7 @@ def _confirm(
     again |= {i for i in candidates if i not in again and answers(bus, i)}
     for motor_id, result in candidates.items():
         if motor_id in again:
-            state.add(_found(port, bus, result))
+            state.add(found_motor(port, bus, result))
         else:
             logger.info(
                 "%s: motor %d answered once at %d bps but not when asked again: a late reply "
@@ -309,6 +260,34 @@ def _confirm(
                 bus.baudrate,
             )
     return set(candidates) - again
+
+
+def _patient_look(
+    state: ScanState,
+    port: str,
+    transport: Transport,
+    plan: list[tuple[int, list[int]]],
+    timing: tuple[float | None, float],
+    broadcast: bool,
+    pass_latency_s: float | None,
+) -> None:
+    """Nothing answered on ``port``: its first rates once more, with a patient wait.
+
+    ``find.patient_steps`` says which rates and how patient (``find_bus`` looks the same way);
+    ``timing`` is the latency learned and the return delay. The pass over every ID keeps the
+    port's deadline (``pass_latency_s``): its late replies are caught as strays and asked again
+    with the patient wait, so a silent ID costs no more than before.
+    """
+    steps = patient_steps(plan, timing[0])
+    if steps:
+        logger.info("%s: nothing answered: looking again, patient (a busy machine?)", port)
+    state.total += len(steps) * len(state.ids)
+    for rate, protocol, patient_s in steps:
+        if state.abort_requested():
+            return
+        bus = _scan_bus(port, rate, protocol, transport, patient_s, timing[1])
+        last = (rate, protocol) == steps[-1][:2]
+        _scan_rate(state, port, bus, broadcast, last=last, pass_latency_s=pass_latency_s)
 
 
 def scan(
@@ -340,7 +319,8 @@ def scan(
         return_delay_s: return delay assumed in timeouts.
 
     Returns:
-        The motors found, in the order found. Unknown model numbers give ``model=None``.
+        The motors found, in the order found. Unknown model numbers give ``model=None``. A
+        port where nothing answered was looked at again, patiently (module docstring).
 
     Raises:
         PortError: the only port given cannot be opened (with several ports, one that cannot
@@ -352,7 +332,7 @@ def scan(
     rates = {p: fixed if fixed is not None else list(standard_baudrates(p)) for p in protocol_list}
     id_list = list(ids)
     total = len(port_list) * sum(len(rates[p]) for p in protocol_list) * len(id_list)
-    state = _Scan(id_list, progress, should_abort, on_found, total)
+    state = ScanState(id_list, progress, should_abort, on_found, total)
     for port, transport in open_each(port_list):
         learned = latency_s  # a slower adapter than assumed is learned once, for every rate
         first = True  # nothing sent on this port yet: nothing can come late from elsewhere
@@ -377,6 +357,10 @@ def scan(
                         earlier = _scan_bus(port, previous, protocol, transport, learned, timing[1])
                         _revisit(state, port, earlier, heard_late)
                     previous = rate
+            if not state.aborted and not any(f.port == port for f in state.found):
+                plan = search_order(protocol_list, fixed)
+                timing = (learned, return_delay_s)
+                _patient_look(state, port, transport, plan, timing, broadcast, assumed)
         finally:
             transport.close()
     return state.found

@@ -3,15 +3,17 @@ silence, and never change how the bus reads."""
 
 from __future__ import annotations
 
-import time
+import threading
 
 from poppy_core.bus import DxlBus
 from poppy_core.emulator import FaultInjector, build_bus_from_spec, serve_pty
-from poppy_core.protocol import ping
+from poppy_core.protocol import StatusPacket, ping
 from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.waiting import eventually
 
 MX_PRESENT = 36  # MX-28 present position (e-manual), 2 bytes
 XL_PRESENT = 37  # XL-320 present position (e-manual), 2 bytes
+HOUR_S = 3600.0
 
 
 class GarbleReplies(FaultInjector):
@@ -61,10 +63,21 @@ def test_a_motor_garbled_in_every_group_reply_is_read_on_its_own() -> None:
 
 
 def test_a_garbled_reply_does_not_wait_out_the_deadline() -> None:
+    # The only reply is garbled: the exchange gives up once its bytes came (as many as the
+    # reply takes) and reports it garbled, rather than waiting out its deadline for a reply
+    # that will not come. The deadline is an hour: an exchange that waited it out would still be
+    # waiting when the test's wait gives up (15 s at least, a wait, not a speed check).
     faults = GarbleReplies({1})
     virtual = build_bus_from_spec("XL-320:1", protocol=2, faults=faults)
-    with serve_pty(virtual) as server, DxlBus(server.url, protocol=2, timeout_s=3.0) as bus:
-        started = time.monotonic()
-        assert bus.exchange(ping(1), [(1, 3)]) == {}
-        assert time.monotonic() - started < 1.5  # garbled at once; the deadline was 3 s
-        assert bus.stats.corrupt_packets == 1
+    with serve_pty(virtual) as server, DxlBus(server.url, protocol=2, timeout_s=HOUR_S) as bus:
+        replies: list[dict[int, StatusPacket]] = []
+
+        def exchange() -> None:
+            replies.append(bus.exchange(ping(1), [(1, 3)]))
+
+        thread = threading.Thread(target=exchange, name="garbled-exchange", daemon=True)
+        thread.start()
+        assert eventually(lambda: bool(replies)), "the exchange waits out its deadline"
+        thread.join()
+        assert replies == [{}]
+        assert (bus.stats.corrupt_packets, faults.count) == (1, 1)  # garbled; nothing resent

@@ -56,6 +56,22 @@ def test_scan_without_broadcast_pings_each_id(emulate: Emulate) -> None:
     assert seen[-1].found == 1
 
 
+@pytest.mark.parametrize(("spec", "protocol"), [("AX-12A:1-3", 1), ("XL-320:1-3", 2)])
+def test_a_scan_finds_motors_whose_replies_a_busy_machine_makes_late(
+    emulate: Emulate, spec: str, protocol: int
+) -> None:
+    # Every reply 0.1 s late (an emulator, or a Pi, too busy to answer on time), past the
+    # scan's waits at a rate and its quiet time after: nothing answered in time, and the
+    # patient look at 1 Mbps (find.patient_steps, as find_bus) finds the motors rather than
+    # calling an empty bus.
+    with emulate(spec, protocol=protocol) as (virtual, url):
+        virtual.extra_delay_s = 0.1
+        progress: list[ScanProgress] = []
+        found = scan(url, [1_000_000], [protocol], ids=range(8), progress=progress.append)
+    assert _ids(found) == [(i, spec.split(":")[0], 1_000_000, protocol) for i in (1, 2, 3)]
+    assert progress[-1].fraction == 1.0
+
+
 def test_scan_reports_unknown_model_numbers(emulate: Emulate) -> None:
     with emulate("MX-28:5") as (virtual, url):
         virtual.motor(5).table.set("model_number", 4242)
