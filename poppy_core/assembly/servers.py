@@ -7,8 +7,8 @@ Origin policy (Snap!'s adds snap.berkeley.edu), one token, and one shutdown orde
 Snap!, WebSocket, HTTP (the reverse of starting), then the Zenoh session, then the service's
 recordings and teleoperations (the ROS 2 node stops first). The Zenoh session
 (``ServerSet.zenoh_session``) is one per set, opened before anything serves: every server on
-Zenoh (the fleet node, the ROS 2 node) declares on it.
-Importing this module loads no server library; ``serve`` does.
+Zenoh (the fleet node, the ROS 2 node) declares on it. Each server is built by its builder in
+``server_builders``. Importing this module loads no server library; ``serve`` does.
 """
 
 from __future__ import annotations
@@ -18,6 +18,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from poppy_core.assembly.server_builders import (
+    add_http,
+    add_ros2,
+    add_snap,
+    add_ws,
+    add_zenoh,
+    add_zmq,
+    fleet_page,
+    name_and_announce,
+    own_pages,
+    ros2_session,
+)
 from poppy_core.checks import robot_name
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.zenoh_wire import ZenohSettings
@@ -35,11 +47,6 @@ if TYPE_CHECKING:
 PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh", "ros2")
 """pypot's attribute names of the servers (``robot.http``...), ``zenoh`` and ``ros2``, in the
 order they start."""
-SNAP_ONLINE_NOTE = (
-    "Snap! opens online (snap.berkeley.edu): run `poppy snap download` once on the robot "
-    "to serve Snap! offline"
-)
-"""The page's line when no Snap! copy is served at /app/."""
 DEFAULT_PORTS = {"http": 8080, "ws": 9009, "zmq": 6768, "snap": 6969}
 """pypot's default ports (``zmq``: the documentation's ZMQ example)."""
 LOOPBACK = "127.0.0.1"
@@ -224,9 +231,7 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
         MissingExtraError: the ``server`` (or ``zmq``, ``appliance``, ``fleet``, ``ros2``) extra
             is missing.
     """
-    from poppy_core.server import OriginPolicy, RobotService, ServerThread, create_app
-    from poppy_core.server.background import BackgroundServer
-    from poppy_core.server.stream import create_stream_app
+    from poppy_core.server import OriginPolicy, RobotService, create_app
 
     listens = spec.listens()
     policy = OriginPolicy.for_server(
@@ -245,186 +250,25 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     servers = ServerSet(service, policy, app if "http" in listens else None)
     try:
         if "http" in listens:
-            where = listens["http"]
-            thread = ServerThread(
-                app, where.host, where.port, alias_ports=spec.http_alias_ports
-            ).bind()
-            servers.servers["http"] = BackgroundServer("http", thread, service=service)
+            add_http(servers, spec, listens["http"], app)
         if "ws" in listens:
-            where = listens["ws"]
-            stream = create_stream_app(service, spec.ws_rate_hz, spec.token, policy)
-            thread = ServerThread(stream, where.host, where.port).bind()
-            servers.servers["ws"] = BackgroundServer("ws", thread, service=service)
+            add_ws(servers, spec, listens["ws"])
         if "zmq" in listens:
-            from poppy_core.server.zmqserver import ZmqRobotServer
-
-            where = listens["zmq"]
-            servers.servers["zmq"] = ZmqRobotServer(robot, where.host, where.port, service=service)
+            add_zmq(servers, robot, listens["zmq"])
         if "snap" in listens:
-            _add_snap(servers, robot, spec, listens["snap"])
+            add_snap(servers, robot, spec, listens["snap"])
         if spec.ros2 is not None:  # first: its session stamps samples, for both nodes
-            _ros2_session(servers, spec, spec.ros2)
+            ros2_session(servers, spec, spec.ros2)
         if spec.zenoh is not None:
-            _add_zenoh(servers, spec, spec.zenoh, app)
+            add_zenoh(servers, spec, spec.zenoh, app)
         if spec.ros2 is not None:
-            _add_ros2(servers, spec, spec.ros2)
-        _own_pages(servers)
-        _named(servers, robot, spec)
-        _fleet_page(servers)
+            add_ros2(servers, spec, spec.ros2)
+        own_pages(servers)
+        name_and_announce(servers, robot, spec)
+        fleet_page(servers)
         if start:
             servers.start()
     except BaseException:
         servers.stop()
         raise
     return servers
-
-
-def _named(servers: ServerSet, robot: Robot, spec: ServeSpec) -> None:
-    """Give the page's settings the robot's name; announce it when asked (before serving, so
-    the name won is accepted by the Host check from the first request)."""
-    from poppy_core.server.settings import ServedRobot
-
-    name = spec.name or ("poppy" if spec.announce else None)
-    policies = [servers.policy] + ([servers.snap.policy] if servers.snap is not None else [])
-    served = ServedRobot(
-        name=name,
-        protocols=tuple(servers.servers),
-        token_required=bool(spec.token),
-        policies=policies,
-        settings_file=spec.settings_file,
-        token_file=spec.token_file,
-    )
-    if servers.app is not None:
-        servers.app.state.settings.served = served
-    if not spec.announce or name is None:
-        return
-    from poppy_core.server.announce import Announcer
-
-    ports = {p: s.port for p, s in servers.servers.items()}
-    properties = {"creature": _creature(robot), "version": served.version}
-    if spec.token:
-        properties["token"] = "1"
-    announcer = Announcer(
-        name,
-        ports,
-        listen_host=spec.host,
-        properties=properties,
-        on_name=served.named,
-    )
-    servers.announcer = announcer
-    served.announcer = announcer
-    announcer.start()
-
-
-def _creature(robot: Robot) -> str:
-    profile = robot.config.profile if robot.config is not None else None
-    return (profile.kind or profile.name) if profile is not None else "custom"
-
-
-def _add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) -> None:
-    from poppy_core.server.snap import create_snap_server
-    from poppy_core.server.snap.server import snap_policy
-
-    policy = snap_policy(
-        where.host, cors=spec.cors, allow_hosts=spec.allow_hosts, report=spec.report
-    )
-    if spec.name is not None:
-        policy.with_names([spec.name])  # Snap! projects call http://poppy.local:6969 too
-    snap = create_snap_server(
-        robot,
-        where.host,
-        where.port,
-        service=servers.service,
-        policy=policy,
-        snap_dir=spec.snap_dir,
-        token=spec.token,
-        report=spec.report,
-    )
-    servers.servers["snap"] = snap
-    snap.thread.bind()
-
-
-def _zenoh_session(servers: ServerSet, settings: ZenohSettings) -> Any:
-    """The set's one Zenoh session, opened on first use: every server on Zenoh of the set (the
-    fleet node, ROS 2) declares on it; ``ServerSet.stop`` closes it after them."""
-    if servers.zenoh_session is None:
-        from poppy_core.zenoh_wire import open_session
-
-        servers.zenoh_session = open_session(settings)
-    return servers.zenoh_session
-
-
-def _add_zenoh(servers: ServerSet, spec: ServeSpec, settings: ZenohSettings, app: Any) -> None:
-    from poppy_core.server.zenoh import ZenohRobotServer
-    from poppy_core.zenoh_wire import check_name, default_name
-
-    name = check_name(spec.name) if spec.name is not None else default_name()
-    servers.servers["zenoh"] = ZenohRobotServer(
-        servers.service,
-        app,
-        _zenoh_session(servers, settings),
-        name,
-        token=spec.token,
-        state_rate_hz=spec.state_rate_hz,
-        endpoints=settings.listen,
-    )
-
-
-def _ros2_session(servers: ServerSet, spec: ServeSpec, settings: Ros2Settings) -> None:
-    """The set's session, with timestamps (the fleet's settings when it is served too)."""
-    from poppy_core.server.ros2.ros2_session import open_ros2_session
-
-    servers.zenoh_session = open_ros2_session(spec.zenoh or settings.zenoh)
-
-
-def _add_ros2(servers: ServerSet, spec: ServeSpec, settings: Ros2Settings) -> None:
-    """The ROS 2 node, on the set's Zenoh session."""
-    from poppy_core.server.ros2 import Ros2Node
-    from poppy_core.zenoh_wire import check_name, default_name
-
-    name = check_name(spec.name) if spec.name is not None else default_name()
-    servers.servers["ros2"] = Ros2Node(
-        servers.service,
-        servers.zenoh_session,
-        settings,
-        name,
-        state_rate_hz=spec.state_rate_hz,
-    )
-
-
-def _fleet_page(servers: ServerSet) -> None:
-    """The page lists the robots its Zenoh session sees; the description names the page."""
-    node = servers.zenoh
-    if node is None or servers.app is None:
-        return
-    from poppy_core.server.zenoh.web_fleet import add_fleet_route
-
-    add_fleet_route(servers.app, node)
-    if servers.http is not None:
-        node.page = servers.http.url
-
-
-def _own_pages(servers: ServerSet) -> None:
-    """The pages of every port count as the servers' own; the home page links to Snap!."""
-    ports = [
-        p
-        for name, s in servers.servers.items()
-        if name not in ("zmq", "zenoh", "ros2")
-        for p in _ports(s)
-    ]
-    servers.policy.with_ports(ports)
-    snap = servers.snap
-    if snap is None:
-        return
-    snap.bound(ports)
-    if servers.app is not None:
-        from poppy_core.server.web import add_link, add_note
-
-        add_link(servers.app, "Snap! with the Poppy blocks", snap.editor_url)
-        if not snap.local_app:
-            add_note(servers.app, "snap", SNAP_ONLINE_NOTE)
-
-
-def _ports(server: Any) -> list[int]:
-    """Every port a server listens on (the HTTP server's aliases too)."""
-    return list(getattr(server, "ports", [server.port]))

@@ -45,7 +45,8 @@ from poppy_core.motion.move_library import (
     moves_dir,
     save_move,
 )
-from poppy_core.motion.player import MovePlayer, PlayProgress
+from poppy_core.motion.play_plan import PlayProgress
+from poppy_core.motion.player import MovePlayer
 from poppy_core.motion.primitive import Primitive
 from poppy_core.motion.primitive_failure import PrimitiveFailure
 from poppy_core.motion.recorder import MoveRecorder

@@ -12,8 +12,7 @@ import os
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,93 +20,27 @@ from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_format import read_move
+from poppy_core.motion.play_plan import (
+    DEFAULT_RAMP_SPEED_DPS,
+    MAX_LOOPS,
+    MAX_SPEED,
+    MIN_SPEED,
+    Phase,
+    PlayProgress,
+    ProgressCallback,
+    clamp_to_limits,
+    missing_motors,
+    played_fraction,
+    ramp_timing,
+    within_limits,
+    write_rate_hz,
+)
 from poppy_core.schedule import Gate, Periodic, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
 
 logger = logging.getLogger(__name__)
-
-DEFAULT_RATE_HZ = 50.0
-DEFAULT_RAMP_SPEED_DPS = 60.0
-"""Mean speed of the ramp to the first frame (a minimum-jerk peak is 1.875 times that)."""
-MIN_RAMP_S = 0.3
-MIN_SPEED = 0.01
-MAX_SPEED = 100.0
-MAX_LOOPS = 10_000
-LIMIT_TOLERANCE_DEG = 0.5
-"""Past a limit by less than this is noise of a recording at the limit: clamped silently."""
-RAMP_SKIP_DEG = 0.5
-"""No ramp when every motor is already this close to the first frame."""
-
-Phase = Literal["ramp", "play", "done"]
-
-
-@dataclass(frozen=True)
-class PlayProgress:
-    """Where a playback is, given to the progress callback.
-
-    Attributes:
-        phase: ``"ramp"`` (going to the first frame), ``"play"`` or ``"done"``.
-        loop: the loop being played, from 1.
-        loops: how many loops in all.
-        move_t_s: time in the move (0..``Move.duration_s``; counts down when backwards).
-        fraction: share of the whole playback done (ramps excluded), 0..1.
-    """
-
-    phase: Phase
-    loop: int
-    loops: int
-    move_t_s: float
-    fraction: float
-
-
-ProgressCallback = Callable[[PlayProgress], None]
-
-
-def write_rate_hz(robot: Robot) -> float:
-    """The rate the robot writes goals at (its slowest ``goals`` loop; 50 Hz if unknown)."""
-    rates = [
-        loop.target_hz
-        for stats in robot.sync_stats().values()
-        for name, loop in stats.loops.items()
-        if name == "goals" and loop.target_hz > 0
-    ]
-    return min(rates) if rates else DEFAULT_RATE_HZ
-
-
-def clamp_to_limits(move: Move, motors: list[Motor]) -> dict[str, float]:
-    """How far past its angle limits each motor of ``move`` goes (motors within are left out).
-
-    Args:
-        move: the move.
-        motors: the robot's motors, one per column of the move (wheels have no limits).
-    """
-    beyond: dict[str, float] = {}
-    for index, motor in enumerate(motors):
-        if motor.wheel_mode or not len(move):
-            continue
-        low, high = motor.angle_limit
-        column = move.positions[:, index]
-        worst = max(low - float(column.min()), float(column.max()) - high, 0.0)
-        if worst > LIMIT_TOLERANCE_DEG:
-            beyond[motor.name] = worst
-    return beyond
-
-
-def _within_limits(move: Move, motors: list[Motor]) -> Move:
-    positions = move.positions.copy()
-    for index, motor in enumerate(motors):
-        if not motor.wheel_mode:
-            low, high = motor.angle_limit
-            np.clip(positions[:, index], low, high, out=positions[:, index])
-    return Move(move.framerate, move.motors, positions, speeds=move.speeds, metadata=move.metadata)
-
-
-def missing_motors(robot: Robot, move: Move) -> list[str]:
-    """The motors of ``move`` the robot does not have."""
-    names = {m.name for m in robot.motors}
-    return [m for m in move.motors if m not in names]
 
 
 class MovePlayer:
@@ -199,7 +132,7 @@ class MovePlayer:
                 "the move goes past the angle limits of %s: played at the limits",
                 ", ".join(f"{n} (by {d:.1f}°)" for n, d in self.clamped.items()),
             )
-        played = _within_limits(move, self._motors) if self.clamped else move
+        played = within_limits(move, self._motors) if self.clamped else move
         self._played = played.reversed() if backwards else played
         self._worker: Worker | None = None
         self._gate: Gate | None = None
@@ -332,22 +265,17 @@ class MovePlayer:
         distance = max(
             abs(m.present_position - float(v)) for m, v in zip(self._motors, first, strict=True)
         )
-        duration = self.ramp_s
-        if duration is None:
-            duration = (
-                0.0 if distance < RAMP_SKIP_DEG else max(MIN_RAMP_S, distance / self.ramp_speed_dps)
+        duration, origin = ramp_timing(
+            distance, self.ramp_s, self.ramp_speed_dps, shared, self._clock
+        )
+        if shared is not None and origin is None:
+            logger.info(
+                "%.1f° from the move's first frame: the playback starts after a %.1f s ramp, "
+                "not in phase with the shared start (give ramp_s to keep it)",
+                distance,
+                duration,
             )
-            if shared is not None and duration > 0:
-                logger.info(
-                    "%.1f° from the move's first frame: the playback starts after a %.1f s ramp, "
-                    "not in phase with the shared start (give ramp_s to keep it)",
-                    distance,
-                    duration,
-                )
-                shared = None
-        elif shared is not None:
-            shared += duration  # a ramp of a given length ends at the same time on every robot
-            duration = shared - self._clock()  # the rest of it, for a thread that woke late
+        shared = origin
         if duration <= 0:
             if shared is None:  # else the playback writes the frame due at once
                 self._set_goals(first)
@@ -380,7 +308,7 @@ class MovePlayer:
                     break
                 self._set_goals(move.positions_at(move_t))
                 shown_t = duration - move_t if self.backwards else move_t
-                done = (loop - 1 + move_t / duration) / self.loops if duration else 0.0
+                done = played_fraction(loop, self.loops, move_t, duration)
                 self._report("play", loop, shown_t, done)
                 schedule.advance(self._clock())
                 stopping.wait(max(0.0, schedule.next_deadline - self._clock()))

@@ -5,7 +5,7 @@ from typing import Annotated
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, JsonValue
 
 from poppy_core import checks
-from poppy_core.motion.player import MAX_SPEED, MIN_SPEED
+from poppy_core.motion.play_plan import MAX_SPEED, MIN_SPEED
 from poppy_core.trajectory import CONTROLS, control_name
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]

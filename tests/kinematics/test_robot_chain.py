@@ -129,7 +129,7 @@ class _BrokenRobot:
 
 
 def test_a_straight_move_that_fails_says_so_to_its_waiter() -> None:
-    from poppy_core.motion.cartesian import LinearMove
+    from poppy_core.motion.straight_line import LinearMove
 
     move = LinearMove(_BrokenRobot(), [{"m1": 0.0}, {"m1": 1.0}], 0.01, "arm")  # type: ignore[arg-type]
     with pytest.raises(RuntimeError, match="the goto broke"):

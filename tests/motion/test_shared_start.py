@@ -16,7 +16,8 @@ import numpy as np
 
 from poppy_core.motion import PositionWatcher, Sinus
 from poppy_core.motion.move import Move
-from poppy_core.motion.player import RAMP_SKIP_DEG, MovePlayer, PlayProgress
+from poppy_core.motion.play_plan import RAMP_SKIP_DEG, PlayProgress
+from poppy_core.motion.player import MovePlayer
 from poppy_core.robot import Robot
 from poppy_core.schedule import Gate
 from tests.helpers import eventually

@@ -401,7 +401,7 @@ def test_camera_and_chain_jog(browser: Any, creature: Served) -> None:
 def test_the_links_offer_the_notebook_and_the_notes_of_the_server(
     page: Any, served: Served
 ) -> None:
-    from poppy_core.assembly.servers import SNAP_ONLINE_NOTE
+    from poppy_core.assembly.server_builders import SNAP_ONLINE_NOTE
     from poppy_core.server.web import add_note
 
     link = page.locator("#links a", has_text="Jupyter: discover your robot")
