@@ -7,14 +7,8 @@ It speaks the server's ``/api/v1`` with the standard library only (keep-alive co
 """
 
 from poppy_core.remote.client import HttpClient
-from poppy_core.remote.remote_robot import (
-    ModelInfo,
-    RemoteGoto,
-    RemoteMotor,
-    RemoteMoves,
-    RemotePrimitive,
-    RemoteRobot,
-)
+from poppy_core.remote.remote_motion import RemoteMoves, RemotePrimitive
+from poppy_core.remote.remote_robot import ModelInfo, RemoteGoto, RemoteMotor, RemoteRobot
 from poppy_core.remote.teleop_follower import RemoteFollower
 
 __all__ = [

@@ -14,12 +14,12 @@ Nothing here touches the bus: reads return the values the sync loops last read, 
 value and mark it for the next write cycle. That side (register cache, pending writes, online
 state) is the motor's ``MotorLink`` (``poppy_core.robot.motor_link``), which only the robot's
 internals reach (``link_of``): a ``Motor``'s public names are the user's API. pypot's other
-names and the model-specific registers are in ``poppy_core.robot.motor_pypot``.
+names and the model-specific registers are in ``poppy_core.robot.motor_pypot``; compliance
+(``compliant``, ``compliant_behavior``, safe compliance) in ``poppy_core.robot.motor_compliance``.
 """
 
 from __future__ import annotations
 
-import logging
 from typing import TYPE_CHECKING, Literal
 
 from poppy_core import checks
@@ -28,25 +28,20 @@ from poppy_core.models import ServoModel
 from poppy_core.robot import frames
 from poppy_core.robot import registers as regs
 from poppy_core.robot.goto import GotoHandle, GotoRunner
+from poppy_core.robot.motor_compliance import CompliantBehavior, MotorCompliance
 from poppy_core.robot.motor_link import MotorLink
-from poppy_core.robot.motor_pypot import CompliantBehaviorSetting, PypotMotorMixin
+from poppy_core.robot.motor_pypot import PypotMotorMixin
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import MotorConfig
 
-logger = logging.getLogger(__name__)
-
-CompliantBehavior = Literal["dummy", "safe"]
-BEHAVIORS: tuple[str, ...] = ("dummy", "safe")
-# A motor stiffened by safe compliance goes compliant again once this far inside its limits.
-SAFE_RELEASE_MARGIN_DEG = 1.0
 FULL_TORQUE_PCT = 100.0
 # poppy's gotos are smooth by default (pypot's motors default to 'dummy'; its Torso and Humanoid
 # set 'minjerk'): the pypot creature classes set their creature's control.
 DEFAULT_GOTO_BEHAVIOR = "minjerk"
 
 
-class Motor(PypotMotorMixin):
+class Motor(PypotMotorMixin, MotorCompliance):
     """A servo on a robot: registers by name in SI units, user frame.
 
     Args:
@@ -99,7 +94,7 @@ class Motor(PypotMotorMixin):
         ends = sorted(float(register.to_si(r)) for r in (register.min_raw, register.max_raw))
         self._range = (ends[0], ends[1])
         low, high = angle_limit if angle_limit is not None else self._user_range()
-        self._limits = self._checked_limits(low, high)
+        self._limits: tuple[float, float] = self._checked_limits(low, high)
 
     @classmethod
     def from_config(
@@ -296,75 +291,6 @@ class Motor(PypotMotorMixin):
                 motor=self.name,
             )
         self._link.store("torque_limit", regs.finite(value, f"{self.name}.torque_limit"))
-
-    # -- compliance --------------------------------------------------------------------------
-
-    @property
-    def compliant(self) -> bool:
-        """True when the motor is meant to be free (torque off)."""
-        return self._link.compliant
-
-    @compliant.setter
-    def compliant(self, value: bool) -> None:
-        link = self._link
-        with link.lock:
-            link.compliant = bool(value)
-            if link.compliant:
-                link.set_torque(False)
-                self._apply_safe_compliance()
-            elif not link.torque:
-                self._set_goal(self.present_position)
-                link.set_torque(True)
-
-    @property
-    def torque_enabled(self) -> bool:
-        """True when the torque is (meant to be) on, including a safe-compliance stiffening."""
-        return self._link.torque
-
-    @property
-    def compliant_behavior(self) -> CompliantBehaviorSetting:
-        """``"dummy"``: compliant means free; ``"safe"``: free inside the limits, stiff at them.
-
-        Set it (``m.compliant_behavior = "safe"``) or call it as the Poppy documentation does
-        (``m.compliant_behavior("safe")``); read, it compares and prints as the name.
-        """
-        return CompliantBehaviorSetting(self._behavior, self)
-
-    @compliant_behavior.setter
-    def compliant_behavior(self, value: str) -> None:
-        if value not in BEHAVIORS:
-            raise RegisterError(
-                f"{self.name}: compliant behavior must be 'dummy' or 'safe', not {value!r}",
-                register="compliant_behavior",
-                motor=self.name,
-            )
-        link = self._link
-        with link.lock:
-            self._behavior = "safe" if value == "safe" else "dummy"
-            if link.compliant:
-                link.set_torque(False)
-                self._apply_safe_compliance()
-
-    def _apply_safe_compliance(self) -> None:
-        """Safe compliance: stiffen a compliant motor pushed past a limit, free it once back.
-
-        Runs under the link's lock (after each present position read, or from a setter).
-        """
-        link = self._link
-        if not (link.compliant and self._behavior == "safe") or self.wheel_mode:
-            return
-        if link.cached("present_position") is None:
-            return
-        position = self.present_position
-        low, high = self._limits
-        if not link.torque and not low <= position <= high:
-            logger.debug("%s pushed past its limits (%.1f°): holding it", self.name, position)
-            self._set_goal(position)
-            link.set_torque(True)
-        elif link.torque and low + SAFE_RELEASE_MARGIN_DEG <= position <= high - (
-            SAFE_RELEASE_MARGIN_DEG
-        ):
-            link.set_torque(False)
 
     # -- limits ------------------------------------------------------------------------------
 

@@ -7,33 +7,12 @@ API, reached through the motor's ``MotorLink`` cache as the rest of ``Motor`` is
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING
 
 from poppy_core.errors import ArgumentError, RegisterError
 from poppy_core.models import ServoModel
 from poppy_core.robot import registers as regs
 from poppy_core.robot.motor_link import MotorLink, SIValue
 from poppy_core.trajectory import control_name
-
-if TYPE_CHECKING:
-    from poppy_core.robot.motor import Motor
-
-
-class CompliantBehaviorSetting(str):
-    """A motor's compliant behaviour: a string (``"dummy"``/``"safe"``) that can be called to set
-    it, as the Poppy documentation writes ``robot.head_z.compliant_behavior('safe')``."""
-
-    __slots__ = ("_motor",)
-    _motor: Motor
-
-    def __new__(cls, value: str, motor: Motor) -> CompliantBehaviorSetting:
-        setting = super().__new__(cls, value)
-        setting._motor = motor
-        return setting
-
-    def __call__(self, value: str) -> None:
-        """Set the motor's compliant behaviour to ``value``."""
-        self._motor.compliant_behavior = value
 
 
 class PypotMotorMixin:
@@ -45,7 +24,6 @@ class PypotMotorMixin:
     model: ServoModel
     wheel_mode: bool
     angle_limit: tuple[float, float]
-    compliant_behavior: str
     torque_limit: float
     _goto_behavior: str
     _link: MotorLink
@@ -169,15 +147,6 @@ class PypotMotorMixin:
     def control_mode(self) -> str:
         """``"wheel"`` (endless turn) or ``"joint"`` (position control), as pypot names them."""
         return "wheel" if self.wheel_mode else "joint"
-
-    @property
-    def safe_compliant(self) -> bool:
-        """pypot's flag: True when the compliant behaviour is ``"safe"``."""
-        return self.compliant_behavior == "safe"
-
-    @safe_compliant.setter
-    def safe_compliant(self, value: bool) -> None:
-        self.compliant_behavior = "safe" if value else "dummy"
 
     # -- introspection -----------------------------------------------------------------------
 

@@ -2,7 +2,8 @@
 
 Build one with ``poppy_core.robot.from_config``, ``from_profile`` or ``autodetect``; a Robot owns
 its buses, threads and (with ``sim=True``) emulators, and ``close()`` stops them all. pypot's
-names for its groups and primitives are in ``robot_pypot``; ``motors_of`` resolves specs with
+names for its groups and primitives are in ``robot_pypot``, its sync loops and ports in
+``robot_syncs``, pypot's V-REP calls in ``vrep_names``; ``motors_of`` resolves specs with
 ``motor_spec``.
 """
 
@@ -10,19 +11,18 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from poppy_core.bus import DxlBus
 from poppy_core.errors import ConfigError, RobotClosedError, UnknownGroupError, UnknownMotorError
 from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.group import MotorGroup, degrees
-from poppy_core.robot.health import BusHealth, SyncStats
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.motor_link import link_of
 from poppy_core.robot.motor_spec import MotorSpec, NamedMotor, resolve
 from poppy_core.robot.robot_pypot import Behaviour, PypotRobotMixin
+from poppy_core.robot.robot_syncs import SyncLoops
 from poppy_core.robot.sync import BusSync
 from poppy_core.robot.vrep_names import VrepNames
 
@@ -35,7 +35,7 @@ logger = logging.getLogger(__name__)
 __all__ = ["Behaviour", "MotorSpec", "NamedMotor", "Robot"]
 
 
-class Robot(PypotRobotMixin, VrepNames):
+class Robot(PypotRobotMixin, SyncLoops, VrepNames):
     """Motors by name (``robot.m1``), groups by name (``robot.base``, a list of Motor).
 
     Args:
@@ -265,100 +265,6 @@ class Robot(PypotRobotMixin, VrepNames):
         if wait:
             handle.wait()
         return handle
-
-    # -- letting go of the buses ------------------------------------------------------------
-
-    @property
-    def released(self) -> bool:
-        """True while the motors are released (``release_motors``): their ports are closed."""
-        return any(sync.released for sync in self._syncs)
-
-    def release_motors(self) -> list[str]:
-        """Let go of the motors: gotos cancelled, every motor compliant, the sync loops stopped
-        and the ports closed, so that another program can open them (a notebook, `poppy
-        scan`). The motors read offline until ``take_motors``. Stop primitives and moves first
-        (``RobotService.release_motors`` does). Returns the ports closed.
-
-        Raises:
-            RobotClosedError: the robot is closed.
-        """
-        with self._close_lock:
-            if self._closed:
-                raise RobotClosedError("the robot is closed: nothing to release")
-            for motor in self._motors:
-                self._runner.cancel(motor)
-                if not self.released:
-                    motor.compliant = True
-            for sync in self._syncs:
-                if not sync.released:
-                    sync.release_port()
-        logger.warning("motors released: %s closed", ", ".join(self.ports) or "no port")
-        return self.ports
-
-    def take_motors(self) -> list[str]:
-        """Take the motors back after ``release_motors``: reopen the ports, ping and read the
-        motors, restart the sync loops. They stay compliant. Returns the ports opened.
-
-        Raises:
-            PortError: a port cannot be opened (another program still holds it): close that
-                program and take them again (the buses opened stay open).
-            RobotClosedError: the robot is closed.
-        """
-        with self._close_lock:
-            if self._closed:
-                raise RobotClosedError("the robot is closed: open it again")
-            for sync in self._syncs:
-                if sync.released:
-                    sync.take_port()
-        logger.warning("motors taken back: %s open", ", ".join(self.ports) or "no port")
-        return self.ports
-
-    @property
-    def ports(self) -> list[str]:
-        """The ports of the robot's buses, in controller order."""
-        return [bus.port for bus in self.buses.values()]
-
-    # -- loops -------------------------------------------------------------------------------
-
-    def start_sync(self) -> None:
-        """Start the sync loops (``from_config`` does it)."""
-        for sync in self._syncs:
-            sync.start()
-
-    def stop_sync(self) -> None:
-        """Stop the sync loops (pending writes are sent first)."""
-        for sync in self._syncs:
-            sync.stop()
-
-    def run_loop(self, name: str) -> None:
-        """Run the sync loop ``name`` once now on every bus that has it, from the calling thread.
-
-        ``"present"`` reads the present state, ``"goals"`` sends the goals set since the last
-        write. Errors propagate (a silent motor is counted and goes offline as in the thread).
-        """
-        for sync in self._syncs:
-            if sync.has_loop(name):
-                sync.run_once(name)
-
-    @contextmanager
-    def driving(self, name: str) -> Iterator[None]:
-        """Within the block the sync threads skip loop ``name``: the caller runs it with
-        ``run_loop`` at its own pace (teleoperation reads a leader so, right before using it)."""
-        for sync in self._syncs:
-            sync.drive(name)
-        try:
-            yield
-        finally:
-            for sync in self._syncs:
-                sync.release(name)
-
-    def sync_stats(self) -> dict[str, SyncStats]:
-        """Controller name -> measured loop rates, error counts and offline motors."""
-        return {sync.controller: sync.stats() for sync in self._syncs}
-
-    def health(self) -> dict[str, BusHealth]:
-        """Controller name -> its bus's health: connected, loop rates, errors, offline motors."""
-        return {sync.controller: sync.health() for sync in self._syncs}
 
     # -- config and lifetime -----------------------------------------------------------------
 
