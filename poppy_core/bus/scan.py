@@ -302,6 +302,7 @@ def scan(
     broadcast: bool = True,
     latency_s: float | None = None,
     return_delay_s: float = DEFAULT_RETURN_DELAY_S,
+    patient: bool = True,
 ) -> list[FoundMotor]:
     """Find every motor answering on ``ports`` at ``baudrates`` in ``protocols``.
 
@@ -317,6 +318,8 @@ def scan(
         broadcast: use a protocol 2 broadcast ping first (see the module docstring).
         latency_s: adapter latency (None: from the port).
         return_delay_s: return delay assumed in timeouts.
+        patient: look again patiently at a port where nothing answered (False: a caller
+            trying rates one by one, whose first call was patient, pays it once).
 
     Returns:
         The motors found, in the order found. Unknown model numbers give ``model=None``. A
@@ -357,7 +360,7 @@ def scan(
                         earlier = _scan_bus(port, previous, protocol, transport, learned, timing[1])
                         _revisit(state, port, earlier, heard_late)
                     previous = rate
-            if not state.aborted and not any(f.port == port for f in state.found):
+            if patient and not state.aborted and not any(f.port == port for f in state.found):
                 plan = search_order(protocol_list, fixed)
                 timing = (learned, return_delay_s)
                 _patient_look(state, port, transport, plan, timing, broadcast, assumed)

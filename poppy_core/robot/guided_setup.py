@@ -260,8 +260,9 @@ class GuidedSetup:
         rates.sort(key=lambda r: (r != target.baudrate, r != factory_bps))
         if protocol_for(target.protocol).has_broadcast_ping:
             return scan(self.port, rates, [target.protocol])
-        for rate in rates:
-            found = scan(self.port, [rate], [target.protocol])
+        for index, rate in enumerate(rates):
+            # patient at the profile's rate only: each empty rate would pay the patient look
+            found = scan(self.port, [rate], [target.protocol], patient=index == 0)
             if found:
                 return found
         return []

@@ -72,6 +72,17 @@ def test_a_scan_finds_motors_whose_replies_a_busy_machine_makes_late(
     assert progress[-1].fraction == 1.0
 
 
+def test_a_scan_told_not_to_be_patient_does_not_look_again(emulate: Emulate) -> None:
+    # A caller trying rates one call at a time (guided setup, protocol 1) is patient once:
+    # an impatient call does not look again, so it misses replies a busy machine made late.
+    with emulate("AX-12A:1-3", protocol=1) as (virtual, url):
+        virtual.extra_delay_s = 0.1
+        progress: list[ScanProgress] = []
+        found = scan(url, [1_000_000], [1], ids=range(8), progress=progress.append, patient=False)
+    assert found == []
+    assert progress[-1].total == 8  # one pass over the IDs, no patient look added
+
+
 def test_scan_reports_unknown_model_numbers(emulate: Emulate) -> None:
     with emulate("MX-28:5") as (virtual, url):
         virtual.motor(5).table.set("model_number", 4242)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import pytest
 
 from poppy_core.bus import DxlBus
@@ -74,3 +76,27 @@ def test_a_protocol_1_kit_motor_is_found_at_its_factory_rate_and_set_up() -> Non
     assert motor.table.get_si("min_position_limit") == pytest.approx(
         target.angle_limits[0], abs=0.1
     )
+
+
+def test_a_protocol_1_search_is_patient_at_the_profile_s_rate_only(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # each empty rate tried one by one would pay the scan's patient look (1-2 s each)
+    import poppy_core.robot.guided_setup as guided
+
+    calls: list[tuple[list[int], bool]] = []
+    real = guided.scan
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        calls.append((list(args[1] or []), kwargs.get("patient", True)))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(guided, "scan", spy)
+    torso = load_profile("torso")
+    virtual = build_bus_from_spec("MX-28:1", protocol=1, baudrate=115_200)
+    with serve_link(virtual) as server:
+        flow = GuidedSetup(torso, server.url)
+        found = flow.find_single(flow.targets[0])
+    assert (found.id, found.baudrate) == (1, 115_200)
+    assert calls[0] == ([flow.targets[0].baudrate], True)  # the profile's rate, patient
+    assert len(calls) >= 3 and all(not patient for _, patient in calls[1:])
