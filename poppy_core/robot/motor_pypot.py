@@ -1,12 +1,15 @@
 """pypot's motor names and the model-specific registers: gains, compliance slopes, LED.
 
-``PypotMotorMixin`` is a base of ``Motor`` (``poppy_core.robot.motor``): everything here is user
-API, reached through the motor's ``MotorLink`` cache as the rest of ``Motor`` is.
+``PypotMotorMixin`` is a base of ``Motor`` (``poppy_core.robot.motor``) and takes ``self`` as a
+typed host Protocol, ``PypotMotorHost``, so mypy checks that ``Motor`` gives what it uses:
+everything here is user API, reached through the motor's ``MotorLink`` cache as the rest of
+``Motor`` is.
 """
 
 from __future__ import annotations
 
 import functools
+from typing import Protocol
 
 from poppy_core.errors import ArgumentError, RegisterError
 from poppy_core.models import ServoModel
@@ -15,125 +18,115 @@ from poppy_core.robot.motor_link import MotorLink, SIValue
 from poppy_core.trajectory import control_name
 
 
-class PypotMotorMixin:
-    """Gains, compliance slopes and LED (as the model has them), the register list, and pypot's
-    other names for what ``Motor`` holds (``lower_limit``, ``control_mode``...)."""
+class PypotMotorHost(Protocol):
+    """What ``PypotMotorMixin`` needs of the motor it is mixed into (``Motor`` gives it)."""
 
-    # Provided by Motor.
     name: str
     model: ServoModel
     wheel_mode: bool
-    angle_limit: tuple[float, float]
-    torque_limit: float
     _goto_behavior: str
     _link: MotorLink
+
+    @property
+    def angle_limit(self) -> tuple[float, float]:
+        """(min, max) in degrees, user frame."""
+        ...
+
+    @angle_limit.setter
+    def angle_limit(self, limits: tuple[float, float]) -> None: ...
+
+    @property
+    def torque_limit(self) -> float:
+        """Torque limit in % (RAM)."""
+        ...
+
+    @torque_limit.setter
+    def torque_limit(self, value: float) -> None: ...
+
+
+class PypotMotorMixin:
+    """Gains, compliance slopes and LED (as the model has them), the register list, and pypot's
+    other names for what a ``PypotMotorHost`` (a ``Motor``) holds (``lower_limit``,
+    ``control_mode``...)."""
 
     # -- gains and LED ---------------------------------------------------------------------
 
     @property
-    def pid(self) -> tuple[float, float, float]:
+    def pid(self: PypotMotorHost) -> tuple[float, float, float]:
         """(P, I, D) gains, in the model's e-manual scaling (MX, XL-320, X-series)."""
-        names = self._pid_names()
+        names = _pid_names(self)
         link = self._link
         return (link.number(names[0]), link.number(names[1]), link.number(names[2]))
 
     @pid.setter
-    def pid(self, gains: tuple[float, float, float]) -> None:
-        for name, value in zip(self._pid_names(), gains, strict=True):
+    def pid(self: PypotMotorHost, gains: tuple[float, float, float]) -> None:
+        for name, value in zip(_pid_names(self), gains, strict=True):
             gain = regs.capped(self.model.register(name), value, f"{self.name}.pid")
             self._link.store(name, gain)  # pypot capped the gains to the registers' range too
 
-    def _pid_names(self) -> tuple[str, str, str]:
-        names = regs.pid_names(self.model)
-        if names is None:
-            raise RegisterError(
-                f"{self.name}: {self.model.name} has no PID gains (use compliance_margin/slope)",
-                register="pid",
-                motor=self.name,
-            )
-        return names
-
     @property
-    def compliance_margin(self) -> tuple[int, int]:
+    def compliance_margin(self: PypotMotorHost) -> tuple[int, int]:
         """(CW, CCW) compliance margins (AX); set one number for both or a pair."""
-        return self._pair(regs.AX_MARGINS)
+        return _pair(self, regs.AX_MARGINS)
 
     @compliance_margin.setter
-    def compliance_margin(self, value: int | tuple[int, int]) -> None:
-        self._set_pair(regs.AX_MARGINS, value)
+    def compliance_margin(self: PypotMotorHost, value: int | tuple[int, int]) -> None:
+        _set_pair(self, regs.AX_MARGINS, value)
 
     @property
-    def compliance_slope(self) -> tuple[int, int]:
+    def compliance_slope(self: PypotMotorHost) -> tuple[int, int]:
         """(CW, CCW) compliance slopes (AX); set one number for both or a pair."""
-        return self._pair(regs.AX_SLOPES)
+        return _pair(self, regs.AX_SLOPES)
 
     @compliance_slope.setter
-    def compliance_slope(self, value: int | tuple[int, int]) -> None:
-        self._set_pair(regs.AX_SLOPES, value)
-
-    def _pair(self, names: tuple[str, str]) -> tuple[int, int]:
-        self._need_slopes()
-        return int(self._link.number(names[0])), int(self._link.number(names[1]))
-
-    def _set_pair(self, names: tuple[str, str], value: int | tuple[int, int]) -> None:
-        self._need_slopes()
-        pair = (value, value) if isinstance(value, int) else value
-        for name, item in zip(names, pair, strict=True):
-            self._link.store(name, item)
-
-    def _need_slopes(self) -> None:
-        if not regs.has_compliance_slopes(self.model):
-            raise RegisterError(
-                f"{self.name}: {self.model.name} has no compliance margin/slope (use pid)",
-                register="compliance_margin",
-                motor=self.name,
-            )
+    def compliance_slope(self: PypotMotorHost, value: int | tuple[int, int]) -> None:
+        _set_pair(self, regs.AX_SLOPES, value)
 
     @property
-    def led(self) -> SIValue:
+    def led(self: PypotMotorHost) -> SIValue:
         """LED state: a bool, or a colour name on the XL-320."""
         return self._link.get("led", False)
 
     @led.setter
-    def led(self, value: SIValue) -> None:
+    def led(self: PypotMotorHost, value: SIValue) -> None:
         self._link.store("led", value)
 
     # -- pypot's names -----------------------------------------------------------------------
 
     @property
-    def lower_limit(self) -> float:
+    def lower_limit(self: PypotMotorHost) -> float:
         """The lower angle limit in degrees, user frame (pypot's name; ``angle_limit[0]``)."""
         return self.angle_limit[0]
 
     @lower_limit.setter
-    def lower_limit(self, value: float) -> None:
+    def lower_limit(self: PypotMotorHost, value: float) -> None:
         self.angle_limit = (float(value), self.angle_limit[1])
 
     @property
-    def upper_limit(self) -> float:
+    def upper_limit(self: PypotMotorHost) -> float:
         """The upper angle limit in degrees, user frame (pypot's name; ``angle_limit[1]``)."""
         return self.angle_limit[1]
 
     @upper_limit.setter
-    def upper_limit(self, value: float) -> None:
+    def upper_limit(self: PypotMotorHost, value: float) -> None:
         self.angle_limit = (self.angle_limit[0], float(value))
 
     @property
-    def max_torque(self) -> float:
+    def max_torque(self: PypotMotorHost) -> float:
         """pypot's name for the torque limit (the RAM register; EEPROM Max Torque is left alone)."""
         return self.torque_limit
 
     @max_torque.setter
-    def max_torque(self, value: float) -> None:
+    def max_torque(self: PypotMotorHost, value: float) -> None:
         self.torque_limit = value
 
     @property
-    def goto_behavior(self) -> str:
+    def goto_behavior(self: PypotMotorHost) -> str:
         """The control of gotos that name none: ``"minjerk"`` or ``"dummy"`` (pypot's name)."""
         return self._goto_behavior
 
     @goto_behavior.setter
-    def goto_behavior(self, value: str) -> None:
+    def goto_behavior(self: PypotMotorHost, value: str) -> None:
         try:
             self._goto_behavior = control_name(value)
         except ArgumentError as exc:
@@ -144,48 +137,82 @@ class PypotMotorMixin:
             ) from exc
 
     @property
-    def control_mode(self) -> str:
+    def control_mode(self: PypotMotorHost) -> str:
         """``"wheel"`` (endless turn) or ``"joint"`` (position control), as pypot names them."""
         return "wheel" if self.wheel_mode else "joint"
 
     # -- introspection -----------------------------------------------------------------------
 
     @property
-    def registers(self) -> list[str]:
+    def registers(self: PypotMotorHost) -> list[str]:
         """The attribute names this motor offers (they depend on the model)."""
-        return list(self._register_names)
+        return list(_register_names(self.model))
 
-    @functools.cached_property
-    def _register_names(self) -> tuple[str, ...]:
-        names = [
-            "id",
-            "name",
-            "model",
-            "orientation",
-            "offset",
-            "angle_limit",
-            "present_position",
-            "present_speed",
-            "present_load",
-            "present_temperature",
-            "present_voltage",
-            "goal_position",
-            "goal_speed",
-            "moving_speed",
-            "compliant",
-            "compliant_behavior",
-            "led",
-            "lower_limit",
-            "upper_limit",
-            "goto_behavior",
-            "control_mode",
-            "registers",
-            "safe_compliant",
-        ]
-        if self.model.has_torque_limit:
-            names += ["torque_limit", "max_torque"]
-        if regs.pid_names(self.model) is not None:
-            names.append("pid")
-        if regs.has_compliance_slopes(self.model):
-            names += ["compliance_margin", "compliance_slope"]
-        return tuple(names)
+
+def _pid_names(motor: PypotMotorHost) -> tuple[str, str, str]:
+    names = regs.pid_names(motor.model)
+    if names is None:
+        raise RegisterError(
+            f"{motor.name}: {motor.model.name} has no PID gains (use compliance_margin/slope)",
+            register="pid",
+            motor=motor.name,
+        )
+    return names
+
+
+def _pair(motor: PypotMotorHost, names: tuple[str, str]) -> tuple[int, int]:
+    _need_slopes(motor)
+    return int(motor._link.number(names[0])), int(motor._link.number(names[1]))
+
+
+def _set_pair(motor: PypotMotorHost, names: tuple[str, str], value: int | tuple[int, int]) -> None:
+    _need_slopes(motor)
+    pair = (value, value) if isinstance(value, int) else value
+    for name, item in zip(names, pair, strict=True):
+        motor._link.store(name, item)
+
+
+def _need_slopes(motor: PypotMotorHost) -> None:
+    if not regs.has_compliance_slopes(motor.model):
+        raise RegisterError(
+            f"{motor.name}: {motor.model.name} has no compliance margin/slope (use pid)",
+            register="compliance_margin",
+            motor=motor.name,
+        )
+
+
+@functools.cache
+def _register_names(model: ServoModel) -> tuple[str, ...]:
+    """The attribute names a motor of ``model`` offers (models are shared, immutable singletons)."""
+    names = [
+        "id",
+        "name",
+        "model",
+        "orientation",
+        "offset",
+        "angle_limit",
+        "present_position",
+        "present_speed",
+        "present_load",
+        "present_temperature",
+        "present_voltage",
+        "goal_position",
+        "goal_speed",
+        "moving_speed",
+        "compliant",
+        "compliant_behavior",
+        "led",
+        "lower_limit",
+        "upper_limit",
+        "goto_behavior",
+        "control_mode",
+        "registers",
+        "safe_compliant",
+    ]
+    if model.has_torque_limit:
+        names += ["torque_limit", "max_torque"]
+    if regs.pid_names(model) is not None:
+        names.append("pid")
+    if regs.has_compliance_slopes(model):
+        names += ["compliance_margin", "compliance_slope"]
+    return tuple(names)

@@ -1,7 +1,8 @@
 """pypot's robot names: groups as ``alias``/``motorgroups``, attached primitives, ``to_config``.
 
-``PypotRobotMixin`` is a base of ``Robot`` (``poppy_core.robot.robot``); everything here is user
-API over what ``Robot`` holds.
+``PypotRobotMixin`` is a base of ``Robot`` (``poppy_core.robot.robot``) and takes ``self`` as a
+typed host Protocol, ``PypotRobotHost``, so mypy checks that ``Robot`` gives what it uses;
+everything here is user API over what ``Robot`` holds.
 """
 
 from __future__ import annotations
@@ -28,32 +29,48 @@ class Behaviour(Protocol):
         ...
 
 
-class PypotRobotMixin:
-    """pypot's names for a robot's groups and primitives, and its config as pypot's dict."""
+class PypotRobotHost(Protocol):
+    """What ``PypotRobotMixin`` needs of the robot it is mixed into (``Robot`` gives it)."""
 
-    # Provided by Robot.
     extensions: dict[str, object]
     _groups: dict[str, MotorGroup]
     _primitive_names: list[str]
 
-    if TYPE_CHECKING:
+    def attach(self, name: str, obj: object) -> None:
+        """Make ``obj`` reachable as ``robot.<name>``."""
+        ...
 
-        def attach(self, name: str, obj: object) -> None: ...
-
-        def to_robot_config(self) -> RobotConfig: ...
+    def to_robot_config(self) -> RobotConfig:
+        """``to_config`` as a validated ``RobotConfig``."""
+        ...
 
     @property
-    def motorgroups(self) -> dict[str, list[Motor]]:
+    def primitive_names(self) -> list[str]:
+        """Names of the attached primitives (``PypotRobotMixin`` gives it)."""
+        ...
+
+    @property
+    def primitives(self) -> list[Any]:
+        """The attached primitives (``PypotRobotMixin`` gives it)."""
+        ...
+
+
+class PypotRobotMixin:
+    """pypot's names for the groups and primitives of a ``PypotRobotHost`` (a ``Robot``), and its
+    config as pypot's dict."""
+
+    @property
+    def motorgroups(self: PypotRobotHost) -> dict[str, list[Motor]]:
         """Group name -> its motors."""
         return {name: list(members) for name, members in self._groups.items()}
 
     @property
-    def alias(self) -> list[str]:
+    def alias(self: PypotRobotHost) -> list[str]:
         """The group names (pypot's ``robot.alias``); each group is ``robot.<name>``."""
         return list(self._groups)
 
     @property
-    def _primitive_manager(self) -> Any:
+    def _primitive_manager(self: PypotRobotHost) -> Any:
         """The primitive manager (pypot's name; also ``robot.primitive_manager``), attached by
         the assembly when it builds the robot (``poppy_core.motion.primitive_manager``).
 
@@ -69,7 +86,7 @@ class PypotRobotMixin:
             )
         return manager
 
-    def attach_primitive(self, primitive: Behaviour, name: str) -> None:
+    def attach_primitive(self: PypotRobotHost, primitive: Behaviour, name: str) -> None:
         """Attach a primitive as ``robot.<name>`` and list it in ``primitives`` (pypot's order).
 
         Raises:
@@ -82,21 +99,21 @@ class PypotRobotMixin:
             self._primitive_names.append(name)
 
     @property
-    def primitive_names(self) -> list[str]:
+    def primitive_names(self: PypotRobotHost) -> list[str]:
         """Names of the attached primitives, in attach order."""
         return [n for n in self._primitive_names if n in self.extensions]
 
     @property
-    def primitives(self) -> list[Any]:
+    def primitives(self: PypotRobotHost) -> list[Any]:
         """The attached primitives, in attach order."""
         return [self.extensions[n] for n in self.primitive_names]
 
     @property
-    def active_primitives(self) -> list[Any]:
+    def active_primitives(self: PypotRobotHost) -> list[Any]:
         """The attached primitives that are running (or paused)."""
         return [p for p in self.primitives if p.is_alive()]
 
-    def to_config(self) -> dict[str, Any]:
+    def to_config(self: PypotRobotHost) -> dict[str, Any]:
         """The robot's config as pypot's JSON-ready dict, with the motors' present orientation,
         offset and angle limits (``json.dump(robot.to_config(), f)`` saves it).
 
