@@ -100,6 +100,45 @@ def test_compliance_toggles_change_the_robot(page: Any, served: Served) -> None:
     eventually(lambda: robot.compliant, "the robot compliant")
 
 
+def test_a_poll_asked_before_a_compliance_click_does_not_undo_it(page: Any, served: Served) -> None:
+    # The page polls the motors' details every 0.5 s: one asked before the click and answered
+    # after it carries the old compliance, and used to put the box back under the user's click
+    # (Playwright's uncheck then failed: "clicking the checkbox did not change its state").
+    robot = served.robot
+    robot.compliant = True
+    box = "#motor-m3 input[type=checkbox]"
+    eventually(lambda: page.is_checked(box), "m3 shown compliant")
+    stale: list[tuple[Any, Any]] = []  # the first poll, answered now (m3 compliant)
+    later: list[Any] = []  # the polls after it, held unanswered until let go
+
+    def hold(route: Any) -> None:
+        if stale:
+            later.append(route)
+        else:
+            stale.append((route, route.fetch()))
+
+    page.route("**/api/v1/web/motors", hold)
+    try:
+        eventually(lambda: page.wait_for_timeout(50) or stale, "a poll to be held")
+        page.uncheck(box)
+        eventually(lambda: robot.m3.compliant is False, "m3 stiff")
+        eventually(lambda: page.wait_for_timeout(50) or later, "a poll after the click")
+        for route in later:  # the answers after the click come first: m3 stiff
+            route.continue_()
+        later.clear()
+        page.wait_for_timeout(300)
+        assert not page.is_checked(box)
+        route, old = stale[0]
+        route.fulfill(response=old)  # the poll asked before the click is answered last
+        page.wait_for_timeout(150)  # handled at once (the next poll is held)
+        assert not page.is_checked(box)
+    finally:
+        for route in later:
+            route.continue_()
+        page.unroute("**/api/v1/web/motors")  # and lets the polls held meanwhile go
+    robot.compliant = True
+
+
 def test_a_goal_slider_moves_the_motor(page: Any, served: Served) -> None:
     robot = served.robot
     robot.compliant = False

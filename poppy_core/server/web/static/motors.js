@@ -6,6 +6,19 @@ const FAST = ["present_position", "present_speed", "present_load", "present_temp
 let pending = null; // the latest frame received before the table existed
 const rows = new Map(); // motor name -> {cells, slider, compliant, led, online}
 export const stats = { frames: 0, firstFrameAt: null, started: performance.now() };
+// A poll answered while the user changes a compliance (or asked before it) would put the old
+// state back under their click: its compliance boxes are left as the user set them.
+const compliance = { changing: 0, changes: 0 };
+
+async function changeCompliance(request) {
+  compliance.changing += 1;
+  compliance.changes += 1;
+  try {
+    await request();
+  } finally {
+    compliance.changing -= 1;
+  }
+}
 
 function fmt(value, digits = 1) {
   return typeof value === "number" ? value.toFixed(digits) : value ?? "–";
@@ -30,8 +43,8 @@ export function sections(motors, groups) {
 
 async function setCompliant(names, value) {
   try {
-    await api("PATCH", "/api/v1/motors",
-      Object.fromEntries(names.map((n) => [n, { compliant: value }])));
+    await changeCompliance(() => api("PATCH", "/api/v1/motors",
+      Object.fromEntries(names.map((n) => [n, { compliant: value }]))));
     say(`${names.length === 1 ? names[0] : `${names.length} motors`}: ${value ? "compliant" : "stiff"}`);
   } catch (error) {
     say(error.message, true);
@@ -91,7 +104,7 @@ function motorRow(name, info, leds) {
 
 async function setRobotCompliant(value) {
   try {
-    await api("PUT", "/api/v1/robot/compliant", { compliant: value });
+    await changeCompliance(() => api("PUT", "/api/v1/robot/compliant", { compliant: value }));
     say(`robot: ${value ? "compliant" : "stiff"}`);
   } catch (error) {
     say(error.message, true);
@@ -134,12 +147,12 @@ export function buildTable(motorNames, details) {
   pending = null;
 }
 
-function applyDetails(motors) {
+function applyDetails(motors, withCompliance = true) {
   for (const [name, info] of Object.entries(motors)) {
     const row = rows.get(name);
     if (!row) continue;
     row.cells.present_voltage.textContent = fmt(info.present_voltage);
-    row.compliant.checked = info.compliant;
+    if (withCompliance) row.compliant.checked = info.compliant;
     if (document.activeElement !== row.slider) {
       row.slider.value = String(info.goal_position);
       row.goalText.value = fmt(info.goal_position);
@@ -150,8 +163,10 @@ function applyDetails(motors) {
 }
 
 export async function refresh() {
+  const changes = compliance.changes;
   try {
-    applyDetails((await get("/api/v1/web/motors")).motors);
+    const { motors } = await get("/api/v1/web/motors");
+    applyDetails(motors, compliance.changing === 0 && compliance.changes === changes);
   } catch { /* the connection badge says */ }
 }
 
