@@ -33,7 +33,8 @@ class Terminal:
     """`poppy ARGS...` on a pty of its own; ``shown`` is everything it printed so far."""
 
     def __init__(self, *args: str, env: Mapping[str, str] | None = None) -> None:
-        full = dict(os.environ, **ENV, **(env or {}))
+        # a hang is reported with its threads' stacks (``wait``)
+        full = dict(os.environ, **ENV, PYTHONFAULTHANDLER="1", **(env or {}))
         self.proc, self.master, slave = start_on_pty(
             [sys.executable, "-c", _SHIM, *POPPY, *args], full
         )
@@ -61,11 +62,27 @@ class Terminal:
         self.proc.send_signal(signum)
 
     def wait(self, timeout_s: float = 60) -> int:
-        """The command's exit code once it ended (what it printed is read on the way)."""
+        """The command's exit code once it ended (what it printed is read on the way).
+
+        Raises:
+            AssertionError: it did not end within ``timeout_s``; the message ends with what it
+                printed, then the stacks of its threads (faulthandler's dump on SIGABRT).
+        """
         deadline = time.monotonic() + timeout_s
         while self.proc.poll() is None and time.monotonic() < deadline:
             self._read(0.2)
-        code = self.proc.wait(timeout=max(0.1, deadline - time.monotonic()))
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGABRT)  # PYTHONFAULTHANDLER: its threads' stacks
+            end = time.monotonic() + 10
+            while self.proc.poll() is None and time.monotonic() < end:
+                self._read(0.2)
+            while self._read(0.05):
+                pass
+            raise AssertionError(
+                f"the command did not end within {timeout_s:g} s; it printed, then its "
+                f"threads were:\n{self.text[-6000:]}"
+            )
+        code = self.proc.wait()
         while self._read(0.05):
             pass
         return code
