@@ -9,6 +9,7 @@ from pathlib import Path
 
 from bench import (
     camera_bench,
+    emulator_bench,
     fleet_bench,
     ik_bench,
     move_bench,
@@ -41,6 +42,7 @@ _MODULES = (
     camera_bench,
     teleop_bench,
     soak_bench,
+    emulator_bench,
     snap_bench,
     web_bench,
     zmq_bench,
@@ -71,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
         type=Path,
         default=None,
         help="another checkout of poppy (e.g. `git worktree add /tmp/old REV`) that `scan` "
-        "measures beside this one, alternately",
+        "and `emulator` measure beside this one, alternately",
     )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="bench: %(message)s")
