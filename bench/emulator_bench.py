@@ -11,6 +11,11 @@ each chunk its reader takes off the pty stamped) and runs against it, one after 
   then disabling the torque of the 6 XL-320 150 times (300 SYNC_WRITEs, each read back);
 * the same with pypot's output flush skipped (the control: what the emulator itself loses).
 
+Each round also runs ``bench/emulator_flush.py`` with no emulator at all: a client writes to a
+bare pty, flushes its output 50 µs later, with nobody reading the master or with a process of
+its own blocked in ``read()`` on it, to tell what the kernel discards from what a reader could
+save.
+
 Sessions run in rounds (``--repeat``, default 3), on ``poppy emulate --profile ergo-jr`` and
 ``poppy sim --profile ergo-jr --pty``. With ``--baseline DIR`` the older checkout's emulator
 runs in the same round, right before or after this one's (the order swaps each round), so both
@@ -45,6 +50,8 @@ IDS = 6
 CYCLES = 150  # enable + disable each: 300 SYNC_WRITEs
 PINGS = 300
 START_TIMEOUT_S = 60.0
+FLUSH_GAP_US = 50.0
+FLUSH_WRITES = 1000
 
 
 def _session(tree: Path, args: list[str], peers: Path | None) -> dict[str, Any]:
@@ -119,6 +126,31 @@ def _latencies(ping: dict[str, Any], stamps: list[list[float]]) -> list[float]:
     return delays
 
 
+def _bare_pty(rep: int) -> list[dict[str, Any]]:
+    """The flush experiment with no emulator: no reader, then a reader process (order swapped
+    each round)."""
+    readers = ["none", "process"] if rep % 2 == 0 else ["process", "none"]
+    return [
+        {
+            **run_client(
+                [
+                    sys.executable,
+                    str(BENCH_DIR / "emulator_flush.py"),
+                    "--gap-us",
+                    str(FLUSH_GAP_US),
+                    "--count",
+                    str(FLUSH_WRITES),
+                    "--reader",
+                    reader,
+                ]
+            ).record,
+            "rep": rep,
+            "load1": round(os.getloadavg()[0], 2),
+        }
+        for reader in readers
+    ]
+
+
 @register(
     "emulator",
     "pypot as is (flush before every packet) on poppy emulate and sim --pty; write-to-read delay",
@@ -129,6 +161,9 @@ def emulator(ctx: BenchContext) -> BenchResult:
     if ctx.baseline is not None:
         trees[BASELINE] = ctx.baseline.resolve()
     sessions: list[dict[str, Any]] = []
+    bare: list[dict[str, Any]] = []
+    for rep in range(ctx.repeat):
+        bare += _bare_pty(rep)
     for label, args in MODES.items():
         for rep in range(ctx.repeat):
             order = list(trees.items())
@@ -148,6 +183,7 @@ def emulator(ctx: BenchContext) -> BenchResult:
                 sessions.append(session)
     raw = {
         "sessions": sessions,
+        "bare_pty": bare,
         "ids": IDS,
         "cycles": CYCLES,
         "pings": PINGS,

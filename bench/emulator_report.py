@@ -32,7 +32,7 @@ def lost_syncs(record: dict[str, Any] | None, ids: int) -> float | None:
 def _fmt(value: float | None) -> str:
     if value is None:
         return "failed"
-    return f"{value:g}"
+    return f"{value:g}" if value == int(value) else f"{value:.2f}"
 
 
 def _label(raw: dict[str, Any], tree: str) -> str:
@@ -90,6 +90,28 @@ def loss_table(raw: dict[str, Any]) -> Table:
     )
 
 
+def bare_table(raw: dict[str, Any]) -> Table:
+    """The flush experiment on a bare pty, per round."""
+    rows = []
+    for run in raw.get("bare_pty") or []:
+        rows.append(
+            [
+                str(run["rep"] + 1),
+                "nobody" if run.get("reader") == "none" else "a process blocked in read()",
+                f"{run.get('gap_us', 0):g} µs",
+                f"{run.get('lost', '-')} of {run.get('count', '-')}"
+                if not run.get("error")
+                else f"failed: {run['error']}",
+                f"{run['load1']:.1f}",
+            ]
+        )
+    return Table(
+        "No emulator: a write to a bare pty, then the client's output flush; packets discarded",
+        ["Round", "Reading the master", "Write to flush", "Lost", "Load (1 min)"],
+        rows,
+    )
+
+
 def goal_met(raw: dict[str, Any]) -> bool | None:
     """Every round of this checkout at most ``MAX_LOST`` lost on each command, and (with a
     baseline) no more lost in all than the baseline in the same rounds; None without pypot."""
@@ -110,7 +132,7 @@ def goal_met(raw: dict[str, Any]) -> bool | None:
 
 def build_result(raw: dict[str, Any]) -> BenchResult:
     """The report section."""
-    tables = [latency_table(raw)]
+    tables = [latency_table(raw), bare_table(raw)]
     notes = []
     if any(session.get("pypot") for session in raw["sessions"]):
         tables.append(loss_table(raw))
