@@ -11,6 +11,10 @@ each chunk its reader takes off the pty stamped) and runs against it, one after 
   then disabling the torque of the 6 XL-320 150 times (300 SYNC_WRITEs, each read back);
 * the same with pypot's output flush skipped (the control: what the emulator itself loses).
 
+Beside ``poppy emulate`` in each round, ``bench/emulator_minimal.py`` (one thread blocked in
+``read()``, six XL-320 byte tables, nothing else) gets the same pypot runs: what any emulator
+loses on this machine at that moment.
+
 Each round also runs ``bench/emulator_flush.py`` with no emulator at all: a client writes to a
 bare pty, flushes its output 50 µs later, with nobody reading the master or with a process of
 its own blocked in ``read()`` on it, to tell what the kernel discards from what a reader could
@@ -35,7 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from bench.clients import run_client
-from bench.emulator_report import BASELINE, THIS, build_result
+from bench.emulator_report import BASELINE, MINIMAL, THIS, build_result
 from bench.procs import interrupt
 from bench.registry import BENCH_DIR, REPO_ROOT, BenchContext, BenchResult, register
 from bench.scan_baseline import baseline_label
@@ -85,19 +89,7 @@ def _session(tree: Path, args: list[str], peers: Path | None) -> dict[str, Any]:
                     str(PINGS),
                 ]
             ).record
-            if peers is not None:
-                torque = [
-                    str(peers),
-                    str(BENCH_DIR / "peers" / "pypot_torque.py"),
-                    "--port",
-                    port,
-                    "--cycles",
-                    str(CYCLES),
-                    "--ids",
-                    f"1-{IDS}",
-                ]
-                out["pypot"] = run_client(torque).record
-                out["control"] = run_client([*torque, "--keep-output"]).record
+            out.update(_pypot_runs(port, peers))
         finally:
             interrupt(proc)
             if proc.stdout is not None:
@@ -108,6 +100,50 @@ def _session(tree: Path, args: list[str], peers: Path | None) -> dict[str, Any]:
             return {**out, "error": "the emulator wrote no stamps"}
     out["latency_us"] = _latencies(ping, stamps)
     return out
+
+
+def _pypot_runs(port: str, peers: Path | None) -> dict[str, Any]:
+    """pypot as is, then its control, on ``port``."""
+    if peers is None:
+        return {}
+    torque = [
+        str(peers),
+        str(BENCH_DIR / "peers" / "pypot_torque.py"),
+        "--port",
+        port,
+        "--cycles",
+        str(CYCLES),
+        "--ids",
+        f"1-{IDS}",
+    ]
+    return {
+        "pypot": run_client(torque).record,
+        "control": run_client([*torque, "--keep-output"]).record,
+    }
+
+
+def _minimal_session(peers: Path | None) -> dict[str, Any]:
+    """pypot against ``bench/emulator_minimal.py``."""
+    proc = subprocess.Popen(
+        [sys.executable, str(BENCH_DIR / "emulator_minimal.py")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        stdin=subprocess.DEVNULL,
+        text=True,
+        cwd=BENCH_DIR,
+    )
+    out: dict[str, Any] = {"load1": round(os.getloadavg()[0], 2)}
+    try:
+        assert proc.stdout is not None
+        ready, _, _ = select.select([proc.stdout], [], [], START_TIMEOUT_S)
+        port = proc.stdout.readline().strip() if ready else ""
+        if not port:
+            return {**out, "error": "the minimal responder printed no port"}
+        return {**out, **_pypot_runs(port, peers)}
+    finally:
+        interrupt(proc)
+        if proc.stdout is not None:
+            proc.stdout.close()
 
 
 def _latencies(ping: dict[str, Any], stamps: list[list[float]]) -> list[float]:
@@ -166,11 +202,16 @@ def emulator(ctx: BenchContext) -> BenchResult:
         bare += _bare_pty(rep)
     for label, args in MODES.items():
         for rep in range(ctx.repeat):
-            order = list(trees.items())
+            order: list[tuple[str, Path | None]] = list(trees.items())
+            if args[0] == "emulate":
+                order.append((MINIMAL, None))
             if rep % 2:
                 order.reverse()
             for who, tree in order:
-                session = _session(tree, args, ctx.peers_python)
+                if tree is None:
+                    session = _minimal_session(ctx.peers_python)
+                else:
+                    session = _session(tree, args, ctx.peers_python)
                 session.update(mode=label, rep=rep, tree=who)
                 logger.info(
                     "%s, round %d, %s: %s lost of %d",

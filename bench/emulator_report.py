@@ -11,6 +11,7 @@ from bench.registry import BenchResult, Table
 
 THIS = "this checkout"
 BASELINE = "baseline"
+MINIMAL = "minimal responder"
 MAX_LOST = 1  # SYNC_WRITEs of 300 pypot may lose on a quiet machine
 
 
@@ -43,6 +44,8 @@ def latency_table(raw: dict[str, Any]) -> Table:
     """Write-to-read delay per command and checkout, pooled over the rounds."""
     pooled: dict[tuple[str, str], list[float]] = defaultdict(list)
     for session in raw["sessions"]:
+        if session["tree"] == MINIMAL:
+            continue
         pooled[(session["mode"], session["tree"])] += session.get("latency_us") or []
     rows = [
         [
@@ -72,6 +75,7 @@ def loss_table(raw: dict[str, Any]) -> Table:
     headers = ["Command", "Round", "Load (1 min)", f"This: lost of {total}"]
     if with_baseline:
         headers.append(f"{raw['baseline']}: lost of {total}")
+    headers.append("bench/emulator_minimal.py (emulate's round)")
     headers.append("Flush skipped (control), this" + (" / baseline" if with_baseline else ""))
     rows = []
     for (mode, rep), trees in by_round.items():
@@ -83,6 +87,8 @@ def loss_table(raw: dict[str, Any]) -> Table:
             base = trees.get(BASELINE, {})
             row.append(_fmt(lost_syncs(base.get("pypot"), ids)) if base else "-")
             controls.append(_fmt(lost_syncs(base.get("control"), ids)))
+        minimal = trees.get(MINIMAL)
+        row.append(_fmt(lost_syncs(minimal.get("pypot"), ids)) if minimal else "-")
         row.append(" / ".join(controls))
         rows.append(row)
     return Table(
@@ -122,7 +128,10 @@ def goal_met(raw: dict[str, Any]) -> bool | None:
         lost = lost_syncs(session.get("pypot"), ids)
         if lost is None:
             continue
-        (mine if session["tree"] == THIS else theirs)[session["mode"]].append(lost)
+        if session["tree"] == THIS:
+            mine[session["mode"]].append(lost)
+        elif session["tree"] == BASELINE:
+            theirs[session["mode"]].append(lost)
     if not mine:
         return None
     quiet = all(max(values) <= MAX_LOST for values in mine.values())
@@ -150,7 +159,9 @@ def build_result(raw: dict[str, Any]) -> BenchResult:
         "tens of microseconds later. On a pty the bytes a client wrote sit in the kernel until "
         "a kernel worker moves them to the emulator's side, and that flush discards what it has "
         "not moved yet: no reader, however fast, sees them (docs/emulator.md). The control "
-        "(same client, output flush skipped) counts what the emulator itself loses."
+        "(same client, output flush skipped) counts what the emulator itself loses; "
+        "bench/emulator_minimal.py (one thread blocked in read(), six byte tables, nothing "
+        "else) what any emulator would lose at that moment."
     )
     notes.append(
         f"Goal: pypot loses at most {MAX_LOST} SYNC_WRITE of {2 * raw['cycles']} in every round "
