@@ -16,6 +16,7 @@ from poppy_core import checks
 from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
+    from poppy_cli.commands.emulate_hand import HandCommands, Joint
     from poppy_core.emulator import VirtualBus
     from poppy_core.emulator.control import EmulatorControl
 
@@ -108,12 +109,13 @@ def emulate(
     control: bool = typer.Option(
         False,
         "--control",
-        help="Read fault commands from stdin, one per line (`help` lists them; see docs).",
+        help="Read fault and hand commands from stdin, one per line (`help` lists them; see docs).",
     ),
     seed: int = typer.Option(0, "--seed", help="Seed of the fault injection's random numbers."),
 ) -> None:
     """Serve virtual motors: print the pty path (or socket:// URL), then serve until Ctrl-C."""
-    from poppy_core.emulator import build_bus_from_spec, serve_pty, serve_tcp
+    from poppy_cli.commands.emulate_hand import HandCommands, joints_of
+    from poppy_core.emulator import Hand, build_bus_from_spec, serve_pty, serve_tcp
     from poppy_core.emulator.control import ControlError, EmulatorControl, ScheduledUnplug
 
     if (profile is None) == (motors is None):
@@ -136,11 +138,13 @@ def emulate(
         "seed": seed,
     }
     buses: list[tuple[str, VirtualBus]]
+    joints: dict[str, Joint] = {}
     if profile is not None:
         from poppy_core.robot.factory import virtual_buses
         from poppy_core.robot.profiles import load_profile
 
         config = load_profile(profile)
+        joints = joints_of(config)
         # motors as they come from the factory (return delay 500 µs), as on a new robot
         found = virtual_buses(
             config, baudrate=baud, set_up=False, adapter="usb2ax" if usb2ax else None, **options
@@ -169,6 +173,7 @@ def emulate(
         signal.signal(signum, lambda *_: stop.set())
     servers = []
     faults = None
+    hand = Hand(*(bus for _, bus in buses))
     try:
         for index, (_name, bus) in enumerate(buses):
             if hostport is None:
@@ -197,29 +202,41 @@ def emulate(
                 )
             )
         if control:
-            _read_commands(faults, stop)
+            _read_commands(faults, HandCommands(hand, joints), stop)
         while not stop.wait(0.5):
             pass
     finally:
+        hand.close()
         if faults is not None:
             faults.close()
         for server in servers:
             server.stop()
 
 
-def _read_commands(faults: EmulatorControl, stop: threading.Event) -> None:
-    """Run fault commands read from stdin, one per line, in a thread (answers on stderr)."""
+def _read_commands(faults: EmulatorControl, hand: HandCommands, stop: threading.Event) -> None:
+    """Run fault and hand commands read from stdin, one per line, in a thread (answers on
+    stderr)."""
+    from poppy_cli.commands import emulate_hand
     from poppy_core.emulator.control import ControlError
 
     if sys.stdin.isatty():
-        err_console.print("fault commands: type `help` (unplug 3 · lose 2 · drop 0.01 …)")
+        err_console.print(
+            "commands: type `help` (unplug 3 · lose 2 · drop 0.01 · move 3 30 --over 2 · where …)"
+        )
+
+    def execute(line: str) -> str:
+        words = line.split()
+        if words and words[0].lower() in emulate_hand.WORDS:
+            return hand.execute(words[0].lower(), words[1:])
+        answer = faults.execute(line)
+        return f"{answer}\n{emulate_hand.HELP}" if words and words[0].lower() == "help" else answer
 
     def run() -> None:
         for line in sys.stdin:
             if stop.is_set():
                 return
             try:
-                answer = faults.execute(line)
+                answer = execute(line)
             except ControlError as exc:
                 error_line(str(exc))
                 continue

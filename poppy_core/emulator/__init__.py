@@ -27,6 +27,7 @@ from poppy_core.emulator.bus_spec import (
     parse_spec,
 )
 from poppy_core.emulator.faults import FaultInjector, fault_bits
+from poppy_core.emulator.hand import Hand
 from poppy_core.emulator.linespeed import BAUD_TOLERANCE, baud_matches, read_pty_baudrate
 from poppy_core.emulator.link import LinkServer, VirtualLine, serve_link
 from poppy_core.emulator.motor import VirtualMotor
@@ -41,6 +42,7 @@ __all__ = [
     "EmulatorServer",
     "Endpoint",
     "FaultInjector",
+    "Hand",
     "IdealPlant",
     "LinkServer",
     "Plant",

@@ -7,7 +7,7 @@ import threading
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from poppy_core.emulator.dispatch import ReplyFrame, dispatch
 from poppy_core.emulator.faults import FaultInjector
@@ -18,6 +18,9 @@ from poppy_core.emulator.sniff import CorruptSniffer
 from poppy_core.emulator.wire_timing import LineClock, transfer_time_s
 from poppy_core.errors import ConfigError
 from poppy_core.protocol import InstructionPacket, PacketDecoder, protocol_for
+
+if TYPE_CHECKING:
+    from poppy_core.emulator.hand import Hand
 
 logger = logging.getLogger(__name__)
 
@@ -107,6 +110,7 @@ class VirtualBus:
         self._sniffer = CorruptSniffer(self.proto)
         self._line = LineClock()
         self.packets_received = 0
+        self._hand: Hand | None = None
 
     # ------------------------------------------------------------------ motors and knobs
 
@@ -203,6 +207,16 @@ class VirtualBus:
         return not self.faults.is_unplugged(motor.id) and baud_matches(line_bps, motor.baudrate_bps)
 
     # ------------------------------------------------------------------ plant
+
+    @property
+    def hand(self) -> Hand:
+        """A hand on this bus's motors (made at first use; see ``poppy_core.emulator.hand``)."""
+        with self._lock:
+            if self._hand is None:
+                from poppy_core.emulator.hand import Hand
+
+                self._hand = Hand(self)
+            return self._hand
 
     def advance(self, dt_s: float | None = None) -> None:
         """Step the plant: by ``dt_s`` seconds, or by the time elapsed since the last step."""

@@ -61,6 +61,8 @@ class VirtualMotor:
         table: the control table (raw bytes plus write checks).
         lock: guards the table; the bus replaces it with its own lock.
         hand_mover: hook a plant sets to take over :meth:`move_by_hand` (e.g. a physics engine).
+        hand_deg: where a hand holds the horn (degrees), None when no hand holds it; the
+            plant reads it and ``hand_speed_dps`` (see :meth:`hold_by_hand`).
     """
 
     def __init__(self, model: ServoModel, motor_id: int, baudrate_bps: int | None = None) -> None:
@@ -70,6 +72,8 @@ class VirtualMotor:
         self.table = ControlTable(model)
         self.lock: threading.RLock = threading.RLock()
         self.hand_mover: HandMover | None = None
+        self.hand_deg: float | None = None
+        self.hand_speed_dps = 0.0
         self._registered: tuple[int, bytes] | None = None
         self._fault_bits = 0
         if self.table.get("firmware") == 0:
@@ -168,6 +172,27 @@ class VirtualMotor:
                 self.hand_mover(self, position_deg)
             else:
                 self.table.set_si("present_position", position_deg)
+
+    def hold_by_hand(self, position_deg: float | None, speed_dps: float = 0.0) -> None:
+        """A hand holds the horn at ``position_deg``, moving at ``speed_dps``, until it lets go
+        (None).
+
+        Unlike :meth:`move_by_hand` (a horn put somewhere once), the hand stays: a compliant
+        motor follows it, a stiff one resists it (its load rises, see ``IdealPlant``). A plant
+        that owns the joint state (``hand_mover``) is moved for a compliant motor only.
+        """
+        with self.lock:
+            self.hand_deg = position_deg
+            self.hand_speed_dps = speed_dps if position_deg is not None else 0.0
+            mover = None if self.torque_enabled else self.hand_mover
+            if position_deg is not None and mover is not None:
+                mover(self, position_deg)
+
+    @property
+    def torque_limit_pct(self) -> float:
+        """The torque limit in percent of the maximum (100 for models without one)."""
+        limit = self.table.get_si("torque_limit") if self.model.has_torque_limit else None
+        return 100.0 if limit is None else float(limit)
 
     # ------------------------------------------------------------------ faults
 

@@ -31,6 +31,12 @@ class Plant(Protocol):
         ...
 
 
+HAND_FRICTION_PCT = 2.0
+"""Present load of a compliant horn while a hand moves it (percent, against the motion)."""
+STALL_SPAN_DEG = 5.0
+"""How far a hand pulls a stiff horn away from its position for the full torque limit."""
+
+
 class IdealPlant:
     """An ideal servo: moves toward its goal at its moving speed, no inertia, no load.
 
@@ -38,7 +44,12 @@ class IdealPlant:
       speed (0 = the model's no-load speed, never faster than it); present speed is that speed
       while moving, 0 once there; ``moving`` is set while the goal is not reached;
     - torque off (compliant): the horn stays where it is (or where it was put by hand);
-    - present load is always 0.
+    - present load is 0, unless a hand holds the horn (``motor.hand_deg``, see
+      ``poppy_core.emulator.hand``): a compliant horn follows the hand, its present speed is
+      the hand's and its load a small ``HAND_FRICTION_PCT`` against the motion; a stiff horn
+      goes on toward its goal and its load resists the hand, from 0 to the torque limit as the
+      hand pulls ``STALL_SPAN_DEG`` or more away from where the horn is (the sign opposes the
+      hand: a hand pushing toward higher angles reads a negative load).
 
     Positions are integrated in floating point, so slow motions at small steps are not lost to
     the register's resolution; a position changed in the table from outside (by hand) is picked
@@ -72,8 +83,14 @@ class IdealPlant:
         if not math.isclose(table_position, self._written.get(key, table_position), abs_tol=1e-9):
             position = table_position  # moved by hand, reset or written from outside
         speed = 0.0
+        load = 0.0
         moving = False
-        if motor.torque_enabled:
+        hand = motor.hand_deg
+        if hand is not None and not motor.torque_enabled:
+            speed = motor.hand_speed_dps
+            load = -math.copysign(HAND_FRICTION_PCT, speed) if abs(speed) > 1e-6 else 0.0
+            position = hand
+        elif motor.torque_enabled:
             low, high = motor.position_limits_deg()
             goal = min(max(motor.goal_position_deg, low), high)
             delta = goal - position
@@ -84,6 +101,9 @@ class IdealPlant:
                 position += math.copysign(max_step, delta)
                 speed = math.copysign(motor.speed_limit_dps, delta)
                 moving = True
-        motor.set_state(position, speed, 0.0, moving)
+            if hand is not None:
+                push = max(-1.0, min(1.0, (hand - position) / STALL_SPAN_DEG))
+                load = -push * motor.torque_limit_pct
+        motor.set_state(position, speed, load, moving)
         self._position[key] = position
         self._written[key] = motor.present_position_deg
