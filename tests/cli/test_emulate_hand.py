@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import os
 import re
+import signal
+import subprocess
+import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -12,7 +17,12 @@ import pytest
 from poppy_cli.commands.emulate_hand import HandCommands, Joint
 from poppy_core.emulator import Hand, VirtualBus, build_bus_from_spec
 from poppy_core.emulator.control import ControlError
-from poppy_core.motion import Move, write_move
+from poppy_core.motion import Move, read_move, write_move
+from tests.helpers.cli import POPPY, no_user_settings
+from tests.helpers.processes import start
+from tests.helpers.waiting import eventually
+
+ARRIVED = re.compile(r"^m1 (39\.[7-9]|40\.[0-3])° \(held\), m2 -(29\.[7-9]|30\.[0-3])° \(held\)")
 
 
 @pytest.fixture
@@ -83,3 +93,69 @@ def test_play_without_a_profile_says_what_to_do(bus: VirtualBus) -> None:
         HandCommands(Hand(bus)).execute("play", ["x.move"])
     with pytest.raises(ControlError, match="give an ID"):
         HandCommands(Hand(bus)).execute("move", ["m1", "3"])
+
+
+def test_poppy_record_records_what_the_emulators_hand_does(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`poppy emulate --profile ergo-jr --control` on a pty, driven through its stdin, while
+    `poppy record` on that pty records the motion the hand makes."""
+    library = no_user_settings(tmp_path, monkeypatch, moves=True)
+    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    emulator = subprocess.Popen(
+        [*POPPY, "emulate", "--profile", "ergo-jr", "--control"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    assert emulator.stdin is not None and emulator.stdout is not None
+    said_by_emulator: list[str] = []
+    reader = threading.Thread(
+        target=lambda: said_by_emulator.extend(emulator.stderr or ()), daemon=True
+    )
+    recorder = None
+    try:
+        url = emulator.stdout.readline().strip()
+        reader.start()
+        assert url.startswith("/dev/"), url
+        args = ["record", "byhand", "--profile", "ergo-jr", "--port", url, "--motors", "m1,m2"]
+        recorder = start([*POPPY, *args], env, stdin=subprocess.DEVNULL)
+        assert recorder.stderr is not None
+        said = [recorder.stderr.readline()]  # a warning first: the factory return delays
+        while not said[-1].startswith("recording") and said[-1] and len(said) < 5:
+            said.append(recorder.stderr.readline())
+        assert said[-1].startswith("recording"), "".join(said)
+        emulator.stdin.write("move m1 40 --over 1\nmove m2 -30 --over 1\nmove m9 1\n")
+        emulator.stdin.flush()
+
+        def arrived() -> bool:  # asks `where` until the emulator says the hand got there
+            emulator.stdin.write("where\n")
+            emulator.stdin.flush()
+            return any(ARRIVED.search(line) for line in list(said_by_emulator))
+
+        assert eventually(arrived, timeout_s=30.0, interval_s=0.2), "".join(said_by_emulator)
+        time.sleep(1.0)  # the recorder reads the held pose at least once more (50 Hz)
+        recorder.send_signal(signal.SIGINT)
+        _, stderr = recorder.communicate(timeout=30)
+        assert recorder.returncode == 0, stderr
+    finally:
+        if recorder is not None and recorder.poll() is None:
+            recorder.kill()
+        emulator.stdin.write("release all\n")
+        emulator.stdin.flush()
+        emulator.send_signal(signal.SIGINT)
+        emulator.wait(timeout=20)
+        reader.join(10.0)
+    err = "".join(said_by_emulator)
+    assert emulator.returncode == 0, err
+    assert "hand: m1 to 40° over 1 s" in err
+    assert "error: no motor 'm9' (names: m1, m2, m3, m4, m5, m6)" in err
+    move = read_move(library / "byhand.move")
+    assert move.motors == ("m1", "m2")
+    last = move.frame(-1)
+    assert last["m1"] == pytest.approx(40.0, abs=1.0)
+    assert last["m2"] == pytest.approx(-30.0, abs=1.0)
+    m1 = move.trajectory("m1")
+    assert ((m1 > 5.0) & (m1 < 35.0)).any()  # frames along the way, not a jump
