@@ -155,7 +155,7 @@ FLAGS: dict[str, Flag] = {
     "--drop": Flag(None, "PROBABILITY", "fault: probability that a reply is lost"),
     "--delay-ms": Flag(None, "MS", "fault: delay added to every reply, in milliseconds"),
     "--unplug": Flag(None, "ID@T[+D]", "fault: unplug a motor T seconds after start"),
-    "--control": Flag(None, None, "read fault commands from stdin"),
+    "--control": Flag(None, None, "read fault and hand commands from stdin"),
     "--seed": Flag(None, "SEED", "seed of the random numbers"),
     "--quick": Flag(None, None, "ten times faster"),
     "--view": Flag(None, None, "open MuJoCo's viewer"),

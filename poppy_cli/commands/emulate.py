@@ -16,7 +16,7 @@ from poppy_core import checks
 from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
-    from poppy_cli.commands.emulate_hand import HandCommands, Joint
+    from poppy_cli.commands.emulate_hand import HandCommands, HandJoint
     from poppy_core.emulator import VirtualBus
     from poppy_core.emulator.control import EmulatorControl
 
@@ -138,7 +138,7 @@ def emulate(
         "seed": seed,
     }
     buses: list[tuple[str, VirtualBus]]
-    joints: dict[str, Joint] = {}
+    joints: dict[str, HandJoint] = {}
     if profile is not None:
         from poppy_core.robot.factory import virtual_buses
         from poppy_core.robot.profiles import load_profile

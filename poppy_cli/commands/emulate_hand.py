@@ -32,7 +32,7 @@ MOVE_USAGE = "move ID|NAME DEGREES [--over SECONDS] [--linear]"
 
 
 @dataclass(frozen=True)
-class Joint:
+class HandJoint:
     """A named motor of the profile: its id and how it is mounted."""
 
     id: int
@@ -48,7 +48,7 @@ class HandCommands:
         joints: the profile's motors by name (empty without a profile).
     """
 
-    def __init__(self, hand: Hand, joints: Mapping[str, Joint] | None = None) -> None:
+    def __init__(self, hand: Hand, joints: Mapping[str, HandJoint] | None = None) -> None:
         self.hand = hand
         self.joints = dict(joints or {})
 
@@ -73,7 +73,7 @@ class HandCommands:
         except PoppyError as exc:
             raise ControlError(str(exc).splitlines()[0]) from None
 
-    def _joint(self, text: str) -> tuple[int, Joint | None]:
+    def _joint(self, text: str) -> tuple[int, HandJoint | None]:
         """(motor id, its joint when named) of ``text``."""
         if text.isdigit():
             return int(text), None
@@ -152,17 +152,17 @@ class HandCommands:
             if motor_id in names:
                 name, joint = names[motor_id]
                 user = to_user(degrees, joint.orientation, joint.offset)
-                text = f"{name} {user:.1f}°"
+                text = f"{name} {_degrees(user)}"
             else:
-                text = f"{motor_id} {degrees:.1f}°"
+                text = f"{motor_id} {_degrees(degrees)}"
             parts.append(text + (" (held)" if motor_id in held else ""))
         return ", ".join(parts)
 
 
-def joints_of(config: object) -> dict[str, Joint]:
+def joints_of(config: object) -> dict[str, HandJoint]:
     """The motors of a robot config (``RobotConfig.motors``) as joints by name."""
     motors = getattr(config, "motors", {})
-    return {n: Joint(m.id, m.orientation, float(m.offset)) for n, m in motors.items()}
+    return {n: HandJoint(m.id, m.orientation, float(m.offset)) for n, m in motors.items()}
 
 
 def _number(text: str, what: str) -> float:
@@ -170,3 +170,9 @@ def _number(text: str, what: str) -> float:
         return float(text)
     except ValueError:
         raise ControlError(f"{what}, not {text!r}") from None
+
+
+def _degrees(value: float) -> str:
+    """``12.3°``, and ``0.0°`` for a value that rounds to zero from below (not ``-0.0°``)."""
+    text = f"{value:.1f}"
+    return ("0.0" if text == "-0.0" else text) + "°"

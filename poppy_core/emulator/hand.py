@@ -22,11 +22,11 @@ import threading
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
-from poppy_core.emulator.bus import VirtualBus
 from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.errors import ArgumentError
 from poppy_core.schedule import Worker
@@ -39,6 +39,17 @@ PERIOD_S = 0.01
 PROFILES: tuple[str, ...] = ("minjerk", "linear")
 MAX_GESTURE_S = 3600.0
 """The longest gesture (an hour): a typo such as ``--over 1e9`` is refused, not run forever."""
+
+
+class HandBus(Protocol):
+    """What a hand needs of a bus (a ``VirtualBus``): its motors and a way to step its plant."""
+
+    @property
+    def motors(self) -> list[VirtualMotor]: ...
+
+    def motor(self, motor_id: int) -> VirtualMotor: ...
+
+    def advance(self, dt_s: float | None = None) -> None: ...
 
 
 @dataclass
@@ -74,7 +85,7 @@ class Hand:
 
     def __init__(
         self,
-        *buses: VirtualBus,
+        *buses: HandBus,
         period_s: float = PERIOD_S,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from poppy_cli.commands.emulate_hand import HandCommands, Joint
+from poppy_cli.commands.emulate_hand import HandCommands, HandJoint
 from poppy_core.emulator import Hand, VirtualBus, build_bus_from_spec
 from poppy_core.emulator.control import ControlError
 from poppy_core.motion import Move, read_move, write_move
@@ -37,7 +37,9 @@ def where(commands: HandCommands) -> str:
 
 
 def test_hand_commands(bus: VirtualBus) -> None:
-    commands = HandCommands(Hand(bus), {"base": Joint(1, "indirect", 10.0), "top": Joint(2)})
+    commands = HandCommands(
+        Hand(bus), {"base": HandJoint(1, "indirect", 10.0), "top": HandJoint(2)}
+    )
     assert commands.execute("move", ["base", "20", "--over", "0.2", "--linear"]).startswith(
         "hand: base to 20°"
     )
@@ -54,7 +56,7 @@ def test_hand_commands(bus: VirtualBus) -> None:
 def test_hand_commands_play_a_move_file(bus: VirtualBus, tmp_path: Path) -> None:
     path = tmp_path / "wave.move"
     write_move(Move(10, ["top"], np.linspace(0.0, 30.0, 6)[:, None]), path)
-    commands = HandCommands(Hand(bus), {"top": Joint(2, "direct", 0.0)})
+    commands = HandCommands(Hand(bus), {"top": HandJoint(2, "direct", 0.0)})
     assert commands.execute("play", [str(path), "--speed", "2"]) == (
         f"hand: playing {path} (1 motors, 0.25 s)"
     )
@@ -82,7 +84,7 @@ def test_hand_commands_play_a_move_file(bus: VirtualBus, tmp_path: Path) -> None
 def test_bad_hand_commands_are_one_line_errors(
     bus: VirtualBus, name: str, args: list[str], message: str
 ) -> None:
-    commands = HandCommands(Hand(bus), {"base": Joint(1)})
+    commands = HandCommands(Hand(bus), {"base": HandJoint(1)})
     with pytest.raises(ControlError, match=re.escape(message)) as caught:
         commands.execute(name, args)
     assert "\n" not in str(caught.value)
