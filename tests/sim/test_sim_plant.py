@@ -167,3 +167,16 @@ def test_render_gives_a_non_blank_image(ergo: World) -> None:
     assert float(np.std(image)) > 5.0
     framed = ergo.sim.render(camera="front", width=64, height=48)
     assert framed.shape == (48, 64, 3)
+
+
+def test_a_hand_holds_a_compliant_joint_and_not_a_stiff_one(ergo: World) -> None:
+    """The emulator's hand on MuJoCo: a compliant joint goes where the hand holds it; a stiff
+    one is left to the physics (no force is applied for the hand, see docs/emulator.md)."""
+    ergo.command("m1", 0.0, torque=False)
+    ergo.command("m2", 0.0)
+    ergo.run(0.3)
+    ergo.motors["m1"].hold_by_hand(30.0)
+    ergo.motors["m2"].hold_by_hand(30.0)
+    ergo.run(0.5)
+    assert ergo.sim.joint_deg("m1") == pytest.approx(30.0, abs=1.0)
+    assert ergo.sim.joint_deg("m2") == pytest.approx(0.0, abs=3.0)
