@@ -77,8 +77,8 @@ def test_the_hand_is_read_over_the_bus(bus: VirtualBus) -> None:
 
 def test_play_moves_through_timed_positions_then_holds(bus: VirtualBus) -> None:
     hand = bus.hand
-    duration = hand.play([0.0, 0.5, 1.0], {1: [0.0, 30.0, 10.0], 2: [0.0, -20.0, -20.0]}, 2.0)
-    assert duration == 0.5
+    duration = hand.play([0.0, 0.5, 1.0], {1: [0.0, 30.0, 10.0], 2: [0.0, -20.0, -20.0]}, 0.5)
+    assert duration == 2.0  # at half speed
     seen: list[float] = []
     assert eventually(lambda: seen.append(hand.where()[1]) or not hand.busy())
     assert max(seen) > 15.0  # went up toward 30 before coming back
