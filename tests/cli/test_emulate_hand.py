@@ -152,7 +152,7 @@ def test_poppy_record_records_what_the_emulators_hand_does(
         reader.join(10.0)
     err = "".join(said_by_emulator)
     assert emulator.returncode == 0, err
-    assert "hand: m1 to 40° over 1 s" in err
+    assert "hand: m1 to 40° over 2 s" in err
     assert "error: no motor 'm9' (names: m1, m2, m3, m4, m5, m6)" in err
     move = read_move(library / "byhand.move")
     assert move.motors == ("m1", "m2")
