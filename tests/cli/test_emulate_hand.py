@@ -129,7 +129,7 @@ def test_poppy_record_records_what_the_emulators_hand_does(
         while not said[-1].startswith("recording") and said[-1] and len(said) < 5:
             said.append(recorder.stderr.readline())
         assert said[-1].startswith("recording"), "".join(said)
-        emulator.stdin.write("move m1 40 --over 1\nmove m2 -30 --over 1\nmove m9 1\n")
+        emulator.stdin.write("move m1 40 --over 2\nmove m2 -30 --over 2\nmove m9 1\n")
         emulator.stdin.flush()
 
         def arrived() -> bool:  # asks `where` until the emulator says the hand got there
