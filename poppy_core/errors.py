@@ -36,6 +36,8 @@ The tree (catch the bases, raise the leaves)::
     ├── MissingExtraError         a feature whose optional dependencies (an extra, e.g.
     │                             ``poppy[sim]``) are not installed; carries ``extra``, ``module``
     ├── PrimitiveError            a primitive's thread died; carries ``primitive`` and ``failure``
+    ├── ControllerError           a controller's setup failed (pypot's ``MotorsController``);
+    │                             also a ``RuntimeError``
     └── CalibrationCancelled      the user cancelled a calibration (nothing was written)
 
 This module imports nothing of ours, so every layer (protocol included) may use it.
@@ -312,6 +314,11 @@ class KinematicsError(PoppyError):
         self.target = target
         self.nearest = nearest
         self.distance_m = distance_m
+
+
+class ControllerError(PoppyError, RuntimeError):
+    """A controller thread's ``setup`` failed (``poppy_core.robot.controller``); also a
+    ``RuntimeError``, as pypot's ``MotorsController.start`` raised."""
 
 
 class PrimitiveError(PoppyError):
