@@ -12,7 +12,9 @@ The tree (catch the bases, raise the leaves)::
     ├── MotorError                a motor answered with error bits; carries ``motor_id``, ``errors``
     ├── UnknownModelError         a model number or name poppy does not know
     ├── RegisterError             unknown register, read-only register, value out of range;
-    │                             carries ``register`` and ``motor``
+    │   │                         carries ``register`` and ``motor``
+    │   └── MissingRegisterError  a register the motor's model does not have (``pid`` on an
+    │                             AX-12A); also an ``AttributeError``
     ├── ArgumentError             a call argument outside what the call takes (negative duration,
     │                             unknown control, a frequency of 0); also a ``ValueError``;
     │                             carries ``field``, ``value``, ``motor``
@@ -34,6 +36,8 @@ The tree (catch the bases, raise the leaves)::
     ├── MissingExtraError         a feature whose optional dependencies (an extra, e.g.
     │                             ``poppy[sim]``) are not installed; carries ``extra``, ``module``
     ├── PrimitiveError            a primitive's thread died; carries ``primitive`` and ``failure``
+    ├── ControllerError           a controller's setup failed (pypot's ``MotorsController``);
+    │                             also a ``RuntimeError``
     └── CalibrationCancelled      the user cancelled a calibration (nothing was written)
 
 This module imports nothing of ours, so every layer (protocol included) may use it.
@@ -112,6 +116,14 @@ class RegisterError(PoppyError):
         super().__init__(message)
         self.register = register
         self.motor = motor
+
+
+class MissingRegisterError(RegisterError, AttributeError):
+    """A register the motor's model does not have (``pid`` on an AX-12A).
+
+    Also an ``AttributeError``: ``hasattr(motor, "pid")`` is False, as on pypot, whose motors of
+    such a model had no such attribute.
+    """
 
 
 class ArgumentError(PoppyError, ValueError):
@@ -302,6 +314,11 @@ class KinematicsError(PoppyError):
         self.target = target
         self.nearest = nearest
         self.distance_m = distance_m
+
+
+class ControllerError(PoppyError, RuntimeError):
+    """A controller thread's ``setup`` failed (``poppy_core.robot.controller``); also a
+    ``RuntimeError``, as pypot's ``MotorsController.start`` raised."""
 
 
 class PrimitiveError(PoppyError):

@@ -129,7 +129,6 @@ class CreaturePosture(SimplePosture):
         super().__init__(robot, duration, clamp_to_limits(robot, target_position))
         self.control = control
         self.led = led
-        self._speeds: dict[str, float] = {}
 
     @property
     def control(self) -> str:
@@ -149,7 +148,6 @@ class CreaturePosture(SimplePosture):
     def setup(self) -> None:
         """Note the moving speeds, stiffen the posture's motors and light their LEDs."""
         super().setup()
-        self._speeds = {n: self.real_robot.motor(n).moving_speed for n in self.target_position}
         if self.led is not None:
             for name in self.target_position:
                 self.robot.motor(name).led = self.led
@@ -162,8 +160,7 @@ class CreaturePosture(SimplePosture):
 
     def teardown(self) -> None:
         """Give the motors back their moving speeds and turn the LEDs off (as pypot does)."""
-        for name, speed in self._speeds.items():
-            self.robot.motor(name).moving_speed = speed
+        super().teardown()
         if self.led is not None:
             for name in self.target_position:
                 self.robot.motor(name).led = "off"

@@ -10,7 +10,6 @@ from poppy_core.motion.builtins import (
     BUILTINS,
     Cosinus,
     PositionWatcher,
-    SimplePosture,
     Sinus,
     Square,
     attach_builtins,
@@ -51,6 +50,7 @@ from poppy_core.motion.primitive import Primitive
 from poppy_core.motion.primitive_failure import PrimitiveFailure
 from poppy_core.motion.recorder import MoveRecorder
 from poppy_core.motion.sandbox import MockupMotor, MockupRobot
+from poppy_core.motion.simple_posture import SimplePosture
 from poppy_core.motion.teleop import (
     Follower,
     JointLink,

@@ -1,4 +1,4 @@
-"""Built-in primitives: Sinus, Cosinus, Square, PositionWatcher and SimplePosture.
+"""Built-in primitives: Sinus, Cosinus, Square, PositionWatcher and SimplePosture (its own module).
 
 Each one can be built with the robot alone (``Sinus(robot)``): motor lists default to every motor
 and the other arguments to gentle values, so ``poppy primitive run`` can start any of them.
@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import io
 import math
-import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias
 
@@ -20,6 +19,7 @@ from poppy_core.motion.attached import attach_primitive
 from poppy_core.motion.loop_primitive import LoopPrimitive
 from poppy_core.motion.primitive import Primitive
 from poppy_core.motion.sandbox import MockupMotor
+from poppy_core.motion.simple_posture import SimplePosture
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -265,70 +265,6 @@ class PositionWatcher(LoopPrimitive):
         axes.set_ylabel("present position (°)")
         if self.record_positions:
             axes.legend(loc="upper right")
-
-
-class SimplePosture(Primitive):
-    """Goes to a posture (motor name -> degrees) in ``duration`` seconds, then ends.
-
-    ``start()`` then ``wait_to_stop()`` (or ``go(wait=True)``) blocks until it is reached.
-
-    Args:
-        robot: the robot.
-        duration: seconds to reach the posture.
-        target_position: the posture; every motor at 0° when None.
-    """
-
-    properties: ClassVar[Sequence[str]] = ("duration", "target_position")
-    methods: ClassVar[Sequence[str]] = (*Primitive.methods, "go")
-
-    def __init__(
-        self,
-        robot: Robot,
-        duration: float = 2.0,
-        target_position: Mapping[str, float] | None = None,
-    ) -> None:
-        super().__init__(robot)
-        self.duration = duration
-        if target_position is None:
-            target_position = {m.name: 0.0 for m in robot.motors}
-        self.target_position = dict(target_position)
-
-    @property
-    def target_position(self) -> dict[str, float]:
-        """The posture: motor name -> degrees (unknown motors are refused when set)."""
-        return self._target
-
-    @target_position.setter
-    def target_position(self, value: Mapping[str, float]) -> None:
-        _check_motors(self.real_robot, list(value))
-        self._target = dict(value)
-
-    @property
-    def duration(self) -> float:
-        """Seconds to reach the posture (>= 0)."""
-        return self._duration
-
-    @duration.setter
-    def duration(self, value: float) -> None:
-        self._duration = checks.duration(value)
-
-    def setup(self) -> None:
-        """Check the posture and stiffen its motors."""
-        _check_motors(self.real_robot, list(self.target_position))
-        for name in self.target_position:
-            self.robot.motor(name).compliant = False
-
-    def run(self) -> None:
-        """Move, and return once the posture is reached (or when stopped)."""
-        start = time.monotonic()
-        self.robot.goto_position(self.target_position, self.duration)
-        self.sleep(self.duration - (time.monotonic() - start))
-
-    def go(self, wait: bool = True) -> None:
-        """Start (or restart) and, with ``wait``, block until the posture is reached."""
-        self.start()
-        if wait:
-            self.wait_to_stop()
 
 
 BUILTINS: dict[str, type[Primitive]] = {

@@ -49,6 +49,15 @@ class LoopPrimitive(Primitive):
         return 1.0 / self._freq
 
     @property
+    def period(self) -> float:
+        """pypot's name for ``period_s``; setting it sets ``update_freq`` (at the next start)."""
+        return self.period_s
+
+    @period.setter
+    def period(self, value: float) -> None:
+        self.update_freq = 1.0 / checks.period(value, "period")
+
+    @property
     def update_rate_hz(self) -> float:
         """Measured update rate over the last updates (0 until two ran)."""
         return self._meter.rate_hz

@@ -25,6 +25,9 @@ NUMERIC_REGISTERS: tuple[str, ...] = ("goal_position", "moving_speed", "torque_l
 STATE_REGISTERS: tuple[str, ...] = ("compliant", "led")
 """Requests where the most recently started primitive wins (a mean of on/off makes no sense)."""
 REQUESTABLE: tuple[str, ...] = (*NUMERIC_REGISTERS, *STATE_REGISTERS)
+PASSED_THROUGH: tuple[str, ...] = ("pid", "compliance_margin", "compliance_slope")
+"""Servo settings a primitive writes to the motor at once (pypot's manager set them from the
+request; there is nothing to combine: poppy-humanoid's StandPosition sets ``m.pid``)."""
 _ALIASES = {"max_torque": "torque_limit"}
 _OWN = frozenset({"_motor", "_lock", "_requests", "_trajectory", "_stopped", "_clock"})
 
@@ -112,11 +115,15 @@ class MockupMotor:
         if name == "goal_speed":
             self._request_speed(_number(self._motor.name, name, value))
             return
+        if name in PASSED_THROUGH:
+            setattr(self._motor, name, value)
+            return
         register = _ALIASES.get(name, name)
         if register not in REQUESTABLE:
             raise RegisterError(
                 f"{self._motor.name}: a primitive may request only "
-                f"{', '.join(REQUESTABLE)} or goal_speed, not {name!r}",
+                f"{', '.join(REQUESTABLE)} or goal_speed (and set "
+                f"{', '.join(PASSED_THROUGH)}), not {name!r}",
                 register=name,
                 motor=self._motor.name,
             )

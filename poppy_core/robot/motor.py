@@ -82,6 +82,11 @@ class Motor(PypotMotorMixin, MotorCompliance):
         self._behavior: CompliantBehavior = "dummy"
         self._goto_behavior = DEFAULT_GOTO_BEHAVIOR
         self._goal_speed: float | None = None
+        self.ideal_plant = False
+        """True for a servo of an ideal simulation (``sim=True``, ``simulator='dummy'``): its
+        ``present_position`` reads the goal once reached (see there)."""
+        position = model.register("present_position")
+        self._half_step = abs(float(position.to_si(1)) - float(position.to_si(0))) / 2 + 1e-9
         self._link = MotorLink(
             name,
             model,
@@ -167,8 +172,18 @@ class Motor(PypotMotorMixin, MotorCompliance):
 
     @property
     def present_position(self) -> float:
-        """Position in degrees (user frame), as last read."""
-        return self.to_user(self._link.number("present_position"))
+        """Position in degrees (user frame), as last read.
+
+        On an ideal virtual servo (``ideal_plant``) that reached its goal (within half a step of
+        the position register), the goal itself, as pypot's dummy robot gave it: the register's
+        steps would read 89.94° for a goal of 90° on an AX-12A, as a real servo does.
+        """
+        present = self.to_user(self._link.number("present_position"))
+        if self.ideal_plant and not self.wheel_mode:
+            goal = self.goal_position
+            if abs(present - goal) <= self._half_step:
+                return goal
+        return present
 
     @property
     def present_speed(self) -> float:

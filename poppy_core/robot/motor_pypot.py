@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 from typing import Protocol
 
-from poppy_core.errors import ArgumentError, RegisterError
+from poppy_core.errors import ArgumentError, MissingRegisterError, RegisterError
 from poppy_core.models import ServoModel
 from poppy_core.robot import registers as regs
 from poppy_core.robot.motor_link import MotorLink, SIValue
@@ -152,7 +152,7 @@ class PypotMotorMixin:
 def _pid_names(motor: PypotMotorHost) -> tuple[str, str, str]:
     names = regs.pid_names(motor.model)
     if names is None:
-        raise RegisterError(
+        raise MissingRegisterError(
             f"{motor.name}: {motor.model.name} has no PID gains (use compliance_margin/slope)",
             register="pid",
             motor=motor.name,
@@ -174,7 +174,7 @@ def _set_pair(motor: PypotMotorHost, names: tuple[str, str], value: int | tuple[
 
 def _need_slopes(motor: PypotMotorHost) -> None:
     if not regs.has_compliance_slopes(motor.model):
-        raise RegisterError(
+        raise MissingRegisterError(
             f"{motor.name}: {motor.model.name} has no compliance margin/slope (use pid)",
             register="compliance_margin",
             motor=motor.name,

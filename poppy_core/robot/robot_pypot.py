@@ -10,11 +10,13 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Protocol
 
 from poppy_core.errors import ConfigError
+from poppy_core.robot.controller import BusController
 from poppy_core.robot.group import MotorGroup
 from poppy_core.robot.motor import Motor
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import RobotConfig
+    from poppy_core.robot.sync import BusSync
 
 MANAGER_KEY = "primitive_manager"
 """Where the assembly keeps the primitive manager in ``robot.extensions`` (``motion.manager``'s
@@ -34,6 +36,7 @@ class PypotRobotHost(Protocol):
 
     extensions: dict[str, object]
     _groups: dict[str, MotorGroup]
+    _syncs: list[BusSync]
     _primitive_names: list[str]
 
     def attach(self, name: str, obj: object) -> None:
@@ -68,6 +71,12 @@ class PypotRobotMixin:
     def alias(self: PypotRobotHost) -> list[str]:
         """The group names (pypot's ``robot.alias``); each group is ``robot.<name>``."""
         return list(self._groups)
+
+    @property
+    def _controllers(self: PypotRobotHost) -> list[BusController]:
+        """One controller per bus (pypot's name): ``io`` the bus, ``motors`` its motors,
+        ``_updated`` set after each pass of its sync loops (``poppy_core.robot.controller``)."""
+        return [BusController(sync) for sync in self._syncs]
 
     @property
     def _primitive_manager(self: PypotRobotHost) -> Any:

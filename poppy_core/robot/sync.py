@@ -103,6 +103,9 @@ class BusSync:
         self._stop = self._worker.stopping
         self._transfers = SyncTransfers(bus, self.motors, offline_after, self._stop)
         self._driven: set[str] = set()
+        self.updated = threading.Event()
+        """Set after each pass that ran a loop (pypot's ``controller._updated``: clear it, wait
+        for it, and the values are one sync newer)."""
         self.connected = bus.is_open
         """False while the port is lost, not there yet (a bus made ``DxlBus.absent``: the
         thread opens it with backoff) or released."""
@@ -115,6 +118,11 @@ class BusSync:
         if not self.connected:
             for motor in self.motors:
                 link_of(motor).mark_offline()
+
+    @property
+    def loop_specs(self) -> list[LoopSpec]:
+        """The register groups this bus syncs (its retry loop last)."""
+        return list(self._specs)
 
     @property
     def offline_after(self) -> int:
@@ -289,6 +297,7 @@ class BusSync:
 
     def _run_due_loops(self) -> None:
         now = self._clock()
+        ran = False
         for loop in self._loops:
             if self._stop.is_set():
                 return
@@ -298,6 +307,7 @@ class BusSync:
                 loop.schedule.advance(now)
                 continue
             loop.meter.tick(now)
+            ran = ran or loop.spec.name != RETRY
             started = self._clock()
             try:
                 self._transfers.run(loop.spec)
@@ -313,6 +323,8 @@ class BusSync:
                     logger.exception("%s %s loop failed", self.controller, loop.spec.name)
             loop.last_duration_s = self._clock() - started
             loop.schedule.advance(now)
+        if ran:
+            self.updated.set()
         wake = min(loop.schedule.next_deadline for loop in self._loops)
         self._stop.wait(max(0.0, wake - self._clock()))
 

@@ -1,4 +1,5 @@
-"""pypot 5.0.2's own tests/test_primitive.py, run on poppy with only its import lines changed.
+"""pypot 5.0.2's own tests (test_primitive, test_crashed_prim, test_dummy), run on poppy with only
+their import lines changed.
 
 pypot's file is not part of this repository, and neither pypot's wheel nor its sdist on PyPI
 ships its tests, while the machines the suite runs on reach only the package registries. So the
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -21,12 +23,23 @@ PYPOT_TAG = "5.0.2"
 PYPOT_COMMIT = "82e8337c79fbf49533ae6736af7304b65e0a6d7d"  # git rev-parse 5.0.2^{commit}
 SOURCES = {
     "test_primitive.py": "292ff87263047c24c1f3a8ad44af1f7d14a3046ac663fbd450510b3119332885",
+    "test_crashed_prim.py": "4b9dec42d798151dca69dee97f9ce476d83b71195d639331caf47fdef18cdb28",
+    "test_dummy.py": "b220809e67e057199214d2e82d25703547862bdccedbcd4dc8133d1e41a51d34",
 }
 # The import lines changed, as a pypot user changes them (every other line runs as written).
 IMPORTS = {
     "from pypot.creatures import PoppyErgoJr": "from poppy_core.creatures import PoppyErgoJr",
     "from pypot.primitive import LoopPrimitive": "from poppy_core.motion import LoopPrimitive",
+    "from pypot.robot.controller import MotorsController": (
+        "from poppy_core.robot.controller import MotorsController"
+    ),
 }
+# Every test of those files passes but one, on purpose (docs/pypot.md, "What behaves
+# differently"): test_dummy_controller sets moving_speed 10000 and expects every motor at its goal
+# one sync later; pypot's dummy moved at 10000°/s, poppy's virtual servos at their model's top
+# speed (681°/s on an XL-320, the register's cap, as pypot's real motors), so 25° takes 2-3 syncs.
+EXPECTED_FAILURES = {"test_dummy_controller"}
+RESULT = re.compile(r"^(test_\w+) \([\w.]+\) \.\.\. (ok|FAIL|ERROR)$", re.M)
 REPO_ROOT = Path(__file__).resolve().parents[2]
 RUN_TIMEOUT_S = 90.0  # under pytest-timeout's 120 s: a hang is reported as one
 
@@ -54,17 +67,20 @@ def pypot_test_file(name: str) -> Path:
 
 
 @pytest.mark.slow
-def test_pypot_test_primitive_passes_with_the_import_changed(tmp_path: Path) -> None:
-    source = pypot_test_file("test_primitive.py").read_text(encoding="utf-8")
-    for pypot_line, poppy_line in IMPORTS.items():
-        assert pypot_line in source, f"pypot's file no longer has {pypot_line!r}"
-        source = source.replace(pypot_line, poppy_line)
-    replay = tmp_path / "pypot_test_primitive.py"
-    replay.write_text(source, encoding="utf-8")
+def test_pypot_own_tests_pass_with_the_imports_changed(tmp_path: Path) -> None:
+    modules = []
+    for name in SOURCES:
+        source = pypot_test_file(name).read_text(encoding="utf-8")
+        for pypot_line, poppy_line in IMPORTS.items():
+            source = source.replace(pypot_line, poppy_line)
+        assert "pypot" not in source.replace("pypot_", ""), f"{name}: an import left unchanged"
+        module = f"pypot_{name.removesuffix('.py')}"
+        (tmp_path / f"{module}.py").write_text(source, encoding="utf-8")
+        modules.append(module)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO_ROOT), str(tmp_path)])}
     try:
         run = subprocess.run(
-            [sys.executable, "-m", "unittest", "-v", "pypot_test_primitive"],
+            [sys.executable, "-m", "unittest", "-v", *modules],
             cwd=tmp_path,
             env=env,
             capture_output=True,
@@ -72,6 +88,8 @@ def test_pypot_test_primitive_passes_with_the_import_changed(tmp_path: Path) -> 
             timeout=RUN_TIMEOUT_S,
         )
     except subprocess.TimeoutExpired as exc:
-        pytest.fail(f"pypot's test_primitive.py hung ({RUN_TIMEOUT_S:g} s):\n{exc.stderr!s}")
-    assert run.returncode == 0, run.stderr
-    assert "Ran 4 tests" in run.stderr and "OK" in run.stderr
+        pytest.fail(f"pypot's tests hung ({RUN_TIMEOUT_S:g} s):\n{exc.stderr!s}")
+    results = dict(RESULT.findall(run.stderr))
+    assert "Ran 7 tests" in run.stderr, run.stderr
+    failed = {test for test, outcome in results.items() if outcome != "ok"}
+    assert len(results) == 7 and failed == EXPECTED_FAILURES, run.stderr

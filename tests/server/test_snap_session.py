@@ -18,7 +18,7 @@ import httpx
 import pytest
 
 from poppy_core.creatures import from_profile
-from poppy_core.motion import list_moves, load_move
+from poppy_core.motion import SimplePosture, list_moves, load_move
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, start_snap_server
 from tests.server.snap_helpers import near, served_ergo, wait_until
@@ -174,6 +174,19 @@ def test_values_read_as_pypot_writes_them(snap: tuple[Robot, SnapServer, httpx.C
     assert http.get("/primitive/dance/methodes").text == "start/stop/pause/resume"
     assert http.get("/primitive/dance/set/tempo_scale/0.5").text == ""
     assert http.get("/primitive/dance/get/tempo_scale").text == "0.5"
+    # pypot's get/<attribute> read the primitive's state too: nothing (200) when false
+    still = SimplePosture(robot, 60.0, {"m1": robot.m1.present_position})
+    robot.attach_primitive(still, "snap_state_probe")
+    for state in ("running", "started"):
+        answer = http.get(f"/primitive/snap_state_probe/get/{state}")
+        assert (answer.status_code, answer.text) == (200, "")
+    still.start()
+    try:
+        assert http.get("/primitive/snap_state_probe/get/running").text == "True"
+        assert http.get("/primitive/snap_state_probe/get/started").text == "True"
+    finally:
+        still.stop()
+    assert http.get("/primitive/snap_state_probe/get/running").text == ""
     assert http.get("/motor/m3/set/compliant/false").text == "Done!"  # a compliant one stays
     assert http.get("/motors/set/positions/5;6;7;").text == "Done!"
     assert wait_until(lambda: near(robot.m3.present_position, 7))

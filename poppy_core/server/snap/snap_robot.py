@@ -31,6 +31,10 @@ from poppy_core.server.snap.text import (
 )
 from poppy_core.trajectory import goto_duration
 
+PRIMITIVE_STATES = ("running", "started")
+"""A primitive's states pypot's ``/primitive/<p>/get/<name>`` read besides its properties (it read
+any attribute)."""
+
 NO_DETECTOR = "Error: marker detector is not activated"
 """pypot's answer to ``/detect/<marker>`` without a detector."""
 
@@ -190,7 +194,11 @@ class SnapRobot:
         return names_text(self.service.method_names(primitive))
 
     def get_property(self, primitive: str, prop: str) -> str:
-        """``/primitive/<p>/get/<property>``."""
+        """``/primitive/<p>/get/<property>``; also pypot's primitive states ``running`` and
+        ``started``: ``True``, or nothing when false (pypot's answer then; it failed with a 500
+        when true)."""
+        if prop in PRIMITIVE_STATES:
+            return "True" if getattr(self.service.primitive(primitive), prop) else ""
         return value_text(self.service.get_property(primitive, prop))
 
     def set_property(self, primitive: str, prop: str, value: str) -> str:
