@@ -23,6 +23,7 @@ import tarfile
 import urllib.error
 import urllib.request
 import zipfile
+import zlib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
@@ -251,35 +252,35 @@ def _member_path(name: str) -> PurePosixPath | None:
 
 
 def _unpack(archive: Path, into: Path) -> None:
-    """Unpack a zip or tar archive of regular files and folders; refuse anything else."""
-    total = 0
-    count = 0
+    """Unpack a zip or tar archive of regular files and folders; refuse anything else.
 
-    def account(size: int) -> None:
-        nonlocal total, count
-        total += size
-        count += 1
-        if total > MAX_UNPACKED_BYTES or count > MAX_FILES:
-            raise DownloadError("the archive unpacks to more than a Snap! release: refused")
+    Every entry counts (a folder too: 60,000 empty ones are no release), before it is made; the
+    bytes are counted as they are written, whatever size the archive claims."""
+    budget = _Budget()
 
     def bad(name: str) -> DownloadError:
         return DownloadError(f"the archive holds {name[:80]!r}, outside its folder: refused")
 
     if zipfile.is_zipfile(archive):
-        with zipfile.ZipFile(archive) as zipped:
-            for info in zipped.infolist():
-                path = _member_path(info.filename)
-                if path is None:
-                    raise bad(info.filename)
-                if stat.S_ISLNK(info.external_attr >> 16):
-                    raise DownloadError(f"the archive holds a link {info.filename[:80]!r}: refused")
-                if info.is_dir():
-                    (into / path).mkdir(parents=True, exist_ok=True)
-                    continue
-                account(info.file_size)
-                (into / path).parent.mkdir(parents=True, exist_ok=True)
-                with zipped.open(info) as src, (into / path).open("wb") as dst:
-                    shutil.copyfileobj(src, dst, CHUNK)
+        try:
+            with zipfile.ZipFile(archive) as zipped:
+                for info in zipped.infolist():
+                    path = _member_path(info.filename)
+                    if path is None:
+                        raise bad(info.filename)
+                    if stat.S_ISLNK(info.external_attr >> 16):
+                        raise DownloadError(
+                            f"the archive holds a link {info.filename[:80]!r}: refused"
+                        )
+                    budget.entry(0 if info.is_dir() else info.file_size)
+                    if info.is_dir():
+                        (into / path).mkdir(parents=True, exist_ok=True)
+                        continue
+                    (into / path).parent.mkdir(parents=True, exist_ok=True)
+                    with zipped.open(info) as src, (into / path).open("wb") as dst:
+                        budget.copy(src, dst)
+        except (zipfile.BadZipFile, zlib.error, EOFError, NotImplementedError) as exc:
+            raise DownloadError(f"the zip archive is damaged ({exc}): refused") from None
         return
     try:
         with tarfile.open(archive) as tarred:
@@ -288,18 +289,44 @@ def _unpack(archive: Path, into: Path) -> None:
                 if path is None:
                     raise bad(member.name)
                 if member.isdir():
+                    budget.entry(0)
                     (into / path).mkdir(parents=True, exist_ok=True)
                 elif member.isfile():
-                    account(member.size)
+                    budget.entry(member.size)
                     (into / path).parent.mkdir(parents=True, exist_ok=True)
                     member_file = tarred.extractfile(member)
                     assert member_file is not None
                     with member_file, (into / path).open("wb") as dst:
-                        shutil.copyfileobj(member_file, dst, CHUNK)
+                        budget.copy(member_file, dst)
                 elif member.type not in (tarfile.XGLTYPE, tarfile.XHDTYPE):
                     raise DownloadError(f"the archive holds a link {member.name[:80]!r}: refused")
-    except tarfile.TarError as exc:
+    except (tarfile.TarError, zlib.error, EOFError) as exc:
         raise DownloadError(f"the download is not a zip or tar archive ({exc})") from None
+
+
+class _Budget:
+    """What an archive may unpack to: ``MAX_FILES`` entries, ``MAX_UNPACKED_BYTES`` written."""
+
+    def __init__(self) -> None:
+        self.entries = 0
+        self.written = 0
+
+    def _refuse(self) -> DownloadError:
+        return DownloadError("the archive unpacks to more than a Snap! release: refused")
+
+    def entry(self, claimed: int) -> None:
+        """One more entry (file or folder) claiming ``claimed`` bytes."""
+        self.entries += 1
+        if self.entries > MAX_FILES or self.written + claimed > MAX_UNPACKED_BYTES:
+            raise self._refuse()
+
+    def copy(self, src: IO[bytes], dst: IO[bytes]) -> None:
+        """Copy ``src`` into ``dst``, counting the bytes actually read."""
+        while chunk := src.read(CHUNK):
+            self.written += len(chunk)
+            if self.written > MAX_UNPACKED_BYTES:
+                raise self._refuse()
+            dst.write(chunk)
 
 
 def _release_root(unpacked: Path) -> Path:
