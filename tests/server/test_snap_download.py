@@ -9,6 +9,7 @@ import os
 import signal
 import stat
 import subprocess
+import tarfile
 import urllib.request
 import zipfile
 from pathlib import Path
@@ -227,8 +228,9 @@ def test_a_tar_gz_release_is_taken_too(tmp_path: Path, data_home: Path) -> None:
     assert release.release_digest(copy.path) == fake.digest
 
 
+@pytest.mark.parametrize("kind", ["zip", "tar"])
 def test_an_archive_of_too_many_entries_is_refused_folders_counted(
-    tmp_path: Path, data_home: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, data_home: Path, monkeypatch: pytest.MonkeyPatch, kind: str
 ) -> None:
     # 60,000 empty folders are no Snap! release: every entry counts, before it is made
     monkeypatch.setattr(release, "MAX_FILES", 100)
@@ -239,15 +241,22 @@ def test_an_archive_of_too_many_entries_is_refused_folders_counted(
         made.append(self.name)
         real_mkdir(self, *args, **kwargs)  # type: ignore[arg-type]
 
-    archive = tmp_path / "folders.zip"
-    with zipfile.ZipFile(archive, "w") as zipped:
-        zipped.writestr("Snap/snap.html", "<html></html>")
-        for number in range(300):
-            zipped.writestr(f"Snap/empty-{number}/", "")
+    archive = tmp_path / f"folders.{kind}"
+    if kind == "zip":
+        with zipfile.ZipFile(archive, "w") as zipped:
+            zipped.writestr("Snap/snap.html", "<html></html>")
+            for number in range(300):
+                zipped.writestr(f"Snap/empty-{number}/", "")
+    else:
+        with tarfile.open(archive, "w") as tarred:
+            for number in range(300):
+                folder = tarfile.TarInfo(f"Snap/empty-{number}")
+                folder.type = tarfile.DIRTYPE
+                tarred.addfile(folder)
     monkeypatch.setattr(Path, "mkdir", mkdir)
     with pytest.raises(DownloadError, match="more than a Snap! release"):
         release.download("folders", str(archive), "0" * 64)
-    assert len([m for m in made if m.startswith("empty-")]) <= 100
+    assert len({m for m in made if m.startswith("empty-")}) <= 100
     assert _leftovers() == []
 
 
