@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from poppy_core.errors import ArgumentError, DownloadError
-from poppy_core.server.snap import release
+from poppy_core.server.snap import release, unpack
 from tests.helpers.cli import POPPY, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.snap_release import Files, make_release, release_server, zip_folder
@@ -233,7 +233,7 @@ def test_an_archive_of_too_many_entries_is_refused_folders_counted(
     tmp_path: Path, data_home: Path, monkeypatch: pytest.MonkeyPatch, kind: str
 ) -> None:
     # 60,000 empty folders are no Snap! release: every entry counts, before it is made
-    monkeypatch.setattr(release, "MAX_FILES", 100)
+    monkeypatch.setattr(unpack, "MAX_FILES", 100)
     made: list[str] = []
     real_mkdir = Path.mkdir
 
