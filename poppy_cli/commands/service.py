@@ -100,7 +100,7 @@ def install(
         _usage("--run-as is for the system service: a --user service runs as you")
     load_profile(profile)  # an unknown profile: one line naming the known ones
     ports = tuple(http_ports or (units.USER_PORTS if user else units.SYSTEM_PORTS))
-    run_as = None if user else _service_user(run_as)
+    run_as = None if user else _service_user(run_as, dry_run)
     files = files_of(run_as)
     spec = units.ServiceSpec(
         poppy=units.poppy_command(),
@@ -179,25 +179,37 @@ def install(
         )
 
 
-def _service_user(run_as: str | None) -> str:
+def _service_user(run_as: str | None, dry_run: bool) -> str:
     """The user a system service runs as: ``--run-as``, else who ran sudo, else the current
-    user; never root, and one that exists."""
+    user; never root (a dry run shows root's unit, with a warning), and one that exists with
+    a home (the service's settings and token are kept there)."""
     import getpass
     import os
     import pwd
 
     chosen = run_as or os.environ.get("SUDO_USER") or getpass.getuser()
     if chosen == "root":
-        _usage(
-            "the service must not run as root: pass --run-as USER (a user of the dialout "
-            "group, e.g. pi or poppy)"
+        advice = "pass --run-as USER (a user of the dialout group, e.g. pi or poppy)"
+        if not dry_run:
+            _usage(f"the service must not run as root: {advice}")
+        err_console.print(
+            f"warning: this unit runs as root, which `poppy service install` refuses: {advice}",
+            soft_wrap=True,
+            highlight=False,
+            markup=False,
         )
     try:
-        pwd.getpwnam(chosen)
+        home = Path(pwd.getpwnam(chosen).pw_dir)
     except KeyError:
         _usage(
             f"--run-as {chosen!r}: no such user on this machine; create it (sudo adduser "
             f"{chosen} && sudo adduser {chosen} dialout) or give another"
+        )
+    if not home.is_dir():
+        _usage(
+            f"--run-as {chosen!r}: its home {home} is not a folder, and the service keeps its "
+            f"settings and token there; give a user with a home (sudo adduser poppy && sudo "
+            "adduser poppy dialout)"
         )
     return chosen
 
