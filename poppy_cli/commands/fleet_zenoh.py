@@ -148,7 +148,7 @@ def _status_table(
 ) -> Any:
     from rich.table import Table
 
-    from poppy_core.models.degrees import fmt_deg
+    from poppy_cli.output import fmt_deg
 
     table = Table("robot", "health", "state Hz", "age", "motors (°)")
     now = time.time()

@@ -24,6 +24,7 @@ from poppy_cli.output import (
     EXIT_FAILURE,
     err_console,
     error_line,
+    fmt_deg,
     print_json,
     printable,
 )
@@ -80,7 +81,7 @@ def _live_table(recorder: MoveRecorder, duration: float | None) -> Table:
     table.add_column("motor")
     table.add_column("position", justify="right")
     for name, value in recorder.latest().items():
-        table.add_row(name, f"{value:.1f}°")
+        table.add_row(name, fmt_deg(value))
     return table
 
 
