@@ -226,6 +226,14 @@ def shown_unit(unit: str) -> str:
     return SHOWN_UNITS.get(unit, unit)
 
 
+def fmt_deg(value: float, step_deg: float = 0.1, unit: str = "°") -> str:
+    """Degrees as the CLI prints them: the decimals of ``step_deg`` (a motor's resolution,
+    ``poppy_core.models.degrees.tick_deg``), never ``-0``."""
+    from poppy_core.models.degrees import fmt_deg as core_fmt_deg
+
+    return core_fmt_deg(value, step_deg, unit)
+
+
 def fmt_value(value: Any, unit: str = "") -> str:
     """Format an SI register value with its unit for humans (``30 °``, ``4.5 V``, ``on``)."""
     unit = shown_unit(unit)

@@ -10,6 +10,8 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from poppy_core.checks import one_line
+
 UNIT = "poppy.service"
 JUPYTER_UNIT = "poppy-jupyter.service"
 JUPYTER_PORT = 8888
@@ -105,7 +107,10 @@ def jupyter_command(spec: ServiceSpec) -> list[str]:
 
 
 def _exec(args: list[str]) -> str:
-    # systemd's ExecStart splits words as a shell does, and expands % and $: quote both
+    # systemd's ExecStart splits words as a shell does, and expands % and $: quote both; a
+    # newline would end the line (and start another, root's ExecStartPre= say): refused
+    for arg in args:
+        one_line(arg, "a word of ExecStart")
     line = " ".join(shlex.quote(a) for a in args)
     return line.replace("%", "%%").replace("$", "$$")
 

@@ -1,13 +1,15 @@
-"""Checks of call arguments (finite, positive, a duration, a rate, a robot's name): one rule
-each, ArgumentError."""
+"""Checks of call arguments (finite, positive, a duration, a rate, a robot's name, one line of
+text, a Wi-Fi network and password; a peer's page link): one rule each, ArgumentError."""
 
 from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
+import unicodedata
+from collections.abc import Callable, Iterable
 from numbers import Real
 from typing import Any, Generic, TypeVar, overload
+from urllib.parse import urlsplit
 
 from poppy_core.errors import ArgumentError
 
@@ -181,6 +183,88 @@ def robot_name_of_host(hostname: str) -> str:
     label = hostname.split(".")[0].lower()
     name = re.sub(r"[^a-z0-9-]", "-", label)[:63].strip("-")
     return name or "poppy"
+
+
+def _shown(text: str) -> str:
+    return repr(text if len(text) <= 40 else text[:40] + "...")
+
+
+def one_line(value: object, field: str = "") -> str:
+    """``value`` as text without a control character (a newline, a tab, a NUL, DEL...): a
+    value written into a file of lines (a systemd unit) or handed to another program."""
+    if not isinstance(value, str):
+        raise ArgumentError(
+            f"{_describe(field)} must be text, got {value!r}", field=field, value=value
+        )
+    if any(unicodedata.category(c) == "Cc" for c in value):
+        raise ArgumentError(
+            f"{_describe(field)} {_shown(value)} holds a control character (a newline, tab or "
+            "NUL): give it on one line of visible characters",
+            field=field,
+            value=value,
+        )
+    return value
+
+
+MIN_PSK = 8
+MAX_PSK = 63
+MAX_SSID_BYTES = 32
+_HEX_PSK = re.compile(r"[0-9a-fA-F]{64}")
+
+
+def wifi_password(value: object, field: str = "password") -> str:
+    """A WPA password: 8-63 printable ASCII characters (space to ``~``), or a 64-hex-digit
+    key (IEEE 802.11i's two forms of a pre-shared key)."""
+    text = value if isinstance(value, str) else ""
+    if _HEX_PSK.fullmatch(text) or (
+        MIN_PSK <= len(text) <= MAX_PSK and all(" " <= c <= "~" for c in text)
+    ):
+        return text
+    raise ArgumentError(
+        f"{_describe(field)} is not a WPA password: give {MIN_PSK}-{MAX_PSK} printable ASCII "
+        "characters (letters, digits, punctuation, space; no accent or control character) "
+        "or a 64-hex-digit key",
+        field=field,
+    )
+
+
+def wifi_ssid(value: object, field: str = "ssid") -> str:
+    """A Wi-Fi network's name: 1-32 bytes (UTF-8), no control character, not starting with
+    ``-`` (nmcli would read it as an option)."""
+    text = one_line(value, field)
+    if not 1 <= len(text.encode()) <= MAX_SSID_BYTES or text.startswith("-"):
+        raise ArgumentError(
+            f"{_describe(field)} {_shown(text)} is not a Wi-Fi network name: give 1-"
+            f"{MAX_SSID_BYTES} bytes, not starting with '-'",
+            field=field,
+            value=value,
+        )
+    return text
+
+
+UNSPECIFIED_HOSTS = frozenset({"0.0.0.0", "::", ""})
+"""Bind-all addresses: in a browser they mean the viewer's own machine, never a peer."""
+
+
+def peer_page(page: object, hosts: Iterable[str]) -> str | None:
+    """A peer robot's ``page`` URL as a link, or None: only ``http(s)`` to one of ``hosts``, the
+    peer's own announced addresses (its Zenoh endpoints' hosts, ``NAME.local``).
+
+    What a peer describes is anyone's text on the network: a ``javascript:`` URL or a link to
+    another site (a page asking for the robot's token) is not shown as a link.
+    """
+    if not isinstance(page, str) or len(page) > 2048 or any(c.isspace() for c in page):
+        return None
+    try:
+        parts = urlsplit(page)
+        host = (parts.hostname or "").lower()
+        parts.port  # noqa: B018 (a bad port raises here)
+    except ValueError:
+        return None
+    allowed = {h.lower().strip("[]") for h in hosts} - UNSPECIFIED_HOSTS
+    if parts.scheme not in ("http", "https") or parts.username or parts.password:
+        return None
+    return page if host in allowed and host not in UNSPECIFIED_HOSTS else None
 
 
 T = TypeVar("T")

@@ -119,3 +119,49 @@ def test_a_robot_name_refused_names_the_field_the_rule_and_an_example(given: obj
     assert message.startswith(f"--name {given!r} is not a robot name: ")
     assert "e.g. poppy or ergo-2" in message and "\n" not in message
     assert refused.value.field == "--name"
+
+
+@pytest.mark.parametrize(
+    "password",
+    ["password1", "a b~c!d{e}", "x" * 63, "0123456789abcdef" * 4, "ABCDEF0123456789" * 4],
+)
+def test_wpa_passwords_are_printable_ascii_or_64_hex(password: str) -> None:
+    assert checks.wifi_password(password) == password
+
+
+@pytest.mark.parametrize(
+    "password",
+    [
+        "short1",
+        "x" * 64,
+        "g" * 64,
+        "pass\x00word1",
+        "pass\tword1",
+        "pässwörd12",
+        "pass\x7fword",
+        None,
+    ],
+)
+def test_other_wpa_passwords_are_refused_in_one_line(password: object) -> None:
+    with pytest.raises(ArgumentError, match="not a WPA password") as caught:
+        checks.wifi_password(password, "password")
+    assert "\n" not in str(caught.value)
+    assert not isinstance(password, str) or password not in str(caught.value)  # a secret
+
+
+@pytest.mark.parametrize("ssid", ["", "-ask", "--", "é" * 17, "a\nb", "a\x00b", "x" * 33])
+def test_bad_ssids_are_refused(ssid: str) -> None:
+    with pytest.raises(ArgumentError):
+        checks.wifi_ssid(ssid)
+
+
+def test_ssids_of_up_to_32_bytes_are_taken() -> None:
+    assert checks.wifi_ssid("é" * 16) == "é" * 16
+    assert checks.wifi_ssid("Class:room a-b") == "Class:room a-b"
+
+
+@pytest.mark.parametrize("text", ["a\nb", "a\rb", "a\x00", "\x1b[2J", "a\x85b", 3])
+def test_one_line_refuses_control_characters(text: object) -> None:
+    with pytest.raises(ArgumentError) as caught:
+        checks.one_line(text, "--port")
+    assert str(caught.value).startswith("--port ") and "\n" not in str(caught.value)

@@ -23,6 +23,7 @@ from poppy_cli.output import (
     console,
     err_console,
     error_line,
+    fmt_deg,
     fmt_value,
     print_json,
     styled,
@@ -93,7 +94,8 @@ class RichAnswers:
             else:
                 done.wait()
         for reading in watch.readings():
-            err_console.print(f"  {reading.motor}: {reading.low:.1f}° … {reading.high:.1f}°")
+            low, high = fmt_deg(reading.low), fmt_deg(reading.high)
+            err_console.print(f"  {reading.motor}: {low} … {high}")
         return answer[0]
 
     def confirm(self, question: str) -> bool:

@@ -7,7 +7,15 @@ from typing import TYPE_CHECKING
 import typer
 
 from poppy_cli.options import BusPortOpt, JsonOpt, ProfileOpt
-from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, console, error_line, print_json, styled
+from poppy_cli.output import (
+    EXIT_FAILURE,
+    EXIT_USAGE,
+    console,
+    err_console,
+    error_line,
+    print_json,
+    styled,
+)
 
 if TYPE_CHECKING:
     from poppy_core.robot.doctor import Check
@@ -31,6 +39,31 @@ def _render(check: Check) -> None:
         console.print(styled("    [yellow]fix:[/] {}", check.fix))
 
 
+def _found_profile(probe: SystemProbe, port: str | None) -> str:
+    """The profile of no option, variable or setting: the installed service's, else the one
+    whose motors answer on ``port``; else a usage error."""
+    from poppy_core.robot.doctor_system import service_profile
+    from poppy_core.robot.profile_match import profile_on_port
+
+    found = service_profile(probe)
+    if found is not None:
+        _say(f"checking {found}, the profile poppy.service serves")
+        return found
+    if port is not None:
+        _say(f"no profile given: looking for a known robot on {port}")
+        found = profile_on_port(port)
+        if found is not None:
+            _say(f"the motors on {port} are those of {found}: checking it")
+            return found
+    where = f"the motors on {port} are no known robot's" if port else "no bus found"
+    error_line(f"no profile given and {where}: pass --profile NAME (see `poppy config list`)")
+    raise typer.Exit(EXIT_USAGE)
+
+
+def _say(message: str) -> None:
+    err_console.print(message, style="dim", highlight=False, markup=False)
+
+
 def doctor(
     profile: str | None = ProfileOpt,
     port: str | None = BusPortOpt,
@@ -52,16 +85,14 @@ def doctor(
     from poppy_core.robot.doctor_system import run_doctor
     from poppy_core.robot.profiles import load_profile
 
-    chosen = resolve(profile, None).profile
-    if chosen is None:
-        error_line("no profile given: pass --profile NAME (see `poppy config list`)")
-        raise typer.Exit(EXIT_USAGE)
-    config = load_profile(chosen)
     probe = system_probe()
+    bus_port = chosen_port(port)
+    chosen = resolve(profile, None).profile or _found_profile(probe, bus_port)
+    config = load_profile(chosen)
     report = run_doctor(
         config,
         chosen,
-        chosen_port(port),
+        bus_port,
         page_url=url,
         probe=probe,
         progress=None if json_output else _render,

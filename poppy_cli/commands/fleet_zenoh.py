@@ -148,6 +148,8 @@ def _status_table(
 ) -> Any:
     from rich.table import Table
 
+    from poppy_cli.output import fmt_deg
+
     table = Table("robot", "health", "state Hz", "age", "motors (°)")
     now = time.time()
     for name in sorted(n for n, alive in present.items() if alive):
@@ -159,7 +161,7 @@ def _status_table(
             table.add_row(name, verdict, "", "", "")
             continue
         motors = " ".join(
-            f"{m}:{v['present_position']:.0f}{'' if v['online'] else '!'}"
+            f"{m}:{fmt_deg(v['present_position'], 1.0, '')}{'' if v['online'] else '!'}"
             if v["present_position"] is not None
             else f"{m}:-"
             for m, v in state.motors.items()

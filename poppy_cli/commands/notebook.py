@@ -77,14 +77,24 @@ def check_robot_url(url: str) -> str:
     return f"{parts.scheme}://{parts.netloc}"
 
 
-def jupyter_command(host: str, port: int, folder: Path, open_browser: bool) -> list[str]:
-    """The Jupyter Notebook server's command line (``python -m notebook``)."""
+def jupyter_command(
+    host: str, port: int, folder: Path, open_browser: bool, as_root: bool = False
+) -> list[str]:
+    """The Jupyter Notebook server's command line (``python -m notebook``); ``as_root`` passes
+    ``--allow-root``, without which Jupyter refuses to start as root."""
     args = [sys.executable, "-m", "notebook", f"--ServerApp.ip={host}"]
     args += [f"--ServerApp.port={port}", "--ServerApp.port_retries=0"]
     args += [f"--ServerApp.root_dir={folder}"]
     if not open_browser:
         args.append("--no-browser")
+    if as_root:
+        args.append("--allow-root")
     return args
+
+
+def running_as_root() -> bool:
+    """Whether this process runs as root (the default user of many Pi images and containers)."""
+    return hasattr(os, "geteuid") and os.geteuid() == 0
 
 
 def run_jupyter(args: Sequence[str], env: dict[str, str]) -> NoReturn:
@@ -123,6 +133,14 @@ def notebook(
     for added in add_shipped_notebooks(where):
         print(f"added {added}", file=sys.stderr, flush=True)
     env = dict(os.environ, POPPY_ROBOT_URL=base)
+    as_root = running_as_root()
+    if as_root:
+        print(
+            "warning: running as root, so Jupyter is started with --allow-root "
+            "(its notebooks can change anything on this machine; a user account is safer)",
+            file=sys.stderr,
+            flush=True,
+        )
     shown = f"[{host}]" if ":" in host else host
     print(
         f"Jupyter on http://{shown}:{port}/notebooks/{FIRST_NOTEBOOK} (notebooks in {where}); "
@@ -130,7 +148,7 @@ def notebook(
         file=sys.stderr,
         flush=True,
     )
-    run_jupyter(jupyter_command(host, port, where, not no_browser), env)
+    run_jupyter(jupyter_command(host, port, where, not no_browser, as_root), env)
 
 
 def _usage(message: str) -> NoReturn:

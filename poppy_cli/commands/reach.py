@@ -21,7 +21,7 @@ from poppy_cli.options import (
     SimOpt,
     duration_option,
 )
-from poppy_cli.output import console, print_json
+from poppy_cli.output import console, fmt_deg, print_json
 from poppy_cli.robots import build_robot
 from poppy_core import checks
 from poppy_core.errors import ArgumentError
@@ -197,7 +197,7 @@ def reach(
     if json_output:
         print_json(result)
         return
-    motors = ", ".join(f"{n}={a:.1f}°" for n, a in angles.items())
+    motors = ", ".join(f"{n}={fmt_deg(a)}" for n, a in angles.items())
     if reached is None:
         console.print(f"{chain.label}: moving to {_xyz(target)} in {duration:g} s ({motors})")
     else:

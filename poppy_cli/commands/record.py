@@ -24,6 +24,7 @@ from poppy_cli.output import (
     EXIT_FAILURE,
     err_console,
     error_line,
+    fmt_deg,
     print_json,
     printable,
 )
@@ -80,7 +81,7 @@ def _live_table(recorder: MoveRecorder, duration: float | None) -> Table:
     table.add_column("motor")
     table.add_column("position", justify="right")
     for name, value in recorder.latest().items():
-        table.add_row(name, f"{value:.1f}°")
+        table.add_row(name, fmt_deg(value))
     return table
 
 
@@ -169,11 +170,8 @@ def record(
         recorder.start()  # refused here when another `poppy record` writes the same file
         for motor_name in names:
             robot.motor(motor_name).compliant = True
-        err_console.print(
-            f"recording {', '.join(names)} at {freq:g} Hz into {path}"
-            " — move them by hand; Enter or Ctrl-C stops",
-            soft_wrap=True,
-        )
+        for line in start_lines(names, freq, path):
+            err_console.print(line, soft_wrap=True, highlight=False, markup=False)
         sys.stderr.flush()
         _wait(recorder, stop, duration)
         stop.set()
@@ -202,6 +200,22 @@ def record(
         sys.stdout.flush()
     if save_failure is not None and not _interactive():
         raise typer.Exit(EXIT_FAILURE)
+
+
+def start_lines(names: list[str], freq: float, path: Path, width: int = 80) -> list[str]:
+    """What a recording's start says, in lines of at most ``width`` columns (a path longer than
+    that alone on its line)."""
+    listed = ", ".join(names)
+    motors = listed if len(listed) <= 30 else f"{len(names)} motors"
+    parts = [f"recording {motors} at {freq:g} Hz", f"into {path}"]
+    parts.append("— move them by hand; Enter or Ctrl-C stops")
+    lines = [parts[0]]
+    for part in parts[1:]:
+        if len(lines[-1]) + 1 + len(part) <= width:
+            lines[-1] += " " + part
+        else:
+            lines.append(part.removeprefix("— "))
+    return lines
 
 
 def check_name(name: str) -> None:

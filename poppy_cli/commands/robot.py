@@ -92,7 +92,25 @@ def status_table(robot: Robot | RemoteRobot, title: str = "robot status") -> Tab
             "yes" if state["compliant"] else "no",
             link,
         )
+    table.caption = frame_note(robot)
     return table
+
+
+def frame_note(robot: Robot | RemoteRobot) -> str | None:
+    """Why a robot's angle differs from the motor's own (`poppy motor` speaks the motor's):
+    the motors mounted indirect (sign flipped) or with an offset; None when none is."""
+    flipped = [m.name for m in robot.motors if getattr(m, "orientation", "") == "indirect"]
+    shifted = [
+        f"{m.name} {float(getattr(m, 'offset', 0.0)):+g}°"
+        for m in robot.motors
+        if float(getattr(m, "offset", 0.0))
+    ]
+    parts = ([" ".join(flipped) + " sign flipped"] if flipped else []) + (
+        ["offset " + " ".join(shifted)] if shifted else []
+    )
+    if not parts:
+        return None
+    return f"robot frame: {'; '.join(parts)} (`poppy motor` shows the motor's own)"
 
 
 def robot_health(robot: Robot | RemoteRobot) -> dict[str, dict[str, Any]]:

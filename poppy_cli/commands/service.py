@@ -4,6 +4,7 @@ another program or taken back (release, take)."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -19,6 +20,8 @@ app = typer.Typer(
 )
 
 DEFAULT_REMOTE = "http://127.0.0.1:8080"
+FILE_MODE = 0o644
+"""The units and the polkit rule: root (or the user) writes them, everyone reads them."""
 SHOWN = ("Id", "LoadState", "ActiveState", "SubState", "UnitFileState", "MainPID", "FragmentPath")
 
 UserOpt = typer.Option(
@@ -79,7 +82,7 @@ def install(
     from poppy_cli.service_files import files_of, write_files
     from poppy_cli.service_polkit import RULE_FILE, polkit_dir, rule_text
     from poppy_cli.systemd import Systemd, unit_dir
-    from poppy_core.checks import robot_name
+    from poppy_core.checks import one_line, robot_name
     from poppy_core.errors import ArgumentError
     from poppy_core.files import write_file
     from poppy_core.robot import load_profile
@@ -87,6 +90,8 @@ def install(
 
     try:
         name = robot_name(name, "--name")  # the rule `poppy serve --name` applies
+        for flag, value in (("--port", port), ("--host", host), ("--profile", profile)):
+            one_line(value, flag)  # a newline would end the unit's ExecStart= line
     except ArgumentError as exc:
         _usage(str(exc))
     if not port.strip():
@@ -95,7 +100,7 @@ def install(
         _usage("--run-as is for the system service: a --user service runs as you")
     load_profile(profile)  # an unknown profile: one line naming the known ones
     ports = tuple(http_ports or (units.USER_PORTS if user else units.SYSTEM_PORTS))
-    run_as = None if user else _service_user(run_as)
+    run_as = None if user else _service_user(run_as, dry_run)
     files = files_of(run_as)
     spec = units.ServiceSpec(
         poppy=units.poppy_command(),
@@ -112,7 +117,10 @@ def install(
         settings_file=files.settings,
         token_file=files.token if token else None,
     )
-    texts = units.units(spec)
+    try:
+        texts = units.units(spec)
+    except ArgumentError as exc:
+        _usage(str(exc))
     systemd = Systemd(user)
     folder = unit_dir(user)
     stale = [] if jupyter else [units.JUPYTER_UNIT]
@@ -137,6 +145,8 @@ def install(
         )
         return
     systemd.systemctl("--version")  # no systemd: one line before anything is written
+    # folders made on the way get at most rwxr-xr-x, whatever the umask (files: their modes)
+    os.umask(os.umask(0o022) | 0o022)
     made = write_files(files, ServeOptions(snap=snap, zmq=zmq), token, run_as)
     _write_units(folder, texts)
     if run_as is not None:  # the page's restarts and settings, for the service's user
@@ -145,6 +155,7 @@ def install(
             rule_text(run_as, (units.UNIT, units.JUPYTER_UNIT)),
             replace=True,
             make_folder=True,
+            mode=FILE_MODE,
         )
     _remove_units(systemd, folder, [u for u in stale if (folder / u).exists()])
     systemd.systemctl("daemon-reload")
@@ -168,25 +179,37 @@ def install(
         )
 
 
-def _service_user(run_as: str | None) -> str:
+def _service_user(run_as: str | None, dry_run: bool) -> str:
     """The user a system service runs as: ``--run-as``, else who ran sudo, else the current
-    user; never root, and one that exists."""
+    user; never root (a dry run shows root's unit, with a warning), and one that exists with
+    a home (the service's settings and token are kept there)."""
     import getpass
     import os
     import pwd
 
     chosen = run_as or os.environ.get("SUDO_USER") or getpass.getuser()
     if chosen == "root":
-        _usage(
-            "the service must not run as root: pass --run-as USER (a user of the dialout "
-            "group, e.g. pi or poppy)"
+        advice = "pass --run-as USER (a user of the dialout group, e.g. pi or poppy)"
+        if not dry_run:
+            _usage(f"the service must not run as root: {advice}")
+        err_console.print(
+            f"warning: this unit runs as root, which `poppy service install` refuses: {advice}",
+            soft_wrap=True,
+            highlight=False,
+            markup=False,
         )
     try:
-        pwd.getpwnam(chosen)
+        home = Path(pwd.getpwnam(chosen).pw_dir)
     except KeyError:
         _usage(
             f"--run-as {chosen!r}: no such user on this machine; create it (sudo adduser "
             f"{chosen} && sudo adduser {chosen} dialout) or give another"
+        )
+    if not home.is_dir():
+        _usage(
+            f"--run-as {chosen!r}: its home {home} is not a folder, and the service keeps its "
+            f"settings and token there; give a user with a home (sudo adduser poppy && sudo "
+            "adduser poppy dialout)"
         )
     return chosen
 
@@ -195,7 +218,7 @@ def _write_units(folder: Path, texts: dict[str, str]) -> None:
     from poppy_core.files import write_file
 
     for unit, text in texts.items():
-        write_file(folder / unit, text, replace=True, make_folder=True)
+        write_file(folder / unit, text, replace=True, make_folder=True, mode=FILE_MODE)
 
 
 def _installed(user: bool) -> list[str]:

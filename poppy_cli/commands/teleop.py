@@ -23,6 +23,7 @@ from poppy_cli.output import (
     console,
     err_console,
     error_line,
+    fmt_deg,
     print_json,
     styled,
 )
@@ -381,8 +382,8 @@ def _table(teleop_run: Teleoperation) -> Table:
         now = status.follower.get(link.follower)
         table.add_row(
             f"{link.follower} ← {link.leader}",
-            "-" if leader is None else f"{leader:.1f}°",
-            "-" if target is None else f"{target:.1f}°",
-            "-" if now is None else f"{now:.1f}°",
+            "-" if leader is None else fmt_deg(leader),
+            "-" if target is None else fmt_deg(target),
+            "-" if now is None else fmt_deg(now),
         )
     return table

@@ -21,6 +21,7 @@ from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.results import PingResult, SetupResult
 from poppy_core.errors import CommunicationError, SetupError
 from poppy_core.models import ServoModel, SIValue, standard_baudrates
+from poppy_core.models.degrees import fmt_deg, tick_deg
 from poppy_core.protocol import protocol_for
 
 logger = logging.getLogger(__name__)
@@ -268,11 +269,15 @@ def set_angle_limits(
         RegisterError: a limit outside the model's range.
     """
     if min_deg >= max_deg:
-        raise SetupError(f"angle limits need min < max (got {min_deg}° and {max_deg}°)")
+        raise SetupError(f"angle limits need min < max (got {min_deg:g}° and {max_deg:g}°)")
     _, model = identify(bus, motor_id)
     for name, value in (("min_position_limit", min_deg), ("max_position_limit", max_deg)):
         model.register(name).from_si(value)  # out of range: refused before a word
-    say(progress, f"motor {motor_id}: angle limits {min_deg}° .. {max_deg}°")
+    step = tick_deg(model)
+    say(
+        progress,
+        f"motor {motor_id}: angle limits {fmt_deg(min_deg, step)} .. {fmt_deg(max_deg, step)}",
+    )
     result = new_result(bus, "set_angle_limits", motor_id)
     for name, value in (("min_position_limit", min_deg), ("max_position_limit", max_deg)):
         result.changes[name] = _write_verified(bus, motor_id, model, name, value)

@@ -177,6 +177,20 @@ def service_name(probe: SystemProbe, scope: list[str] | None) -> str:
     return found.group(1) if found else DEFAULT_NAME
 
 
+_PROFILE_FLAG = re.compile(r"^ExecStart=.*?--profile[= ]+([A-Za-z0-9][A-Za-z0-9_.-]*)", re.M)
+
+
+def service_profile(probe: SystemProbe) -> str | None:
+    """The profile the installed poppy.service serves (``--profile`` in its unit's ExecStart),
+    None when it is not installed or names none."""
+    scope = service_scope(probe)
+    if scope is None:
+        return None
+    code, out = probe.run(["systemctl", *scope, "cat", SERVICE])
+    found = _PROFILE_FLAG.search(out) if code == 0 else None
+    return found.group(1) if found else None
+
+
 def check_page(url: str, installed: bool, probe: SystemProbe) -> Check:
     """The robot's page answers at ``url`` (http://NAME.local/), when the service is installed."""
     if not installed:

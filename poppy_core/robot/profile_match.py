@@ -74,3 +74,26 @@ def matching_profile(
             continue
         return info.name, config, ports
     return None
+
+
+def profile_on_port(port: str) -> str | None:
+    """The profile whose motors answer on ``port`` (scanned at the rates, protocols and IDs of
+    the known one-bus profiles only), None when they are no profile's."""
+    from poppy_core.bus.scan import scan
+
+    settings: set[tuple[int, int]] = set()
+    ids: set[int] = set()
+    for info in list_profiles():
+        try:
+            config = load_profile(info.name)
+        except ConfigError:
+            continue
+        if len(config.controllers) != 1:
+            continue
+        settings |= {(c.baudrate, c.protocol) for c in config.controllers.values()}
+        ids |= {m.id for m in config.motors.values()}
+    found: list[FoundMotor] = []
+    for baudrate, protocol in sorted(settings):
+        found += scan(port, [baudrate], [protocol], sorted(ids), patient=False)
+    match = matching_profile([f for f in found if f.model is not None])
+    return match[0] if match is not None else None

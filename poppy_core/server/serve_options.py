@@ -95,7 +95,8 @@ def read_options(path: Path) -> ServeOptions:
 
 def write_options(path: Path, options: ServeOptions) -> None:
     """Write ``options`` to ``path`` atomically (its folder made when missing)."""
-    write_file(path, json.dumps(asdict(options), indent=2) + "\n", replace=True, make_folder=True)
+    text = json.dumps(asdict(options), indent=2) + "\n"
+    write_file(path, text, replace=True, make_folder=True, mode=0o644)
 
 
 def check_token(text: str) -> str:

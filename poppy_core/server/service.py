@@ -16,6 +16,7 @@ from typing import Any
 from poppy_core.motion import Primitive, attach_builtins, attached_primitive, attached_primitives
 from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
+from poppy_core.server.compliant_goals import GOAL_REGISTERS, CompliantGoals, goal_motors
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from poppy_core.server.pypot_json import html_safe
@@ -46,6 +47,8 @@ class RobotService:
         self.teleop = TeleopRegistry()
         """Which WebSocket connection teleoperates which motor."""
         self._description: tuple[float, bytes] | None = None
+        self.compliant_goals = CompliantGoals()
+        """Goals to compliant motors: refused on v1, logged once per motor either way."""
 
     # -- motors and groups ---------------------------------------------------------------------
 
@@ -79,12 +82,41 @@ class RobotService:
         """The JSON value of a register."""
         return values.read_register(self.motor(motor), register)
 
-    def write(self, motor: str, register: str, value: Any) -> Any:
-        """Check then write a register; returns the value written."""
-        return values.jsonable(values.write_register(self.motor(motor), register, value))
+    def write(
+        self, motor: str, register: str, value: Any, *, refuse_compliant: bool = False
+    ) -> Any:
+        """Check then write a register; returns the value written.
 
-    def write_many(self, commands: Any) -> dict[str, dict[str, Any]]:
-        """Apply ``{motor: {register: value}}`` after checking every value (all or nothing)."""
+        Raises:
+            CompliantMotorError: with ``refuse_compliant`` (the v1 API), a goal to a compliant
+                motor (written otherwise, as pypot does, and logged once).
+        """
+        found = self.motor(motor)
+        checked = values.check_write(found, register, value)
+        if register in GOAL_REGISTERS:
+            self._goals([found], refuse_compliant)
+        values.apply_checked(found, register, checked)
+        if register == "compliant" and checked is False:
+            self.compliant_goals.stiff([found.name])
+        return values.jsonable(checked)
+
+    def _goals(self, motors: Sequence[Motor], refuse_compliant: bool) -> None:
+        """Goals for ``motors``: refused when one is compliant and ``refuse_compliant``, else
+        noted (the log names a compliant motor once)."""
+        if refuse_compliant:
+            self.compliant_goals.refuse(motors)
+        for motor in motors:
+            self.compliant_goals.note(motor)
+
+    def write_many(
+        self, commands: Any, *, refuse_compliant: bool = False
+    ) -> dict[str, dict[str, Any]]:
+        """Apply ``{motor: {register: value}}`` after checking every value (all or nothing).
+
+        Raises:
+            CompliantMotorError: with ``refuse_compliant``, a goal to a compliant motor that the
+                same command does not make stiff (nothing is written then).
+        """
         if not isinstance(commands, Mapping):
             raise ApiError("invalid", "expected an object {motor: {register: value}}")
         checked: list[tuple[Motor, str, Any]] = []
@@ -96,10 +128,13 @@ class RobotService:
                 checked.append(
                     (motor, str(register), values.check_write(motor, str(register), value))
                 )
+        self._goals([self.motor(str(m)) for m in goal_motors(commands)], refuse_compliant)
         out: dict[str, dict[str, Any]] = {}
         for motor, register, value in checked:
             values.apply_checked(motor, register, value)
             out.setdefault(motor.name, {})[register] = values.jsonable(value)
+            if register == "compliant" and value is False:
+                self.compliant_goals.stiff([motor.name])
         return out
 
     def register_values(self, register: str) -> dict[str, Any]:
@@ -117,11 +152,18 @@ class RobotService:
     def set_compliant(self, compliant: bool) -> None:
         """Make every motor compliant or stiff."""
         self.robot.compliant = compliant
+        if not compliant:
+            self.compliant_goals.stiff(self.motor_names())
 
     # -- gotos ---------------------------------------------------------------------------------
 
     def goto(
-        self, positions: Mapping[str, Any], duration_s: Any, control: str = "minjerk"
+        self,
+        positions: Mapping[str, Any],
+        duration_s: Any,
+        control: str = "minjerk",
+        *,
+        refuse_compliant: bool = False,
     ) -> GotoHandle:
         """Start a goto of several motors after checking every target and the duration.
 
@@ -132,10 +174,13 @@ class RobotService:
             UnknownMotorError: an unknown motor.
             ArgumentError: a target that is not a finite number, a bad duration or control.
             ApiError: no motor.
+            CompliantMotorError: with ``refuse_compliant`` (the v1 API), a compliant motor (it
+                would not move; pypot's routes start the goto, and the log names it once).
         """
         duration = goto_duration(duration_s)
         control = control_name(control)
         targets = self.targets(positions)
+        self._goals([self.motor(name) for name in targets], refuse_compliant)
         return self.robot.goto_position(targets, duration, control=control, wait=False)
 
     def targets(self, positions: Mapping[str, Any]) -> dict[str, float]:

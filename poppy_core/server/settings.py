@@ -11,13 +11,15 @@ from __future__ import annotations
 import dataclasses
 import logging
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from poppy_core import checks
 from poppy_core.checks import robot_name, robot_name_of_host
-from poppy_core.errors import ConfigError, FileError
+from poppy_core.errors import ArgumentError, ConfigError, FileError
 from poppy_core.server import serve_options
 from poppy_core.server.errors import ApiError
 from poppy_core.server.origins import OriginPolicy
@@ -33,11 +35,13 @@ SERVICE_UNITS = {"jupyter": "poppy-jupyter.service"}
 SERVED_OPTIONS = {"snap": "--snap", "zmq": "--zmq"}
 """Services served by ``poppy.service`` itself: changed in its settings file (``poppy serve
 --settings``), then the service restarts."""
+ZMQ_WITH_TOKEN = (
+    "ZMQ is not turned on from the page of a robot that requires a token: pypot's ZMQ API has "
+    "no token, anyone on the network could move the robot"
+)
+"""Why the page's ZMQ switch only turns ZMQ off (every change from the page needs a token)."""
 SERVICE_UNIT = "poppy.service"
 """The installed service (``poppy service install``), restarted after a change of its files."""
-MIN_PSK = 8
-MAX_PSK = 63
-MAX_SSID_BYTES = 32
 
 
 def poppy_version() -> str:
@@ -88,7 +92,8 @@ class RobotSettings:
     # -- reading -------------------------------------------------------------------------------
 
     def overview(self) -> dict[str, Any]:
-        """Everything the settings panel shows, and whether (and why not) it can change it."""
+        """Everything the settings panel shows, and whether (and why not) it can change it
+        (a service the page may not turn on has a ``reason``)."""
         missing = self.system.unavailable()
         reason = self._without_token() or missing
         how = "settings" if self.served.settings_file is not None else None
@@ -96,6 +101,8 @@ class RobotSettings:
             name: {"on": name in self.served.protocols, "unit": None, "how": how or f"serve {flag}"}
             for name, flag in SERVED_OPTIONS.items()
         }
+        if self.served.token_required:
+            services["zmq"]["reason"] = ZMQ_WITH_TOKEN
         for name, unit in SERVICE_UNITS.items():
             active = self.system.service_active(unit) if missing is None else None
             services[name] = {"on": active, "unit": unit, "how": "systemctl"}
@@ -163,28 +170,31 @@ class RobotSettings:
         return won
 
     def join(self, ssid: str, password: str | None, who: str) -> None:
-        """Join a Wi-Fi network (and remember it)."""
-        _check_ssid(ssid)
-        if password is not None and password and not MIN_PSK <= len(password) <= MAX_PSK:
-            raise ApiError("invalid", f"a Wi-Fi password has {MIN_PSK} to {MAX_PSK} characters")
+        """Join a Wi-Fi network (and remember it); no password (or "") for an open one."""
+        ssid = _checked(checks.wifi_ssid, ssid, "ssid")
+        if password:
+            password = _checked(checks.wifi_password, password, "password")
         self.check_change()
         self.system.join(ssid, password or None)
         logger.warning("settings: %s joined the Wi-Fi network %r", who, ssid)
 
     def forget(self, name: str, who: str) -> None:
-        """Forget a saved Wi-Fi network."""
-        _check_ssid(name)
+        """Forget a saved Wi-Fi network (only one: never the Ethernet or another connection)."""
+        name = _checked(checks.one_line, name, "name")
         self.check_change()
+        saved = [s.name for s in self.system.saved()]
+        if name not in saved:
+            raise ApiError(
+                "invalid",
+                f"{name!r} is not a saved Wi-Fi network (saved: {', '.join(saved) or 'none'})",
+            )
         self.system.forget(name)
         logger.warning("settings: %s forgot the Wi-Fi network %r", who, name)
 
     def hotspot(self, on: bool, password: str | None, who: str) -> str | None:
         """Set up (or remove) the access point named after the robot; returns its name."""
-        if on and (password is None or not MIN_PSK <= len(password) <= MAX_PSK):
-            raise ApiError(
-                "invalid",
-                f"the access point needs a password of {MIN_PSK} to {MAX_PSK} characters",
-            )
+        if on:
+            password = _checked(checks.wifi_password, password, "the access point's password")
         self.check_change()
         if not on:
             self.system.remove_hotspot()
@@ -197,7 +207,7 @@ class RobotSettings:
         return ssid
 
     def set_service(self, service: str, on: bool, who: str) -> bool:
-        """Start and enable a service's unit, or stop and disable it; Snap! and ZMQ are
+        """Start a service's unit, or stop it (until the next boot); Snap! and ZMQ are
         switched in the settings file and ``poppy.service`` restarts. Returns True when the
         server restarts now."""
         unit = SERVICE_UNITS.get(service)
@@ -221,6 +231,10 @@ class RobotSettings:
                 tip="install the service (poppy service install) to switch it from the page",
             )
         self._check_token()
+        if service == "zmq" and on and self.served.token_required:
+            raise ApiError(
+                "conflict", ZMQ_WITH_TOKEN, tip="use the REST API or Zenoh, which ask for the token"
+            )
         try:
             with self._files:
                 options = serve_options.read_options(path)
@@ -274,8 +288,9 @@ class RobotSettings:
         return True
 
 
-def _check_ssid(ssid: str) -> None:
-    if not ssid or len(ssid.encode()) > MAX_SSID_BYTES or any(ord(c) < 32 for c in ssid):
-        raise ApiError(
-            "invalid", f"a Wi-Fi network name has 1 to {MAX_SSID_BYTES} bytes, no control character"
-        )
+def _checked(rule: Callable[[Any, str], str], value: object, field: str) -> str:
+    """``rule(value, field)``, its ArgumentError a 422 with its one line."""
+    try:
+        return rule(value, field)
+    except ArgumentError as exc:
+        raise ApiError("invalid", str(exc)) from None

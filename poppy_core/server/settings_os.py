@@ -287,9 +287,9 @@ class SystemTools:
             return False
 
     def set_service(self, unit: str, on: bool) -> None:
-        """Start and enable ``unit``, or stop and disable it (``systemctl enable|disable
-        --now``)."""
-        self.run(*self._systemctl("enable" if on else "disable", "--now", unit))
+        """Start ``unit``, or stop it (``systemctl start|stop``): what the polkit rule of
+        ``poppy service install`` grants; whether it starts at boot stays as installed."""
+        self.run(*self._systemctl("start" if on else "stop", unit))
 
     def restart_later(self, unit: str) -> None:
         """Ask systemd to restart ``unit`` and return at once (``systemctl restart --no-block``):

@@ -150,3 +150,21 @@ def test_a_signal_during_play_exits_130_after_the_summary(signum: int) -> None:
     assert proc.returncode == 130, stderr
     summary = json.loads(stdout)
     assert summary["completed"] is False and summary["played_s"] < 60
+
+
+def test_the_recording_s_start_lines_fit_80_columns() -> None:
+    from pathlib import Path
+
+    from poppy_cli.commands.record import start_lines
+
+    names = [f"motor_{i}" for i in range(25)]
+    for motors, path in (
+        (["m1", "m2", "m3", "m4", "m5", "m6"], Path("/root/.local/share/poppy/moves/wave.json")),
+        (names, Path("/home/pi/.local/share/poppy/moves/a-long-move-name-of-the-humanoid.json")),
+        (["m1"], Path("wave.json")),
+    ):
+        lines = start_lines(motors, 50, path)
+        assert all(len(line) <= 80 for line in lines), lines
+        text = " ".join(lines)
+        assert str(path) in text and "Enter or Ctrl-C stops" in text
+        assert ("m1" in text) if len(motors) < 10 else "25 motors" in text

@@ -40,6 +40,9 @@ def test_status_table(poppy: Any) -> None:
     result = poppy("robot", "status", "--sim", "--profile", "ergo-jr")
     assert result.code == 0, result.stderr
     assert "m6" in result.stdout and "online" in result.stdout
+    # why a robot's angle is not the one `poppy motor` shows (m3 at +30 after `motor set -30`)
+    note = " ".join(result.stdout.split())
+    assert "robot frame: m2 m3 m5 m6 sign flipped (`poppy motor` shows the motor's own)" in note
 
 
 def test_goto_sim_reaches_target(poppy: Any) -> None:

@@ -61,7 +61,7 @@ def someone() -> str:
     """A user of this machine that is not root, for --run-as."""
     import pwd
 
-    users = [u.pw_name for u in pwd.getpwall() if u.pw_uid != 0]
+    users = [u.pw_name for u in pwd.getpwall() if u.pw_uid != 0 and Path(u.pw_dir).is_dir()]
     if not users:
         pytest.skip("no user but root on this machine")
     return users[0]
@@ -267,6 +267,29 @@ def test_bad_install_options_are_one_line(
     assert says in result.stderr and "Traceback" not in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1, result.stderr
     assert fake.calls() == [] and not fake.units.exists()
+
+
+def test_the_dry_run_as_root_shows_root_s_unit_with_a_warning(fake: Fake) -> None:
+    result = fake.run("install", "--dry-run", "--run-as", "root")
+    assert result.code == 0, result.stderr
+    assert "User=root" in result.stdout
+    (warning,) = result.stderr.strip().splitlines()[:-1]  # then what it would write
+    assert warning.startswith("warning: this unit runs as root") and "--run-as USER" in warning
+    assert fake.calls() == [] and not fake.units.exists()
+
+
+def test_a_user_without_a_home_is_refused(fake: Fake) -> None:
+    import pwd
+
+    homeless = [u.pw_name for u in pwd.getpwall() if not Path(u.pw_dir).is_dir()]
+    if not homeless:
+        pytest.skip("every user of this machine has a home")
+    for args in ((), ("--dry-run",)):
+        result = fake.run("install", "--run-as", homeless[0], *args)
+        assert result.code == 2, result.stderr
+        assert "is not a folder" in result.stderr and "Traceback" not in result.stderr
+        assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+        assert fake.calls() == [] and not fake.units.exists() and "/" not in result.stdout
 
 
 def test_without_systemd_install_is_one_line_and_writes_nothing(

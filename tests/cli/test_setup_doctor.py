@@ -6,7 +6,7 @@ from __future__ import annotations
 import io
 import os
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import pytest
@@ -16,7 +16,7 @@ from poppy_core.emulator import VirtualBus, build_bus_from_spec, serve_link, ser
 from poppy_core.robot.doctor_system import SystemProbe
 from poppy_core.robot.guided_setup import motor_targets
 from poppy_core.robot.profiles import load_profile
-from tests.helpers.cli import Result, run_poppy
+from tests.helpers.cli import Result, no_user_settings, run_poppy
 
 ERGO_JR = load_profile("ergo-jr")
 
@@ -396,3 +396,34 @@ def test_setup_stops_when_the_input_ends() -> None:
         result = run_poppy("setup", "motors", "--profile", "ergo-jr", "--port", server.url)
     assert result.code == 1
     assert "input ended before m1 was set up" in result.stderr
+
+
+def test_doctor_without_a_profile_takes_the_installed_service_s(
+    robot: Callable[..., tuple[VirtualBus, str]], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    no_user_settings(tmp_path, monkeypatch)
+    _, port = robot(set_up_robot())
+    result = run_poppy("doctor", "--port", port, "--json")
+    assert (result.code, result.json()["ok"]) == (0, True), result.stderr
+    assert "checking ergo-jr, the profile poppy.service serves" in result.stderr
+
+
+def test_doctor_without_a_profile_or_service_finds_the_robot_on_the_bus(
+    robot: Callable[..., tuple[VirtualBus, str]],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    no_user_settings(tmp_path, monkeypatch)
+    probe = replace(doctor_cmd.system_probe(), run=lambda argv: (1, ""))  # no service
+    monkeypatch.setattr(doctor_cmd, "system_probe", lambda: probe)
+    _, port = robot(set_up_robot())
+    result = run_poppy("doctor", "--port", port, "--json")
+    assert (result.code, result.json()["ok"]) == (0, True), result.stdout
+    assert f"the motors on {port} are those of ergo-jr: checking it" in result.stderr
+    _, other = robot(set_up_robot("XL-320:11-12"))
+    result = run_poppy("doctor", "--port", other)
+    assert result.code == 2 and "Traceback" not in result.stderr
+    assert result.stderr.strip().splitlines()[-1] == (
+        f"error: no profile given and the motors on {other} are no known robot's: "
+        "pass --profile NAME (see `poppy config list`)"
+    )

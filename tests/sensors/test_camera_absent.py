@@ -157,3 +157,28 @@ def test_poppy_serve_starts_without_its_camera_and_the_page_says_so(tmp_path: Pa
     assert proc.returncode == 0, err
     lines = [line for line in err.splitlines() if "camera" in line]
     assert len(lines) == 1 and "is not available" in lines[0], err
+
+
+def test_the_mjpeg_stream_of_an_absent_camera_is_503_at_once(
+    ergo_url: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import httpx
+
+    from tests.helpers.server import serve_robot
+
+    device = tmp_path / "video0.avi"  # never plugged in
+    robot = ergo_jr_on(ergo_url, device)
+    camera = robot.sensor("camera")
+    assert isinstance(camera, Camera)
+    # were the stream to wait for a first frame, it would wait a minute: longer than the client
+    monkeypatch.setattr(camera, "latest", lambda timeout_s=60.0: Camera.latest(camera, 60.0))
+    served = serve_robot(robot)
+    url = next(served).url
+    try:
+        with httpx.Client(base_url=url, timeout=30.0) as http:
+            answer = http.get("/api/v1/sensors/camera/stream.mjpg")
+        assert answer.status_code == 503, answer.text
+        detail = answer.json()["detail"]
+        assert "not available" in detail and "does not exist" in detail and "\n" not in detail
+    finally:
+        served.close()

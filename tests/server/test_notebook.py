@@ -93,6 +93,7 @@ def test_the_command_adds_the_notebook_once_and_starts_jupyter_for_the_robot(
         raise SystemExit(0)
 
     monkeypatch.setattr(notebook_cmd, "run_jupyter", recorded)
+    monkeypatch.setattr(notebook_cmd, "running_as_root", lambda: False)
     folder = tmp_path / "notebooks"
     args = ["notebook", "--dir", str(folder), "--no-browser", "--port", "8899"]
     done = run_poppy(*args, "--robot", "http://poppy.local:8080/", "--host", "0.0.0.0")
@@ -109,6 +110,24 @@ def test_the_command_adds_the_notebook_once_and_starts_jupyter_for_the_robot(
     assert first.read_text() == "my own edits"
     assert "--no-browser" not in started[1][0]
     assert started[1][1]["POPPY_ROBOT_URL"] == notebook_cmd.DEFAULT_ROBOT
+
+
+def test_as_root_jupyter_gets_allow_root_and_the_user_is_told(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    started: list[list[str]] = []
+
+    def recorded(args: list[str], env: dict[str, str]) -> None:
+        started.append(list(args))
+        raise SystemExit(0)
+
+    monkeypatch.setattr(notebook_cmd, "run_jupyter", recorded)
+    for root in (True, False):
+        monkeypatch.setattr(notebook_cmd, "running_as_root", lambda root=root: root)
+        done = run_poppy("notebook", "--dir", str(tmp_path / "nb"), "--no-browser")
+        assert done.code == 0, done.stderr
+        assert ("--allow-root" in started[-1]) is root
+        assert ("running as root" in done.stderr) is root, done.stderr
 
 
 def test_bad_input_is_one_line_and_a_missing_extra_names_it(

@@ -43,9 +43,13 @@ def test_same_names_groups_and_registers(remote: RemoteRobot, served: Served) ->
 def test_registers_read_and_write(remote: RemoteRobot, served: Served) -> None:
     remote.m4.led = "yellow"
     assert served.robot.m4.led == "yellow" and remote.m4.led == "yellow"
+    with pytest.raises(ConfigError, match=r"m4 is compliant .* make it stiff first"):
+        remote.m4.goal_position = 10.0  # a compliant motor would not move: the server says so
+    remote.m4.compliant = False
     remote.m4.goal_position = 1000.0  # beyond the angle limits: clamped, as the library does
     top = served.robot.m4.angle_limit[1]
     assert eventually(lambda: abs(served.robot.m4.goal_position - top) < 0.5)
+    remote.m4.compliant = True
     with pytest.raises(RegisterError, match="read-only"):
         remote.m4.present_position = 3.0
     with pytest.raises(AttributeError):

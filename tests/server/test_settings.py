@@ -95,8 +95,8 @@ def test_the_adapter_runs_exactly_these_commands(fake: FakeTools) -> None:
         HOTSPOT_ADD,
         ["nmcli", "-t", "-f", "NAME,TYPE,AUTOCONNECT-PRIORITY", "connection", "show"],
         ["nmcli", "connection", "delete", "id", HOTSPOT],
-        ["systemctl", "enable", "--now", "poppy-jupyter.service"],
-        ["systemctl", "disable", "--now", "poppy-jupyter.service"],
+        ["systemctl", "start", "poppy-jupyter.service"],
+        ["systemctl", "stop", "poppy-jupyter.service"],
         ["systemctl", "is-active", "poppy-jupyter.service"],
     ]
 
@@ -106,7 +106,7 @@ def test_a_user_service_is_reached_with_systemctl_user(fake: FakeTools) -> None:
     tools.set_service("poppy-jupyter.service", True)
     assert tools.service_active("poppy-jupyter.service") is True
     assert fake.calls() == [
-        ["systemctl", "--user", "enable", "--now", "poppy-jupyter.service"],
+        ["systemctl", "--user", "start", "poppy-jupyter.service"],
         ["systemctl", "--user", "is-active", "poppy-jupyter.service"],
     ]
 
@@ -213,7 +213,7 @@ def test_wifi_and_services_from_the_routes(fake: FakeTools, with_token: Served) 
         assert http.post(
             "/api/v1/settings/wifi/join", json={"ssid": "Home Wifi", "password": "password1"}
         ).json() == {"joined": "Home Wifi"}
-        assert http.post("/api/v1/settings/wifi/forget", json={"name": "Home Wifi"}).is_success
+        assert http.post("/api/v1/settings/wifi/forget", json={"name": "Class:room"}).is_success
         assert http.put(
             "/api/v1/settings/wifi/hotspot", json={"on": True, "password": "hotspot-pw"}
         ).json() == {"on": True, "ssid": "ergo-2"}
@@ -224,10 +224,10 @@ def test_wifi_and_services_from_the_routes(fake: FakeTools, with_token: Served) 
         assert failed.status_code == 409 and "Secrets were required" in failed.json()["detail"]
     assert fake.changes() == [
         ["nmcli", "device", "wifi", "connect", "Home Wifi", "password", "password1"],
-        ["nmcli", "connection", "delete", "id", "Home Wifi"],
+        ["nmcli", "connection", "delete", "id", "Class:room"],
         ["nmcli", "connection", "delete", "id", HOTSPOT],
         HOTSPOT_ADD,
-        ["systemctl", "enable", "--now", "poppy-jupyter.service"],
+        ["systemctl", "start", "poppy-jupyter.service"],
         ["nmcli", "device", "wifi", "connect", "Nowhere", "password", "wrongpass1"],
     ]
 
@@ -240,6 +240,19 @@ def test_wifi_and_services_from_the_routes(fake: FakeTools, with_token: Served) 
         ("POST", "/api/v1/settings/wifi/join", {"ssid": "", "password": None}, 422),
         ("POST", "/api/v1/settings/wifi/join", {"ssid": "Home", "password": "short"}, 422),
         ("PUT", "/api/v1/settings/wifi/hotspot", {"on": True}, 422),
+        # a NUL, a control or a non-ASCII character is no WPA password (8-63 printable ASCII)
+        ("POST", "/api/v1/settings/wifi/join", {"ssid": "Home", "password": "pass\x00word1"}, 422),
+        ("POST", "/api/v1/settings/wifi/join", {"ssid": "Home", "password": "pass\tword1"}, 422),
+        ("POST", "/api/v1/settings/wifi/join", {"ssid": "Home", "password": "pässwörd12"}, 422),
+        ("POST", "/api/v1/settings/wifi/join", {"ssid": "Home", "password": "f" * 63 + "g"}, 422),
+        ("PUT", "/api/v1/settings/wifi/hotspot", {"on": True, "password": "hotspot\x7fpw"}, 422),
+        # an SSID is 1-32 bytes, and one starting with '-' would reach nmcli as an option
+        ("POST", "/api/v1/settings/wifi/join", {"ssid": "--ask", "password": None}, 422),
+        ("POST", "/api/v1/settings/wifi/join", {"ssid": "é" * 17, "password": None}, 422),
+        ("POST", "/api/v1/settings/wifi/join", {"ssid": "Home\nWifi", "password": None}, 422),
+        # only a saved Wi-Fi network is forgotten: never the Ethernet connection
+        ("POST", "/api/v1/settings/wifi/forget", {"name": "Wired connection 1"}, 422),
+        ("POST", "/api/v1/settings/wifi/forget", {"name": "Nowhere"}, 422),
         ("PUT", "/api/v1/settings/services/snap", {"on": True}, 409),
         ("PUT", "/api/v1/settings/services/nothing", {"on": True}, 404),
     ],
@@ -253,6 +266,22 @@ def test_bad_changes_are_refused_in_one_line_and_run_nothing(
     detail = answer.json()["detail"]
     assert isinstance(detail, str) and "\n" not in detail
     assert fake.changes() == []
+
+
+def test_a_64_hex_digit_key_and_printable_ascii_are_wpa_passwords(
+    fake: FakeTools, with_token: Served
+) -> None:
+    key = "0123456789abcdef" * 4
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+        for password in (key, "a b~c!d{e}"):
+            answer = http.post(
+                "/api/v1/settings/wifi/join", json={"ssid": "Home Wifi", "password": password}
+            )
+            assert answer.status_code == 200, answer.text
+    assert fake.changes() == [
+        ["nmcli", "device", "wifi", "connect", "Home Wifi", "password", key],
+        ["nmcli", "device", "wifi", "connect", "Home Wifi", "password", "a b~c!d{e}"],
+    ]
 
 
 def test_elsewhere_the_settings_are_read_only_with_the_reason(

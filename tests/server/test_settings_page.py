@@ -80,7 +80,7 @@ def test_without_networkmanager_the_panel_is_read_only_and_says_why(
     assert fake.changes() == []
 
 
-def test_zmq_and_the_token_from_the_page_write_the_files_and_restart_the_service(
+def test_snap_and_the_token_from_the_page_write_the_files_and_restart_the_service(
     browser: Any,
     with_token: Served,
     fake: FakeTools,
@@ -100,9 +100,12 @@ def test_zmq_and_the_token_from_the_page_write_the_files_and_restart_the_service
     restart = ["systemctl", "restart", "--no-block", "poppy.service"]
     context, page = _settings_page(browser, with_token)
     try:
-        page.check("#settings-zmq")
+        # ZMQ has no token: a robot requiring one does not turn it on from its page, which says so
+        assert page.is_disabled("#settings-zmq")
+        assert "ZMQ API has no token" in page.inner_text("#settings")
+        page.check("#settings-snap")
         assert eventually(lambda: fake.changes() == [restart], 30.0)
-        assert serve_options.read_options(folder / "serve.json").zmq
+        assert serve_options.read_options(folder / "serve.json").snap
         page.wait_for_function(
             "() => document.getElementById('message').textContent.includes('Reconnected')"
         )

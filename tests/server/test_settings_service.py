@@ -74,19 +74,41 @@ def test_snap_and_zmq_are_switched_in_the_file_and_the_service_restarts(
     fake: FakeTools, appliance: tuple[Served, Path], caplog: pytest.LogCaptureFixture
 ) -> None:
     served, folder = appliance
+    serve_options.write_options(
+        folder / "serve.json", serve_options.ServeOptions(snap=True, zmq=True)
+    )
     caplog.set_level(logging.WARNING, logger="poppy_core.server.settings")
     with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
         shown = http.get("/api/v1/settings").json()
         assert shown["services"]["zmq"]["how"] == "settings" and shown["restarts"] is True
         assert shown["token_changeable"] is True
-        answer = http.put("/api/v1/settings/services/zmq", json={"on": True})
+        answer = http.put("/api/v1/settings/services/zmq", json={"on": False})
         assert answer.status_code == 200, answer.text
-        assert answer.json() == {"service": "zmq", "on": True, "restarting": True}
-        assert options(folder) == {"snap": True, "zmq": True}
+        assert answer.json() == {"service": "zmq", "on": False, "restarting": True}
+        assert options(folder) == {"snap": True, "zmq": False}
         assert http.put("/api/v1/settings/services/snap", json={"on": False}).is_success
-        assert options(folder) == {"snap": False, "zmq": True}
-    assert fake.changes() == [RESTART, RESTART]
-    assert "turned zmq on" in caplog.text and "turned snap off" in caplog.text
+        assert options(folder) == {"snap": False, "zmq": False}
+        assert http.put("/api/v1/settings/services/snap", json={"on": True}).is_success
+        assert options(folder) == {"snap": True, "zmq": False}
+    assert fake.changes() == [RESTART, RESTART, RESTART]
+    assert "turned zmq off" in caplog.text and "turned snap off" in caplog.text
+
+
+def test_zmq_is_not_turned_on_from_the_page_of_a_robot_requiring_a_token(
+    fake: FakeTools, appliance: tuple[Served, Path]
+) -> None:
+    # pypot's ZMQ API has no token: served on the robot's address, it would let anyone on the
+    # network move a robot whose page and API require one. The page says why, and refuses.
+    served, folder = appliance
+    with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
+        zmq = http.get("/api/v1/settings").json()["services"]["zmq"]
+        assert "ZMQ API has no token" in zmq["reason"] and zmq["on"] is False
+        answer = http.put("/api/v1/settings/services/zmq", json={"on": True})
+    assert answer.status_code == 409, answer.text
+    detail = answer.json()["detail"]
+    assert "ZMQ API has no token" in detail and "\n" not in detail
+    assert options(folder) == {"snap": True, "zmq": False}
+    assert fake.changes() == []
 
 
 def test_the_token_is_changed_in_its_file_readable_by_its_owner_only(
@@ -138,9 +160,9 @@ def test_outside_the_service_the_change_applies_at_the_next_start(
     monkeypatch.setattr(settings, "system", SystemTools(cgroup="0::/user.slice/session-2.scope"))
     with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
         assert http.get("/api/v1/settings").json()["restarts"] is False
-        answer = http.put("/api/v1/settings/services/zmq", json={"on": True})
-        assert answer.json() == {"service": "zmq", "on": True, "restarting": False}
-    assert options(folder) == {"snap": True, "zmq": True}
+        answer = http.put("/api/v1/settings/services/snap", json={"on": False})
+        assert answer.json() == {"service": "snap", "on": False, "restarting": False}
+    assert options(folder) == {"snap": False, "zmq": False}
     assert fake.changes() == []
 
 
@@ -152,11 +174,11 @@ def test_a_refused_restart_says_the_change_is_saved(
     fake.canned[" ".join(RESTART)] = {"err": refused, "code": 1}
     fake.save()
     with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
-        answer = http.put("/api/v1/settings/services/zmq", json={"on": True})
+        answer = http.put("/api/v1/settings/services/snap", json={"on": False})
     assert answer.status_code == 409
     detail = answer.json()["detail"]
     assert "saved in" in detail and "Interactive authentication required" in detail
-    assert options(folder) == {"snap": True, "zmq": True}
+    assert options(folder) == {"snap": False, "zmq": False}
     assert fake.calls() == [RESTART]
 
 

@@ -9,6 +9,7 @@ import os
 import signal
 import stat
 import subprocess
+import tarfile
 import urllib.request
 import zipfile
 from pathlib import Path
@@ -16,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from poppy_core.errors import ArgumentError, DownloadError
-from poppy_core.server.snap import release
+from poppy_core.server.snap import release, unpack
 from tests.helpers.cli import POPPY, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.snap_release import Files, make_release, release_server, zip_folder
@@ -225,3 +226,49 @@ def test_a_tar_gz_release_is_taken_too(tmp_path: Path, data_home: Path) -> None:
         tarred.add(fake.folder, arcname=fake.folder.name)
     copy = release.download(fake.version, archive.as_uri(), fake.digest)
     assert release.release_digest(copy.path) == fake.digest
+
+
+@pytest.mark.parametrize("kind", ["zip", "tar"])
+def test_an_archive_of_too_many_entries_is_refused_folders_counted(
+    tmp_path: Path, data_home: Path, monkeypatch: pytest.MonkeyPatch, kind: str
+) -> None:
+    # 60,000 empty folders are no Snap! release: every entry counts, before it is made
+    monkeypatch.setattr(unpack, "MAX_FILES", 100)
+    made: list[str] = []
+    real_mkdir = Path.mkdir
+
+    def mkdir(self: Path, *args: object, **kwargs: object) -> None:
+        made.append(self.name)
+        real_mkdir(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    archive = tmp_path / f"folders.{kind}"
+    if kind == "zip":
+        with zipfile.ZipFile(archive, "w") as zipped:
+            zipped.writestr("Snap/snap.html", "<html></html>")
+            for number in range(300):
+                zipped.writestr(f"Snap/empty-{number}/", "")
+    else:
+        with tarfile.open(archive, "w") as tarred:
+            for number in range(300):
+                folder = tarfile.TarInfo(f"Snap/empty-{number}")
+                folder.type = tarfile.DIRTYPE
+                tarred.addfile(folder)
+    monkeypatch.setattr(Path, "mkdir", mkdir)
+    with pytest.raises(DownloadError, match="more than a Snap! release"):
+        release.download("folders", str(archive), "0" * 64)
+    assert len({m for m in made if m.startswith("empty-")}) <= 100
+    assert _leftovers() == []
+
+
+@pytest.mark.parametrize("claimed", [0, 3])
+def test_a_zip_member_with_a_false_size_is_refused_in_one_line(
+    tmp_path: Path, data_home: Path, claimed: int
+) -> None:
+    archive = tmp_path / "lying.zip"
+    with zipfile.ZipFile(archive, "w") as zipped:
+        zipped.writestr("Snap/snap.html", "<html>" + "x" * 500 + "</html>")
+        zipped.infolist()[0].file_size = claimed  # the central directory lies
+    with pytest.raises(DownloadError) as caught:
+        release.download("lying", str(archive), "0" * 64)
+    assert "damaged" in str(caught.value) and "\n" not in str(caught.value)
+    assert _leftovers() == []

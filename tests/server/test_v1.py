@@ -46,10 +46,12 @@ def test_motor_registers(client: httpx.Client, served: Served) -> None:
     answer = client.put("/api/v1/motors/m1/registers/led", json={"value": "green"})
     assert answer.status_code == 200 and answer.json()["value"] == "green"
     assert served.robot.m1.led == "green"
+    served.robot.m1.compliant = False  # a compliant motor's goal is refused (409)
     answer = client.put("/api/v1/motors/m1/registers/goal_position", json={"value": 500})
     # Beyond the angle limits: clamped to them, as the library does, and the answer says so.
     assert answer.status_code == 200
     assert answer.json()["value"] == served.robot.m1.angle_limit[1]
+    served.robot.m1.compliant = True
     assert client.get("/api/v1/motors/m7/registers/led").status_code == 404
     assert client.get("/api/v1/registers/id").json() == {f"m{i}": i for i in range(1, 7)}
     served.robot.m1.led = "off"

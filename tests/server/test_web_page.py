@@ -151,6 +151,24 @@ def test_a_goal_slider_moves_the_motor(page: Any, served: Served) -> None:
     robot.compliant = True
 
 
+def test_a_compliant_motor_says_so_where_its_goal_is_set(page: Any, served: Served) -> None:
+    robot = served.robot
+    robot.compliant = True
+    note = page.locator("#motor-m4 .free-note")
+    eventually(lambda: note.is_visible(), "m4's goal cell to say it is compliant")
+    assert "make it stiff" in note.inner_text()
+    slider = page.locator("#motor-m4 input[type=range]")
+    slider.focus()
+    page.keyboard.press("ArrowRight")
+    slider.dispatch_event("change")  # refused (409): the status line says why
+    status = page.locator("#message")
+    eventually(lambda: "m4 is compliant" in status.inner_text(), "the refusal's reason shown")
+    page.uncheck("#motor-m4 input[type=checkbox]")
+    eventually(lambda: not note.is_visible(), "the note gone once m4 is stiff")
+    eventually(lambda: robot.m4.compliant is False, "m4 stiff")
+    robot.compliant = True
+
+
 def test_a_primitive_starts_and_stops_from_its_buttons(page: Any, served: Served) -> None:
     robot = served.robot
     page.click("#primitive-sinus summary")
@@ -322,6 +340,7 @@ def test_a_clamped_goal_is_shown(page: Any, served: Served) -> None:
     motor = served.robot.m5
     old = motor.angle_limit
     motor.angle_limit = (-10.0, 10.0)  # narrowed after the page drew its slider (-90..90)
+    motor.compliant = False  # a compliant motor's goal is refused (409)
     try:
         slider = page.locator("#motor-m5 input[type=range]")
         slider.fill("60")
@@ -332,6 +351,7 @@ def test_a_clamped_goal_is_shown(page: Any, served: Served) -> None:
         eventually(lambda: abs(motor.goal_position - 10.0) < 0.5, "the goal clamped to the limit")
     finally:
         motor.angle_limit = old
+        motor.compliant = True
 
 
 def test_the_sensors_are_shown_and_a_lost_camera_says_why(

@@ -228,12 +228,16 @@ class RobotPanel(Vertical):
             words = self.query_one("#goto", Input).value.replace(",", " ").split()
             targets = parse_targets(words, [m.name for m in self.robot.motors])
             duration = float(self.query_one("#goto-duration", Input).value or 1.0)
+            freed = [name for name in targets if self.robot.motor(name).compliant]
             for name in targets:
                 self.robot.motor(name).compliant = False
             self.robot.goto_position(targets, max(duration, 0.0), wait=False)
         except (PoppyError, ValueError) as exc:
             self.notify(str(exc), severity="error")
             return
+        if freed:  # a compliant motor does not move: the goto makes it stiff, and says so
+            said = f"{', '.join(freed)} compliant: made stiff for the goto"
+            self.notify(said, severity="warning")
         self.notify(f"goto {', '.join(f'{n}={short(v)}°' for n, v in targets.items())}")
 
     def toggle_compliant(self) -> None:

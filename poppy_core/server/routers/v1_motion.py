@@ -35,7 +35,7 @@ router = APIRouter(responses=ERRORS)
 async def goto(body: GotoRequest, service: Service) -> GotoResult:
     """Starts the motion; with ``wait`` answers once it is over (other requests go on)."""
     targets = service.targets(body.positions)  # clamped to the angle limits: the answer says so
-    handle = service.goto(targets, body.duration_s, body.control)
+    handle = service.goto(targets, body.duration_s, body.control, refuse_compliant=True)
     waited = await wait_goto(handle) if body.wait else False
     return GotoResult(
         positions=targets,

@@ -38,7 +38,7 @@ async def write_many(
     ),
 ) -> dict[str, dict[str, JsonValue]]:
     """Every value is checked before any is written; answers the values written."""
-    written: dict[str, dict[str, Any]] = service.write_many(commands)
+    written: dict[str, dict[str, Any]] = service.write_many(commands, refuse_compliant=True)
     return written
 
 
@@ -65,7 +65,7 @@ async def write_register(
     motor: str, register: str, body: ValueBody, service: Service
 ) -> RegisterValue:
     """Checks the value (type, range, limits) before the motor gets it."""
-    value = service.write(motor, register, body.value)
+    value = service.write(motor, register, body.value, refuse_compliant=True)
     return RegisterValue(motor=motor, register=register, value=value)
 
 

@@ -105,6 +105,11 @@ async def stream(
     """Every new frame as a JPEG part, at most ``fps`` per second, until the client leaves."""
     fps = checks.in_range(fps, MIN_FPS, MAX_FPS, "fps", "Hz")  # NaN, 0, 1e-300: a 422
     camera = sensors_of(request).camera(sensor)
+    health = camera.health()
+    if not health.connected:  # unplugged or busy: a 503 now, not a stream of nothing
+        raise SensorError(
+            f"camera {sensor!r} is not available now: {health.last_error}", sensor=sensor
+        )
     await run_in_threadpool(camera.latest)  # the first frame (or a 503 now, not mid-stream)
     return StreamingResponse(
         mjpeg(camera, request, fps),

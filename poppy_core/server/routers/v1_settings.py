@@ -127,7 +127,7 @@ async def hotspot(body: HotspotBody, request: Request) -> dict[str, Any]:
     return {"on": body.on, "ssid": ssid}
 
 
-@router.put("/services/{service}", summary="Start and enable a service, or stop and disable it")
+@router.put("/services/{service}", summary="Start a service, or stop it (until the next boot)")
 async def set_service(service: str, body: ServiceBody, request: Request) -> dict[str, Any]:
     """``jupyter`` (poppy-jupyter.service); ``snap`` and ``zmq`` are written in the settings
     file of poppy.service, which restarts (``restarting``: the page reconnects)."""

@@ -18,19 +18,17 @@ import os
 import re
 import secrets
 import shutil
-import stat
-import tarfile
 import urllib.error
 import urllib.request
-import zipfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import IO
 
 import platformdirs
 
 from poppy_core.errors import ArgumentError, DownloadError, FileError
+from poppy_core.server.snap.unpack import unpack
 
 log = logging.getLogger(__name__)
 
@@ -57,8 +55,6 @@ RELEASES = {PINNED.version: PINNED}
 MARKER = ".poppy-snap.json"
 """Written in an installed copy: its version, digest and source."""
 MAX_ARCHIVE_BYTES = 512 * 1024 * 1024
-MAX_UNPACKED_BYTES = 1024 * 1024 * 1024
-MAX_FILES = 50_000
 VERSION = re.compile(r"[0-9A-Za-z][0-9A-Za-z._-]{0,39}")
 DIGEST = re.compile(r"[0-9a-f]{64}")
 CHUNK = 1 << 16
@@ -242,66 +238,6 @@ def _fetch(source: str, target: Path, timeout_s: float, progress: Callable[[int]
     return sha.hexdigest()
 
 
-def _member_path(name: str) -> PurePosixPath | None:
-    """A member's path inside the archive, or None for one that would land outside it."""
-    path = PurePosixPath(name.replace("\\", "/"))
-    if path.is_absolute() or ".." in path.parts or not path.parts:
-        return None
-    return path
-
-
-def _unpack(archive: Path, into: Path) -> None:
-    """Unpack a zip or tar archive of regular files and folders; refuse anything else."""
-    total = 0
-    count = 0
-
-    def account(size: int) -> None:
-        nonlocal total, count
-        total += size
-        count += 1
-        if total > MAX_UNPACKED_BYTES or count > MAX_FILES:
-            raise DownloadError("the archive unpacks to more than a Snap! release: refused")
-
-    def bad(name: str) -> DownloadError:
-        return DownloadError(f"the archive holds {name[:80]!r}, outside its folder: refused")
-
-    if zipfile.is_zipfile(archive):
-        with zipfile.ZipFile(archive) as zipped:
-            for info in zipped.infolist():
-                path = _member_path(info.filename)
-                if path is None:
-                    raise bad(info.filename)
-                if stat.S_ISLNK(info.external_attr >> 16):
-                    raise DownloadError(f"the archive holds a link {info.filename[:80]!r}: refused")
-                if info.is_dir():
-                    (into / path).mkdir(parents=True, exist_ok=True)
-                    continue
-                account(info.file_size)
-                (into / path).parent.mkdir(parents=True, exist_ok=True)
-                with zipped.open(info) as src, (into / path).open("wb") as dst:
-                    shutil.copyfileobj(src, dst, CHUNK)
-        return
-    try:
-        with tarfile.open(archive) as tarred:
-            for member in tarred:
-                path = _member_path(member.name)
-                if path is None:
-                    raise bad(member.name)
-                if member.isdir():
-                    (into / path).mkdir(parents=True, exist_ok=True)
-                elif member.isfile():
-                    account(member.size)
-                    (into / path).parent.mkdir(parents=True, exist_ok=True)
-                    member_file = tarred.extractfile(member)
-                    assert member_file is not None
-                    with member_file, (into / path).open("wb") as dst:
-                        shutil.copyfileobj(member_file, dst, CHUNK)
-                elif member.type not in (tarfile.XGLTYPE, tarfile.XHDTYPE):
-                    raise DownloadError(f"the archive holds a link {member.name[:80]!r}: refused")
-    except tarfile.TarError as exc:
-        raise DownloadError(f"the download is not a zip or tar archive ({exc})") from None
-
-
 def _release_root(unpacked: Path) -> Path:
     """The folder holding snap.html: the archive's own, or its single top folder."""
     if (unpacked / "snap.html").is_file():
@@ -357,7 +293,7 @@ def download(
         archive_sha = _fetch(release.url, archive, timeout_s, progress or (lambda _: None))
         unpacked = work / "unpacked"
         unpacked.mkdir()
-        _unpack(archive, unpacked)
+        unpack(archive, unpacked)
         root = _release_root(unpacked)
         found = release_digest(root)
         if found != release.digest:

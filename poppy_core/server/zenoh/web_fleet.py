@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
 
-from poppy_core import zenoh_wire
+from poppy_core import checks, zenoh_wire
 
 if TYPE_CHECKING:
     from fastapi import FastAPI
@@ -31,10 +31,21 @@ def fleet_of(node: ZenohRobotServer) -> list[dict[str, Any]]:
                 "self": name == node.name,
                 "creature": str(described.get("creature", "")),
                 "ok": bool(health.get("ok", False)),
-                "page": described.get("page"),
+                "page": checks.peer_page(described.get("page"), announced_hosts(name, described)),
             }
         )
     return robots
+
+
+def announced_hosts(name: str, described: dict[str, Any]) -> list[str]:
+    """Where a robot says it is: ``NAME.local``, its host name, its Zenoh endpoints' hosts
+    (``tcp/192.168.1.7:7447``, ``tcp/[fe80::1]:7447#iface=wlan0``)."""
+    host = str(described.get("host", ""))
+    hosts = [f"{name}.local", host, f"{host}.local"] if host else [f"{name}.local"]
+    for endpoint in described.get("endpoints", []):
+        address = str(endpoint).split("#", 1)[0].split("/", 1)[-1]
+        hosts.append(address.rsplit(":", 1)[0].strip("[]"))
+    return hosts
 
 
 @router.get("/fleet", summary="The robots on this robot's Zenoh network and their pages")

@@ -75,11 +75,17 @@ function motorRow(name, info, leds) {
   });
   slider.setAttribute("aria-label", `${name} goal position (${low}° to ${high}°)`);
   const goalText = el("output", { className: "num" });
+  // a compliant motor's goal moves nothing (the v1 API refuses it with a 409): said where it is set
+  const freeNote = el("small", { className: "muted free-note", textContent: "compliant: make it stiff to move it" });
+  freeNote.hidden = !info.compliant;
   slider.addEventListener("input", () => { goalText.value = slider.value; });
   slider.addEventListener("change", () => setGoal(name, Number(slider.value), slider));
   const compliant = el("input", { type: "checkbox", checked: info.compliant });
   compliant.setAttribute("aria-label", `${name} compliant`);
-  compliant.addEventListener("change", () => setCompliant([name], compliant.checked));
+  compliant.addEventListener("change", () => {
+    freeNote.hidden = !compliant.checked;
+    setCompliant([name], compliant.checked);
+  });
   const led = el("select");
   led.setAttribute("aria-label", `${name} LED`);
   // values are JSON: colour names (XL-320) or false/true (shown off/on)
@@ -94,11 +100,11 @@ function motorRow(name, info, leds) {
   const tr = el("tr", { id: `motor-${name}` },
     el("th", { scope: "row" }, name, el("small", { className: "muted", textContent: ` ${info.id} · ${info.model}` })),
     cells.present_position,
-    el("td", {}, el("span", { className: "goal" }, slider, goalText)),
+    el("td", {}, el("span", { className: "goal" }, slider, goalText), freeNote),
     cells.present_speed, cells.present_load, cells.present_temperature, cells.present_voltage,
     el("td", {}, compliant), el("td", {}, led), online);
   tr.dataset.motor = name;
-  rows.set(name, { cells, slider, goalText, compliant, led, online });
+  rows.set(name, { cells, slider, goalText, freeNote, compliant, led, online });
   return tr;
 }
 
@@ -152,7 +158,10 @@ function applyDetails(motors, withCompliance = true) {
     const row = rows.get(name);
     if (!row) continue;
     row.cells.present_voltage.textContent = fmt(info.present_voltage);
-    if (withCompliance) row.compliant.checked = info.compliant;
+    if (withCompliance) {
+      row.compliant.checked = info.compliant;
+      row.freeNote.hidden = !info.compliant;
+    }
     if (document.activeElement !== row.slider) {
       row.slider.value = String(info.goal_position);
       row.goalText.value = fmt(info.goal_position);

@@ -91,11 +91,13 @@ function wifiRow(settings) {
 function servicesRow(settings) {
   const items = Object.entries(settings.services).map(([name, service]) => {
     if (service.how === "settings") { // Snap!, ZMQ: the service's settings file, then it restarts
-      const box = el("input", { id: `settings-${name}`, type: "checkbox", checked: Boolean(service.on), disabled: !settings.token_required });
+      const blocked = Boolean(service.reason) && !service.on; // ZMQ has no token: only turned off here
+      const box = el("input", { id: `settings-${name}`, type: "checkbox", checked: Boolean(service.on), disabled: !settings.token_required || blocked });
       box.setAttribute("aria-label", `${name} on`);
       box.addEventListener("change", () => change("PUT", `/api/v1/settings/services/${name}`, { on: box.checked },
         (answer) => `${name} ${box.checked ? "on" : "off"}${answer.restarting ? "" : " at the next start"}`));
-      return el("li", {}, el("label", {}, box, ` ${name} (poppy.service)`));
+      const why = service.reason ? el("span", { className: "muted", textContent: ` (${service.reason})` }) : "";
+      return el("li", {}, el("label", {}, box, ` ${name} (poppy.service)`), why);
     }
     if (service.how !== "systemctl") {
       return el("li", { textContent: `${name}: ${service.on ? "on" : "off"} (poppy serve ${service.how.replace("serve ", "")})` });
