@@ -187,15 +187,18 @@ def open_session(
         except zenoh.ZError as exc:
             message = zenoh_message(exc)
             waiting = mode_of(settings) == "client" and "Unable to connect" in message
-            if not waiting or (end is not None and time.monotonic() >= end):
-                hint = (
-                    "start the router (zenohd, or poppy fleet router) or the robot there, or "
-                    "check the endpoint"
-                    if waiting
-                    else "check --zenoh-listen / --zenoh-connect"
-                )
+            if waiting and end is not None and time.monotonic() >= end:
                 raise ConfigError(
-                    f"cannot open the Zenoh session ({message}): {hint}", field="zenoh"
+                    f"no Zenoh router or robot answers at {', '.join(settings.connect)}: start "
+                    "the router (zenohd, or poppy fleet router) or the robot there, or check "
+                    "the endpoint",
+                    field="zenoh",
+                ) from None
+            if not waiting:
+                raise ConfigError(
+                    f"cannot open the Zenoh session ({message}): check --zenoh-listen / "
+                    "--zenoh-connect",
+                    field="zenoh",
                 ) from None
             if not warned and end is None:
                 _log.warning(

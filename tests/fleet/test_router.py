@@ -248,3 +248,16 @@ def test_the_router_refuses_a_busy_port_in_one_line(router: Router) -> None:
     assert result.code == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "cannot start the Zenoh router" in lines[0], lines
+
+
+def test_a_fleet_command_without_its_router_is_one_line() -> None:
+    from tests.helpers.zenoh_served import free_endpoint
+
+    endpoint = free_endpoint()
+    result = run_poppy("fleet", "list", "--connect", endpoint)
+    assert result.code == 2
+    lines = result.stderr.strip().splitlines()
+    assert lines == [
+        f"error: no Zenoh router or robot answers at {endpoint}: start the router (zenohd, or "
+        "poppy fleet router) or the robot there, or check the endpoint"
+    ], lines
