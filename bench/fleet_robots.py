@@ -67,15 +67,14 @@ def main() -> None:
             robot = from_profile("ergo-jr", sim=True)
             robots.append(robot)
             endpoint = args.router or (f"tcp/127.0.0.1:{free_port()}" if args.zenoh else "")
-            zenoh = (
-                ZenohSettings(connect=(endpoint,))
-                if args.router
-                else ZenohSettings(listen=(endpoint,))
-            )
+            zenoh = None
+            if args.zenoh:
+                where = {"connect" if args.router else "listen": (endpoint,)}
+                zenoh = ZenohSettings(**where)
             spec = ServeSpec(
                 ws=Listen(port=0) if args.ws else None,
                 ws_rate_hz=50.0,
-                zenoh=zenoh if args.zenoh else None,
+                zenoh=zenoh,
                 name=name,
             )
             servers = serve(robot, spec)
