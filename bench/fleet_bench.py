@@ -33,10 +33,12 @@ from bench.fleet_procs import (
     SLOW_S,
     SLOW_SUBSCRIBERS,
     cpu_per_robot,
+    cpu_s,
     robot_processes,
     slow_subscribers,
 )
 from bench.fleet_report import build_result
+from bench.fleet_router import RouterProcess
 from bench.fleet_spread import play_spread
 from bench.registry import BenchContext, BenchResult, register
 from bench.side_by_side import percentile
@@ -48,12 +50,16 @@ TELEOP_HZ = 100.0
 TELEOP_S = 4.0
 
 
-def fanout_zenoh() -> dict[str, Any]:
+def fanout_zenoh(router: Any = None) -> dict[str, Any]:
+    """The fan-out, peer to peer or (``router``: a ``bench.fleet_router.RouterProcess``)
+    through a router, whose CPU is then measured over the same window."""
     from poppy_core.remote.zenoh_fleet import Fleet
     from poppy_core.zenoh_wire import ZenohSettings
 
-    with robot_processes(zenoh=True, ws=False) as (procs, robots):
-        settings = ZenohSettings(connect=tuple(r["endpoint"] for r in robots))
+    endpoint = router.endpoint if router is not None else None
+    with robot_processes(zenoh=True, ws=False, router=endpoint) as (procs, robots):
+        endpoints = list({r["endpoint"]: 0 for r in robots})
+        settings = ZenohSettings(connect=tuple(endpoints))
         counts: dict[str, int] = defaultdict(int)
         ages: list[float] = []
         loops: dict[str, list[float]] = defaultdict(list)
@@ -71,12 +77,14 @@ def fanout_zenoh() -> dict[str, Any]:
                     if hz is not None:
                         loops[name].append(float(hz))
 
-        with slow_subscribers(1, [r["endpoint"] for r in robots]), Fleet(settings) as fleet:
+        with slow_subscribers(1, endpoints), Fleet(settings) as fleet:
             fleet.on_state(state)
             fleet.on_health(health)
             time.sleep(WARMUP_S)
             measuring.set()
+            router_before = cpu_s([router.proc]) if router is not None else 0.0
             cpu = cpu_per_robot(procs, WINDOW_S)
+            router_after = cpu_s([router.proc]) if router is not None else 0.0
             measuring.clear()
         ages.sort()
         rates = sorted(counts.get(r["name"], 0) / WINDOW_S for r in robots)
@@ -90,6 +98,9 @@ def fanout_zenoh() -> dict[str, Any]:
             "cpu_per_robot_pct": cpu,
             "sync_hz_min": sync[0] if sync else None,
             "sync_hz_median": sync[len(sync) // 2] if sync else None,
+            "router_cpu_pct": (router_after - router_before) / WINDOW_S * 100.0
+            if router is not None
+            else None,
         }
 
 
@@ -306,6 +317,14 @@ def fleet_bench(ctx: BenchContext) -> BenchResult:
     raw["idle_cpu_per_robot_pct"] = idle_cpu()
     with tempfile.TemporaryDirectory() as tmp:
         raw["play"] = play_spread(Path(tmp))
+    with RouterProcess() as router:
+        raw["router"] = {"zenoh": fanout_zenoh(router)}
+        with tempfile.TemporaryDirectory() as tmp:
+            before, began = cpu_s([router.proc]), time.monotonic()
+            raw["router"]["play"] = play_spread(Path(tmp), router.endpoint)
+            raw["router"]["play_router_cpu_pct"] = (
+                (cpu_s([router.proc]) - before) / (time.monotonic() - began) * 100.0
+            )
     raw["teleop"] = teleop_goals()
     raw["encoding"] = encoding()
     raw["load_after"] = os.getloadavg()[0]

@@ -41,10 +41,15 @@ TICK = os.sysconf("SC_CLK_TCK")
 
 @contextmanager
 def robot_processes(
-    zenoh: bool, ws: bool, starts: Path | None = None, env: dict[str, str] | None = None
+    zenoh: bool,
+    ws: bool,
+    starts: Path | None = None,
+    env: dict[str, str] | None = None,
+    router: str | None = None,
 ) -> Iterator[tuple[list[Any], list[dict[str, Any]]]]:
-    """Start the robot processes (``env``: more environment); yields them and one record per
-    robot (name, endpoint, ws)."""
+    """Start the robot processes (``env``: more environment; ``router``: the robots connect
+    only to it, their endpoint is its); yields them and one record per robot (name, endpoint,
+    ws)."""
     procs, robots = [], []
     python = str(POPPY_PYTHON) if POPPY_PYTHON.exists() else sys.executable
     try:
@@ -62,6 +67,7 @@ def robot_processes(
             args += ["--zenoh"] if zenoh else []
             args += ["--ws"] if ws else []
             args += ["--starts", str(starts)] if starts is not None else []
+            args += ["--router", router] if router is not None else []
             full = {**os.environ, **(env or {}), "PYTHONPATH": str(REPO_ROOT)}
             procs.append(
                 subprocess.Popen(args, cwd=REPO_ROOT, stdout=subprocess.PIPE, text=True, env=full)
@@ -83,7 +89,8 @@ def robot_processes(
                 proc.stdout.close()
 
 
-def _cpu_s(procs: list[Any]) -> float:
+def cpu_s(procs: list[Any]) -> float:
+    """The CPU time (user + system, s) ``procs`` used so far."""
     total = 0
     for proc in procs:
         fields = Path(f"/proc/{proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
@@ -92,9 +99,9 @@ def _cpu_s(procs: list[Any]) -> float:
 
 
 def cpu_per_robot(procs: list[Any], window_s: float) -> float:
-    before = _cpu_s(procs)
+    before = cpu_s(procs)
     time.sleep(window_s)
-    return (_cpu_s(procs) - before) / window_s / ROBOTS * 100.0
+    return (cpu_s(procs) - before) / window_s / ROBOTS * 100.0
 
 
 @contextmanager

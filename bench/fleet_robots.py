@@ -56,6 +56,7 @@ def main() -> None:
     parser.add_argument("--zenoh", action="store_true")
     parser.add_argument("--ws", action="store_true")
     parser.add_argument("--starts", type=Path)
+    parser.add_argument("--router", help="connect only to this router (listen nowhere)")
     args = parser.parse_args()
     if args.starts is not None:
         _log_starts(args.starts)
@@ -65,11 +66,15 @@ def main() -> None:
             name = f"jr{index:02d}"
             robot = from_profile("ergo-jr", sim=True)
             robots.append(robot)
-            endpoint = f"tcp/127.0.0.1:{free_port()}" if args.zenoh else ""
+            endpoint = args.router or (f"tcp/127.0.0.1:{free_port()}" if args.zenoh else "")
+            zenoh = None
+            if args.zenoh:
+                where = {"connect" if args.router else "listen": (endpoint,)}
+                zenoh = ZenohSettings(**where)
             spec = ServeSpec(
                 ws=Listen(port=0) if args.ws else None,
                 ws_rate_hz=50.0,
-                zenoh=ZenohSettings(listen=(endpoint,)) if args.zenoh else None,
+                zenoh=zenoh,
                 name=name,
             )
             servers = serve(robot, spec)

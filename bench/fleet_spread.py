@@ -34,16 +34,19 @@ def _wave(moves: Path) -> dict[str, str]:
     return {MOVES_DIR_ENV: str(moves)}
 
 
-def play_spread(tmp: Path) -> dict[str, Any]:
+def play_spread(tmp: Path, router: str | None = None) -> dict[str, Any]:
     from poppy_core.remote.zenoh_fleet import Fleet
     from poppy_core.zenoh_wire import ZenohSettings
 
     starts = tmp / "starts.txt"
     env = _wave(tmp / "moves")
     found: dict[str, Any] = {}
-    with robot_processes(zenoh=True, ws=False, starts=starts, env=env) as (_, served):
+    with robot_processes(zenoh=True, ws=False, starts=starts, env=env, router=router) as (
+        _,
+        served,
+    ):
         names = [r["name"] for r in served]
-        settings = ZenohSettings(connect=tuple(r["endpoint"] for r in served))
+        settings = ZenohSettings(connect=tuple({r["endpoint"]: 0 for r in served}))
         with Fleet(settings, timeout_s=5.0) as fleet:
             fleet.wait_for(names, 10.0)
             for what, (path, body, stop) in STARTS.items():

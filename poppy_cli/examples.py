@@ -99,6 +99,10 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("fleet discover", "listen 3 s on every interface"),
         ("fleet discover --timeout 1 --interface 127.0.0.1 --json", "this machine's only"),
     ),
+    "fleet router": (
+        ("fleet router", "a Zenoh router on port 7447 of every interface, until Ctrl-C"),
+        ("fleet router --listen tcp/192.168.1.10:7447", "on the classroom's interface only"),
+    ),
     "fleet list": (
         ("fleet list", "through a router on this computer (tcp/127.0.0.1:7447)"),
         ("fleet list --connect tcp/192.168.1.10:7447 --json", "for scripts"),

@@ -111,6 +111,7 @@ FLAGS: dict[str, Flag] = {
     "--ros-domain": Flag(None, "N", "ROS 2 domain ID (0-232; ROS_DOMAIN_ID)"),
     "--ros-namespace": Flag(None, "NS", "the ROS 2 node's namespace, e.g. /lab"),
     "--connect": Flag(None, "ENDPOINT", "Zenoh endpoint (peer or router) to connect to"),
+    "--listen": Flag(None, "ENDPOINT", "Zenoh endpoint the router listens on"),
     "--all": Flag(None, None, "every robot of the fleet"),
     "--robots": Flag(None, "NAMES", "robots of the fleet, comma-separated"),
     "--snap": Flag(None, None, "serve pypot's Snap! routes and the Poppy blocks"),

@@ -148,6 +148,11 @@ def data_key(domain: int, name: str, dds_type: str, type_hash: str) -> str:
     return f"{domain}/{name.strip('/')}/{dds_type}/{type_hash}"
 
 
+def name_of_key(key: str) -> str:
+    """The topic or service name of a ``data_key`` (``0/jr1/stop/T/H`` -> ``/jr1/stop``)."""
+    return "/" + "/".join(str(key).split("/")[1:-2])
+
+
 def mangle(part: str) -> str:
     """A name as one key chunk (``/`` written ``%``)."""
     return part.replace("/", SLASH)

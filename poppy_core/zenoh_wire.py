@@ -14,6 +14,7 @@ stream).
 from __future__ import annotations
 
 import json
+import logging
 import math
 import re
 import socket
@@ -42,6 +43,8 @@ FLEET_PORT = 7447
 """Zenoh's own default port (what ``zenohd`` listens on)."""
 
 _ENDPOINT = re.compile(r"[a-z0-9]+/\S+")
+MODES = ("auto", "peer", "client")
+_log = logging.getLogger(__name__)
 
 
 def check_name(name: str) -> str:
@@ -84,14 +87,20 @@ class ZenohSettings:
         config_file: Zenoh's own JSON5 configuration (routers, TLS, access control); the
             endpoints above, when given, replace its own.
         scout: find peers by multicast scouting on the LAN (off unless asked).
+        mode: Zenoh's session mode: ``peer``, ``client``, or ``auto`` (``mode_of``).
     """
 
     listen: tuple[str, ...] = ()
     connect: tuple[str, ...] = ()
     config_file: Path | None = None
     scout: bool = False
+    mode: str = "auto"
 
     def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ConfigError(
+                f"{self.mode!r} is not a Zenoh mode: write peer, client or auto", field="mode"
+            )
         for endpoint in (*self.listen, *self.connect):
             if not _ENDPOINT.fullmatch(endpoint):
                 raise ConfigError(
@@ -101,8 +110,26 @@ class ZenohSettings:
                 )
 
 
+def mode_of(settings: ZenohSettings) -> str | None:
+    """The session mode ``settings`` ask for (None: the configuration file's own).
+
+    ``auto`` is a client when the session listens nowhere, does not scout and connects to one
+    endpoint (a router, or one robot): a Zenoh router relays between its clients and its peers
+    but not between two peers that cannot reach each other (zenohd and rmw_zenoh's router,
+    measured with eclipse-zenoh 1.10), and poppy's sessions that only connect out cannot be
+    reached. Otherwise a peer: it listens, scouts, or links to several robots itself.
+    """
+    if settings.mode != "auto":
+        return settings.mode
+    if settings.config_file is not None:
+        return None
+    if not settings.listen and not settings.scout and len(settings.connect) == 1:
+        return "client"
+    return "peer"
+
+
 def session_config(settings: ZenohSettings) -> zenoh.Config:
-    """The Zenoh configuration of ``settings`` (peer mode, no scouting unless asked).
+    """The Zenoh configuration of ``settings`` (``mode_of``, no scouting unless asked).
 
     Raises:
         ConfigError: the configuration file cannot be read or is not Zenoh's.
@@ -116,9 +143,11 @@ def session_config(settings: ZenohSettings) -> zenoh.Config:
             config = zenoh.Config.from_file(str(settings.config_file))
         else:
             config = zenoh.Config()
-            config.insert_json5("mode", '"peer"')
             config.insert_json5("listen/endpoints", "[]")
             config.insert_json5("transport/link/tx/lease", str(DEFAULT_LEASE_MS))
+        mode = mode_of(settings)
+        if mode is not None:
+            config.insert_json5("mode", json.dumps(mode))
         if settings.listen:
             config.insert_json5("listen/endpoints", json.dumps(list(settings.listen)))
         if settings.connect:
@@ -133,24 +162,51 @@ def session_config(settings: ZenohSettings) -> zenoh.Config:
     return config
 
 
-def open_session(settings: ZenohSettings) -> zenoh.Session:
-    """A Zenoh session joined as ``settings`` say.
+def open_session(
+    settings: ZenohSettings, wait_s: float | None = 3.0, config: zenoh.Config | None = None
+) -> zenoh.Session:
+    """A Zenoh session joined as ``settings`` say (``config``: their configuration, amended).
+
+    A client's session opens only once its router (or robot) answers: it is tried again every
+    quarter second for ``wait_s`` (None: until it answers, with one WARNING, as a served robot
+    waits for the classroom's router; an interrupt stops the wait).
 
     Raises:
         ConfigError: a bad configuration, or an endpoint Zenoh cannot listen on or reach.
         MissingExtraError: eclipse-zenoh is not installed (the ``fleet`` extra).
     """
-    config = session_config(settings)
+    if config is None:
+        config = session_config(settings)
     import zenoh
 
-    try:
-        return zenoh.open(config)
-    except zenoh.ZError as exc:
-        raise ConfigError(
-            f"cannot open the Zenoh session ({zenoh_message(exc)}): check --zenoh-listen / "
-            "--zenoh-connect",
-            field="zenoh",
-        ) from None
+    end = None if wait_s is None else time.monotonic() + wait_s
+    warned = False
+    while True:
+        try:
+            return zenoh.open(config)
+        except zenoh.ZError as exc:
+            message = zenoh_message(exc)
+            waiting = mode_of(settings) == "client" and "Unable to connect" in message
+            if waiting and end is not None and time.monotonic() >= end:
+                raise ConfigError(
+                    f"no Zenoh router or robot answers at {', '.join(settings.connect)}: start "
+                    "the router (zenohd, or poppy fleet router) or the robot there, or check "
+                    "the endpoint",
+                    field="zenoh",
+                ) from None
+            if not waiting:
+                raise ConfigError(
+                    f"cannot open the Zenoh session ({message}): check --zenoh-listen / "
+                    "--zenoh-connect",
+                    field="zenoh",
+                ) from None
+            if not warned and end is None:
+                _log.warning(
+                    "no Zenoh router answers at %s yet: waiting for it",
+                    ", ".join(settings.connect),
+                )
+                warned = True
+            time.sleep(0.25)
 
 
 def zenoh_message(exc: BaseException) -> str:

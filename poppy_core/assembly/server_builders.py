@@ -116,7 +116,7 @@ def _zenoh_session(servers: ServerSet, settings: ZenohSettings) -> Any:
     if servers.zenoh_session is None:
         from poppy_core.zenoh_wire import open_session
 
-        servers.zenoh_session = open_session(settings)
+        servers.zenoh_session = open_session(settings, wait_s=None)
     return servers.zenoh_session
 
 

@@ -18,13 +18,17 @@ def free_endpoint() -> str:
 
 
 class Served:
-    """A virtual Ergo Jr served on Zenoh as ``poppy/NAME``, listening on ``endpoint``."""
+    """A virtual Ergo Jr served on Zenoh as ``poppy/NAME``, listening on ``endpoint``, or
+    connected only to the router at ``router`` (then ``endpoint`` is the router's)."""
 
-    def __init__(self, name: str, token: str | None = TOKEN) -> None:
+    def __init__(self, name: str, token: str | None = TOKEN, router: str | None = None) -> None:
         self.name = name
-        self.endpoint = free_endpoint()
+        self.endpoint = router or free_endpoint()
         self.robot: Robot = from_profile("ergo-jr", sim=True)
-        spec = ServeSpec(zenoh=ZenohSettings(listen=(self.endpoint,)), name=name, token=token)
+        settings = (
+            ZenohSettings(connect=(router,)) if router else ZenohSettings(listen=(self.endpoint,))
+        )
+        spec = ServeSpec(zenoh=settings, name=name, token=token)
         self.servers: ServerSet = serve(self.robot, spec)
 
     def close(self) -> None:

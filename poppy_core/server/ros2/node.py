@@ -26,7 +26,7 @@ from poppy_core.errors import PoppyError
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.schedule import Periodic, RateMeter, Worker
 from poppy_core.server.errors import ApiError
-from poppy_core.server.ros2 import messages, types
+from poppy_core.server.ros2 import messages, rosout, types
 from poppy_core.server.ros2.commands import CommandRefused, Commands
 from poppy_core.server.ros2.joints import UrdfJoints
 
@@ -102,6 +102,7 @@ class Ros2Node:
         self._worker = Worker(f"ros2-{self.node}", self._publish_loop)
         self._camera_worker = Worker(f"ros2-camera-{self.node}", self._camera_loop)
         self._last_refusal = 0.0
+        self.refusals = rosout.Refusals()
 
     @property
     def url(self) -> str:
@@ -136,6 +137,7 @@ class Ros2Node:
         self._publisher(
             "diagnostics", types.DIAGNOSTIC_ARRAY, wire.DEFAULT_QOS, topic="/diagnostics"
         )
+        self._publisher("rosout", rosout.LOG, rosout.ROSOUT_QOS, topic="/rosout")
         if self.joints.urdf is not None:
             self._publisher("robot_description", types.STRING, wire.LATCHED_QOS)
             self._publisher("tf_static", types.TF_MESSAGE, wire.LATCHED_QOS, topic="/tf_static")
@@ -273,6 +275,7 @@ class Ros2Node:
             success, text = False, f"failed: {exc}"
         if not success:
             logger.warning("ROS 2: %s refused: %s", key, text)
+            self._report(f"{wire.name_of_key(key)} refused: {text}", "service")
         response = types.message(f"{typename}_Response", success=success, message=text)
         extra = wire.attachment(
             asked.sequence if asked else 0, time.time_ns(), asked.gid if asked else bytes(16)
@@ -285,6 +288,17 @@ class Ros2Node:
         if now - self._last_refusal > 1.0:  # one line a second, whatever the rate
             self._last_refusal = now
             logger.warning("ROS 2: %s refused, nothing moved: %s", topic, why)
+            self._report(f"{topic} refused, nothing moved: {why}", "subscription")
+        else:
+            self.refusals.add(f"{topic} refused, nothing moved: {why}")
+
+    def _report(self, text: str, function: str) -> None:
+        """A refusal on ``/rosout`` (WARN) and in the ``commands`` diagnostics."""
+        self.refusals.add(text)
+        publisher = self._publishers.get("rosout")
+        if publisher is not None:
+            log = rosout.log_message(self.name_of("~"), rosout.WARN, text, function)
+            publisher.put(types.serialize(log, rosout.LOG))
 
     # -- commands and services -----------------------------------------------------------------
 
@@ -357,7 +371,9 @@ class Ros2Node:
             name: "ok" if health.ok else (health.last_error or "not ok")
             for name, health in self.robot.sensor_health().items()
         }
-        return messages.diagnostics(self.node, self.service.health(), sensors, now)
+        array = messages.diagnostics(self.node, self.service.health(), sensors, now)
+        array.status.append(self.refusals.status(self.node))
+        return array
 
     def _cameras(self) -> list[Any]:
         from poppy_core.sensors import Camera

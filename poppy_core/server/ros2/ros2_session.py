@@ -8,28 +8,20 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from poppy_core.errors import ConfigError
-from poppy_core.zenoh_wire import ZenohSettings, session_config
+from poppy_core.zenoh_wire import ZenohSettings, open_session, session_config
 
 if TYPE_CHECKING:
     import zenoh
 
 
 def open_ros2_session(settings: ZenohSettings) -> zenoh.Session:
-    """A session joined as ``settings`` say, stamping its samples.
+    """A session joined as ``settings`` say, stamping its samples; a client's waits for its
+    router (``open_session``).
 
     Raises:
         ConfigError: a bad configuration, or an endpoint Zenoh cannot listen on or reach.
         MissingExtraError: eclipse-zenoh is not installed.
     """
     config = session_config(settings)
-    import zenoh
-
-    try:
-        config.insert_json5("timestamping/enabled", "true")
-        return zenoh.open(config)
-    except zenoh.ZError as exc:
-        raise ConfigError(
-            f"cannot open the Zenoh session ({exc}): check --zenoh-listen / --zenoh-connect",
-            field="zenoh",
-        ) from None
+    config.insert_json5("timestamping/enabled", "true")
+    return open_session(settings, wait_s=None, config=config)
