@@ -51,13 +51,17 @@ def test_gets_are_answered_while_a_waiting_goto_runs(served: Served, client: htt
 
 def test_v1_waiting_goto_does_not_block_either(client: httpx.Client, served: Served) -> None:
     served.robot.m2.compliant = False
+    goto_s = scaled(3.0)  # outlasts the GET on a loaded machine too
     with ThreadPoolExecutor(1) as pool:
-        body = {"positions": {"m2": 20}, "duration_s": 3.0, "wait": True}
-        future = pool.submit(lambda: httpx.post(f"{served.url}/api/v1/gotos", json=body))
+        body = {"positions": {"m2": 20}, "duration_s": goto_s, "wait": True}
+        wait_s = goto_s + scaled(10.0)
+        future = pool.submit(
+            lambda: httpx.post(f"{served.url}/api/v1/gotos", json=body, timeout=wait_s)
+        )
         time.sleep(0.2)
         assert client.get("/api/v1/robot/state").status_code == 200
-        assert not future.done()  # answered while the 3 s goto still waits, not after it
-        answer = future.result(timeout=5)
+        assert not future.done()  # answered while the goto still waits, not after it
+        answer = future.result(timeout=wait_s)
     assert answer.status_code == 200
     assert answer.json()["done"] is True
     served.robot.compliant = True
