@@ -21,6 +21,7 @@ from bench import (
     snap_bench,
     soak_bench,
     teleop_bench,
+    timing_bench,
     web_bench,
     zmq_bench,
 )
@@ -48,6 +49,7 @@ _MODULES = (
     zmq_bench,
     fleet_bench,
     ros2_bench,
+    timing_bench,
 )
 
 

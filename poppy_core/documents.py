@@ -11,9 +11,11 @@ digits, is a one-line ``ConfigError`` too, never a ``RecursionError`` or a ``Val
 
 from __future__ import annotations
 
+import copy
 import json
 import os
 import stat
+import threading
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -191,6 +193,16 @@ def _check_yaml_depth(text: str | bytes, source: str, limits: Limits) -> None:
             depth -= 1
 
 
+# Documents up to this size are parsed once per text: a robot's build reads the same profiles
+# again (every profile's header to find one, then its config), and the pure-Python scanner and
+# the depth check take tens of milliseconds each, more on a busy machine. A copy is returned.
+_CACHED_MAX_BYTES = 64 * 1024
+_cache: dict[tuple[str | bytes, str, Limits], Any] = {}
+_CACHE_SIZE = 64
+_cache_lock = threading.Lock()
+_MISSING = object()
+
+
 def parse_yaml(text: str | bytes, source: str, limits: Limits) -> Any:
     """Parse a YAML document (safe tags only) and check its shape.
 
@@ -198,6 +210,21 @@ def parse_yaml(text: str | bytes, source: str, limits: Limits) -> Any:
         ConfigError: a syntax error (with line and column), a number too long, a document
             nested too deeply, too large once aliases are expanded, or cyclic.
     """
+    if len(text) > _CACHED_MAX_BYTES:
+        return _parse_yaml(text, source, limits)
+    key = (text, source, limits)
+    with _cache_lock:
+        data = _cache.get(key, _MISSING)
+    if data is _MISSING:
+        data = _parse_yaml(text, source, limits)
+        with _cache_lock:
+            if len(_cache) >= _CACHE_SIZE:
+                _cache.pop(next(iter(_cache)))
+            _cache[key] = data
+    return copy.deepcopy(data)
+
+
+def _parse_yaml(text: str | bytes, source: str, limits: Limits) -> Any:
     try:
         _check_yaml_depth(text, source, limits)
         data = yaml.safe_load(text)

@@ -420,11 +420,18 @@ def ergo_robot(request: pytest.FixtureRequest) -> Iterator[Robot]:
         yield robot
 
 
-def _swings_opposite(robot: Robot, seconds: float, amplitude: float) -> None:
-    """m1 swings both ways by ``amplitude`` and m4 the other way (base_pan x, head_pan -x)."""
+def _swings_opposite(robot: Robot, amplitude: float) -> None:
+    """m1 swings both ways by ``amplitude`` and m4 the other way (base_pan x, head_pan -x):
+    watched until both swings are seen (a loaded machine runs the physics slower than the
+    clock: the wait is polled, the swing is the check)."""
     watcher = PositionWatcher(robot, 25, ["m1", "m4"])
     watcher.start()
-    time.sleep(seconds)
+
+    def swung() -> bool:
+        base = list(watcher.record_positions.get("m1", []))
+        return len(base) > 2 and max(base) > amplitude and min(base) < -amplitude
+
+    wait_until(swung)
     watcher.stop()
     base, head = watcher.record_positions["m1"], watcher.record_positions["m4"]
     assert max(base) > amplitude and min(base) < -amplitude, base
@@ -446,7 +453,7 @@ def test_own_primitive_runs_its_30_seconds(ergo_robot: Robot) -> None:
     )
     dance = names["dance"]
     assert dance.running
-    _swings_opposite(ergo_robot, 1.5, 15.0)  # amp 60
+    _swings_opposite(ergo_robot, 15.0)  # amp 60
     assert dance.wait_to_stop(30.0)  # ends by itself (30 documentation seconds)
     assert dance.error is None and not dance.running
 
@@ -459,7 +466,7 @@ def test_loop_primitive_dances_until_stopped(ergo_robot: Robot) -> None:
     )
     dance = names["dance"]
     try:
-        _swings_opposite(ergo_robot, 1.5, 15.0)  # amp 40
+        _swings_opposite(ergo_robot, 15.0)  # amp 40
         assert dance.recent_update_frequencies
     finally:
         dance.stop()
@@ -475,7 +482,7 @@ def test_attached_primitive_started_by_another(ergo_robot: Robot) -> None:
     dance = ergo_robot.dance
     assert isinstance(dance, names["DancePrimitive"]) and dance.name == "dance"
     assert dance in ergo_robot.primitives and dance.running
-    _swings_opposite(ergo_robot, 1.0, 10.0)  # amp 30
+    _swings_opposite(ergo_robot, 10.0)  # amp 30
     assert dance.wait_to_stop(30.0)
     selector = names["SelectorPrimitive"](ergo_robot)
     selector.start()  # the dance has ended: the selector starts it again

@@ -6,6 +6,9 @@ from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager
 from typing import Any, Protocol, TypeVar
 
+import pytest
+
+from poppy_core.bus import DxlBus
 from poppy_core.emulator import (
     EmulatorServer,
     VirtualBus,
@@ -14,13 +17,16 @@ from poppy_core.emulator import (
     serve_pty,
     serve_tcp,
 )
+from poppy_core.robot import build_steps
+from tests.helpers.waiting import scaled
 
 # The first-reply floor for a DxlBus whose other end is an emulator thread of the test process on
 # a pty: the bus's own floor (MIN_REPLY_TIMEOUT_S, 10 ms) is a real adapter's, and a busy machine
 # (two busy loops and more on two cores) runs that thread tens of milliseconds late now and then.
 # A test that checks what the replies say, not how fast they come, gives its bus this floor; it
-# costs nothing while the motors answer.
-LOADED_REPLY_FLOOR_S = 0.5
+# costs nothing while the motors answer. Half a second on an idle machine, times the load factor
+# measured when the tests start (once per worker).
+LOADED_REPLY_FLOOR_S = scaled(0.5)
 
 Emulate = Callable[..., AbstractContextManager[tuple[VirtualBus, str]]]
 
@@ -52,3 +58,18 @@ def client_on_pty(bus: VirtualBus, open_client: Callable[[EmulatorServer], C]) -
             yield client
         finally:
             client.close()
+
+
+def robot_buses_wait_for_a_loaded_emulator(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Robots built in this test open their buses with ``LOADED_REPLY_FLOOR_S`` as their
+    first-reply floor: for robots whose motors are an emulator thread of the test process on a
+    pty or TCP (a busy machine runs it late; the real adapter's 10 ms floor would take a late
+    reply for a missing motor, or a motor that stopped answering). A test of the deadlines
+    themselves does not use it."""
+
+    class LoadedBus(DxlBus):
+        def __init__(self, *args: Any, **options: Any) -> None:
+            options.setdefault("min_timeout_s", LOADED_REPLY_FLOOR_S)
+            super().__init__(*args, **options)
+
+    monkeypatch.setattr(build_steps, "DxlBus", LoadedBus)

@@ -26,6 +26,8 @@ from typing import Any
 
 import pytest
 
+from tests.helpers.waiting import scaled
+
 POPPY = [sys.executable, "-m", "poppy_cli"]
 # What a `poppy` subprocess of the tests sees: a wide terminal, no colours.
 ENV = {"COLUMNS": "200", "NO_COLOR": "1"}
@@ -55,7 +57,12 @@ def run_poppy_process(
     """Run `poppy ARGS...` as a subprocess (``env``: added to its environment)."""
     full = dict(os.environ, **ENV, **(env or {}))
     proc = subprocess.run(
-        [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=full, input=input
+        [*POPPY, *args],
+        capture_output=True,
+        text=True,
+        timeout=scaled(timeout),
+        env=full,
+        input=input,
     )
     return Result(proc.returncode, proc.stdout, proc.stderr)
 

@@ -11,6 +11,8 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
+from tests.helpers.waiting import scaled
+
 
 def read_until(
     fd: int,
@@ -20,7 +22,7 @@ def read_until(
 ) -> str:
     """What ``fd`` gives until ``text`` shows (None: until it ends), ``proc`` ends, or timeout."""
     seen = b""
-    deadline = time.monotonic() + timeout_s
+    deadline = time.monotonic() + scaled(timeout_s)
     while (text is None or text.encode() not in seen) and time.monotonic() < deadline:
         ready, _, _ = select.select([fd], [], [], 0.2)
         if ready:

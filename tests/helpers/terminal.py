@@ -17,6 +17,7 @@ from collections.abc import Mapping
 
 from tests.helpers.cli import ENV, POPPY
 from tests.helpers.processes import start_on_pty
+from tests.helpers.waiting import scaled
 
 # setsid, then the pty (stdin) becomes the controlling terminal, then poppy replaces the shim
 _SHIM = (
@@ -48,7 +49,7 @@ class Terminal:
 
     def read_until(self, text: str, timeout_s: float = 60) -> str:
         """Read what the command prints until ``text`` shows (or it ends, or ``timeout_s``)."""
-        deadline = time.monotonic() + timeout_s
+        deadline = time.monotonic() + scaled(timeout_s)
         while text not in self.shown and time.monotonic() < deadline:
             if not self._read(0.2):
                 break
@@ -68,7 +69,7 @@ class Terminal:
             AssertionError: it did not end within ``timeout_s``; the message ends with what it
                 printed, then the stacks of its threads (faulthandler's dump on SIGABRT).
         """
-        deadline = time.monotonic() + timeout_s
+        deadline = time.monotonic() + scaled(timeout_s)
         while self.proc.poll() is None and time.monotonic() < deadline:
             self._read(0.2)
         if self.proc.poll() is None:

@@ -9,7 +9,7 @@ from collections.abc import Callable, Coroutine
 from typing import Any
 
 from poppy_core.bus import PortInfo
-from tests.helpers.waiting import MIN_TIMEOUT_S
+from tests.helpers.waiting import MIN_TIMEOUT_S, scaled
 
 
 def no_ports() -> list[PortInfo]:
@@ -21,8 +21,8 @@ async def wait_for(
     pilot: object, check: Callable[[], bool], timeout_s: float = 10.0, what: str = ""
 ) -> None:
     """Let the app run until ``check()`` holds (fails the test after ``timeout_s``, at least
-    ``MIN_TIMEOUT_S``: a wait is not a speed check)."""
-    end = time.monotonic() + max(timeout_s, MIN_TIMEOUT_S)
+    ``MIN_TIMEOUT_S``, times the load factor: a wait is not a speed check)."""
+    end = time.monotonic() + scaled(max(timeout_s, MIN_TIMEOUT_S))
     while not check():
         if time.monotonic() > end:
             raise AssertionError(f"timed out waiting for {what or check}")

@@ -1,24 +1,61 @@
-"""Waiting for something a background thread does, without timed assertions."""
+"""Waiting for something a background thread does, without timed assertions; waits that grow
+with the machine's measured load."""
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 # A test's own timeout says how long the thing should take on an idle machine; a loaded one
 # (the suite's parallel workers on 2 cores, CI) makes threads late, never wrong, so no wait gives
-# up before this. Waiting longer costs nothing when the state comes: it is polled.
+# up before this (times the load factor). Waiting longer costs nothing when the state comes: it
+# is polled.
 MIN_TIMEOUT_S = 15.0
+
+# The load factor's bound: a machine this loaded is stuck, not busy, and a wait must end.
+MAX_LOAD_FACTOR = 8.0
+
+
+def _runnable_now() -> int:
+    """Threads running or ready to run right now (``/proc/loadavg``'s 4th field), 0 if unknown.
+
+    The load averages lag: the 1-minute one takes a minute to see busy loops started beside the
+    suite; this count sees them at once."""
+    try:
+        field = Path("/proc/loadavg").read_text().split()[3]
+        return max(0, int(field.split("/")[0]) - 1)  # less the reader itself
+    except (OSError, IndexError, ValueError):
+        return 0
+
+
+def load_factor() -> float:
+    """How many times slower than an idle machine a thread may be served now: the load (the
+    1-minute average or the threads ready now, whichever is higher) per core, at least 1, at most
+    ``MAX_LOAD_FACTOR``. Measured at each call (a few microseconds)."""
+    try:
+        average = os.getloadavg()[0]
+    except OSError:
+        average = 0.0
+    cores = os.cpu_count() or 1
+    return min(MAX_LOAD_FACTOR, max(1.0, max(average, float(_runnable_now())) / cores))
+
+
+def scaled(seconds: float) -> float:
+    """``seconds`` (enough on an idle machine) times the load factor: a deadline that must be met
+    by a thread of the test process or of the emulator it serves."""
+    return seconds * load_factor()
 
 
 def eventually(check: Callable[[], bool], timeout_s: float = 3.0, interval_s: float = 0.01) -> bool:
     """Poll ``check`` until it holds (True) or the timeout runs out (False, after a last look).
 
-    The timeout is ``timeout_s``, but never less than ``MIN_TIMEOUT_S``: tests wait for the
-    state they expect instead of sleeping a fixed time, and a wait is not a speed check (speed
-    goals live in the benchmarks).
+    The timeout is ``timeout_s``, but never less than ``MIN_TIMEOUT_S``, times the load factor
+    (measured when the wait starts): tests wait for the state they expect instead of sleeping a
+    fixed time, and a wait is not a speed check (speed goals live in the benchmarks).
     """
-    deadline = time.monotonic() + max(timeout_s, MIN_TIMEOUT_S)
+    deadline = time.monotonic() + scaled(max(timeout_s, MIN_TIMEOUT_S))
     while time.monotonic() < deadline:
         if check():
             return True
@@ -27,9 +64,10 @@ def eventually(check: Callable[[], bool], timeout_s: float = 3.0, interval_s: fl
 
 
 def within(check: Callable[[], bool], timeout_s: float, interval_s: float = 0.005) -> bool:
-    """Poll ``check`` for at most ``timeout_s`` (no floor): for the few waits whose window is
-    what the test checks (a write heard before a held-back reply is due), or that may run out
-    by design (a step that gives no sign it was taken). Any other wait is ``eventually``."""
+    """Poll ``check`` for at most ``timeout_s`` (no floor, no load factor): for the few waits
+    whose window is what the test checks (a write heard before a held-back reply is due), or that
+    may run out by design (a step that gives no sign it was taken). Any other wait is
+    ``eventually``."""
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         if check():

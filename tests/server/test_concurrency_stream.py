@@ -13,50 +13,55 @@ import pytest
 from websockets.sync.client import connect
 
 from tests.helpers.server import Served
+from tests.helpers.waiting import eventually, scaled
 
 
 def test_gets_are_answered_while_a_waiting_goto_runs(served: Served, client: httpx.Client) -> None:
+    # The GETs are answered while the waiting goto still runs (how fast: `python -m bench
+    # timing`); the goto outlasts them on a loaded machine too: 1.5 s times the load factor.
     served.robot.m1.compliant = False
     result: dict[str, Any] = {}
+    goto_s = scaled(1.5)
+    before = served.robot.m1.goal_position
+    target = -30.0 if before > 0 else 30.0
 
     def slow_goto() -> None:
-        with httpx.Client(base_url=served.url, timeout=10.0) as http:
+        with httpx.Client(base_url=served.url, timeout=10.0 + goto_s) as http:
             t0 = time.monotonic()
-            body = {"position": 30, "duration": 1.5, "wait": True}
+            body = {"position": target, "duration": goto_s, "wait": True}
             result["answer"] = http.post("/motors/m1/goto.json", json=body)
             result["elapsed"] = time.monotonic() - t0
 
     mover = threading.Thread(target=slow_goto)
     mover.start()
-    time.sleep(0.2)
+    assert eventually(lambda: abs(served.robot.m1.goal_position - before) > 0.1)  # it runs
 
-    def timed_get(_: int) -> tuple[int, float]:
-        t0 = time.monotonic()
-        status = client.get("/motors/m1/registers/present_position/value.json").status_code
-        return status, time.monotonic() - t0
+    def get(_: int) -> int:
+        return client.get("/motors/m1/registers/present_position/value.json").status_code
 
-    t0 = time.monotonic()
     with ThreadPoolExecutor(8) as pool:
-        answers = list(pool.map(timed_get, range(40)))
-    all_done = time.monotonic() - t0
-    assert mover.is_alive(), "the GETs should finish long before the 1.5 s goto"
+        statuses = list(pool.map(get, range(40)))
+    assert mover.is_alive(), "the GETs should be answered while the waiting goto runs"
     mover.join()
-    assert all(status == 200 for status, _ in answers)
-    assert all_done < 1.0
+    assert statuses == [200] * 40
     assert result["answer"].status_code == 202
-    assert result["elapsed"] >= 1.4
+    assert result["elapsed"] >= goto_s - 0.1  # answered once the motion is over, never before
     served.robot.compliant = True
 
 
 def test_v1_waiting_goto_does_not_block_either(client: httpx.Client, served: Served) -> None:
     served.robot.m2.compliant = False
+    goto_s = scaled(3.0)  # outlasts the GET on a loaded machine too
     with ThreadPoolExecutor(1) as pool:
-        body = {"positions": {"m2": 20}, "duration_s": 3.0, "wait": True}
-        future = pool.submit(lambda: httpx.post(f"{served.url}/api/v1/gotos", json=body))
+        body = {"positions": {"m2": 20}, "duration_s": goto_s, "wait": True}
+        wait_s = goto_s + scaled(10.0)
+        future = pool.submit(
+            lambda: httpx.post(f"{served.url}/api/v1/gotos", json=body, timeout=wait_s)
+        )
         time.sleep(0.2)
         assert client.get("/api/v1/robot/state").status_code == 200
-        assert not future.done()  # answered while the 3 s goto still waits, not after it
-        answer = future.result(timeout=5)
+        assert not future.done()  # answered while the goto still waits, not after it
+        answer = future.result(timeout=wait_s)
     assert answer.status_code == 200
     assert answer.json()["done"] is True
     served.robot.compliant = True

