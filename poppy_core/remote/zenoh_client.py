@@ -142,7 +142,7 @@ def answer_of(where: str, replies: list[Any], timeout_s: float, waited_s: float)
     if not replies and waited_s < timeout_s * 0.9:
         raise CommunicationError(
             f"{where}: no robot of that name on the Zenoh network (`poppy fleet list` shows "
-            "the robots seen; check the endpoints: --connect or POPPY_ZENOH_CONNECT)",
+            "the robots seen; check the endpoints: --zenoh-connect or POPPY_ZENOH_CONNECT)",
             port=where,
         )
     errors = [r.err.payload.to_bytes().decode(errors="replace") for r in replies]
