@@ -291,3 +291,41 @@ def test_a_raising_publish_tick_is_logged_once_shown_in_health_and_recovers(
     assert not node.state_loop.failing and node.state_loop.last_error is None
     warned = [r for r in caplog.records if "a tick failed" in r.getMessage()]
     assert len(warned) == 1 and "the bus went away" in warned[0].getMessage()
+
+
+def test_sigterm_with_a_held_request_answers_it_and_ends_cleanly(moves: Any) -> None:
+    """`poppy serve --zenoh` stopped by SIGTERM while a request waits for its start time: the
+    request is answered 503, and asyncio reports no task destroyed while pending."""
+    import signal
+    import subprocess
+
+    from tests.helpers.cli import ENV, POPPY
+    from tests.helpers.processes import read_until, reap
+
+    endpoint = free_endpoint()
+    argv = [*POPPY, "serve", "--zenoh", "--name", "jr-t", "--zenoh-listen", endpoint]
+    proc = subprocess.Popen(
+        [*argv, "--token", TOKEN, "--profile", "ergo-jr", "--sim"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env={**os.environ, **ENV},
+    )
+    try:
+        assert proc.stdout is not None and proc.stderr is not None
+        assert "poppy/jr-t" in read_until(proc.stdout.fileno(), "poppy/jr-t", 60, proc)
+        with Fleet(Settings(connect=(endpoint,))) as plain:
+            assert plain.wait_for(["jr-t"], timeout_s=30) == ["jr-t"]
+            held = zenoh_wire.api_request(
+                "GET", "/api/v1/motors", token=TOKEN, start_at=time.time() + 30, robot="jr-t"
+            )
+            handler = plain.session.get("poppy/jr-t/api", payload=held, timeout=25.0)
+            time.sleep(1.0)  # the request reaches the robot and waits there
+            proc.send_signal(signal.SIGTERM)
+            replies = [json.loads(r.ok.payload.to_bytes()) for r in handler if r.ok is not None]
+        assert replies == [{"status": 503, "body": {"detail": "the robot is stopping"}}]
+        assert proc.wait(30) == 0
+        stderr = proc.stderr.read().decode(errors="replace")
+        assert "stopped" in stderr
+        assert "Task was destroyed" not in stderr, stderr
+    finally:
+        reap(proc)
