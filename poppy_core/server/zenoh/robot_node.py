@@ -14,7 +14,6 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
-import math
 import re
 import socket
 import threading
@@ -28,6 +27,7 @@ from poppy_core.motion.chains import robot_chains
 from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
 from poppy_core.server.errors import ApiError
 from poppy_core.server.start_time import START_AT
+from poppy_core.server.zenoh import described
 from poppy_core.server.zenoh.asgi_call import AsgiCaller
 from poppy_core.server.zenoh.intake import ApiRequest, Intake
 from poppy_core.zenoh_auth import Refused
@@ -255,26 +255,16 @@ class ZenohRobotServer:
     def description(self) -> dict[str, Any]:
         """Creature, motors (with limits), groups, primitives, moves, chains, host, endpoints."""
         robot = self.service.robot
-        profile = robot.config.profile if robot.config is not None else None
-        motors = [
-            {
-                "name": m.name,
-                "id": m.id,
-                "model": m.model.name,
-                "angle_limit": _jsonable(getattr(m, "angle_limit", None)),
-            }
-            for m in robot.motors
-        ]
         return {
             "version": zenoh_wire.STATE_VERSION,
             "name": self.name,
-            "creature": profile.name if profile is not None else "",
+            "creature": described.creature(robot),
             "host": socket.gethostname(),
             "endpoints": list(self.endpoints),
             "page": self.page,
             "token": self.token is not None,
             "state_rate_hz": self.state_rate_hz,
-            "motors": motors,
+            "motors": described.motors(robot),
             "groups": self.service.groups(),
             "primitives": list(self.service.primitives()),
             "moves": self.service.moves.names(),
@@ -402,11 +392,3 @@ def _undeclare(declared: list[Any]) -> None:
             item.undeclare()
         except Exception as exc:  # a session already closed
             logger.debug("undeclaring on Zenoh: %s", exc)
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, tuple | list):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
