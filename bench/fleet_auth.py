@@ -8,6 +8,9 @@
 2. **Round trip**: ``GET /api/v1/motors`` over Zenoh to two robots served in this process, one
    with a token (signed requests) and one without, interleaved request by request (so that a
    neighbour's load falls on both alike), ``TRIPS`` each.
+3. **Unsigned flood**: ``FLOOD`` unsigned starts due 50 s ahead, sent at once to the robot with
+   a token: how long until every one is answered (401, on arrival), and the process's resident
+   memory before and after (robot and client share it).
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from bench.side_by_side import percentile
 
 OPS = 5000
 TRIPS = 400
+FLOOD = 300
 TOKEN = "a-bench-token-0123456789abcdef"
 
 
@@ -52,6 +56,7 @@ def sign_and_check() -> dict[str, Any]:
 
 
 def round_trip() -> dict[str, Any]:
+    """``{"trip": the interleaved round trips, "flood": flood()}`` on two robots served here."""
     import socket
 
     from poppy_core.assembly import ServeSpec, ZenohSettings, serve
@@ -73,6 +78,7 @@ def round_trip() -> dict[str, Any]:
             served.append((robot, serve(robot, spec)))
             settings = ZenohSettings(connect=(where,))
             clients[label] = ZenohClient(f"b-{label}", token, 5.0, settings=settings)
+        flooded = flood(clients, "b-signed")
         times: dict[str, list[float]] = {"signed": [], "plain": []}
         for index in range(TRIPS + 20):
             for label, client in clients.items():
@@ -88,18 +94,54 @@ def round_trip() -> dict[str, Any]:
         for robot, servers in served:
             servers.stop()
             robot.close()
-    return {
+    trip = {
         "trips": TRIPS,
         **{f"{k}_p50_ms": _ms(v, 0.5) for k, v in times.items()},
         **{f"{k}_p99_ms": _ms(v, 0.99) for k, v in times.items()},
         "added_p50_ms": _ms(times["signed"], 0.5) - _ms(times["plain"], 0.5),
         "added_p99_ms": _ms(times["signed"], 0.99) - _ms(times["plain"], 0.99),
     }
+    return {"trip": trip, "flood": flooded}
+
+
+def _rss_mib() -> float:
+    with open("/proc/self/status", encoding="ascii") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    return 0.0
+
+
+def flood(clients: dict[str, Any], robot: str) -> dict[str, Any]:
+    """``FLOOD`` unsigned starts due 50 s ahead to ``robot`` (one with a token), at once."""
+    import json
+
+    from poppy_core import zenoh_wire
+
+    session = clients["signed"].session
+    before = _rss_mib()
+    start_at = time.time() + 50.0
+    payload = zenoh_wire.api_request("POST", "/api/v1/primitives/dance/start", start_at=start_at)
+    key = zenoh_wire.robot_key(robot, "api")
+    began = time.perf_counter()
+    handlers = [session.get(key, payload=payload, timeout=45.0) for _ in range(FLOOD)]
+    statuses = set()
+    for handler in handlers:
+        for reply in handler:
+            if reply.ok is not None:
+                statuses.add(json.loads(reply.ok.payload.to_bytes())["status"])
+    return {
+        "requests": FLOOD,
+        "answered_s": time.perf_counter() - began,
+        "before_start": time.time() < start_at,
+        "statuses": sorted(statuses),
+        "rss_added_mib": _rss_mib() - before,
+    }
 
 
 def signed_requests() -> dict[str, Any]:
-    """Both measures: ``{"check": sign_and_check(), "trip": round_trip()}``."""
-    return {"check": sign_and_check(), "trip": round_trip()}
+    """The three measures: ``check``, ``trip`` and ``flood``."""
+    return {"check": sign_and_check(), **round_trip()}
 
 
 if __name__ == "__main__":
