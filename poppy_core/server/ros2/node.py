@@ -109,6 +109,7 @@ class Ros2Node:
         them)."""
         self.state_loop = TickGuard(f"ros2-{self.node}")
         """The publish loop's failures (a raising tick is retried with backoff)."""
+        self.diagnostics_loop = TickGuard(f"ros2-diagnostics-{self.node}")
         self.camera_loop = TickGuard(f"ros2-camera-{self.node}")
 
     @property
@@ -346,7 +347,7 @@ class Ros2Node:
             self.state_loop.run(partial(self._publish_state, states, tf, now, wall), stopping)
             if now >= next_diagnostics:
                 next_diagnostics = now + DIAGNOSTICS_PERIOD_S
-                self.state_loop.run(partial(self._publish_diagnostics, wall), stopping)
+                self.diagnostics_loop.run(partial(self._publish_diagnostics, wall), stopping)
 
     def _publish_state(self, states: _Publisher, tf: _Publisher, now: float, wall: float) -> None:
         states.put(
