@@ -1,8 +1,9 @@
 """`poppy fleet list/status/run/play/stop`: the robots served with `poppy serve --zenoh`, together.
 
 Commands reach the robots on Zenoh (`--zenoh-connect ENDPOINT` as `poppy serve` says it, or
-`--connect`; else POPPY_ZENOH_CONNECT, else a router or robot on tcp/127.0.0.1:7447); `run`, `play` and `stop` go to `--all` robots or
-`--robots a,b` and carry a shared start time, so the robots start within a sync period.
+`--connect`; else POPPY_ZENOH_CONNECT, else a router or robot on tcp/127.0.0.1:7447); `run`,
+`play` and `stop` go to `--all` robots or `--robots a,b` and carry a shared start time, so the
+robots start within a sync period. With `--token` every command is signed, never sent in clear.
 """
 
 from __future__ import annotations
