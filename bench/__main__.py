@@ -71,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
         type=Path,
         default=None,
         help="another checkout of poppy (e.g. `git worktree add /tmp/old REV`) that `scan` "
-        "measures beside this one, alternately",
+        "and `server` measure beside this one, alternately",
     )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="bench: %(message)s")
