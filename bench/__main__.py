@@ -74,8 +74,8 @@ def main(argv: list[str] | None = None) -> int:
         "--baseline",
         type=Path,
         default=None,
-        help="another checkout of poppy (e.g. `git worktree add /tmp/old REV`) that `scan` "
-        "and `emulator` measure beside this one, alternately",
+        help="another checkout of poppy (e.g. `git worktree add /tmp/old REV`) that `scan`, "
+        "`emulator` and `server` measure beside this one, alternately",
     )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="bench: %(message)s")

@@ -14,6 +14,8 @@
 4. **Teleop goals at 100 Hz**: a follower served in this process gets 100 goals/s over Zenoh
    (its ``goals`` stream) and over the WebSocket (``{motor: {goal_position}}`` frames); the
    latency is from the send to the server's handling of that goal (matched by its value).
+5. **Signed requests** (``bench.fleet_auth``): what signing and checking add per request (CPU
+   time), and a request's round trip to a robot with a token against one without.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
+from bench.fleet_auth import signed_requests
 from bench.fleet_procs import (
     PROCESSES,
     ROBOTS,
@@ -304,7 +307,9 @@ def encoding() -> dict[str, Any]:
     }
 
 
-@register("fleet", "20 Ergo Jrs on Zenoh: state fan-out vs WebSocket, fleet play spread, teleop")
+@register(
+    "fleet", "20 Ergo Jrs on Zenoh: state fan-out vs WebSocket, fleet play spread, teleop, signing"
+)
 def fleet_bench(ctx: BenchContext) -> BenchResult:
     """Fan-out, start spread and teleop goals (one run each: the machine is shared)."""
     import tempfile
@@ -327,6 +332,7 @@ def fleet_bench(ctx: BenchContext) -> BenchResult:
             )
     raw["teleop"] = teleop_goals()
     raw["encoding"] = encoding()
+    raw["auth"] = signed_requests()
     raw["load_after"] = os.getloadavg()[0]
     settings = {
         "ROBOTS": ROBOTS,

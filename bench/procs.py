@@ -9,6 +9,7 @@ import socket
 import subprocess
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 from bench.registry import POPPY_PYTHON, REPO_ROOT, BenchContext
@@ -53,12 +54,13 @@ def child(
     stdout: int = subprocess.DEVNULL,
     env: Mapping[str, str] | None = None,
     stop_timeout_s: float = 10.0,
+    cwd: Path | None = None,
 ) -> Iterator[subprocess.Popen[str]]:
-    """``args`` run from the repository (text, stderr piped, ``env`` added to this process's);
-    when the block ends: stopped by ``interrupt`` and its pipes closed."""
+    """``args`` run from the repository, or ``cwd`` (text, stderr piped, ``env`` added to this
+    process's); when the block ends: stopped by ``interrupt`` and its pipes closed."""
     proc = subprocess.Popen(
         args,
-        cwd=REPO_ROOT,
+        cwd=cwd or REPO_ROOT,
         stdout=stdout,
         stderr=subprocess.PIPE,
         text=True,

@@ -24,7 +24,7 @@ class BenchContext:
         peers_note: why the peers are unavailable (empty when they are).
         minutes: duration of the long benchmarks (``soak``), None for their default.
         baseline: another checkout of poppy measured beside this one, alternately, by the
-            benchmarks that support it (``scan``); None for none.
+            benchmarks that support it (``scan``, ``server``); None for none.
     """
 
     repeat: int = 3

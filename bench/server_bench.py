@@ -6,6 +6,9 @@ from wrk (a C load generator, one thread, ``CLIENTS`` keep-alive connections) wh
 installed (Debian package ``wrk``; ``bench/setup_peers.sh`` installs it when run as root), else
 from ``CLIENTS`` threads of this process, each with one keep-alive ``http.client`` connection —
 a Python client whose own cost caps the rate it can measure (about 9,000 requests/s here).
+With ``--baseline DIR`` the poppy of another checkout is served beside this one and each run of
+one is followed by the same run of the other, the order swapping each round (see
+bench/server_baseline.py).
 """
 
 from __future__ import annotations
@@ -26,6 +29,8 @@ from typing import Any
 from bench import side_by_side
 from bench.procs import child, free_port, served_ergo
 from bench.registry import BenchContext, BenchResult, Table, register
+from bench.scan_baseline import BASELINE_CLIENT, baseline_label
+from bench.server_baseline import baseline_rps_table
 from bench.side_by_side import measure_sides, median_cells, percentile
 
 CLIENTS = 4
@@ -72,9 +77,15 @@ def _wait_listening(port: int, proc: subprocess.Popen[str]) -> None:
 
 @contextmanager
 def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
+    """``kind``: "poppy", "pypot", or BASELINE_CLIENT (poppy run from the --baseline checkout)."""
     port = free_port()
-    args = served_ergo(kind, ctx, PYPOT_SERVER, port, "--http", "--http-port", str(port))
-    with child(args) as proc:
+    flags = ("--http", "--http-port", str(port))
+    if kind == BASELINE_CLIENT and ctx.baseline is not None:  # its poppy_core first
+        args = served_ergo("poppy", ctx, PYPOT_SERVER, port, *flags)
+        where: dict[str, Any] = {"cwd": ctx.baseline, "env": {"PYTHONPATH": str(ctx.baseline)}}
+    else:
+        args, where = served_ergo(kind, ctx, PYPOT_SERVER, port, *flags), {}
+    with child(args, **where) as proc:
         _wait_listening(port, proc)
         yield port
 
@@ -194,31 +205,57 @@ def _goto_loop(port: int, stop: threading.Event) -> None:
     conn.close()
 
 
-def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
-    out: dict[str, Any] = {}
+def _run(port: int, name: str) -> dict[str, Any]:
+    """One run of scenario ``name`` on the server at ``port``, with the load average at start."""
+    method, path, body = SCENARIOS[name]
     wrk = shutil.which("wrk")
-    with _server(kind, ctx) as port:
-        for name, (method, path, body) in SCENARIOS.items():
-            runs = []
-            for _ in range(ctx.repeat):
-                stop = threading.Event()
-                mover = None
-                if "goto" in name:
-                    mover = threading.Thread(target=_goto_loop, args=(port, stop))
-                    mover.start()
-                    time.sleep(0.1)
-                try:
-                    if wrk is not None:
-                        runs.append(_load_wrk(wrk, port, method, path, body))
-                    else:
-                        runs.append(_load(port, method, path, body))
-                finally:
-                    stop.set()
-                    if mover is not None:
-                        mover.join()
-            runs.sort(key=lambda r: float(r["rps"]))
-            out[name] = {"median": runs[len(runs) // 2], "runs": runs}
+    load1 = os.getloadavg()[0]
+    stop = threading.Event()
+    mover = None
+    if "goto" in name:
+        mover = threading.Thread(target=_goto_loop, args=(port, stop))
+        mover.start()
+        time.sleep(0.1)
+    try:
+        if wrk is not None:
+            result = _load_wrk(wrk, port, method, path, body)
+        else:
+            result = _load(port, method, path, body)
+    finally:
+        stop.set()
+        if mover is not None:
+            mover.join()
+    result["load1"] = load1
+    return result
+
+
+def _medians(runs_by_name: dict[str, list[dict[str, Any]]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for name, runs in runs_by_name.items():
+        ordered = sorted(runs, key=lambda r: float(r["rps"]))
+        out[name] = {"median": ordered[len(ordered) // 2], "runs": runs}
     return out
+
+
+def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
+    with _server(kind, ctx) as port:
+        return _medians({name: [_run(port, name) for _ in range(ctx.repeat)] for name in SCENARIOS})
+
+
+def _measure_beside_baseline(ctx: BenchContext) -> dict[str, Any]:
+    """This poppy and the --baseline one, both served at once; in each round of each scenario
+    one runs right after the other, the order swapping each round (baseline first in round 0)."""
+    runs: dict[str, dict[str, list[dict[str, Any]]]] = {"poppy": {}, BASELINE_CLIENT: {}}
+    with _server(BASELINE_CLIENT, ctx) as base_port, _server("poppy", ctx) as port:
+        ports = {"poppy": port, BASELINE_CLIENT: base_port}
+        for name in SCENARIOS:
+            for rep in range(ctx.repeat):
+                order = ("poppy", BASELINE_CLIENT) if rep % 2 else (BASELINE_CLIENT, "poppy")
+                for side in order:
+                    run = _run(ports[side], name)
+                    run["rep"] = rep
+                    runs[side].setdefault(name, []).append(run)
+    return {side: _medians(by_name) for side, by_name in runs.items()}
 
 
 GOAL_RATIO = 2.0
@@ -228,7 +265,21 @@ GOAL_RATIO = 2.0
 def server_bench(ctx: BenchContext) -> BenchResult:
     """Measure both servers on every scenario."""
     raw: dict[str, Any] = {"clients": CLIENTS, "duration_s": DURATION_S, "goto_s": GOTO_S}
-    sides, notes = measure_sides(ctx, _measure, "server")
+    tables: list[Table] = []
+    if ctx.baseline is not None:
+        beside = _measure_beside_baseline(ctx)
+        label = baseline_label(ctx.baseline)
+        raw[BASELINE_CLIENT] = {"label": label, **beside[BASELINE_CLIENT]}
+
+        def measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
+            return beside["poppy"] if kind == "poppy" else _measure(kind, ctx)
+
+        sides, notes = measure_sides(ctx, measure, "server")
+        table, more = baseline_rps_table(raw[BASELINE_CLIENT], sides["poppy"], label)
+        tables.append(table)
+        notes += more
+    else:
+        sides, notes = measure_sides(ctx, _measure, "server")
     raw.update(sides)
     rows = [[name, *median_cells(raw, name)] for name in SCENARIOS]
     headers = side_by_side.headers()
@@ -267,7 +318,7 @@ def server_bench(ctx: BenchContext) -> BenchResult:
             "poppy (`poppy serve --http --sim`) against pypot 5 (`PoppyErgoJr(simulator="
             "'dummy', use_http=True)`), both on 127.0.0.1 in their own process."
         ),
-        tables=[Table("REST server", headers, rows)],
+        tables=[Table("REST server", headers, rows), *tables],
         notes=notes,
         passed=all(verdicts) if verdicts else None,
         raw=raw,

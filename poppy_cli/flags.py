@@ -104,13 +104,15 @@ FLAGS: dict[str, Flag] = {
     "--zmq-port": Flag(None, "PORT", "TCP port of the ZMQ API"),
     "--zenoh": Flag(None, None, "serve the robot on Zenoh under poppy/NAME (fleets)"),
     "--zenoh-listen": Flag(None, "ENDPOINT", "Zenoh endpoint to listen on, e.g. tcp/0.0.0.0:7447"),
-    "--zenoh-connect": Flag(None, "ENDPOINT", "Zenoh peer or router to connect to"),
+    "--zenoh-connect": Flag(
+        None, "ENDPOINT", "Zenoh peer or router to connect to (`--connect` in fleet, teleop)"
+    ),
     "--zenoh-config": Flag(None, "FILE", "Zenoh's own JSON5 configuration (TLS, access control)"),
     "--zenoh-scout": Flag(None, None, "find Zenoh peers by multicast scouting on the LAN"),
     "--ros2": Flag(None, None, "serve the robot as a ROS 2 node over rmw_zenoh"),
     "--ros-domain": Flag(None, "N", "ROS 2 domain ID (0-232; ROS_DOMAIN_ID)"),
     "--ros-namespace": Flag(None, "NS", "the ROS 2 node's namespace, e.g. /lab"),
-    "--connect": Flag(None, "ENDPOINT", "Zenoh endpoint (peer or router) to connect to"),
+    "--connect": Flag(None, "ENDPOINT", "`--zenoh-connect`'s other name in `fleet` and `teleop`"),
     "--listen": Flag(None, "ENDPOINT", "Zenoh endpoint the router listens on"),
     "--all": Flag(None, None, "every robot of the fleet"),
     "--robots": Flag(None, "NAMES", "robots of the fleet, comma-separated"),

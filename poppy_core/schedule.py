@@ -262,3 +262,56 @@ class Gate:
     def wait(self, timeout_s: float | None = None) -> bool:
         """Block until the gate opens (True) or is cancelled (False); False also on timeout."""
         return self._event.wait(timeout_s) and not self._cancelled
+
+
+class TickGuard:
+    """Keeps a loop alive through a raising tick: the failure is logged once at WARNING (with
+    its traceback) until a tick succeeds again, the loop waits a doubling backoff before the
+    next tick, and ``health()`` shows it; the first tick that succeeds resumes the rate.
+
+    Args:
+        name: the loop's name, in the log.
+        first_s: the first wait after a failure (doubling up to ``max_s``).
+        max_s: the longest wait between failing ticks.
+    """
+
+    def __init__(self, name: str, first_s: float = 0.05, max_s: float = 1.0) -> None:
+        self.name = name
+        self.backoff = Backoff(first_s, max_s)
+        self.failures = 0
+        """Ticks that raised since the loop started."""
+        self.last_error: str | None = None
+        """The last failure's one line while the loop fails; None once a tick succeeded."""
+        self._failing = False
+
+    @property
+    def failing(self) -> bool:
+        """True from a raising tick until one succeeds."""
+        return self._failing
+
+    def run(self, tick: Callable[[], None], stopping: threading.Event) -> bool:
+        """Run ``tick``; on an exception, log it (the first of a run of failures), wait the
+        backoff (or until ``stopping``) and return False. True when the tick succeeded."""
+        try:
+            tick()
+        except Exception as exc:
+            self.failures += 1
+            self.last_error = f"{type(exc).__name__}: {exc}"
+            if not self._failing:
+                self._failing = True
+                logger.warning(
+                    "%s: a tick failed, retrying with backoff: %s", self.name, exc, exc_info=exc
+                )
+            stopping.wait(self.backoff.delay_s)
+            self.backoff.failed()
+            return False
+        if self._failing:
+            self._failing = False
+            self.last_error = None
+            self.backoff.reset()
+            logger.info("%s: recovered after %d failed ticks", self.name, self.failures)
+        return True
+
+    def health(self) -> dict[str, object]:
+        """``ok`` (no failure now), ``failures`` (since the start) and ``last_error``."""
+        return {"ok": not self._failing, "failures": self.failures, "last_error": self.last_error}

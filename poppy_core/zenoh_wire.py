@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from poppy_core import checks
+from poppy_core import checks, zenoh_auth
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.extras import require
 
@@ -356,25 +356,39 @@ def api_request(
     *,
     token: str | None = None,
     start_at: float | None = None,
+    robot: str | None = None,
+    sender: str = "",
 ) -> bytes:
     """The payload of a query to ``poppy/NAME/api``: a v1 REST request (``start_at``: the
-    wall-clock time the robot runs it at, for commands started together)."""
+    wall-clock time the robot runs it at, for commands started together). With ``token`` it is
+    signed for ``robot`` (``zenoh_auth.sign``): the token itself never travels."""
     request: dict[str, Any] = {"method": method, "path": path}
     if body is not None:
         request["body"] = body
-    if token:
-        request["token"] = token
     if start_at is not None:
         request["start_at"] = start_at
+    if token:
+        return zenoh_auth.sign(token, check_name(robot or ""), request, sender)
     return json.dumps(request).encode()
 
 
-def goals_message(goals: Mapping[str, float], token: str | None = None) -> bytes:
-    """The payload of ``poppy/NAME/goals``: motor -> goal position (degrees)."""
+def goals_message(
+    goals: Mapping[str, float],
+    token: str | None = None,
+    robot: str | None = None,
+    sender: str = "",
+) -> bytes:
+    """The payload of ``poppy/NAME/goals``: motor -> goal position (degrees); signed for
+    ``robot`` with ``token`` when one is given."""
     message: dict[str, Any] = {"goals": dict(goals)}
     if token:
-        message["token"] = token
+        return zenoh_auth.sign(token, check_name(robot or ""), message, sender)
     return json.dumps(message).encode()
+
+
+def sender_of(session: zenoh.Session) -> str:
+    """Who signs from ``session``, for the robot's log: ``HOST (zenoh ZID)``."""
+    return f"{socket.gethostname()} (zenoh {session.info.zid()})"
 
 
 def names_list(names: Sequence[str]) -> str:

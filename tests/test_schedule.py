@@ -8,7 +8,7 @@ import threading
 import pytest
 
 from poppy_core.errors import ArgumentError
-from poppy_core.schedule import Backoff, Periodic, RateMeter, Worker
+from poppy_core.schedule import Backoff, Periodic, RateMeter, TickGuard, Worker
 from tests.helpers.waiting import eventually
 
 
@@ -130,3 +130,27 @@ def test_worker_stopped_from_its_own_body_only_asks() -> None:
     worker.start()
     assert worker.wait(timeout_s=5.0)
     assert answers == [True] and worker.error is None
+
+
+def test_a_tick_guard_keeps_a_loop_through_failures_logged_once_with_backoff(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+
+    guard = TickGuard("loop", first_s=0.001, max_s=0.004)
+    stopping = threading.Event()
+    calls: list[int] = []
+
+    def failing() -> None:
+        calls.append(1)
+        raise ValueError("no data")
+
+    caplog.set_level(logging.WARNING, logger="poppy_core.schedule")
+    assert [guard.run(failing, stopping) for _ in range(4)] == [False] * 4
+    assert guard.backoff.delay_s == 0.004  # doubled up to its longest
+    assert guard.health() == {"ok": False, "failures": 4, "last_error": "ValueError: no data"}
+    assert guard.run(lambda: None, stopping) is True
+    assert guard.health() == {"ok": True, "failures": 4, "last_error": None}
+    assert guard.backoff.delay_s == 0.001
+    guard.run(failing, stopping)  # a new run of failures is logged again, once
+    warned = [r for r in caplog.records if "a tick failed" in r.getMessage()]
+    assert len(warned) == 2 and len(calls) == 5

@@ -1,8 +1,9 @@
 """`poppy fleet list/status/run/play/stop`: the robots served with `poppy serve --zenoh`, together.
 
-Commands reach the robots on Zenoh (`--connect ENDPOINT`, else POPPY_ZENOH_CONNECT, else a
-router or robot on tcp/127.0.0.1:7447); `run`, `play` and `stop` go to `--all` robots or
-`--robots a,b` and carry a shared start time, so the robots start within a sync period.
+Commands reach the robots on Zenoh (`--zenoh-connect ENDPOINT` as `poppy serve` says it, or
+`--connect`; else POPPY_ZENOH_CONNECT, else a router or robot on tcp/127.0.0.1:7447); `run`,
+`play` and `stop` go to `--all` robots or `--robots a,b` and carry a shared start time, so the
+robots start within a sync period. With `--token` every command is signed, never sent in clear.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ if TYPE_CHECKING:
 
 ConnectOpt = typer.Option(
     None,
+    "--zenoh-connect",
     "--connect",
     help="A Zenoh peer or router to connect to, e.g. tcp/192.168.1.10:7447 (repeat it). "
     "Default: POPPY_ZENOH_CONNECT, else tcp/127.0.0.1:7447.",
@@ -72,7 +74,9 @@ def fleet_list(
         print_json(rows)
         return
     if not rows:
-        console.print("no robot on Zenoh (check --connect; robots need `poppy serve --zenoh`)")
+        console.print(
+            "no robot on Zenoh (check --zenoh-connect; robots need `poppy serve --zenoh`)"
+        )
         return
     from rich.table import Table
 
@@ -200,7 +204,7 @@ def _targets(fleet: Fleet, wanted: list[str] | None) -> list[str]:
         return wanted
     names = fleet.names()
     if not names:
-        error_line("no robot on Zenoh (check --connect; robots need `poppy serve --zenoh`)")
+        error_line("no robot on Zenoh (check --zenoh-connect; robots need `poppy serve --zenoh`)")
         raise typer.Exit(EXIT_FAILURE)
     return names
 

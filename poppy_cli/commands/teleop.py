@@ -134,6 +134,7 @@ def teleop(
     json_output: bool = JsonSummaryOpt,
     connect: list[str] | None = typer.Option(
         None,
+        "--zenoh-connect",
         "--connect",
         help="For zenoh:NAME robots: a Zenoh peer or router to connect to (repeat it). "
         "Default: POPPY_ZENOH_CONNECT, else tcp/127.0.0.1:7447.",

@@ -60,6 +60,8 @@ def name_and_announce(servers: ServerSet, robot: Robot, spec: ServeSpec) -> None
         settings_file=spec.settings_file,
         token_file=spec.token_file,
     )
+    if servers.zenoh is not None:  # renamed from the page: on Zenoh too, without a restart
+        served.on_rename.append(servers.zenoh.rename)
     if servers.app is not None:
         servers.app.state.settings.served = served
     if not spec.announce or name is None:

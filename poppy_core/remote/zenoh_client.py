@@ -54,7 +54,7 @@ class ZenohClient(HttpClient):
 
     Args:
         name: the robot's name (``poppy/NAME``).
-        token: sent with every request when set.
+        token: signs every request when set (``zenoh_auth``: the token itself is never sent).
         timeout_s: how long to wait for an answer.
         settings: how to join the Zenoh network (``client_settings()`` when None).
         session: an open session to use (kept open on ``close``) instead of opening one.
@@ -81,6 +81,8 @@ class ZenohClient(HttpClient):
         settings = settings or client_settings()
         self.session = session or zenoh_wire.open_session(settings)
         self._key = zenoh_wire.robot_key(name, "api")
+        self.sender = zenoh_wire.sender_of(self.session)
+        """Who signs this client's requests (for the robot's log)."""
         if self._owned:  # a new session: let its links come up and the robot be seen
             zenoh_wire.await_peers(self.session, settings, timeout_s)
             zenoh_wire.await_token(self.session, name, min(timeout_s, 3.0))
@@ -102,7 +104,15 @@ class ZenohClient(HttpClient):
         self, method: str, path: str, body: Any = None, start_at: float | None = None
     ) -> tuple[int, Any]:
         """The robot's status and answer (undecoded: refusals are returned, not raised)."""
-        payload = zenoh_wire.api_request(method, path, body, token=self.token, start_at=start_at)
+        payload = zenoh_wire.api_request(
+            method,
+            path,
+            body,
+            token=self.token,
+            start_at=start_at,
+            robot=self.name,
+            sender=self.sender,
+        )
         timeout = self.timeout_s + (max(0.0, start_at - time.time()) if start_at else 0.0)
         began = time.monotonic()
         try:
@@ -132,7 +142,7 @@ def answer_of(where: str, replies: list[Any], timeout_s: float, waited_s: float)
     if not replies and waited_s < timeout_s * 0.9:
         raise CommunicationError(
             f"{where}: no robot of that name on the Zenoh network (`poppy fleet list` shows "
-            "the robots seen; check the endpoints: --connect or POPPY_ZENOH_CONNECT)",
+            "the robots seen; check the endpoints: --zenoh-connect or POPPY_ZENOH_CONNECT)",
             port=where,
         )
     errors = [r.err.payload.to_bytes().decode(errors="replace") for r in replies]

@@ -54,7 +54,7 @@ class Fleet:
 
     Args:
         settings: how to join it (``client_settings()`` when None).
-        token: sent with every command.
+        token: signs every command (``zenoh_auth``: the token itself is never sent).
         timeout_s: how long a robot has to answer.
         session: an open session to use (kept open on ``close``).
     """
@@ -73,6 +73,7 @@ class Fleet:
         settings = settings or client_settings()
         self.session = session or zenoh_wire.open_session(settings)
         self._declared: list[Any] = []
+        self._sender = zenoh_wire.sender_of(self.session)
         self.last_start_at: float | None = None
         """The shared start time of the last command sent ``together``."""
         if self._owned:  # a new session: let its links come up before the first query
@@ -129,7 +130,13 @@ class Fleet:
         pending = []
         for name in names:
             payload = zenoh_wire.api_request(
-                method, path, body, token=self.token, start_at=start_at
+                method,
+                path,
+                body,
+                token=self.token,
+                start_at=start_at,
+                robot=name,
+                sender=self._sender,
             )
             key = zenoh_wire.robot_key(name, "api")
             pending.append((name, self.session.get(key, payload=payload, timeout=timeout)))
@@ -205,7 +212,7 @@ class Fleet:
 
         def send(goals: dict[str, float]) -> None:
             with lock:
-                publisher.put(zenoh_wire.goals_message(goals, self.token))
+                publisher.put(zenoh_wire.goals_message(goals, self.token, name, self._sender))
 
         return send
 

@@ -215,7 +215,9 @@ class ZenohFollower:
                 self._set("following", "ramp done")
             elif self.state != "ramping":
                 self._set("ramping", "to the leader")
-        self._publisher.put(zenoh_wire.goals_message(goals, self.token))
+        client = self.client
+        message = zenoh_wire.goals_message(goals, self.token, client.name, client.sender)
+        self._publisher.put(message)
 
     def hold(self, reason: str) -> None:
         """Stop sending (the motors keep their last goal); the next targets ramp again."""

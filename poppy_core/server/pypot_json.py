@@ -48,13 +48,16 @@ def pypot_bytes(content: Any) -> bytes:
     return html_safe(ENCODER.encode(content).encode("utf-8"))
 
 
+RAW_HEADERS: tuple[tuple[bytes, bytes], ...] = (
+    (b"content-type", PYPOT_CONTENT_TYPE.encode()),
+    *((name.lower().encode(), value.encode()) for name, value in PYPOT_HEADERS.items()),
+)
+"""The ASGI headers of every pypot answer but its length, encoded once (not per request)."""
+
+
 def pypot_raw_headers(length: int) -> list[tuple[bytes, bytes]]:
     """The ASGI headers of a pypot answer of ``length`` bytes (for the fast path)."""
-    return [
-        (b"content-type", PYPOT_CONTENT_TYPE.encode()),
-        (b"content-length", str(length).encode()),
-        *((name.lower().encode(), value.encode()) for name, value in PYPOT_HEADERS.items()),
-    ]
+    return [*RAW_HEADERS, (b"content-length", b"%d" % length)]
 
 
 class PypotJSON(JSONResponse):

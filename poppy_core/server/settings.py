@@ -67,6 +67,9 @@ class ServedRobot:
     """The serve options file (``poppy serve --settings``): Snap! and ZMQ are switched there."""
     token_file: Path | None = None
     """The token file (``poppy serve --token-file``): the token is changed there."""
+    on_rename: list[Callable[[str], None]] = field(default_factory=list)
+    """Called with the new name when the page renames the robot (the Zenoh node serves under
+    it from then on)."""
 
     def named(self, name: str) -> None:
         """The robot is now ``name`` (an mDNS name won, a new name set): the Host check
@@ -166,6 +169,8 @@ class RobotSettings:
         announcer = self.served.announcer
         won = announcer.rename(name) if announcer is not None else name
         self.served.named(won)
+        for rename in self.served.on_rename:
+            rename(name)
         logger.warning("settings: %s renamed the robot %s (announced as %s.local)", who, name, won)
         return won
 

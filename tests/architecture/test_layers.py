@@ -18,7 +18,8 @@ ROOT = Path(__file__).resolve().parents[2]
 # sandbox), `checks` (the one rule of each kind of call argument) and `extras` (the optional
 # dependencies, with the one-line error naming a missing extra) are leaves every room may use;
 # so is `zenoh_wire` (the Zenoh keys, session settings and state message a served robot and its
-# clients share, as `line` is the byte-line contract of buses and emulators), and `ros2_wire`
+# clients share, as `line` is the byte-line contract of buses and emulators), `zenoh_auth` (how
+# those clients sign their messages and the robot checks them), and `ros2_wire`
 # (rmw_zenoh's keys, liveliness tokens and attachments, on top of `zenoh_wire`'s settings).
 LEAVES = {
     "errors",
@@ -30,6 +31,7 @@ LEAVES = {
     "extras",
     "schedule",
     "zenoh_wire",
+    "zenoh_auth",
     "ros2_wire",
 }
 ALLOWED: dict[str, set[str]] = {

@@ -127,7 +127,7 @@ def test_a_gate_opens_or_is_cancelled_whichever_comes_first() -> None:
 
 
 def _send(fleet: Fleet, name: str, path: str, start_at: float | None, body: Any = None) -> Any:
-    payload = zenoh_wire.api_request("POST", path, body, token=TOKEN, start_at=start_at)
+    payload = zenoh_wire.api_request("POST", path, body, token=TOKEN, start_at=start_at, robot=name)
     key = zenoh_wire.robot_key(name, "api")
     return fleet.session.get(key, payload=payload, timeout=10.0)
 

@@ -18,17 +18,19 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from functools import partial
 from typing import TYPE_CHECKING, Any
 
 from poppy_core import checks
 from poppy_core import ros2_wire as wire
 from poppy_core.errors import PoppyError
 from poppy_core.ros2_wire import Ros2Settings
-from poppy_core.schedule import Periodic, RateMeter, Worker
+from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
 from poppy_core.server.errors import ApiError
 from poppy_core.server.ros2 import messages, rosout, types
 from poppy_core.server.ros2.commands import CommandRefused, Commands
 from poppy_core.server.ros2.joints import UrdfJoints
+from poppy_core.server.ros2.refusal_log import Refusal, Refusals
 
 if TYPE_CHECKING:
     import zenoh
@@ -96,13 +98,21 @@ class Ros2Node:
         """The liveliness keys declared (node first)."""
         self._declared: list[Any] = []
         self._publishers: dict[str, _Publisher] = {}
+        self._service_names: dict[str, str] = {}
         self._entity = 0
         self._zid = ""
         self._pool: ThreadPoolExecutor | None = None
         self._worker = Worker(f"ros2-{self.node}", self._publish_loop)
         self._camera_worker = Worker(f"ros2-camera-{self.node}", self._camera_loop)
-        self._last_refusal = 0.0
-        self.refusals = rosout.Refusals()
+        self.refusals = Refusals(logger)
+        """Every command turned down, as ``Refusal`` events (``refusals.listen`` to publish
+        them)."""
+        self.state_loop = TickGuard(f"ros2-{self.node}")
+        """The publish loop's failures (a raising tick is retried with backoff)."""
+        self.diagnostics_loop = TickGuard(f"ros2-diagnostics-{self.node}")
+        self.camera_loop = TickGuard(f"ros2-camera-{self.node}")
+        self._rosout = rosout.RosoutRefusals(self._publish_rosout)
+        self.refusals.listen(self._rosout.publish)
 
     @property
     def url(self) -> str:
@@ -249,6 +259,7 @@ class Ros2Node:
                 pool.submit(self._answer, query, key, typename, handle)
 
         self._declared.append(self.session.declare_queryable(key, on_query, complete=True))
+        self._service_names[key] = name
         self._token(wire.SERVICE, self._next_id(), (name, typ.dds, typ.hash, wire.SERVICE_QOS))
 
     def _answer(self, query: zenoh.Query, key: str, typename: str, handle: Any) -> None:
@@ -274,8 +285,7 @@ class Ros2Node:
             logger.exception("ROS 2: %s failed", key)
             success, text = False, f"failed: {exc}"
         if not success:
-            logger.warning("ROS 2: %s refused: %s", key, text)
-            self._report(f"{wire.name_of_key(key)} refused: {text}", "service")
+            self.refuse(Refusal(self._service_names.get(key, key), text, "service"))
         response = types.message(f"{typename}_Response", success=success, message=text)
         extra = wire.attachment(
             asked.sequence if asked else 0, time.time_ns(), asked.gid if asked else bytes(16)
@@ -283,18 +293,15 @@ class Ros2Node:
         query.reply(key, types.serialize(response, f"{typename}_Response"), attachment=extra)
 
     def _refused(self, topic: str, why: str) -> None:
-        self.commands.refused += 1
-        now = time.monotonic()
-        if now - self._last_refusal > 1.0:  # one line a second, whatever the rate
-            self._last_refusal = now
-            logger.warning("ROS 2: %s refused, nothing moved: %s", topic, why)
-            self._report(f"{topic} refused, nothing moved: {why}", "subscription")
-        else:
-            self.refusals.add(f"{topic} refused, nothing moved: {why}")
+        self.refuse(Refusal(topic, why, "topic"))
 
-    def _report(self, text: str, function: str) -> None:
-        """A refusal on ``/rosout`` (WARN) and in the ``commands`` diagnostics."""
-        self.refusals.add(text)
+    def refuse(self, refusal: Refusal) -> None:
+        """The one place a refusal of the node goes: counted, logged, handed to listeners."""
+        if refusal.kind == "topic":
+            self.commands.refused += 1
+        self.refusals.report(refusal)
+
+    def _publish_rosout(self, text: str, function: str) -> None:
         publisher = self._publishers.get("rosout")
         if publisher is not None:
             log = rosout.log_message(self.name_of("~"), rosout.WARN, text, function)
@@ -346,24 +353,28 @@ class Ros2Node:
             now = time.monotonic()
             schedule.advance(now)
             wall = time.time()
-            states.put(
-                types.serialize(
-                    messages.joint_state(self.robot, self.joints, wall), types.JOINT_STATE
-                )
-            )
-            self.published += 1
-            self.rate.tick(now)
-            if self.joints.description is not None:
-                tf.put(
-                    types.serialize(
-                        messages.tf_message(self.robot, self.joints, wall), types.TF_MESSAGE
-                    )
-                )
+            self.state_loop.run(partial(self._publish_state, states, tf, now, wall), stopping)
             if now >= next_diagnostics:
                 next_diagnostics = now + DIAGNOSTICS_PERIOD_S
-                self._publishers["diagnostics"].put(
-                    types.serialize(self.diagnostics(wall), types.DIAGNOSTIC_ARRAY)
+                self.diagnostics_loop.run(partial(self._publish_diagnostics, wall), stopping)
+
+    def _publish_state(self, states: _Publisher, tf: _Publisher, now: float, wall: float) -> None:
+        states.put(
+            types.serialize(messages.joint_state(self.robot, self.joints, wall), types.JOINT_STATE)
+        )
+        self.published += 1
+        self.rate.tick(now)
+        if self.joints.description is not None:
+            tf.put(
+                types.serialize(
+                    messages.tf_message(self.robot, self.joints, wall), types.TF_MESSAGE
                 )
+            )
+
+    def _publish_diagnostics(self, wall: float) -> None:
+        self._publishers["diagnostics"].put(
+            types.serialize(self.diagnostics(wall), types.DIAGNOSTIC_ARRAY)
+        )
 
     def diagnostics(self, now: float | None = None) -> Any:
         """The buses' and sensors' health as a DiagnosticArray."""
@@ -372,7 +383,7 @@ class Ros2Node:
             for name, health in self.robot.sensor_health().items()
         }
         array = messages.diagnostics(self.node, self.service.health(), sensors, now)
-        array.status.append(self.refusals.status(self.node))
+        array.status.append(rosout.commands_status(self.refusals, self.node))
         return array
 
     def _cameras(self) -> list[Any]:
@@ -395,9 +406,13 @@ class Ros2Node:
             except PoppyError:
                 continue
             last = frame.number
-            jpeg = encode_image(frame.image, ".jpg")
-            message = messages.compressed_image(jpeg, CAMERA_FRAME, time.time())
-            publisher.put(types.serialize(message, types.COMPRESSED_IMAGE))
+
+            def publish(image: Any = frame.image) -> None:
+                jpeg = encode_image(image, ".jpg")
+                message = messages.compressed_image(jpeg, CAMERA_FRAME, time.time())
+                publisher.put(types.serialize(message, types.COMPRESSED_IMAGE))
+
+            self.camera_loop.run(publish, stopping)
 
     def stop(self) -> None:
         """Stop publishing and following, then undeclare everything (tokens first)."""

@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 from poppy_core.ros2_wire import TRANSIENT_LOCAL, Qos
 from poppy_core.server.ros2 import types
 from poppy_core.server.ros2.messages import stamp
+from poppy_core.server.ros2.refusal_log import LOG_EVERY_S, Refusal, Refusals
 
 LOG = "rcl_interfaces/msg/Log"
 WARN = 30
@@ -40,36 +42,48 @@ def log_message(logger: str, level: int, text: str, function: str, now: float | 
     )
 
 
-class Refusals:
-    """The refusals of a node: counted, the last one kept for ``/diagnostics``."""
+class RosoutRefusals:
+    """A ``Refusals`` listener that publishes each refusal on ``/rosout``: a service's each time,
+    a topic's one a second at most, whatever the rate (as the log does).
 
-    def __init__(self) -> None:
+    Args:
+        publish: ``publish(text, function)`` puts one WARN line on ``/rosout``.
+    """
+
+    def __init__(self, publish: Callable[[str, str], None]) -> None:
+        self._publish = publish
         self._lock = threading.Lock()
-        self.count = 0
-        self.last = ""
-        self._at = -RECENT_S
+        self._last_topic = -LOG_EVERY_S
 
-    def add(self, text: str) -> None:
-        with self._lock:
-            self.count += 1
-            self.last = text
-            self._at = time.monotonic()
+    def publish(self, refusal: Refusal) -> None:
+        if refusal.kind == "topic":
+            now = time.monotonic()
+            with self._lock:
+                if now - self._last_topic <= LOG_EVERY_S:
+                    return
+                self._last_topic = now
+            self._publish(
+                f"{refusal.where} refused, nothing moved: {refusal.reason}", "subscription"
+            )
+        else:
+            self._publish(f"{refusal.where} refused: {refusal.reason}", "service")
 
-    def status(self, node: str) -> Any:
-        """A ``DiagnosticStatus`` named ``NODE: commands``: WARN with the last refusal for
-        ``RECENT_S`` after it, else OK; the count and the last refusal as values."""
-        with self._lock:
-            recent = time.monotonic() - self._at < RECENT_S
-            count, last = self.count, self.last
-        values = [
-            types.message("diagnostic_msgs/msg/KeyValue", key="refused", value=str(count)),
-            types.message("diagnostic_msgs/msg/KeyValue", key="last_refusal", value=last),
-        ]
-        return types.message(
-            "diagnostic_msgs/msg/DiagnosticStatus",
-            level=1 if recent else 0,
-            name=f"{node}: commands",
-            message=f"refused: {last}" if recent else "ok",
-            hardware_id=node,
-            values=values,
-        )
+
+def commands_status(refusals: Refusals, node: str) -> Any:
+    """A ``DiagnosticStatus`` named ``NODE: commands``: WARN with the last refusal for
+    ``RECENT_S`` after it, else OK; the count and the last refusal as values."""
+    last = refusals.last
+    recent = last is not None and time.time() - last.stamp < RECENT_S
+    text = f"{last.where} refused, nothing moved: {last.reason}" if last is not None else ""
+    values = [
+        types.message("diagnostic_msgs/msg/KeyValue", key="refused", value=str(refusals.count)),
+        types.message("diagnostic_msgs/msg/KeyValue", key="last_refusal", value=text),
+    ]
+    return types.message(
+        "diagnostic_msgs/msg/DiagnosticStatus",
+        level=1 if recent else 0,
+        name=f"{node}: commands",
+        message=f"refused: {text}" if recent else "ok",
+        hardware_id=node,
+        values=values,
+    )

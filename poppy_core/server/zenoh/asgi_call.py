@@ -1,7 +1,9 @@
 """``AsgiCaller``: run one HTTP request through the REST app in-process, on a loop of its own.
 
 The Zenoh queryable ``poppy/NAME/api`` answers v1 requests with the REST app itself, so a
-request over Zenoh meets the same token, checks and error wording as one over HTTP.
+request over Zenoh meets the same token, checks and error wording as one over HTTP. A route that
+raises is answered 500 with its one line (never silence); closing cancels the requests still
+under way and lets each of them answer before the loop ends.
 """
 
 from __future__ import annotations
@@ -39,15 +41,24 @@ class AsgiCaller:
         async def guarded() -> None:
             try:
                 await coroutine
+            except asyncio.CancelledError:
+                pass  # closing: the coroutine answered as it was cancelled
             except Exception:
                 logger.exception("a Zenoh request failed")
 
         asyncio.run_coroutine_threadsafe(guarded(), self.loop)
 
     async def call(
-        self, method: str, path: str, body: Any = None, token: str | None = None
+        self,
+        method: str,
+        path: str,
+        body: Any = None,
+        token: str | None = None,
+        client: str = "zenoh",
     ) -> tuple[int, Any]:
-        """The status and decoded JSON answer of ``method path`` (``body`` sent as JSON)."""
+        """The status and decoded JSON answer of ``method path`` (``body`` sent as JSON);
+        ``client`` is who the app sees asking (its logs name it). A route that raises gives
+        500 and the failure's line (the app's own 500 when it sent one first)."""
         path, _, query = path.partition("?")
         payload = b"" if body is None else json.dumps(body).encode()
         headers = [(b"host", HOST), (b"accept", b"application/json")]
@@ -67,11 +78,12 @@ class AsgiCaller:
             "query_string": query.encode(),
             "root_path": "",
             "headers": headers,
-            "client": ("zenoh", 0),
+            "client": (client, 0),
             "server": ("127.0.0.1", 0),
         }
         sent = False
         status = 500
+        started = False
         chunks: list[bytes] = []
 
         async def receive() -> dict[str, Any]:
@@ -84,22 +96,43 @@ class AsgiCaller:
 
         async def send(message: dict[str, Any]) -> None:
             nonlocal status
+            nonlocal started
             if message["type"] == "http.response.start":
+                started = True
                 status = int(message["status"])
             elif message["type"] == "http.response.body":
                 chunks.append(message.get("body", b""))
 
-        await self.app(scope, receive, send)
+        try:
+            await self.app(scope, receive, send)
+        except Exception as exc:  # the app's error middleware answers first, then re-raises
+            logger.warning("zenoh: %s %s failed: %s", method, path, exc, exc_info=exc)
+            if not started:
+                return 500, {"detail": f"the route failed: {type(exc).__name__}: {exc}"}
         data = b"".join(chunks)
         try:
             return status, json.loads(data) if data else None
         except ValueError:
             return status, data[:200].decode("utf-8", errors="replace")
 
-    def close(self) -> None:
-        """Stop the loop (requests under way are dropped)."""
+    def close(self, timeout_s: float = 2.0) -> None:
+        """Cancel the requests under way (each answers as it is cancelled: a request held for
+        its start time says the robot stops), let them end, then stop the loop: no task is
+        left pending when it closes."""
         if self.loop.is_running():
+            try:
+                asyncio.run_coroutine_threadsafe(_cancel_all(), self.loop).result(timeout_s)
+            except Exception as exc:  # a task that would not end: the loop stops anyway
+                logger.debug("zenoh: cancelling the requests under way: %s", exc)
             self.loop.call_soon_threadsafe(self.loop.stop)
-        self._thread.join(2.0)
+        self._thread.join(timeout_s)
         if not self.loop.is_running():
             self.loop.close()
+
+
+async def _cancel_all() -> None:
+    """Cancel every task of the running loop but this one, and wait for them to end."""
+    tasks = [t for t in asyncio.all_tasks() if t is not asyncio.current_task()]
+    for task in tasks:
+        task.cancel()
+    await asyncio.gather(*tasks, return_exceptions=True)

@@ -12,24 +12,25 @@ cannot keep up never slows the robot.
 from __future__ import annotations
 
 import asyncio
-import hmac
 import json
 import logging
-import math
 import re
 import socket
 import threading
 import time
+from functools import partial
 from typing import TYPE_CHECKING, Any
 
 from poppy_core import checks, zenoh_wire
-from poppy_core.errors import ArgumentError, PoppyError
+from poppy_core.errors import PoppyError
 from poppy_core.motion.chains import robot_chains
-from poppy_core.schedule import Periodic, RateMeter, Worker
+from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
 from poppy_core.server.errors import ApiError
-from poppy_core.server.middleware import MAX_BODY_BYTES
 from poppy_core.server.start_time import START_AT
+from poppy_core.server.zenoh import described
 from poppy_core.server.zenoh.asgi_call import AsgiCaller
+from poppy_core.server.zenoh.intake import ApiRequest, Intake
+from poppy_core.zenoh_auth import Refused
 
 if TYPE_CHECKING:
     import zenoh
@@ -41,13 +42,9 @@ logger = logging.getLogger(__name__)
 DEFAULT_STATE_RATE_HZ = 50.0
 """The sync loop's default rate: one state message per cycle."""
 HEALTH_PERIOD_S = 1.0
-MAX_START_DELAY_S = 60.0
-"""How far in the future a ``start_at`` may be (a clock that far off is refused, not waited)."""
-METHODS = ("GET", "PUT", "POST", "DELETE")
 STARTS = re.compile(r"/api/v1/(primitives/[^/?]+/start|moves/[^/?]+/play)")
 """The requests whose action waits for ``start_at`` in its own thread (``start_time``); any
 other request with a ``start_at`` is sent to the app at that time."""
-API_SHAPE = 'send {"method": "GET|PUT|POST|DELETE", "path": "/api/v1/...", "body": {...}}'
 
 
 class ZenohRobotServer:
@@ -58,7 +55,8 @@ class ZenohRobotServer:
         app: the REST app (built for this server when HTTP is not served) answering ``api``.
         session: an open Zenoh session (the server set's, shared with other Zenoh servers).
         name: the robot's name (one key chunk).
-        token: required in every command (``api`` and ``goals``), as on REST.
+        token: signs every command (``api`` and ``goals``, ``zenoh_auth``): only messages
+            signed with it, for this robot, recent and not seen before, are taken.
         state_rate_hz: state messages per second (the sync loop's rate).
         endpoints: where the session listens, for the description.
     """
@@ -91,8 +89,13 @@ class ZenohRobotServer:
         self.page: str | None = None
         """The robot's web page (``http://...``), when it serves one, for the fleet's pages."""
         self._seen: set[str] = set()
+        self.intake = Intake(self.name, token)
+        """The arrival checks of ``api`` and ``goals`` (signature, shape, start time, places)."""
+        self.state_loop = TickGuard(f"zenoh-state-{self.name}")
+        self.health_loop = TickGuard(f"zenoh-health-{self.name}")
         self._worker = Worker(f"zenoh-state-{name}", self._publish_loop)
         self._lock = threading.Lock()
+        self._declare_lock = threading.Lock()
         self._last_refusal = 0.0
 
     @property
@@ -116,18 +119,25 @@ class ZenohRobotServer:
 
     def start(self) -> None:
         """Declare the queryables, the goal subscriber, then the liveliness token; publish."""
-        import zenoh
-
         if self.running:
             return
         self._caller = AsgiCaller(self._app)
+        with self._declare_lock:
+            self._declared = self._declare()
+        self._worker.start()
+        self._caller.submit(self._warm_up(self._caller))
+
+    def _declare(self) -> list[Any]:
+        """Everything under ``poppy/NAME`` for the current name (the token last)."""
+        import zenoh
+
         session = self.session
         drop = zenoh.CongestionControl.DROP
         self._publisher = session.declare_publisher(
             self.key("state"), congestion_control=drop, express=True
         )
         self._health = session.declare_publisher(self.key("health"), congestion_control=drop)
-        self._declared = [
+        return [
             self._publisher,
             self._health,
             session.declare_queryable(self.key("api"), self._on_api),
@@ -138,8 +148,21 @@ class ZenohRobotServer:
             ),
             session.liveliness().declare_token(zenoh_wire.robot_key(self.name)),
         ]
-        self._worker.start()
-        self._caller.submit(self._warm_up(self._caller))
+
+    def rename(self, name: str) -> None:
+        """Serve as ``poppy/<name>`` from now on (the page renamed the robot): everything is
+        declared under the new name, then the old one is undeclared (the fleet sees the old
+        name leave and the new one come); requests are signed for the new name."""
+        name = zenoh_wire.check_name(name)
+        with self._declare_lock:
+            if name == self.name:
+                return
+            old, self.name = self._declared, name
+            self.intake.rename(name)
+            if self._declared:  # started: serve under the new name, then drop the old one
+                self._declared = self._declare()
+                _undeclare(old)
+        logger.info("zenoh: the robot is now poppy/%s", name)
 
     async def _warm_up(self, caller: AsgiCaller) -> None:
         """One request through the app before any client's: its first one builds the routes'
@@ -150,17 +173,14 @@ class ZenohRobotServer:
 
     def stop(self) -> None:
         """Stop publishing, then undeclare everything (the token first: the fleet sees the
-        robot leave), then the API's loop."""
+        robot leave), then the API's loop (requests still held are answered 503)."""
         self._worker.close()
-        for declared in reversed(self._declared):
-            try:
-                declared.undeclare()
-            except Exception as exc:  # a session already closed
-                logger.debug("undeclaring on Zenoh: %s", exc)
-        self._declared = []
+        with self._declare_lock:
+            declared, self._declared = self._declared, []
         if self._caller is not None:
             self._caller.close()
             self._caller = None
+        _undeclare(declared)
 
     def seen(self) -> list[str]:
         """The robots alive on the network, by their liveliness tokens (this one too)."""
@@ -189,12 +209,18 @@ class ZenohRobotServer:
                 return
             now = time.monotonic()
             schedule.advance(now)
-            self._publisher.put(self.state_message())
-            self.published += 1
-            self.rate.tick(now)
-            if now >= next_health:
+            self.state_loop.run(partial(self._publish_state, now), stopping)
+            if now >= next_health:  # guarded apart: a failing state still has its health
                 next_health = now + HEALTH_PERIOD_S
-                self._health.put(json.dumps(self.health()).encode())
+                self.health_loop.run(self._publish_health, stopping)
+
+    def _publish_state(self, now: float) -> None:
+        self._publisher.put(self.state_message())
+        self.published += 1
+        self.rate.tick(now)
+
+    def _publish_health(self) -> None:
+        self._health.put(json.dumps(self.health()).encode())
 
     def state_message(self) -> bytes:
         """The state of every motor now (``zenoh_wire.pack_state``)."""
@@ -212,12 +238,15 @@ class ZenohRobotServer:
         buses = self.service.health()
         offline = sorted({m for bus in buses.values() for m in bus.get("offline", [])})
         ok = all(bus.get("connected", True) for bus in buses.values()) and not offline
+        ok = ok and not self.state_loop.failing
         return {
             "name": self.name,
             "ok": ok,
             "offline": offline,
             "state_hz": round(self.rate.rate_hz, 1),
             "refused_goals": self.refused_goals,
+            "publishing": self.state_loop.health(),
+            "held": self.intake.held,
             "running": self.service.running_primitives(),
             "playing": self.service.moves.playing(),
             "buses": buses,
@@ -226,26 +255,16 @@ class ZenohRobotServer:
     def description(self) -> dict[str, Any]:
         """Creature, motors (with limits), groups, primitives, moves, chains, host, endpoints."""
         robot = self.service.robot
-        profile = robot.config.profile if robot.config is not None else None
-        motors = [
-            {
-                "name": m.name,
-                "id": m.id,
-                "model": m.model.name,
-                "angle_limit": _jsonable(getattr(m, "angle_limit", None)),
-            }
-            for m in robot.motors
-        ]
         return {
             "version": zenoh_wire.STATE_VERSION,
             "name": self.name,
-            "creature": profile.name if profile is not None else "",
+            "creature": described.creature(robot),
             "host": socket.gethostname(),
             "endpoints": list(self.endpoints),
             "page": self.page,
             "token": self.token is not None,
             "state_rate_hz": self.state_rate_hz,
-            "motors": motors,
+            "motors": described.motors(robot),
             "groups": self.service.groups(),
             "primitives": list(self.service.primitives()),
             "moves": self.service.moves.names(),
@@ -263,39 +282,68 @@ class ZenohRobotServer:
 
     def _on_api(self, query: zenoh.Query) -> None:
         payload = query.payload.to_bytes() if query.payload is not None else b""
+        key = self.key("api")  # the name the query reached (a rename may follow)
         caller = self._caller
-        if caller is not None:
-            caller.submit(self._answer(caller, query, payload))
+        if caller is None:
+            _reply(query, key, _refusal(503, "the robot is stopping"))
+            return
+        caller.submit(self._answer(caller, query, key, payload))
 
-    async def _answer(self, caller: AsgiCaller, query: zenoh.Query, payload: bytes) -> None:
-        query.reply(self.key("api"), json.dumps(await self.api(caller, payload)).encode())
+    async def _answer(
+        self, caller: AsgiCaller, query: zenoh.Query, key: str, payload: bytes
+    ) -> None:
+        """Every request gets an answer: the route's, a refusal, 500 with the failure's line,
+        or 503 when the robot stops while it is held."""
+        try:
+            answer = await self.api(caller, payload)
+        except asyncio.CancelledError:
+            _reply(query, key, _refusal(503, "the robot is stopping"))
+            raise
+        except Exception as exc:
+            logger.warning("zenoh: %s: a request failed: %s", self.name, exc, exc_info=exc)
+            answer = _refusal(500, f"the robot failed to answer: {type(exc).__name__}: {exc}")
+        _reply(query, key, answer)
 
     async def api(self, caller: AsgiCaller, payload: bytes) -> dict[str, Any]:
         """The reply to one ``api`` request: ``{"status", "body"}`` (a refusal: REST's, or
-        400/413), plus ``start_at`` when a start was armed for that time (answered on arrival:
-        the start itself happens at ``start_at``)."""
-        request = _request(payload)
-        if isinstance(request, tuple):
-            status, body = request
-            return {"status": status, "body": body}
+        400/401/413/422/429 of its arrival), plus ``start_at`` when a start was armed for that
+        time (answered on arrival: the start itself happens at ``start_at``).
+
+        Everything is checked on arrival (``Intake``: shape, signature, start time, a place
+        among the requests held), before the robot holds anything for a start time."""
         try:
-            start_at = _start_at(request.get("start_at"))
-        except ArgumentError as exc:
-            return {"status": 422, "body": {"detail": str(exc)}}
-        method, path = request["method"], request["path"]
-        body, token = request.get("body"), request.get("token")
-        if start_at is not None and STARTS.fullmatch(path):
+            request = self.intake.api(payload)
+        except Refused as exc:
+            return _refusal(exc.status, exc.detail)
+        if request.start_at is None:
+            return await self._call(caller, request)
+        try:
+            place = self.intake.hold(request.start_at)
+        except Refused as exc:
+            return _refusal(exc.status, exc.detail)
+        if STARTS.fullmatch(request.path):
             # armed now (checked, its thread made, held at a gate); the gate opens at start_at
-            context = START_AT.set(start_at)
+            context = START_AT.set(request.start_at)
             try:
-                status, answer = await caller.call(method, path, body, token)
+                reply = await self._call(caller, request)
             finally:
                 START_AT.reset(context)
-            reply = {"status": status, "body": answer}
-            return {**reply, "start_at": start_at} if status < 400 else reply
-        if start_at is not None:
-            await asyncio.sleep(max(0.0, start_at - time.time()))
-        status, answer = await caller.call(method, path, body, token)
+            if reply["status"] >= 400:
+                self.intake.release(place)
+                return reply
+            return {**reply, "start_at": request.start_at}
+        try:
+            await asyncio.sleep(max(0.0, request.start_at - time.time()))
+            return await self._call(caller, request)
+        finally:
+            self.intake.release(place)
+
+    async def _call(self, caller: AsgiCaller, request: ApiRequest) -> dict[str, Any]:
+        """The app's answer: the request passed its arrival checks, so it carries the robot's
+        own token (the sender proved it knows it)."""
+        status, answer = await caller.call(
+            request.method, request.path, request.body, self.token, client=request.sender
+        )
         return {"status": status, "body": answer}
 
     # -- the goal stream ---------------------------------------------------------------------
@@ -303,7 +351,7 @@ class ZenohRobotServer:
     def _on_goals(self, sample: zenoh.Sample) -> None:
         try:
             self.apply_goals(sample.payload.to_bytes())
-        except (ApiError, PoppyError, ValueError, TypeError, RecursionError) as exc:
+        except (Refused, ApiError, PoppyError, ValueError, TypeError, RecursionError) as exc:
             self.refused_goals += 1
             now = time.monotonic()
             if now - self._last_refusal > 1.0:  # one line a second, whatever the rate
@@ -314,64 +362,33 @@ class ZenohRobotServer:
         """Check every goal of a ``goals`` message, then set them all (or none).
 
         Raises:
-            ApiError: a bad token, a bad message or a bad goal (nothing moved).
+            Refused: not signed with the robot's token (or stale, replayed, for another
+                robot), not a goals message (nothing moved).
+            ApiError: a bad goal (nothing moved).
             UnknownMotorError: an unknown motor (nothing moved).
         """
-        if len(payload) > MAX_BODY_BYTES:
-            raise ApiError("invalid", f"the message is over {MAX_BODY_BYTES} bytes")
-        message = json.loads(payload)
-        if not isinstance(message, dict) or not isinstance(message.get("goals"), dict):
-            raise ApiError("invalid", 'expected {"goals": {motor: degrees}}')
-        if self.token is not None:
-            given = message.get("token")
-            if not isinstance(given, str) or not hmac.compare_digest(
-                given.encode(), self.token.encode()
-            ):
-                raise ApiError("invalid", "missing or wrong token")
-        targets = self.service.targets(message["goals"])
+        targets = self.service.targets(self.intake.goals(payload))
         with self._lock:
             for name, goal in targets.items():
                 self.service.motor(name).goal_position = goal
         return targets
 
 
-def _request(payload: bytes) -> dict[str, Any] | tuple[int, Any]:
-    """The ``api`` request in ``payload`` (method, path, token checked), or the refusal."""
-    if len(payload) > MAX_BODY_BYTES:
-        return 413, {"detail": f"the request is over {MAX_BODY_BYTES} bytes"}
+def _refusal(status: int, detail: str) -> dict[str, Any]:
+    return {"status": status, "body": {"detail": detail}}
+
+
+def _reply(query: zenoh.Query, key: str, answer: dict[str, Any]) -> None:
     try:
-        request = json.loads(payload)
-    except (ValueError, RecursionError):
-        return 400, {"detail": f"the request is not JSON: {API_SHAPE}"}
-    if not isinstance(request, dict):
-        return 400, {"detail": f"the request is not an object: {API_SHAPE}"}
-    method = request.get("method")
-    path = request.get("path")
-    if method not in METHODS or not isinstance(path, str) or not path.startswith("/"):
-        return 400, {"detail": f"bad method or path: {API_SHAPE}"}
-    token = request.get("token")
-    if token is not None and not isinstance(token, str):
-        return 400, {"detail": "the token must be a string"}
-    return request
+        query.reply(key, json.dumps(answer).encode())
+    except Exception as exc:  # the session closed under it: the client's timeout says so
+        logger.debug("zenoh: no reply sent: %s", exc)
 
 
-def _start_at(value: Any) -> float | None:
-    """The wall-clock start of a command, checked as its delay from now (a clock a minute or
-    more ahead of the robot's is refused rather than waited for)."""
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        checks.number(value, "start_at")  # raises, naming the field
-    now = time.time()
-    delay = checks.in_range(
-        float(value) - now, -MAX_START_DELAY_S, MAX_START_DELAY_S, "start_at (from now)", "s"
-    )
-    return now + delay
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, tuple | list):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
+def _undeclare(declared: list[Any]) -> None:
+    """Undeclare in reverse order (the liveliness token first)."""
+    for item in reversed(declared):
+        try:
+            item.undeclare()
+        except Exception as exc:  # a session already closed
+            logger.debug("undeclaring on Zenoh: %s", exc)
