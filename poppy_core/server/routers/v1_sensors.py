@@ -11,7 +11,6 @@ from starlette.concurrency import run_in_threadpool
 from poppy_core import checks
 from poppy_core.errors import SensorError
 from poppy_core.sensors import Camera
-from poppy_core.sensors.opencv import encode_image
 from poppy_core.server.routers.pypot_sensors import sensors_of
 from poppy_core.server.schemas import Problem
 from poppy_core.server.sensors import IMAGE_TYPES
@@ -66,21 +65,26 @@ async def frame(sensor: str, ext: str, request: Request) -> Response:
 
 
 async def mjpeg(camera: Camera, request: Request, fps: float) -> AsyncIterator[bytes]:
-    """Parts of a ``multipart/x-mixed-replace`` stream: each new frame as a JPEG."""
+    """Parts of a ``multipart/x-mixed-replace`` stream: each new frame as a JPEG.
+
+    A viewer waits for frames in the event loop and shares each frame's one JPEG with the
+    others (``Camera.wait_frame``, ``Camera.encoded_async``): hundreds of viewers hold no
+    thread of the pool the other routes run in.
+    """
     period = 1.0 / fps
     number = 0
     loop = asyncio.get_running_loop()
     while not await request.is_disconnected():
         started = loop.time()
         try:
-            latest = await run_in_threadpool(camera.next_frame, number, FRAME_WAIT_S)
+            latest = await camera.wait_frame(number, FRAME_WAIT_S)
         except SensorError:
             # a lost camera: keep the connection, frames come back with it; a camera that
             # failed for good answers at once, so wait before asking again (no spinning)
             await asyncio.sleep(max(period, LOST_CAMERA_RETRY_S))
             continue
         number = latest.number
-        jpeg = await run_in_threadpool(encode_image, latest.image, ".jpg", MJPEG_QUALITY)
+        jpeg = await camera.encoded_async(latest, ".jpg", MJPEG_QUALITY)
         yield (
             (
                 f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(jpeg)}\r\n\r\n"
