@@ -70,7 +70,8 @@ def main(argv: list[str] | None = None) -> int:
         "--baseline",
         type=Path,
         default=None,
-        help="another checkout of poppy (e.g. `git worktree add /tmp/old REV`) that `scan` "
+        help="another checkout of poppy (e.g. `git worktree add /tmp/old REV`) that `scan` and "
+        "`camera` (its MJPEG viewers) "
         "measures beside this one, alternately",
     )
     args = parser.parse_args(argv)

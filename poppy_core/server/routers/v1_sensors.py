@@ -74,14 +74,15 @@ async def mjpeg(camera: Camera, request: Request, fps: float) -> AsyncIterator[b
     period = 1.0 / fps
     number = 0
     loop = asyncio.get_running_loop()
+    due = loop.time()
     while not await request.is_disconnected():
-        started = loop.time()
         try:
             latest = await camera.wait_frame(number, FRAME_WAIT_S)
         except SensorError:
             # a lost camera: keep the connection, frames come back with it; a camera that
             # failed for good answers at once, so wait before asking again (no spinning)
             await asyncio.sleep(max(period, LOST_CAMERA_RETRY_S))
+            due = loop.time()
             continue
         number = latest.number
         jpeg = await camera.encoded_async(latest, ".jpg", MJPEG_QUALITY)
@@ -92,7 +93,10 @@ async def mjpeg(camera: Camera, request: Request, fps: float) -> AsyncIterator[b
             + jpeg
             + b"\r\n"
         )
-        await asyncio.sleep(max(0.0, period - (loop.time() - started)))
+        # parts due every period from the first: the wait for a frame does not add to it, and
+        # after a stall at most one part comes early (no burst to catch up)
+        due = max(due + period, loop.time() - period)
+        await asyncio.sleep(max(0.0, due - loop.time()))
 
 
 @router.get(
