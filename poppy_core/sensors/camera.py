@@ -263,10 +263,9 @@ class Camera(Sensor):
             with self._new_frame:
                 self._async_waiting += 1
             try:
-                # shielded: a waiter cancelled (its client left) leaves the loop's future alone
-                await asyncio.wait_for(asyncio.shield(future), remaining)
-            except TimeoutError:
-                pass  # said above, on the next turn
+                # asyncio.wait neither cancels the loop's shared future on a timeout nor when
+                # this waiter is cancelled (its client left); a timeout is said on the next turn
+                await asyncio.wait((future,), timeout=remaining)
             finally:
                 with self._new_frame:
                     self._async_waiting -= 1
@@ -297,6 +296,8 @@ class Camera(Sensor):
         future, mine = self._claim(frame, ext, quality)
         if mine:
             return await asyncio.to_thread(self._encode_into, future, frame, ext, quality)
+        if future.done():  # the usual case: another viewer's encoding of this frame is ready
+            return future.result()
         return await asyncio.wrap_future(future)
 
     def _claim(
