@@ -153,9 +153,7 @@ def test_the_wifi_key_reaches_nmcli_in_a_private_file_never_on_a_command_line(
         join_add("Class:room"),
         join_up("Class:room"),
     ]
-    assert fake.secrets() == [
-        {"text": "802-11-wireless-security.psk:password1\n", "mode": "0o600"}
-    ]
+    assert fake.secrets() == [{"text": "802-11-wireless-security.psk:password1\n", "mode": "0o600"}]
     assert not any("password1" in arg for call in fake.calls() for arg in call)
 
 
