@@ -75,7 +75,8 @@ def main(argv: list[str] | None = None) -> int:
         type=Path,
         default=None,
         help="another checkout of poppy (e.g. `git worktree add /tmp/old REV`) that `scan`, "
-        "`emulator` and `server` measure beside this one, alternately",
+        "`emulator`, `server` and `camera` (its MJPEG viewers) measure beside this one, "
+        "alternately",
     )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="bench: %(message)s")

@@ -3,10 +3,15 @@
 A frame is a numpy array ``(height, width, 3)`` of ``uint8`` in OpenCV's BGR order, as pypot's
 cameras give (``cv2.imwrite("f.png", robot.camera.frame)`` works). ``camera.frame`` is a copy
 of the latest frame (draw on it freely); ``latest()`` is the shared, read-only one.
+``encoded(frame, ".jpg", q)`` encodes a frame once for every reader asking the same format and
+quality; ``await wait_frame(after)`` waits for a new frame in an event loop, holding no thread.
 """
 
 from __future__ import annotations
 
+import asyncio
+import concurrent.futures
+import contextlib
 import math
 import threading
 from collections.abc import Sequence
@@ -17,6 +22,7 @@ import numpy as np
 
 from poppy_core.errors import SensorError
 from poppy_core.sensors.base import FIRST_VALUE_TIMEOUT_S, Sensor
+from poppy_core.sensors.opencv import encode_image
 
 DEFAULT_RESOLUTION = (640, 480)
 DEFAULT_FPS = 20.0
@@ -121,6 +127,13 @@ class Camera(Sensor):
         self.calibration = calibration
         self._latest: Frame | None = None
         self._new_frame = threading.Condition()
+        self._loops: dict[asyncio.AbstractEventLoop, asyncio.Future[None]] = {}
+        """Per event loop with coroutines waiting for a frame: one future the next frame settles."""
+        self._async_waiting = 0
+        self._encodings: dict[tuple[str, int], concurrent.futures.Future[bytes]] = {}
+        """The latest frame's encodings by (format, quality), its number in ``_encoded_number``."""
+        self._encoded_number = 0
+        self._encodings_lock = threading.Lock()
 
     def grab(self) -> np.ndarray:
         """Take one BGR frame (called in the camera's thread).
@@ -137,10 +150,19 @@ class Camera(Sensor):
             number = 1 if self._latest is None else self._latest.number + 1
             self._latest = Frame(image, number, self._clock())
             self._new_frame.notify_all()
+            self._wake_loops()
 
     def wake(self) -> None:
         with self._new_frame:
             self._new_frame.notify_all()
+            self._wake_loops()
+
+    def _wake_loops(self) -> None:
+        """Settle each waiting loop's future in its own thread (called holding ``_new_frame``)."""
+        loops, self._loops = self._loops, {}
+        for loop, future in loops.items():
+            with contextlib.suppress(RuntimeError):  # a loop closed: nobody waits there now
+                loop.call_soon_threadsafe(_settle, future)
 
     # -- registers -----------------------------------------------------------------------------
 
@@ -206,6 +228,113 @@ class Camera(Sensor):
                     sensor=self.name,
                 )
             return self._latest
+
+    async def wait_frame(self, after: int = 0, timeout_s: float = FIRST_VALUE_TIMEOUT_S) -> Frame:
+        """``next_frame`` for a coroutine: awaits in the event loop, holding no thread.
+
+        However many coroutines of one loop wait, the camera's thread wakes that loop once a
+        frame (``loop.call_soon_threadsafe``).
+
+        Raises:
+            SensorError: none came within ``timeout_s``, or the camera failed for good.
+        """
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout_s
+        self.start()
+        while True:
+            with self._new_frame:
+                latest = self._latest
+                if self._fatal:
+                    raise SensorError(f"camera {self.name!r}: {self._fatal}", sensor=self.name)
+                if after < 0:
+                    after = 0 if latest is None else latest.number
+                if latest is not None and latest.number > after:
+                    return latest
+                future = self._loops.get(loop)
+                if future is None:
+                    future = self._loops[loop] = loop.create_future()
+            remaining = deadline - loop.time()
+            if remaining <= 0:
+                why = f" ({self.health().last_error})" if self.health().last_error else ""
+                raise SensorError(
+                    f"camera {self.name!r} gave no new frame in {timeout_s:g} s{why}",
+                    sensor=self.name,
+                )
+            with self._new_frame:
+                self._async_waiting += 1
+            try:
+                # asyncio.wait neither cancels the loop's shared future on a timeout nor when
+                # this waiter is cancelled (its client left); a timeout is said on the next turn
+                await asyncio.wait((future,), timeout=remaining)
+            finally:
+                with self._new_frame:
+                    self._async_waiting -= 1
+
+    def async_waiters(self) -> int:
+        """How many coroutines are in ``wait_frame`` now (a stream whose client left is not)."""
+        return self._async_waiting
+
+    # -- one encoding per frame, format and quality ---------------------------------------------
+
+    def encoded(self, frame: Frame, ext: str = ".jpg", quality: int = 85) -> bytes:
+        """``frame`` as ``.jpg`` or ``.png`` bytes, encoded once for the latest frame's readers.
+
+        The first reader asking a (format, quality) of the latest frame encodes it; readers
+        asking meanwhile wait for that encoding instead of doing their own. An older frame is
+        encoded for its reader alone.
+
+        Raises:
+            SensorError: an unknown format, or OpenCV could not encode it.
+        """
+        future, mine = self._claim(frame, ext, quality)
+        if not mine:
+            return future.result()
+        return self._encode_into(future, frame, ext, quality)
+
+    async def encoded_async(self, frame: Frame, ext: str = ".jpg", quality: int = 85) -> bytes:
+        """``encoded`` for a coroutine: one thread encodes; the others await, holding none."""
+        future, mine = self._claim(frame, ext, quality)
+        if mine:
+            return await asyncio.to_thread(self._encode_into, future, frame, ext, quality)
+        if future.done():  # the usual case: another viewer's encoding of this frame is ready
+            return future.result()
+        return await asyncio.wrap_future(future)
+
+    def _claim(
+        self, frame: Frame, ext: str, quality: int
+    ) -> tuple[concurrent.futures.Future[bytes], bool]:
+        """The encoding of ``frame`` to wait for, and whether the caller must make it."""
+        key = (ext, quality)
+        with self._encodings_lock:
+            if frame.number > self._encoded_number:
+                self._encodings = {}
+                self._encoded_number = frame.number
+            elif frame.number < self._encoded_number:
+                return concurrent.futures.Future(), True
+            future = self._encodings.get(key)
+            if future is not None:
+                return future, False
+            future = self._encodings[key] = concurrent.futures.Future()
+            return future, True
+
+    def _encode_into(
+        self, future: concurrent.futures.Future[bytes], frame: Frame, ext: str, quality: int
+    ) -> bytes:
+        try:
+            data = encode_image(frame.image, ext, quality)
+        except BaseException as exc:
+            future.set_exception(exc)
+            with self._encodings_lock:  # the next reader tries again
+                if self._encodings.get((ext, quality)) is future:
+                    del self._encodings[(ext, quality)]
+            raise
+        future.set_result(data)
+        return data
+
+
+def _settle(future: asyncio.Future[None]) -> None:
+    if not future.done():
+        future.set_result(None)
 
 
 class DummyCamera(Camera):

@@ -14,7 +14,6 @@ import numpy as np
 from poppy_core.errors import UnknownCardError
 from poppy_core.robot import Robot
 from poppy_core.sensors import Camera, MarkerDetector, Sensor
-from poppy_core.sensors.opencv import encode_image
 from poppy_core.server.errors import ApiError
 
 SENSOR_TIP = "the sensors are listed by /sensors/list.json"
@@ -105,8 +104,8 @@ class SensorService:
         """The latest frame of camera ``name`` as ``png`` or ``jpg`` bytes."""
         if ext not in IMAGE_TYPES:
             raise ApiError("not_found", f"no image format {ext!r} (png or jpg)")
-        frame = self.camera(name).latest()
-        return encode_image(frame.image, f".{ext}")
+        camera = self.camera(name)
+        return camera.encoded(camera.latest(), f".{ext}")
 
     def health(self) -> dict[str, dict[str, object]]:
         """Sensor name -> its health as data."""

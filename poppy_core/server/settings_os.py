@@ -14,6 +14,7 @@ import os
 import shutil
 import socket
 import subprocess
+import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +32,8 @@ HOTSPOT_PRIORITY = "-100"
 """Lower than any network joined (0): NetworkManager starts the access point only when no
 known network answers."""
 WIFI_TYPE = "802-11-wireless"
+PSK_SETTING = "802-11-wireless-security.psk"
+"""A WPA key's line in an ``nmcli ... passwd-file`` is ``802-11-wireless-security.psk:KEY``."""
 SECRET_AFTER = ("password", "wifi-sec.psk")
 """Arguments whose next argument is a secret, never logged."""
 
@@ -220,11 +223,48 @@ class SystemTools:
         return found
 
     def join(self, ssid: str, password: str | None) -> None:
-        """Join ``ssid`` now and remember it: ``nmcli device wifi connect SSID [password PW]``."""
-        argv = ["nmcli", "device", "wifi", "connect", ssid]
-        if password:
-            argv += ["password", password]
-        self.run(*argv)
+        """Join ``ssid`` now and remember it.
+
+        An open network: ``nmcli device wifi connect SSID``. A WPA one: a connection named
+        ``SSID`` is made without its key (``nmcli connection add``), then started with the key
+        in a ``passwd-file`` that only this user can read (``nmcli connection up ... passwd-file
+        FILE``, nmcli's documented way to give secrets at activation; NetworkManager keeps a key
+        given so for the next joins). The key is never on a command line, where any user of the
+        machine sees it in the process list. A refused key leaves no connection behind.
+        """
+        if not password:
+            self.run("nmcli", "device", "wifi", "connect", ssid)
+            return
+        if any(s.name == ssid for s in self.saved()):
+            self.forget(ssid)  # its old key would be tried first
+        self.run(
+            "nmcli",
+            "connection",
+            "add",
+            "type",
+            "wifi",
+            "ifname",
+            self.wifi_device(),
+            "con-name",
+            ssid,
+            "ssid",
+            ssid,
+            "wifi-sec.key-mgmt",
+            "wpa-psk",
+        )
+        with tempfile.TemporaryDirectory(prefix="poppy-wifi-") as folder:  # mode 0700
+            secrets = Path(folder) / "secrets"
+            fd = os.open(secrets, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+            with os.fdopen(fd, "w", encoding="utf-8") as out:
+                out.write(f"{PSK_SETTING}:{password}\n")
+            try:
+                self.run("nmcli", "connection", "up", "id", ssid, "passwd-file", str(secrets))
+            except SystemToolError:
+                try:
+                    self.forget(ssid)
+                except SystemToolError as exc:
+                    logger.warning("the refused connection %r stays: %s", ssid, exc)
+                raise
 
     def forget(self, name: str) -> None:
         """Forget a saved network: ``nmcli connection delete id NAME``."""

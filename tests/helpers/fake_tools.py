@@ -1,5 +1,6 @@
 """Recording fakes of the OS's tools (``hostnamectl``, ``nmcli``, ``systemctl``) put first on
-``PATH``: each appends its argv (one JSON list a line) to a log and prints canned output."""
+``PATH``: each appends its argv (one JSON list a line) to a log and prints canned output. A
+``passwd-file``'s text and mode are logged apart (``secrets()``), its path logged as ``FILE``."""
 
 from __future__ import annotations
 
@@ -14,6 +15,13 @@ SCRIPT = """#!{python}
 import json, os, sys
 tool = os.path.basename(sys.argv[0])
 argv = [tool, *sys.argv[1:]]
+if "passwd-file" in argv[:-1]:  # read the secrets as nmcli would, then log the argument as FILE
+    at = argv.index("passwd-file") + 1
+    with open(argv[at], encoding="utf-8") as given:
+        secrets = {{"text": given.read(), "mode": oct(os.stat(argv[at]).st_mode & 0o777)}}
+    with open(os.environ["FAKE_TOOLS_LOG"] + ".secrets", "a", encoding="utf-8") as log:
+        log.write(json.dumps(secrets) + "\\n")
+    argv[at] = "FILE"
 with open(os.environ["FAKE_TOOLS_LOG"], "a", encoding="utf-8") as log:
     log.write(json.dumps(argv) + "\\n")
 canned = json.loads(open(os.environ["FAKE_TOOLS_CANNED"], encoding="utf-8").read())
@@ -43,7 +51,7 @@ CANNED = {
     "nmcli -t -f DEVICE,TYPE device": {"out": "eth0:ethernet\nwlan0:wifi\nlo:loopback\n"},
     "systemctl is-active poppy-jupyter.service": {"out": "inactive\n", "code": 3},
     "systemctl --user is-active poppy-jupyter.service": {"out": "active\n"},
-    "nmcli device wifi connect Nowhere password wrongpass1": {
+    "nmcli connection up id Nowhere passwd-file FILE": {
         "err": "Error: Connection activation failed: Secrets were required, but not provided.\n",
         "code": 4,
     },
@@ -77,6 +85,12 @@ class FakeTools:
     def calls(self) -> list[list[str]]:
         """Every command run so far, in order."""
         lines = self.log.read_text(encoding="utf-8").splitlines()
+        return [json.loads(line) for line in lines if line]
+
+    def secrets(self) -> list[dict[str, str]]:
+        """Each ``passwd-file`` given, in order: its text (``text``) and octal mode (``mode``)."""
+        log = self.log.with_name(self.log.name + ".secrets")
+        lines = log.read_text(encoding="utf-8").splitlines() if log.exists() else []
         return [json.loads(line) for line in lines if line]
 
     def changes(self) -> list[list[str]]:

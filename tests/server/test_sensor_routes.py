@@ -106,11 +106,11 @@ def test_the_mjpeg_stream_waits_between_tries_of_a_camera_failed_for_good(
     camera = next(s for s in served.robot.sensors if s.name == "camera")
     tries: list[int] = []
 
-    def failed_for_good(after: int = 0, timeout_s: float = 0.0) -> object:
+    async def failed_for_good(after: int = 0, timeout_s: float = 0.0) -> object:
         tries.append(after)
         raise SensorError("camera 'camera': unplugged for good", sensor="camera")
 
-    monkeypatch.setattr(camera, "next_frame", failed_for_good)
+    monkeypatch.setattr(camera, "wait_frame", failed_for_good)
     with (
         httpx.Client(base_url=served.url, timeout=10.0) as http,
         http.stream("GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 30}) as answer,

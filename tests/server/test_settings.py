@@ -25,6 +25,23 @@ from tests.helpers.server import Served, serve
 
 TOKEN = "s3cret"
 BEARER = {"Authorization": f"Bearer {TOKEN}"}
+
+
+def join_add(ssid: str) -> list[str]:
+    """The connection a WPA network is joined with, made without its key."""
+    return [
+        *("nmcli", "connection", "add", "type", "wifi", "ifname", "wlan0", "con-name", ssid),
+        *("ssid", ssid, "wifi-sec.key-mgmt", "wpa-psk"),
+    ]
+
+
+def join_up(ssid: str) -> list[str]:
+    """Starting it with the key in a file (the fake logs the file's path as FILE)."""
+    return ["nmcli", "connection", "up", "id", ssid, "passwd-file", "FILE"]
+
+
+SAVED = ["nmcli", "-t", "-f", "NAME,TYPE,AUTOCONNECT-PRIORITY", "connection", "show"]
+DEVICE = ["nmcli", "-t", "-f", "DEVICE,TYPE", "device"]
 HOTSPOT_ADD = [
     "nmcli",
     "connection",
@@ -86,7 +103,10 @@ def test_the_adapter_runs_exactly_these_commands(fake: FakeTools) -> None:
     assert fake.calls() == [
         ["nmcli", "-t", "-f", "RUNNING", "general"],
         ["hostnamectl", "set-hostname", "ergo-2"],
-        ["nmcli", "device", "wifi", "connect", "Home Wifi", "password", "password1"],
+        SAVED,
+        DEVICE,
+        join_add("Home Wifi"),
+        join_up("Home Wifi"),
         ["nmcli", "device", "wifi", "connect", "Cafe"],
         ["nmcli", "connection", "delete", "id", "Home Wifi"],
         ["nmcli", "-t", "-f", "NAME,TYPE,AUTOCONNECT-PRIORITY", "connection", "show"],
@@ -121,12 +141,37 @@ def test_networks_and_saved_ones_are_read_from_nmcli_terse_output(fake: FakeTool
     assert tools.saved() == [SavedNetwork("Class:room", 0), SavedNetwork(HOTSPOT, -100)]
 
 
-def test_a_tool_failing_is_one_line_quoting_it_without_the_password(fake: FakeTools) -> None:
+def test_the_wifi_key_reaches_nmcli_in_a_private_file_never_on_a_command_line(
+    fake: FakeTools,
+) -> None:
+    tools = SystemTools(user_units=False)
+    tools.join("Class:room", "password1")  # saved already: remade with the new key
+    assert fake.calls() == [
+        SAVED,
+        ["nmcli", "connection", "delete", "id", "Class:room"],
+        DEVICE,
+        join_add("Class:room"),
+        join_up("Class:room"),
+    ]
+    assert fake.secrets() == [{"text": "802-11-wireless-security.psk:password1\n", "mode": "0o600"}]
+    assert not any("password1" in arg for call in fake.calls() for arg in call)
+
+
+def test_a_refused_key_is_one_line_without_it_and_leaves_no_connection(fake: FakeTools) -> None:
     with pytest.raises(SystemToolError) as caught:
         SystemTools(user_units=False).join("Nowhere", "wrongpass1")
     message = str(caught.value)
     assert "\n" not in message and "Secrets were required" in message
-    assert "wrongpass1" not in message and "password ***" in message
+    assert "wrongpass1" not in message
+    assert fake.changes() == [
+        join_add("Nowhere"),
+        join_up("Nowhere"),
+        ["nmcli", "connection", "delete", "id", "Nowhere"],
+    ]
+    assert fake.secrets() == [
+        {"text": "802-11-wireless-security.psk:wrongpass1\n", "mode": "0o600"}
+    ]
+    assert not any("wrongpass1" in arg for call in fake.calls() for arg in call)
 
 
 def test_without_networkmanager_the_reason_is_given(
@@ -223,12 +268,15 @@ def test_wifi_and_services_from_the_routes(fake: FakeTools, with_token: Served) 
         )
         assert failed.status_code == 409 and "Secrets were required" in failed.json()["detail"]
     assert fake.changes() == [
-        ["nmcli", "device", "wifi", "connect", "Home Wifi", "password", "password1"],
+        join_add("Home Wifi"),
+        join_up("Home Wifi"),
         ["nmcli", "connection", "delete", "id", "Class:room"],
         ["nmcli", "connection", "delete", "id", HOTSPOT],
         HOTSPOT_ADD,
         ["systemctl", "start", "poppy-jupyter.service"],
-        ["nmcli", "device", "wifi", "connect", "Nowhere", "password", "wrongpass1"],
+        join_add("Nowhere"),
+        join_up("Nowhere"),
+        ["nmcli", "connection", "delete", "id", "Nowhere"],
     ]
 
 
@@ -278,9 +326,10 @@ def test_a_64_hex_digit_key_and_printable_ascii_are_wpa_passwords(
                 "/api/v1/settings/wifi/join", json={"ssid": "Home Wifi", "password": password}
             )
             assert answer.status_code == 200, answer.text
-    assert fake.changes() == [
-        ["nmcli", "device", "wifi", "connect", "Home Wifi", "password", key],
-        ["nmcli", "device", "wifi", "connect", "Home Wifi", "password", "a b~c!d{e}"],
+    assert fake.changes() == [join_add("Home Wifi"), join_up("Home Wifi")] * 2
+    assert [secret["text"] for secret in fake.secrets()] == [
+        f"802-11-wireless-security.psk:{key}\n",
+        "802-11-wireless-security.psk:a b~c!d{e}\n",
     ]
 
 

@@ -11,7 +11,6 @@ from starlette.concurrency import run_in_threadpool
 from poppy_core import checks
 from poppy_core.errors import SensorError
 from poppy_core.sensors import Camera
-from poppy_core.sensors.opencv import encode_image
 from poppy_core.server.routers.pypot_sensors import sensors_of
 from poppy_core.server.schemas import Problem
 from poppy_core.server.sensors import IMAGE_TYPES
@@ -66,21 +65,32 @@ async def frame(sensor: str, ext: str, request: Request) -> Response:
 
 
 async def mjpeg(camera: Camera, request: Request, fps: float) -> AsyncIterator[bytes]:
-    """Parts of a ``multipart/x-mixed-replace`` stream: each new frame as a JPEG."""
+    """Parts of a ``multipart/x-mixed-replace`` stream: each new frame as a JPEG.
+
+    A viewer waits for frames in the event loop and shares each frame's one JPEG with the
+    others (``Camera.wait_frame``, ``Camera.encoded_async``): hundreds of viewers hold no
+    thread of the pool the other routes run in.
+    """
     period = 1.0 / fps
     number = 0
     loop = asyncio.get_running_loop()
-    while not await request.is_disconnected():
-        started = loop.time()
+    due = loop.time()
+    # no request.is_disconnected() per part (hundreds of viewers: its cost shows): a client that
+    # leaves ends the stream by itself (Starlette cancels it on the disconnect message, or
+    # sending it the next part fails)
+    while True:
         try:
-            latest = await run_in_threadpool(camera.next_frame, number, FRAME_WAIT_S)
+            latest = await camera.wait_frame(number, FRAME_WAIT_S)
         except SensorError:
             # a lost camera: keep the connection, frames come back with it; a camera that
             # failed for good answers at once, so wait before asking again (no spinning)
             await asyncio.sleep(max(period, LOST_CAMERA_RETRY_S))
+            if await request.is_disconnected():  # nothing is sent meanwhile: ask
+                return
+            due = loop.time()
             continue
         number = latest.number
-        jpeg = await run_in_threadpool(encode_image, latest.image, ".jpg", MJPEG_QUALITY)
+        jpeg = await camera.encoded_async(latest, ".jpg", MJPEG_QUALITY)
         yield (
             (
                 f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(jpeg)}\r\n\r\n"
@@ -88,7 +98,10 @@ async def mjpeg(camera: Camera, request: Request, fps: float) -> AsyncIterator[b
             + jpeg
             + b"\r\n"
         )
-        await asyncio.sleep(max(0.0, period - (loop.time() - started)))
+        # parts due every period from the first: the wait for a frame does not add to it, and
+        # after a stall at most one part comes early (no burst to catch up)
+        due = max(due + period, loop.time() - period)
+        await asyncio.sleep(max(0.0, due - loop.time()))
 
 
 @router.get(
