@@ -8,7 +8,7 @@ import threading
 import pytest
 
 from poppy_core.errors import ArgumentError
-from poppy_core.schedule import Backoff, Periodic, RateMeter, Worker
+from poppy_core.schedule import Backoff, Periodic, RateMeter, Worker, close_all
 from tests.helpers.waiting import eventually
 
 
@@ -130,3 +130,35 @@ def test_worker_stopped_from_its_own_body_only_asks() -> None:
     worker.start()
     assert worker.wait(timeout_s=5.0)
     assert answers == [True] and worker.error is None
+
+
+def test_close_all_runs_every_step_and_logs_each_failure_once(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    ran: list[str] = []
+    log = logging.getLogger("poppy_core.test_close")
+
+    def step(name: str, error: BaseException | None = None) -> tuple[str, object]:
+        def run() -> None:
+            ran.append(name)
+            if error is not None:
+                raise error
+
+        return name, run
+
+    steps = [
+        step("a", OSError("port gone")),
+        step("b", KeyboardInterrupt()),  # Ctrl-C while closing: the rest still closes
+        step("c", RuntimeError("")),
+        step("d"),
+    ]
+    with (
+        caplog.at_level(logging.WARNING, logger="poppy_core.test_close"),
+        pytest.raises(KeyboardInterrupt),
+    ):
+        close_all(steps, log, "the thing")  # type: ignore[arg-type]
+    assert ran == ["a", "b", "c", "d"]
+    assert [r.getMessage() for r in caplog.records] == [
+        "closing the thing: a failed: port gone",
+        "closing the thing: c failed: RuntimeError",
+    ]
