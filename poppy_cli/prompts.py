@@ -96,9 +96,9 @@ def read_key(fd: int) -> bytes:
 def _answer(question: str) -> str:
     """Show ``question`` on stderr and read the answer, as Click's prompts do: Ctrl-C or the
     end of input raise ``typer.Abort`` (Ctrl-C kept as its context, see ``poppy_cli.main``)."""
-    sys.stderr.write(question)
-    sys.stderr.flush()
-    try:
+    try:  # a signal landing while the question is written is one at the question too
+        sys.stderr.write(question)
+        sys.stderr.flush()
         line = read_line()
         if not line:
             raise EOFError
