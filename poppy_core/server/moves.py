@@ -243,7 +243,6 @@ class MoveService:
         speed: float = 1.0,
         backwards: bool = False,
         ramp_s: float | None = None,
-        *,
         refuse_playing: bool = False,
     ) -> MovePlayer:
         """Play a library move; ``ramp_s``: the ramp to its first frame (None: from the

@@ -12,8 +12,10 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import httpx
 import pytest
 
+from poppy_core.assembly import Listen, ServeSpec, serve
 from poppy_core.motion import Move, save_move
 from poppy_core.robot import Robot, from_profile
 from poppy_core.server import moves as moves_module
@@ -113,3 +115,21 @@ def test_nothing_plays_or_records_after_close(robot: Robot, started: list[Any]) 
             start()
         assert refused.value.kind == "unavailable"
     assert len(started) == 1 and service.recording() == []
+
+
+def test_over_http_a_second_play_is_refused_on_v1_and_left_alone_on_pypots_route(
+    robot: Robot, started: list[Any]
+) -> None:
+    with (
+        serve(robot, ServeSpec(http=Listen())) as servers,
+        httpx.Client(base_url=servers.http.url, timeout=10.0) as client,  # type: ignore[union-attr]
+    ):
+        assert client.post("/api/v1/moves/long/play", json={"speed": 1}).status_code == 202
+        again = client.post("/api/v1/moves/long/play", json={"speed": 2})
+        assert again.status_code == 409
+        assert "already playing: stop it first" in again.json()["detail"]
+        pypot = client.post("/records/long/play.json", json={"speed": "1.0"})
+        assert pypot.status_code == 202 and pypot.json() == {"long": "started replay"}
+        assert len(started) == 1 and started[0].playing
+        assert client.post("/api/v1/moves/long/stop").status_code == 200
+        assert not started[0].playing

@@ -176,10 +176,8 @@ def save(move: str, service: Service) -> MoveInfo:
 async def play(move: str, body: PlayRequest, service: Service) -> MovesStatus:
     """Starts playing; a move already playing is refused (409): stop it first."""
     await run_in_threadpool(
-        lambda: service.moves.play(
-            move, body.speed, body.backwards, body.ramp_s, refuse_playing=True
-        )
-    )
+        service.moves.play, move, body.speed, body.backwards, body.ramp_s, True
+    )  # True: refuse_playing
     return await moves_status(service)
 
 
