@@ -4,10 +4,17 @@ A command may have replaced the SIGINT/SIGTERM handlers (a recording stops on Ct
 question is asked, Ctrl-C raises ``KeyboardInterrupt`` again (exit 130, see ``poppy_cli.main``)
 and SIGTERM ends the command with exit code 143 (128 + SIGTERM), the command's ``with`` blocks
 closing what they opened. The command's handlers are put back once the answer is read.
+
+An answer is never waited for in one blocking read (``input()``): Python runs a signal's handler
+only between bytecodes, so a signal that lands just before the read starts (or in another
+thread) would leave the read blocked until Enter. ``read_line`` and ``read_key`` wait for the
+terminal in slices of ``POLL_S``, so a handler runs within that.
 """
 
 from __future__ import annotations
 
+import os
+import select
 import signal
 import sys
 import threading
@@ -18,6 +25,8 @@ from types import FrameType
 import typer
 
 EXIT_TERMINATED = 128 + signal.SIGTERM
+POLL_S = 0.1
+"""The longest a signal waits for its handler while a prompt waits for the terminal."""
 
 
 def interactive() -> bool:
@@ -60,6 +69,44 @@ def _new_line_when_aborted() -> Iterator[None]:
         raise
 
 
+def wait_readable(fd: int) -> None:
+    """Return once ``fd`` can be read, looking every ``POLL_S`` so that signal handlers run."""
+    while True:
+        ready, _, _ = select.select([fd], [], [], POLL_S)
+        if ready:
+            return
+
+
+def read_line() -> str:
+    """A line typed on stdin ("" at the end of input), without blocking signal handlers.
+
+    On a terminal in its usual (canonical) mode, stdin is readable once a whole line is there,
+    so the read after the wait returns at once.
+    """
+    wait_readable(sys.stdin.fileno())
+    return sys.stdin.readline()
+
+
+def read_key(fd: int) -> bytes:
+    """One byte from ``fd`` (a terminal in cbreak mode; b"" at its end), as ``read_line``."""
+    wait_readable(fd)
+    return os.read(fd, 1)
+
+
+def _answer(question: str) -> str:
+    """Show ``question`` on stderr and read the answer, as Click's prompts do: Ctrl-C or the
+    end of input raise ``typer.Abort`` (Ctrl-C kept as its context, see ``poppy_cli.main``)."""
+    try:  # a signal landing while the question is written is one at the question too
+        sys.stderr.write(question)
+        sys.stderr.flush()
+        line = read_line()
+        if not line:
+            raise EOFError
+    except (KeyboardInterrupt, EOFError):
+        raise typer.Abort() from None
+    return line.rstrip("\r\n")
+
+
 def confirm(question: str, *, default: bool) -> bool | None:
     """Ask a yes/no ``question`` on stderr; None when stdin is not a terminal (nothing asked).
 
@@ -69,8 +116,17 @@ def confirm(question: str, *, default: bool) -> bool | None:
     """
     if not interactive():
         return None
+    shown = f"{question} [{'Y/n' if default else 'y/N'}]: "
     with interruptible(), _new_line_when_aborted():
-        return typer.confirm(question, default=default, err=True)
+        while True:
+            value = _answer(shown).strip().lower()
+            if value in ("y", "yes"):
+                return True
+            if value in ("n", "no"):
+                return False
+            if not value:
+                return default
+            sys.stderr.write("Error: invalid input\n")
 
 
 def ask(question: str, *, default: str = "") -> str | None:
@@ -83,8 +139,7 @@ def ask(question: str, *, default: str = "") -> str | None:
     if not interactive():
         return None
     with interruptible(), _new_line_when_aborted():
-        answer: str = typer.prompt(question, default=default, show_default=False, err=True)
-    return answer
+        return _answer(f"{question}: ") or default
 
 
 def require_yes(question: str, *, declined: str) -> None:

@@ -1,5 +1,5 @@
 """Loop machinery: drift-free deadlines, a rate meter, a doubling backoff, a worker thread and
-the gate an armed start waits at."""
+the gate an armed start waits at, and ``close_all`` (every closing step, whatever fails)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import logging
 import math
 import threading
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 from poppy_core import checks
 from poppy_core.errors import ArgumentError
@@ -315,3 +315,24 @@ class TickGuard:
     def health(self) -> dict[str, object]:
         """``ok`` (no failure now), ``failures`` (since the start) and ``last_error``."""
         return {"ok": not self._failing, "failures": self.failures, "last_error": self.last_error}
+
+
+def close_all(
+    steps: Iterable[tuple[str, Callable[[], object]]], log: logging.Logger, whole: str
+) -> None:
+    """Run every closing step in order whatever fails first; each failure is logged once at
+    WARNING (``"closing {whole}: {step} failed: ..."``) and the next step runs.
+
+    A ``KeyboardInterrupt`` or ``SystemExit`` during a step (Ctrl-C twice) is raised again once
+    every step ran, so that nothing is left open by it.
+    """
+    interrupted: BaseException | None = None
+    for what, step in steps:
+        try:
+            step()
+        except Exception as exc:
+            log.warning("closing %s: %s failed: %s", whole, what, str(exc) or type(exc).__name__)
+        except BaseException as exc:
+            interrupted = interrupted or exc
+    if interrupted is not None:
+        raise interrupted

@@ -8,7 +8,7 @@ import threading
 import pytest
 
 from poppy_core.errors import ArgumentError
-from poppy_core.schedule import Backoff, Periodic, RateMeter, TickGuard, Worker
+from poppy_core.schedule import Backoff, Periodic, RateMeter, TickGuard, Worker, close_all
 from tests.helpers.waiting import eventually
 
 
@@ -154,3 +154,35 @@ def test_a_tick_guard_keeps_a_loop_through_failures_logged_once_with_backoff(
     guard.run(failing, stopping)  # a new run of failures is logged again, once
     warned = [r for r in caplog.records if "a tick failed" in r.getMessage()]
     assert len(warned) == 2 and len(calls) == 5
+
+
+def test_close_all_runs_every_step_and_logs_each_failure_once(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    ran: list[str] = []
+    log = logging.getLogger("poppy_core.test_close")
+
+    def step(name: str, error: BaseException | None = None) -> tuple[str, object]:
+        def run() -> None:
+            ran.append(name)
+            if error is not None:
+                raise error
+
+        return name, run
+
+    steps = [
+        step("a", OSError("port gone")),
+        step("b", KeyboardInterrupt()),  # Ctrl-C while closing: the rest still closes
+        step("c", RuntimeError("")),
+        step("d"),
+    ]
+    with (
+        caplog.at_level(logging.WARNING, logger="poppy_core.test_close"),
+        pytest.raises(KeyboardInterrupt),
+    ):
+        close_all(steps, log, "the thing")  # type: ignore[arg-type]
+    assert ran == ["a", "b", "c", "d"]
+    assert [r.getMessage() for r in caplog.records] == [
+        "closing the thing: a failed: port gone",
+        "closing the thing: c failed: RuntimeError",
+    ]

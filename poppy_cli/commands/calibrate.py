@@ -12,7 +12,7 @@ import threading
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TextIO, cast
 
 import typer
 
@@ -28,6 +28,7 @@ from poppy_cli.output import (
     print_json,
     styled,
 )
+from poppy_cli.prompts import interactive, interruptible, read_key, read_line
 from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
@@ -85,14 +86,16 @@ class RichAnswers:
                 done.set()
 
             threading.Thread(target=read_answer, name="calibrate enter", daemon=True).start()
-            if err_console.is_terminal:
-                from rich.live import Live
+            with interruptible():
+                if err_console.is_terminal:
+                    from rich.live import Live
 
-                with Live(_range_table(watch), console=err_console, transient=True) as live:
+                    with Live(_range_table(watch), console=err_console, transient=True) as live:
+                        while not done.wait(REFRESH_S):
+                            live.update(_range_table(watch))
+                else:
                     while not done.wait(REFRESH_S):
-                        live.update(_range_table(watch))
-            else:
-                done.wait()
+                        pass
         for reading in watch.readings():
             low, high = fmt_deg(reading.low), fmt_deg(reading.high)
             err_console.print(f"  {reading.motor}: {low} … {high}")
@@ -103,10 +106,23 @@ class RichAnswers:
         from rich.prompt import Confirm
 
         try:
-            return Confirm.ask(question, default=True, console=err_console)
+            with interruptible():
+                stream = cast("TextIO", _Lines())  # Rich calls only its readline
+                return Confirm.ask(question, default=True, console=err_console, stream=stream)
         except EOFError:  # no more input: the safe answer
             err_console.print()
             return False
+
+
+class _Lines:
+    """stdin for Rich's prompts, read as ``poppy_cli.prompts`` reads it (a signal's handler runs
+    at once); the end of input raises EOFError, as ``input()`` does."""
+
+    def readline(self) -> str:
+        line = read_line() if interactive() else sys.stdin.readline()
+        if not line:
+            raise EOFError
+        return line
 
 
 @contextmanager
@@ -136,7 +152,7 @@ def _read_key(fd: int) -> bool:
     are ignored."""
     while True:
         try:
-            key = os.read(fd, 1)
+            key = read_key(fd)
         except OSError:
             return False
         if key in (b"\r", b"\n"):
@@ -161,7 +177,7 @@ def _read_line() -> str:
 
 
 def _enter(prompt: str) -> bool:
-    with single_keys() as keys:  # before the prompt: a key typed at once is not lost
+    with single_keys() as keys, interruptible():  # a key typed at once is not lost
         err_console.print(prompt)
         sys.stderr.flush()
         return _go_on(keys)

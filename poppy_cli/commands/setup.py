@@ -44,12 +44,12 @@ def _say(message: str) -> None:
 
 def _wait_for_enter(target: MotorTarget) -> bool:
     """Show the motor's prompt and wait for Enter; False when the input has ended."""
-    from poppy_cli.prompts import interactive, interruptible
+    from poppy_cli.prompts import interactive, interruptible, read_line
 
     err_console.print(styled("[bold]{}[/]", target.prompt))
     if interactive():
         with interruptible():
-            line = sys.stdin.readline()
+            line = read_line()
     else:
         line = sys.stdin.readline()
     return line != ""

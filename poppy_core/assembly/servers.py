@@ -13,7 +13,8 @@ Zenoh (the fleet node, the ROS 2 node) declares on it. Each server is built by i
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import logging
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -32,6 +33,7 @@ from poppy_core.assembly.server_builders import (
 )
 from poppy_core.checks import robot_name
 from poppy_core.ros2_wire import Ros2Settings
+from poppy_core.schedule import close_all
 from poppy_core.zenoh_wire import ZenohSettings
 
 if TYPE_CHECKING:
@@ -50,6 +52,8 @@ order they start."""
 DEFAULT_PORTS = {"http": 8080, "ws": 9009, "zmq": 6768, "snap": 6969}
 """pypot's default ports (``zmq``: the documentation's ZMQ example)."""
 LOOPBACK = "127.0.0.1"
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -195,19 +199,26 @@ class ServerSet:
 
     def stop(self) -> None:
         """Stop the servers (Zenoh, ZMQ, Snap!, WebSocket, HTTP), the Zenoh session, then the
-        service (again: nothing)."""
+        service, saving its takes (again: nothing). Every part is stopped whatever fails first:
+        each failure is logged once at WARNING."""
         if self._stopped:
             return
         self._stopped = True
-        if self.announcer is not None:
-            self.announcer.stop()  # goodbye first: nobody is sent to a server that is going
+        close_all(self._stopping_steps(), logger, "the servers")
+
+    def _stopping_steps(self) -> Iterator[tuple[str, Callable[[], object]]]:
+        if self.announcer is not None:  # goodbye first: nobody is sent to a server that is going
+            yield "the mDNS announcement", self.announcer.stop
         for name in reversed(PROTOCOLS):
             if name in self.servers:
-                self.servers[name].stop()
+                yield f"the {name} server", self.servers[name].stop
         if self.zenoh_session is not None:
-            self.zenoh_session.close()
-            self.zenoh_session = None
-        self.service.close()
+            yield "the Zenoh session", self._close_session
+        yield "the recordings and playbacks", self.service.close
+
+    def _close_session(self) -> None:
+        session, self.zenoh_session = self.zenoh_session, None
+        session.close()
 
     def __enter__(self) -> ServerSet:
         return self

@@ -15,7 +15,7 @@ import logging
 import threading
 import time
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 from poppy_core.bus.latency import ReplyClock
 from poppy_core.bus.replies import ErrorBits, collect_replies
@@ -201,6 +201,24 @@ class BusCore:
     def lock(self) -> threading.RLock:
         """The bus lock; hold it to chain several transactions without interleaving."""
         return self._lock
+
+    @contextlib.contextmanager
+    def patient(self, retries: int, min_timeout_s: float) -> Iterator[None]:
+        """Transactions of the block (this thread holds the lock) try ``retries`` times more at
+        least and wait ``min_timeout_s`` at least for a first reply.
+
+        For a few one-off transactions with motors known to be there (a robot's start-up), where
+        a reply the OS delivered late (a loaded machine, a starved emulator) must not count as
+        silence; a motor answering in time costs nothing more.
+        """
+        with self._lock:
+            saved = (self.retries, self.min_timeout_s)
+            self.retries = max(retries, self.retries)
+            self.min_timeout_s = max(min_timeout_s, self.min_timeout_s)
+            try:
+                yield
+            finally:
+                self.retries, self.min_timeout_s = saved
 
     # -- core ------------------------------------------------------------------------------------
 

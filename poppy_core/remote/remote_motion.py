@@ -108,7 +108,7 @@ class RemoteMoves:
         return answer
 
     def play(self, name: str, speed: float = 1.0, backwards: bool = False) -> None:
-        """Start playing a library move."""
+        """Start playing a library move (a ConfigError while it is playing: stop it first)."""
         body = {"speed": speed, "backwards": backwards}
         self._client.request("POST", path_of("moves", name, "play"), body)
 

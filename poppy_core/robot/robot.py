@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from poppy_core.bus import DxlBus
@@ -25,6 +25,7 @@ from poppy_core.robot.robot_pypot import Behaviour, PypotRobotMixin
 from poppy_core.robot.robot_syncs import SyncLoops
 from poppy_core.robot.sync import BusSync
 from poppy_core.robot.vrep_names import VrepNames
+from poppy_core.schedule import close_all
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import RobotConfig
@@ -294,32 +295,30 @@ class Robot(PypotRobotMixin, SyncLoops, VrepNames):
 
     def close(self) -> None:
         """Close sensors, stop gotos and loops (sending pending writes), close buses, stop owned
-        emulators and the simulation."""
+        emulators and the simulation: every part, whatever fails first (each failure is logged
+        once at WARNING and the next part is closed)."""
         with self._close_lock:
             if self._closed:
                 return
             self._closed = True
+        close_all(self._closing_steps(), logger, "the robot")
+
+    def _closing_steps(self) -> Iterator[tuple[str, Callable[[], object]]]:
         for callback in reversed(self._closers):
-            try:
-                callback()
-            except Exception:
-                logger.exception("closing the robot: %r failed", callback)
+            yield repr(callback), callback
         for sensor in reversed(self._sensors.values()):  # detectors before their cameras
-            sensor.close()
-        self._runner.close()
+            yield f"sensor {sensor.name}", sensor.close
+        yield "the gotos", self._runner.close
         for sync in self._syncs:
-            sync.stop()
+            yield f"the sync loop of {sync.controller}", sync.stop
         for motor in self._motors:  # after the loops: only callers' writes are refused now
-            link_of(motor).mark_closed()
+            yield f"motor {motor.name}", link_of(motor).mark_closed
         for name, bus in self.buses.items():
-            try:
-                bus.close()
-            except OSError as exc:
-                logger.warning("closing bus %s: %s", name, exc)
-        for server in self.emulators.values():
-            server.stop()
+            yield f"bus {name}", bus.close
+        for name, server in self.emulators.items():
+            yield f"the emulator of {name}", server.stop
         if self.simulation is not None:
-            self.simulation.close()
+            yield "the simulation", self.simulation.close
 
     def __enter__(self) -> Robot:
         return self

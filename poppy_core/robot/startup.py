@@ -14,6 +14,7 @@ again after it.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -54,6 +55,16 @@ def where(bus: DxlBus) -> str:
 
 
 STARTUP_PING_RETRIES = 3
+# Start-up reads and writes go to motors that answered their ping: a reply the OS delivered
+# late (an emulator starved on a loaded machine, seen stalling past 20 ms beside four busy
+# loops) must not fail the first state or a write the user agreed to. A motor that answers in
+# time costs nothing more; one that stopped answering costs at most 4 x 0.1 s per transaction.
+STARTUP_RETRIES = 3
+STARTUP_REPLY_TIMEOUT_S = 0.1
+
+
+def _patient(bus: DxlBus) -> contextlib.AbstractContextManager[None]:
+    return bus.patient(STARTUP_RETRIES, STARTUP_REPLY_TIMEOUT_S)
 
 
 def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> list[str]:
@@ -90,11 +101,12 @@ def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> lis
 
 def load_state(bus: DxlBus, motors: Sequence[Motor]) -> None:
     """Read each online motor's control table once and fill its cache (one read per motor)."""
-    for motor in motors:
-        if not motor.online:
-            continue
-        data = bus.read(motor.id, 0, motor.model.table_size)
-        link_of(motor).update(regs.decode_table(motor.model, data))
+    with _patient(bus):
+        for motor in motors:
+            if not motor.online:
+                continue
+            data = bus.read(motor.id, 0, motor.model.table_size)
+            link_of(motor).update(regs.decode_table(motor.model, data))
 
 
 def return_delay_issues(
@@ -145,7 +157,7 @@ def fix_return_delays(
     for issue in issues:
         motor = by_name[issue.motor]
         try:
-            with eeprom_unlocked(bus, motor.id, motor.model):
+            with _patient(bus), eeprom_unlocked(bus, motor.id, motor.model):
                 bus.write_register(motor.id, motor.model, "return_delay_time", issue.target_us)
         except (BusError, MotorError, RegisterError) as exc:
             logger.warning("%s: could not set the return delay: %s", issue.motor, exc)
@@ -169,7 +181,8 @@ def write_angle_limits(bus: DxlBus, motors: Sequence[Motor]) -> None:
         if all(abs(w - p) <= step for w, p in zip(wanted, present, strict=True)):
             continue
         try:
-            with eeprom_unlocked(bus, motor.id, model):  # a stiff motor stays stiff after
+            # a stiff motor stays stiff after
+            with _patient(bus), eeprom_unlocked(bus, motor.id, model):
                 for name, value in zip(names, wanted, strict=True):
                     bus.write_register(motor.id, model, name, value)
         except (BusError, MotorError) as exc:

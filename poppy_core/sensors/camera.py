@@ -205,13 +205,22 @@ class Camera(Sensor):
         assert latest is not None
         return latest
 
-    def next_frame(self, after: int = 0, timeout_s: float = FIRST_VALUE_TIMEOUT_S) -> Frame:
+    def next_frame(
+        self, after: int = 0, timeout_s: float = FIRST_VALUE_TIMEOUT_S, *, start: bool = True
+    ) -> Frame:
         """The first frame whose number is above ``after`` (0: any; -1: one grabbed from now on).
 
+        ``start=False`` (a reader that only follows a camera someone else opened) never starts
+        the camera: a camera not running raises at once.
+
         Raises:
-            SensorError: none came within ``timeout_s``.
+            SensorError: none came within ``timeout_s``, or the camera is not running
+                (``start=False``).
         """
-        self.start()
+        if start:
+            self.start()
+        elif not self.running:
+            raise SensorError(f"camera {self.name!r} is not running", sensor=self.name)
         with self._new_frame:
             if after < 0:
                 after = 0 if self._latest is None else self._latest.number

@@ -23,9 +23,7 @@ def halt_activity(service: RobotService) -> tuple[list[str], list[str]]:
     stopped = service.running_primitives()
     for name in stopped:
         service.primitive(name).halt(wait=True)
-    moves = service.moves.playing()
-    for name in moves:
-        service.moves.stop(name)
+    moves = service.moves.stop_all()  # a playback being started too
     return stopped, moves
 
 

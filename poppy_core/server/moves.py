@@ -79,6 +79,10 @@ class MoveService:
         self._recorders: dict[str, MoveRecorder] = {}
         self._players: dict[str, MovePlayer] = {}
         self._closing = threading.Lock()
+        self._starting = threading.Lock()
+        """Held while a playback is checked, built, started and registered (one at a time), and
+        by ``stop``/``stop_all``/``close``: a stop never misses a playback being started."""
+        self._closed = False
         self.saved_on_close: list[SavedTake] = []
         """The takes ``close()`` saved (a server says where on stopping)."""
         self._lengths: dict[Path, tuple[tuple[int, int], float | None, int | None]] = {}
@@ -173,6 +177,7 @@ class MoveService:
                 tip='give motors as a list or a comma-separated string, e.g. {"motors": ["m1"]}',
             )
         with self._lock:
+            self._check_open()
             old = self._recorders.pop(name, None)
             if old is not None:
                 old.stop()
@@ -233,27 +238,53 @@ class MoveService:
     # -- playing -------------------------------------------------------------------------------
 
     def play(
-        self, name: str, speed: float = 1.0, backwards: bool = False, ramp_s: float | None = None
+        self,
+        name: str,
+        speed: float = 1.0,
+        backwards: bool = False,
+        ramp_s: float | None = None,
+        refuse_playing: bool = False,
     ) -> MovePlayer:
-        """Play a library move (a playback of it already running is left alone); ``ramp_s``:
-        the ramp to its first frame (None: from the distance; give it to a fleet's robots so
-        that, wherever each one is, they play in phase from the shared start)."""
+        """Play a library move; ``ramp_s``: the ramp to its first frame (None: from the
+        distance; give it to a fleet's robots so that, wherever each one is, they play in phase
+        from the shared start).
+
+        A move plays once at a time: a second play of a move that is playing starts nothing and
+        answers the playback running, as pypot's ``start_move_player`` does (its REST, ZMQ and
+        Snap! routes), or, with ``refuse_playing`` (the v1 API), is refused with
+        ``ApiError("conflict")``. The check, the start and the registration are one step, so two
+        plays at once never start two players, and ``stop`` reaches the one started.
+
+        Raises:
+            ApiError: bad name, no such move, a move that cannot be played, already playing
+                (``refuse_playing``), or the service closed.
+        """
         check_move_name(name)
-        with self._lock:
-            running = self._players.get(name)
-        if running is not None and running.playing:
-            return running
-        move = self.load(name)
-        try:
-            player = MovePlayer(self.robot, move, speed=speed, backwards=backwards, ramp_s=ramp_s)
-        except ConfigError as exc:
-            raise ApiError("invalid", str(exc)) from None
-        except ValueError as exc:
-            raise ApiError("invalid", f"cannot play {name!r}: {exc}") from None
-        gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
-        player.start(gate=gate)
-        with self._lock:
-            self._players[name] = player  # a stop before the start time finds it, and cancels it
+        with self._starting:
+            self._check_open()
+            with self._lock:
+                running = self._players.get(name)
+            if running is not None and running.playing:
+                if refuse_playing:
+                    raise ApiError(
+                        "conflict",
+                        f"the move {name!r} is already playing: stop it first",
+                        tip=f"POST /api/v1/moves/{name}/stop, then play it again",
+                    )
+                return running
+            move = self.load(name)
+            try:
+                player = MovePlayer(
+                    self.robot, move, speed=speed, backwards=backwards, ramp_s=ramp_s
+                )
+            except ConfigError as exc:
+                raise ApiError("invalid", str(exc)) from None
+            except ValueError as exc:
+                raise ApiError("invalid", f"cannot play {name!r}: {exc}") from None
+            gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
+            player.start(gate=gate)
+            with self._lock:
+                self._players[name] = player  # a stop before the start time finds it, cancels it
         return player
 
     def playing(self) -> list[str]:
@@ -264,7 +295,7 @@ class MoveService:
     def stop(self, name: str) -> None:
         """Stop playing ``name`` (``ApiError("conflict")`` when it was never played)."""
         check_move_name(name)
-        with self._lock:
+        with self._starting, self._lock:  # a play of it under way is registered first
             player = self._players.get(name)
         if player is None:
             raise ApiError(
@@ -272,8 +303,22 @@ class MoveService:
             )
         player.stop()
 
+    def stop_all(self) -> list[str]:
+        """Stop every playback, those being started included; the names that were playing."""
+        with self._starting, self._lock:
+            players = dict(self._players)
+        playing = sorted(name for name, player in players.items() if player.playing)
+        for player in players.values():
+            player.stop()
+        return playing
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise ApiError("unavailable", "the server is stopping: nothing new starts")
+
     def close(self) -> list[SavedTake]:
-        """Stop every playback and recording, and save the takes not saved yet.
+        """Stop every playback and recording, and save the takes not saved yet; nothing starts
+        after (``ApiError("unavailable")``).
 
         A recording in progress and a take kept after a failed save go to the library under
         their name when it is free there (a saved move is never replaced), else to
@@ -284,16 +329,24 @@ class MoveService:
             The takes saved by this call (all of them are in ``saved_on_close``).
         """
         with self._closing:
-            with self._lock:
+            with self._starting, self._lock:  # nothing starts after this
+                self._closed = True
                 recorders = dict(self._recorders)
                 players = list(self._players.values())
                 self._recorders.clear()
                 self._players.clear()
             for player in players:
-                player.stop()
+                try:
+                    player.stop()
+                except Exception as exc:  # the others are stopped and the takes saved anyway
+                    logger.warning("stopping a playback on closing failed: %s", exc)
             saved = []
             for name, recorder in sorted(recorders.items()):
-                take = self._save_on_close(name, recorder)
+                try:
+                    take = self._save_on_close(name, recorder)
+                except Exception as exc:
+                    logger.warning("saving the take %s on closing failed: %s", name, exc)
+                    continue
                 if take is not None:
                     saved.append(take)
             self.saved_on_close.extend(saved)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -129,7 +130,10 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
     assert len(read_move(tmp_path / "wave.move")) > 250
 
 
-def test_ctrl_c_where_to_save_keeps_the_take_in_a_temporary_file(tmp_path: Path) -> None:
+@pytest.mark.parametrize(("stop", "code"), [("ctrl-c", 130), ("sigterm", 143)])
+def test_ctrl_c_where_to_save_keeps_the_take_in_a_temporary_file(
+    tmp_path: Path, stop: str, code: int
+) -> None:
     with tmpfs(tmp_path / "full", "32k") as library:
         (library / "filler").write_bytes(b"\0" * 28_000)
         terminal = Terminal(
@@ -137,8 +141,11 @@ def test_ctrl_c_where_to_save_keeps_the_take_in_a_temporary_file(tmp_path: Path)
         )
         try:
             assert "Save it where?" in terminal.read_until("Save it where?")
-            terminal.type(CTRL_C)
-            assert terminal.wait(timeout_s=30) == 130, terminal.text[-2000:]
+            if stop == "ctrl-c":
+                terminal.type(CTRL_C)
+            else:
+                terminal.signal(signal.SIGTERM)
+            assert terminal.wait(timeout_s=30) == code, terminal.text[-2000:]
         finally:
             terminal.close()
     [kept] = list((tmp_path / "tmp").glob("poppy-take-wave-*.move"))

@@ -7,6 +7,7 @@ The command's stdin, stdout and stderr are the pty, and the pty is its controlli
 
 from __future__ import annotations
 
+import codecs
 import os
 import re
 import select
@@ -41,6 +42,8 @@ class Terminal:
         )
         os.close(slave)
         self.shown = ""
+        # a character split between two reads ("µ" is 2 bytes) is decoded once whole
+        self._decoder = codecs.getincrementaldecoder("utf-8")(errors="replace")
 
     @property
     def text(self) -> str:
@@ -103,5 +106,5 @@ class Terminal:
             chunk = os.read(self.master, 4096)
         except OSError:  # EIO: the command ended and closed its side
             return False
-        self.shown += chunk.decode(errors="replace")
+        self.shown += self._decoder.decode(chunk)
         return bool(chunk)

@@ -402,7 +402,7 @@ class Ros2Node:
                 stopping.wait(0.5)
                 continue
             try:
-                frame = camera.next_frame(after=last, timeout_s=1.0)
+                frame = camera.next_frame(after=last, timeout_s=1.0, start=False)
             except PoppyError:
                 continue
             last = frame.number

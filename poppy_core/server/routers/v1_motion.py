@@ -174,8 +174,10 @@ def save(move: str, service: Service) -> MoveInfo:
 
 @router.post("/moves/{move}/play", tags=["moves"], status_code=202, summary="Play a move")
 async def play(move: str, body: PlayRequest, service: Service) -> MovesStatus:
-    """Starts playing (a playback of it already running is left alone)."""
-    await run_in_threadpool(service.moves.play, move, body.speed, body.backwards, body.ramp_s)
+    """Starts playing; a move already playing is refused (409): stop it first."""
+    await run_in_threadpool(
+        service.moves.play, move, body.speed, body.backwards, body.ramp_s, True
+    )  # True: refuse_playing
     return await moves_status(service)
 
 
