@@ -116,13 +116,15 @@ class RichAnswers:
 
 class _Lines:
     """stdin for Rich's prompts, read as ``poppy_cli.prompts`` reads it (a signal's handler runs
-    at once); the end of input raises EOFError, as ``input()`` does."""
+    at once); the end of input raises EOFError, and the line comes without its newline, as
+    ``input()`` gives them (Rich takes a stream's line as it is: "\n" would not be Enter's
+    default but an answer it asks again for)."""
 
     def readline(self) -> str:
         line = read_line() if interactive() else sys.stdin.readline()
         if not line:
             raise EOFError
-        return line
+        return line.rstrip("\r\n")
 
 
 @contextmanager

@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import io
 import os
+import sys
 import termios
 from pathlib import Path
 
+import pytest
+
+from poppy_cli.commands.calibrate import RichAnswers
 from tests.helpers.cli import POPPY
 from tests.helpers.processes import read_until, start_on_pty
 
@@ -61,3 +66,18 @@ def test_q_at_the_posture_cancels_at_once(tmp_path: Path) -> None:
             proc.kill()
         os.close(parent)
         os.close(child)
+
+
+@pytest.mark.parametrize(
+    ("piped", "answer"),
+    [("\n", True), ("n\n", False), ("y\r\n", True), ("maybe\n\n", True), ("", False)],
+)
+def test_a_calibration_question_takes_the_lines_piped_to_it(
+    monkeypatch: pytest.MonkeyPatch, piped: str, answer: bool
+) -> None:
+    """Enter on a pipe is the default (yes), as on a terminal; the end of input is no. Rich
+    takes a stream's line as it is, and a line still ending in its newline was never an answer:
+    the question was asked again for every Enter piped (the README tour's `poppy calibrate`
+    through pipes asked until it was killed)."""
+    monkeypatch.setattr(sys, "stdin", io.StringIO(piped))
+    assert RichAnswers().confirm("Record these zeros anyway?") is answer
