@@ -12,6 +12,7 @@ from typing import Any
 import pytest
 
 from poppy_core.assembly import ServeSpec, ZenohSettings, serve
+from poppy_core.errors import ConfigError
 from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import from_profile
 from poppy_core.zenoh_wire import ZenohSettings as Settings
@@ -61,8 +62,16 @@ def test_a_peer_without_the_credentials_cannot_join_nor_read_the_state(
         )
         assert result.code == 0, result.stderr
         assert [row["name"] for row in result.json()] == ["jr-s"]
-        for stranger in (None, wrong):
-            with Fleet(Settings(connect=(endpoint,), config_file=stranger)) as outsider:
+        # with nothing else to reach, a session without a file is the robot's Zenoh client:
+        # refused at the door, it never opens
+        with pytest.raises(ConfigError, match="no Zenoh router or robot answers"):
+            Fleet(Settings(connect=(endpoint,)))
+        strangers = (
+            Settings(connect=(endpoint,), mode="peer"),
+            Settings(connect=(endpoint,), config_file=wrong),
+        )
+        for stranger in strangers:
+            with Fleet(stranger) as outsider:
                 got = threading.Event()
                 outsider.on_state(lambda name, state, got=got: got.set())
                 assert not list(outsider.session.info.peers_zid())  # not linked at all
