@@ -392,8 +392,6 @@ class Ros2Node:
         return [s for s in self.robot.sensors if isinstance(s, Camera)]
 
     def _camera_loop(self, stopping: threading.Event) -> None:
-        from poppy_core.sensors.opencv import encode_image
-
         camera = self._cameras()[0]
         publisher = self._publishers["camera"]
         last = 0
@@ -407,8 +405,8 @@ class Ros2Node:
                 continue
             last = frame.number
 
-            def publish(image: Any = frame.image) -> None:
-                jpeg = encode_image(image, ".jpg")
+            def publish(taken: Any = frame) -> None:
+                jpeg = camera.encoded(taken, ".jpg")  # shared with the MJPEG viewers
                 message = messages.compressed_image(jpeg, CAMERA_FRAME, time.time())
                 publisher.put(types.serialize(message, types.COMPRESSED_IMAGE))
 
