@@ -167,3 +167,57 @@ def test_over_tls_a_peer_without_the_classrooms_ca_cannot_join_nor_read_the_stat
                 assert outsider.names() == []
                 assert not got.wait(1.0)  # 50 states a second flow to the teacher meanwhile
                 assert outsider.describe() == {}
+
+
+# Zenoh's access control on the robot, per user: teachers do anything under poppy/**; pupils
+# see which robots are there and watch their states, nothing else (no description, no api).
+_EVERYTHING = ["put", "delete", "declare_subscriber", "query", "reply", "declare_queryable"]
+_LIVELINESS = ["liveliness_token", "liveliness_query", "declare_liveliness_subscriber"]
+ACCESS_CONTROL: dict[str, Any] = {
+    "enabled": True,
+    "default_permission": "deny",
+    "rules": [
+        {"id": "all", "permission": "allow", "flows": ["egress", "ingress"],
+         "messages": _EVERYTHING + _LIVELINESS, "key_exprs": ["poppy/**"]},
+        {"id": "presence", "permission": "allow", "flows": ["egress", "ingress"],
+         "messages": ["reply", *_LIVELINESS], "key_exprs": ["poppy/*"]},
+        {"id": "states", "permission": "allow", "flows": ["egress", "ingress"],
+         "messages": ["put", "declare_subscriber"], "key_exprs": ["poppy/*/state"]},
+    ],
+    "subjects": [{"id": "teachers", "usernames": ["teacher"]},
+                 {"id": "pupils", "usernames": ["pupil"]}],
+    "policies": [{"rules": ["all"], "subjects": ["teachers"]},
+                 {"rules": ["presence", "states"], "subjects": ["pupils"]}],
+}  # fmt: skip
+
+
+def test_access_control_lets_a_pupil_watch_the_states_but_not_query_the_robot(
+    moves: Path, tmp_path: Path
+) -> None:
+    users = tmp_path / "users.txt"
+    users.write_text("teacher:classroom-pw\npupil:pupil-pw\njr-s:robot-pw\n", encoding="utf-8")
+    robot_config = _config(tmp_path / "robot.json5", "jr-s", "robot-pw", dictionary_file=str(users))
+    config = json.loads(robot_config.read_text(encoding="utf-8"))
+    robot_config.write_text(json.dumps(config | {"access_control": ACCESS_CONTROL}), "utf-8")
+    teacher = _config(tmp_path / "teacher.json5", "teacher", "classroom-pw")
+    pupil = _config(tmp_path / "pupil.json5", "pupil", "pupil-pw")
+    endpoint = free_endpoint()
+    spec = ServeSpec(
+        zenoh=ZenohSettings(listen=(endpoint,), config_file=robot_config), name="jr-s", token=TOKEN
+    )
+    with from_profile("ergo-jr", sim=True) as robot, serve(robot, spec):
+        with Fleet(Settings(connect=(endpoint,), config_file=teacher), token=TOKEN) as fleet:
+            assert fleet.wait_for(["jr-s"]) == ["jr-s"]
+            assert fleet.describe()["jr-s"]["name"] == "jr-s"
+            (motors,) = fleet.command(["jr-s"], "GET", "/api/v1/motors", together=False)
+            assert motors.ok, motors.message
+        # the pupil has the token, but access control stops its queries at the robot
+        with Fleet(Settings(connect=(endpoint,), config_file=pupil), token=TOKEN) as watcher:
+            assert watcher.wait_for(["jr-s"]) == ["jr-s"]
+            states: list[int] = []
+            watcher.on_state(lambda name, state: states.append(state.seq))
+            assert eventually(lambda: len(states) >= 3)
+            assert watcher.describe() == {}
+            (refused,) = watcher.command(["jr-s"], "GET", "/api/v1/motors", together=False)
+            assert not refused.ok
+            assert refused.status == 0  # no answer at all: access control dropped the query
