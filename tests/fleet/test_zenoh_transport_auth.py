@@ -220,4 +220,5 @@ def test_access_control_lets_a_pupil_watch_the_states_but_not_query_the_robot(
             assert watcher.describe() == {}
             (refused,) = watcher.command(["jr-s"], "GET", "/api/v1/motors", together=False)
             assert not refused.ok
-            assert refused.status == 0  # no answer at all: access control dropped the query
+            # no answer at all: access control keeps the api from the pupil
+            assert refused.status == 0
