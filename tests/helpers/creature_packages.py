@@ -22,9 +22,8 @@ import zipfile
 from pathlib import Path
 from types import ModuleType
 
-import pytest
-
 from poppy_core.files import write_file
+from tests.helpers.pypot_files import DOWNLOAD_ERRORS, needed
 
 # pypot's module -> poppy's: every pypot name these primitives import is in poppy_core.motion.
 _FROM_IMPORT = re.compile(r"^(\s*)from pypot\.primitive(?:\.utils|\.move)? import ", re.M)
@@ -99,20 +98,11 @@ def creature_primitives(
     """Module name -> the package's primitives module, imported from ``folder`` as poppy runs it."""
     try:
         sources = _primitive_sources(_archive(distribution, version), package)
-    except (
-        OSError,
-        RuntimeError,
-        subprocess.SubprocessError,
-        tarfile.TarError,
-        zipfile.BadZipFile,
-    ) as exc:
-        message = (
+    except DOWNLOAD_ERRORS as exc:
+        needed(
             f"{distribution} {version} is needed (PyPI through pip download, cached in "
             f"{cache_folder()}): {exc}"
         )
-        if os.environ.get("CI"):
-            pytest.fail(message)
-        pytest.skip(message)
     replay = f"replayed_{package}"
     write_file(folder / replay / "__init__.py", "", make_folder=True)
     for name, source in sources.items():

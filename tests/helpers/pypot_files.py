@@ -15,6 +15,7 @@ import tarfile
 import tempfile
 import zipfile
 from pathlib import Path
+from typing import NoReturn
 
 import pytest
 
@@ -32,6 +33,23 @@ SNAP_FILES = (
 INSIDE = "pypot/server/snap_projects/"
 ROOT = Path(__file__).resolve().parents[2]
 PEERS = ROOT / "bench" / ".venv-peers"
+
+
+DOWNLOAD_ERRORS = (
+    OSError,
+    RuntimeError,
+    subprocess.SubprocessError,
+    tarfile.TarError,
+    zipfile.BadZipFile,
+)
+"""What a missing, unreachable or damaged distribution raises while it is fetched and read."""
+
+
+def needed(message: str) -> NoReturn:
+    """A file from the package index is missing: fail on CI (which must have it), skip elsewhere."""
+    if os.environ.get("CI"):
+        pytest.fail(message)
+    pytest.skip(message)
 
 
 def cache_folder() -> Path:
@@ -89,18 +107,9 @@ def snap_project_files() -> dict[str, Path]:
         if not all((folder / name).is_file() for name in SNAP_FILES):
             try:
                 _download(folder)
-            except (
-                OSError,
-                RuntimeError,
-                subprocess.SubprocessError,
-                tarfile.TarError,
-                zipfile.BadZipFile,
-            ) as exc:
-                message = (
+            except DOWNLOAD_ERRORS as exc:
+                needed(
                     f"pypot {PYPOT_VERSION}'s Snap! files are needed (bench/.venv-peers, or "
                     f"PyPI through pip download, cached in {folder}): {exc}"
                 )
-                if os.environ.get("CI"):
-                    pytest.fail(message)
-                pytest.skip(message)
     return {name: folder / name for name in SNAP_FILES}
