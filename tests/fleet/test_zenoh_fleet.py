@@ -229,6 +229,14 @@ def test_a_command_to_a_silent_robot_reports_within_its_timeout(two: tuple[Serve
     assert time.monotonic() - began < 30  # it reports; it never hangs
 
 
+def _listening(host: str, port: int) -> bool:
+    try:
+        with socket.create_connection((host, port), timeout=1.0):
+            return True
+    except OSError:
+        return False
+
+
 def test_a_killed_robot_leaves_the_fleet(moves: Path) -> None:
     endpoint = free_endpoint()
     proc = subprocess.Popen(
@@ -249,6 +257,10 @@ def test_a_killed_robot_leaves_the_fleet(moves: Path) -> None:
         env={**__import__("os").environ, **ENV},
     )
     try:
+        # one endpoint: the teacher is the robot's Zenoh client, which opens only once the robot
+        # listens (3 s at most): wait for the robot's process to come up first, however loaded
+        host, port = endpoint.removeprefix("tcp/").rsplit(":", 1)
+        assert eventually(lambda: _listening(host, int(port)), timeout_s=60)
         with Fleet(Settings(connect=(endpoint,))) as client:
             assert client.wait_for(["doomed"], timeout_s=60) == ["doomed"]
             proc.kill()

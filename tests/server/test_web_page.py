@@ -163,7 +163,9 @@ def test_a_compliant_motor_says_so_where_its_goal_is_set(page: Any, served: Serv
     slider.dispatch_event("change")  # refused (409): the status line says why
     status = page.locator("#message")
     eventually(lambda: "m4 is compliant" in status.inner_text(), "the refusal's reason shown")
-    page.uncheck("#motor-m4 input[type=checkbox]")
+    box = "#motor-m4 input[type=checkbox]"  # the page's poll has shown m4 compliant
+    eventually(lambda: page.is_checked(box), "m4's compliance box checked")
+    page.uncheck(box)
     eventually(lambda: not note.is_visible(), "the note gone once m4 is stiff")
     eventually(lambda: robot.m4.compliant is False, "m4 stiff")
     robot.compliant = True
