@@ -22,9 +22,9 @@ the same run. Goals come from the project's issues; each table says whether they
 Run everything with `make bench` (it runs `.venv/bin/python -m bench`), or one benchmark with
 `.venv/bin/python -m bench scan`. Options: `--repeat N` (default 3), `--no-peers` (poppy
 only), `--list`, `--minutes M` (the soak's length per robot and client, default 10),
-`--baseline DIR` (`scan` also measures the poppy of another checkout, e.g. `git worktree add
-/tmp/old REV`, alternately with this one in every round: on a loaded machine only figures taken
-side by side compare). The fault
+`--baseline DIR` (`scan`, `emulator`, `server` and `camera` also measure the poppy of another
+checkout, e.g. `git worktree add /tmp/old REV`, alternately with this one in every round: on a
+loaded machine only figures taken side by side compare). The fault
 soak takes about 45 minutes: it runs only when named (`python -m bench soak`). The peers live
 in their own venv, `bench/.venv-peers`, built by `bench/setup_peers.sh` on first use (see
 `bench/README.md`); without it the benchmarks still run and say that the peers were not
