@@ -85,13 +85,7 @@ class HandCommands:
 
     def _move(self, args: list[str]) -> str:
         words = [a for a in args if a != "--linear"]
-        over = 0.0
-        if "--over" in words:
-            at = words.index("--over")
-            if at + 1 >= len(words):
-                raise ControlError(f"usage: {MOVE_USAGE}")
-            over = _number(words[at + 1], "--over takes seconds")
-            del words[at : at + 2]
+        over = _take_option(words, "--over", 0.0, MOVE_USAGE, "--over takes seconds")
         if len(words) != 2:
             raise ControlError(f"usage: {MOVE_USAGE}")
         motor_id, joint = self._joint(words[0])
@@ -106,13 +100,7 @@ class HandCommands:
 
         usage = "play FILE [--speed X]"
         words = list(args)
-        speed = 1.0
-        if "--speed" in words:
-            at = words.index("--speed")
-            if at + 1 >= len(words):
-                raise ControlError(f"usage: {usage}")
-            speed = _number(words[at + 1], "--speed takes a factor")
-            del words[at : at + 2]
+        speed = _take_option(words, "--speed", 1.0, usage, "--speed takes a factor")
         if len(words) != 1:
             raise ControlError(f"usage: {usage}")
         if not self.joints:
@@ -163,6 +151,18 @@ def joints_of(config: object) -> dict[str, HandJoint]:
     """The motors of a robot config (``RobotConfig.motors``) as joints by name."""
     motors = getattr(config, "motors", {})
     return {n: HandJoint(m.id, m.orientation, float(m.offset)) for n, m in motors.items()}
+
+
+def _take_option(words: list[str], flag: str, default: float, usage: str, what: str) -> float:
+    """``flag``'s number, removed from ``words`` with it (``default`` when it is not there)."""
+    if flag not in words:
+        return default
+    at = words.index(flag)
+    if at + 1 >= len(words):
+        raise ControlError(f"usage: {usage}")
+    value = _number(words[at + 1], what)
+    del words[at : at + 2]
+    return value
 
 
 def _number(text: str, what: str) -> float:
