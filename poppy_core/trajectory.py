@@ -44,9 +44,11 @@ by zero)."""
 def clamp_goal(target: float, limits: tuple[float, float] | None) -> float:
     """``target`` clamped to the angle ``limits`` (None: a wheel, no limits).
 
-    The one clamp-or-refuse rule of every surface (docs/rest.md, "Arguments and errors"): a
-    finite goal beyond the limits is clamped (as ``Motor.goal_position`` and pypot do) and the
-    answer says where the motor goes; a goal that is not a finite number is refused before.
+    The limit rule, written here once (docs/internals.md, "The limit rule"): a finite goal
+    beyond the limits is clamped, on every surface (Python's ``Motor.goal_position``, the
+    service behind REST, pypot's routes, the WebSocket, Snap!, ZMQ, Zenoh and ROS 2), and the
+    answer says where the motor goes where the surface has an answer; a goal that is not a
+    finite number is refused before (``checks.number``).
     """
     return target if limits is None else min(max(target, limits[0]), limits[1])
 

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, ClassVar
 
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import SimplePosture
-from poppy_core.trajectory import CONTROLS
+from poppy_core.trajectory import CONTROLS, clamp_goal
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
@@ -99,8 +99,8 @@ def clamp_to_limits(robot: Robot, posture: Mapping[str, float]) -> dict[str, flo
     out: dict[str, float] = {}
     for name, value in posture.items():
         if name in names:
-            low, high = robot.motor(name).angle_limit
-            out[name] = min(max(float(value), low), high)
+            motor = robot.motor(name)
+            out[name] = clamp_goal(float(value), None if motor.wheel_mode else motor.angle_limit)
     return out
 
 

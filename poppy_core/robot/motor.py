@@ -31,6 +31,7 @@ from poppy_core.robot.goto import GotoHandle, GotoRunner
 from poppy_core.robot.motor_compliance import CompliantBehavior, MotorCompliance
 from poppy_core.robot.motor_link import MotorLink
 from poppy_core.robot.motor_pypot import PypotMotorMixin
+from poppy_core.trajectory import clamp_goal
 
 if TYPE_CHECKING:
     from poppy_core.robot.config import MotorConfig
@@ -236,8 +237,7 @@ class Motor(PypotMotorMixin, MotorCompliance):
     def _set_goal(self, user_deg: float) -> None:
         """Set the goal position without cancelling a running goto (the goto runner's way, through
         ``MotorLink.set_goal``)."""
-        low, high = self._limits
-        target = float(user_deg) if self.wheel_mode else min(max(float(user_deg), low), high)
+        target = clamp_goal(float(user_deg), None if self.wheel_mode else self._limits)
         motor_deg = self.to_motor(target)
         bottom, top = self._range if self.wheel_mode else self.motor_limits()
         self._link.store("goal_position", min(max(motor_deg, bottom), top))

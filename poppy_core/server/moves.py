@@ -36,7 +36,7 @@ from poppy_core.motion import (
 )
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
-from poppy_core.server.start_time import start_gate
+from poppy_core.server.start_time import StartTimes, check_start_at
 
 logger = logging.getLogger(__name__)
 
@@ -71,10 +71,12 @@ class MoveService:
 
     Args:
         robot: the robot.
+        starts: where a play with a ``start_at`` is armed (the service's; its own without one).
     """
 
-    def __init__(self, robot: Robot) -> None:
+    def __init__(self, robot: Robot, starts: StartTimes | None = None) -> None:
         self.robot = robot
+        self.starts = starts if starts is not None else StartTimes()
         self._lock = threading.Lock()
         self._recorders: dict[str, MoveRecorder] = {}
         self._players: dict[str, MovePlayer] = {}
@@ -244,10 +246,13 @@ class MoveService:
         backwards: bool = False,
         ramp_s: float | None = None,
         refuse_playing: bool = False,
+        *,
+        start_at: float | None = None,
     ) -> MovePlayer:
         """Play a library move; ``ramp_s``: the ramp to its first frame (None: from the
         distance; give it to a fleet's robots so that, wherever each one is, they play in phase
-        from the shared start).
+        from the shared start); ``start_at``: the shared start (wall clock, ``check_start_at``):
+        the playback is armed now and starts then (None: now).
 
         A move plays once at a time: a second play of a move that is playing starts nothing and
         answers the playback running, as pypot's ``start_move_player`` does (its REST, ZMQ and
@@ -258,8 +263,10 @@ class MoveService:
         Raises:
             ApiError: bad name, no such move, a move that cannot be played, already playing
                 (``refuse_playing``), or the service closed.
+            ArgumentError: a ``start_at`` too far from now.
         """
         check_move_name(name)
+        when = check_start_at(start_at)
         with self._starting:
             self._check_open()
             with self._lock:
@@ -281,8 +288,7 @@ class MoveService:
                 raise ApiError("invalid", str(exc)) from None
             except ValueError as exc:
                 raise ApiError("invalid", f"cannot play {name!r}: {exc}") from None
-            gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
-            player.start(gate=gate)
+            player.start(gate=self.starts.gate(when))  # with a start_at: armed now
             with self._lock:
                 self._players[name] = player  # a stop before the start time finds it, cancels it
         return player

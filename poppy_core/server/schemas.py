@@ -171,6 +171,12 @@ class RecordRequest(BaseModel):
     motors: list[MotorName] | None = Field(None, max_length=64)
 
 
+START_AT = (
+    "the wall-clock time (seconds since 1970, within a minute of now) the start is armed for: "
+    "checked and made now, started then (null: now); a stop before it calls it off"
+)
+
+
 class PlayRequest(BaseModel):
     """How to play a move."""
 
@@ -186,6 +192,14 @@ class PlayRequest(BaseModel):
         description="seconds of the ramp to the first frame (null: from the distance); the "
         "same on every robot of a fleet keeps them in phase",
     )
+    start_at: Finite | None = Field(None, description=START_AT)
+
+
+class StartRequest(BaseModel):
+    """When to start (a fleet's shared start): nothing, or a ``start_at``."""
+
+    model_config = ConfigDict(extra="forbid")
+    start_at: Finite | None = Field(None, description=START_AT)
 
 
 class MovesStatus(BaseModel):

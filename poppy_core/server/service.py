@@ -14,13 +14,15 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from poppy_core.motion import Primitive, attach_builtins, attached_primitive, attached_primitives
+from poppy_core.motion.play_plan import write_rate_hz
+from poppy_core.motion.waypoints import WaypointFollower, Waypoints
 from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import values
 from poppy_core.server.compliant_goals import GOAL_REGISTERS, CompliantGoals, goal_motors
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from poppy_core.server.pypot_json import html_safe
-from poppy_core.server.start_time import start_gate
+from poppy_core.server.start_time import StartTimes, check_start_at, on_monotonic
 from poppy_core.server.teleop_channel import TeleopRegistry
 from poppy_core.trajectory import control_name, goto_duration
 
@@ -43,7 +45,11 @@ class RobotService:
         self.robot = robot
         if builtins:
             attach_builtins(robot)
-        self.moves = MoveService(robot)
+        self.starts = StartTimes()
+        """The starts armed for a shared start time (``start_at``)."""
+        self.moves = MoveService(robot, self.starts)
+        self.follower = WaypointFollower(robot, write_rate_hz(robot), "trajectory")
+        """The trajectory followed (``follow``): one at a time, the next replaces it."""
         self.teleop = TeleopRegistry()
         """Which WebSocket connection teleoperates which motor."""
         self._description: tuple[float, bytes] | None = None
@@ -197,6 +203,80 @@ class RobotService:
             for name, value in positions.items()
         }
 
+    def set_goals(
+        self,
+        positions: Mapping[str, Any],
+        *,
+        refuse_compliant: bool = False,
+        replace_trajectory: bool = False,
+    ) -> dict[str, float]:
+        """Check every goal (``targets``: the limit rule), then set them all (or none).
+
+        Args:
+            positions: motor name -> degrees.
+            refuse_compliant: refuse a goal to a compliant motor (v1's rule, ROS 2's).
+            replace_trajectory: the goals end the trajectory followed (ROS 2's joint command).
+
+        Raises:
+            UnknownMotorError: an unknown motor (nothing moved).
+            ApiError: no motor, or a goal that is not a finite number (nothing moved).
+            CompliantMotorError: with ``refuse_compliant``, a compliant motor (nothing moved).
+        """
+        targets = self.targets(positions)
+        motors = [self.motor(name) for name in targets]
+        self._goals(motors, refuse_compliant)
+        if replace_trajectory:
+            self.follower.stop()
+        for motor in motors:
+            motor.goal_position = targets[motor.name]
+        return targets
+
+    def follow(
+        self,
+        motors: Sequence[str],
+        times: Sequence[float],
+        points: Sequence[Sequence[Any]],
+        *,
+        start_at: float | None = None,
+        refuse_compliant: bool = True,
+    ) -> Waypoints | None:
+        """Follow a trajectory (replacing the one followed): ``points[i]`` (degrees, one per
+        motor) is due ``times[i]`` seconds after ``start_at`` (wall clock; None: now). Every
+        point is checked first (``targets``: the limit rule); no point stops the trajectory.
+
+        Raises:
+            UnknownMotorError: an unknown motor (nothing moved).
+            ApiError: a point that is not one finite number per motor, times going back.
+            ArgumentError: a ``start_at`` too far from now (``check_start_at``).
+            CompliantMotorError: with ``refuse_compliant``, a compliant motor (nothing moved).
+        """
+        if not points:
+            self.follower.stop()
+            return None
+        names = tuple(motors)
+        if len(set(names)) != len(names):
+            raise ApiError("invalid", "the trajectory names a motor twice")
+        checked: list[tuple[float, ...]] = []
+        for index, point in enumerate(points):
+            if len(point) != len(names):
+                raise ApiError(
+                    "invalid", f"point {index} has {len(point)} positions for {len(names)} motors"
+                )
+            if index and times[index] < times[index - 1]:
+                raise ApiError("invalid", f"point {index} goes back in time")
+            goals = self.targets(dict(zip(names, point, strict=True)))
+            checked.append(tuple(goals[n] for n in names))
+        self._goals([self.motor(n) for n in names], refuse_compliant)
+        when = check_start_at(start_at)
+        start = None if when is None or when <= time.time() else on_monotonic(when)
+        waypoints = Waypoints(names, tuple(float(t) for t in times), tuple(checked), start)
+        self.follower.follow(waypoints)
+        return waypoints
+
+    def stop_following(self) -> bool:
+        """Stop the trajectory followed (the motors hold their goals); True when one was."""
+        return self.follower.stop()
+
     # -- primitives ------------------------------------------------------------------------------
 
     def primitives(self) -> dict[str, Primitive]:
@@ -251,12 +331,23 @@ class RobotService:
         playing = [f"_{name}_player" for name in self.moves.playing()]
         return [*self.running_primitives(), *recording, *playing]
 
-    def control_primitive(self, name: str, action: str) -> Primitive:
-        """``start``, ``stop``, ``pause`` or ``resume`` a primitive (``stop`` joins its thread)."""
+    def control_primitive(
+        self, name: str, action: str, *, start_at: float | None = None
+    ) -> Primitive:
+        """``start``, ``stop``, ``pause`` or ``resume`` a primitive (``stop`` joins its thread).
+
+        A start with ``start_at`` (wall clock, ``check_start_at``) is armed now and fires then
+        (``StartTimes``); another action takes none.
+
+        Raises:
+            ArgumentError: a ``start_at`` too far from now, or one given to another action.
+        """
+        when = check_start_at(start_at)
+        if when is not None and action != "start":
+            raise ApiError("invalid", f"only a start takes a start_at, not {action!r}")
         primitive = self.primitive(name)
         if action == "start":
-            gate = start_gate()  # a fleet's shared start time (none over HTTP): armed now
-            primitive.start(gate=gate)
+            primitive.start(gate=self.starts.gate(when))
         elif action == "stop":
             primitive.halt(wait=True)
         elif action == "pause":
@@ -330,6 +421,7 @@ class RobotService:
     # -- lifetime ----------------------------------------------------------------------------
 
     def close(self) -> None:
-        """Stop the recordings, playbacks and teleoperations this server started."""
+        """Stop the recordings, playbacks, trajectory and teleoperations this server started."""
         self.teleop.close()
+        self.follower.close()
         self.moves.close()

@@ -1,28 +1,28 @@
-"""A request's shared start time: the robots of a fleet command start together, armed then fired.
+"""Shared start times: the robots of a fleet command start together, armed then fired.
 
-The Zenoh ``api`` queryable runs a request with ``start_at`` (wall clock) at once, with
-``START_AT`` set. The actions that start something (a primitive, a move) do all their work on
-arrival: the move is loaded and checked, the player or primitive and its thread are made; that
-thread then waits at a ``Gate`` (``start_gate``), and the request is answered (a refusal too:
-the checks ran on arrival). At ``start_at`` one thread per process, woken by a precise wait (a
-sleep to ``SPIN_S`` before, then one for the rest, so that a long sleep's drift is made up),
-opens every gate due: the start itself is only a thread released. Nothing else wakes then (the
-replies went out on arrival), so the robots of one process fire within a fraction of a
-millisecond of each other and of ``start_at`` on an idle machine. A stop before ``start_at``
-cancels the gate and nothing starts.
+A start with a ``start_at`` (wall clock; an explicit argument of the service's operations:
+``RobotService.control_primitive``, ``MoveService.play``, ``RobotService.follow``) does all its
+work on arrival: the move is loaded and checked, the player or primitive and its thread are
+made; that thread then waits at a ``Gate`` (``StartTimes.gate``), and the request is answered
+(a refusal too: the checks ran on arrival). At ``start_at`` one thread per start time and
+service, woken by a precise wait (a sleep to ``SPIN_S`` before, then one for the rest, so that a
+long sleep's drift is made up), opens every gate due: the start itself is only a thread
+released. Nothing else wakes then (the replies went out on arrival), so the robots of one process
+fire within a fraction of a millisecond of each other and of ``start_at`` on an idle machine. A
+stop before ``start_at`` cancels the gate and nothing starts.
 """
 
 from __future__ import annotations
 
 import threading
 import time
-from contextvars import ContextVar
-from dataclasses import dataclass, field
+from typing import Any
 
+from poppy_core import checks
 from poppy_core.schedule import Gate
 
-START_AT: ContextVar[float | None] = ContextVar("start_at", default=None)
-"""The wall-clock time (``time.time()``) the current request's action starts at, or None."""
+MAX_START_DELAY_S = 60.0
+"""How far from now a ``start_at`` may be (a clock that far off is refused, not waited)."""
 
 SPIN_S = 0.002
 """How long before the start time the firing thread's first sleep ends; the rest is slept again
@@ -30,32 +30,27 @@ from a fresh reading of the clock. Not a spin nor short steps: each wake-up of a
 take the GIL back, which on a busy process can wait for another thread's switch interval."""
 
 
-@dataclass
-class _Due:
-    gates: list[Gate] = field(default_factory=list)
+def check_start_at(value: Any) -> float | None:
+    """``start_at`` (``time.time()`` seconds) checked as its delay from now: the one rule of
+    every surface that takes one (REST v1, Zenoh, ROS 2's ``header.stamp``).
 
-
-_lock = threading.Lock()
-_due: dict[float, _Due] = {}
-
-
-def start_gate() -> Gate | None:
-    """The gate an armed start of the current request waits at, or None: start at once (no
-    ``START_AT``, or one already past). The gate opens at ``START_AT``; cancel it to call the
-    start off."""
-    when = START_AT.get()
-    if when is None or when <= time.time():
+    Raises:
+        ArgumentError: not a number, or more than ``MAX_START_DELAY_S`` from now either way.
+    """
+    if value is None:
         return None
-    gate = Gate(at=time.monotonic() + (when - time.time()))  # the start, on the motion's clock
-    with _lock:
-        due = _due.get(when)
-        first = due is None
-        if due is None:
-            due = _due[when] = _Due()
-        due.gates.append(gate)
-    if first:
-        threading.Thread(target=_fire, args=(when, due), name="fleet-start", daemon=True).start()
-    return gate
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        checks.number(value, "start_at")  # raises, naming the field
+    now = time.time()
+    delay = checks.in_range(
+        float(value) - now, -MAX_START_DELAY_S, MAX_START_DELAY_S, "start_at (from now)", "s"
+    )
+    return now + delay
+
+
+def on_monotonic(start_at: float) -> float:
+    """Wall-clock ``start_at`` on the ``time.monotonic()`` clock (the motion's)."""
+    return time.monotonic() + (start_at - time.time())
 
 
 def wait_until(when: float) -> None:
@@ -68,10 +63,40 @@ def wait_until(when: float) -> None:
         time.sleep(left - SPIN_S if left > SPIN_S else left)
 
 
-def _fire(when: float, due: _Due) -> None:
-    wait_until(when)
-    with _lock:
-        _due.pop(when, None)
-        gates = list(due.gates)
-    for gate in gates:
-        gate.open()
+class StartTimes:
+    """The gates armed for start times, one firing thread per start time (a service's)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._due: dict[float, list[Gate]] = {}
+
+    def gate(self, start_at: float | None) -> Gate | None:
+        """The gate an armed start waits at, or None: start at once (no ``start_at``, or one
+        already past). The gate opens at ``start_at``; cancel it to call the start off."""
+        if start_at is None or start_at <= time.time():
+            return None
+        gate = Gate(at=on_monotonic(start_at))  # the start, on the motion's clock
+        with self._lock:
+            gates = self._due.get(start_at)
+            first = gates is None
+            if gates is None:
+                gates = self._due[start_at] = []
+            gates.append(gate)
+        if first:
+            threading.Thread(
+                target=self._fire, args=(start_at,), name="fleet-start", daemon=True
+            ).start()
+        return gate
+
+    @property
+    def armed(self) -> int:
+        """Gates waiting for their start time."""
+        with self._lock:
+            return sum(len(gates) for gates in self._due.values())
+
+    def _fire(self, when: float) -> None:
+        wait_until(when)
+        with self._lock:
+            gates = self._due.pop(when, [])
+        for gate in gates:
+            gate.open()

@@ -16,6 +16,7 @@ from typing import Any
 import pytest
 
 from poppy_core import zenoh_wire
+from poppy_core.errors import ArgumentError
 from poppy_core.motion import Primitive
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_library import save_move
@@ -24,7 +25,7 @@ from poppy_core.remote.zenoh_client import answer_of
 from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import Robot, from_profile
 from poppy_core.schedule import Gate
-from poppy_core.server.start_time import START_AT, start_gate, wait_until
+from poppy_core.server.start_time import StartTimes, check_start_at, wait_until
 from tests.helpers.cli import run_poppy
 from tests.helpers.waiting import eventually
 from tests.helpers.zenoh_served import TOKEN, Served
@@ -49,30 +50,30 @@ def robot() -> Iterator[Robot]:
         yield jr
 
 
-def _at(when: float) -> Any:
-    return START_AT.set(when)
-
-
 def test_without_a_start_time_there_is_no_gate() -> None:
-    assert start_gate() is None
-    context = _at(time.time() - 1.0)  # a start time already past: at once
-    try:
-        assert start_gate() is None
-    finally:
-        START_AT.reset(context)
+    starts = StartTimes()
+    assert starts.gate(None) is None
+    assert starts.gate(time.time() - 1.0) is None  # a start time already past: at once
+    assert starts.armed == 0
+
+
+def test_a_start_time_more_than_a_minute_away_is_refused() -> None:
+    for off in (-120.0, 120.0):
+        with pytest.raises(ArgumentError, match="start_at"):
+            check_start_at(time.time() + off)
+    with pytest.raises(ArgumentError, match="start_at"):
+        check_start_at("soon")
+    assert check_start_at(None) is None
 
 
 def test_armed_primitives_all_fire_after_their_start_time(robot: Robot) -> None:
     stamps = [Stamp(robot) for _ in range(5)]
     when = time.time() + LEAD_S
-    context = _at(when)
-    try:
-        gates = [start_gate() for _ in stamps]
-        for stamp, gate in zip(stamps, gates, strict=True):
-            stamp.start(gate=gate)  # armed: its thread is made, held at the gate
-        assert not any(s.began for s in stamps) or time.time() >= when
-    finally:
-        START_AT.reset(context)
+    starts = StartTimes()
+    gates = [starts.gate(when) for _ in stamps]
+    for stamp, gate in zip(stamps, gates, strict=True):
+        stamp.start(gate=gate)  # armed: its thread is made, held at the gate
+    assert not any(s.began for s in stamps) or time.time() >= when
     assert eventually(lambda: all(s.began for s in stamps))
     assert all(s.began[0] >= when for s in stamps)  # fired at the start time, not on arrival
     assert all(len(s.began) == 1 for s in stamps)
@@ -81,15 +82,11 @@ def test_armed_primitives_all_fire_after_their_start_time(robot: Robot) -> None:
 def test_a_stop_before_the_start_time_means_the_primitive_never_runs(robot: Robot) -> None:
     stamp = Stamp(robot)
     when = time.time() + LEAD_S
-    context = _at(when)
-    try:
-        gate = start_gate()
-        assert gate is not None
-        stamp.start(gate=gate)
-        stamp.stop()  # before the start time
-        assert gate.cancelled and stamp.state == "stopped" and not stamp.is_alive()
-    finally:
-        START_AT.reset(context)
+    gate = StartTimes().gate(when)
+    assert gate is not None
+    stamp.start(gate=gate)
+    stamp.stop()  # before the start time
+    assert gate.cancelled and stamp.state == "stopped" and not stamp.is_alive()
     wait_until(when + 0.05)
     assert stamp.began == []
     stamp.start()  # it can still be started again, now
@@ -240,11 +237,7 @@ def test_a_together_command_returns_once_its_start_time_came(
 
 def test_the_gate_of_a_shared_start_carries_its_start_time(robot: Robot) -> None:
     when = time.time() + LEAD_S
-    context = _at(when)
-    try:
-        gate = start_gate()
-    finally:
-        START_AT.reset(context)
+    gate = StartTimes().gate(when)
     assert gate is not None and gate.at is not None
     # start_at on the motion's clock (time.monotonic()); the two clocks read a moment apart
     assert gate.at - time.monotonic() == pytest.approx(when - time.time(), abs=0.05)

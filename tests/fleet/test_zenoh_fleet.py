@@ -105,9 +105,9 @@ def test_fleet_play_starts_both_robots(two: tuple[Served, Served], fleet: Fleet)
     for served in (a, b):
         real = served.servers.service.moves.play
 
-        def spy(*args: Any, real: Any = real, name: str = served.name) -> Any:
+        def spy(*args: Any, real: Any = real, name: str = served.name, **kwargs: Any) -> Any:
             played.append(name)
-            return real(*args)
+            return real(*args, **kwargs)
 
         served.servers.service.moves.play = spy  # type: ignore[method-assign]
     result = run_poppy("fleet", "play", "wave", "--all", "--token", TOKEN, *_fleet_args(a, b))

@@ -337,7 +337,7 @@ def test_bad_commands_move_nothing(node: Node, caplog: pytest.LogCaptureFixture)
     bad = [
         (["m1", "m9"], [0.1, 0.1]),  # an unknown joint
         (["m1", "m2"], [0.1, float("nan")]),  # NaN
-        (["m1"], [10.0]),  # out of m1's limits (10 rad)
+        (["m1"], [1e12]),  # huge: refused as on every surface (not clamped)
         (["m1", "m2"], [0.1]),  # fewer positions than names
     ]
     caplog.set_level(logging.WARNING, logger="poppy_core.server.ros2.node")
@@ -357,6 +357,19 @@ def test_bad_commands_move_nothing(node: Node, caplog: pytest.LogCaptureFixture)
     assert eventually(lambda: _refusals(node) == seen + 1, 10.0)
     assert not node.servers.ros2.commands.following
     assert {m.name: m.goal_position for m in node.robot.motors} == before
+
+
+def test_a_goal_beyond_the_limits_is_clamped_to_them(node: Node) -> None:
+    """The limit rule of every surface (ros2_control's saturation limiter does the same)."""
+    _stiff(node)
+    m1 = node.robot.motor("m1")
+    low, high = m1.angle_limit
+    node.client.publish("/joint_command", JOINT_STATE, _joint_command(["m1"], np.array([10.0])))
+    assert eventually(lambda: abs(m1.goal_position - high) < 0.5, 10.0), m1.goal_position
+    node.client.publish("/joint_trajectory", TRAJECTORY, _trajectory(["m1"], [(0.2, [-10.0])]))
+    assert eventually(lambda: abs(m1.goal_position - low) < 0.5, 10.0), m1.goal_position
+    assert eventually(lambda: not node.servers.ros2.commands.following, 10.0)
+    assert node.servers.ros2.commands.refused == 0
 
 
 def test_compliant_motors_are_not_moved_and_the_refusal_says_why(

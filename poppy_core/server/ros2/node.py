@@ -7,7 +7,9 @@ transient-local subscriptions query), ``diagnostics`` (every second) and, while 
 ``camera/image_raw/compressed``; subscriptions ``joint_trajectory`` and ``joint_command``;
 services ``~/set_compliant``, ``~/stop`` and per primitive ``~/<primitive>/start`` and
 ``~/<primitive>/stop``; and the liveliness token of the node and of each of those entities.
-Every sample and reply carries rmw_zenoh's attachment. Publications drop rather than wait.
+The entities are declared by ``entities.Entities``; the commands are the service's operations
+(``commands.Commands``). Every sample and reply carries rmw_zenoh's attachment. Publications
+drop rather than wait.
 """
 
 from __future__ import annotations
@@ -16,8 +18,6 @@ import logging
 import re
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
@@ -26,9 +26,9 @@ from poppy_core import ros2_wire as wire
 from poppy_core.errors import PoppyError
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
-from poppy_core.server.errors import ApiError
 from poppy_core.server.ros2 import messages, rosout, types
-from poppy_core.server.ros2.commands import CommandRefused, Commands
+from poppy_core.server.ros2.commands import Commands
+from poppy_core.server.ros2.entities import Entities, Publisher
 from poppy_core.server.ros2.joints import UrdfJoints
 from poppy_core.server.ros2.refusal_log import Refusal, Refusals
 
@@ -42,23 +42,6 @@ logger = logging.getLogger(__name__)
 DIAGNOSTICS_PERIOD_S = 1.0
 CAMERA_FRAME = "camera"
 _PRIMITIVE = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
-
-
-@dataclass
-class _Publisher:
-    name: str
-    typ: types.RosType
-    qos: wire.Qos
-    publisher: Any = None
-    gid: bytes = b""
-    sequence: int = 0
-    lock: threading.Lock = field(default_factory=threading.Lock)
-
-    def put(self, payload: bytes) -> None:
-        with self.lock:
-            self.sequence += 1
-            extra = wire.attachment(self.sequence, time.time_ns(), self.gid)
-            self.publisher.put(payload, attachment=extra)
 
 
 class Ros2Node:
@@ -91,17 +74,11 @@ class Ros2Node:
         self.node = settings.node or wire.node_name_from(name)
         self.state_rate_hz = checks.rate(state_rate_hz, "state_rate_hz")
         self.joints = UrdfJoints(self.robot)
-        self.commands = Commands(self.robot, self.joints, self.state_rate_hz)
+        self.commands = Commands(service, self.joints)
         self.rate = RateMeter()
         self.published = 0
-        self.tokens: list[str] = []
-        """The liveliness keys declared (node first)."""
-        self._declared: list[Any] = []
-        self._publishers: dict[str, _Publisher] = {}
-        self._service_names: dict[str, str] = {}
-        self._entity = 0
-        self._zid = ""
-        self._pool: ThreadPoolExecutor | None = None
+        self.entities = Entities(session, self.domain, self.namespace, self.node, self.refuse)
+        self._publishers = self.entities.publishers
         self._worker = Worker(f"ros2-{self.node}", self._publish_loop)
         self._camera_worker = Worker(f"ros2-camera-{self.node}", self._camera_loop)
         self.refusals = Refusals(logger)
@@ -129,9 +106,14 @@ class Ros2Node:
         """True while ``joint_states`` is published."""
         return self._worker.running
 
+    @property
+    def tokens(self) -> list[str]:
+        """The liveliness keys declared (node first)."""
+        return self.entities.tokens
+
     def name_of(self, relative: str) -> str:
         """The fully qualified name of a topic or service of this node."""
-        return wire.fully_qualified(self.namespace, self.node, relative)
+        return self.entities.name_of(relative)
 
     # -- declarations --------------------------------------------------------------------------
 
@@ -139,37 +121,38 @@ class Ros2Node:
         """Declare the node, its publishers, subscriptions and services; publish."""
         if self.running:
             return
-        self._zid = str(self.session.info.zid())
-        self._pool = ThreadPoolExecutor(2, thread_name_prefix=f"ros2-{self.node}")
-        self._token(wire.NODE, 0)
-        self._publisher("joint_states", types.JOINT_STATE, wire.DEFAULT_QOS)
-        self._publisher("tf", types.TF_MESSAGE, wire.TF_QOS, topic="/tf")
-        self._publisher(
+        entities = self.entities
+        entities.open()
+        entities.publisher("joint_states", types.JOINT_STATE, wire.DEFAULT_QOS)
+        entities.publisher("tf", types.TF_MESSAGE, wire.TF_QOS, topic="/tf")
+        entities.publisher(
             "diagnostics", types.DIAGNOSTIC_ARRAY, wire.DEFAULT_QOS, topic="/diagnostics"
         )
-        self._publisher("rosout", rosout.LOG, rosout.ROSOUT_QOS, topic="/rosout")
+        entities.publisher("rosout", rosout.LOG, rosout.ROSOUT_QOS, topic="/rosout")
         if self.joints.urdf is not None:
-            self._publisher("robot_description", types.STRING, wire.LATCHED_QOS)
-            self._publisher("tf_static", types.TF_MESSAGE, wire.LATCHED_QOS, topic="/tf_static")
+            entities.publisher("robot_description", types.STRING, wire.LATCHED_QOS)
+            entities.publisher("tf_static", types.TF_MESSAGE, wire.LATCHED_QOS, topic="/tf_static")
         if self._cameras():
-            self._publisher(
+            entities.publisher(
                 "camera",
                 types.COMPRESSED_IMAGE,
                 wire.SENSOR_QOS,
                 topic="camera/image_raw/compressed",
             )
-        self._subscription("joint_trajectory", types.JOINT_TRAJECTORY, self._on_trajectory)
-        self._subscription("joint_command", types.JOINT_STATE, self._on_command)
-        self._service("~/set_compliant", types.SET_BOOL, self._set_compliant)
-        self._service("~/stop", types.TRIGGER, self._stop_all)
+        entities.subscription("joint_trajectory", types.JOINT_TRAJECTORY, self._on_trajectory)
+        entities.subscription("joint_command", types.JOINT_STATE, self._on_command)
+        entities.service("~/set_compliant", types.SET_BOOL, self._set_compliant)
+        entities.service("~/stop", types.TRIGGER, self._stop_all)
         for primitive in self.service.primitives():
             if not _PRIMITIVE.fullmatch(primitive) or "__" in primitive:
                 logger.info("ROS 2: primitive %r has no ROS name: no service", primitive)
                 continue
-            self._service(
+            entities.service(
                 f"~/{primitive}/start", types.TRIGGER, self._primitive(primitive, "start")
             )
-            self._service(f"~/{primitive}/stop", types.TRIGGER, self._primitive(primitive, "stop"))
+            entities.service(
+                f"~/{primitive}/stop", types.TRIGGER, self._primitive(primitive, "stop")
+            )
         if self.joints.urdf is not None:
             self._publishers["robot_description"].put(
                 types.serialize(messages.string(self.joints.urdf), types.STRING)
@@ -180,120 +163,6 @@ class Ros2Node:
         self._worker.start()
         if "camera" in self._publishers:
             self._camera_worker.start()
-
-    def _next_id(self) -> int:
-        self._entity += 1
-        return self._entity
-
-    def _token(
-        self, kind: str, entity: int, topic: tuple[str, str, str, wire.Qos] | None = None
-    ) -> str:
-        key = wire.token_key(
-            self.domain, self._zid, 0, entity, kind, self.namespace, self.node, topic=topic
-        )
-        self._declared.append(self.session.liveliness().declare_token(key))
-        self.tokens.append(key)
-        return key
-
-    def _key(self, name: str, typ: types.RosType) -> str:
-        return wire.data_key(self.domain, name, typ.dds, typ.hash)
-
-    def _publisher(
-        self, label: str, typename: str, qos: wire.Qos, *, topic: str | None = None
-    ) -> None:
-        import zenoh
-        import zenoh.ext
-
-        typ = types.ros_type(typename)
-        name = self.name_of(topic or label)
-        key = self._key(name, typ)
-        drop = zenoh.CongestionControl.DROP
-        publisher: Any
-        if qos.durability == wire.TRANSIENT_LOCAL:
-            publisher = zenoh.ext.declare_advanced_publisher(
-                self.session,
-                key,
-                congestion_control=drop,
-                cache=zenoh.ext.CacheConfig(qos.depth),
-                publisher_detection=True,
-            )
-        else:
-            publisher = self.session.declare_publisher(
-                key,
-                congestion_control=drop,
-                express=True,
-                reliability=zenoh.Reliability.BEST_EFFORT
-                if qos.reliability == wire.BEST_EFFORT
-                else zenoh.Reliability.RELIABLE,
-            )
-        self._declared.append(publisher)
-        token = self._token(wire.PUBLISHER, self._next_id(), (name, typ.dds, typ.hash, qos))
-        self._publishers[label] = _Publisher(name, typ, qos, publisher, wire.gid(token))
-
-    def _subscription(self, topic: str, typename: str, handle: Any) -> None:
-        typ = types.ros_type(typename)
-        name = self.name_of(topic)
-
-        def on_sample(sample: zenoh.Sample) -> None:
-            try:
-                message = types.deserialize(sample.payload.to_bytes(), typename)
-            except Exception as exc:  # rosbags' SerdeError and its kin: a bad message
-                self._refused(name, f"not a {typename} message ({exc})")
-                return
-            try:
-                handle(message)
-            except (CommandRefused, PoppyError, ApiError, ValueError) as exc:
-                self._refused(name, str(exc))
-
-        self._declared.append(self.session.declare_subscriber(self._key(name, typ), on_sample))
-        self._token(wire.SUBSCRIPTION, self._next_id(), (name, typ.dds, typ.hash, wire.DEFAULT_QOS))
-
-    def _service(self, relative: str, typename: str, handle: Any) -> None:
-        typ = types.ros_type(typename)
-        name = self.name_of(relative)
-        key = self._key(name, typ)
-
-        def on_query(query: zenoh.Query) -> None:
-            pool = self._pool
-            if pool is not None:  # off Zenoh's thread: a primitive's stop joins its thread
-                pool.submit(self._answer, query, key, typename, handle)
-
-        self._declared.append(self.session.declare_queryable(key, on_query, complete=True))
-        self._service_names[key] = name
-        self._token(wire.SERVICE, self._next_id(), (name, typ.dds, typ.hash, wire.SERVICE_QOS))
-
-    def _answer(self, query: zenoh.Query, key: str, typename: str, handle: Any) -> None:
-        try:
-            self._reply(query, key, typename, handle)
-        finally:
-            query.drop()  # type: ignore[no-untyped-call]  # the client stops waiting
-
-    def _reply(self, query: zenoh.Query, key: str, typename: str, handle: Any) -> None:
-        try:
-            asked = wire.read_attachment(query.attachment.to_bytes()) if query.attachment else None
-            payload = query.payload.to_bytes() if query.payload is not None else b""
-            request = types.deserialize(payload, f"{typename}_Request")
-        except Exception as exc:  # a request that is not this service's
-            logger.warning("ROS 2: %s: bad request: %s", key, exc)
-            query.reply_err(f"bad request: {exc}".encode())
-            return
-        try:
-            success, text = handle(request)
-        except (PoppyError, ApiError, ValueError) as exc:
-            success, text = False, str(exc)
-        except Exception as exc:  # a reply still goes out: a client never waits in vain
-            logger.exception("ROS 2: %s failed", key)
-            success, text = False, f"failed: {exc}"
-        if not success:
-            self.refuse(Refusal(self._service_names.get(key, key), text, "service"))
-        response = types.message(f"{typename}_Response", success=success, message=text)
-        extra = wire.attachment(
-            asked.sequence if asked else 0, time.time_ns(), asked.gid if asked else bytes(16)
-        )
-        query.reply(key, types.serialize(response, f"{typename}_Response"), attachment=extra)
-
-    def _refused(self, topic: str, why: str) -> None:
-        self.refuse(Refusal(topic, why, "topic"))
 
     def refuse(self, refusal: Refusal) -> None:
         """The one place a refusal of the node goes: counted, logged, handed to listeners."""
@@ -358,7 +227,7 @@ class Ros2Node:
                 next_diagnostics = now + DIAGNOSTICS_PERIOD_S
                 self.diagnostics_loop.run(partial(self._publish_diagnostics, wall), stopping)
 
-    def _publish_state(self, states: _Publisher, tf: _Publisher, now: float, wall: float) -> None:
+    def _publish_state(self, states: Publisher, tf: Publisher, now: float, wall: float) -> None:
         states.put(
             types.serialize(messages.joint_state(self.robot, self.joints, wall), types.JOINT_STATE)
         )
@@ -416,15 +285,5 @@ class Ros2Node:
         """Stop publishing and following, then undeclare everything (tokens first)."""
         self._worker.close()
         self._camera_worker.close()
-        self.commands.close()
-        if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
-            self._pool = None
-        tokens = [d for d in self._declared if type(d).__name__ == "LivelinessToken"]
-        others = [d for d in self._declared if d not in tokens]
-        for declared in [*reversed(tokens), *reversed(others)]:
-            try:
-                declared.undeclare()
-            except Exception as exc:  # a session already closed
-                logger.debug("undeclaring on Zenoh: %s", exc)
-        self._declared = []
+        self.commands.stop()
+        self.entities.close()

@@ -1,9 +1,9 @@
 """``Refusal`` and ``Refusals``: a ROS 2 command the node turned down, as one typed event.
 
 Every refusal of the node (a message on ``joint_command`` or ``joint_trajectory`` that names a
-compliant motor or goes beyond a limit, a service that said no) goes through ``Refusals.report``:
-it is counted, logged on the robot's stderr (a topic's: one line a second at most, whatever the
-rate; a service's: each, as each was asked) and
+compliant or unknown motor or holds a value that is not a finite number, a service that said
+no) goes through ``Refusals.report``: it is counted, logged on the robot's stderr (a topic's:
+one line a second at most, whatever the rate; a service's: each, as each was asked) and
 handed to every listener (``listen``), which may publish it where a ROS 2 user looks (/rosout).
 """
 
@@ -29,12 +29,15 @@ class Refusal:
         reason: the one-line reason (what was wrong and what to do).
         kind: ``topic`` (a message dropped) or ``service`` (a request answered ``success: false``).
         stamp: when (``time.time()``).
+        error: the refusal's kind as every surface names it (``server.errors.refusal_kind``):
+            ``invalid``, ``not_found``, ``conflict``...
     """
 
     where: str
     reason: str
     kind: str = "topic"
     stamp: float = field(default_factory=time.time)
+    error: str = "invalid"
 
 
 class Refusals:

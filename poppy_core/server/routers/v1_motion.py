@@ -1,5 +1,7 @@
 """v1: gotos, primitives and moves."""
 
+from functools import partial
+
 from fastapi import APIRouter, Query  # noqa: TID253 (the server room is FastAPI's)
 from starlette.concurrency import run_in_threadpool
 
@@ -17,6 +19,7 @@ from poppy_core.server.schemas import (
     PrimitiveInfo,
     Problem,
     RecordRequest,
+    StartRequest,
     ValueBody,
 )
 
@@ -65,15 +68,17 @@ async def primitive(primitive: str, service: Service) -> PrimitiveInfo:
     return _primitive(service, primitive)
 
 
-def _control(service: Service, name: str, action: str) -> PrimitiveInfo:
-    service.control_primitive(name, action)
+def _control(
+    service: Service, name: str, action: str, start_at: float | None = None
+) -> PrimitiveInfo:
+    service.control_primitive(name, action, start_at=start_at)
     return _primitive(service, name)
 
 
 @router.post("/primitives/{primitive}/start", tags=["primitives"], summary="Start (or restart)")
-def start(primitive: str, service: Service) -> PrimitiveInfo:
-    """Starts the primitive's thread."""
-    return _control(service, primitive, "start")
+def start(primitive: str, service: Service, body: StartRequest | None = None) -> PrimitiveInfo:
+    """Starts the primitive's thread (with a ``start_at``: armed now, started then)."""
+    return _control(service, primitive, "start", body.start_at if body is not None else None)
 
 
 @router.post("/primitives/{primitive}/stop", tags=["primitives"], summary="Stop")
@@ -176,8 +181,13 @@ def save(move: str, service: Service) -> MoveInfo:
 async def play(move: str, body: PlayRequest, service: Service) -> MovesStatus:
     """Starts playing; a move already playing is refused (409): stop it first."""
     await run_in_threadpool(
-        service.moves.play, move, body.speed, body.backwards, body.ramp_s, True
-    )  # True: refuse_playing
+        partial(service.moves.play, start_at=body.start_at),
+        move,
+        body.speed,
+        body.backwards,
+        body.ramp_s,
+        True,  # refuse_playing
+    )
     return await moves_status(service)
 
 

@@ -1,7 +1,8 @@
 """``AsgiCaller``: run one HTTP request through the REST app in-process, on a loop of its own.
 
-The Zenoh queryable ``poppy/NAME/api`` answers v1 requests with the REST app itself, so a
-request over Zenoh meets the same token, checks and error wording as one over HTTP. A route that
+The Zenoh queryable ``poppy/NAME/api`` answers v1 requests with the REST app itself, through
+httpx's ``ASGITransport``, so a request over Zenoh meets the same routes, service operations,
+token, checks and error mapping (``server/errors.py``) as one over HTTP. A route that
 raises is answered 500 with its one line (never silence); closing cancels the requests still
 under way and lets each of them answer before the loop ends.
 """
@@ -14,11 +15,10 @@ import logging
 import threading
 from collections.abc import Awaitable
 from typing import Any
-from urllib.parse import unquote
 
 logger = logging.getLogger(__name__)
 
-HOST = b"127.0.0.1"
+HOST = "127.0.0.1"
 """The Host header of a request over Zenoh: a loopback name, which the Host check answers."""
 
 
@@ -59,61 +59,39 @@ class AsgiCaller:
         """The status and decoded JSON answer of ``method path`` (``body`` sent as JSON);
         ``client`` is who the app sees asking (its logs name it). A route that raises gives
         500 and the failure's line (the app's own 500 when it sent one first)."""
-        path, _, query = path.partition("?")
-        payload = b"" if body is None else json.dumps(body).encode()
-        headers = [(b"host", HOST), (b"accept", b"application/json")]
-        if payload:
-            headers.append((b"content-type", b"application/json"))
-            headers.append((b"content-length", str(len(payload)).encode()))
+        import httpx
+
+        headers = {"host": HOST, "accept": "application/json"}
         if token:
-            headers.append((b"authorization", b"Bearer " + token.encode()))
-        scope: dict[str, Any] = {
-            "type": "http",
-            "asgi": {"version": "3.0"},
-            "http_version": "1.1",
-            "method": method.upper(),
-            "scheme": "http",
-            "path": unquote(path),
-            "raw_path": path.encode(),
-            "query_string": query.encode(),
-            "root_path": "",
-            "headers": headers,
-            "client": (client, 0),
-            "server": ("127.0.0.1", 0),
-        }
-        sent = False
-        status = 500
-        started = False
-        chunks: list[bytes] = []
+            headers["authorization"] = f"Bearer {token}"
+        request = httpx.Request(
+            method.upper(),
+            f"http://{HOST}{path}",
+            headers=headers,
+            content=None if body is None else json.dumps(body).encode(),
+        )
+        if body is not None:
+            request.headers["content-type"] = "application/json"
+        failure: list[Exception] = []
 
-        async def receive() -> dict[str, Any]:
-            nonlocal sent
-            if not sent:
-                sent = True
-                return {"type": "http.request", "body": payload, "more_body": False}
-            await asyncio.Event().wait()  # never: the app read the whole body
-            return {"type": "http.disconnect"}
+        async def app(scope: Any, receive: Any, send: Any) -> None:
+            try:
+                await self.app(scope, receive, send)
+            except Exception as exc:  # the app's error middleware answers first, then re-raises
+                logger.warning("zenoh: %s %s failed: %s", method, path, exc, exc_info=exc)
+                failure.append(exc)
+                raise
 
-        async def send(message: dict[str, Any]) -> None:
-            nonlocal status
-            nonlocal started
-            if message["type"] == "http.response.start":
-                started = True
-                status = int(message["status"])
-            elif message["type"] == "http.response.body":
-                chunks.append(message.get("body", b""))
-
+        transport = httpx.ASGITransport(app, raise_app_exceptions=False, client=(client, 0))
+        response = await transport.handle_async_request(request)
+        data = await response.aread()
+        if failure and not data:
+            exc = failure[0]
+            return 500, {"detail": f"the route failed: {type(exc).__name__}: {exc}"}
         try:
-            await self.app(scope, receive, send)
-        except Exception as exc:  # the app's error middleware answers first, then re-raises
-            logger.warning("zenoh: %s %s failed: %s", method, path, exc, exc_info=exc)
-            if not started:
-                return 500, {"detail": f"the route failed: {type(exc).__name__}: {exc}"}
-        data = b"".join(chunks)
-        try:
-            return status, json.loads(data) if data else None
+            return response.status_code, json.loads(data) if data else None
         except ValueError:
-            return status, data[:200].decode("utf-8", errors="replace")
+            return response.status_code, data[:200].decode("utf-8", errors="replace")
 
     def close(self, timeout_s: float = 2.0) -> None:
         """Cancel the requests under way (each answers as it is cancelled: a request held for

@@ -15,13 +15,12 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from poppy_core import checks, zenoh_auth
+from poppy_core import zenoh_auth
 from poppy_core.errors import ArgumentError
 from poppy_core.server.middleware import MAX_BODY_BYTES
+from poppy_core.server.start_time import check_start_at
 from poppy_core.zenoh_auth import Refused
 
-MAX_START_DELAY_S = 60.0
-"""How far in the future a ``start_at`` may be (a clock that far off is refused, not waited)."""
 MAX_ARMED = 32
 """Requests a robot holds for their start time at once (armed starts and timed requests)."""
 METHODS = ("GET", "PUT", "POST", "DELETE")
@@ -72,7 +71,7 @@ class Intake:
         if method not in METHODS or not isinstance(path, str) or not path.startswith("/"):
             raise Refused(400, f"bad method or path: {API_SHAPE}")
         try:
-            start_at = _start_at(message.get("start_at"))
+            start_at = check_start_at(message.get("start_at"))
         except ArgumentError as exc:
             raise Refused(422, str(exc)) from None
         sender = message.get("from")
@@ -152,17 +151,3 @@ class Intake:
         now = time.time()
         with self._lock:
             return sum(1 for t in self._held if t > now)
-
-
-def _start_at(value: Any) -> float | None:
-    """The wall-clock start of a command, checked as its delay from now (a clock a minute or
-    more ahead of the robot's is refused rather than waited for)."""
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        checks.number(value, "start_at")  # raises, naming the field
-    now = time.time()
-    delay = checks.in_range(
-        float(value) - now, -MAX_START_DELAY_S, MAX_START_DELAY_S, "start_at (from now)", "s"
-    )
-    return now + delay

@@ -3,8 +3,9 @@
 It declares the liveliness token ``poppy/NAME`` (seen leaving when the robot goes), publishes
 the state every sync cycle (``zenoh_wire.pack_state``) and the health every second, answers
 ``poppy/NAME/description`` and ``poppy/NAME/api`` (v1 REST requests run through the REST app
-in-process: the same token, checks and refusal wording as HTTP, optionally at a shared
-wall-clock ``start_at``) and takes goal positions as a stream on ``poppy/NAME/goals``. Every
+in-process by httpx's ASGITransport: the same service operations, token, checks and refusal
+wording as HTTP, optionally at a shared wall-clock ``start_at``, which a start gets as its
+route's explicit ``start_at``) and takes goal positions as a stream on ``poppy/NAME/goals``. Every
 publication drops rather than waits (Zenoh's ``CongestionControl.DROP``): a subscriber that
 cannot keep up never slows the robot.
 """
@@ -18,6 +19,7 @@ import re
 import socket
 import threading
 import time
+from dataclasses import replace
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
@@ -25,8 +27,7 @@ from poppy_core import checks, zenoh_wire
 from poppy_core.errors import PoppyError
 from poppy_core.motion.chains import robot_chains
 from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
-from poppy_core.server.errors import ApiError
-from poppy_core.server.start_time import START_AT
+from poppy_core.server.errors import ApiError, refusal_kind
 from poppy_core.server.zenoh import described
 from poppy_core.server.zenoh.asgi_call import AsgiCaller
 from poppy_core.server.zenoh.intake import ApiRequest, Intake
@@ -43,8 +44,9 @@ DEFAULT_STATE_RATE_HZ = 50.0
 """The sync loop's default rate: one state message per cycle."""
 HEALTH_PERIOD_S = 1.0
 STARTS = re.compile(r"/api/v1/(primitives/[^/?]+/start|moves/[^/?]+/play)")
-"""The requests whose action waits for ``start_at`` in its own thread (``start_time``); any
-other request with a ``start_at`` is sent to the app at that time."""
+"""The requests whose action is armed for ``start_at`` (the route's own ``start_at`` argument,
+put in the body: ``start_time``); any other request with a ``start_at`` is sent to the app at
+that time."""
 
 
 class ZenohRobotServer:
@@ -79,6 +81,9 @@ class ZenohRobotServer:
         self.state_rate_hz = checks.rate(state_rate_hz, "state_rate_hz")
         self.endpoints = endpoints
         self.refused_goals = 0
+        self.last_refusal: tuple[str, str] | None = None
+        """The last goals refused: the refusal's kind (``errors.refusal_kind``; ``refused`` for
+        one of the arrival checks) and its line."""
         self.published = 0
         self.rate = RateMeter()
         self._app = app
@@ -323,11 +328,11 @@ class ZenohRobotServer:
             return _refusal(exc.status, exc.detail)
         if STARTS.fullmatch(request.path):
             # armed now (checked, its thread made, held at a gate); the gate opens at start_at
-            context = START_AT.set(request.start_at)
-            try:
-                reply = await self._call(caller, request)
-            finally:
-                START_AT.reset(context)
+            if request.body is not None and not isinstance(request.body, dict):
+                self.intake.release(place)
+                return _refusal(422, "the body of a start is an object (or nothing)")
+            body = {**(request.body or {}), "start_at": request.start_at}
+            reply = await self._call(caller, replace(request, body=body))
             if reply["status"] >= 400:
                 self.intake.release(place)
                 return reply
@@ -353,10 +358,12 @@ class ZenohRobotServer:
             self.apply_goals(sample.payload.to_bytes())
         except (Refused, ApiError, PoppyError, ValueError, TypeError, RecursionError) as exc:
             self.refused_goals += 1
+            kind = "refused" if isinstance(exc, Refused) else refusal_kind(exc)
             now = time.monotonic()
             if now - self._last_refusal > 1.0:  # one line a second, whatever the rate
                 self._last_refusal = now
-                logger.warning("%s: goals refused: %s", self.name, exc)
+                logger.warning("%s: goals refused (%s): %s", self.name, kind, exc)
+            self.last_refusal = (kind, str(exc))
 
     def apply_goals(self, payload: bytes) -> dict[str, float]:
         """Check every goal of a ``goals`` message, then set them all (or none).
@@ -367,11 +374,9 @@ class ZenohRobotServer:
             ApiError: a bad goal (nothing moved).
             UnknownMotorError: an unknown motor (nothing moved).
         """
-        targets = self.service.targets(self.intake.goals(payload))
+        goals = self.intake.goals(payload)
         with self._lock:
-            for name, goal in targets.items():
-                self.service.motor(name).goal_position = goal
-        return targets
+            return self.service.set_goals(goals)
 
 
 def _refusal(status: int, detail: str) -> dict[str, Any]:
