@@ -1,17 +1,22 @@
 """One argument/error contract: the same bad arguments (NaN, inf, negative, zero, huge, unknown
-names) through the Python API, the CLI, REST (v1 and pypot's routes), the WebSocket, Snap! and
-ZMQ give the same KIND of refusal, or the same clamp (docs/rest.md, "Arguments and errors").
+names) through the Python API, the CLI, REST (v1 and pypot's routes), the WebSocket, Snap!,
+ZMQ, Zenoh (its ``api`` queryable and its goal stream) and ROS 2 (``joint_command`` and
+``joint_trajectory``) give the same KIND of refusal, or the same clamp (docs/rest.md,
+"Arguments and errors"; docs/internals.md, "The limit rule").
 
 Kinds: ``invalid`` (an ``ArgumentError``: 422 on v1, 400 on pypot's routes and Snap!),
 ``not_found`` (an ``UnknownNameError``: 404), ``accepted`` (the call went through). A goal
 beyond the angle limits is ``accepted`` and clamped: the motor aims at the limit. The servers
-and the robot are the ones of tests/server/test_hostile_numbers.py (its ``surfaces`` fixture).
+and the robot are the ones of tests/server/test_hostile_numbers.py (its ``surfaces`` fixture);
+the same robot is also served on Zenoh and as a ROS 2 node (``network``, loopback only).
 """
 
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+import math
+import queue
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,6 +27,7 @@ from poppy_core.errors import ArgumentError, PoppyError, UnknownNameError
 from poppy_core.motion import attached_primitive, load_move
 from tests.helpers.cli import run_poppy
 from tests.helpers.waiting import eventually
+from tests.helpers.zenoh_served import free_endpoint
 from tests.server.conftest import moves_folder  # noqa: F401  (the fixture `surfaces` needs)
 from tests.server.test_hostile_numbers import Surfaces, surfaces  # noqa: F401
 
@@ -37,6 +43,20 @@ PYPOT_KINDS = {400: "invalid", 404: "not_found"}
 
 
 @dataclass(frozen=True)
+class V1:
+    """A v1 request: sent over HTTP, and the same over Zenoh's ``api`` queryable."""
+
+    method: str
+    path: str
+    body: str | None = None
+
+    def __call__(self, s: Surfaces) -> Outcome:
+        headers = {"Content-Type": "application/json"}
+        answer = s.http.request(self.method, self.path, content=self.body, headers=headers)
+        return _http_kind(answer.status_code, answer.text, V1_KINDS)
+
+
+@dataclass(frozen=True)
 class Case:
     """One bad (or clamped) argument and how each surface is asked it (None: not on it)."""
 
@@ -44,14 +64,68 @@ class Case:
     kind: str
     python: Send | None = None
     cli: Send | None = None
-    rest_v1: Send | None = None
+    rest_v1: V1 | None = None
     rest_pypot: Send | None = None
     ws: Send | None = None
     snap: Send | None = None
     zmq: Send | None = None
+    zenoh_goals: Send | None = None
+    ros2: Send | None = None
+
+    @property
+    def zenoh_api(self) -> Send | None:
+        """The v1 request, through the Zenoh ``api`` queryable."""
+        return None if self.rest_v1 is None else zenoh_api(self.rest_v1)
 
 
-SURFACES = ("python", "cli", "rest_v1", "rest_pypot", "ws", "snap", "zmq")
+SURFACES = (
+    "python",
+    "cli",
+    "rest_v1",
+    "rest_pypot",
+    "ws",
+    "snap",
+    "zmq",
+    "zenoh_api",
+    "zenoh_goals",
+    "ros2",
+)
+NETWORK = ("zenoh_api", "zenoh_goals", "ros2")
+"""The surfaces of the ``network`` fixture (Zenoh and ROS 2 on loopback)."""
+
+
+@dataclass
+class Network:
+    """The robot of ``surfaces`` served on Zenoh as ``poppy/jr1`` and as the ROS 2 node
+    ``/jr1``, and a client session on loopback."""
+
+    servers: Any
+    session: Any
+    ros2: Any
+    """A ROS 2 client (tests/ros2/rmw_client.Client)."""
+
+
+@pytest.fixture(scope="module")
+def network(surfaces: Surfaces) -> Iterator[Network]:  # noqa: F811  (the fixture imported below)
+    pytest.importorskip("zenoh")
+    pytest.importorskip("rosbags")
+    from poppy_core.assembly import ServeSpec, serve
+    from poppy_core.ros2_wire import Ros2Settings
+    from poppy_core.zenoh_wire import ZenohSettings
+    from tests.ros2.rmw_client import Client
+    from tests.ros2.test_ros2_node import client_session
+
+    endpoint = free_endpoint()
+    spec = ServeSpec(zenoh=ZenohSettings(listen=(endpoint,)), ros2=Ros2Settings(), name="jr1")
+    servers = serve(surfaces.robot, spec)
+    session = client_session(endpoint)
+    client = Client(session, 0)
+    try:
+        yield Network(servers, session, client)
+    finally:
+        client.close()
+        session.close()
+        servers.stop()
 
 
 # -- how each surface is asked, and how its answer reads as a kind ----------------------------
@@ -95,13 +169,8 @@ def _http_kind(status: int, text: str, kinds: dict[int, str]) -> Outcome:
     return kinds.get(status, f"status {status}"), text
 
 
-def rest_v1(method: str, path: str, body: str | None = None) -> Send:
-    def send(s: Surfaces) -> Outcome:
-        headers = {"Content-Type": "application/json"}
-        answer = s.http.request(method, path, content=body, headers=headers)
-        return _http_kind(answer.status_code, answer.text, V1_KINDS)
-
-    return send
+def rest_v1(method: str, path: str, body: str | None = None) -> V1:
+    return V1(method, path, body)
 
 
 def rest_pypot(method: str, path: str, body: str | None = None) -> Send:
@@ -150,6 +219,120 @@ def zmq(method: str, **arguments: Any) -> Send:
     return send
 
 
+def zenoh_api(request: V1) -> Send:
+    """The v1 request as a query to ``poppy/jr1/api``; its answer's status read as on v1."""
+
+    def send(s: Surfaces, n: Network) -> Outcome:
+        from poppy_core import zenoh_wire
+        from poppy_core.remote.zenoh_client import answer_of
+
+        body = None if request.body is None else json.loads(request.body)
+        payload = zenoh_wire.api_request(request.method, request.path, body)
+        replies = list(n.session.get("poppy/jr1/api", payload=payload, timeout=20.0))
+        status, answer = answer_of("jr1", replies, 20.0, 0.0)
+        return _http_kind(status, json.dumps(answer), V1_KINDS)
+
+    return send  # type: ignore[return-value]
+
+
+def _heard(owner: Any, method: str, send: Callable[[], None]) -> tuple[str, BaseException | None]:
+    """Call ``send`` (a message with no answer), and hear what ``owner.method`` (the handler
+    the message reaches, spied on for this one call) did with it: returned, or raised."""
+    heard: queue.Queue[tuple[str, BaseException | None]] = queue.Queue()
+    real = getattr(owner, method)
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        try:
+            result = real(*args, **kwargs)
+        except Exception as exc:
+            heard.put(("raised", exc))
+            raise
+        heard.put(("accepted", None))
+        return result
+
+    setattr(owner, method, spy)
+    try:
+        for _ in range(3):  # a first message of a new publisher may find no route yet: again
+            send()
+            try:
+                return heard.get(timeout=5.0)
+            except queue.Empty:
+                continue
+        return "no answer", None
+    finally:
+        delattr(owner, method)  # the class's method again
+
+
+def zenoh_goals(motor: str, position: float) -> Send:
+    """A goals message on ``poppy/jr1/goals``; the refusal's kind as the server logs it."""
+
+    def send(s: Surfaces, n: Network) -> Outcome:
+        from poppy_core import zenoh_wire
+
+        server = n.servers.zenoh
+        payload = zenoh_wire.goals_message({motor: position})
+        what, _ = _heard(server, "apply_goals", lambda: n.session.put("poppy/jr1/goals", payload))
+        if what != "raised":
+            return what, ""
+        kind, said = server.last_refusal
+        return kind, said
+
+    return send  # type: ignore[return-value]
+
+
+def _radians(n: Network, motor: str, degrees: float) -> float:
+    ros2 = n.servers.ros2
+    return ros2.joints.to_joint(motor, degrees) if motor in ros2.joints.frames else degrees
+
+
+def ros2_command(motor: str, position: float) -> Send:
+    """A sensor_msgs/JointState on ``/joint_command``; the refusal's kind as the node reports
+    it (its ``Refusal`` event, on /rosout and /diagnostics)."""
+
+    def send(s: Surfaces, n: Network) -> Outcome:
+        import numpy as np
+
+        from tests.ros2.test_ros2_node import JOINT_STATE, _joint_command
+
+        message = _joint_command([motor], np.array([_radians(n, motor, position)]))
+        return _ros2_outcome(
+            n, "command", lambda: n.ros2.publish("/joint_command", JOINT_STATE, message)
+        )
+
+    return send  # type: ignore[return-value]
+
+
+def ros2_trajectory(motor: str, position: float, duration_s: float) -> Send:
+    """A trajectory_msgs/JointTrajectory of one point, ``duration_s`` after its start."""
+
+    def send(s: Surfaces, n: Network) -> Outcome:
+        from tests.ros2.test_ros2_node import TRAJECTORY, _trajectory
+
+        point = (duration_s, [_radians(n, motor, position)])
+        message = _trajectory([motor], [point])
+        return _ros2_outcome(
+            n, "follow", lambda: n.ros2.publish("/joint_trajectory", TRAJECTORY, message)
+        )
+
+    return send  # type: ignore[return-value]
+
+
+def _ros2_outcome(n: Network, method: str, publish: Callable[[], None]) -> Outcome:
+    node = n.servers.ros2
+    refusals: list[Any] = []
+    node.refusals.listen(refusals.append)
+    what, _ = _heard(node.commands, method, publish)
+    if what != "raised":
+        return what, ""
+    assert eventually(lambda: bool(refusals)), "a refusal is reported"
+    return refusals[-1].error, refusals[-1].reason
+
+
+def _ros2_duration(duration: float) -> bool:
+    """A duration a builtin_interfaces/Duration holds (whole nanoseconds; no NaN nor inf)."""
+    return math.isfinite(duration) and (duration == 0 or abs(duration) >= 1e-9)
+
+
 # -- the table ----------------------------------------------------------------------------------
 
 
@@ -167,6 +350,7 @@ def goto_case(name: str, kind: str, position: str, duration: str) -> Case:
         rest_pypot=rest_pypot("POST", "/motors/m1/goto.json", pypot),
         snap=snap(f"/motor/m1/goto/{position}/{duration}"),
         zmq=zmq("set_goto_position_for_motor", motor="m1", position=p, duration=d),
+        ros2=ros2_trajectory("m1", p, d) if _ros2_duration(d) else None,
     )
 
 
@@ -188,6 +372,8 @@ def goal_case(name: str, kind: str, position: str) -> Case:
         ws=ws(f'{{"m1": {{"goal_position": {_json(p)}}}}}'),
         snap=snap(f"/motor/m1/set/goal_position/{position}"),
         zmq=zmq("set_register_value", motor="m1", register="goal_position", value=p),
+        zenoh_goals=zenoh_goals("m1", p),
+        ros2=ros2_command("m1", p),
     )
 
 
@@ -222,6 +408,13 @@ CASES = [
         ws=ws('{"m9": {"goal_position": 10}}'),
         snap=snap("/motor/m9/goto/10/1"),
         zmq=zmq("set_goto_position_for_motor", motor="m9", position=10, duration=1),
+        zenoh_goals=zenoh_goals("m9", 10.0),
+        ros2=ros2_trajectory("m9", 10.0, 1.0),
+    ),
+    Case(
+        "goal-unknown-motor",
+        "not_found",
+        ros2=ros2_command("m9", 10.0),
     ),
     Case(
         "goto-unknown-control",
@@ -289,14 +482,19 @@ def _reset_goal(robot: Any) -> None:
 @pytest.mark.parametrize(("case", "surface"), PAIRS)
 def test_every_surface_gives_the_same_kind(
     surfaces: Surfaces,  # noqa: F811  (the fixture imported above)
+    request: pytest.FixtureRequest,
     case: Case,
     surface: str,
 ) -> None:
     """The same argument: the same kind of refusal (or the same clamp) on every surface."""
     robot = surfaces.robot
     _reset_goal(robot)
-    send: Send = getattr(case, surface)
-    kind, said = send(surfaces)
+    send: Any = getattr(case, surface)
+    if surface in NETWORK:
+        network: Network = request.getfixturevalue("network")
+        kind, said = send(surfaces, network)
+    else:
+        kind, said = send(surfaces)
     if case.kind != "clamped":
         assert kind == case.kind, f"{case.name} on {surface}: {kind}: {said}"
         return
@@ -307,5 +505,5 @@ def test_every_surface_gives_the_same_kind(
         return
     # the same clamp: the motor aims at its limit (one register step from it)
     assert eventually(lambda: abs(robot.m1.goal_position - limit) < 0.5), robot.m1.goal_position
-    if surface == "rest_v1" and case.name.startswith("goto"):
+    if surface in ("rest_v1", "zenoh_api") and case.name.startswith("goto"):
         assert json.loads(said)["positions"] == {"m1": limit}  # the answer says the clamp
