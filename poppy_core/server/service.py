@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import logging
-import math
 import time
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -17,7 +16,7 @@ from poppy_core.motion import Primitive, attach_builtins, attached_primitive, at
 from poppy_core.motion.play_plan import write_rate_hz
 from poppy_core.motion.waypoints import WaypointFollower, Waypoints
 from poppy_core.robot import GotoHandle, Motor, Robot
-from poppy_core.server import values
+from poppy_core.server import primitive_calls, values
 from poppy_core.server.compliant_goals import GOAL_REGISTERS, CompliantGoals, goal_motors
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
@@ -29,8 +28,6 @@ from poppy_core.trajectory import control_name, goto_duration
 DESCRIPTION_TTL_S = 0.01
 
 logger = logging.getLogger(__name__)
-
-PRIMITIVE_TIP = "the primitives are listed by /primitives/list.json"
 
 
 class RobotService:
@@ -364,21 +361,11 @@ class RobotService:
 
     def get_property(self, name: str, prop: str) -> Any:
         """A primitive's property as JSON."""
-        primitive = self.primitive(name)
-        self._known(primitive, name, prop, primitive.properties, "property")
-        return values.jsonable(primitive.get_property(prop))
+        return primitive_calls.get_property(self.primitive(name), name, prop)
 
     def set_property(self, name: str, prop: str, value: Any) -> Any:
         """Set a primitive's property (converted and checked by the primitive)."""
-        primitive = self.primitive(name)
-        self._known(primitive, name, prop, primitive.properties, "property")
-        if isinstance(value, float) and not math.isfinite(value):
-            raise ApiError("invalid", f"{name}.{prop}: expected a finite number")
-        try:
-            primitive.set_property(prop, value)  # ArgumentError -> 4xx "invalid"
-        except (OverflowError, RecursionError):
-            raise ApiError("invalid", f"{name}.{prop}: the value is out of range") from None
-        return values.jsonable(primitive.get_property(prop))
+        return primitive_calls.set_property(self.primitive(name), name, prop, value)
 
     def method_names(self, name: str) -> list[str]:
         """The methods a primitive exposes."""
@@ -392,31 +379,11 @@ class RobotService:
         kwargs: Mapping[str, Any] | None = None,
     ) -> Any:
         """Call a declared method of a primitive; returns its result as JSON."""
-        primitive = self.primitive(name)
-        self._known(primitive, name, method, primitive.methods, "method")
-        try:
-            result = getattr(primitive, method)(*args, **(kwargs or {}))
-        except (TypeError, ValueError, ArithmeticError) as exc:
-            raise ApiError("invalid", f"{name}.{method}: {exc}") from None
-        return values.jsonable(result)
-
-    @staticmethod
-    def _known(primitive: Primitive, name: str, item: str, known: Any, kind: str) -> None:
-        if item not in known:
-            listed = ", ".join(known) or "none"
-            plural = "properties" if kind == "property" else f"{kind}s"
-            message = f"{name} has no {kind} {item!r} ({plural}: {listed})"
-            raise ApiError("not_found", message, tip=PRIMITIVE_TIP)
+        return primitive_calls.call_method(self.primitive(name), name, method, args, kwargs)
 
     def describe_primitive(self, name: str) -> dict[str, Any]:
         """State, properties, methods and error of a primitive (JSON)."""
-        primitive = self.primitive(name)
-        described = values.jsonable(primitive.describe())
-        assert isinstance(described, dict)
-        if described.get("error"):
-            # the traceback (server paths) stays in the server's log, where the primitive put it
-            described["error"] = {k: v for k, v in described["error"].items() if k != "traceback"}
-        return {"name": name, **described}
+        return primitive_calls.describe(self.primitive(name), name)
 
     # -- lifetime ----------------------------------------------------------------------------
 
