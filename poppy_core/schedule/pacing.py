@@ -11,7 +11,7 @@ from collections import deque
 from collections.abc import Callable
 
 from poppy_core import checks
-from poppy_core.errors import ArgumentError
+from poppy_core.errors import ArgumentError, PoppyError
 
 logger = logging.getLogger(__name__)
 
@@ -160,8 +160,12 @@ class TickGuard:
         self.last_error = f"{type(exc).__name__}: {exc}"
         if not self._failing:
             self._failing = True
+            # a typed error says what went wrong in its line; anything else is a bug: traceback
             logger.warning(
-                "%s: a tick failed, retrying with backoff: %s", self.name, exc, exc_info=exc
+                "%s: a tick failed, retrying with backoff: %s",
+                self.name,
+                exc,
+                exc_info=None if isinstance(exc, PoppyError) else exc,
             )
         stopping.wait(self.backoff.delay_s)
         self.backoff.failed()
@@ -195,9 +199,13 @@ class Ticker:
         catch_up: overrun deadlines still run at once (``Periodic``'s ``catch_up``).
         first_s, max_s: the backoff after a failing tick, doubling from one to the other.
         clock: monotonic clock in seconds.
-        due: for a tick that paces several schedules of its own (the sync loops): when the
-            next tick is due, asked before each wait; the ticker's own deadlines then only
-            count ``missed``.
+        due: for a tick that paces itself at times (several schedules in one thread, a
+            reconnection's backoff): asked before each wait, the time the next tick is due,
+            or None for the ticker's own deadline.
+        retry: the exceptions retried with backoff; any other one ends the loop (raised to
+            the worker: logged once, kept in its ``error``).
+        on_failure: called with each retried exception, before the backoff (an owner's own
+            health counts it; a follower told to hold).
     """
 
     def __init__(
@@ -210,22 +218,27 @@ class Ticker:
         first_s: float = 0.05,
         max_s: float = 1.0,
         clock: Callable[[], float] = time.monotonic,
-        due: Callable[[], float] | None = None,
+        due: Callable[[], float | None] | None = None,
+        retry: tuple[type[Exception], ...] = (Exception,),
+        on_failure: Callable[[Exception], None] | None = None,
     ) -> None:
         self.name = name
         self.period_s = checks.period(1.0 / checks.rate(rate_hz))
         self.catch_up = catch_up
         self.guard = TickGuard(name, first_s, max_s)
         self.meter = RateMeter()
-        self.schedule = Periodic(self.period_s, clock(), catch_up)
+        self.schedule: Periodic | None = None
+        """The deadlines of the current (or last) run."""
         self._tick = tick
         self._clock = clock
         self._due = due
+        self._retry = retry
+        self._on_failure = on_failure
 
     @property
     def missed(self) -> int:
         """Periods skipped because a tick came too late (since the last start)."""
-        return self.schedule.missed
+        return 0 if self.schedule is None else self.schedule.missed
 
     def health(self) -> dict[str, object]:
         """The guard's ``ok``, ``failures``, ``last_error``, and the measured ``rate_hz``."""
@@ -235,9 +248,11 @@ class Ticker:
         """Tick until the tick returns False or ``stopping`` is set; the first deadline is
         ``start_s`` (default: now)."""
         first = self._clock() if start_s is None else start_s
-        self.schedule = Periodic(self.period_s, first, self.catch_up)
+        schedule = self.schedule = Periodic(self.period_s, first, self.catch_up)
         while not stopping.is_set():
-            deadline = self.schedule.next_deadline if self._due is None else self._due()
+            deadline = None if self._due is None else self._due()
+            if deadline is None:
+                deadline = schedule.next_deadline
             wait = deadline - self._clock()
             if wait > 0 and stopping.wait(wait):
                 return
@@ -245,11 +260,13 @@ class Ticker:
             self.meter.tick(now)
             try:
                 outcome = self._tick(now)
-            except Exception as exc:
+            except self._retry as exc:
+                if self._on_failure is not None:
+                    self._on_failure(exc)
                 self.guard.failed(exc, stopping)
                 outcome = None
             else:
                 self.guard.succeeded()
             if outcome is False:
                 return
-            self.schedule.advance(self._clock())
+            schedule.advance(self._clock())

@@ -58,7 +58,9 @@ class Worker:
         first_s: float = 0.05,
         max_s: float = 1.0,
         clock: Callable[[], float] = time.monotonic,
-        due: Callable[[], float] | None = None,
+        due: Callable[[], float | None] | None = None,
+        retry: tuple[type[Exception], ...] = (Exception,),
+        on_failure: Callable[[Exception], None] | None = None,
         start_s: Callable[[], float] | None = None,
         on_exit: Callable[[], None] | None = None,
         quiet: tuple[type[BaseException], ...] = (),
@@ -81,6 +83,8 @@ class Worker:
             max_s=max_s,
             clock=clock,
             due=due,
+            retry=retry,
+            on_failure=on_failure,
         )
 
         def body(stopping: threading.Event) -> None:
