@@ -31,7 +31,7 @@ class LoopPrimitive(Primitive):
         self.update_freq = freq
         self._meter = RateMeter(window=10)
         self._recent: deque[float] = deque(maxlen=10)
-        self._last: float | None = None
+        self._loop_last: float | None = None
 
     @property
     def update_freq(self) -> float:
@@ -78,17 +78,17 @@ class LoopPrimitive(Primitive):
         """
         self._meter = RateMeter(window=10)
         self._recent.clear()
-        self._last = None
-        ticker = Ticker(self.name, self.update_freq, self._tick, retry=())
+        self._loop_last = None
+        ticker = Ticker(self.name, self.update_freq, self._loop_tick, retry=())
         ticker.run(self._stop_event, self.shared_start)
 
-    def _tick(self, now: float) -> None:
+    def _loop_tick(self, now: float) -> None:
         if self.should_pause():
             self.wait_to_resume()
-            self._last = None
+            self._loop_last = None
             return
         self.update()
         self._meter.tick(now)
-        if self._last is not None and now > self._last:
-            self._recent.append(1.0 / (now - self._last))
-        self._last = now
+        if self._loop_last is not None and now > self._loop_last:
+            self._recent.append(1.0 / (now - self._loop_last))
+        self._loop_last = now

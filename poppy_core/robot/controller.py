@@ -110,11 +110,12 @@ class AbstractController:
         finally:
             self._set_up.set()
         try:
-            Ticker(self._worker.name, self.sync_freq, self._tick, catch_up=1).run(stopping)
+            tick = self._controller_tick
+            Ticker(self._worker.name, self.sync_freq, tick, catch_up=1).run(stopping)
         finally:
             self.teardown()
 
-    def _tick(self, now: float) -> None:
+    def _controller_tick(self, now: float) -> None:
         self.update()
         self._updated.set()
 

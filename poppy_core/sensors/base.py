@@ -125,10 +125,10 @@ class Sensor:
         self._ticker = Ticker(
             f"sensor {name}",
             self._rate_hz,
-            self._tick,
+            self._loop_tick,
             catch_up=1,
             clock=clock,
-            due=self._due,
+            due=self._loop_due,
             on_failure=self._update_failed,
         )
         self._last_good: float | None = None
@@ -318,11 +318,11 @@ class Sensor:
     def _loop(self) -> None:
         self._ticker.run(self._stop)
 
-    def _due(self) -> float | None:
+    def _loop_due(self) -> float | None:
         """While the device is away: the next reopening; else the ticker's own deadline."""
         return None if self._connected else self._next_retry
 
-    def _tick(self, now: float) -> bool | None:
+    def _loop_tick(self, now: float) -> bool | None:
         if not self._connected:
             self._reopen(now)
             return not (self._connected and self._park())
