@@ -28,13 +28,14 @@ from poppy_core.errors import ConfigError, FileError, PoppyError
 from poppy_core.motion.teleop.follower import Follower, LocalFollower
 from poppy_core.motion.teleop.goal_stream import GoalStreamChange
 from poppy_core.motion.teleop.joint_map import JointMap
+from poppy_core.motion.teleop.leader import Leader, LeaderMotor
 from poppy_core.motion.teleop.recording import TrajectoryRecorder
 from poppy_core.motion.teleop.stats import TeleopReport, TeleopStatus
 from poppy_core.robot.robot import Robot
 from poppy_core.schedule import Ticker, Worker
 
 if TYPE_CHECKING:
-    from poppy_core.robot import Motor
+    pass
 
 logger = logging.getLogger(__name__)
 
@@ -87,7 +88,7 @@ class Teleoperation:
 
     def __init__(
         self,
-        leader: Robot,
+        leader: Leader,
         follower: Robot | Follower,
         joint_map: JointMap | None = None,
         *,
@@ -123,7 +124,7 @@ class Teleoperation:
                     value=both,
                 )
         self.leader = leader
-        self._leader_motors: list[Motor] = [leader.motor(n) for n in self.joint_map.leaders]
+        self._leader_motors: list[LeaderMotor] = [leader.motor(n) for n in self.joint_map.leaders]
         self.rate_hz = float(rate_hz)
         self.duration_s = duration_s
         self.recorder = (
@@ -365,7 +366,7 @@ class Teleoperation:
 
 
 def teleoperate(
-    leader: Robot,
+    leader: Leader,
     follower: Robot | Follower,
     joint_map: JointMap | str | None = None,
     *,
