@@ -8,7 +8,15 @@ import threading
 import pytest
 
 from poppy_core.errors import ArgumentError
-from poppy_core.schedule import Backoff, Periodic, RateMeter, TickGuard, Worker, close_all
+from poppy_core.schedule import (
+    Backoff,
+    Periodic,
+    RateMeter,
+    Ticker,
+    TickGuard,
+    Worker,
+    close_all,
+)
 from tests.helpers.waiting import eventually
 
 
@@ -186,3 +194,108 @@ def test_close_all_runs_every_step_and_logs_each_failure_once(
         "closing the thing: a failed: port gone",
         "closing the thing: c failed: RuntimeError",
     ]
+
+
+def test_worker_start_is_atomic(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Two threads starting one worker at once start one thread: the second finds it running."""
+    from poppy_core.schedule import worker as worker_module
+
+    class SlowThread(threading.Thread):
+        def start(self) -> None:  # widens the window between "not running" and "started"
+            stopping_wait.wait(0.05)
+            super().start()
+
+    stopping_wait = threading.Event()
+    runs: list[int] = []
+    worker = Worker("once", lambda stopping: (runs.append(1), stopping.wait(5.0)))
+    barrier = threading.Barrier(4)
+
+    def start() -> None:
+        barrier.wait()
+        worker.start()
+
+    starters = [threading.Thread(target=start) for _ in range(4)]  # plain threads
+    monkeypatch.setattr(worker_module.threading, "Thread", SlowThread)  # the worker's are slow
+    for starter in starters:
+        starter.start()
+    for starter in starters:
+        starter.join(5.0)
+    eventually(lambda: len(runs) >= 1)
+    threading.Event().wait(0.1)  # a second thread, if any, would have run its body by now
+    worker.stop()
+    assert runs == [1]
+
+
+def test_periodic_worker_ticks_until_the_tick_says_done() -> None:
+    ticks: list[float] = []
+
+    def tick(now: float) -> bool:
+        ticks.append(now)
+        return len(ticks) < 5
+
+    worker = Worker.periodic("five", 200.0, tick)
+    worker.start()
+    assert worker.wait(timeout_s=5.0)
+    assert len(ticks) == 5 and ticks == sorted(ticks) and worker.error is None
+    assert worker.ticker is not None and worker.ticker.meter.count == 5
+
+
+def test_periodic_worker_logs_a_failing_tick_once_backs_off_and_resumes(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    outcomes = ["fail"] * 4 + ["ok"] * 3
+    seen: list[str] = []
+
+    def tick(now: float) -> bool:
+        outcome = outcomes[len(seen)]
+        seen.append(outcome)
+        if outcome == "fail":
+            raise OSError("bus away")
+        return len(seen) < len(outcomes)
+
+    caplog.set_level(logging.WARNING, logger="poppy_core.schedule")
+    worker = Worker.periodic("flaky", 500.0, tick, first_s=0.001, max_s=0.004)
+    assert worker.ticker is not None
+    worker.start()
+    assert worker.wait(timeout_s=5.0)
+    assert seen == outcomes and worker.error is None  # the loop lived through the failures
+    warned = [r for r in caplog.records if "a tick failed" in r.getMessage()]
+    assert len(warned) == 1 and "flaky" in warned[0].getMessage()
+    assert worker.ticker.health()["ok"] is True
+    assert worker.ticker.health()["failures"] == 4
+
+
+def test_periodic_worker_shows_a_failing_loop_in_its_health() -> None:
+    worker = Worker.periodic("broken", 100.0, lambda now: 1 / 0, first_s=0.001, max_s=0.002)
+    assert worker.ticker is not None
+    worker.start()
+    try:
+        eventually(lambda: worker.ticker is not None and worker.ticker.guard.failures >= 3)
+        health = worker.ticker.health()
+        assert health["ok"] is False and "ZeroDivisionError" in str(health["last_error"])
+        assert worker.running  # still retrying
+    finally:
+        worker.stop()
+
+
+def test_a_ticker_that_overran_does_not_burst() -> None:
+    """A tick that takes several periods is followed by one tick on the grid, not a burst of the
+    ticks it missed (fake clock: each tick advances it)."""
+    clock = [0.0]
+    ticks: list[float] = []
+
+    def tick(now: float) -> bool:
+        ticks.append(now)
+        clock[0] += 0.35 if len(ticks) == 2 else 0.001  # the second tick overruns 3.5 periods
+        return len(ticks) < 4
+
+    ticker = Ticker("slow", 10.0, tick, clock=lambda: clock[0])
+
+    class NoWait(threading.Event):
+        def wait(self, timeout: float | None = None) -> bool:
+            clock[0] += timeout or 0.0
+            return False
+
+    ticker.run(NoWait(), start_s=0.0)
+    assert [round(t, 3) for t in ticks] == [0.0, 0.1, 0.5, 0.6]
+    assert ticker.missed == 3

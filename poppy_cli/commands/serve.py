@@ -8,7 +8,7 @@ import signal
 import sys
 import threading
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 import typer
 
@@ -20,11 +20,20 @@ from poppy_cli.output import EXIT_FAILURE, EXIT_USAGE, err_console, error_line, 
 from poppy_cli.robots import build_robot
 
 if TYPE_CHECKING:
-    from poppy_core.assembly import ServerSet, ServeSpec
+    from poppy_core.assembly import Server, ServerSet
     from poppy_core.server.moves import SavedTake
     from poppy_core.zenoh_wire import ZenohSettings
 
-LOOPBACK = ("127.0.0.1", "localhost", "::1")
+FLAGS = {
+    "http": "--http-port",
+    "ws": "--ws-port",
+    "zmq": "--zmq-port",
+    "snap": "--snap-port",
+    "cors": "--cors",
+    "allow_hosts": "--allow-host",
+    "name": "--name",
+}
+"""The flag of each ``ServeSpec`` attribute, named before a refusal of the spec."""
 
 
 def serve(
@@ -171,8 +180,6 @@ def serve(
     if not (http or ws or snap or zmq or zenoh or ros2):
         _usage("nothing to serve: pass --http, --ws, --snap, --zmq, --zenoh and/or --ros2")
     http_port, *alias_ports = http_ports or [8080]
-    _check_http_ports(http_ports)
-    robot_name = _robot_name(name)
     zenoh_settings = _zenoh_settings(
         zenoh or ros2, zenoh_listen, zenoh_connect, zenoh_config, zenoh_scout
     )
@@ -184,44 +191,34 @@ def serve(
         )
     except (ValueError, ConfigError) as exc:
         _usage(str(exc))
-    if http and ws and ws_port in http_ports and ws_port != 0:
-        _usage(
-            f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
-            "server streams the same state at /api/v1/ws)"
-        )
-    snap_dir = check_snap_options(
-        snap,
-        snap_port,
-        snap_dir,
-        open_browser,
-        {
-            "--http-port": snap_port if http and snap_port in http_ports else 0,
-            "--ws-port": ws_port if ws else 0,
-        },
-    )
+    snap_dir = check_snap_options(snap, snap_dir, open_browser)
     from poppy_core.assembly import Listen, ServeSpec, serve
+    from poppy_core.errors import ArgumentError
 
-    spec = ServeSpec(
-        http=Listen(host, http_port) if http else None,
-        ws=Listen(host, ws_port) if ws else None,
-        zmq=Listen(host, zmq_port) if zmq else None,
-        snap=Listen(host, snap_port) if snap else None,
-        token=token or None,
-        cors=tuple(cors or ()),
-        allow_hosts=tuple(allow_host or ()),
-        ws_rate_hz=ws_rate,
-        snap_dir=snap_dir,
-        name=robot_name,
-        announce=announce,
-        http_alias_ports=tuple(alias_ports),
-        report=_report,
-        zenoh=zenoh_settings,
-        ros2=ros2_spec,
-        settings_file=settings,
-        token_file=token_file,
-    )
-    any_origin = _check_origins(spec)
-    _warn_exposure(spec, host, any_origin)
+    try:  # the spec checks ports, name, origins and Host names, and warns of what it exposes
+        spec = ServeSpec(
+            http=Listen(host, http_port) if http else None,
+            ws=Listen(host, ws_port) if ws else None,
+            zmq=Listen(host, zmq_port) if zmq else None,
+            snap=Listen(host, snap_port) if snap else None,
+            token=token or None,
+            cors=tuple(cors or ()),
+            allow_hosts=tuple(allow_host or ()),
+            ws_rate_hz=ws_rate,
+            snap_dir=snap_dir,
+            name=name,
+            announce=announce,
+            http_alias_ports=tuple(alias_ports),
+            report=_report,
+            zenoh=zenoh_settings,
+            ros2=ros2_spec,
+            settings_file=settings,
+            token_file=token_file,
+            warn=warn_line,
+        )
+    except ArgumentError as exc:
+        flag = FLAGS.get(exc.field or "")
+        _usage(f"{flag}: {exc}" if flag else str(exc))
     # SIGTERM is taken before anything serves: a client may stop the server as soon as its
     # address is printed (the default action, exit -15, when it came that early)
     stop = threading.Event()
@@ -252,28 +249,6 @@ def serve(
     print("stopped", file=sys.stderr, flush=True)
 
 
-def _robot_name(name: str | None) -> str | None:
-    """The robot's name as announced on mDNS and Zenoh (``checks.robot_name``), or a usage
-    error before anything is built."""
-    if name is None:
-        return None
-    from poppy_core.checks import robot_name
-    from poppy_core.errors import ArgumentError
-
-    try:
-        return robot_name(name, "--name")
-    except ArgumentError as exc:
-        _usage(str(exc))
-
-
-def _check_http_ports(ports: list[int]) -> None:
-    """Refuse a port given twice to ``--http-port`` (0, a free port each, may repeat)."""
-    given = [p for p in ports if p != 0]
-    twice = sorted({p for p in given if given.count(p) > 1})
-    if twice:
-        _usage(f"--http-port {twice[0]} is given twice: give each port once")
-
-
 def _zenoh_settings(
     zenoh: bool,
     listen: list[str] | None,
@@ -297,40 +272,6 @@ def _zenoh_settings(
         return ZenohSettings(tuple(listen or ()), tuple(connect or ()), config, scout)
     except ConfigError as exc:
         _usage(str(exc))
-
-
-def _check_origins(spec: ServeSpec) -> bool:
-    """Refuse a --cors or --allow-host that is not one, before the robot is built; True when
-    every origin is allowed."""
-    from poppy_core.server import OriginPolicy
-    from poppy_core.server.snap import snap_policy
-
-    try:
-        policy = OriginPolicy.for_server(spec.host, cors=spec.cors, allow_hosts=spec.allow_hosts)
-        if spec.snap is not None:
-            snap_policy(spec.host, cors=spec.cors, allow_hosts=spec.allow_hosts)
-    except ValueError as exc:
-        _usage(f"{exc} (--cors takes an origin or '*', --allow-host a host name)")
-    return policy.any_origin
-
-
-def _warn_exposure(spec: ServeSpec, host: str, any_origin: bool) -> None:
-    """Say what a server reachable from the network, or open to every page, lets others do."""
-    if spec.zmq is not None and host not in LOOPBACK:
-        warn_line(
-            f"serving the ZMQ API on {host}: it has no token, anyone who can reach this machine "
-            "can move the robot; keep --host 127.0.0.1 unless the network is yours"
-        )
-    if host not in LOOPBACK and not spec.token:
-        warn_line(
-            f"serving on {host} without --token: anyone who can reach this machine can move "
-            "the robot (and write its EEPROM); pass --token or keep --host 127.0.0.1"
-        )
-    if any_origin:
-        warn_line(
-            "--cors '*': every web page you open can move the robot; allow the origins you "
-            "use instead (e.g. --cors https://snap.berkeley.edu)"
-        )
 
 
 def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
@@ -396,7 +337,7 @@ def _host(host: str) -> str:
     return f"[{host}]" if ":" in host else host
 
 
-def _wait_for_signal(servers: list[Any], stop: threading.Event) -> None:
+def _wait_for_signal(servers: list[Server], stop: threading.Event) -> None:
     """Block until Ctrl-C, SIGTERM (``stop`` set), or a server thread ended on its own."""
     try:
         while not stop.wait(0.2):

@@ -5,7 +5,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
@@ -22,23 +21,15 @@ def _usage(message: str) -> NoReturn:
     raise typer.Exit(EXIT_USAGE)
 
 
-def check_snap_options(
-    snap: bool,
-    snap_port: int,
-    snap_dir: Path | None,
-    open_browser: bool,
-    other_ports: Mapping[str, int],
-) -> Path | None:
+def check_snap_options(snap: bool, snap_dir: Path | None, open_browser: bool) -> Path | None:
     """Refuse Snap! options that cannot work, before the robot is built; the Snap! copy to serve
-    at /app/ (``--snap-dir``, else the one ``poppy snap download`` installed, else None)."""
+    at /app/ (``--snap-dir``, else the one ``poppy snap download`` installed, else None). Its
+    port is checked with the others by ``ServeSpec``."""
     if not snap:
         for given, name in ((snap_dir is not None, "--snap-dir"), (open_browser, "--open")):
             if given:
                 _usage(f"{name} needs --snap (it concerns the Snap! server)")
         return None
-    for option, port in other_ports.items():
-        if port and port == snap_port:
-            _usage(f"--snap-port {snap_port} is also the {option}: choose another port")
     if snap_dir is not None and not (snap_dir / "snap.html").is_file():
         _usage(
             f"--snap-dir {snap_dir}: no snap.html there; give the folder of a downloaded Snap! "

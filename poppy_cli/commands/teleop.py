@@ -32,7 +32,9 @@ if TYPE_CHECKING:
     from rich.table import Table
 
     from poppy_core.motion.teleop.joint_map import JointMap
+    from poppy_core.motion.teleop.leader import Leader
     from poppy_core.motion.teleop.session import Teleoperation
+    from poppy_core.remote.zenoh_teleop import ZenohLeader
     from poppy_core.robot import Robot, RobotConfig
 
 REFRESH_S = 0.1
@@ -197,7 +199,7 @@ def teleop(
     with ExitStack() as stack:
         # Everything that can be refused is, before a robot is built (nothing turns compliant).
         follow: Any = None
-        lead: Any = None
+        zenoh_lead: ZenohLeader | None = None
         settings = _zenoh_settings(connect) if zenoh_leader or zenoh_follower else None
         if zenoh_follower:
             follow = _zenoh_follower(follower, settings)
@@ -210,13 +212,16 @@ def teleop(
         else:
             follower_motors = list((follower_config or leader_config).motors)  # type: ignore[union-attr]
         if leader_config is None:
-            lead = _zenoh_leader(str(leader), settings)
-            stack.callback(lead.close)
-            leader_motors = [m.name for m in lead.motors]
+            zenoh_lead = _zenoh_leader(str(leader), settings)
+            stack.callback(zenoh_lead.close)
+            leader_motors = [m.name for m in zenoh_lead.motors]
         else:
             leader_motors = list(leader_config.motors)
         _check_map(mapping, leader_motors, follower_motors, follower == SELF)
-        if lead is None:
+        lead: Leader
+        if zenoh_lead is not None:
+            lead = zenoh_lead
+        else:
             assert leader_config is not None
             lead = stack.enter_context(_build(leader_config, None))
         if follow is None:
@@ -300,7 +305,7 @@ def _zenoh_settings(connect: list[str] | None) -> Any:
     return client_settings(tuple(connect or ()))
 
 
-def _zenoh_leader(spec: str, settings: Any) -> Any:
+def _zenoh_leader(spec: str, settings: Any) -> ZenohLeader:
     from poppy_core.remote.zenoh_client import robot_name
     from poppy_core.remote.zenoh_teleop import ZenohLeader
 
@@ -317,7 +322,7 @@ def _zenoh_follower(spec: str, settings: Any) -> Any:
 
 
 def _start(
-    leader: Robot,
+    leader: Leader,
     follower: Any,
     mapping: JointMap | None,
     rate: float,

@@ -16,7 +16,7 @@ from poppy_core.assembly.pypot_creatures import (
     PoppyHumanoid,
     PoppyTorso,
 )
-from poppy_core.assembly.servers import Listen, ServerSet, ServeSpec, serve
+from poppy_core.assembly.servers import Listen, Server, ServerSet, ServeSpec, serve
 from poppy_core.zenoh_wire import ZenohSettings
 
 installed_poppy_creatures = MappingProxyType(
@@ -32,6 +32,7 @@ __all__ = [
     "PoppyHumanoid",
     "PoppyTorso",
     "ServeSpec",
+    "Server",
     "ServerSet",
     "ZenohSettings",
     "autodetect",

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from poppy_core.assembly.servers import Listen, ServerSet, ServeSpec
+    from poppy_core.assembly.servers import Listen, Server, ServerSet, ServeSpec
     from poppy_core.robot import Robot
     from poppy_core.ros2_wire import Ros2Settings
     from poppy_core.zenoh_wire import ZenohSettings
@@ -68,7 +68,8 @@ def name_and_announce(servers: ServerSet, robot: Robot, spec: ServeSpec) -> None
         return
     from poppy_core.server.announce import Announcer
 
-    ports = {p: s.port for p, s in servers.servers.items()}
+    # the TCP ports (Zenoh and ROS 2 have none: their session's endpoints are their addresses)
+    ports = {p: s.port for p, s in servers.servers.items() if s.port is not None}
     properties = {"creature": _creature(robot), "version": served.version}
     if spec.token:
         properties["token"] = "1"
@@ -91,13 +92,8 @@ def _creature(robot: Robot) -> str:
 
 def add_snap(servers: ServerSet, robot: Robot, spec: ServeSpec, where: Listen) -> None:
     from poppy_core.server.snap import create_snap_server
-    from poppy_core.server.snap.server import snap_policy
 
-    policy = snap_policy(
-        where.host, cors=spec.cors, allow_hosts=spec.allow_hosts, report=spec.report
-    )
-    if spec.name is not None:
-        policy.with_names([spec.name])  # Snap! projects call http://poppy.local:6969 too
+    policy = spec.snap_policy(where.host)
     snap = create_snap_server(
         robot,
         where.host,
@@ -193,6 +189,7 @@ def own_pages(servers: ServerSet) -> None:
             add_note(servers.app, "snap", SNAP_ONLINE_NOTE)
 
 
-def _ports(server: Any) -> list[int]:
+def _ports(server: Server) -> list[int]:
     """Every port a server listens on (the HTTP server's aliases too)."""
-    return list(getattr(server, "ports", [server.port]))
+    port = server.port
+    return list(getattr(server, "ports", [] if port is None else [port]))

@@ -17,8 +17,9 @@ import logging
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol, cast
 
+from poppy_core.assembly.serve_checks import check_origins, check_ports, exposure
 from poppy_core.assembly.server_builders import (
     add_http,
     add_ros2,
@@ -96,6 +97,13 @@ class ServeSpec:
             page's settings switch Snap! and ZMQ there.
         token_file: the file ``token`` was read from (``--token-file``): the page's settings
             change the token there.
+        warn: called with each exposure warning when the spec is made (a server on another
+            address than loopback without a token, ZMQ off loopback, ``cors`` ``"*"``);
+            default: a WARNING of this module's logger.
+
+    A spec checks itself when it is made (``serve_checks``): a port that clashes, a name, an
+    origin or a Host name that is not one is an ``ArgumentError`` (a ``ValueError``) whose
+    ``field`` names the attribute; then the exposure warnings are given to ``warn``.
     """
 
     http: Listen | None = None
@@ -116,12 +124,41 @@ class ServeSpec:
     ros2: Ros2Settings | None = None
     settings_file: Path | None = None
     token_file: Path | None = None
+    warn: Callable[[str], None] | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
-        """``name`` as the robot's one name on mDNS and Zenoh (``checks.robot_name``:
-        ``Poppy.local`` -> ``poppy``; ArgumentError, a ValueError, for another name)."""
+        """Check the spec: ``name`` as the robot's one name on mDNS and Zenoh
+        (``checks.robot_name``: ``Poppy.local`` -> ``poppy``), the ports, the origins and Host
+        names (ArgumentError, a ValueError); then warn of what it exposes."""
         if self.name is not None:
             object.__setattr__(self, "name", robot_name(self.name, "name"))
+        check_ports(self)
+        check_origins(self)
+        for line in exposure(self):
+            (self.warn or logger.warning)(line)
+
+    def policy(self) -> OriginPolicy:
+        """The Host and Origin rules of the HTTP and WebSocket servers, made from the spec (a
+        new one each call: a server set adds its own ports and names to it)."""
+        from poppy_core.server import OriginPolicy
+
+        return OriginPolicy.for_server(
+            self.host,
+            cors=self.cors,
+            allow_hosts=self.allow_hosts,
+            name=self.name,
+            report=self.report,
+        )
+
+    def snap_policy(self, host: str) -> OriginPolicy:
+        """The Snap! server's rules on ``host``: the REST server's, snap.berkeley.edu allowed,
+        the robot's name its own."""
+        from poppy_core.server.snap.server import snap_policy
+
+        policy = snap_policy(host, cors=self.cors, allow_hosts=self.allow_hosts, report=self.report)
+        if self.name is not None:
+            policy.with_names([self.name])  # Snap! projects call http://poppy.local:6969 too
+        return policy
 
     def listens(self) -> dict[str, Listen]:
         """Protocol -> where it listens, for the servers asked for, in starting order."""
@@ -135,6 +172,34 @@ class ServeSpec:
         return listens[0].host if listens else LOOPBACK
 
 
+class Server(Protocol):
+    """What every server of a set is, whatever its protocol (REST, WebSocket, ZMQ, Snap!,
+    Zenoh, ROS 2): where it serves, whether it runs, started and stopped by its set."""
+
+    @property
+    def url(self) -> str:
+        """Where clients reach it (``http://...``, ``tcp://...``, ``zenoh:NAME``...)."""
+        ...
+
+    @property
+    def port(self) -> int | None:
+        """Its TCP port (None on Zenoh: the session's endpoints are its addresses)."""
+        ...
+
+    @property
+    def running(self) -> bool:
+        """True while it serves."""
+        ...
+
+    def start(self) -> object:
+        """Serve in the background."""
+        ...
+
+    def stop(self) -> None:
+        """Stop serving (idempotent)."""
+        ...
+
+
 class ServerSet:
     """The servers of one robot, sharing ``service`` and ``policy``.
 
@@ -142,14 +207,14 @@ class ServerSet:
         service: the one ``RobotService`` of every protocol.
         policy: the Host and Origin rules of the HTTP and WebSocket servers.
         app: the HTTP app (``None`` without ``http``).
-        servers: protocol -> its server (each has ``url``, ``port``, ``run()``, ``stop()``).
+        servers: protocol -> its ``Server``, in starting order.
     """
 
     def __init__(self, service: RobotService, policy: OriginPolicy, app: Any) -> None:
         self.service = service
         self.policy = policy
         self.app = app
-        self.servers: dict[str, Any] = {}
+        self.servers: dict[str, Server] = {}
         self.announcer: Announcer | None = None
         """The mDNS announcement (``announce``); ``announcer.name`` is the name won."""
         self.zenoh_session: Any = None
@@ -159,32 +224,32 @@ class ServerSet:
     @property
     def http(self) -> BackgroundServer | None:
         """The REST server."""
-        return self.servers.get("http")
+        return cast("BackgroundServer | None", self.servers.get("http"))
 
     @property
     def ws(self) -> BackgroundServer | None:
         """pypot's WebSocket server."""
-        return self.servers.get("ws")
+        return cast("BackgroundServer | None", self.servers.get("ws"))
 
     @property
     def zmq(self) -> ZmqRobotServer | None:
         """pypot's ZMQ server."""
-        return self.servers.get("zmq")
+        return cast("ZmqRobotServer | None", self.servers.get("zmq"))
 
     @property
     def snap(self) -> SnapServer | None:
         """The Snap! server."""
-        return self.servers.get("snap")
+        return cast("SnapServer | None", self.servers.get("snap"))
 
     @property
     def zenoh(self) -> ZenohRobotServer | None:
         """The robot on Zenoh."""
-        return self.servers.get("zenoh")
+        return cast("ZenohRobotServer | None", self.servers.get("zenoh"))
 
     @property
     def ros2(self) -> Ros2Node | None:
         """The robot as a ROS 2 node."""
-        return self.servers.get("ros2")
+        return cast("Ros2Node | None", self.servers.get("ros2"))
 
     @property
     def running(self) -> bool:
@@ -237,21 +302,14 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
     Raises:
         ListenError: a port is taken or an address unusable.
         RuntimeError: a server did not start (its log says why).
-        ValueError: an origin in ``cors`` or a name in ``allow_hosts`` that is not one.
         ConfigError: a Zenoh endpoint or configuration that cannot be used.
         MissingExtraError: the ``server`` (or ``zmq``, ``appliance``, ``fleet``, ``ros2``) extra
             is missing.
     """
-    from poppy_core.server import OriginPolicy, RobotService, create_app
+    from poppy_core.server import RobotService, create_app
 
     listens = spec.listens()
-    policy = OriginPolicy.for_server(
-        spec.host,
-        cors=spec.cors,
-        allow_hosts=spec.allow_hosts,
-        name=spec.name,
-        report=spec.report,
-    )
+    policy = spec.policy()
     service = RobotService(robot)
     app = None
     if "http" in listens or spec.zenoh is not None:

@@ -27,9 +27,10 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
+from poppy_core import checks
 from poppy_core.emulator.motor import VirtualMotor
 from poppy_core.errors import ArgumentError
-from poppy_core.schedule import Worker
+from poppy_core.schedule import Ticker, Worker
 from poppy_core.trajectory import minimum_jerk_weight
 
 logger = logging.getLogger(__name__)
@@ -90,7 +91,7 @@ class Hand:
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.buses = list(buses)
-        self._period_s = period_s
+        self._period_s = checks.period(period_s, "period_s")
         self._clock = clock
         self._cond = threading.Condition()
         self._gestures: dict[int, _Gesture] = {}
@@ -283,15 +284,19 @@ class Hand:
         for bus in self.buses:
             bus.advance()
 
+    def _tick(self, now: float) -> bool:
+        with self._cond:
+            if not self._gestures:
+                self._running = False
+                return False
+            self._apply(self._clock())
+            return True
+
     def _run(self, stopping: threading.Event) -> None:
+        # a gesture that raises ends them all: nothing retried
+        ticker = Ticker("emulator hand", 1.0 / self._period_s, self._tick, retry=())
         try:
-            while not stopping.is_set():
-                with self._cond:
-                    if not self._gestures:
-                        self._running = False
-                        return
-                    self._apply(self._clock())
-                stopping.wait(self._period_s)
+            ticker.run(stopping)
         except BaseException:
             with self._cond:  # the gestures stop with the thread (Worker logs the error)
                 self._running = False

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import time
 from collections import deque
 from typing import TYPE_CHECKING
 
 from poppy_core import checks
 from poppy_core.motion.primitive import Primitive
-from poppy_core.schedule import Periodic, RateMeter
+from poppy_core.schedule import RateMeter, Ticker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
@@ -20,7 +19,7 @@ class LoopPrimitive(Primitive):
     Its updates fall at ``t0 + k * period``: ``t0`` is when ``run`` begins, or the
     ``shared_start`` of a start through a gate with a start time (a fleet's robots then update
     on one grid; a thread that woke late updates at once, with the value due now, and goes on
-    on the grid). After a pause the grid starts again at the resume.
+    on the grid). After a pause it goes on on its grid (the periods paused are skipped).
 
     Args:
         robot: the robot to act on.
@@ -32,6 +31,7 @@ class LoopPrimitive(Primitive):
         self.update_freq = freq
         self._meter = RateMeter(window=10)
         self._recent: deque[float] = deque(maxlen=10)
+        self._loop_last: float | None = None
 
     @property
     def update_freq(self) -> float:
@@ -71,25 +71,24 @@ class LoopPrimitive(Primitive):
         """One step of the behaviour, called at ``update_freq``."""
 
     def run(self) -> None:
-        """Call ``update()`` on a drift-free schedule; late updates skip missed periods."""
+        """Call ``update()`` on a drift-free schedule; late updates skip missed periods.
+
+        An ``update`` that raises ends the primitive (pypot's story: the primitive's ``error``,
+        ``wait_to_stop`` raises ``PrimitiveError``), so the ticker retries nothing.
+        """
         self._meter = RateMeter(window=10)
         self._recent.clear()
-        last: float | None = None
-        origin = self.shared_start
-        schedule = Periodic(self.period_s, time.monotonic() if origin is None else origin)
-        if origin is not None and self.sleep(origin - time.monotonic()):  # a gate opened early
+        self._loop_last = None
+        ticker = Ticker(self.name, self.update_freq, self._loop_tick, retry=())
+        ticker.run(self._stop_event, self.shared_start)
+
+    def _loop_tick(self, now: float) -> None:
+        if self.should_pause():
+            self.wait_to_resume()
+            self._loop_last = None
             return
-        while not self.should_stop():
-            if self.should_pause():
-                self.wait_to_resume()
-                schedule = Periodic(self.period_s, time.monotonic())
-                last = None
-                continue
-            now = time.monotonic()
-            self.update()
-            self._meter.tick(now)
-            if last is not None and now > last:
-                self._recent.append(1.0 / (now - last))
-            last = now
-            schedule.advance(time.monotonic())
-            self.sleep(schedule.next_deadline - time.monotonic())
+        self.update()
+        self._meter.tick(now)
+        if self._loop_last is not None and now > self._loop_last:
+            self._recent.append(1.0 / (now - self._loop_last))
+        self._loop_last = now

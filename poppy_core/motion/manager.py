@@ -6,7 +6,8 @@ robot. Its thread starts with the first running primitive and ends when none is 
 numeric ones with ``filter`` (mean by default, ``"sum"`` or any function of a list of floats) and
 lets the most recently started primitive win on on/off registers (``compliant``, ``led``).
 A primitive whose requests cannot be applied (a motor the robot does not have) is stopped as
-failed, one WARNING line; the others and the manager go on.
+failed, one WARNING line; the others and the manager go on. A combination that raises is the
+thread's ``schedule.Ticker``'s: logged once, counted in ``errors``, retried with backoff.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from poppy_core import checks
 from poppy_core.errors import ArgumentError, ConfigError, RobotClosedError
 from poppy_core.motion.sandbox import NUMERIC_REGISTERS
 from poppy_core.robot.robot_pypot import MANAGER_KEY
-from poppy_core.schedule import Periodic, RateMeter, Worker
+from poppy_core.schedule import RateMeter, Worker
 
 if TYPE_CHECKING:
     from poppy_core.motion.primitive import Primitive
@@ -69,7 +70,6 @@ class PrimitiveManager:
         self._lock = threading.RLock()
         self._primitives: list[Primitive] = []
         self._thread: Worker | None = None  # one per run: it ends when no primitive is left
-        self._wake = threading.Event()
         self._closed = False
         self._applied: dict[tuple[str, str], Any] = {}
         self._meter = RateMeter()
@@ -120,8 +120,13 @@ class PrimitiveManager:
             if primitive not in self._primitives:
                 self._primitives.append(primitive)
             if self._thread is None:
-                self._wake.clear()
-                self._thread = Worker("primitive manager", self._loop)
+                self._thread = Worker.periodic(
+                    "primitive manager",
+                    self.freq,
+                    self._tick,
+                    on_failure=lambda exc: self._note_error(f"{type(exc).__name__}: {exc}"),
+                    on_exit=self._ended,
+                )
                 self._thread.start()
 
     def remove(self, primitive: Primitive) -> None:
@@ -211,28 +216,23 @@ class PrimitiveManager:
         self.errors += 1
         self.last_error = message
 
-    def _loop(self, stopping: threading.Event) -> None:  # ends itself; close sets _wake
-        try:
-            self._combine_while_running()
-        except BaseException:  # the worker logs why; the next add starts another thread
-            with self._lock:
-                if self._thread is not None and self._thread.is_current():
-                    self._thread = None
-                self._applied.clear()
-            raise
+    def _tick(self, now: float) -> bool:
+        """One combination; False (the thread ends) once no primitive is left."""
+        with self._lock:
+            if not self._primitives or self._closed:
+                self._ended()
+                return False
+            self.update()
+        self._meter.tick(now)
+        return True
 
-    def _combine_while_running(self) -> None:
-        schedule = Periodic(1.0 / self.freq, time.monotonic())
-        while True:
-            with self._lock:
-                if not self._primitives or self._closed:
-                    self._thread = None
-                    self._applied.clear()
-                    return
-                self.update()
-            self._meter.tick(time.monotonic())
-            schedule.advance(time.monotonic())
-            self._wake.wait(max(0.0, schedule.next_deadline - time.monotonic()))
+    def _ended(self) -> None:
+        """The thread is ending (no primitive left, closed, or stopped): the next ``add``
+        starts another."""
+        with self._lock:
+            if self._thread is not None and self._thread.is_current():
+                self._thread = None
+                self._applied.clear()
 
     # -- lifetime ----------------------------------------------------------------------------
 
@@ -244,7 +244,6 @@ class PrimitiveManager:
             self._closed = True
             self._primitives.clear()
             thread = self._thread
-            self._wake.set()
         if thread is not None:
             thread.close(2.0)
 

@@ -35,7 +35,7 @@ from poppy_core.motion.play_plan import (
     within_limits,
     write_rate_hz,
 )
-from poppy_core.schedule import Gate, Periodic, Worker
+from poppy_core.schedule import Gate, Ticker, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -293,25 +293,23 @@ class MovePlayer:
     def _play_once(self, loop: int, stopping: threading.Event, origin: float | None) -> None:
         """Play the frames, counted from ``origin`` (player's clock; None: from now)."""
         move = self._played
-        period = 1.0 / self.rate_hz
-        start = self._clock() if origin is None else origin
-        schedule = Periodic(period, start)
+        start = self._clock() if origin is None else origin  # a gate's: the first frame's time
         duration = move.duration_s
-        if origin is not None:  # a gate opened before its time: the first frame is due then
-            stopping.wait(max(0.0, start - self._clock()))
+
+        def frame(now: float) -> bool:
+            move_t = (now - start) * self.speed
+            if move_t >= duration:
+                self._set_goals(move.positions[-1])
+                return False
+            self._set_goals(move.positions_at(move_t))
+            shown_t = duration - move_t if self.backwards else move_t
+            self._report("play", loop, shown_t, played_fraction(loop, self.loops, move_t, duration))
+            return True
+
+        # a frame that raises ends the play (``error``; ``play()`` raises it): nothing retried
+        ticker = Ticker("move player", self.rate_hz, frame, clock=self._clock, retry=())
         try:
-            while not stopping.is_set():
-                now = self._clock()
-                move_t = (now - start) * self.speed
-                if move_t >= duration:
-                    self._set_goals(move.positions[-1])
-                    break
-                self._set_goals(move.positions_at(move_t))
-                shown_t = duration - move_t if self.backwards else move_t
-                done = played_fraction(loop, self.loops, move_t, duration)
-                self._report("play", loop, shown_t, done)
-                schedule.advance(self._clock())
-                stopping.wait(max(0.0, schedule.next_deadline - self._clock()))
+            ticker.run(stopping, start)
         finally:
             self.loop_times.append((start, self._clock()))
 

@@ -29,7 +29,7 @@ from poppy_core.errors import ArgumentError, FileError
 from poppy_core.files import FileLock, output_path, probe_folder
 from poppy_core.motion.move import MAX_FRAMERATE_HZ, MIN_FRAMERATE_HZ, Move, resample
 from poppy_core.motion.move_format import MOVE_SUFFIX, write_move
-from poppy_core.schedule import Periodic, Worker
+from poppy_core.schedule import Ticker, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot import Motor, Robot
@@ -123,6 +123,7 @@ class MoveRecorder:
         self._lock = threading.Lock()
         self._worker: Worker | None = None
         self._t0 = 0.0
+        self._next_checkpoint = 0.0
         self.checkpoints = 0
         self.checkpoint_error: Exception | None = None
         self.saved_path: Path | None = None
@@ -328,18 +329,17 @@ class MoveRecorder:
             self.checkpoint_error = None
 
     def _run(self, stopping: threading.Event) -> None:
-        schedule = Periodic(1.0 / self.freq, self._t0)  # start() took the sample at t0
-        next_checkpoint = self._t0 + self.checkpoint_period_s
-        while True:
-            schedule.advance(self._clock())
-            if stopping.wait(max(0.0, schedule.next_deadline - self._clock())):
-                break
-            now = self._clock()
-            self._sample(now)
-            if now >= next_checkpoint:
-                self._checkpoint()
-                next_checkpoint = now + self.checkpoint_period_s
+        self._next_checkpoint = self._t0 + self.checkpoint_period_s
+        # a sample that raises ends the take (kept, ``error`` says why): nothing retried
+        ticker = Ticker("move recorder", self.freq, self._tick, clock=self._clock, retry=())
+        ticker.run(stopping, self._t0 + 1.0 / self.freq)  # start() took the sample at t0
         self._sample(self._clock())  # the take ends at stop(), not at the last tick before it
+
+    def _tick(self, now: float) -> None:
+        self._sample(now)
+        if now >= self._next_checkpoint:
+            self._checkpoint()
+            self._next_checkpoint = now + self.checkpoint_period_s
 
     # -- context manager -----------------------------------------------------------------------
 

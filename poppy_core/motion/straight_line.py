@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
-import time
 from collections.abc import Callable
 from dataclasses import replace
 from typing import TYPE_CHECKING
@@ -15,7 +15,7 @@ from poppy_core.errors import KinematicsError, PortError
 from poppy_core.kinematics import Chain, make_target
 from poppy_core.kinematics.chain import Orientation
 from poppy_core.kinematics.transforms import Matrix, Vector, axis_angle_matrix, rotation_log
-from poppy_core.schedule import Periodic, Worker
+from poppy_core.schedule import Ticker, Worker
 from poppy_core.trajectory import minimum_jerk_weight
 
 if TYPE_CHECKING:
@@ -145,18 +145,21 @@ class LinearMove:
         self._worker.request_stop()
 
     def _run(self, cancel: threading.Event) -> None:
-        # a late waypoint goes at once and the next keep their times (no deadline is skipped)
-        schedule = Periodic(self._period_s, time.monotonic(), catch_up=len(self._waypoints))
-        try:
-            for angles in self._waypoints:
-                if cancel.is_set():
-                    break
-                # dummy control: each motor gets the next waypoint and the speed to reach it in
-                # one period, so the servos move continuously between waypoints
-                self._robot.goto_position(angles, self._period_s, control="dummy")
-                schedule.advance(time.monotonic())
-                delay = schedule.next_deadline - time.monotonic()
-                if delay > 0 and cancel.wait(delay):
-                    break
-        except PortError:
-            pass  # the robot closed under the move
+        # a late waypoint goes at once and the next keep their times (no deadline is skipped);
+        # a waypoint that raises ends the move (``wait()`` raises it): nothing retried
+        waypoints = iter(self._waypoints)
+
+        def send(now: float) -> bool:
+            angles = next(waypoints, None)
+            if angles is None:
+                return False
+            # dummy control: each motor gets the next waypoint and the speed to reach it in
+            # one period, so the servos move continuously between waypoints
+            self._robot.goto_position(angles, self._period_s, control="dummy")
+            return True
+
+        ticker = Ticker(
+            self._worker.name, 1.0 / self._period_s, send, catch_up=len(self._waypoints), retry=()
+        )
+        with contextlib.suppress(PortError):  # the robot closed under the move
+            ticker.run(cancel)

@@ -114,7 +114,14 @@ class RangeWatch:
         self._low = dict(first)
         self._high = dict(first)
         self._current = dict(first)
-        self._worker = Worker("calibration range", self._run)
+        # a sampler that fails ends the thread and says so at ``__exit__``: nothing retried
+        self._worker = Worker.periodic(
+            "calibration range",
+            1.0 / self._period_s,
+            lambda now: self._sample(),
+            retry=(),
+            start_s=lambda: time.monotonic() + self._period_s,
+        )
 
     def __enter__(self) -> RangeWatch:
         self._worker.start()
@@ -123,10 +130,6 @@ class RangeWatch:
     def __exit__(self, *_: object) -> None:
         self._worker.stop(2.0)  # a sampler that failed says so here
         self._sample()
-
-    def _run(self, stopping: threading.Event) -> None:
-        while not stopping.wait(self._period_s):
-            self._sample()
 
     def _sample(self) -> None:
         with self._lock:

@@ -4,20 +4,20 @@ sync loops seen as one (``robot._controllers``).
 pypot's controllers were the threads syncing a robot's motors with their hardware; scripts
 subclassed ``MotorsController`` (``setup``/``update``/``teardown``) and read
 ``robot._controllers[i]._updated``, set after each sync. Here ``AbstractController`` runs
-``update()`` at ``sync_freq`` Hz in a ``Worker`` thread; ``BusController`` is the same face over
+``update()`` at ``sync_freq`` Hz in a ``Worker`` thread (an ``update`` that raises is logged once
+and retried with backoff: ``schedule.Ticker``); ``BusController`` is the same face over
 one bus's ``BusSync`` (which keeps its own thread, started and stopped with the robot).
 """
 
 from __future__ import annotations
 
 import threading
-import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from poppy_core import checks
 from poppy_core.errors import ControllerError
-from poppy_core.schedule import Periodic, Worker
+from poppy_core.schedule import Ticker, Worker
 
 if TYPE_CHECKING:
     from poppy_core.robot.sync import BusSync
@@ -110,14 +110,14 @@ class AbstractController:
         finally:
             self._set_up.set()
         try:
-            schedule = Periodic(self.period, time.monotonic(), catch_up=1)
-            while not stopping.is_set():
-                self.update()
-                self._updated.set()
-                schedule.advance(time.monotonic())
-                stopping.wait(max(0.0, schedule.next_deadline - time.monotonic()))
+            tick = self._controller_tick
+            Ticker(self._worker.name, self.sync_freq, tick, catch_up=1).run(stopping)
         finally:
             self.teardown()
+
+    def _controller_tick(self, now: float) -> None:
+        self.update()
+        self._updated.set()
 
 
 class MotorsController(AbstractController):

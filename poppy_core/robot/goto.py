@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from poppy_core.errors import RobotClosedError
 from poppy_core.robot.motor_link import link_of
-from poppy_core.schedule import Periodic, Worker
+from poppy_core.schedule import Worker
 from poppy_core.trajectory import MinimumJerk, check_goto, control_name, plan_goto
 
 if TYPE_CHECKING:
@@ -79,7 +79,6 @@ class GotoRunner:
         self._lock = threading.Lock()
         self._moves: dict[int, _Move] = {}
         self._thread: Worker | None = None  # one per run: it ends when no goto is left
-        self._wake = threading.Event()
         self._closed = False
 
     @property
@@ -126,8 +125,9 @@ class GotoRunner:
                     motor, plan.goal, plan.trajectory, now, now + duration_s, handle
                 )
             if self._moves and self._thread is None:
-                self._wake.clear()
-                self._thread = Worker(self.name, self._run)
+                self._thread = Worker.periodic(
+                    self.name, 1.0 / self.period_s, self._step, clock=self._clock
+                )
                 self._thread.start()
         return handle
 
@@ -154,7 +154,6 @@ class GotoRunner:
                 move.handle._finish_one(cancelled=True)
             self._moves.clear()
             thread = self._thread
-            self._wake.set()
         if thread is not None:
             thread.close(2.0)
 
@@ -179,15 +178,6 @@ class GotoRunner:
                 self._thread = None
                 return False
             return True
-
-    def _run(self, stopping: threading.Event) -> None:  # ends itself; close sets _wake
-        schedule = Periodic(self.period_s, self._clock())
-        while True:
-            now = self._clock()
-            if not self._step(now):
-                return
-            schedule.advance(now)
-            self._wake.wait(max(0.0, schedule.next_deadline - self._clock()))
 
 
 def running_goals(motors: Iterable[Motor]) -> dict[str, float]:

@@ -99,8 +99,16 @@ class BusSync:
         self._clock = clock
         self._specs = [*loops, LoopSpec(RETRY, (), False, 1.0 / retry_period_s)]
         self._loops: list[_Loop] = []
-        self._worker = Worker(f"sync {controller}", self._run)
+        self._worker = Worker.periodic(
+            f"sync {controller}",
+            max(spec.rate_hz for spec in self._specs),
+            self._tick,
+            catch_up=1,
+            clock=clock,
+            due=self._due,
+        )
         self._stop = self._worker.stopping
+        self._start_lock = threading.Lock()
         self._transfers = SyncTransfers(bus, self.motors, offline_after, self._stop)
         self._driven: set[str] = set()
         self.updated = threading.Event()
@@ -135,12 +143,13 @@ class BusSync:
         return self._worker.running
 
     def start(self) -> None:
-        """Start the thread (no-op when running)."""
-        if self.running:
-            return
-        now = self._clock()
-        self._loops = [_Loop(spec, now) for spec in self._specs]
-        self._worker.start()
+        """Start the thread (no-op when running; of two starts at once, one starts it)."""
+        with self._start_lock:
+            if self.running:
+                return
+            now = self._clock()
+            self._loops = [_Loop(spec, now) for spec in self._specs]
+            self._worker.start()
 
     def stop(self, timeout_s: float = 2.0) -> None:
         """Stop and join the thread, then send the writes still pending (idempotent)."""
@@ -248,7 +257,7 @@ class BusSync:
                 for loop in loops
             },
             target_hz={loop.spec.name: loop.spec.rate_hz for loop in loops},
-            loop_errors=sum(loop.errors for loop in self._loops),
+            loop_errors=sum(loop.errors for loop in self._loops) + self._thread_failures(),
             timeouts=stats.timeouts,
             retries=stats.retries,
             corrupt_packets=stats.corrupt_packets,
@@ -282,21 +291,28 @@ class BusSync:
 
     # -- the thread ------------------------------------------------------------------------------
 
-    def _run(self, stopping: threading.Event) -> None:
-        while not stopping.is_set():
-            try:
-                if self.released:
-                    self._stop.wait(RECONNECT_MAX_S)
-                elif self.connected:
-                    self._run_due_loops()
-                else:
-                    self._reconnect()
-            except Exception:  # never let the thread die: log, breathe, go on
-                logger.exception("%s: sync thread error", self.controller)
-                self._stop.wait(0.1)
+    def _thread_failures(self) -> int:
+        ticker = self._worker.ticker
+        return ticker.guard.failures if ticker is not None else 0
 
-    def _run_due_loops(self) -> None:
-        now = self._clock()
+    def _due(self) -> float:
+        """When the thread's next pass is due: the earliest loop, or the next reopening."""
+        if self.released:
+            return self._clock() + RECONNECT_MAX_S
+        if not self.connected:
+            return self._next_reopen
+        return min(loop.schedule.next_deadline for loop in self._loops)
+
+    def _tick(self, now: float) -> None:
+        """One pass of the thread (a failure is the worker's: logged once, backoff, health)."""
+        if self.released:
+            return
+        if self.connected:
+            self._run_due_loops(now)
+        else:
+            self._reconnect()
+
+    def _run_due_loops(self, now: float) -> None:
         ran = False
         for loop in self._loops:
             if self._stop.is_set():
@@ -315,7 +331,7 @@ class BusSync:
                 loop.errors += 1
                 self._lost(exc)
                 return
-            except Exception as exc:
+            except Exception as exc:  # one register group failed; the others go on
                 loop.errors += 1
                 if isinstance(exc, PoppyError | OSError):
                     logger.debug("%s %s loop: %s", self.controller, loop.spec.name, exc)
@@ -325,8 +341,6 @@ class BusSync:
             loop.schedule.advance(now)
         if ran:
             self.updated.set()
-        wake = min(loop.schedule.next_deadline for loop in self._loops)
-        self._stop.wait(max(0.0, wake - self._clock()))
 
     def _lost(self, exc: PortError) -> None:
         """The port went away: every motor offline now, one warning, reopen with backoff."""
@@ -347,8 +361,6 @@ class BusSync:
         )
 
     def _reconnect(self) -> None:
-        if self._stop.wait(max(0.0, self._next_reopen - self._clock())):
-            return
         try:
             self.bus.reopen()
         except PortError as exc:

@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 
 from poppy_core import checks
 from poppy_core.errors import ArgumentError, SensorError
-from poppy_core.schedule import Backoff, Periodic, RateMeter, Worker
+from poppy_core.schedule import Backoff, RateMeter, Ticker, Worker
 
 logger = logging.getLogger(__name__)
 
@@ -120,7 +120,17 @@ class Sensor:
         self._losses = 0
         self._errors = 0
         self._last_error = ""
-        self._warned = False
+        self._backoff = Backoff(BACKOFF_START_S, BACKOFF_MAX_S)
+        self._next_retry = 0.0
+        self._ticker = Ticker(
+            f"sensor {name}",
+            self._rate_hz,
+            self._loop_tick,
+            catch_up=1,
+            clock=clock,
+            due=self._loop_due,
+            on_failure=self._update_failed,
+        )
         self._last_good: float | None = None
         self._fatal = ""
         self._watching = False
@@ -133,7 +143,8 @@ class Sensor:
 
         Raises:
             SensorLost: the device went away (``reconnect`` is then retried with backoff).
-            Exception: any other failure is counted and logged once; the loop goes on.
+            Exception: any other failure is counted and logged once; the loop goes on with
+                backoff (``schedule.Ticker``).
         """
         raise NotImplementedError
 
@@ -305,37 +316,31 @@ class Sensor:
             raise
 
     def _loop(self) -> None:
-        schedule = Periodic(1.0 / self._rate_hz, self._clock(), catch_up=1)
-        while not self._stop.is_set():
-            if self._connected:
-                self._step()
-            else:
-                self._retry()
-                if self._park():
-                    return
-                continue
-            now = self._clock()
-            schedule.advance(now)  # late: one run at once, the periods missed before it skipped
-            self._stop.wait(max(0.0, schedule.next_deadline - now))
+        self._ticker.run(self._stop)
 
-    def _step(self) -> None:
+    def _loop_due(self) -> float | None:
+        """While the device is away: the next reopening; else the ticker's own deadline."""
+        return None if self._connected else self._next_retry
+
+    def _loop_tick(self, now: float) -> bool | None:
+        if not self._connected:
+            self._reopen(now)
+            return not (self._connected and self._park())
         try:
             self.update()
         except SensorLost as exc:
             self._lost(str(exc))
-            return
-        except Exception as exc:
-            self._errors += 1
-            self._last_error = str(exc) or type(exc).__name__
-            if not self._warned:
-                self._warned = True
-                logger.warning("%s %s: update failed: %s", self.kind, self._name, exc)
-            return
+            return None
         now = self._clock()
         self._rate.tick(now)
         self._last_good = now
-        self._warned = False
         self._first.set()
+        return None
+
+    def _update_failed(self, exc: Exception) -> None:
+        """An update raised (the ticker logs it once and retries with backoff)."""
+        self._errors += 1
+        self._last_error = str(exc) or type(exc).__name__
 
     def _park(self) -> bool:
         """After a device away at start was reopened: end the thread until first use."""
@@ -352,6 +357,7 @@ class Sensor:
         self._losses += 1
         self._errors += 1
         self._last_error = reason
+        self._next_retry = self._down_since + self._backoff.reset()
         if at_start:
             logger.warning(
                 "%s %s is not available: %s; starting without it, retrying",
@@ -362,16 +368,14 @@ class Sensor:
         else:
             logger.warning("%s %s lost: %s; retrying", self.kind, self._name, reason)
 
-    def _retry(self) -> None:
-        backoff = Backoff(BACKOFF_START_S, BACKOFF_MAX_S)
-        while not self._stop.wait(backoff.delay_s):
-            try:
-                self.reconnect()
-            except Exception as exc:
-                self._last_error = str(exc)
-                backoff.failed()
-                continue
-            self._connected = True
-            down_s = self._clock() - self._down_since
-            logger.warning("%s %s is back after %.1f s", self.kind, self._name, down_s)
+    def _reopen(self, now: float) -> None:
+        """One attempt at reopening the device; the next one after a doubling backoff."""
+        try:
+            self.reconnect()
+        except Exception as exc:
+            self._last_error = str(exc)
+            self._next_retry = now + self._backoff.failed()
             return
+        self._connected = True
+        down_s = self._clock() - self._down_since
+        logger.warning("%s %s is back after %.1f s", self.kind, self._name, down_s)

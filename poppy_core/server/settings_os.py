@@ -135,8 +135,9 @@ class SystemTools:
 
     # -- running -------------------------------------------------------------------------------
 
-    def run(self, *argv: str) -> str:
-        """Run ``argv`` and return its standard output.
+    def run(self, *argv: str, stdin: str | None = None) -> str:
+        """Run ``argv`` and return its standard output; ``stdin``: text given on its standard
+        input (a secret, never on the command line).
 
         Raises:
             SystemToolError: the tool is missing, exits non-zero or outlasts the timeout.
@@ -149,6 +150,7 @@ class SystemTools:
         try:
             done = subprocess.run(
                 [tool, *argv[1:]],
+                input=stdin,
                 capture_output=True,
                 text=True,
                 errors="replace",
@@ -280,7 +282,15 @@ class SystemTools:
 
     def set_hotspot(self, ssid: str, password: str) -> None:
         """Make (or remake) the fallback access point ``ssid``: NetworkManager starts it only
-        when no network it knows answers (lowest autoconnect priority)."""
+        when no network it knows answers (lowest autoconnect priority).
+
+        The connection is made without its key (``nmcli connection add``), then the key is
+        set through nmcli's connection editor reading its commands on standard input
+        (``nmcli connection edit id poppy-hotspot``: ``set 802-11-wireless-security.psk KEY``,
+        ``save persistent``, ``quit``; the way Ansible's nmcli module keeps secrets off the
+        command line). Starting it now with a ``passwd-file``, as ``join`` does, would take the
+        robot off the network it is on. A key that cannot be set leaves no access point behind.
+        """
         if any(s.name == HOTSPOT for s in self.saved()):
             self.forget(HOTSPOT)
         self.run(
@@ -305,9 +315,16 @@ class SystemTools:
             "shared",
             "wifi-sec.key-mgmt",
             "wpa-psk",
-            "wifi-sec.psk",
-            password,
         )
+        commands = f"set {PSK_SETTING} {password}\nsave persistent\nquit\n"
+        try:
+            self.run("nmcli", "connection", "edit", "id", HOTSPOT, stdin=commands)
+        except SystemToolError:
+            try:
+                self.forget(HOTSPOT)
+            except SystemToolError as exc:
+                logger.warning("the access point without its key stays: %s", exc)
+            raise
 
     def remove_hotspot(self) -> None:
         """Remove the fallback access point (nothing when there is none)."""

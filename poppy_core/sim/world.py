@@ -5,7 +5,6 @@ from __future__ import annotations
 import logging
 import math
 import threading
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -84,7 +83,8 @@ class Simulation(Observing, Placing):
         self._state_age_s = math.inf  # simulated time since the state was last written
         self._objects = _Objects()
         self._renderers: dict[tuple[int, int], Any] = {}
-        self._worker = Worker("mujoco physics", self._run)
+        self._worker = Worker.periodic("mujoco physics", 1.0 / SYNC_PERIOD_S, self._step_physics)
+        self._last_step: float | None = None
 
     @classmethod
     def from_file(cls, path: Path, speed: float = 1.0) -> Simulation:
@@ -204,18 +204,17 @@ class Simulation(Observing, Placing):
 
     def start(self) -> None:
         """Run the physics in real time (times ``speed``) in a background thread."""
+        if not self._worker.running:
+            self._last_step = None
         self._worker.start()
 
-    def _run(self, stopping: threading.Event) -> None:
-        last = time.monotonic()
-        while not stopping.wait(SYNC_PERIOD_S):
-            now = time.monotonic()
-            elapsed = min(now - last, 0.1)  # never try to catch up more than 100 ms
-            last = now
-            try:
-                self.advance(elapsed * self.speed)
-            except Exception:  # keep the emulator answering; the error is in the log
-                logger.exception("physics step failed")
+    def _step_physics(self, now: float) -> None:
+        """One wake of the physics thread: the world stepped by the time since the last one
+        (times ``speed``); a step that raises is logged once and retried with backoff while
+        the emulator goes on answering."""
+        last, self._last_step = self._last_step, now
+        if last is not None:
+            self.advance(min(now - last, 0.1) * self.speed)  # never catch up more than 100 ms
 
     def stop(self) -> None:
         """Stop the physics thread (idempotent)."""

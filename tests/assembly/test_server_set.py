@@ -157,3 +157,41 @@ def _record(
         real()
 
     monkeypatch.setattr(target, method, recorded)
+
+
+def test_mdns_announces_the_tcp_ports_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A set's servers are ``Server``s: Zenoh's (and ROS 2's) port is None, and no ``zenoh=None``
+    goes into the announcement's TXT record."""
+    from poppy_core.assembly.server_builders import name_and_announce
+    from poppy_core.server import RobotService, announce
+
+    announced: dict[str, int] = {}
+
+    class Announcer:
+        def __init__(self, name: str, ports: dict[str, int], **options: Any) -> None:
+            announced.update(ports)
+
+        def start(self) -> None:
+            pass
+
+    class Served:
+        def __init__(self, port: int | None) -> None:
+            self.port, self.url, self.running = port, "x", True
+
+        def start(self) -> None:
+            pass
+
+        def stop(self) -> None:
+            pass
+
+        def rename(self, name: str) -> None:
+            pass
+
+    monkeypatch.setattr(announce, "Announcer", Announcer)
+    spec = ServeSpec(name="jr", announce=True)
+    with from_profile("ergo-jr", sim=True, sensors=False) as robot:
+        servers = ServerSet(RobotService(robot), spec.policy(), None)
+        servers.servers.update({"http": Served(8080), "zenoh": Served(None)})
+        name_and_announce(servers, robot, spec)
+        servers.service.close()
+    assert announced == {"http": 8080}

@@ -97,5 +97,6 @@ def test_serve_refuses_a_name_either_side_would_refuse(name: str) -> None:
     result = run_poppy("serve", "--zenoh", "--name", name, "--sim")
     assert result.code == 2, result.stderr
     lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and f"--name {name!r} is not a robot name" in lines[0], lines
+    assert len(lines) == 1 and lines[0].startswith("error: --name: "), lines
+    assert f"{name!r} is not a robot name" in lines[0], lines
     assert "e.g. poppy or ergo-2" in lines[0]

@@ -1,6 +1,7 @@
 """Recording fakes of the OS's tools (``hostnamectl``, ``nmcli``, ``systemctl``) put first on
 ``PATH``: each appends its argv (one JSON list a line) to a log and prints canned output. A
-``passwd-file``'s text and mode are logged apart (``secrets()``), its path logged as ``FILE``."""
+``passwd-file``'s text and mode are logged apart (``secrets()``), its path logged as ``FILE``;
+so is what ``nmcli connection edit`` reads on its standard input (``{"stdin": TEXT}``)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,9 @@ if "passwd-file" in argv[:-1]:  # read the secrets as nmcli would, then log the 
     with open(os.environ["FAKE_TOOLS_LOG"] + ".secrets", "a", encoding="utf-8") as log:
         log.write(json.dumps(secrets) + "\\n")
     argv[at] = "FILE"
+if argv[1:3] == ["connection", "edit"]:  # the editor's commands come on standard input
+    with open(os.environ["FAKE_TOOLS_LOG"] + ".secrets", "a", encoding="utf-8") as log:
+        log.write(json.dumps({{"stdin": sys.stdin.read()}}) + "\\n")
 with open(os.environ["FAKE_TOOLS_LOG"], "a", encoding="utf-8") as log:
     log.write(json.dumps(argv) + "\\n")
 canned = json.loads(open(os.environ["FAKE_TOOLS_CANNED"], encoding="utf-8").read())
@@ -88,7 +92,8 @@ class FakeTools:
         return [json.loads(line) for line in lines if line]
 
     def secrets(self) -> list[dict[str, str]]:
-        """Each ``passwd-file`` given, in order: its text (``text``) and octal mode (``mode``)."""
+        """Each ``passwd-file`` given, in order: its text (``text``) and octal mode (``mode``);
+        or what ``nmcli connection edit`` read on its standard input (``stdin``)."""
         log = self.log.with_name(self.log.name + ".secrets")
         lines = log.read_text(encoding="utf-8").splitlines() if log.exists() else []
         return [json.loads(line) for line in lines if line]

@@ -265,3 +265,32 @@ def test_a_refused_write_is_logged_once_until_it_is_taken_again(
     assert all("\n" not in r.getMessage() for r in refused)
     assert manager.errors >= 7  # the manager's own loop may update too
     manager.close()
+
+
+def test_a_combination_that_raises_is_logged_once_and_the_manager_goes_on(
+    ergo: Robot, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """The manager's thread lives through a raising combination (logged once, counted in
+    ``errors``, retried with backoff) and applies the requests again once it passes."""
+    manager = primitive_manager(ergo)
+    real = manager.update
+    failing = [True]
+
+    def flaky() -> None:
+        if failing[0]:
+            raise RuntimeError("combination broke")
+        real()
+
+    monkeypatch.setattr(manager, "update", flaky)
+    caplog.set_level(logging.WARNING, logger="poppy_core.schedule")
+    hold = constant(ergo, "m1", 20.0)
+    hold.start()
+    try:
+        assert eventually(lambda: manager.errors >= 3)
+        assert manager.running and "combination broke" in str(manager.last_error)
+        failing[0] = False
+        assert eventually(lambda: ergo.m1.goal_position == pytest.approx(20, abs=0.5))
+    finally:
+        hold.stop()
+    warned = [r for r in caplog.records if "a tick failed" in r.getMessage()]
+    assert len(warned) == 1 and "primitive manager" in warned[0].getMessage()

@@ -108,3 +108,40 @@ def test_missing_motor_goes_offline_then_back(line: tuple[VirtualBus, DxlBus]) -
     virtual.plug(1)
     sync.run_once("retry")
     assert motors[0].online
+
+
+def test_a_failing_pass_of_the_sync_thread_is_logged_once_counted_and_the_loops_resume(
+    line: tuple[VirtualBus, DxlBus],
+    monkeypatch: pytest.MonkeyPatch,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """A pass that raises (a bug, not a lost port) costs a WARNING once, is counted in health,
+    and the thread goes on with backoff: the loops resume when the passes succeed again."""
+    import logging
+
+    from tests.helpers import eventually
+
+    virtual, bus = line
+    motors = [Motor("a", model_by_name("AX-12A"), 1)]
+    sync = BusSync("c", bus, motors)
+    real = sync._run_due_loops
+    failing = [True]
+
+    def flaky(now: float) -> None:
+        if failing[0]:
+            raise RuntimeError("a pass went wrong")
+        real(now)
+
+    monkeypatch.setattr(sync, "_run_due_loops", flaky)
+    caplog.set_level(logging.WARNING, logger="poppy_core.schedule")
+    sync.start()
+    try:
+        assert eventually(lambda: sync.health().loop_errors >= 3)
+        assert sync.running
+        failing[0] = False
+        virtual.motor(1).move_by_hand(30.0)
+        assert eventually(lambda: motors[0].present_position == pytest.approx(30, abs=0.5))
+    finally:
+        sync.stop()
+    warned = [r for r in caplog.records if "a tick failed" in r.getMessage()]
+    assert len(warned) == 1 and "sync c" in warned[0].getMessage()

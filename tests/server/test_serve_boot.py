@@ -125,4 +125,5 @@ def test_the_same_http_port_twice_is_a_usage_error() -> None:
         timeout=60,
     )
     assert done.returncode == 2
-    assert "--http-port 8123 is given twice" in done.stderr and "Traceback" not in done.stderr
+    assert "--http-port: the HTTP port 8123 is given twice" in done.stderr
+    assert "Traceback" not in done.stderr

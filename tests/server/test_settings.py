@@ -64,10 +64,15 @@ HOTSPOT_ADD = [
     "shared",
     "wifi-sec.key-mgmt",
     "wpa-psk",
-    "wifi-sec.psk",
-    "hotspot-pw",
 ]
-"""The fallback access point as NetworkManager is asked to make it."""
+"""The fallback access point as NetworkManager is asked to make it (without its key)."""
+HOTSPOT_EDIT = ["nmcli", "connection", "edit", "id", HOTSPOT]
+"""Its key set through nmcli's editor, the commands on standard input."""
+
+
+def hotspot_key(password: str) -> dict[str, str]:
+    """What the editor reads on its standard input to set the access point's key."""
+    return {"stdin": f"set 802-11-wireless-security.psk {password}\nsave persistent\nquit\n"}
 
 
 @pytest.fixture
@@ -113,6 +118,7 @@ def test_the_adapter_runs_exactly_these_commands(fake: FakeTools) -> None:
         ["nmcli", "connection", "delete", "id", HOTSPOT],  # remade, not doubled
         ["nmcli", "-t", "-f", "DEVICE,TYPE", "device"],
         HOTSPOT_ADD,
+        HOTSPOT_EDIT,
         ["nmcli", "-t", "-f", "NAME,TYPE,AUTOCONNECT-PRIORITY", "connection", "show"],
         ["nmcli", "connection", "delete", "id", HOTSPOT],
         ["systemctl", "start", "poppy-jupyter.service"],
@@ -155,6 +161,29 @@ def test_the_wifi_key_reaches_nmcli_in_a_private_file_never_on_a_command_line(
     ]
     assert fake.secrets() == [{"text": "802-11-wireless-security.psk:password1\n", "mode": "0o600"}]
     assert not any("password1" in arg for call in fake.calls() for arg in call)
+
+
+def test_the_access_point_key_reaches_nmcli_on_standard_input_never_on_a_command_line(
+    fake: FakeTools,
+) -> None:
+    SystemTools(user_units=False).set_hotspot("ergo-2", "ap secret~1")
+    assert fake.changes() == [
+        ["nmcli", "connection", "delete", "id", HOTSPOT],
+        HOTSPOT_ADD,
+        HOTSPOT_EDIT,
+    ]
+    assert fake.secrets() == [hotspot_key("ap secret~1")]
+    assert not any("secret" in arg for call in fake.calls() for arg in call)
+
+
+def test_an_access_point_whose_key_cannot_be_set_is_removed(fake: FakeTools) -> None:
+    fake.canned[" ".join(HOTSPOT_EDIT)] = {"err": "Error: invalid psk.\n", "code": 1}
+    fake.save()
+    with pytest.raises(SystemToolError) as caught:
+        SystemTools(user_units=False).set_hotspot("ergo-2", "ap-secret-2")
+    assert "invalid psk" in str(caught.value) and "ap-secret-2" not in str(caught.value)
+    assert fake.changes()[-2:] == [HOTSPOT_EDIT, ["nmcli", "connection", "delete", "id", HOTSPOT]]
+    assert not any("ap-secret-2" in arg for call in fake.calls() for arg in call)
 
 
 def test_a_refused_key_is_one_line_without_it_and_leaves_no_connection(fake: FakeTools) -> None:
@@ -273,6 +302,7 @@ def test_wifi_and_services_from_the_routes(fake: FakeTools, with_token: Served) 
         ["nmcli", "connection", "delete", "id", "Class:room"],
         ["nmcli", "connection", "delete", "id", HOTSPOT],
         HOTSPOT_ADD,
+        HOTSPOT_EDIT,
         ["systemctl", "start", "poppy-jupyter.service"],
         join_add("Nowhere"),
         join_up("Nowhere"),

@@ -93,7 +93,10 @@ def test_snap_options_are_checked_before_the_robot_is_built(tmp_path: Path) -> N
         (["--http", "--open"], "--open needs --snap"),
         (["--http", "--snap-dir", str(tmp_path)], "--snap-dir needs --snap"),
         (["--snap", "--snap-dir", str(tmp_path)], "no snap.html there"),
-        (["--snap", "--http", "--snap-port", "8080"], "--snap-port 8080 is also the --http-port"),
+        (
+            ["--snap", "--http", "--snap-port", "8080"],
+            "--snap-port: the Snap! port 8080 is also the HTTP port",
+        ),
         (["--snap", "--cors", "snap.berkeley.edu"], "is not an origin"),
     ]:
         done = _run("serve", *args, "--sim", "--profile", "ergo-jr", cwd=tmp_path)

@@ -28,13 +28,14 @@ from poppy_core.errors import ConfigError, FileError, PoppyError
 from poppy_core.motion.teleop.follower import Follower, LocalFollower
 from poppy_core.motion.teleop.goal_stream import GoalStreamChange
 from poppy_core.motion.teleop.joint_map import JointMap
+from poppy_core.motion.teleop.leader import Leader, LeaderMotor
 from poppy_core.motion.teleop.recording import TrajectoryRecorder
 from poppy_core.motion.teleop.stats import TeleopReport, TeleopStatus
 from poppy_core.robot.robot import Robot
-from poppy_core.schedule import Backoff, Periodic, Worker
+from poppy_core.schedule import Ticker, Worker
 
 if TYPE_CHECKING:
-    from poppy_core.robot import Motor
+    pass
 
 logger = logging.getLogger(__name__)
 
@@ -59,8 +60,9 @@ __all__ = [
 ]
 
 
-class _LeaderLost(Exception):
-    """The leader could not be read (the message says why)."""
+class _LeaderLost(PoppyError):
+    """The leader could not be read (the message says why): the follower holds, the loop
+    retries with backoff."""
 
 
 class Teleoperation:
@@ -86,7 +88,7 @@ class Teleoperation:
 
     def __init__(
         self,
-        leader: Robot,
+        leader: Leader,
         follower: Robot | Follower,
         joint_map: JointMap | None = None,
         *,
@@ -122,7 +124,7 @@ class Teleoperation:
                     value=both,
                 )
         self.leader = leader
-        self._leader_motors: list[Motor] = [leader.motor(n) for n in self.joint_map.leaders]
+        self._leader_motors: list[LeaderMotor] = [leader.motor(n) for n in self.joint_map.leaders]
         self.rate_hz = float(rate_hz)
         self.duration_s = duration_s
         self.recorder = (
@@ -133,13 +135,22 @@ class Teleoperation:
             else None
         )
         self._worker: Worker | None = None
+        self._ticker = Ticker(
+            "teleop",
+            self.rate_hz,
+            self._tick,
+            first_s=RETRY_FIRST_S,
+            max_s=RETRY_MAX_S,
+            clock=clock,
+            retry=(_LeaderLost,),
+            on_failure=lambda exc: self._leader_lost(str(exc)),
+        )
         self._lock = threading.Lock()
         self._save_error: FileError | None = None
         self._t0 = 0.0
         self._first_tick: float | None = None
         self._last_tick = 0.0
         self._ticks = 0
-        self._missed = 0
         self._holds = 0
         self._read_s: deque[float] = deque(maxlen=KEPT_SAMPLES)
         self._pipeline_s: deque[float] = deque(maxlen=KEPT_SAMPLES)
@@ -234,7 +245,7 @@ class Teleoperation:
                 duration_s=max(0.0, end - self._t0) if self._t0 else 0.0,
                 ticks=self._ticks,
                 measured_hz=self._measured_hz(),
-                missed_periods=self._missed,
+                missed_periods=self._ticker.missed,
                 holds=self._holds,
                 read_s=list(self._read_s),
                 pipeline_s=list(self._pipeline_s),
@@ -258,37 +269,27 @@ class Teleoperation:
                 motor.compliant = True
             self._t0 = self._clock()
             self.follower.start(self.joint_map.followers)
-            self._loop(stopping)
+            self._ticker.run(stopping, self._t0)
 
-    def _loop(self, stopping: threading.Event) -> None:
-        period = 1.0 / self.rate_hz
-        schedule = Periodic(period, self._t0)
-        retry_at = self._t0
-        backoff = Backoff(RETRY_FIRST_S, RETRY_MAX_S)
-        while not stopping.is_set():
-            tick = self._clock()
-            if self.duration_s is not None and tick - self._t0 >= self.duration_s:
-                break
-            if tick >= retry_at:
-                try:
-                    positions = self._read_leader()
-                except _LeaderLost as exc:
-                    self._leader_lost(str(exc))
-                    retry_at = tick + backoff.delay_s
-                    backoff.failed()
-                else:
-                    backoff.reset()
-                    self._follow(tick, positions)
-            follower_positions = self.follower.positions()
-            if self.recorder is not None:
-                self.recorder.sample(tick - self._t0, follower_positions)
-            with self._lock:
-                self._follower_positions = follower_positions
-                self._ticks += 1
-                self._first_tick = tick if self._first_tick is None else self._first_tick
-                self._last_tick = tick
-            self._missed += schedule.advance(self._clock())
-            stopping.wait(max(0.0, schedule.next_deadline - self._clock()))
+    def _tick(self, now: float) -> bool:
+        """One period: the leader read, the follower sent its targets, its positions kept.
+
+        A lost leader raises ``_LeaderLost``: the follower is told to hold, the ticker logs it
+        once and retries with backoff (``RETRY_FIRST_S`` doubling to ``RETRY_MAX_S``).
+        """
+        if self.duration_s is not None and now - self._t0 >= self.duration_s:
+            return False
+        positions = self._read_leader()
+        self._follow(now, positions)
+        follower_positions = self.follower.positions()
+        if self.recorder is not None:
+            self.recorder.sample(now - self._t0, follower_positions)
+        with self._lock:
+            self._follower_positions = follower_positions
+            self._ticks += 1
+            self._first_tick = now if self._first_tick is None else self._first_tick
+            self._last_tick = now
+        return True
 
     def _read_leader(self) -> dict[str, float]:
         try:
@@ -318,8 +319,7 @@ class Teleoperation:
             self._targets = targets
 
     def _leader_lost(self, reason: str) -> None:
-        if self._lost is None:
-            logger.warning("%s: the follower holds where it is", reason)
+        if self._lost is None:  # the ticker logs it once
             with self._lock:
                 self._lost = reason
                 self._holds += 1
@@ -366,7 +366,7 @@ class Teleoperation:
 
 
 def teleoperate(
-    leader: Robot,
+    leader: Leader,
     follower: Robot | Follower,
     joint_map: JointMap | str | None = None,
     *,
