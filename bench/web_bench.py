@@ -4,8 +4,8 @@ Measures page load to the first live values, the state stream's update rate as t
 with 25 motors, and the server process's CPU with one page open (against none), its 3D view
 drawn; then the 3D view's first paint and frame rate (``bench.web_view_bench``). The server runs
 in its own process (``poppy serve --http --sim --profile humanoid``) so its CPU is its own.
-``python -m bench.web_bench --screenshots`` writes docs/img/web-desktop.png, web-phone.png and
-web-offline.png with the same browser. Duration of the rate and CPU windows:
+``python -m bench.web_bench --screenshots`` writes docs/img/web-desktop.png, web-phone.png,
+web-offline.png and web-token.png with the same browser. Duration of the rate and CPU windows:
 ``POPPY_BENCH_WEB_S`` (default 10).
 """
 
@@ -46,11 +46,13 @@ def chromium() -> str | None:
 
 
 @contextmanager
-def served(profile: str) -> Iterator[tuple[str, int]]:
-    """``poppy serve --http --sim --profile PROFILE`` in its own process: (base URL, pid)."""
+def served(
+    profile: str, options: tuple[str, ...] = ("--sim", "--no-sensors")
+) -> Iterator[tuple[str, int]]:
+    """``poppy serve --http --profile PROFILE OPTIONS`` in its own process: (base URL, pid)."""
     port = free_port()
-    args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", "--sim"]
-    args += ["--profile", profile, "--http-port", str(port), "--no-sensors"]
+    args = [str(POPPY_PYTHON), "-m", "poppy_cli", "serve", "--http", *options]
+    args += ["--profile", profile, "--http-port", str(port)]
     library = tempfile.TemporaryDirectory(prefix="poppy-web-bench-")  # the user's moves stay
     env = {"POPPY_MOVES_DIR": library.name}
     try:
@@ -206,28 +208,64 @@ def web_benchmark(ctx: BenchContext) -> BenchResult:
     )
 
 
+SHOWN_AS = ("--name", "jr1", "--sim", "mujoco", "--snap", "--snap-port")
+"""The figures' robot: named, simulated by MuJoCo (its camera sees), with Snap! linked."""
+
+
+SEEN = """() => {
+  const img = document.querySelector("#camera-camera img");
+  if (!img.naturalWidth) return false;
+  const canvas = document.createElement("canvas");
+  canvas.width = 64; canvas.height = 48;
+  const context = canvas.getContext("2d");
+  context.drawImage(img, 0, 0, 64, 48);
+  const data = context.getImageData(0, 0, 64, 48).data;
+  return data.some((value, i) => i % 4 !== 3 && value > 40);
+}"""
+"""The camera's picture is in the page (not its first, black, frames)."""
+
+
+def _busy(http: Any) -> None:
+    """A three-motor move recorded (to plot) and ``sinus`` turning the base."""
+    http.put("/api/v1/robot/compliant", json={"compliant": False})
+    http.post("/api/v1/moves/wave/record", json={"motors": ["m1", "m2", "m3"]})
+    for angles in ([30, -20, 20], [-30, 10, -20], [0, 0, 0]):
+        positions = dict(zip(["m1", "m2", "m3"], angles, strict=True))
+        http.post("/api/v1/gotos", json={"positions": positions, "duration_s": 0.8, "wait": True})
+    http.post("/api/v1/moves/wave/save")
+    # the head looks over the table's edge (its camera sees the table and the floor) and the
+    # base turns
+    pose = {"m1": 0, "m2": -20, "m3": 30, "m4": 0, "m5": 20, "m6": 0}
+    http.post("/api/v1/gotos", json={"positions": pose, "duration_s": 0.8, "wait": True})
+    http.put("/api/v1/primitives/sinus/properties/motor_list", json={"value": ["m1"]})
+    http.put("/api/v1/primitives/sinus/properties/amplitude", json={"value": 15})
+    http.post("/api/v1/primitives/sinus/start")
+
+
 def screenshots(folder: str) -> list[str]:
-    """The page of a served Ergo Jr, busy, at desktop and phone widths, then with its server
-    gone (PNG files written)."""
+    """The page of a served Ergo Jr named jr1 (MuJoCo, Snap!), busy, at desktop and phone
+    widths, then with its server gone; the token prompt of a robot served with a token (PNG
+    files written)."""
     import httpx
 
     written = []
     with browser() as chrome:
-        with served("ergo-jr") as (url, _pid), httpx.Client(base_url=url) as http:
-            http.put("/api/v1/robot/compliant", json={"compliant": False})
-            http.post("/api/v1/moves/wave/record", json={"motors": ["m1", "m2", "m3"]})
-            for angles in ([30, -20, 20], [-30, 10, -20], [0, 0, 0]):
-                http.post(
-                    "/api/v1/gotos",
-                    json={
-                        "positions": dict(zip(["m1", "m2", "m3"], angles, strict=True)),
-                        "duration_s": 0.8,
-                        "wait": True,
-                    },
-                )
-            http.post("/api/v1/moves/wave/save")
-            http.put("/api/v1/primitives/sinus/properties/amplitude", json={"value": 25})
-            http.post("/api/v1/primitives/sinus/start")
+        with served("ergo-jr", ("--sim", "--no-sensors", "--token", "s3cret-figure")) as (
+            url,
+            _pid,
+        ):
+            context = chrome.new_context(viewport={"width": 1280, "height": 700})
+            page = context.new_page()
+            page.goto(url + "/")
+            page.wait_for_selector("#token-dialog[open]")
+            time.sleep(1.5)
+            path = os.path.join(folder, "web-token.png")
+            page.screenshot(path=path)
+            written.append(path)
+            context.close()
+        options = (*SHOWN_AS, str(free_port()))
+        with served("ergo-jr", options) as (url, _pid), httpx.Client(base_url=url) as http:
+            _busy(http)
             shots = (
                 ("desktop", (1280, 900), False),
                 ("phone", (390, 844), True),
@@ -244,8 +282,11 @@ def screenshots(folder: str) -> list[str]:
                 page.wait_for_function(READY, timeout=30_000)
                 page.click("button[aria-label='plot wave']")
                 page.wait_for_selector("#plot polyline")
+                if name == "desktop":
+                    page.click("#camera-camera button")  # what the simulated camera sees
+                    page.wait_for_function(SEEN, timeout=90_000)
                 page.evaluate("window.scrollTo(0, 0)")
-                time.sleep(1.5)
+                time.sleep(3.0)  # the 3D view drawn
                 if name == "offline":
                     break  # shot once the server is gone
                 path = os.path.join(folder, f"web-{name}.png")

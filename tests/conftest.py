@@ -50,6 +50,7 @@ BROWSER_MODULES = {
     "server/test_mdns_browser.py",
     "server/test_settings_page.py",
     "server/test_web_view.py",
+    "server/test_web_page_layout.py",
 }
 # pytest-timeout (120 s, by signal) stops a test that waits in Python. A thread stuck inside a
 # C library (an OpenGL driver, a serial ioctl) never sees the signal; this watchdog then prints

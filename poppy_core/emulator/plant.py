@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Sequence
 from typing import Protocol, runtime_checkable
 
@@ -35,14 +36,19 @@ HAND_FRICTION_PCT = 2.0
 """Present load of a compliant horn while a hand moves it (percent, against the motion)."""
 STALL_SPAN_DEG = 5.0
 """How far a hand pulls a stiff horn away from its position for the full torque limit."""
+SPEED_WINDOW_S = 0.1
+"""A stiff horn's present speed is its mean velocity over this last stretch of time."""
 
 
 class IdealPlant:
     """An ideal servo: moves toward its goal at its moving speed, no inertia, no load.
 
     - torque on: the position goes toward the goal (clamped to the angle limits) at the moving
-      speed (0 = the model's no-load speed, never faster than it); present speed is that speed
-      while moving, 0 once there; ``moving`` is set while the goal is not reached;
+      speed (0 = the model's no-load speed, never faster than it); present speed is the horn's
+      mean velocity over the last ``SPEED_WINDOW_S`` (the moving speed during a long move, 0
+      once still; a goto's goal moved a little at each step reads as the goto's speed, not 0:
+      the horn reaches each of those goals within the step); ``moving`` is set while the goal
+      is not reached;
     - torque off (compliant): the horn stays where it is (or where it was put by hand);
     - present load is 0, unless a hand holds the horn (``motor.hand_deg``, see
       ``poppy_core.emulator.hand``): a compliant horn follows the hand, its present speed is
@@ -60,6 +66,9 @@ class IdealPlant:
         self._motors: list[VirtualMotor] = []
         self._position: dict[int, float] = {}
         self._written: dict[int, float] = {}
+        self._clock = 0.0
+        self._moves: dict[int, deque[tuple[float, float, float]]] = {}
+        """Per motor, its recent stretches of motion: (start s, end s, velocity °/s)."""
 
     def attach(self, motors: Sequence[VirtualMotor]) -> None:
         """Take charge of ``motors``."""
@@ -75,6 +84,22 @@ class IdealPlant:
         for motor in self._motors:
             with motor.lock:
                 self._step_motor(motor, dt_s)
+        self._clock += dt_s
+
+    def _mean_speed(self, key: int, moved: float, moving_s: float, dt_s: float) -> float:
+        """The mean velocity over the last ``SPEED_WINDOW_S``, once this step moved ``moved``
+        degrees in its first ``moving_s`` seconds (of ``dt_s``)."""
+        moves = self._moves.setdefault(key, deque())
+        if moved:
+            moves.append((self._clock, self._clock + moving_s, moved / moving_s))
+        end = self._clock + dt_s
+        start = end - SPEED_WINDOW_S
+        while moves and moves[0][1] <= start:
+            moves.popleft()
+        if not moves:
+            return 0.0
+        travelled = sum(v * (min(b, end) - max(a, start)) for a, b, v in moves if b > start)
+        return travelled / min(SPEED_WINDOW_S, end)
 
     def _step_motor(self, motor: VirtualMotor, dt_s: float) -> None:
         key = id(motor)
@@ -96,11 +121,13 @@ class IdealPlant:
             delta = goal - position
             max_step = motor.speed_limit_dps * dt_s
             if abs(delta) <= max_step or abs(delta) < 1e-9:
+                moved, moving_s = delta, abs(delta) / motor.speed_limit_dps
                 position = goal
             else:
-                position += math.copysign(max_step, delta)
-                speed = math.copysign(motor.speed_limit_dps, delta)
+                moved, moving_s = math.copysign(max_step, delta), dt_s
+                position += moved
                 moving = True
+            speed = self._mean_speed(key, moved if abs(moved) >= 1e-9 else 0.0, moving_s, dt_s)
             if hand is not None:
                 push = max(-1.0, min(1.0, (hand - position) / STALL_SPAN_DEG))
                 load = -push * motor.torque_limit_pct

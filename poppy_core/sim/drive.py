@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
@@ -19,6 +20,11 @@ _MOVING_DPS = 2.0
 # every call may wait a whole thread switch interval (5 ms) to get it back while the bus and the
 # sync loops run, so stepping one call per physics step cannot keep real time.
 RAMP_SEGMENT_STEPS = 5
+
+# Present speed: the joint's mean velocity over this last stretch of simulated time. The joint's
+# instantaneous velocity jitters with each goal step of a goto or a primitive (sampled, it read
+# +30 °/s on a joint going down at 75 °/s); a servo's speed register is a measured mean too.
+SPEED_WINDOW_S = 0.1
 
 State = tuple[float, float, float, bool]
 
@@ -54,6 +60,7 @@ class Drive:
         self._load_scale = empty
         self._dirty = True  # gains or force ranges to write into the model
         self._settled = False  # every target at its goal and in data.ctrl: nothing ramps
+        self._sensed: deque[tuple[float, np.ndarray]] = deque()  # (sim time, joint angles)
 
     def add(self, joint: Joint, target_rad: float) -> int:
         """Add a motor's joint (compliant, target and goal ``target_rad``); returns its index."""
@@ -163,14 +170,29 @@ class Drive:
         self.target[index] = target_rad
         self._settled = False
 
+    def _mean_speed(self, now: float, position: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+        """Each joint's mean velocity (°/s) over the last ``SPEED_WINDOW_S`` of simulated time
+        (its velocity now until that much time is sensed)."""
+        sensed = self._sensed
+        if sensed and (now < sensed[-1][0] or len(sensed[-1][1]) != len(position)):
+            sensed.clear()  # the simulation was reset, or a motor added
+        sensed.append((now, position.copy()))
+        while len(sensed) > 1 and now - sensed[1][0] >= SPEED_WINDOW_S:
+            sensed.popleft()
+        then, before = sensed[0]
+        if now - then < SPEED_WINDOW_S / 2:
+            return velocity
+        return np.asarray((position - before) / (now - then))
+
     def sense(self, data: Any) -> list[State]:
         """Each motor's (position °, speed °/s, load %, moving), in the motor's frame."""
         position = np.degrees(data.qpos[self.qpos])
-        speed = np.degrees(data.qvel[self.dof])
+        velocity = np.degrees(data.qvel[self.dof])
+        speed = self._mean_speed(float(data.time), position, velocity)
         # e-manual: present load is a percentage of the maximum (stall) torque
         load = data.actuator_force[self.act] * self._load_scale
         load = np.minimum(np.maximum(load, -100.0), 100.0)
-        moving = np.abs(speed) > _MOVING_DPS
+        moving = np.abs(velocity) > _MOVING_DPS
         if not self._settled:
             moving |= np.abs(self.goal - self.target) > _REACHED_RAD
         moving &= self.on

@@ -111,7 +111,8 @@ def test_the_page_is_reached_by_the_announced_name(
     context, page = _open(browser, f"http://{name}.local:{servers.http.port}/")
     try:
         page.wait_for_function("() => window.poppy && window.poppy.ready")
-        assert page.inner_text("#robot-name") == "ergo-jr"
+        assert page.inner_text("#robot-name") == name  # the robot's name, its creature beside
+        assert page.inner_text("#creature") == "ergo-jr"
         assert page.evaluate("() => location.host") == f"{name}.local:{servers.http.port}"
     finally:
         context.close()

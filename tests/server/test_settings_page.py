@@ -43,7 +43,7 @@ def _settings_page(browser: Any, served: Served) -> tuple[Any, Any]:
     page.set_default_timeout(WAIT_MS)
     page.goto(served.url + "/")
     page.wait_for_function("() => window.poppy && window.poppy.ready")
-    page.click("#settings summary")
+    page.click("#settings-open")
     page.wait_for_selector("#settings-version")
     return context, page
 

@@ -31,6 +31,34 @@ def test_pypots_route_listing_moved_to_routes(client: httpx.Client) -> None:
     assert "/robot.json" in client.get("/routes").text
 
 
+def test_about_names_the_robot_as_served_and_as_renamed(
+    client: httpx.Client, served: Served, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # `/api/v1/web/about` gave the profile as the name: a robot served --name jr1 was "ergo-jr"
+    served_robot = served.app.state.settings.served
+    monkeypatch.setattr(served_robot, "name", "jr1")  # what `poppy serve --name jr1` sets
+    about = client.get("/api/v1/web/about").json()
+    assert (about["name"], about["creature"]) == ("jr1", "ergo-jr")
+    served_robot.named("jr2")  # renamed from the settings, or the mDNS name won
+    assert client.get("/api/v1/web/about").json()["name"] == "jr2"
+
+
+def test_about_shows_no_black_camera_and_no_dead_jupyter(
+    client: httpx.Client, served: Served, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import socket
+
+    with socket.socket() as probe:  # a port nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        closed = probe.getsockname()[1]
+    monkeypatch.setattr(served.app.state, "web_notebook_port", closed)
+    monkeypatch.setattr(served.app.state, "web_notebook_seen", {})
+    about = client.get("/api/v1/web/about").json()
+    assert about["cameras"] == ["camera"]  # an ideal simulation's DummyCamera: black frames
+    assert about["camera_views"] == [] and about["no_camera"].startswith("No camera")
+    assert about["notebook"] is None  # the page links to no Jupyter
+
+
 def test_about_says_what_the_robot_is(client: httpx.Client) -> None:
     about = client.get("/api/v1/web/about").json()
     assert about["name"] == "ergo-jr" and about["simulated"] is True

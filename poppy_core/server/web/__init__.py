@@ -9,6 +9,7 @@ import time
 from importlib.resources import files
 from typing import TYPE_CHECKING
 
+from poppy_core.server.web.about_parts import NOTEBOOK_PORT
 from poppy_core.server.web.logs import LogBuffer
 
 if TYPE_CHECKING:
@@ -62,6 +63,8 @@ def add_web_page(app: FastAPI) -> None:
     app.state.web_started = time.monotonic()
     app.state.web_links = {"API docs": "/docs", "routes": "/routes"}
     app.state.web_notes = {}
+    app.state.web_notebook_port = NOTEBOOK_PORT  # the Jupyter linked when it answers there
+    app.state.web_notebook_seen = {}
     app.state.web_logs = LogBuffer()
     index = f"{static_folder()}/index.html"
 

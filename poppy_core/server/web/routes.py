@@ -22,6 +22,7 @@ from poppy_core.server.deps import Service
 from poppy_core.server.schemas import Problem
 from poppy_core.server.service import RobotService
 from poppy_core.server.values import jsonable
+from poppy_core.server.web.about_parts import camera_views, notebook, robot_name
 from poppy_core.server.web.logs import LogBuffer
 
 logger = logging.getLogger(__name__)
@@ -58,14 +59,19 @@ def about(robot: Robot, request: Request) -> dict[str, Any]:
     profile = robot.config.profile if robot.config is not None else None
     state = request.app.state
     health = {name: h.as_dict() for name, h in robot.health().items()}
+    settings = getattr(state, "settings", None)
+    name, creature = robot_name(robot, settings.served.name if settings is not None else None)
+    views, no_camera = camera_views(robot)
     return {
-        "name": profile.name if profile else "robot",
-        "creature": (profile.kind or profile.name) if profile else "custom",
+        "name": name,
+        "creature": creature,
         "description": profile.description if profile else "",
         "simulated": simulated(robot),
         "uptime_s": round(time.monotonic() - state.web_started, 1),
         "buses": jsonable(health),
         "cameras": [s.name for s in robot.sensors if isinstance(s, Camera)],
+        "camera_views": views,
+        "no_camera": no_camera,
         "sensors": {name: h.as_dict() for name, h in robot.sensor_health().items()},
         "chains": _chain_names(robot),
         "links": dict(state.web_links),
@@ -126,8 +132,12 @@ def stop_everything(service: RobotService, then: str) -> StopResult:
 
 @router.get("/about", summary="The robot: name, creature, buses' health, uptime, links")
 async def about_route(request: Request, service: Service) -> dict[str, Any]:
-    """What the page shows in its header."""
-    return about(service.robot, request)
+    """What the page shows in its header; ``notebook`` (port and path) when a Jupyter answers
+    on the address the page reached this server at, else null."""
+    answer = about(service.robot, request)
+    server = request.scope.get("server")
+    answer["notebook"] = await notebook(request.app.state, server[0] if server else None)
+    return answer
 
 
 @router.get("/motors", summary="Each motor's goal, voltage, compliance, limits (LED values)")

@@ -5,6 +5,17 @@
 
 const TOKEN_KEY = "poppy-token";
 let asking = null;
+const askedListeners = [];
+
+// True while the page waits for the token to be entered.
+export function tokenAsked() {
+  return asking !== null;
+}
+
+// Call `listener` when the token dialog opens and once a token is entered.
+export function onTokenAsked(listener) {
+  askedListeners.push(listener);
+}
 
 export function token() {
   return localStorage.getItem(TOKEN_KEY) || "";
@@ -39,11 +50,13 @@ function askToken(wrong) {
         localStorage.setItem(TOKEN_KEY, input.value.trim());
         input.value = "";
         asking = null;
+        for (const listener of askedListeners) listener();
         resolve();
       });
       dialog.showModal();
       input.focus();
     });
+    for (const listener of askedListeners) listener();
   }
   return asking;
 }

@@ -1,5 +1,5 @@
 // The robot's home page: fetches who the robot is, builds each part, keeps them live.
-import { api, get, openStream, post } from "./api.js";
+import { api, get, onTokenAsked, openStream, post, tokenAsked } from "./api.js";
 import { showCameras, showChains } from "./extras.js";
 import { refreshFleet } from "./fleet.js";
 import { buildTable, onFrame, refresh, stats } from "./motors.js";
@@ -13,6 +13,7 @@ import { setupView, viewFrame } from "./view-panel.js";
 const STREAM_HZ = 20;
 let uptimeBase = null;
 let live = false; // frames are arriving: the page shows the robot as it is
+let everLive = false; // the page has shown the robot: its values may be stale now
 
 function duration(seconds) {
   const s = Math.floor(seconds);
@@ -20,10 +21,20 @@ function duration(seconds) {
   return h ? `${h} h ${m} min` : m ? `${m} min ${s % 60} s` : `${s} s`;
 }
 
+// The links for programmers sit with the robot; the header keeps those a class uses (Snap!,
+// Jupyter), short enough not to wrap it.
+const DEV_LINKS = new Set(["API docs", "routes"]);
+
+function link(name, url) {
+  return el("a", { href: url, textContent: name, target: name === "routes" ? "" : "_blank", rel: "noopener" });
+}
+
 function showAbout(about) {
   document.getElementById("robot-name").textContent = about.name;
-  document.title = `${about.name} · poppy`;
-  document.getElementById("creature").textContent = about.creature;
+  // the creature beside the name, once (a robot served without --name is named after it)
+  const creature = about.creature === about.name ? "" : about.creature;
+  document.getElementById("creature").textContent = creature;
+  document.title = `${about.name} · ${creature || "poppy"}`;
   document.getElementById("description").textContent = about.description;
   document.getElementById("sim-badge").hidden = !about.simulated;
   uptimeBase = { at: performance.now(), uptime: about.uptime_s };
@@ -42,10 +53,14 @@ function showAbout(about) {
     return el("li", { className: sensor.ok ? "ok" : "bad" },
       el("strong", { textContent: name }), ` ${sensor.kind}: ${text}`);
   }));
-  const links = document.getElementById("links");
-  links.replaceChildren(...Object.entries(about.links).map(([name, url]) =>
-    el("a", { href: url, textContent: name, target: name === "routes" ? "" : "_blank", rel: "noopener" })),
-    notebookLink(), ...notes(about));
+  const entries = Object.entries(about.links);
+  const shown = [...entries.filter(([name]) => !DEV_LINKS.has(name)).map(([n, u]) => link(n, u)),
+    notebookLink(about)].filter(Boolean);
+  document.getElementById("links").replaceChildren(...shown);
+  const dev = entries.filter(([name]) => DEV_LINKS.has(name)).map(([n, u]) => link(n, u));
+  document.getElementById("dev-links").replaceChildren(
+    ...(dev.length ? ["For programmers: ", ...dev.flatMap((a, i) => (i ? [" · ", a] : [a]))] : []),
+    ...notes(about).flatMap((note) => [el("br"), note]));
 }
 
 function tickUptime() {
@@ -107,16 +122,20 @@ function setupStop() {
 
 // The stream is up (frames arriving) or down: down, everything is greyed out and every control
 // is off (the values shown are the last received, not the robot's); back, all is read again.
+// Before the first frame there is nothing stale to warn about: the badge says what the page
+// waits for (the token, or the robot), and no outage banner shows.
 function setLive(up) {
   const conn = document.getElementById("conn");
-  conn.textContent = up ? "connected" : "disconnected";
-  conn.className = `badge ${up ? "ok" : "bad"}`;
+  const waiting = !up && !everLive;
+  conn.textContent = up ? "connected" : waiting ? (tokenAsked() ? "token needed" : "connecting…") : "disconnected";
+  conn.className = `badge ${up ? "ok" : waiting ? "" : "bad"}`;
   const wasDown = !live;
   live = up;
-  document.body.classList.toggle("offline", !up);
+  everLive = everLive || up;
+  document.body.classList.toggle("offline", !up && everLive);
   document.getElementById("live").disabled = !up;
   document.getElementById("stop-all").disabled = !up;
-  document.getElementById("offline").hidden = up;
+  document.getElementById("offline").hidden = up || !everLive;
   if (!up) {
     document.getElementById("stop-dialog").close();
     document.getElementById("rate").textContent = "not live: no connection";
@@ -143,6 +162,7 @@ async function main() {
   window.poppy = { stats };
   setupStop();
   setupSettings();
+  onTokenAsked(() => { if (!live) setLive(false); }); // the badge says what the page waits for
   // the stream opens at once and every first request goes out together: first values sooner
   openStream(STREAM_HZ, (frame) => { onFrame(frame); viewFrame(frame); }, setLive);
   const [about, details] = await Promise.all([
@@ -153,7 +173,7 @@ async function main() {
   const motors = Object.keys(details.motors); // in the robot's order
   buildTable(motors, details);
   setupRecorder(motors);
-  showCameras(about.cameras);
+  showCameras(about);
   showChains(about.chains);
   rateMeter();
   every(1, tickUptime);

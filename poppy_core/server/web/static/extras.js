@@ -2,20 +2,25 @@
 import { get, post, token } from "./api.js";
 import { button, el, say } from "./ui.js";
 
-export function showCameras(cameras) {
-  if (!cameras.length) return;
+// The camera panel: each camera with a picture (a real one, MuJoCo's simulated one) under its
+// label, shown on demand; without one, the panel says why ("no camera").
+export function showCameras(about) {
   const views = document.getElementById("camera-views");
-  for (const name of cameras) {
-    const img = el("img", { alt: `camera ${name}`, width: 320 });
+  if (!about.camera_views.length) {
+    views.replaceChildren(el("p", { className: "muted", id: "no-camera", textContent: about.no_camera }));
+    return;
+  }
+  views.replaceChildren(...about.camera_views.map(({ name, label }) => {
+    const img = el("img", { alt: `what ${name} sees`, width: 320, height: 240 });
     const start = button(`show ${name}`, async () => {
       if (img.src) { img.removeAttribute("src"); start.textContent = `show ${name}`; return; }
       // an <img> cannot send a header: with a token, the stream is read with fetch instead
       if (token()) { await streamWithFetch(name, img); } else { img.src = `/api/v1/sensors/${name}/stream.mjpg?fps=10`; }
       start.textContent = `hide ${name}`;
     });
-    views.append(el("figure", {}, img, el("figcaption", {}, start)));
-  }
-  document.getElementById("camera").hidden = false;
+    return el("figure", { className: "camera-view", id: `camera-${name}` }, img,
+      el("figcaption", {}, el("span", { className: "camera-label", textContent: label }), start));
+  }));
 }
 
 // Polls single frames with the Authorization header (about 5 per second).

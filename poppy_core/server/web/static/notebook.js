@@ -1,15 +1,17 @@
-// The links the page adds by itself: the Jupyter notebook of `poppy notebook` (port 8888), and
-// the server's notes (how to get Snap! offline...).
+// The links the page adds by itself: the Jupyter notebook of `poppy notebook`, only while a
+// Jupyter answers (the server says where: /api/v1/web/about's `notebook`), and the server's
+// notes (how to get Snap! offline...).
 import { el } from "./ui.js";
 
-export const NOTEBOOK_PORT = 8888;
-export const NOTEBOOK_FILE = "discover-your-robot.ipynb";
+export const NOTEBOOK_TEXT = "Jupyter: discover your robot";
 
-export function notebookLink() {
+// The link to the notebook on the page's own host name, or null when no Jupyter runs there.
+export function notebookLink(about) {
+  if (!about.notebook) return null;
   const host = location.hostname.includes(":") ? `[${location.hostname}]` : location.hostname;
-  const url = `${location.protocol}//${host}:${NOTEBOOK_PORT}/notebooks/${NOTEBOOK_FILE}`;
-  return el("a", { href: url, textContent: "Jupyter: discover your robot", target: "_blank",
-    rel: "noopener", title: "needs `poppy notebook` running on the robot (port 8888)" });
+  const url = `${location.protocol}//${host}:${about.notebook.port}${about.notebook.path}`;
+  return el("a", { href: url, textContent: NOTEBOOK_TEXT, target: "_blank", rel: "noopener",
+    id: "link-jupyter", title: `the notebook of \`poppy notebook\` (port ${about.notebook.port})` });
 }
 
 export function notes(about) {

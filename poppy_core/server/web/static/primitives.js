@@ -1,14 +1,13 @@
-// Behaviours: each primitive with start / pause / resume / stop and its properties editable.
+// Behaviours: a compact list, each primitive with its state, one start/stop toggle, and under
+// its "⋯" pause / resume and its properties (editable).
 import { get, post, put } from "./api.js";
 import { button, el, say } from "./ui.js";
 
-const cards = new Map(); // name -> {state, inputs, node, actions}
-const ACTIONS = ["start", "pause", "resume", "stop"];
-// What each state allows (poppy_core.motion.primitive: idle, running, paused, stopped, failed)
-const ALLOWED = {
-  idle: ["start"], stopped: ["start"], failed: ["start"],
-  running: ["pause", "stop"], paused: ["resume", "stop"],
-};
+const rows = new Map(); // name -> {state, inputs, node, run, pause, resume}
+// One toggle per behaviour: start when it can start, stop when it runs or is paused
+// (poppy_core.motion.primitive: idle, running, paused, stopped, failed); pause and resume
+// sit with its properties, under its "⋯".
+const STARTS = new Set(["idle", "stopped", "failed"]);
 
 function parse(text, old) {
   if (typeof old === "number") return Number(text);
@@ -30,7 +29,7 @@ async function control(name, action) {
   }
 }
 
-function card(info) {
+function row(info) {
   const state = el("span", { className: "state" });
   const inputs = new Map();
   const props = el("div", { className: "props" });
@@ -53,29 +52,40 @@ function card(info) {
     inputs.set(prop, input);
     props.append(el("label", {}, el("span", { textContent: prop }), input));
   }
-  const buttons = new Map(ACTIONS.map((a) => [a, button(a, () => control(info.name, a), `${a} ${info.name}`)]));
-  const actions = el("div", { className: "actions" }, ...buttons.values());
-  const node = el("article", { id: `primitive-${info.name}`, className: "card" },
-    el("h3", {}, info.name, " ", state), actions,
-    el("details", {}, el("summary", { textContent: "properties" }), props));
+  const run = button("start", () => control(info.name, run.dataset.action));
+  run.className = "run";
+  const pause = button("pause", () => control(info.name, "pause"), `pause ${info.name}`);
+  const resume = button("resume", () => control(info.name, "resume"), `resume ${info.name}`);
+  const more = el("div", { className: "more", id: `more-${info.name}`, hidden: true },
+    el("div", { className: "actions" }, pause, resume), props);
+  const fold = button("⋯", () => {
+    more.hidden = !more.hidden;
+    fold.setAttribute("aria-expanded", String(!more.hidden));
+  }, `more of ${info.name}: pause, resume, properties`);
+  fold.className = "fold";
+  fold.setAttribute("aria-expanded", "false");
+  fold.setAttribute("aria-controls", more.id);
+  const node = el("li", { id: `primitive-${info.name}`, className: "behaviour" },
+    el("div", { className: "row" }, el("strong", { textContent: info.name, title: info.name }), state, run, fold),
+    more);
   node.dataset.primitive = info.name;
-  cards.set(info.name, { state, inputs, node, buttons });
+  rows.set(info.name, { state, inputs, node, run, pause, resume });
   return node;
 }
 
 function update(info) {
-  const found = cards.get(info.name);
+  const found = rows.get(info.name);
   if (!found) return;
   found.state.textContent = info.state + (info.error ? ` (error: ${info.error.message ?? ""})` : "");
   found.state.className = `state ${info.state}`;
   found.node.dataset.state = info.state;
-  const allowed = ALLOWED[info.state] ?? ACTIONS; // a state this page does not know: all offered
-  const focused = [...found.buttons.values()].includes(document.activeElement);
-  for (const [action, node] of found.buttons) node.disabled = !allowed.includes(action);
-  // a keyboard user keeps a focus in the card: on the action the new state allows
-  if (focused && document.activeElement?.disabled !== false) {
-    [...found.buttons.values()].find((node) => !node.disabled)?.focus();
-  }
+  const action = STARTS.has(info.state) ? "start" : "stop";
+  found.run.dataset.action = action;
+  found.run.textContent = action;
+  found.run.setAttribute("aria-label", `${action} ${info.name}`);
+  found.run.setAttribute("aria-pressed", String(action === "stop"));
+  found.pause.disabled = info.state !== "running";
+  found.resume.disabled = info.state !== "paused";
   for (const [prop, input] of found.inputs) {
     if (document.activeElement !== input && prop in info.properties) {
       input.value = show(info.properties[prop]);
@@ -88,7 +98,7 @@ export async function refreshPrimitives() {
   try { list = await get("/api/v1/primitives"); } catch { return; }
   const container = document.getElementById("primitive-list");
   for (const info of list) {
-    if (!cards.has(info.name)) container.append(card(info));
+    if (!rows.has(info.name)) container.append(row(info));
     update(info);
   }
 }

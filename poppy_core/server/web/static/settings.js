@@ -140,10 +140,17 @@ export async function showSettings() {
     row("Version", el("span", { id: "settings-version", textContent: `poppy ${settings.version}` })));
 }
 
-// The panel is read when first opened (it asks the OS: not on every page load).
+// One click on the header's Settings opens the panel at the top of the page (read when first
+// opened: it asks the OS, not on every page load); again, or its close button, hides it.
 export function setupSettings() {
   const panel = document.getElementById("settings");
-  panel.addEventListener("toggle", () => {
-    if (panel.open && !loaded) { loaded = true; showSettings(); }
-  });
+  const open = document.getElementById("settings-open");
+  const show = (on) => {
+    panel.hidden = !on;
+    open.setAttribute("aria-expanded", String(on));
+    if (on && !loaded) { loaded = true; showSettings(); }
+    if (on) window.scrollTo({ top: 0 }); // the panel heads the page, under the header
+  };
+  open.addEventListener("click", () => show(panel.hidden));
+  document.getElementById("settings-close").addEventListener("click", () => { show(false); open.focus(); });
 }
