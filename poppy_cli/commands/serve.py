@@ -1,6 +1,6 @@
-"""`poppy serve --http [--ws] [--snap] [--zmq] [--zenoh] [--ros2]`: serve a robot over REST
-(pypot's routes + /api/v1), WebSocket, Snap!'s routes, pypot's ZMQ request/reply API, Zenoh
-(fleets) and ROS 2 (rmw_zenoh's wire)."""
+"""`poppy serve --http [--ws] [--snap] [--zmq] [--zenoh] [--ros2] [--foxglove]`: serve a robot
+over REST (pypot's routes + /api/v1), WebSocket, Snap!'s routes, pypot's ZMQ request/reply API,
+Zenoh (fleets), ROS 2 (rmw_zenoh's wire) and Foxglove (foxglove-sdk's WebSocket server)."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 import typer
 
 from poppy_cli.commands.serve_files import read_served_files
+from poppy_cli.commands.serve_foxglove import announce_foxglove, check_foxglove
 from poppy_cli.commands.serve_ros2 import announce_ros2, ros2_settings
 from poppy_cli.commands.serve_snap import announce_snap, check_snap_options
 from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, finite
@@ -163,13 +164,24 @@ def serve(
     ros_namespace: str | None = typer.Option(
         None, "--ros-namespace", help="The node's ROS 2 namespace, e.g. /lab (default /)."
     ),
+    foxglove: bool = typer.Option(
+        False,
+        "--foxglove",
+        help="Serve the robot to the Foxglove app (no ROS needed): its URDF and meshes, joint "
+        "states, camera, detections and health, on --host (see docs/foxglove.md).",
+    ),
+    foxglove_port: int = typer.Option(
+        8765, "--foxglove-port", min=0, max=65535, help="Foxglove WebSocket port."
+    ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
-    from poppy_core.errors import ConfigError
+    from poppy_core.errors import ArgumentError, ConfigError
 
     snap, zmq, token = read_served_files(settings, token_file, token, snap, zmq)
-    if not (http or ws or snap or zmq or zenoh or ros2):
-        _usage("nothing to serve: pass --http, --ws, --snap, --zmq, --zenoh and/or --ros2")
+    if not (http or ws or snap or zmq or zenoh or ros2 or foxglove):
+        _usage(
+            "nothing to serve: pass --http, --ws, --snap, --zmq, --zenoh, --ros2 and/or --foxglove"
+        )
     http_port, *alias_ports = http_ports or [8080]
     _check_http_ports(http_ports)
     robot_name = _robot_name(name)
@@ -189,6 +201,17 @@ def serve(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
             "server streams the same state at /api/v1/ws)"
         )
+    if (
+        foxglove
+        and foxglove_port != 0
+        and foxglove_port
+        in _ports_taken(http_ports if http else [], ws_port if ws else 0, zmq_port if zmq else 0)
+    ):
+        _usage(f"--foxglove-port {foxglove_port} is also another server's port: choose another")
+    try:
+        check_foxglove(foxglove, host, token)
+    except ArgumentError as exc:
+        _usage(str(exc))
     snap_dir = check_snap_options(
         snap,
         snap_port,
@@ -217,6 +240,7 @@ def serve(
         report=_report,
         zenoh=zenoh_settings,
         ros2=ros2_spec,
+        foxglove=Listen(host, foxglove_port) if foxglove else None,
         settings_file=settings,
         token_file=token_file,
     )
@@ -264,6 +288,11 @@ def _robot_name(name: str | None) -> str | None:
         return robot_name(name, "--name")
     except ArgumentError as exc:
         _usage(str(exc))
+
+
+def _ports_taken(http_ports: list[int], ws_port: int, zmq_port: int) -> set[int]:
+    """The fixed ports of the other servers asked for (0, a free port, is nobody's)."""
+    return {p for p in [*http_ports, ws_port, zmq_port] if p != 0}
 
 
 def _check_http_ports(ports: list[int]) -> None:
@@ -354,6 +383,7 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
         where = ", ".join(servers.zenoh.endpoints) or "no endpoint (it connects out)"
         print(f"zenoh: poppy/{servers.zenoh.name} listening on {where}", flush=True)
     announce_ros2(servers)
+    announce_foxglove(servers)
     if servers.http is not None:  # last: scripts read the lines above by their order
         print(f"page: http://{base}:{servers.http.port}/ (with the 3D view)", flush=True)
 

@@ -1,0 +1,147 @@
+"""``FoxgloveServer``: foxglove-sdk's WebSocket server over a robot (``poppy serve --foxglove``).
+
+Foxglove (the app, desktop or web) connects to ``ws://HOST:PORT`` and subscribes to the
+publisher's channels; its 3D panel fetches the URDF's meshes from the server (``package://``
+URLs, the ``assets`` capability). The server only shows the robot: it takes no command (no
+client publishing, no services, no parameters).
+
+foxglove-sdk's server has no authentication: it cannot ask for the token the other servers
+require. ``check_access`` refuses it on an address other machines reach while a token is
+required; on loopback it serves this machine's programs only, as the default does.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import foxglove
+from foxglove import Context
+from foxglove.websocket import ChannelView, Client, ServerListener, WebSocketServer
+
+from poppy_core.errors import ArgumentError
+from poppy_core.server.errors import ListenError
+from poppy_core.server.foxglove.assets import RobotAssets
+from poppy_core.server.foxglove.publisher import FoxglovePublisher
+from poppy_core.server.host_names import is_loopback
+from poppy_core.server.runner import listen_error
+
+if TYPE_CHECKING:
+    from poppy_core.robot import Robot
+
+logger = logging.getLogger(__name__)
+
+DEFAULT_PORT = 8765
+"""Foxglove's usual WebSocket port (foxglove_bridge's and the SDK's)."""
+_OS_ERROR = re.compile(r"os error (\d+)")
+
+
+def check_access(host: str, token: str | None) -> None:
+    """Refuse a Foxglove server that would let others past the token.
+
+    Raises:
+        ArgumentError: a token is required and ``host`` is not loopback.
+    """
+    if token and not is_loopback(host.strip("[]")):
+        raise ArgumentError(
+            f"the Foxglove server cannot require the token (foxglove-sdk's WebSocket server "
+            f"has no authentication): it serves on loopback only, not on {host}; reach it "
+            "through an SSH tunnel (ssh -L 8765:127.0.0.1:8765 ...) or serve without a token",
+            field="host",
+            value=host,
+        )
+
+
+class _Listener(ServerListener):
+    """A client subscribing to a channel gets the URDF and health at once."""
+
+    def __init__(self, publisher: FoxglovePublisher) -> None:
+        self.publisher = publisher
+
+    def on_subscribe(self, client: Client, channel: ChannelView) -> None:
+        self.publisher.listening()
+
+
+class FoxgloveServer:
+    """The robot on foxglove-sdk's WebSocket server, bound on ``host:port`` (0: a free port).
+
+    Args:
+        robot: the robot shown.
+        host: the address to listen on.
+        port: the port (0 picks a free one).
+        name: the robot's name (the server's name in Foxglove).
+        state_rate_hz: joint states and transforms per second.
+        token: the token the other servers require (refused off loopback: ``check_access``).
+
+    Raises:
+        ListenError: the port is taken or the address is not this machine's.
+        ArgumentError: a token with a host other than loopback.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        host: str,
+        port: int,
+        name: str,
+        *,
+        state_rate_hz: float = 50.0,
+        token: str | None = None,
+    ) -> None:
+        check_access(host, token)
+        self.host = host
+        self.name = name
+        self.context = Context()
+        self.publisher = FoxglovePublisher(robot, self.context, name, state_rate_hz=state_rate_hz)
+        self.assets: RobotAssets | None = None
+        source = self.publisher.joints.description
+        if self.publisher.joints.urdf is not None and source is not None:
+            self.assets = RobotAssets(Path(source.source), self.publisher.joints.urdf)
+        try:
+            self._server: WebSocketServer | None = foxglove.start_server(
+                name=f"poppy {name}",
+                host=host,
+                port=port,
+                server_listener=_Listener(self.publisher),
+                asset_handler=self.assets.fetch if self.assets is not None else None,
+                context=self.context,
+            )
+        except RuntimeError as exc:  # the SDK's FoxgloveError: "Failed to bind port: ..."
+            self.publisher.close()
+            raise _bind_error(exc, host, port) from None
+        self.port = self._server.port
+
+    @property
+    def url(self) -> str:
+        """``ws://HOST:PORT`` (what Foxglove's "Open connection" takes)."""
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return f"ws://{host}:{self.port}"
+
+    @property
+    def running(self) -> bool:
+        """True while the server serves and the publisher publishes."""
+        return self._server is not None and self.publisher.running
+
+    def start(self) -> None:
+        """Publish (the server already listens)."""
+        self.publisher.start()
+
+    def stop(self) -> None:
+        """Stop publishing, then the server (every client is disconnected)."""
+        self.publisher.stop()
+        server, self._server = self._server, None
+        if server is not None:
+            server.stop()
+        self.publisher.close()
+
+
+def _bind_error(exc: RuntimeError, host: str, port: int) -> ListenError:
+    match = _OS_ERROR.search(str(exc))
+    if match is None:
+        return ListenError(f"cannot listen on {host}:{port}: {exc}")
+    import os
+
+    code = int(match.group(1))
+    return listen_error(OSError(code, os.strerror(code)), host, port)
