@@ -32,6 +32,7 @@ TOPICS = {
     "/health",
     "/camera/image",
     "/camera/detections",
+    "/robot_model",
 }
 
 
@@ -94,6 +95,21 @@ def test_a_recording_reads_back_with_every_channel_decoded(tmp_path: Path) -> No
     )
     assert {t.child_frame_id for t in decoded["/tf"][-1].transforms} >= {"long_U", "tip"}
     assert decoded["/camera/image"][0].data[:2] == b"\xff\xd8"
+    [scene] = decoded["/robot_model"]  # the meshes, embedded once (a file has no server)
+    urdf_meshes = {
+        line.split('"')[1].rsplit("/", 1)[1]
+        for line in URDF.read_text().splitlines()
+        if "package://" in line
+    }
+    frames = {e.frame_id for e in scene.entities}
+    assert frames == {"base_link", "long_U", "section_1", "section_2", "section_3"} | {
+        "section_4",
+        "tip",
+    }
+    embedded = {m.data for e in scene.entities for m in e.models}
+    assert embedded == {(URDF.parent / "meshes" / n).read_bytes() for n in urdf_meshes}
+    assert {m.media_type for e in scene.entities for m in e.models} == {"model/stl"}
+    assert all(e.frame_locked for e in scene.entities)
     assert any(line.message.startswith("bus ") for line in decoded["/health"])
 
 

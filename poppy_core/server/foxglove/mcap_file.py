@@ -2,9 +2,10 @@
 (``poppy record --mcap FILE``).
 
 The file gets what a Foxglove client would (``FoxglovePublisher``: joint states, transforms, the
-URDF, health, cameras and detections), written by foxglove-sdk's MCAP writer into a temporary
-file beside the target, put in place when the recording stops: a file at the target is
-always a whole MCAP file (the one there before, when the recording failed).
+URDF, health, cameras and detections) and the URDF's meshes embedded (``/robot_model``), written
+by foxglove-sdk's MCAP writer into a temporary file beside the target, put in place when the
+recording stops: a file at the target is always a whole MCAP file (the one there before, when
+the recording failed).
 """
 
 from __future__ import annotations
@@ -51,7 +52,9 @@ class McapRecording:
         self.path = output_path(path, replace=replace)
         self.replace = replace
         self.context = Context()
-        self.publisher = FoxglovePublisher(robot, self.context, name, state_rate_hz=state_rate_hz)
+        self.publisher = FoxglovePublisher(
+            robot, self.context, name, state_rate_hz=state_rate_hz, embed_model=True
+        )
         self._temp = self.path.parent / f".{self.path.name[:200]}.{secrets.token_hex(6)}.tmp"
         self._writer: foxglove.MCAPWriter | None = None
 

@@ -10,6 +10,8 @@ channel someone watches, never otherwise. Channels:
 - ``/tf`` (``foxglove.FrameTransforms``): the URDF's tree at those angles, with it;
 - ``/robot_description`` (JSON ``{"data": URDF}``): the URDF, when a sink starts listening and
   every few seconds (Foxglove's WebSocket protocol keeps no last message for late clients);
+- ``/robot_model`` (``foxglove.SceneUpdate``, files only: ``embed_model``): the URDF's meshes
+  embedded, one entity per link, logged once (a file has no server to fetch them from);
 - ``/health`` (``foxglove.Log``): every bus and sensor once at the start, then each change;
 - per camera ``/NAME/image`` (``foxglove.CompressedImage``, the camera's shared JPEG) and, with
   a marker or face detector on it, ``/NAME/detections`` (``foxglove.ImageAnnotations``).
@@ -22,6 +24,7 @@ import logging
 import threading
 import time
 from functools import partial
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from foxglove import Channel, Context, Schema
@@ -31,12 +34,15 @@ from foxglove.channels import (
     ImageAnnotationsChannel,
     JointStatesChannel,
     LogChannel,
+    SceneUpdateChannel,
 )
 
 from poppy_core import checks
 from poppy_core.errors import PoppyError
 from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
 from poppy_core.server.foxglove import robot_messages as messages
+from poppy_core.server.foxglove.assets import RobotAssets
+from poppy_core.server.foxglove.model_scene import model_scene
 from poppy_core.server.ros2.joints import UrdfJoints
 
 if TYPE_CHECKING:
@@ -63,10 +69,17 @@ class FoxglovePublisher:
         context: the SDK context its sinks (server, MCAP writer) listen to.
         name: the robot's name (the health log's ``name``).
         state_rate_hz: joint states and transforms per second.
+        embed_model: log the URDF's meshes on ``/robot_model`` (for files).
     """
 
     def __init__(
-        self, robot: Robot, context: Context, name: str, *, state_rate_hz: float = 50.0
+        self,
+        robot: Robot,
+        context: Context,
+        name: str,
+        *,
+        state_rate_hz: float = 50.0,
+        embed_model: bool = False,
     ) -> None:
         self.robot = robot
         self.context = context
@@ -82,13 +95,20 @@ class FoxglovePublisher:
         """Set when a sink started listening: the URDF goes out at once."""
         self._health: dict[str, messages.HealthLine] = {}
         self._detected: dict[str, tuple[float, list[Any]]] = {}
+        self._model_sent = False
         self.states = JointStatesChannel("/joint_states", context=context)
         self.health = LogChannel("/health", context=context)
         self.tf: FrameTransformsChannel | None = None
         self.description: Channel | None = None
+        self.model: SceneUpdateChannel | None = None
+        self.assets: RobotAssets | None = None
+        """The URDF and its meshes (``package://`` URLs), None without a URDF."""
         if self.joints.description is not None:
             self.tf = FrameTransformsChannel("/tf", context=context)
-        if self.joints.urdf is not None:
+        if self.joints.urdf is not None and self.joints.description is not None:
+            self.assets = RobotAssets(Path(self.joints.description.source), self.joints.urdf)
+            if embed_model:
+                self.model = SceneUpdateChannel("/robot_model", context=context)
             self.description = Channel(
                 "/robot_description",
                 schema=Schema(
@@ -119,9 +139,12 @@ class FoxglovePublisher:
     @property
     def topics(self) -> list[str]:
         """The channels' topics."""
-        channels: list[Any] = [self.states, self.health, self.tf, self.description]
+        return [c.topic() for c in self._channels()]
+
+    def _channels(self) -> list[Any]:
+        channels: list[Any] = [self.states, self.health, self.tf, self.description, self.model]
         channels += [c for _, c in self.cameras.values()] + list(self.detections.values())
-        return [c.topic() for c in channels if c is not None]
+        return [c for c in channels if c is not None]
 
     @property
     def running(self) -> bool:
@@ -149,11 +172,8 @@ class FoxglovePublisher:
     def close(self) -> None:
         """Stop and close the channels."""
         self.stop()
-        channels: list[Any] = [self.states, self.health, self.tf, self.description]
-        channels += [c for _, c in self.cameras.values()] + list(self.detections.values())
-        for channel in channels:
-            if channel is not None:
-                channel.close()
+        for channel in self._channels():
+            channel.close()
 
     # -- the state loop --------------------------------------------------------------------
 
@@ -172,6 +192,7 @@ class FoxglovePublisher:
                 next_description = now
                 self._health = {}  # every part's line again, for the newcomer
                 self._detected = {}
+                self._model_sent = False
             self.state_loop.run(partial(self._publish_state, now, wall), stopping)
             if now >= next_description:
                 next_description = now + DESCRIPTION_PERIOD_S
@@ -192,6 +213,12 @@ class FoxglovePublisher:
     def _publish_description(self) -> None:
         if self.description is not None and self.description.has_sinks():
             self.description.log({"data": self.joints.urdf})
+        model, assets, urdf = self.model, self.assets, self.joints.urdf
+        if model is None or assets is None or urdf is None or self._model_sent:
+            return
+        if model.has_sinks():
+            model.log(model_scene(urdf, assets, time.time()))
+            self._model_sent = True
 
     def _publish_health(self, wall: float) -> None:
         """Each part's line when it changed (all of them the first time)."""

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import logging
 import re
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import foxglove
@@ -23,7 +22,6 @@ from foxglove.websocket import ChannelView, Client, ServerListener, WebSocketSer
 
 from poppy_core.errors import ArgumentError
 from poppy_core.server.errors import ListenError
-from poppy_core.server.foxglove.assets import RobotAssets
 from poppy_core.server.foxglove.publisher import FoxglovePublisher
 from poppy_core.server.host_names import is_loopback
 from poppy_core.server.runner import listen_error
@@ -36,6 +34,8 @@ logger = logging.getLogger(__name__)
 DEFAULT_PORT = 8765
 """Foxglove's usual WebSocket port (foxglove_bridge's and the SDK's)."""
 _OS_ERROR = re.compile(r"os error (\d+)")
+SDK_CLIENT_LOGGER = "foxglove.websocket.connected_client.poller"
+"""Where foxglove-sdk logs what happens to one client's connection."""
 
 
 def check_access(host: str, token: str | None) -> None:
@@ -52,6 +52,23 @@ def check_access(host: str, token: str | None) -> None:
             field="host",
             value=host,
         )
+
+
+class _ClientGone(logging.Filter):
+    """foxglove-sdk logs a client that left without closing (a closed tab, a dropped Wi-Fi) at
+    ERROR: it is a client's doing, logged at INFO like the other servers' lost clients."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.levelno >= logging.ERROR and "without closing handshake" in record.getMessage():
+            record.levelno, record.levelname = logging.INFO, "INFO"
+            return logging.getLogger(record.name).isEnabledFor(logging.INFO)
+        return True
+
+
+def _client_resets_at_info() -> None:
+    sdk = logging.getLogger(SDK_CLIENT_LOGGER)
+    if not any(isinstance(f, _ClientGone) for f in sdk.filters):
+        sdk.addFilter(_ClientGone())
 
 
 class _Listener(ServerListener):
@@ -91,14 +108,12 @@ class FoxgloveServer:
         token: str | None = None,
     ) -> None:
         check_access(host, token)
+        _client_resets_at_info()
         self.host = host
         self.name = name
         self.context = Context()
         self.publisher = FoxglovePublisher(robot, self.context, name, state_rate_hz=state_rate_hz)
-        self.assets: RobotAssets | None = None
-        source = self.publisher.joints.description
-        if self.publisher.joints.urdf is not None and source is not None:
-            self.assets = RobotAssets(Path(source.source), self.publisher.joints.urdf)
+        self.assets = self.publisher.assets
         try:
             self._server: WebSocketServer | None = foxglove.start_server(
                 name=f"poppy {name}",
