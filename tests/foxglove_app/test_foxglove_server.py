@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import os
+import signal
 import subprocess
 from collections.abc import Iterator
 from pathlib import Path
@@ -23,7 +24,7 @@ from poppy_core.server.errors import ListenError
 from tests.foxglove_app.client import FoxgloveClient
 from tests.helpers.cli import ENV, POPPY, run_poppy
 from tests.helpers.processes import reap
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, scaled
 
 ROOT = Path(__file__).resolve().parents[2]
 PROFILE = ROOT / "profiles" / "ergo-jr"
@@ -213,7 +214,7 @@ def test_a_busy_port_is_a_listen_error(served: Served) -> None:
         robot.close()
 
 
-def test_poppy_serve_foxglove_says_where_and_serves() -> None:
+def test_poppy_serve_foxglove_says_where_serves_and_stops_on_sigterm() -> None:
     proc = subprocess.Popen(
         [*POPPY, "serve", "--foxglove", "--foxglove-port", "0", "--profile", "ergo-jr", "--sim"],
         stdout=subprocess.PIPE,
@@ -222,7 +223,7 @@ def test_poppy_serve_foxglove_says_where_and_serves() -> None:
         env={**os.environ, **ENV},
     )
     try:
-        assert proc.stdout is not None
+        assert proc.stdout is not None and proc.stderr is not None
         line = proc.stdout.readline()
         assert line.startswith("foxglove: ws://127.0.0.1:"), (line, proc.stderr)
         client = FoxgloveClient(line.split()[1])
@@ -230,6 +231,9 @@ def test_poppy_serve_foxglove_says_where_and_serves() -> None:
             assert eventually(lambda: bool(client.of("/joint_states")), 30.0)
         finally:
             client.close()
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(scaled(30)) == 0
+        assert proc.stderr.read().strip().endswith("stopped")
     finally:
         reap(proc)
 
