@@ -201,12 +201,13 @@ def serve(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
             "server streams the same state at /api/v1/ws)"
         )
-    if (
-        foxglove
-        and foxglove_port != 0
-        and foxglove_port
-        in _ports_taken(http_ports if http else [], ws_port if ws else 0, zmq_port if zmq else 0)
-    ):
+    others = _ports_taken(
+        http_ports if http else [],
+        ws_port if ws else 0,
+        zmq_port if zmq else 0,
+        snap_port if snap else 0,
+    )
+    if foxglove and foxglove_port != 0 and foxglove_port in others:
         _usage(f"--foxglove-port {foxglove_port} is also another server's port: choose another")
     try:
         check_foxglove(foxglove, host, token)
@@ -290,9 +291,9 @@ def _robot_name(name: str | None) -> str | None:
         _usage(str(exc))
 
 
-def _ports_taken(http_ports: list[int], ws_port: int, zmq_port: int) -> set[int]:
+def _ports_taken(http_ports: list[int], *others: int) -> set[int]:
     """The fixed ports of the other servers asked for (0, a free port, is nobody's)."""
-    return {p for p in [*http_ports, ws_port, zmq_port] if p != 0}
+    return {p for p in [*http_ports, *others] if p != 0}
 
 
 def _check_http_ports(ports: list[int]) -> None:

@@ -243,6 +243,7 @@ def test_poppy_serve_foxglove_says_where_serves_and_stops_on_sigterm() -> None:
     [
         ["--host", "0.0.0.0", "--token", TOKEN],
         ["--http", "--http-port", "8765"],
+        ["--snap", "--snap-port", "8765"],
     ],
 )
 def test_foxglove_refusals_are_one_line_usage_errors(args: list[str]) -> None:
