@@ -4,6 +4,7 @@ come through asset requests, the camera as JPEG images; the token rules hold."""
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import signal
@@ -252,3 +253,16 @@ def test_foxglove_refusals_are_one_line_usage_errors(args: list[str]) -> None:
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in done.stderr, done.stderr
     assert "foxglove" in lines[0].lower()
+
+
+def test_a_client_that_leaves_without_closing_is_no_error(
+    served: Served, caplog: pytest.LogCaptureFixture
+) -> None:
+    assert served.servers.foxglove is not None
+    caplog.set_level(logging.INFO, logger="foxglove")
+    leaving = FoxgloveClient(served.servers.foxglove.url)
+    assert eventually(lambda: bool(leaving.of("/joint_states")), 30.0)
+    leaving.close()  # drops the connection without a closing handshake
+    assert eventually(lambda: any("from client" in r.getMessage() for r in caplog.records), 30.0)
+    gone = [r for r in caplog.records if r.getMessage().startswith("Error receiving from client")]
+    assert gone and all(r.levelno == logging.INFO for r in gone)

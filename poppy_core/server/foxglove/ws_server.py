@@ -36,6 +36,8 @@ DEFAULT_PORT = 8765
 _OS_ERROR = re.compile(r"os error (\d+)")
 SDK_CLIENT_LOGGER = "foxglove.websocket.connected_client.poller"
 """Where foxglove-sdk logs what happens to one client's connection."""
+CLIENT_ERROR = "Error receiving from client"
+"""How that logger's lines about a connection the client broke begin."""
 
 
 def check_access(host: str, token: str | None) -> None:
@@ -55,11 +57,12 @@ def check_access(host: str, token: str | None) -> None:
 
 
 class _ClientGone(logging.Filter):
-    """foxglove-sdk logs a client that left without closing (a closed tab, a dropped Wi-Fi) at
-    ERROR: it is a client's doing, logged at INFO like the other servers' lost clients."""
+    """foxglove-sdk logs a client that left without closing (a closed tab, a dropped Wi-Fi, a
+    reset connection) at ERROR: it is a client's doing, logged at INFO like the other servers'
+    lost clients."""
 
     def filter(self, record: logging.LogRecord) -> bool:
-        if record.levelno >= logging.ERROR and "without closing handshake" in record.getMessage():
+        if record.levelno >= logging.ERROR and record.getMessage().startswith(CLIENT_ERROR):
             record.levelno, record.levelname = logging.INFO, "INFO"
             return logging.getLogger(record.name).isEnabledFor(logging.INFO)
         return True
