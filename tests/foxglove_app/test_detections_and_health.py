@@ -122,3 +122,30 @@ def test_health_lines_say_each_part_at_its_level() -> None:
         "sensor camera: unplugged": LogLevel.Warning,
         "sensor imu: ok": LogLevel.Info,
     }
+
+
+def test_the_state_loop_survives_a_tick_that_raises() -> None:
+    """Health that fails three times (a bus driver's bug) is logged and retried with backoff:
+    the loop goes on publishing joint states."""
+    failures = iter([True, True, True])
+
+    def health() -> dict[str, Any]:
+        if next(failures, False):
+            raise RuntimeError("the bus's health broke")
+        return {}
+
+    robot = robot_of()
+    robot.health = health
+    context = foxglove.Context()
+    stream = io.BytesIO()
+    publisher = FoxglovePublisher(robot, context, "jr1", state_rate_hz=50)
+    writer = foxglove.open_mcap(stream, context=context)
+    try:
+        publisher.start()
+        assert eventually(lambda: publisher.state_loop.failures >= 3, 30.0)
+        published = publisher.published
+        assert eventually(lambda: publisher.published > published + 5, 30.0)
+        assert publisher.running and not publisher.state_loop.failing
+    finally:
+        publisher.close()
+        writer.close()
