@@ -201,16 +201,10 @@ def serve(
             f"--ws-port {ws_port} is also the --http-port: choose another port (the HTTP "
             "server streams the same state at /api/v1/ws)"
         )
-    others = _ports_taken(
-        http_ports if http else [],
-        ws_port if ws else 0,
-        zmq_port if zmq else 0,
-        snap_port if snap else 0,
-    )
-    if foxglove and foxglove_port != 0 and foxglove_port in others:
-        _usage(f"--foxglove-port {foxglove_port} is also another server's port: choose another")
+    others = [p for p, on in ((ws_port, ws), (zmq_port, zmq), (snap_port, snap)) if on]
+    others += http_ports if http else []
     try:
-        check_foxglove(foxglove, host, token)
+        check_foxglove(foxglove, host, token, foxglove_port, others)
     except ArgumentError as exc:
         _usage(str(exc))
     snap_dir = check_snap_options(
@@ -289,11 +283,6 @@ def _robot_name(name: str | None) -> str | None:
         return robot_name(name, "--name")
     except ArgumentError as exc:
         _usage(str(exc))
-
-
-def _ports_taken(http_ports: list[int], *others: int) -> set[int]:
-    """The fixed ports of the other servers asked for (0, a free port, is nobody's)."""
-    return {p for p in [*http_ports, *others] if p != 0}
 
 
 def _check_http_ports(ports: list[int]) -> None:

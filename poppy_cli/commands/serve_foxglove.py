@@ -12,19 +12,29 @@ if TYPE_CHECKING:
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
 
 
-def check_foxglove(foxglove: bool, host: str, token: str | None) -> None:
-    """Refuse ``--foxglove`` that would let others past the token (foxglove-sdk's server has
-    no authentication); say what it shows to whom.
+def check_foxglove(
+    foxglove: bool, host: str, token: str | None, port: int, others: list[int]
+) -> None:
+    """Refuse ``--foxglove`` on another server's port (``others``; 0 is a free port each) or
+    that would let others past the token (foxglove-sdk's server has no authentication); say
+    what it shows to whom.
 
     Raises:
-        ArgumentError: a token and a host other than loopback (the caller makes it a usage
-            error).
+        ArgumentError: the port is taken, or a token and a host other than loopback (the
+            caller makes it a usage error).
         MissingExtraError: foxglove-sdk is not installed.
     """
     if not foxglove:
         return
+    from poppy_core.errors import ArgumentError
     from poppy_core.server.foxglove import check_access
 
+    if port != 0 and port in others:
+        raise ArgumentError(
+            f"--foxglove-port {port} is also another server's port: choose another",
+            field="--foxglove-port",
+            value=port,
+        )
     check_access(host, token)
     if host not in LOOPBACK:
         warn_line(
