@@ -4,6 +4,7 @@ a camera showing an ArUco marker, recorded to MCAP and read back; health lines b
 from __future__ import annotations
 
 import io
+from dataclasses import replace
 from types import SimpleNamespace
 from typing import Any
 
@@ -149,3 +150,35 @@ def test_the_state_loop_survives_a_tick_that_raises() -> None:
     finally:
         publisher.close()
         writer.close()
+
+
+class NotLookedYet(MarkerDetector):
+    """A detector started whose first look has not come (its camera is slow to open): reading
+    what it found would wait for it."""
+
+    @property
+    def running(self) -> bool:
+        return True
+
+    def health(self) -> Any:
+        return replace(super().health(), age_s=None)
+
+    def found(self) -> list[Any]:
+        raise AssertionError("the state loop waited for a detector's first look")
+
+
+def test_a_detector_that_has_not_looked_yet_holds_no_joint_state_back() -> None:
+    camera = DummyCamera("camera", (64, 48))
+    detector = NotLookedYet("marker_detector", [camera], 5.0)
+    context = foxglove.Context()
+    stream = io.BytesIO()
+    publisher = FoxglovePublisher(robot_of(camera, detector), context, "jr1", state_rate_hz=50)
+    writer = foxglove.open_mcap(stream, context=context)
+    try:
+        publisher.start()
+        assert eventually(lambda: publisher.published >= 20, 30.0)
+        assert publisher.running and publisher.state_loop.failures == 0
+    finally:
+        publisher.close()
+        writer.close()
+        camera.close()

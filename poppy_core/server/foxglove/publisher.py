@@ -200,7 +200,7 @@ class FoxglovePublisher:
             if now >= next_health:
                 next_health = now + HEALTH_PERIOD_S
                 self.state_loop.run(partial(self._publish_health, wall), stopping)
-            self._publish_detections(wall, stopping)
+            self.state_loop.run(partial(self._publish_detections, wall), stopping)
 
     def _publish_state(self, now: float, wall: float) -> None:
         if self.states.has_sinks():
@@ -232,12 +232,14 @@ class FoxglovePublisher:
                 self._health[line.part] = line
                 self.health.log(messages.log(line, self.name, wall))
 
-    def _publish_detections(self, wall: float, stopping: threading.Event) -> None:
+    def _publish_detections(self, wall: float) -> None:
         """Each camera's detections when they change (and every second while they do not), while
-        a detector of it runs."""
+        a detector of it runs and has looked once (never waiting for its first look here)."""
         for camera_name, channel in self.detections.items():
             camera = self.cameras[camera_name][0]
-            detectors = [d for d in self._detectors(camera) if d.running]
+            detectors = [
+                d for d in self._detectors(camera) if d.running and d.health().age_s is not None
+            ]
             if not detectors or not channel.has_sinks():
                 continue
             found = [
@@ -250,11 +252,7 @@ class FoxglovePublisher:
             if last is not None and last[1] == found and wall - last[0] < DETECTIONS_PERIOD_S:
                 continue
             self._detected[camera_name] = (wall, found)
-
-            def log(found: list[Any] = found, channel: Any = channel) -> None:
-                channel.log(messages.image_annotations(found, wall))
-
-            self.state_loop.run(log, stopping)
+            channel.log(messages.image_annotations(found, wall))
 
     # -- cameras -----------------------------------------------------------------------------
 
