@@ -22,6 +22,7 @@ EXTRAS: dict[str, str] = {
     "zmq": "pypot's ZMQ server",
     "fleet": "Zenoh fleets (serve --zenoh, poppy fleet, zenoh: remote robots)",
     "ros2": "ROS 2 over rmw_zenoh (serve --ros2)",
+    "foxglove": "Foxglove without ROS (serve --foxglove, record --mcap)",
     "tui": "the terminal app",
     "plot": "plots (matplotlib)",
     "notebook": "Jupyter notebooks (`poppy notebook`)",

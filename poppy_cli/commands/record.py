@@ -37,6 +37,7 @@ if TYPE_CHECKING:
 
     from poppy_core.errors import FileError
     from poppy_core.motion import MoveRecorder
+    from poppy_core.server.foxglove import McapRecording
 
 REFRESH_S = 0.1
 
@@ -124,7 +125,13 @@ def record(
         help="Save the take here (a file, or a folder for NAME.move) instead of the library.",
     ),
     force: bool = typer.Option(
-        False, "--force", "-f", help="Replace an existing move of that name."
+        False, "--force", "-f", help="Replace an existing move (and --mcap file) of that name."
+    ),
+    mcap: Path | None = typer.Option(
+        None,
+        "--mcap",
+        help="Also write what Foxglove shows (joint states, transforms, URDF, camera, "
+        "detections, health) to this MCAP file (see docs/foxglove.md).",
     ),
     profile: str | None = ProfileOpt,
     config_file: Path | None = ConfigOpt,
@@ -155,6 +162,8 @@ def record(
             error_line(f"{path} exists: pick another name or pass --force")
             raise typer.Exit(EXIT_FAILURE)  # a refused file, as `output_path` refuses one
     probe_folder(path.parent, make_folder=in_library)  # before any motor goes compliant
+    if mcap is not None:
+        check_mcap(mcap, force)
     config = robot_config(profile, config_file, port)
     groups = {g: config.resolve_group(g) for g in config.motorgroups}
     names = _motor_names(motors, list(config.motors), groups)
@@ -168,6 +177,7 @@ def record(
             robot, freq, names, checkpoint_path=path, replace=force, make_folder=in_library
         )
         recorder.start()  # refused here when another `poppy record` writes the same file
+        episode = _start_mcap(robot, mcap, freq, force) if mcap is not None else None
         for motor_name in names:
             robot.motor(motor_name).compliant = True
         for line in start_lines(names, freq, path):
@@ -181,6 +191,7 @@ def record(
             move = recorder.stop()
         except FileError as exc:
             move, save_failure = recorder.move, exc
+        mcap_path = _stop_mcap(episode) if episode is not None else None
     if save_failure is not None:
         path = _save_elsewhere(recorder, save_failure, name)
     summary: dict[str, Any] = {
@@ -190,16 +201,24 @@ def record(
         "framerate": move.framerate,
         "motors": list(move.motors),
     }
+    if mcap_path is not None:
+        summary["mcap"] = str(mcap_path)
     if json_output:
         print_json(summary)
     else:
         err_console.print(
             f"recorded {len(move)} frames ({move.duration_s:.2f} s) of {len(move.motors)} motors"
         )
+        if mcap_path is not None:
+            err_console.print(
+                f"MCAP for Foxglove: {mcap_path}", soft_wrap=True, highlight=False, markup=False
+            )
         sys.stdout.write(f"{printable(str(path))}\n")  # a path may hold terminal escapes
         sys.stdout.flush()
     if save_failure is not None and not _interactive():
         raise typer.Exit(EXIT_FAILURE)
+    if mcap is not None and mcap_path is None:
+        raise typer.Exit(EXIT_FAILURE)  # the move is saved; the MCAP file, asked for, is not
 
 
 def start_lines(names: list[str], freq: float, path: Path, width: int = 80) -> list[str]:
@@ -216,6 +235,34 @@ def start_lines(names: list[str], freq: float, path: Path, width: int = 80) -> l
         else:
             lines.append(part.removeprefix("— "))
     return lines
+
+
+def check_mcap(path: Path, force: bool) -> None:
+    """The MCAP file can be written (its folder exists, no file there without --force) and
+    foxglove-sdk is installed: checked before any motor goes compliant."""
+    from poppy_core.files import output_path
+    from poppy_core.server.foxglove import McapRecording  # noqa: F401  (the extra, now)
+
+    output_path(path, replace=force)
+
+
+def _start_mcap(robot: Any, path: Path, freq: float, force: bool) -> McapRecording:
+    from poppy_core.server.foxglove import McapRecording
+
+    profile = robot.config.profile if robot.config is not None else None
+    name = profile.name if profile is not None else "poppy"
+    return McapRecording(robot, path, name, state_rate_hz=freq, replace=force).start()
+
+
+def _stop_mcap(episode: McapRecording) -> Path | None:
+    """Finish the MCAP file; a failure is one line (the move is saved all the same)."""
+    from poppy_core.errors import FileError
+
+    try:
+        return episode.stop()
+    except FileError as exc:
+        error_line(f"the MCAP file could not be written: {exc}")
+        return None
 
 
 def check_name(name: str) -> None:

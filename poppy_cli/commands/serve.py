@@ -1,6 +1,6 @@
-"""`poppy serve --http [--ws] [--snap] [--zmq] [--zenoh] [--ros2]`: serve a robot over REST
-(pypot's routes + /api/v1), WebSocket, Snap!'s routes, pypot's ZMQ request/reply API, Zenoh
-(fleets) and ROS 2 (rmw_zenoh's wire)."""
+"""`poppy serve --http [--ws] [--snap] [--zmq] [--zenoh] [--ros2] [--foxglove]`: serve a robot
+over REST (pypot's routes + /api/v1), WebSocket, Snap!'s routes, pypot's ZMQ request/reply API,
+Zenoh (fleets), ROS 2 (rmw_zenoh's wire) and Foxglove (foxglove-sdk's WebSocket server)."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, NoReturn
 import typer
 
 from poppy_cli.commands.serve_files import read_served_files
+from poppy_cli.commands.serve_foxglove import announce_foxglove, require_foxglove
 from poppy_cli.commands.serve_ros2 import announce_ros2, ros2_settings
 from poppy_cli.commands.serve_snap import announce_snap, check_snap_options
 from poppy_cli.options import ConfigOpt, PortOpt, ProfileOpt, SimOpt, finite
@@ -32,6 +33,7 @@ FLAGS = {
     "cors": "--cors",
     "allow_hosts": "--allow-host",
     "name": "--name",
+    "foxglove": "--foxglove-port",
 }
 """The flag of each ``ServeSpec`` attribute, named before a refusal of the spec."""
 
@@ -172,13 +174,24 @@ def serve(
     ros_namespace: str | None = typer.Option(
         None, "--ros-namespace", help="The node's ROS 2 namespace, e.g. /lab (default /)."
     ),
+    foxglove: bool = typer.Option(
+        False,
+        "--foxglove",
+        help="Serve the robot to the Foxglove app (no ROS needed): its URDF and meshes, joint "
+        "states, camera, detections and health, on --host (see docs/foxglove.md).",
+    ),
+    foxglove_port: int = typer.Option(
+        8765, "--foxglove-port", min=0, max=65535, help="Foxglove WebSocket port."
+    ),
 ) -> None:
     """Serve a robot: prints the URL(s) it serves, stops on Ctrl-C/SIGTERM and closes the robot."""
     from poppy_core.errors import ConfigError
 
     snap, zmq, token = read_served_files(settings, token_file, token, snap, zmq)
-    if not (http or ws or snap or zmq or zenoh or ros2):
-        _usage("nothing to serve: pass --http, --ws, --snap, --zmq, --zenoh and/or --ros2")
+    if not (http or ws or snap or zmq or zenoh or ros2 or foxglove):
+        _usage(
+            "nothing to serve: pass --http, --ws, --snap, --zmq, --zenoh, --ros2 and/or --foxglove"
+        )
     http_port, *alias_ports = http_ports or [8080]
     zenoh_settings = _zenoh_settings(
         zenoh or ros2, zenoh_listen, zenoh_connect, zenoh_config, zenoh_scout
@@ -191,6 +204,8 @@ def serve(
         )
     except (ValueError, ConfigError) as exc:
         _usage(str(exc))
+    if foxglove:
+        require_foxglove()
     snap_dir = check_snap_options(snap, snap_dir, open_browser)
     from poppy_core.assembly import Listen, ServeSpec, serve
     from poppy_core.errors import ArgumentError
@@ -212,6 +227,7 @@ def serve(
             report=_report,
             zenoh=zenoh_settings,
             ros2=ros2_spec,
+            foxglove=Listen(host, foxglove_port) if foxglove else None,
             settings_file=settings,
             token_file=token_file,
             warn=warn_line,
@@ -295,6 +311,7 @@ def _announce(servers: ServerSet, host: str, open_browser: bool) -> None:
         where = ", ".join(servers.zenoh.endpoints) or "no endpoint (it connects out)"
         print(f"zenoh: poppy/{servers.zenoh.name} listening on {where}", flush=True)
     announce_ros2(servers)
+    announce_foxglove(servers)
     if servers.http is not None:  # last: scripts read the lines above by their order
         print(f"page: http://{base}:{servers.http.port}/ (with the 3D view)", flush=True)
 

@@ -13,7 +13,7 @@ from poppy_core.errors import ArgumentError
 if TYPE_CHECKING:
     from poppy_core.assembly.servers import Listen, ServeSpec
 
-KINDS = {"http": "HTTP", "ws": "WebSocket", "zmq": "ZMQ", "snap": "Snap!"}
+KINDS = {"http": "HTTP", "ws": "WebSocket", "zmq": "ZMQ", "snap": "Snap!", "foxglove": "Foxglove"}
 """What each listening server is called in the lines below."""
 LOOPBACK_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
 ANY_INTERFACE = frozenset({"", "0.0.0.0", "::"})
@@ -66,6 +66,25 @@ def _clash(kind: str, other: str, port: int) -> str:
     )
 
 
+def check_foxglove(spec: ServeSpec) -> None:
+    """Refuse a Foxglove server off loopback while a token is required: foxglove-sdk's
+    WebSocket server has no authentication, so it would let others past the token.
+
+    Raises:
+        ArgumentError: ``field`` is ``host``.
+    """
+    where = spec.foxglove
+    if where is None or not spec.token or where.host.strip("[]") in LOOPBACK_HOSTS:
+        return
+    raise ArgumentError(
+        "the Foxglove server cannot require the token (foxglove-sdk's WebSocket server has no "
+        f"authentication): it serves on loopback only, not on {where.host}; reach it through an "
+        "SSH tunnel (ssh -L 8765:127.0.0.1:8765 ...) or serve without a token",
+        field="host",
+        value=where.host,
+    )
+
+
 def check_origins(spec: ServeSpec) -> None:
     """Refuse an origin in ``cors`` or a name in ``allow_hosts`` that is not one.
 
@@ -111,7 +130,19 @@ def exposure(spec: ServeSpec) -> list[str]:
             f"serving the ZMQ API on {zmq.host}: it has no token, anyone who can reach this "
             "machine can move the robot; keep it on 127.0.0.1 unless the network is yours"
         )
-    public = sorted({w.host for w in spec.listens().values() if w.host not in LOOPBACK_HOSTS})
+    foxglove = spec.foxglove
+    if foxglove is not None and foxglove.host not in LOOPBACK_HOSTS:
+        lines.append(
+            f"serving Foxglove on {foxglove.host}: it has no authentication, anyone who can "
+            "reach this machine sees the robot and its camera (it takes no command)"
+        )
+    elif foxglove is not None and spec.token:
+        lines.append(
+            "the Foxglove server cannot ask for the token: on loopback, every program and web "
+            "page of this machine sees the robot and its camera (it takes no command)"
+        )
+    moving = {k: w for k, w in spec.listens().items() if k != "foxglove"}
+    public = sorted({w.host for w in moving.values() if w.host not in LOOPBACK_HOSTS})
     if public and not spec.token:
         lines.append(
             f"serving on {', '.join(public)} without a token: anyone who can reach this machine "

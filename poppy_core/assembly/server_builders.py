@@ -156,6 +156,20 @@ def add_ros2(servers: ServerSet, spec: ServeSpec, settings: Ros2Settings) -> Non
     )
 
 
+def add_foxglove(servers: ServerSet, spec: ServeSpec, where: Listen) -> None:
+    """The robot for the Foxglove app, bound on ``where`` (refused off loopback with a token)."""
+    from poppy_core.server.foxglove import FoxgloveServer
+    from poppy_core.zenoh_wire import default_name
+
+    servers.servers["foxglove"] = FoxgloveServer(
+        servers.service.robot,
+        where.host,
+        where.port,
+        spec.name or default_name(),
+        state_rate_hz=spec.state_rate_hz,
+    )
+
+
 def fleet_page(servers: ServerSet) -> None:
     """The page lists the robots its Zenoh session sees; the description names the page."""
     node = servers.zenoh
@@ -173,7 +187,7 @@ def own_pages(servers: ServerSet) -> None:
     ports = [
         p
         for name, s in servers.servers.items()
-        if name not in ("zmq", "zenoh", "ros2")
+        if name not in ("zmq", "zenoh", "ros2", "foxglove")
         for p in _ports(s)
     ]
     servers.policy.with_ports(ports)

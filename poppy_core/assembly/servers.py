@@ -19,8 +19,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, cast
 
-from poppy_core.assembly.serve_checks import check_origins, check_ports, exposure
+from poppy_core.assembly.serve_checks import (
+    check_foxglove,
+    check_origins,
+    check_ports,
+    exposure,
+)
 from poppy_core.assembly.server_builders import (
+    add_foxglove,
     add_http,
     add_ros2,
     add_snap,
@@ -42,14 +48,15 @@ if TYPE_CHECKING:
     from poppy_core.server import OriginPolicy, RobotService
     from poppy_core.server.announce import Announcer
     from poppy_core.server.background import BackgroundServer
+    from poppy_core.server.foxglove import FoxgloveServer
     from poppy_core.server.ros2 import Ros2Node
     from poppy_core.server.snap import SnapServer
     from poppy_core.server.zenoh import ZenohRobotServer
     from poppy_core.server.zmqserver import ZmqRobotServer
 
-PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh", "ros2")
-"""pypot's attribute names of the servers (``robot.http``...), ``zenoh`` and ``ros2``, in the
-order they start."""
+PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh", "ros2", "foxglove")
+"""pypot's attribute names of the servers (``robot.http``...), ``zenoh``, ``ros2`` and
+``foxglove``, in the order they start."""
 DEFAULT_PORTS = {"http": 8080, "ws": 9009, "zmq": 6768, "snap": 6969}
 """pypot's default ports (``zmq``: the documentation's ZMQ example)."""
 LOOPBACK = "127.0.0.1"
@@ -93,6 +100,8 @@ class ServeSpec:
         state_rate_hz: the Zenoh state messages per second (the sync loop's rate).
         ros2: the robot as a ROS 2 node on rmw_zenoh's wire (``Ros2Settings``: domain,
             namespace, node; its Zenoh settings serve when ``zenoh`` is None), or None.
+        foxglove: foxglove-sdk's WebSocket server for the Foxglove app (read only; it has no
+            authentication: with a token it serves on loopback only), or None.
         settings_file: the appliance's serve options file (``poppy serve --settings``): the
             page's settings switch Snap! and ZMQ there.
         token_file: the file ``token`` was read from (``--token-file``): the page's settings
@@ -122,6 +131,7 @@ class ServeSpec:
     zenoh: ZenohSettings | None = None
     state_rate_hz: float = 50.0
     ros2: Ros2Settings | None = None
+    foxglove: Listen | None = None
     settings_file: Path | None = None
     token_file: Path | None = None
     warn: Callable[[str], None] | None = field(default=None, compare=False)
@@ -133,6 +143,7 @@ class ServeSpec:
         if self.name is not None:
             object.__setattr__(self, "name", robot_name(self.name, "name"))
         check_ports(self)
+        check_foxglove(self)
         check_origins(self)
         for line in exposure(self):
             (self.warn or logger.warning)(line)
@@ -162,7 +173,13 @@ class ServeSpec:
 
     def listens(self) -> dict[str, Listen]:
         """Protocol -> where it listens, for the servers asked for, in starting order."""
-        wanted = {"http": self.http, "ws": self.ws, "zmq": self.zmq, "snap": self.snap}
+        wanted = {
+            "http": self.http,
+            "ws": self.ws,
+            "zmq": self.zmq,
+            "snap": self.snap,
+            "foxglove": self.foxglove,
+        }
         return {name: where for name, where in wanted.items() if where is not None}
 
     @property
@@ -252,6 +269,11 @@ class ServerSet:
         return cast("Ros2Node | None", self.servers.get("ros2"))
 
     @property
+    def foxglove(self) -> FoxgloveServer | None:
+        """The robot for the Foxglove app."""
+        return cast("FoxgloveServer | None", self.servers.get("foxglove"))
+
+    @property
     def running(self) -> bool:
         """True while every server serves."""
         return bool(self.servers) and all(s.running for s in self.servers.values())
@@ -303,8 +325,9 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
         ListenError: a port is taken or an address unusable.
         RuntimeError: a server did not start (its log says why).
         ConfigError: a Zenoh endpoint or configuration that cannot be used.
-        MissingExtraError: the ``server`` (or ``zmq``, ``appliance``, ``fleet``, ``ros2``) extra
-            is missing.
+        MissingExtraError: the ``server`` (or ``zmq``, ``appliance``, ``fleet``, ``ros2``,
+            ``foxglove``) extra is missing.
+        ArgumentError: ``foxglove`` off loopback while a token is required.
     """
     from poppy_core.server import RobotService, create_app
 
@@ -332,6 +355,8 @@ def serve(robot: Robot, spec: ServeSpec, *, start: bool = True) -> ServerSet:
             add_zenoh(servers, spec, spec.zenoh, app)
         if spec.ros2 is not None:
             add_ros2(servers, spec, spec.ros2)
+        if "foxglove" in listens:
+            add_foxglove(servers, spec, listens["foxglove"])
         own_pages(servers)
         name_and_announce(servers, robot, spec)
         fleet_page(servers)

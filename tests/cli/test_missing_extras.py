@@ -37,6 +37,8 @@ CASES = [
     ("fleet", "zenoh", ["serve", "--zenoh", *ROBOT, "--name", "jr"]),
     ("fleet", "zenoh", ["fleet", "list", "--connect", "tcp/127.0.0.1:9"]),
     ("ros2", "rosbags", ["serve", "--ros2", *ROBOT, "--zenoh-listen", "tcp/127.0.0.1:0"]),
+    ("foxglove", "foxglove", ["serve", "--foxglove", *ROBOT, "--foxglove-port", "0"]),
+    ("foxglove", "foxglove", ["record", "w", *ROBOT, "-o", "{tmp}", "--mcap", "{tmp}/w.mcap"]),
     ("tui", "textual,textual_serve", ["tui"]),
     ("vision", "cv2", ["camera", "snapshot", "-o", "{tmp}/shot.png", "--device", "0"]),
     ("plot", "matplotlib", ["moves", "plot", "{tmp}/wave.json", "-o", "{tmp}/wave.png"]),
