@@ -181,7 +181,10 @@ def build_result(raw: dict[str, Any]) -> BenchResult:
         "that gap at the moment, with no emulator at all. The control "
         "(same client, output flush skipped) counts what the emulator itself loses; "
         "bench/emulator_minimal.py (one thread blocked in read(), six byte tables, nothing "
-        "else) what any emulator would lose at that moment."
+        "else) what any emulator would lose at that moment. A write whose bytes the kernel's "
+        "worker moves later than pypot's gap is lost whatever reads the master: the worker "
+        "column is the floor no emulator can go under (docs/emulator.md has the readers tried, "
+        "a process of its own and C included)."
     )
     notes.append(
         f"Goal: pypot loses at most {MAX_LOST} SYNC_WRITE of {2 * raw['cycles']} in every round "
