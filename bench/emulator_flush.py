@@ -9,15 +9,22 @@ the packet's verdict (1 ms later); ``--reader process``: a process of its own bl
 ``read()`` on the master the whole time and hands each byte on through a pipe at once (the
 fastest reader Python can have). Equal losses mean the flush discards the bytes before any
 reader could have had them: in the kernel, not in a slow reader.
+
+Then, with no flush and nobody reading, it times the kernel's worker itself: for each of
+``--count`` writes, how long until the master's input queue (``FIONREAD``) holds the whole
+packet (``moved_us``: p50, p99, and how many took longer than ``--gap-us``). A write whose bytes
+take longer than the client's gap to get there is one its flush would discard.
 """
 
 from __future__ import annotations
 
 import argparse
+import fcntl
 import json
 import os
 import select
 import signal
+import struct
 import sys
 import termios
 import time
@@ -25,6 +32,33 @@ import tty
 
 PACKET = bytes(range(10))
 VERDICT_S = 0.001
+MOVE_TIMEOUT_S = 0.05
+PAUSE_S = 0.0002  # between timed writes, as a client between packets
+
+
+def _moved_us(master: int, slave: int, count: int) -> list[float]:
+    """Per write, the µs until the master's input queue holds all of it (nobody reads)."""
+    queued = bytearray(4)
+    delays = []
+    clock = time.perf_counter
+    for _ in range(count):
+        start = clock()
+        os.write(slave, PACKET)
+        while True:
+            fcntl.ioctl(master, termios.FIONREAD, queued)
+            now = clock()
+            if struct.unpack("i", queued)[0] >= len(PACKET) or now - start > MOVE_TIMEOUT_S:
+                break
+        delays.append((now - start) * 1e6)
+        os.read(master, 4096)
+        until = clock() + PAUSE_S
+        while clock() < until:
+            pass
+    return sorted(delays)
+
+
+def _quantile(ordered: list[float], q: float) -> float:
+    return round(ordered[min(len(ordered) - 1, int(q * len(ordered)))], 1) if ordered else 0.0
 
 
 def _reader(master: int, pipe_w: int) -> None:
@@ -78,12 +112,15 @@ def main() -> int:
         if child:
             os.kill(child, signal.SIGKILL)
             os.waitpid(child, 0)
-    sys.stdout.write(
-        json.dumps(
-            {"reader": args.reader, "gap_us": args.gap_us, "count": args.count, "lost": lost}
-        )
-        + "\n"
-    )
+    delays = _moved_us(master, slave, args.count) if args.reader == "none" else []
+    record = {"reader": args.reader, "gap_us": args.gap_us, "count": args.count, "lost": lost}
+    if delays:
+        record["moved_us"] = {
+            "p50": _quantile(delays, 0.5),
+            "p99": _quantile(delays, 0.99),
+            "over_gap": sum(1 for delay in delays if delay > args.gap_us),
+        }
+    sys.stdout.write(json.dumps(record) + "\n")
     return 0
 
 

@@ -9,7 +9,9 @@ each write. A write is *lost* when a motor reads back the previous state. pypot'
 ``DxlIO``/``Dxl320IO`` flush the input and output buffers of the port before every packet, so a
 write still in the port's output queue when the next packet starts is discarded unless the
 other end has already read it. Prints one JSON line: ``writes``, ``lost``, ``reads_failed``,
-``elapsed_s``.
+``elapsed_s``, and ``gap_us`` (p50, p95): the time from each SYNC_WRITE's ``write()`` returning
+to pypot's next output flush, the window the kernel has to move those bytes to the emulator's
+side.
 
 ``--keep-output`` is the control: the same client with only the output flush skipped (the input
 flush stays), so that what the emulator itself loses is counted apart from what the kernel
@@ -23,6 +25,43 @@ import time
 from typing import Any
 
 from _common import emit, import_peer, parse_ids
+
+SYNC_WRITE = 0x83  # the instruction byte in both protocols (e-manual)
+INSTRUCTION_AT = {1: 4, 2: 7}  # its offset: FF FF ID LEN INST / FF FF FD 00 ID LEN LEN INST
+
+
+class GapStamps:
+    """Wraps a pyserial port's ``write`` and ``flushOutput`` to time each SYNC_WRITE's gap."""
+
+    def __init__(self, port: Any, protocol: int) -> None:
+        at = INSTRUCTION_AT[protocol]
+        self.gaps_us: list[float] = []
+        self._written_at: float | None = None
+        write, flush_output = port.write, port.flushOutput
+
+        def stamped_write(data: bytes) -> Any:
+            result = write(data)
+            is_sync = len(data) > at and data[at] == SYNC_WRITE
+            self._written_at = time.perf_counter() if is_sync else None
+            return result
+
+        def stamped_flush() -> Any:
+            if self._written_at is not None:
+                self.gaps_us.append((time.perf_counter() - self._written_at) * 1e6)
+                self._written_at = None
+            return flush_output()
+
+        port.write, port.flushOutput = stamped_write, stamped_flush
+
+    def summary(self) -> dict[str, float]:
+        """p50 and p95 of the gaps, in µs."""
+        ordered = sorted(self.gaps_us)
+        if not ordered:
+            return {}
+        return {
+            "p50": round(ordered[len(ordered) // 2], 1),
+            "p95": round(ordered[min(len(ordered) - 1, len(ordered) * 95 // 100)], 1),
+        }
 
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
@@ -38,6 +77,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     with io_class(args.port, baudrate=args.baud) as io:
         if args.keep_output:
             io._serial.flushOutput = lambda: None  # the control: flush input only
+        stamps = GapStamps(io._serial, args.protocol)
         for _ in range(args.cycles):
             for enable in (True, False):
                 if enable:
@@ -59,6 +99,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         lost=lost,
         reads_failed=reads_failed,
         elapsed_s=round(time.perf_counter() - start, 3),
+        gap_us=stamps.summary(),
     )
     return record
 

@@ -3,10 +3,23 @@ what it says (the figures themselves are the bench's, not the tests')."""
 
 from __future__ import annotations
 
+import importlib
+import sys
 from typing import Any
 
+import pytest
+
 from bench.emulator_bench import _latencies
-from bench.emulator_report import BASELINE, THIS, goal_met, lost_syncs, percentile
+from bench.emulator_report import (
+    BASELINE,
+    THIS,
+    bare_table,
+    goal_met,
+    loss_table,
+    lost_syncs,
+    percentile,
+)
+from bench.registry import BENCH_DIR
 
 
 def test_each_ping_is_matched_to_the_read_of_its_last_byte() -> None:
@@ -46,3 +59,66 @@ def test_lost_writes_count_in_sync_writes_and_a_failed_client_counts_none() -> N
     assert lost_syncs({"error": "import failed"}, 6) is None
     assert percentile([3.0, 1.0, 2.0], 0.5) == 2.0
     assert percentile([], 0.99) == 0.0
+
+
+def test_the_bare_pty_row_shows_the_kernel_workers_delay_against_the_gap() -> None:
+    raw = {
+        "bare_pty": [
+            {
+                "rep": 0,
+                "reader": "none",
+                "gap_us": 15.0,
+                "count": 1000,
+                "lost": 94,
+                "moved_us": {"p50": 12.1, "p99": 9896.9, "over_gap": 361},
+                "load1": 13.8,
+            },
+            {"rep": 0, "reader": "process", "gap_us": 15.0, "count": 1000, "lost": 35, "load1": 1},
+        ]
+    }
+    rows = bare_table(raw).rows
+    assert rows[0][2:5] == ["15 µs", "94 of 1000", "12.1 / 9896.9 µs, 361 of 1000"]
+    assert rows[1][4] == "-"  # the worker is timed with nobody reading only
+
+
+def test_the_loss_row_shows_pypots_own_gap_from_write_to_flush() -> None:
+    pypot = {"lost": 12, "writes": 1800, "gap_us": {"p50": 15.3, "p95": 30.0}}
+    session = {"tree": THIS, "mode": "a", "rep": 0, "load1": 2.0, "pypot": pypot}
+    raw = {"ids": 6, "cycles": 150, "baseline": None, "sessions": [session]}
+    row = loss_table(raw).rows[0]
+    assert row[3] == "2" and "15.3 µs" in row
+
+
+class _FakePort:
+    def __init__(self) -> None:
+        self.calls: list[str] = []
+
+    def write(self, data: bytes) -> int:
+        self.calls.append("write")
+        return len(data)
+
+    def flushOutput(self) -> None:
+        self.calls.append("flush")
+
+
+def test_pypots_gap_is_timed_from_a_sync_write_to_the_next_flush_only(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.syspath_prepend(str(BENCH_DIR / "peers"))
+    torque = importlib.import_module("pypot_torque")
+    for name in ("pypot_torque", "_common"):  # the peers' own modules: not left for others
+        sys.modules.pop(name, None)
+    port = _FakePort()
+    stamps = torque.GapStamps(port, 2)
+    sync_write = bytes([0xFF, 0xFF, 0xFD, 0x00, 0xFE, 0x09, 0x00, 0x83, 0x18, 0x00, 0x01, 0x00])
+    read = bytes([0xFF, 0xFF, 0xFD, 0x00, 0x01, 0x07, 0x00, 0x02, 0x18, 0x00, 0x01, 0x00])
+    port.flushOutput()  # nothing written yet: no gap
+    port.write(sync_write)
+    port.flushOutput()  # one gap
+    port.write(read)
+    port.flushOutput()  # after a READ: no gap (a reply follows it)
+    assert port.calls == ["flush", "write", "flush", "write", "flush"]
+    assert len(stamps.gaps_us) == 1 and stamps.gaps_us[0] >= 0
+    assert set(stamps.summary()) == {"p50", "p95"}
+    protocol_1 = torque.GapStamps(_FakePort(), 1)
+    assert protocol_1.summary() == {}
