@@ -28,7 +28,7 @@ SOURCES = {
 }
 # The import lines changed, as a pypot user changes them (every other line runs as written).
 IMPORTS = {
-    "from pypot.creatures import PoppyErgoJr": "from poppy_core.creatures import PoppyErgoJr",
+    "from pypot.creatures import PoppyErgoJr": "from poppy_core.pypot import PoppyErgoJr",
     "from pypot.primitive import LoopPrimitive": "from poppy_core.motion import LoopPrimitive",
     "from pypot.robot.controller import MotorsController": (
         "from poppy_core.robot.controller import MotorsController"
