@@ -48,7 +48,8 @@ def _load() -> str:
 
 def sim_camera(width: int, height: int, fps: float, seconds: float) -> dict[str, Any]:
     """Frames rendered per second by the Ergo Jr's camera, and the 50 Hz loops' rates meanwhile."""
-    from poppy_core.robot import RobotConfig, from_config, load_profile
+    from poppy_core import from_config
+    from poppy_core.robot import RobotConfig, load_profile
     from poppy_core.sensors import Camera
 
     data = load_profile("ergo-jr").to_dict()
@@ -103,7 +104,7 @@ def mjpeg_latency(frames: int = MJPEG_FRAMES) -> dict[str, float]:
     """From a frame's grab to its JPEG part read by an HTTP client of the MJPEG stream (ms)."""
     import httpx
 
-    from poppy_core.robot import from_profile
+    from poppy_core import from_profile
     from poppy_core.server import ServerThread, create_app
 
     latencies = []

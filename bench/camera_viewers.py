@@ -90,7 +90,8 @@ def measure(viewers: int, fps: float, seconds: float) -> dict[str, object]:
     import tempfile
 
     os.environ["POPPY_MOVES_DIR"] = tempfile.mkdtemp(prefix="poppy-bench-moves-")
-    from poppy_core.robot import RobotConfig, from_config, load_profile
+    from poppy_core import from_config
+    from poppy_core.robot import RobotConfig, load_profile
     from poppy_core.server import ServerThread, create_app
 
     data = load_profile("ergo-jr").to_dict()

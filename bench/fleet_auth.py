@@ -59,9 +59,9 @@ def round_trip() -> dict[str, Any]:
     """``{"trip": the interleaved round trips, "flood": flood()}`` on two robots served here."""
     import socket
 
+    from poppy_core import from_profile
     from poppy_core.assembly import ServeSpec, ZenohSettings, serve
     from poppy_core.remote.zenoh_client import ZenohClient
-    from poppy_core.robot import from_profile
 
     def endpoint() -> str:
         with socket.socket() as sock:

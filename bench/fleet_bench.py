@@ -189,10 +189,10 @@ def teleop_goals() -> dict[str, Any]:
     from websockets.sync.client import connect
 
     from bench.procs import free_port
+    from poppy_core import from_profile
     from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
     from poppy_core.assembly import ZenohSettings as Settings
     from poppy_core.remote.zenoh_fleet import Fleet
-    from poppy_core.robot import from_profile
     from poppy_core.server.service import RobotService
 
     endpoint = f"tcp/127.0.0.1:{free_port()}"

@@ -17,8 +17,8 @@ import time
 from pathlib import Path
 
 from bench.procs import free_port
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
-from poppy_core.robot import from_profile
 
 
 def _log_starts(path: Path) -> None:

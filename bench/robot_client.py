@@ -50,8 +50,9 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     """Build the robot, run its loops, and return the JSON-ready record."""
     record: dict[str, Any] = {"peer": "poppy", "error": None, "rate_hz": args.rate_hz}
     import poppy_core
+    from poppy_core import from_config
     from poppy_core.errors import PoppyError
-    from poppy_core.robot import BusSync, RobotConfig, from_config, load_config, loops_for
+    from poppy_core.robot import BusSync, RobotConfig, load_config, loops_for
     from poppy_core.robot import registers as regs
 
     record["version"] = poppy_core.__version__

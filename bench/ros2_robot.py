@@ -7,8 +7,8 @@ import argparse
 import contextlib
 import time
 
+from poppy_core import from_profile
 from poppy_core.assembly import ServeSpec, serve
-from poppy_core.robot import from_profile
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.zenoh_wire import ZenohSettings
 

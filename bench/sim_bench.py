@@ -110,7 +110,7 @@ def step_rtf(robot: str) -> float:
 
 def full_stack(robot: str) -> dict[str, Any]:
     """Simulated vs wall time and the sync loops' rates over ``FULL_STACK_S``, goals moving."""
-    from poppy_core.robot import from_profile
+    from poppy_core import from_profile
 
     with from_profile(robot, sim="mujoco") as bot:
         simulation = bot.simulation

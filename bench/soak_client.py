@@ -193,9 +193,10 @@ class Recorder:
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Build the robot, report ready, record until ``stop``, close; the JSON-ready record."""
     import poppy_core
+    from poppy_core import from_config
     from poppy_core.errors import PoppyError
     from poppy_core.motion.builtins import Sinus
-    from poppy_core.robot import RobotConfig, from_config, load_config
+    from poppy_core.robot import RobotConfig, load_config
 
     record: dict[str, Any] = {"peer": "poppy", "error": None, "version": poppy_core.__version__}
     config = load_config(args.config)

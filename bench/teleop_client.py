@@ -26,9 +26,9 @@ def _state(state: str, reason: str) -> None:
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Build the robots, teleoperate until a signal, return the JSON-ready record."""
+    from poppy_core import from_profile
     from poppy_core.motion.teleop.session import Teleoperation
     from poppy_core.remote import RemoteFollower
-    from poppy_core.robot import from_profile
 
     record: dict[str, Any] = {"peer": "poppy", "version": version("poppy"), "error": None}
     stop = threading.Event()

@@ -20,6 +20,7 @@ from pathlib import Path
 import httpx
 import numpy as np
 
+from poppy_core import from_profile
 from poppy_core.bus import DxlBus, PortInfo, scan
 from poppy_core.emulator import (
     FaultInjector,
@@ -33,7 +34,7 @@ from poppy_core.models import model_by_name
 from poppy_core.motion import Move, MovePlayer, PositionWatcher, read_move
 from poppy_core.motion.teleop.session import teleoperate
 from poppy_core.protocol import ping
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from poppy_core.schedule import Gate
 from poppy_core.server import ServerThread, create_app
 

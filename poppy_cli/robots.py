@@ -77,7 +77,7 @@ def start_robot(
     With ``wait_for_motors`` (a server started at boot), a missing port or silent motors are
     waited for instead of refused.
     """
-    from poppy_core.assembly import from_config
+    from poppy_core import from_config
 
     return from_config(
         config,

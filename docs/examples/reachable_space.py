@@ -15,7 +15,7 @@ import random
 import time
 from pathlib import Path
 
-from poppy_core.robot import from_profile
+from poppy_core import from_profile
 
 ARM = ("l_shoulder_y", "l_shoulder_x", "l_arm_z", "l_elbow_y")
 FOREARM = "l_forearm"  # the URDF link; its origin is the elbow

@@ -119,7 +119,7 @@ def dance(time_factor: float, sim: bool | str = True) -> None:
 
     from rich.live import Live
 
-    from poppy_core.robot import from_profile
+    from poppy_core import from_profile
 
     with from_profile("ergo-jr", sim=sim, sensors=False) as robot:  # the dance needs no camera
         robot.compliant = False

@@ -4,7 +4,8 @@ The top room of ``poppy_core`` (it may import every other): ``from_config``, ``f
 ``autodetect`` and pypot's ``from_json`` build a plain robot (``robot.factory``) and add its
 primitive manager and creature; ``serve(robot, spec)`` builds every server of a robot around one
 service; pypot's creature classes (``PoppyErgoJr(use_http=True)``) do both.
-``poppy_core.robot`` and ``poppy_core.creatures`` re-export the user-facing names.
+User code reaches them through the package's faces (``poppy_core.from_profile``...) and pypot's
+names through ``poppy_core.pypot``.
 """
 
 from types import MappingProxyType

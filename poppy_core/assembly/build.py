@@ -1,8 +1,7 @@
 """Build a robot whole: the plain robot of ``robot.factory``, its primitive manager and creature.
 
-``from_config``, ``from_profile``, ``autodetect`` and pypot's ``from_json`` are the ones user code
-reaches as ``poppy_core.robot.from_profile``... (re-exported there) and as
-``poppy_core.creatures.from_profile`` (earlier releases' spelling, same functions).
+User code reaches ``from_config``, ``from_profile`` and ``autodetect`` as the package's faces
+(``poppy_core.from_profile``...) and pypot's ``from_json`` in ``poppy_core.pypot``.
 """
 
 from __future__ import annotations
@@ -34,8 +33,9 @@ def from_config(
 
     The one way robots are built (the CLI, the server, the TUI, ``from_profile``,
     ``autodetect`` and the creature classes all come here): the plain robot of
-    ``poppy_core.robot.factory.from_config``, its primitive manager (``robot.primitive_manager``,
-    pypot's ``robot._primitive_manager``), and what the config makes it.
+    ``poppy_core.robot.factory.build_plain_robot``, its primitive manager
+    (``robot.primitive_manager``, pypot's ``robot._primitive_manager``), and what the config
+    makes it.
 
     Args:
         config: the config, a dict as pypot's ``from_config(my_config)`` takes, or a file path.
@@ -46,7 +46,7 @@ def from_config(
             its config describes. False: a bare robot.
         start_defaults: start the primitives the creature starts by default.
         **options: ``strict``, ``fix_return_delay``, ``write_angle_limits``, ``ports``,
-            ``start_sync``, ``sensors``: see ``poppy_core.robot.factory.from_config``.
+            ``start_sync``, ``sensors``: see ``poppy_core.robot.factory.build_plain_robot``.
 
     Returns:
         The running robot (close it, or use it in a ``with`` block).
@@ -59,7 +59,7 @@ def from_config(
             motors whose model differs from the config.
         PortError: a port cannot be opened.
     """
-    robot = factory.from_config(config, sim, **options)
+    robot = factory.build_plain_robot(config, sim, **options)
     try:
         primitive_manager(robot)
         if creature:

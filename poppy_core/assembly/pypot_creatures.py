@@ -4,7 +4,7 @@ As in pypot, calling the class builds and returns the robot (a ``Robot`` made by
 ``poppy_core.assembly.from_profile`` / ``from_config``) with the creature's behaviours attached,
 and the servers asked for started by the one ``serve`` (``assembly.servers``), each attached
 under pypot's name (``robot.http``, ``robot.ws``, ``robot.zmq``, ``robot.snap``). They live in the
-assembly because they start servers; ``poppy_core.creatures.PoppyErgoJr`` re-exports them.
+assembly because they start servers; user code imports them from ``poppy_core.pypot``.
 The constructor takes pypot's arguments; each is honoured or refused with a one-line error
 saying what to use instead.
 """

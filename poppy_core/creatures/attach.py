@@ -1,4 +1,4 @@
-"""What ``poppy_core.robot.from_config`` attaches to every robot it builds (its creature hook)."""
+"""What ``poppy_core.from_config`` attaches to every robot it builds (its creature hook)."""
 
 from __future__ import annotations
 

@@ -1,11 +1,8 @@
-"""Robot layer: configs and profiles (pypot JSON compatible); more is added by the robot modules.
+"""Robot layer: configs and profiles (pypot JSON compatible), ``Motor``, ``Robot`` and their loops.
 
-``from_config``, ``from_profile``, ``autodetect`` and ``from_json`` are the assembly's (a robot
-with its creature, ``poppy_core.assembly``), re-exported here on first use by ``__getattr__``:
-the one import that climbs, by design (docs/internals.md, "The composition root").
+A robot is built whole (with its creature) by the package's faces, ``poppy_core.from_profile``,
+``from_config`` and ``autodetect``; ``robot.factory`` builds the plain robot they start from.
 """
-
-from typing import TYPE_CHECKING, Any
 
 from poppy_core.robot.calibration import (
     Calibration,
@@ -89,14 +86,10 @@ __all__ = [
     "RobotConfig",
     "SavedProfile",
     "SyncStats",
-    "autodetect",
     "check_calibration",
     "config_to_text",
     "dump_config",
     "find_profile",
-    "from_config",
-    "from_json",
-    "from_profile",
     "from_remote",
     "list_profiles",
     "load_config",
@@ -109,18 +102,3 @@ __all__ = [
     "user_profile_dir",
     "with_ports",
 ]
-
-if TYPE_CHECKING:
-    from poppy_core.assembly import autodetect, from_config, from_json, from_profile
-
-ASSEMBLED = frozenset({"autodetect", "from_config", "from_json", "from_profile"})
-"""The names re-exported from the assembly (``poppy_core.assembly.build``)."""
-
-
-def __getattr__(name: str) -> Any:
-    """The assembly's builders, imported when first asked for (the room sits below them)."""
-    if name in ASSEMBLED:
-        import poppy_core.assembly
-
-        return getattr(poppy_core.assembly, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

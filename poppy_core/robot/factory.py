@@ -2,7 +2,8 @@
 
 Plain: its motors, buses, sync loops and sensors, no creature. The assembly
 (``poppy_core.assembly``, the floor above every room) adds the primitive manager and the
-creature; ``poppy_core.robot.from_profile`` is the assembly's.
+creature: ``poppy_core.from_config``, ``from_profile`` and ``autodetect`` start from
+:func:`build_plain_robot`.
 
 ``sim=True`` starts one in-process emulator per controller (a ``VirtualBus`` with the configured
 models, IDs and baud rate, reached through the in-process link ``emu://NAME``), so the robot
@@ -32,9 +33,9 @@ from poppy_core.robot.virtual import start_emulators, start_simulation, virtual_
 __all__ = [
     "SIM_MODES",
     "SimMode",
+    "build_plain_robot",
     "detect_config",
-    "from_config",
-    "from_profile",
+    "profile_config",
     "start_emulators",
     "start_simulation",
     "virtual_buses",
@@ -44,7 +45,7 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 
-def from_config(
+def build_plain_robot(
     config: ConfigSource,
     sim: SimMode = False,
     *,
@@ -58,7 +59,7 @@ def from_config(
 ) -> Robot:
     """Build and start a plain robot from a config (a ``RobotConfig``, a dict or a JSON/YAML file).
 
-    The one way robots are built (``poppy_core.assembly.from_config`` comes here, then adds the
+    The one way robots are built (``poppy_core.from_config`` comes here, then adds the
     creature); the steps are ``poppy_core.robot.build_steps``'s.
 
     Args:
@@ -140,20 +141,6 @@ def profile_config(name: str, port: str | Mapping[str, str] | None = None) -> Ro
     controllers' ports of a mapping; None keeps the profile's (``"auto"``: searched for)."""
     config = load_profile(name)
     return config if port is None else with_ports(config, port)
-
-
-def from_profile(
-    name: str, port: str | Mapping[str, str] | None = None, sim: SimMode = False, **options: Any
-) -> Robot:
-    """Build a plain robot from an installed or user profile (``"ergo-jr"``, ``"torso"``...).
-
-    Args:
-        name: the profile name.
-        port: see :func:`profile_config`.
-        sim: serve the motors from emulators (True/``"ideal"`` or ``"mujoco"``).
-        **options: passed to :func:`from_config`.
-    """
-    return from_config(profile_config(name, port), sim, **options)
 
 
 def detect_config(

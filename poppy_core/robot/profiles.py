@@ -10,7 +10,6 @@ from pathlib import Path
 
 import platformdirs
 
-import poppy_core
 from poppy_core.documents import CONFIG_LIMITS, parse_yaml, read_limited
 from poppy_core.errors import ConfigError
 from poppy_core.robot.config import RobotConfig
@@ -54,7 +53,7 @@ def installed_profile_dir() -> Path | None:
     An installed wheel carries them in ``poppy_core/_profiles``; a source checkout has them in
     ``profiles/`` next to ``pyproject.toml``.
     """
-    package_dir = Path(poppy_core.__file__).resolve().parent
+    package_dir = Path(__file__).resolve().parents[1]  # poppy_core/
     bundled = package_dir / "_profiles"
     if bundled.is_dir():
         return bundled

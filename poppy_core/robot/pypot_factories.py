@@ -1,7 +1,7 @@
 """pypot's ``from_remote(host, port)``: the client of a served robot.
 
-pypot's ``from_json`` builds a robot, so it is the assembly's (``poppy_core.assembly.build``),
-re-exported as ``poppy_core.robot.from_json``.
+pypot's ``from_json`` builds a robot, so it is the assembly's (``poppy_core.assembly.build``);
+user code imports both from ``poppy_core.pypot``.
 """
 
 from __future__ import annotations

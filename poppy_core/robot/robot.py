@@ -1,6 +1,6 @@
 """``Robot``: named motors and groups over one or more buses, their sync loops and gotos.
 
-Build one with ``poppy_core.robot.from_config``, ``from_profile`` or ``autodetect``; a Robot owns
+Build one with ``poppy_core.from_config``, ``from_profile`` or ``autodetect``; a Robot owns
 its buses, threads and (with ``sim=True``) emulators, and ``close()`` stops them all. pypot's
 names for its groups and primitives are in ``robot_pypot``, its sync loops and ports in
 ``robot_syncs``, pypot's V-REP calls in ``vrep_names``; ``motors_of`` resolves specs with

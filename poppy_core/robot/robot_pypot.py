@@ -89,7 +89,7 @@ class PypotRobotMixin:
         manager = self.extensions.get(MANAGER_KEY)
         if manager is None:
             raise ConfigError(
-                "this robot has no primitive manager: build it with poppy_core.robot.from_config "
+                "this robot has no primitive manager: build it with poppy_core.from_config "
                 "(or from_profile), or call poppy_core.motion.primitive_manager(robot)",
                 field="_primitive_manager",
             )

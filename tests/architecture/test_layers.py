@@ -19,8 +19,9 @@ ROOT = Path(__file__).resolve().parents[2]
 # dependencies, with the one-line error naming a missing extra) are leaves every room may use;
 # so is `zenoh_wire` (the Zenoh keys, session settings and state message a served robot and its
 # clients share, as `line` is the byte-line contract of buses and emulators), `zenoh_auth` (how
-# those clients sign their messages and the robot checks them), and `ros2_wire`
-# (rmw_zenoh's keys, liveliness tokens and attachments, on top of `zenoh_wire`'s settings).
+# those clients sign their messages and the robot checks them), `ros2_wire`
+# (rmw_zenoh's keys, liveliness tokens and attachments, on top of `zenoh_wire`'s settings) and
+# `zenoh_router` (the fleet's router, started by the CLI, on `zenoh_wire`'s settings).
 LEAVES = {
     "errors",
     "files",
@@ -33,6 +34,7 @@ LEAVES = {
     "zenoh_wire",
     "zenoh_auth",
     "ros2_wire",
+    "zenoh_router",
 }
 ALLOWED: dict[str, set[str]] = {
     "protocol": set(),
@@ -59,14 +61,12 @@ ALLOWED: dict[str, set[str]] = {
 }
 # the composition root (floor 8): builds a robot with its creature, and its servers; every room
 ALLOWED["assembly"] = set(ALLOWED)
-# The one kind of import that climbs, by design (docs/internals.md, "The composition root"): a
-# room's package re-exports the assembly's user-facing names (``poppy_core.robot.from_profile``,
-# ``poppy_core.creatures.PoppyErgoJr`` of user code and the documentation) through its module
-# ``__getattr__``, loaded on first use only.
-FILE_EXCEPTIONS = {
-    ("robot/__init__.py", "__getattr__", "poppy_core.assembly"),
-    ("creatures/__init__.py", "__getattr__", "poppy_core.assembly"),
-}
+# the top floor's faces (modules of the package itself): the package (``poppy_core.from_profile``
+# ..., lazily), pypot's names (``poppy_core.pypot``) and the spellings of the last release
+# (``old_spellings``, which the package loads first: the standard library only); they may import
+# every room. Nothing below them imports them, nor the package itself (``import poppy_core``,
+# ``from poppy_core import __version__``).
+FACES = {"__init__", "pypot", "old_spellings"}
 DYNAMIC_IMPORTERS = {"import_module", "__import__"}
 # a room that imports a module whose name is computed: only the optional third-party libraries
 EXTRAS_LOADER = "extras.py"
@@ -93,6 +93,8 @@ def _imports_where(path: Path) -> set[tuple[str, str]]:
                 inside = child.name if not where else f"{where}.{child.name}"
             if isinstance(child, ast.Import):
                 found.update((alias.name, inside) for alias in child.names)
+            elif isinstance(child, ast.ImportFrom) and child.module == "poppy_core":
+                found.update((_of_the_package(alias.name), inside) for alias in child.names)
             elif isinstance(child, ast.ImportFrom) and child.module and child.level == 0:
                 found.add((child.module, inside))
             elif isinstance(child, ast.Call) and _called(child.func) in DYNAMIC_IMPORTERS:
@@ -107,6 +109,14 @@ def _imports_where(path: Path) -> set[tuple[str, str]]:
 
     visit(tree, "")
     return found
+
+
+def _of_the_package(name: str) -> str:
+    """``from poppy_core import NAME``: the module ``poppy_core.NAME``, or the package itself."""
+    package = ROOT / "poppy_core"
+    if (package / f"{name}.py").is_file() or (package / name / "__init__.py").is_file():
+        return f"poppy_core.{name}"
+    return "poppy_core"
 
 
 def _type_checking_only(node: ast.If) -> bool:
@@ -133,13 +143,10 @@ def _climbing(rooms: dict[str, set[str]]) -> list[str]:
                 parts = name.split(".")
                 if parts[0] == "poppy_cli":
                     bad.append(f"{path.relative_to(ROOT)} imports {name}")
-                if parts[0] != "poppy_core" or len(parts) < 2:
+                if parts[0] != "poppy_core":
                     continue
-                target = parts[1]
+                target = parts[1] if len(parts) > 1 else "__init__"
                 if target == room or target in LEAVES or target in allowed:
-                    continue
-                local = path.relative_to(ROOT / "poppy_core").as_posix()
-                if (local, where, name) in FILE_EXCEPTIONS:
                     continue
                 inside = f" in {where}()" if where else ""
                 bad.append(f"{path.relative_to(ROOT)} imports {name}{inside}")
@@ -164,12 +171,17 @@ def test_every_room_of_the_package_is_in_the_plan() -> None:
         "def f():\n    from poppy_core.creatures import registry\n",
         "HOOK = 'poppy_core.motion.manager:primitive_manager'\n",
         "import importlib\ndef f(name):\n    return importlib.import_module(name)\n",
+        "import poppy_core\n",
+        "from poppy_core import __version__\n",
+        "def __getattr__(name):\n    from poppy_core import from_profile\n",
+        "def __getattr__(name):\n    import poppy_core.assembly\n",
     ],
 )
 def test_the_layer_check_sees_every_way_of_climbing(
     source: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """An import string, a computed module name and a function-level import all climb."""
+    """An import string, a computed module name, a function-level import (a lazy re-export in
+    a module's ``__getattr__`` too) and an import of the package itself all climb."""
     room = tmp_path / "poppy_core" / "robot"
     room.mkdir(parents=True)
     (room / "climber.py").write_text(source, encoding="utf-8")
@@ -177,30 +189,39 @@ def test_the_layer_check_sees_every_way_of_climbing(
     assert len(_climbing({"robot": ALLOWED["robot"]})) == 1
 
 
-@pytest.mark.parametrize("room", ["robot", "creatures"])
-def test_the_one_exception_is_a_re_export_of_the_assembly(room: str) -> None:
-    """The package's ``__getattr__`` imports the assembly, only on first use, and only the
-    assembly's names; importing the room loads no assembly."""
-    found = _imports_where(ROOT / "poppy_core" / room / "__init__.py")
-    climbing = {(n, w) for n, w in found if n.split(".")[1:2] in (["assembly"], ["server"])}
-    assert climbing == {("poppy_core.assembly", "__getattr__")}
-    loaded = subprocess.run(
-        [sys.executable, "-c", f"import sys, poppy_core.{room}\nprint('\\n'.join(sys.modules))"],
+def test_every_module_of_the_package_is_a_leaf_or_a_face() -> None:
+    modules = {p.stem for p in (ROOT / "poppy_core").glob("*.py")}
+    assert modules == LEAVES | FACES, modules ^ (LEAVES | FACES)
+
+
+def test_the_faces_import_only_poppy_core() -> None:
+    for face in sorted(FACES):
+        names = {n for n, _ in _imports_where(ROOT / "poppy_core" / f"{face}.py")}
+        assert not {n for n in names if n.startswith(("poppy_cli", "<"))}, face
+
+
+def test_the_package_loads_its_faces_on_first_use() -> None:
+    """``import poppy_core`` (what every room's import runs first) loads no room: the faces
+    import the assembly when first asked for, and are the assembly's."""
+    out = subprocess.run(
+        [sys.executable, "-c", "import sys, poppy_core\nprint('\\n'.join(sys.modules))"],
         capture_output=True,
         text=True,
         check=True,
         cwd=ROOT,
     ).stdout.split()
-    assert "poppy_core.assembly" not in loaded
-    import importlib
-
+    assert {n for n in out if n.startswith("poppy_core")} == {
+        "poppy_core",
+        "poppy_core.old_spellings",
+    }
+    import poppy_core
     from poppy_core import assembly
 
-    package = importlib.import_module(f"poppy_core.{room}")
-    for name in package.ASSEMBLED:
-        assert getattr(package, name) is getattr(assembly, name)
+    for name in poppy_core.FACES:
+        assert getattr(poppy_core, name) is getattr(assembly, name)
+    assert set(dir(poppy_core)) >= poppy_core.FACES
     with pytest.raises(AttributeError):
-        package.nothing_of_that_name  # noqa: B018
+        poppy_core.nothing_of_that_name  # noqa: B018
 
 
 def _module_level_imports(path: Path) -> set[str]:
@@ -233,18 +254,16 @@ def test_leaves_import_only_errors_and_checks() -> None:
             names = _imports(path)
             ours = {n for n in names if n.split(".")[0] in ("poppy_core", "poppy_cli")}
             ours = {n for n in ours if not n.startswith(f"poppy_core.{leaf}")}  # its own modules
-            below = (
-                {"poppy_core.errors"} if leaf == "checks" else {"poppy_core.errors", "poppy_core"}
-            )
-            if leaf == "zenoh_wire":  # its session needs the optional zenoh: the one-line error
+            below = {"poppy_core.errors"}
+            if leaf != "checks":
+                below |= {"poppy_core.checks"}
+            if leaf in ("zenoh_wire", "zenoh_router"):  # a session needs the optional zenoh
                 below |= {"poppy_core.extras"}
-            if leaf == "ros2_wire":  # the node's Zenoh session settings are the fleet's
+            if leaf == "zenoh_wire":  # a served robot's session checks its clients' signatures
+                below |= {"poppy_core.zenoh_auth"}
+            if leaf in ("ros2_wire", "zenoh_router"):  # the Zenoh session settings are the fleet's
                 below |= {"poppy_core.zenoh_wire"}
-            # `from poppy_core import checks` is recorded as its package
             assert ours <= below, (leaf, path.name, ours)
-            if "poppy_core" in ours:
-                source = path.read_text(encoding="utf-8")
-                assert "from poppy_core import checks" in source, (leaf, path.name)
 
 
 def _loaded_after(code: str) -> set[str]:
@@ -303,4 +322,5 @@ def test_trajectory_is_a_leaf_still_reachable_from_motion() -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT
     ).stdout.split()
     ours = {name for name in out if name.startswith("poppy_core.")}
-    assert ours <= {"poppy_core.trajectory", "poppy_core.errors", "poppy_core.checks"}, ours
+    package = {"poppy_core.old_spellings"}  # the package's own, loaded first (standard library)
+    assert ours <= {"poppy_core.trajectory", "poppy_core.errors", "poppy_core.checks"} | package

@@ -10,8 +10,8 @@ from typing import Any
 import pytest
 
 from poppy_core.assembly import Listen, ServeSpec, pypot_creatures
-from poppy_core.creatures import PoppyErgoJr
 from poppy_core.errors import ArgumentError
+from poppy_core.pypot import PoppyErgoJr
 from tests.helpers.cli import run_poppy
 
 # (the spec's arguments, the same through `poppy serve`, the line, the flag the CLI names)

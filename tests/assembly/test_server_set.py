@@ -10,10 +10,9 @@ from typing import Any
 import pytest
 from websockets.sync.client import ClientConnection, connect
 
-from poppy_core import assembly
+from poppy_core import assembly, from_profile
 from poppy_core.assembly import Listen, ServerSet, ServeSpec, pypot_creatures
-from poppy_core.creatures import PoppyErgoJr
-from poppy_core.robot import from_profile
+from poppy_core.pypot import PoppyErgoJr
 from tests.helpers.cli import run_poppy
 
 EVERY = ("http", "ws", "zmq", "snap")

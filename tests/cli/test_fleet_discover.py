@@ -8,8 +8,8 @@ import uuid
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, serve
-from poppy_core.robot import from_profile
 from tests.helpers.cli import run_poppy
 
 pytest.importorskip("zeroconf")

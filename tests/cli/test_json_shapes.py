@@ -417,8 +417,8 @@ ANSWERS = "\n\ny\n\ny\ny\n"  # calibrate: as tests/cli/test_calibrate_cmd.py ans
 @contextmanager
 def served_on_zenoh(name: str) -> Iterator[str]:
     """A virtual Ergo Jr served on Zenoh as ``name``; yields the endpoint it listens on."""
+    from poppy_core import from_profile
     from poppy_core.assembly import ServeSpec, ZenohSettings, serve
-    from poppy_core.robot import from_profile
 
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
@@ -535,8 +535,8 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
 
 def service_runs(tmp: Path) -> dict[str, Any]:
     """`poppy service status` against a recording systemctl, release/take on a served robot."""
+    from poppy_core import from_profile
     from poppy_core.assembly import Listen, ServeSpec, serve
-    from poppy_core.robot import from_profile
     from tests.helpers.recording import RecordingFake
 
     fake = RecordingFake(tmp / "systemd")

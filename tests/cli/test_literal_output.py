@@ -59,7 +59,7 @@ def test_error_line_is_one_literal_line(captured: tuple[io.StringIO, io.StringIO
 
 def test_tables_and_status_show_motor_names_literally() -> None:
     from poppy_cli.commands.robot import status_table
-    from poppy_core.robot import from_config
+    from poppy_core import from_config
 
     out = io.StringIO()
     wide = LiteralConsole(file=out, width=240, force_terminal=True, color_system=None)

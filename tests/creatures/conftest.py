@@ -6,7 +6,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.robot import Robot
 from tests.helpers.fixtures import ergo_fixture
 

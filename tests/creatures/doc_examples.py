@@ -47,13 +47,13 @@ def run(code: str, **names: Any) -> dict[str, Any]:
 # -- constructors (1.4 "Programming with Python"; the creature libraries) -----------------------
 
 CREATE_ERGO_JR = """
-from poppy_core.creatures import PoppyErgoJr
+from poppy_core.pypot import PoppyErgoJr
 poppy = PoppyErgoJr(simulator=SIMULATOR)
 """  # line 462, with the simulator the test runs on
 
 FROM_JSON = """
-import poppy_core.robot
-poppy = poppy_core.robot.from_json('my_config.json', use_dummy_io=True)
+import poppy_core.pypot
+poppy = poppy_core.pypot.from_json('my_config.json', use_dummy_io=True)
 """  # line 476 (`use_dummy_io`: virtual servos, no hardware here)
 
 # -- motors and groups (line 484-591) -----------------------------------------------------------
@@ -277,9 +277,9 @@ for m in robot.torso:
 # -- pypot.robot.from_config with the Ergo's config (line 2636) ---------------------------------
 
 FROM_CONFIG = """
-import poppy_core.robot
+import poppy_core.pypot
 
-ergo_robot = poppy_core.robot.from_config(my_config, sim=True)
+ergo_robot = poppy_core.pypot.from_config(my_config, sim=True)
 print(ergo_robot.m2.present_position) #get register present_position of motor m2
 
 ergo_robot.m6.compliant = False          #enable torque of the m6 motor
@@ -291,7 +291,7 @@ time.sleep(2)                           #wait for the robot to move
 # -- the creature libraries (lines 1845, 1945) and their behaviours ------------------------------
 
 CREATE_HUMANOID = """
-from poppy_core.creatures import PoppyHumanoid
+from poppy_core.pypot import PoppyHumanoid
 
 poppy = PoppyHumanoid(simulator=SIMULATOR)
 
@@ -299,7 +299,7 @@ print(poppy.motors)
 """  # line 1845, with the simulator the test runs on
 
 CREATE_TORSO = """
-from poppy_core.creatures import PoppyTorso
+from poppy_core.pypot import PoppyTorso
 poppy = PoppyTorso(simulator=SIMULATOR)
 print(poppy.motors)
 """  # line 1945
@@ -454,20 +454,20 @@ with open('myconfig.json', 'w') as f:
 
 LOAD_CONFIG = """
 import json
-import poppy_core.robot
+import poppy_core.pypot
 
-ergo = poppy_core.robot.from_json('myconfig.json', use_dummy_io=True)
+ergo = poppy_core.pypot.from_json('myconfig.json', use_dummy_io=True)
 """  # line 3014 (the documentation reads 'ergo.json'; `use_dummy_io`: no hardware here)
 
 CLOSING = """
 from contextlib import closing
 
-import poppy_core.robot
+import poppy_core.pypot
 
 # The closing decorator make sure that the close function will be called
 # on the object passed as argument when the with block is exited.
 
-with closing(poppy_core.robot.from_json('myconfig.json', use_dummy_io=True)) as my_robot:
+with closing(poppy_core.pypot.from_json('myconfig.json', use_dummy_io=True)) as my_robot:
     # do stuff without having to make sure not to forget to close my_robot!
     pass
 """  # line 3116

@@ -15,9 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core.creatures import PoppyErgoJr, PoppyHumanoid, PoppyTorso
 from poppy_core.creatures.postures import clamp_to_limits
 from poppy_core.motion import SimplePosture
+from poppy_core.pypot import PoppyErgoJr, PoppyHumanoid, PoppyTorso
 from tests.creatures.creature_primitives import ATTACHED, EXPECTED_FAILURES, PACKAGES, replay
 from tests.helpers.creature_packages import creature_primitives
 

@@ -8,13 +8,8 @@ from typing import Any
 
 import pytest
 
-from poppy_core.creatures import (
-    CREATURES,
-    attach_creature,
-    detect_kind,
-    from_config,
-    normalize_kind,
-)
+from poppy_core import from_config
+from poppy_core.creatures import CREATURES, attach_creature, detect_kind, normalize_kind
 from poppy_core.errors import ConfigError
 from poppy_core.robot import RobotConfig, load_profile
 from tests.helpers.pypot_names import UPPER_BODY_PRIMITIVES

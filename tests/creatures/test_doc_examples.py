@@ -16,11 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from poppy_core.creatures import PoppyErgoJr, PoppyTorso
+from poppy_core import from_config
 from poppy_core.creatures.postures import clamp_to_limits, humanoid_sit
 from poppy_core.errors import ConfigError
 from poppy_core.motion import LoopPrimitive, Move, PositionWatcher
-from poppy_core.robot import MotorGroup, Robot, from_config, load_profile
+from poppy_core.pypot import PoppyErgoJr, PoppyTorso
+from poppy_core.robot import MotorGroup, Robot, load_profile
 from tests.creatures import doc_examples as doc
 from tests.creatures.helpers import positions, reached, stop_all, virtual, wait_until
 from tests.helpers.pypot_names import TORSO_PRIMITIVES

@@ -8,8 +8,8 @@ from collections.abc import Iterator
 
 import pytest
 
-from poppy_core.creatures import PoppyErgoJr
 from poppy_core.creatures.ergo_demos import DEMO_POSTURE, FIGURES, LEVEL_ANGLES, puzzle_figure
+from poppy_core.pypot import PoppyErgoJr
 from poppy_core.robot import Robot
 from tests.creatures.helpers import wait_until
 

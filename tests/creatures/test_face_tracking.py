@@ -8,7 +8,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from poppy_core.creatures import FaceTracking, from_config, from_profile
+from poppy_core import from_config, from_profile
+from poppy_core.creatures import FaceTracking
 from poppy_core.robot import RobotConfig, load_profile
 from poppy_core.sensors import Face, FaceDetector
 from tests.creatures.test_tracking import HEIGHT, WIDTH, SeenPoint, turns_to_centre

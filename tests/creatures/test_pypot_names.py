@@ -12,10 +12,11 @@ import httpx
 import numpy as np
 import pytest
 
-from poppy_core.creatures import PoppyErgoJr
+from poppy_core import from_config
 from poppy_core.errors import ArgumentError, ConfigError, RegisterError
 from poppy_core.motion import Move, MovePlayer, MoveRecorder
-from poppy_core.robot import Robot, from_config, from_json, from_remote, load_profile
+from poppy_core.pypot import PoppyErgoJr, from_json
+from poppy_core.robot import Robot, from_remote, load_profile
 from tests.creatures.helpers import wait_until
 
 

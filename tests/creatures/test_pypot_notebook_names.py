@@ -18,12 +18,11 @@ import numpy as np
 import pytest
 
 import poppy_core
-import poppy_core.creatures
 from poppy_core.bus import XL320LEDColors
-from poppy_core.creatures import PoppyErgoJr, PoppyTorso, installed_poppy_creatures
 from poppy_core.errors import ArgumentError, KinematicsError
 from poppy_core.models import XL_320
 from poppy_core.motion import Move
+from poppy_core.pypot import PoppyErgoJr, PoppyTorso, installed_poppy_creatures
 from poppy_core.robot import Robot
 from tests.creatures.helpers import wait_until
 
@@ -49,7 +48,6 @@ def poppy() -> Iterator[Robot]:
 
 def test_module_versions() -> None:
     # pypot.__version__, poppy_ergo_jr.__version__: one version, the installed distribution's.
-    assert poppy_core.creatures.__version__ == poppy_core.__version__
     assert poppy_core.__version__ == importlib.metadata.version("poppy")
 
 

@@ -11,8 +11,8 @@ import re
 import httpx
 import pytest
 
-from poppy_core.creatures import PoppyErgoJr, PoppyHumanoid, PoppyTorso
 from poppy_core.errors import ConfigError
+from poppy_core.pypot import PoppyErgoJr, PoppyHumanoid, PoppyTorso
 
 
 @pytest.mark.parametrize(

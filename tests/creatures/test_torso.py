@@ -6,7 +6,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.robot import Robot
 from tests.creatures.helpers import positions, wait_until
 from tests.helpers.pypot_names import TORSO_PRIMITIVES

@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 RUN = """
 import json, sys
 sys.modules["cv2"] = None
-from poppy_core.creatures import PoppyErgoJr
+from poppy_core.pypot import PoppyErgoJr
 from poppy_core.errors import MissingExtraError
 from tests.helpers.bus import emulate_bus
 

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
 from poppy_core.remote.zenoh_fleet import Fleet
-from poppy_core.robot import from_profile
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from tests.helpers.cli import run_poppy
 from tests.helpers.fake_tools import FakeTools

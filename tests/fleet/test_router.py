@@ -12,9 +12,10 @@ from typing import Any
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
 from poppy_core.remote.zenoh_fleet import Fleet
-from poppy_core.robot import from_profile, from_remote
+from poppy_core.robot import from_remote
 from poppy_core.zenoh_wire import mode_of
 from tests.helpers.cli import ENV, POPPY, run_poppy
 from tests.helpers.processes import read_until, reap

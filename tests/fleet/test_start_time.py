@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 
-from poppy_core import zenoh_wire
+from poppy_core import from_profile, zenoh_wire
 from poppy_core.errors import ArgumentError
 from poppy_core.motion import Primitive
 from poppy_core.motion.move import Move
@@ -23,7 +23,7 @@ from poppy_core.motion.move_library import save_move
 from poppy_core.motion.player import MovePlayer
 from poppy_core.remote.zenoh_client import answer_of
 from poppy_core.remote.zenoh_fleet import Fleet
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from poppy_core.schedule import Gate
 from poppy_core.server.start_time import StartTimes, check_start_at, wait_until
 from tests.helpers.cli import run_poppy

@@ -15,11 +15,12 @@ from typing import Any
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import ServeSpec, ZenohSettings, serve
 from poppy_core.errors import BusTimeout, CommunicationError, UnknownMotorError
 from poppy_core.remote import RemoteRobot
 from poppy_core.remote.zenoh_fleet import Fleet
-from poppy_core.robot import from_profile, from_remote
+from poppy_core.robot import from_remote
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from poppy_core.zenoh_wire import check_name, pack_state, session_config, unpack_state
 from tests.helpers.cli import ENV, POPPY, run_poppy

@@ -14,10 +14,10 @@ from typing import Any
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import ServeSpec, ZenohSettings, serve
 from poppy_core.errors import ConfigError
 from poppy_core.remote.zenoh_fleet import Fleet
-from poppy_core.robot import from_profile
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from tests.helpers.cli import run_poppy
 from tests.helpers.waiting import eventually

@@ -18,9 +18,10 @@ import yaml
 pytest.importorskip("foxglove")
 pytest.importorskip("mcap_protobuf")
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServerSet, ServeSpec, serve
 from poppy_core.errors import ArgumentError
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from poppy_core.server.errors import ListenError
 from tests.foxglove_app.client import FoxgloveClient
 from tests.helpers.cli import ENV, POPPY, run_poppy

@@ -17,9 +17,9 @@ pytest.importorskip("mcap_protobuf")
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 
+from poppy_core import from_profile
 from poppy_core.errors import FileError
 from poppy_core.motion.move_format import read_move
-from poppy_core.robot import from_profile
 from poppy_core.server.foxglove import McapRecording
 from tests.foxglove_app.test_foxglove_server import URDF, orientation_signs
 from tests.helpers.cli import run_poppy

@@ -7,7 +7,8 @@ from typing import Any, Literal
 
 import pytest
 
-from poppy_core.robot import Robot, from_profile
+from poppy_core import from_profile
+from poppy_core.robot import Robot
 
 
 def ergo_fixture(

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from poppy_core.robot import Robot, from_profile
+from poppy_core import from_profile
+from poppy_core.robot import Robot
 
 
 def sim_ergo_jr() -> Robot:

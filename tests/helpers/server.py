@@ -6,7 +6,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from poppy_core.robot import Robot, from_profile
+from poppy_core import from_profile
+from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app
 
 

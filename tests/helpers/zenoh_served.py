@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import socket
 
+from poppy_core import from_profile
 from poppy_core.assembly import ServerSet, ServeSpec, ZenohSettings, serve
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 
 TOKEN = "s3cret"
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from poppy_core.creatures import from_config
+from poppy_core import from_config
 from poppy_core.errors import ConfigError
 from poppy_core.kinematics import load_description
 from poppy_core.motion.cartesian import RobotChain

@@ -7,7 +7,7 @@ import time
 import numpy as np
 import pytest
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.errors import KinematicsError
 from poppy_core.motion.cartesian import RobotChain
 from poppy_core.robot import Robot

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.kinematics.transforms import quat_matrix
 from poppy_core.motion.cartesian import RobotChain

@@ -8,6 +8,7 @@ import time
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.errors import ArgumentError, ConfigError, PrimitiveError, RobotClosedError
 from poppy_core.motion import (
     LoopPrimitive,
@@ -19,7 +20,7 @@ from poppy_core.motion import (
     attached_primitives,
     primitive_manager,
 )
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from tests.helpers import eventually
 from tests.helpers.fixtures import ergo_fixture
 

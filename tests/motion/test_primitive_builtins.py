@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from poppy_core import from_profile
 from poppy_core.motion import (
     BUILTINS,
     Cosinus,
@@ -20,7 +21,7 @@ from poppy_core.motion import (
     Square,
     attach_builtins,
 )
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from tests.helpers.fixtures import ergo_fixture
 
 ergo = ergo_fixture()

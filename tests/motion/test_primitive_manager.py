@@ -7,6 +7,7 @@ import time
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.errors import (
     ArgumentError,
     PrimitiveError,
@@ -22,7 +23,7 @@ from poppy_core.motion import (
     Sinus,
     primitive_manager,
 )
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from tests.helpers import eventually
 from tests.helpers.fixtures import ergo_fixture
 

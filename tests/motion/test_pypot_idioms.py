@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.errors import ArgumentError, RegisterError
 from poppy_core.motion import LoopPrimitive, Primitive, SimplePosture
 from poppy_core.robot import Robot

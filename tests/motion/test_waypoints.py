@@ -7,8 +7,9 @@ from collections.abc import Iterator
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.motion.waypoints import WaypointFollower, Waypoints
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from tests.helpers.waiting import eventually
 
 

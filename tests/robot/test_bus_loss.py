@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.emulator import Endpoint, VirtualBus, serve_link, serve_pty, serve_tcp
-from poppy_core.robot import Robot, from_profile, load_profile
+from poppy_core.robot import Robot, load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.bus import robot_buses_wait_for_a_loaded_emulator
 from tests.helpers.waiting import eventually, scaled

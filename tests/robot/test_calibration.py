@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from poppy_core import from_config, from_profile
 from poppy_core.errors import CalibrationCancelled, ConfigError
 from poppy_core.models import model_by_name
 from poppy_core.robot import (
@@ -22,8 +23,6 @@ from poppy_core.robot import (
     ReferencePosture,
     Robot,
     check_calibration,
-    from_config,
-    from_profile,
     load_profile,
     save_user_profile,
 )

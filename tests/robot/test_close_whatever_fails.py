@@ -11,8 +11,8 @@ import threading
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.errors import SensorError
-from poppy_core.robot import from_profile
 
 
 def _failing(what: str) -> object:

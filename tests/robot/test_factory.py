@@ -8,17 +8,12 @@ from pathlib import Path
 
 import pytest
 
+from poppy_core import autodetect, from_config, from_profile
 from poppy_core.emulator import VirtualBus, VirtualMotor, serve_link
 from poppy_core.emulator.bus_servers import EmulatorServer
 from poppy_core.errors import SetupError
 from poppy_core.models import model_by_name
-from poppy_core.robot import (
-    ReturnDelayIssue,
-    autodetect,
-    from_config,
-    from_profile,
-    load_profile,
-)
+from poppy_core.robot import ReturnDelayIssue, load_profile
 
 DATA = Path(__file__).parent / "data"
 XL320 = model_by_name("XL-320")

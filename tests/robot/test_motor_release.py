@@ -8,11 +8,12 @@ from pathlib import Path
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.bus import DxlBus
 from poppy_core.emulator import VirtualBus, serve_pty
 from poppy_core.errors import PortError, RobotClosedError, SetupError
 from poppy_core.models import model_by_name
-from poppy_core.robot import from_profile, load_profile
+from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.waiting import eventually
 

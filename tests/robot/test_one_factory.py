@@ -1,4 +1,4 @@
-"""One way to build a robot: the factories (autodetect too) attach the creature; aliases agree."""
+"""One way to build a robot: the package's faces (autodetect too) attach the creature."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core import assembly, creatures
+from poppy_core import autodetect, from_config, from_profile
 from poppy_core.creatures import Dance
 from poppy_core.emulator import build_bus_from_spec, ergo_jr_bus, serve_link
 from poppy_core.errors import ConfigError
-from poppy_core.robot import autodetect, from_config, from_profile, load_profile, with_ports
+from poppy_core.robot import load_profile, with_ports
 
 
 def test_from_profile_attaches_the_creature() -> None:
@@ -25,20 +25,6 @@ def test_creature_false_builds_a_bare_robot() -> None:
     with from_config(load_profile("ergo-jr"), sim=True, sensors=False, creature=False) as robot:
         assert getattr(robot, "creature", None) is None
         assert not hasattr(robot, "dance")
-
-
-def test_the_creatures_alias_builds_the_same_robot() -> None:
-    with creatures.from_profile("ergo-jr", sim=True, sensors=False, start_defaults=False) as robot:
-        assert robot.creature is not None and isinstance(robot.dance, Dance)
-
-
-def test_the_robot_and_creatures_names_are_the_assemblys() -> None:
-    import poppy_core.robot
-
-    assert poppy_core.robot.from_profile is assembly.from_profile
-    assert poppy_core.robot.from_config is assembly.from_config
-    assert creatures.from_profile is assembly.from_profile
-    assert creatures.PoppyErgoJr is assembly.PoppyErgoJr
 
 
 def test_a_bare_robot_still_has_pypots_primitive_manager() -> None:

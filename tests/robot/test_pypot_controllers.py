@@ -12,8 +12,8 @@ import time
 
 import pytest
 
-from poppy_core.creatures import PoppyTorso
 from poppy_core.errors import ControllerError
+from poppy_core.pypot import PoppyTorso
 from poppy_core.robot.controller import MotorsController
 from tests.helpers.waiting import eventually
 

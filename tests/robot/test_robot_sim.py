@@ -7,8 +7,9 @@ import time
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.errors import ConfigError, RobotClosedError
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from poppy_core.trajectory import MinimumJerk
 from tests.helpers import eventually
 from tests.helpers.fixtures import ergo_fixture

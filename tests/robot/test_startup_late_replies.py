@@ -7,10 +7,11 @@ from collections.abc import Iterator
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.emulator import VirtualBus, VirtualMotor, serve_link
 from poppy_core.emulator.bus_servers import EmulatorServer
 from poppy_core.models import model_by_name
-from poppy_core.robot import ReturnDelayIssue, from_profile
+from poppy_core.robot import ReturnDelayIssue
 
 XL320 = model_by_name("XL-320")
 # Later than the bus's usual floor (10 ms, one retry) for every reply, as beside four busy loops.

@@ -8,6 +8,7 @@ from typing import Any
 
 import pytest
 
+from poppy_core import from_config, from_profile
 from poppy_core.errors import (
     ArgumentError,
     ConfigError,
@@ -17,7 +18,7 @@ from poppy_core.errors import (
 )
 from poppy_core.motion import MovePlayer, PositionWatcher, Sinus, Square
 from poppy_core.motion.move import Move
-from poppy_core.robot import Robot, RobotConfig, from_config, from_profile, load_profile
+from poppy_core.robot import Robot, RobotConfig, load_profile
 from tests.helpers.fixtures import ergo_fixture
 
 ergo = ergo_fixture(scope="module")

@@ -20,8 +20,9 @@ pytest.importorskip("rosbags")
 
 import zenoh
 
+from poppy_core import from_profile
 from poppy_core.assembly import ServerSet, ServeSpec, serve
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.zenoh_wire import ZenohSettings
 from tests.helpers.waiting import eventually

@@ -19,8 +19,8 @@ pytest.importorskip("zenoh_ros2_sdk")
 
 import zenoh
 
+from poppy_core import from_profile
 from poppy_core.assembly import ServeSpec, serve
-from poppy_core.robot import from_profile
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.zenoh_wire import ZenohSettings
 from tests.helpers.processes import read_until, reap

@@ -11,10 +11,10 @@ import pytest
 pytest.importorskip("zenoh")
 pytest.importorskip("rosbags")
 
+from poppy_core import from_profile
 from poppy_core import ros2_wire as wire
 from poppy_core.assembly import ServeSpec, serve
 from poppy_core.errors import ConfigError
-from poppy_core.robot import from_profile
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.zenoh_wire import ZenohSettings
 from tests.helpers.waiting import eventually

@@ -15,8 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core.creatures import PoppyErgoJr
-from poppy_core.robot import Robot, RobotConfig, from_config, from_profile, load_profile, with_ports
+from poppy_core import from_config, from_profile
+from poppy_core.pypot import PoppyErgoJr
+from poppy_core.robot import Robot, RobotConfig, load_profile, with_ports
 from poppy_core.sensors import Camera
 from poppy_core.sensors.opencv_camera import OpenCVCamera
 from tests.helpers.bus import emulate_bus

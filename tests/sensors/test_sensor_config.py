@@ -7,8 +7,9 @@ from typing import Any
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.errors import ConfigError
-from poppy_core.robot import RobotConfig, from_profile, load_profile
+from poppy_core.robot import RobotConfig, load_profile
 from poppy_core.sensors import DummyCamera, MarkerDetector
 
 pytest.importorskip("cv2")
@@ -109,7 +110,7 @@ def test_sensors_can_be_left_out() -> None:
 def test_a_missing_camera_does_not_stop_a_real_robot(tmp_path: Any) -> None:
     data = with_sensors({"camera": {"type": "OpenCVCamera", "index": "/dev/video99"}})
     data["controllers"]["my_dxl_controller"]["port"] = "loop://"
-    from poppy_core.robot import from_config
+    from poppy_core import from_config
 
     with from_config(RobotConfig.from_dict(data), strict=False) as robot:
         health = robot.sensor_health()["camera"]

@@ -6,7 +6,7 @@ from collections.abc import Iterator
 
 import httpx
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, start_snap_server
 from tests.helpers.waiting import eventually as wait_until

@@ -11,9 +11,10 @@ from collections.abc import Iterator
 import httpx
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServerSet, ServeSpec, serve
 from poppy_core.remote.discovery import AnnouncedRobot, discover, resolve
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from tests.helpers.waiting import eventually
 
 pytest.importorskip("zeroconf")

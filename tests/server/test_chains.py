@@ -9,7 +9,7 @@ import httpx
 import numpy as np
 import pytest
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app
 

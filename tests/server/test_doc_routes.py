@@ -9,7 +9,7 @@ from collections.abc import Iterator
 import httpx
 import pytest
 
-from poppy_core.creatures import PoppyErgoJr
+from poppy_core.pypot import PoppyErgoJr
 from poppy_core.server.legacy_paths import current_path
 from tests.server.conftest import Served
 

@@ -17,7 +17,8 @@ import httpx
 import pytest
 from websockets.sync.client import connect
 
-from poppy_core.robot import Robot, from_profile
+from poppy_core import from_profile
+from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app
 from poppy_core.server.snap import start_snap_server
 from poppy_core.server.zmqserver import start_zmq_server

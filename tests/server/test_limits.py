@@ -15,7 +15,7 @@ import httpx
 import pytest
 from websockets.sync.client import connect
 
-from poppy_core.robot import from_profile
+from poppy_core import from_profile
 from poppy_core.server import ServerThread, create_app
 
 WAIT_S = 15.0  # upper bound for what should take well under a second

@@ -15,9 +15,9 @@ from typing import Any
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServerSet, ServeSpec, serve
 from poppy_core.remote.discovery import resolve
-from poppy_core.robot import from_profile
 from tests.helpers.chromium import launched, needs_chromium
 
 pytest.importorskip("zeroconf")

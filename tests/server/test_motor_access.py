@@ -15,9 +15,10 @@ from pathlib import Path
 import httpx
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, serve
 from poppy_core.emulator import Endpoint, serve_pty
-from poppy_core.robot import Robot, from_profile, load_profile
+from poppy_core.robot import Robot, load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.bus import LOADED_REPLY_FLOOR_S
 from tests.helpers.waiting import eventually

@@ -15,9 +15,10 @@ from typing import Any
 import httpx
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, serve
 from poppy_core.motion import Move, save_move
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from poppy_core.server import moves as moves_module
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService

@@ -13,7 +13,8 @@ import pytest
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
-from poppy_core.robot import Robot, from_profile
+from poppy_core import from_profile
+from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app
 
 TOKEN = "pässwörd-ключ-🤖"

@@ -12,9 +12,9 @@ from pathlib import Path
 import httpx
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.errors import FileError
 from poppy_core.motion import read_move
-from poppy_core.robot import from_profile
 from poppy_core.server import moves as moves_module
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService

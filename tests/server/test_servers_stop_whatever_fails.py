@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, serve
 from poppy_core.motion import read_move
-from poppy_core.robot import from_profile
 from tests.helpers.waiting import eventually
 
 

@@ -11,7 +11,7 @@ import httpx
 import pytest
 from starlette.routing import Match
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.motion import Move, save_move
 from poppy_core.server.snap import robot_facts, start_snap_server
 from poppy_core.server.snap.catalog import BLOCKS, SnapBlock

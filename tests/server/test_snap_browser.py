@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.motion import list_moves
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, start_snap_server

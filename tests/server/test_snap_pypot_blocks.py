@@ -18,7 +18,7 @@ from typing import Any
 import httpx
 import pytest
 
-from poppy_core.creatures import from_profile
+from poppy_core import from_profile
 from poppy_core.motion import list_moves, load_move
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, start_snap_server

@@ -401,7 +401,7 @@ def test_with_a_token_the_page_works_after_it_is_entered(browser: Any, with_toke
 @pytest.fixture(scope="module")
 def creature(moves_folder: str) -> Iterator[Served]:
     """A virtual Ergo Jr as ``poppy serve`` builds it: its chain and camera attached."""
-    from poppy_core.creatures import from_profile
+    from poppy_core import from_profile
 
     yield from serve_robot(from_profile("ergo-jr", sim=True))
 

@@ -14,7 +14,8 @@ from typing import Any
 
 import pytest
 
-from poppy_core.robot import Robot, from_profile
+from poppy_core import from_profile
+from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app
 from tests.helpers.chromium import new_tab
 from tests.server.test_web_page import (  # noqa: F401 (browser is a fixture)

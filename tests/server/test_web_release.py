@@ -9,11 +9,12 @@ from typing import Any
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, serve
 from poppy_core.bus import DxlBus
 from poppy_core.emulator import Endpoint, VirtualBus, serve_pty
 from poppy_core.errors import PortError, SetupError
-from poppy_core.robot import Robot, from_profile, load_profile
+from poppy_core.robot import Robot, load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.bus import LOADED_REPLY_FLOOR_S
 from tests.helpers.chromium import launched, needs_chromium

@@ -17,7 +17,7 @@ import httpx
 import numpy as np
 import pytest
 
-from poppy_core.robot import from_profile
+from poppy_core import from_profile
 from tests.helpers.chromium import CHROMIUM, HEADLESS_ARGS, needs_chromium, new_tab, playwright_api
 from tests.helpers.server import serve_robot
 from tests.helpers.waiting import eventually

@@ -8,7 +8,7 @@ from typing import Any
 
 import pytest
 
-from poppy_core.creatures import PoppyTorso
+from poppy_core.pypot import PoppyTorso
 from poppy_core.robot import Robot
 from poppy_core.server.zmqserver import ZmqRobotServer
 from tests.creatures.helpers import wait_until

@@ -17,7 +17,7 @@ pytest.importorskip("cv2")
 
 @pytest.fixture(scope="module")
 def robot() -> Iterator[Any]:
-    from poppy_core.robot import from_profile
+    from poppy_core import from_profile
 
     with from_profile("ergo-jr", sim="mujoco") as robot:
         try:

@@ -21,7 +21,7 @@ pytestmark = [pytest.mark.slow, pytest.mark.gl]  # renders with OpenGL in the te
 
 @pytest.fixture(scope="module")
 def ergo() -> Iterator[Any]:
-    from poppy_core.creatures import from_config
+    from poppy_core import from_config
     from poppy_core.robot import RobotConfig, load_profile
 
     data = load_profile("ergo-jr").to_dict()

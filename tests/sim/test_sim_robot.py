@@ -7,12 +7,12 @@ import time
 import pytest
 
 from poppy_core.errors import ConfigError
-from poppy_core.robot.factory import from_profile
+from poppy_core.robot.factory import build_plain_robot, profile_config
 from tests.helpers.waiting import eventually
 
 
 def test_ergo_jr_goto_ends_near_the_goal_in_the_physics() -> None:
-    with from_profile("ergo-jr", sim="mujoco") as robot:
+    with build_plain_robot(profile_config("ergo-jr"), sim="mujoco") as robot:
         simulation = robot.simulation
         assert simulation is not None and simulation.running
         robot.compliant = False
@@ -32,7 +32,7 @@ def test_ergo_jr_goto_ends_near_the_goal_in_the_physics() -> None:
 
 
 def test_compliant_robot_can_be_moved_by_hand() -> None:
-    with from_profile("ergo-jr", sim="mujoco") as robot:
+    with build_plain_robot(profile_config("ergo-jr"), sim="mujoco") as robot:
         robot.compliant = True
         time.sleep(0.2)
         bus = next(iter(robot.emulators.values())).bus
@@ -41,17 +41,17 @@ def test_compliant_robot_can_be_moved_by_hand() -> None:
 
 
 def test_ideal_simulation_has_no_handle() -> None:
-    with from_profile("ergo-jr", sim=True) as robot:
+    with build_plain_robot(profile_config("ergo-jr"), sim=True) as robot:
         assert robot.simulation is None
 
 
 def test_unknown_simulation_is_refused() -> None:
     with pytest.raises(ConfigError):
-        from_profile("ergo-jr", sim="bullet")
+        build_plain_robot(profile_config("ergo-jr"), sim="bullet")
 
 
 def test_humanoid_runs_with_two_buses_on_one_world() -> None:
-    with from_profile("humanoid", sim="mujoco") as robot:
+    with build_plain_robot(profile_config("humanoid"), sim="mujoco") as robot:
         assert len(robot.emulators) == 2
         robot.compliant = False
         robot.goto_position({"head_z": 30.0, "l_knee_y": 20.0}, 0.5, wait=True)

@@ -13,7 +13,7 @@ pytest.importorskip("mujoco")
 def test_the_present_speed_during_a_goto_follows_the_goto() -> None:
     # Sampled, the joint's velocity read -171 °/s, 319 °/s and 0 on a goto going up at 30-60
     # °/s: the page's speed column jumped about.
-    from poppy_core.robot import from_profile
+    from poppy_core import from_profile
 
     with from_profile("ergo-jr", sim="mujoco", sensors=False) as robot:
         robot.compliant = False

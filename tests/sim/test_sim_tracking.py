@@ -18,7 +18,7 @@ pytestmark = pytest.mark.slow
 
 @pytest.fixture(scope="module")
 def ergo() -> Iterator[Any]:
-    from poppy_core.creatures import from_profile
+    from poppy_core import from_profile
 
     with from_profile("ergo-jr", sim="mujoco") as robot:
         yield ready_to_look(robot)

@@ -21,7 +21,7 @@ TABLE_TOP_M = 0.05
 
 @pytest.fixture(scope="module")
 def poppy() -> Iterator[Any]:
-    from poppy_core.creatures import PoppyErgoJr
+    from poppy_core.pypot import PoppyErgoJr
 
     robot = PoppyErgoJr(simulator="mujoco")
     yield robot
@@ -154,7 +154,7 @@ def _scene(folder: Path) -> Path:
 
 def test_load_scene_scene_path(tmp_path: Path) -> None:
     # load_scene(scene_path, start=False) on a robot built without a scene
-    from poppy_core.creatures import PoppyErgoJr
+    from poppy_core.pypot import PoppyErgoJr
 
     robot = PoppyErgoJr(simulator="mujoco")
     try:
@@ -170,7 +170,7 @@ def test_load_scene_scene_path(tmp_path: Path) -> None:
 def test_creature_scene_and_tracked_objects(tmp_path: Path) -> None:
     # from_vrep(config, ..., scene, tracked_objects=[...], tracked_collisions=[...]), as the
     # creature's arguments: PoppyErgoJr(simulator='mujoco', scene=...)
-    from poppy_core.creatures import PoppyErgoJr
+    from poppy_core.pypot import PoppyErgoJr
 
     robot = PoppyErgoJr(
         simulator="mujoco",
@@ -187,7 +187,7 @@ def test_creature_scene_and_tracked_objects(tmp_path: Path) -> None:
 
 
 def test_a_scene_without_the_robot_is_refused(tmp_path: Path) -> None:
-    from poppy_core.creatures import PoppyErgoJr
+    from poppy_core.pypot import PoppyErgoJr
 
     empty = tmp_path / "empty.xml"
     empty.write_text("<mujoco><worldbody><geom size='1 1 0.1' type='plane'/></worldbody></mujoco>")

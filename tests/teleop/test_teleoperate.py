@@ -11,11 +11,12 @@ from pathlib import Path
 
 import pytest
 
+from poppy_core import from_profile
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.motion import read_move
 from poppy_core.motion.teleop.joint_map import JointMap
 from poppy_core.motion.teleop.session import Teleoperation, teleoperate
-from poppy_core.robot import Robot, from_profile
+from poppy_core.robot import Robot
 from tests.helpers.waiting import scaled
 from tests.teleop.hands import READ_S, Hand, wait_for
 

@@ -33,9 +33,9 @@ HEALTH_COLUMNS = ("bus", "link", "present Hz", "goals Hz", "timeouts", "retries"
 def open_robot(source: str, sim: SimMode) -> Robot:
     """Build a robot from a config file path or a profile name (blocking).
 
-    It goes through ``poppy_core.robot``: a Poppy creature gets its behaviours attached.
+    It goes through ``poppy_core.from_config``: a Poppy creature gets its behaviours attached.
     """
-    from poppy_core.assembly import from_config, from_profile
+    from poppy_core import from_config, from_profile
 
     if Path(source).is_file():
         return from_config(Path(source), sim, sensors=False)
