@@ -54,6 +54,8 @@ ALLOWED: dict[str, set[str]] = {
     "kinematics": set(),
     "server": {"robot", "motion", "creatures", "models", "kinematics", "sensors"},
     "remote": set(),
+    # the LeRobot v3.0 format (pyarrow, PyAV): a leaf of the plan's floor 2, nothing of ours
+    "dataset": set(),
 }
 # the composition root (floor 8): builds a robot with its creature, and its servers; every room
 ALLOWED["assembly"] = set(ALLOWED)
