@@ -17,20 +17,22 @@ from numpy.typing import NDArray
 
 QUANTILES = (0.01, 0.10, 0.50, 0.90, 0.99)
 QUANTILE_KEYS = tuple(f"q{round(q * 100):02d}" for q in QUANTILES)
-Stats = dict[str, NDArray[np.float64]]
+Stats = dict[str, NDArray[Any]]
+"""Statistic name -> value; min and max keep an integer feature's integers, count is an integer."""
 
 
 def vector_stats(values: NDArray[Any]) -> Stats:
     """Stats of ``values`` (frames x elements, or frames) along the frames."""
-    data = np.asarray(values, dtype=np.float64)
-    if data.ndim == 1:
-        data = data.reshape(-1, 1)
+    raw = np.asarray(values)
+    if raw.ndim == 1:
+        raw = raw.reshape(-1, 1)
+    data = raw.astype(np.float64)
     stats: Stats = {
-        "min": data.min(axis=0),
-        "max": data.max(axis=0),
+        "min": raw.min(axis=0),
+        "max": raw.max(axis=0),
         "mean": data.mean(axis=0),
         "std": data.std(axis=0),
-        "count": np.array([data.shape[0]], dtype=np.float64),
+        "count": np.array([raw.shape[0]], dtype=np.int64),
     }
     for key, q in zip(QUANTILE_KEYS, QUANTILES, strict=True):
         stats[key] = np.quantile(data, q, axis=0)
@@ -77,7 +79,7 @@ class ImageStats:
             "max": high,
             "mean": mean,
             "std": np.sqrt(var),
-            "count": np.array([self.frames], dtype=np.float64),
+            "count": np.array([self.frames], dtype=np.int64),
         }
         cumulative = np.cumsum(hist, axis=1)
         for key, q in zip(QUANTILE_KEYS, QUANTILES, strict=True):
@@ -129,19 +131,13 @@ def aggregate_all(episodes: list[dict[str, Stats]]) -> dict[str, Stats]:
 
 
 def to_json(stats: dict[str, Stats]) -> dict[str, dict[str, Any]]:
-    """stats.json's shape: lists of numbers (count as a whole number)."""
-    out: dict[str, dict[str, Any]] = {}
-    for key, feature in stats.items():
-        out[key] = {
-            name: (value.astype(np.int64) if name == "count" else value).tolist()
-            for name, value in feature.items()
-        }
-    return out
+    """stats.json's shape: lists of numbers."""
+    return {key: {name: value.tolist() for name, value in f.items()} for key, f in stats.items()}
 
 
 def from_json(data: dict[str, dict[str, Any]]) -> dict[str, Stats]:
     """stats.json read back as arrays."""
     return {
-        key: {name: np.asarray(value, dtype=np.float64) for name, value in feature.items()}
+        key: {name: np.asarray(value) for name, value in feature.items()}
         for key, feature in data.items()
     }

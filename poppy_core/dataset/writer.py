@@ -309,7 +309,7 @@ def _stats_of_row(row: dict[str, Any]) -> dict[str, stats.Stats]:
     for column, value in row.items():
         if column.startswith("stats/") and value is not None:
             key, _, name = column.removeprefix("stats/").rpartition("/")
-            found.setdefault(key, {})[name] = np.asarray(value, dtype=np.float64)
+            found.setdefault(key, {})[name] = np.asarray(value)
     return found
 
 

@@ -206,7 +206,7 @@ def test_resume_adds_episodes_and_refuses_other_features(tmp_path: Path) -> None
 
 KILLED = textwrap.dedent(
     """
-    import os, signal, sys
+    import os, signal, sys, time
     sys.path.insert(0, {tests!r})
     from pathlib import Path
     from dataset.test_writer import SPEC, frame, record
@@ -214,6 +214,12 @@ KILLED = textwrap.dedent(
     writer.begin_episode("pick the cube")
     for k in range(30):
         writer.add_frame(*frame(k))
+    video = writer._videos["top"].path
+    for k in range(30, 3000):  # until the encoder has put bytes in its file (it buffers)
+        if video.exists() and video.stat().st_size > 0:
+            break
+        writer.add_frame(*frame(k % 30))
+        time.sleep(0.01)
     print("recording", flush=True)
     os.kill(os.getpid(), signal.SIGKILL)
     """
@@ -221,7 +227,7 @@ KILLED = textwrap.dedent(
 
 
 def killed_recording(root: Path) -> None:
-    """Two episodes saved, the third killed (SIGKILL) after 30 frames."""
+    """Two episodes saved, the third killed (SIGKILL) once its video file has bytes."""
     tests = str(Path(__file__).resolve().parents[1])
     script = KILLED.format(tests=tests, root=str(root))
     done = subprocess.run(
