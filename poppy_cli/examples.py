@@ -48,6 +48,39 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("play wave -s 2 -l 3 --profile ergo-jr -p /dev/ttyUSB0", "twice as fast, 3 times"),
         ("play ./wave.json -r --remote http://poppy.local:8080", "backwards, on a served robot"),
     ),
+    "dataset": (
+        (
+            "dataset record me/pick --profile ergo-jr -p /dev/ttyUSB1 --leader ergo-jr"
+            " --leader-port /dev/ttyUSB0 --episodes 10 --task 'pick the cube'",
+            "ten teleoperated episodes with the robot's camera",
+        ),
+        ("dataset info ~/.cache/huggingface/lerobot/me/pick", "episodes, frames, tasks"),
+    ),
+    "dataset record": (
+        (
+            "dataset record me/pick --profile ergo-jr -p /dev/ttyUSB1 --leader ergo-jr"
+            " --leader-port /dev/ttyUSB0 --episodes 10 --task 'pick the cube'",
+            "a leader arm moved by a student, the follower and its camera recorded",
+        ),
+        (
+            "dataset record me/wave --profile ergo-jr -p /dev/ttyUSB0 --by-hand --task wave"
+            " --episode-s 10",
+            "the robot compliant, moved by hand",
+        ),
+        (
+            "dataset record me/dance --profile ergo-jr --sim mujoco --primitive dance"
+            " --episodes 5 --task dance --root ./dance",
+            "data from the simulation, its camera rendered",
+        ),
+    ),
+    "dataset info": (
+        ("dataset info ./dance", "episodes, frames, duration, tasks, cameras"),
+        ("dataset info ./dance --json", "for scripts"),
+    ),
+    "dataset list": (
+        ("dataset list ./dance", "one row per episode"),
+        ("dataset list ./dance --json", "for scripts"),
+    ),
     "calibrate": (
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0", "zeros and ranges into a user profile"),
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0 --check", "report the drift since"),

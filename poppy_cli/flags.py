@@ -165,7 +165,9 @@ FLAGS: dict[str, Flag] = {
     "--seed": Flag(None, "SEED", "seed of the random numbers"),
     "--quick": Flag(None, None, "ten times faster"),
     "--view": Flag(None, None, "open MuJoCo's viewer"),
-    "--camera": Flag(None, "CAMERA", "camera of the simulation model"),
+    "--camera": Flag(
+        None, "CAMERA", "a camera: of the simulation model; NAME[=SPEC] recorded in a dataset"
+    ),
     "--width": Flag(None, "PIXELS", "image width in pixels"),
     "--height": Flag(None, "PIXELS", "image height in pixels"),
     # -- cameras
@@ -173,6 +175,18 @@ FLAGS: dict[str, Flag] = {
     "--resolution": Flag(None, "WxH", "image size, e.g. 640x480"),
     "--marker": Flag(None, "ID", "an ArUco marker held in view of the simulated camera"),
     "--card": Flag(None, "CARD", "a Poppy card held in view of the simulated camera"),
+    # -- datasets (poppy dataset record)
+    "--root": Flag(None, "DIR", "the dataset's folder"),
+    "--resume": Flag(None, None, "add episodes to the dataset there"),
+    "--play": Flag(None, "MOVE", "actions: play this move each episode"),
+    "--primitive": Flag(None, "NAME", "actions: run this primitive each episode"),
+    "--by-hand": Flag(None, None, "actions: the robot compliant, moved by hand"),
+    "--episodes": Flag(None, "N", "episodes to record"),
+    "--episode-s": Flag(None, "SECONDS", "length of an episode"),
+    "--reset-s": Flag(None, "SECONDS", "pause between episodes"),
+    "--task": Flag(None, "TEXT", "what the episodes show, in words"),
+    "--fps": Flag(None, "N", "frames per second"),
+    "--no-cameras": Flag(None, None, "record no camera"),
     # -- Click's own
     "--help": Flag(None, None, "show the help and exit"),
 }

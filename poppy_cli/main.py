@@ -13,6 +13,7 @@ from poppy_cli.commands import calibrate as calibrate_cmd
 from poppy_cli.commands import (
     camera,
     config,
+    dataset,
     demo,
     doctor,
     emulate,
@@ -151,6 +152,7 @@ app.add_typer(camera.app, name="camera", rich_help_panel=DRIVE)
 app.command("record", rich_help_panel=MOVES)(record_cmd.record)
 app.command("play", rich_help_panel=MOVES)(play_cmd.play)
 app.add_typer(moves_cmd.app, name="moves", rich_help_panel=MOVES)
+app.add_typer(dataset.app, name="dataset", rich_help_panel=MOVES)
 app.command("serve", rich_help_panel=SERVE)(serve_cmd.serve)
 app.add_typer(snap_cmd.app, name="snap", rich_help_panel=SERVE)
 app.command("notebook", rich_help_panel=SERVE)(notebook_cmd.notebook)

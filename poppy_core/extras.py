@@ -27,6 +27,7 @@ EXTRAS: dict[str, str] = {
     "plot": "plots (matplotlib)",
     "notebook": "Jupyter notebooks (`poppy notebook`)",
     "appliance": "the robot's name on the network (mDNS/DNS-SD with zeroconf)",
+    "dataset": "LeRobot datasets (pyarrow, PyAV)",
 }
 """Extra -> what it brings (pyproject.toml's ``[project.optional-dependencies]``)."""
 

@@ -51,13 +51,16 @@ ALLOWED: dict[str, set[str]] = {
     "robot": {"bus", "models", "emulator", "sim", "protocol", "sensors", "remote", "kinematics"},
     # kinematics is a leaf (numpy only, nothing of ours but errors): rooms that need chains
     # import it, whatever their place in the plan's table
-    "motion": {"robot", "models", "kinematics"},
+    # motion records episodes into the LeRobot format (a leaf room of floor 2)
+    "motion": {"robot", "models", "kinematics", "dataset"},
     "creatures": {"robot", "motion", "models", "kinematics"},
     "kinematics": set(),
     "server": {"robot", "motion", "creatures", "models", "kinematics", "sensors"},
     "remote": set(),
     # the loop machinery, a package of leaves (pacing, worker, closing): nothing but the leaves
     "schedule": set(),
+    # the LeRobot v3.0 format (pyarrow, PyAV): a leaf of the plan's floor 2, nothing of ours
+    "dataset": set(),
 }
 # the composition root (floor 8): builds a robot with its creature, and its servers; every room
 ALLOWED["assembly"] = set(ALLOWED)

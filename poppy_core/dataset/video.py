@@ -1,0 +1,134 @@
+"""A camera's episode as an MP4 (PyAV): AV1 where the build has SVT-AV1, else H.264; yuv420p.
+
+Facts from LeRobot 0.4.4's ``video_utils.py``: libsvtav1 with g=2, crf=30, preset 12, yuv420p,
+and what ``get_video_info`` puts in info.json. Frame k is stamped k/fps exactly (time base
+1/fps, pts k). Frames are encoded on a thread of their own, fed through a bounded queue.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import queue
+import threading
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import av
+import numpy as np
+from numpy.typing import NDArray
+
+from poppy_core.errors import PoppyError
+
+AV1 = "libsvtav1"
+H264 = "libx264"
+
+
+def pick_codec() -> str:
+    """libsvtav1 when this PyAV build can encode it, else libx264."""
+    for name in (AV1, H264):
+        try:
+            av.codec.Codec(name, "w")
+        except (av.codec.codec.UnknownCodecError, ValueError):
+            continue
+        return name
+    raise PoppyError("this PyAV build encodes neither AV1 (libsvtav1) nor H.264 (libx264)")
+
+
+def codec_options(codec: str) -> dict[str, str]:
+    """LeRobot's encoder settings: a key frame every 2 frames, crf 30 (and SVT's preset 12)."""
+    options = {"g": "2", "crf": "30"}
+    if codec == AV1:
+        options["preset"] = "12"
+    return options
+
+
+class VideoWriter:
+    """Encodes RGB frames (height x width x 3, uint8) into one MP4 file on a worker thread."""
+
+    def __init__(self, path: Path, fps: int, width: int, height: int, codec: str) -> None:
+        self.path = path
+        self.fps = fps
+        self.width = width
+        self.height = height
+        self.codec = codec
+        self.frames = 0
+        self.error: BaseException | None = None
+        # SVT-AV1 prints its banner on stderr unless told otherwise (1: errors only)
+        os.environ.setdefault("SVT_LOG", "1")
+        self._queue: queue.Queue[NDArray[np.uint8] | None] = queue.Queue(maxsize=max(4, 2 * fps))
+        self._container: Any = av.open(str(path), "w", format="mp4")
+        stream: Any = self._container.add_stream(codec, rate=fps, options=codec_options(codec))
+        stream.pix_fmt = "yuv420p"
+        stream.width = width
+        stream.height = height
+        self._stream: Any = stream
+        self._time_base = Fraction(1, fps)
+        self._thread = threading.Thread(target=self._run, name=f"video {path.name}", daemon=True)
+        self._thread.start()
+
+    def add(self, frame: NDArray[np.uint8]) -> None:
+        """Queue one frame (blocks while the encoder is two seconds behind)."""
+        if self.error is not None:
+            raise PoppyError(f"encoding {self.path.name} failed: {self.error}")
+        self._queue.put(np.ascontiguousarray(frame))
+
+    def finish(self) -> int:
+        """Encode what is queued, close the file; the number of frames written."""
+        self._queue.put(None)
+        self._thread.join()
+        if self.error is not None:
+            raise PoppyError(f"encoding {self.path.name} failed: {self.error}")
+        return self.frames
+
+    def abandon(self) -> None:
+        """Stop encoding and remove the file."""
+        with contextlib.suppress(queue.Empty):
+            while True:
+                self._queue.get_nowait()
+        self._queue.put(None)
+        self._thread.join()
+        with contextlib.suppress(OSError):
+            os.unlink(self.path)
+
+    def _run(self) -> None:
+        try:
+            while (frame := self._queue.get()) is not None:
+                if self.error is None:
+                    self._encode(frame)
+            if self.error is None:
+                for packet in self._stream.encode(None):
+                    self._container.mux(packet)
+        except (av.error.FFmpegError, ValueError, OSError) as exc:
+            self.error = exc
+        finally:
+            with contextlib.suppress(av.error.FFmpegError, OSError):
+                self._container.close()
+
+    def _encode(self, frame: NDArray[np.uint8]) -> None:
+        try:
+            picture = av.VideoFrame.from_ndarray(frame, format="rgb24")
+            picture.pts = self.frames
+            picture.time_base = self._time_base
+            for packet in self._stream.encode(picture):
+                self._container.mux(packet)
+            self.frames += 1
+        except (av.error.FFmpegError, ValueError, OSError) as exc:
+            self.error = exc
+
+
+def video_info(path: Path, fps: int) -> dict[str, Any]:
+    """What LeRobot's ``get_video_info`` records of a video, read from the file."""
+    with av.open(str(path), "r") as container:
+        stream: Any = container.streams.video[0]
+        return {
+            "video.height": stream.height,
+            "video.width": stream.width,
+            "video.codec": stream.codec_context.codec.canonical_name,
+            "video.pix_fmt": stream.pix_fmt,
+            "video.is_depth_map": False,
+            "video.fps": fps,
+            "video.channels": 3,
+            "has_audio": len(container.streams.audio) > 0,
+        }

@@ -1,0 +1,102 @@
+"""Run inside bench/.venv-lerobot (LeRobot 0.4.4): what LeRobot's own code makes of a dataset.
+
+``python lerobot_oracle.py load ROOT REPO_ID FRAMES``: LeRobotDataset(REPO_ID, root=ROOT), its
+length, features, stats, the frames asked for (decoded at their timestamps by LeRobot's
+default decoder), and the stats LeRobot's ``compute_episode_stats``/``aggregate_stats``
+compute from the frames it loaded. ``python lerobot_oracle.py write ROOT SPEC``: the dataset
+LeRobot's ``create/add_frame/save_episode/finalize`` write for the same features (SPEC: JSON of
+fps, robot_type, features, frames). One JSON object on stdout.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+
+def as_lists(value):
+    if isinstance(value, dict):
+        return {key: as_lists(inner) for key, inner in value.items()}
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return value
+
+
+def load(root: str, repo_id: str, frames: list[int]) -> dict:
+    from lerobot.datasets.compute_stats import aggregate_stats, compute_episode_stats
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    dataset = LeRobotDataset(repo_id, root=root)
+    items = []
+    for index in frames:
+        item = dataset[index]
+        entry = {"task": item["task"]}
+        for key, value in item.items():
+            if key.startswith("observation.images."):
+                # (C, H, W) floats in [0, 1]: the pixel the tests draw, back to 0-255
+                entry[key] = {
+                    "shape": list(value.shape),
+                    "pixel": (value[:, 24, 32] * 255).round().tolist(),
+                }
+            elif key != "task":
+                entry[key] = value.tolist()
+        items.append(entry)
+    table = dataset.hf_dataset.with_format("numpy")
+    features = {
+        key: ft for key, ft in dataset.features.items() if ft["dtype"] not in ("video", "image")
+    }
+    per_episode = []
+    episode_column = np.asarray(table["episode_index"])
+    for episode in range(dataset.meta.total_episodes):
+        rows = np.nonzero(episode_column == episode)[0]
+        data = {key: np.stack([np.asarray(table[int(i)][key]) for i in rows]) for key in features}
+        per_episode.append(compute_episode_stats(data, features))
+    recomputed = aggregate_stats(per_episode)
+    return {
+        "len": len(dataset),
+        "num_episodes": dataset.num_episodes,
+        "fps": dataset.fps,
+        "features": as_lists(dataset.features),
+        "stats": as_lists(dataset.meta.stats),
+        "recomputed_stats": as_lists(recomputed),
+        "tasks": list(dataset.meta.tasks.index),
+        "items": items,
+        "video_backend": dataset.video_backend,
+    }
+
+
+def write(root: str, spec: dict) -> dict:
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    features = {
+        key: {**ft, "shape": tuple(ft["shape"])}
+        for key, ft in spec["features"].items()
+        if key not in ("timestamp", "frame_index", "episode_index", "index", "task_index")
+    }
+    dataset = LeRobotDataset.create(
+        "poppy/oracle", spec["fps"], features, root=root, robot_type=spec["robot_type"]
+    )
+    for k in range(spec["frames"]):
+        frame = {"task": "pick the cube"}
+        for key, ft in features.items():
+            if ft["dtype"] == "video":
+                frame[key] = np.full(ft["shape"], k % 256, dtype=np.uint8)
+            else:
+                frame[key] = np.full(ft["shape"], float(k), dtype=np.float32)
+        dataset.add_frame(frame)
+    dataset.save_episode()
+    dataset.finalize()
+    with open(f"{root}/meta/info.json", encoding="utf-8") as file:
+        return json.load(file)
+
+
+if __name__ == "__main__":
+    command, root, argument = sys.argv[1:4]
+    if command == "load":
+        wanted = [int(i) for i in sys.argv[4].split(",")] if len(sys.argv) > 4 else []
+        result = load(root, argument, wanted)
+    else:
+        result = write(root, json.loads(argument))
+    sys.stdout.write(json.dumps(result) + "\n")

@@ -1,0 +1,45 @@
+"""LeRobot 0.4.4 in its own venv, the oracle of the dataset tests, never imported here.
+
+``bench/setup_lerobot.sh`` makes it (``$POPPY_LEROBOT_VENV``, else ``bench/.venv-lerobot``);
+``.ci/run`` calls it. Without it a test fails on CI (``CI`` set) and is skipped elsewhere.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+from typing import Any
+
+from tests.helpers.pypot_files import needed
+
+ROOT = Path(__file__).resolve().parents[2]
+ORACLE = ROOT / "tests" / "dataset" / "lerobot_oracle.py"
+
+
+def lerobot_python() -> Path:
+    """The venv's interpreter (fails on CI, skips elsewhere, without it)."""
+    places = [os.environ.get("POPPY_LEROBOT_VENV"), str(ROOT / "bench" / ".venv-lerobot")]
+    for place in places:
+        if place and (Path(place) / ".installed").is_file():
+            return Path(place) / "bin" / "python"
+    needed("LeRobot 0.4.4's venv is needed: run `bash bench/setup_lerobot.sh` (about 5 GB)")
+
+
+def run_oracle(*args: str, timeout: float = 600) -> dict[str, Any]:
+    """One command of tests/dataset/lerobot_oracle.py in LeRobot's venv: its JSON answer."""
+    env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    env["HF_HUB_OFFLINE"] = "1"  # a dataset on disk: LeRobot must never reach for the hub
+    env["HF_DATASETS_CACHE"] = str(Path(args[1]).parent / "hf-cache")
+    done = subprocess.run(
+        [str(lerobot_python()), str(ORACLE), *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        check=False,
+        env=env,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
+    return result
