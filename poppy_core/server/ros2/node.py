@@ -25,7 +25,7 @@ from poppy_core import checks
 from poppy_core import ros2_wire as wire
 from poppy_core.errors import PoppyError
 from poppy_core.ros2_wire import Ros2Settings
-from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
+from poppy_core.schedule import RateMeter, TickGuard, Worker
 from poppy_core.server.ros2 import messages, rosout, types
 from poppy_core.server.ros2.commands import Commands
 from poppy_core.server.ros2.entities import Entities, Publisher
@@ -79,13 +79,15 @@ class Ros2Node:
         self.published = 0
         self.entities = Entities(session, self.domain, self.namespace, self.node, self.refuse)
         self._publishers = self.entities.publishers
-        self._worker = Worker(f"ros2-{self.node}", self._publish_loop)
+        self._worker = Worker.periodic(f"ros2-{self.node}", self.state_rate_hz, self._tick)
         self._camera_worker = Worker(f"ros2-camera-{self.node}", self._camera_loop)
         self.refusals = Refusals(logger)
         """Every command turned down, as ``Refusal`` events (``refusals.listen`` to publish
         them)."""
-        self.state_loop = TickGuard(f"ros2-{self.node}")
+        assert self._worker.ticker is not None
+        self.state_loop = self._worker.ticker.guard
         """The publish loop's failures (a raising tick is retried with backoff)."""
+        self._next_diagnostics = 0.0
         self.diagnostics_loop = TickGuard(f"ros2-diagnostics-{self.node}")
         self.camera_loop = TickGuard(f"ros2-camera-{self.node}")
         self._rosout = rosout.RosoutRefusals(self._publish_rosout)
@@ -160,6 +162,7 @@ class Ros2Node:
             self._publishers["tf_static"].put(
                 types.serialize(messages.tf_static(self.joints), types.TF_MESSAGE)
             )
+        self._next_diagnostics = 0.0
         self._worker.start()
         if "camera" in self._publishers:
             self._camera_worker.start()
@@ -210,22 +213,14 @@ class Ros2Node:
 
     # -- publications ------------------------------------------------------------------------
 
-    def _publish_loop(self, stopping: threading.Event) -> None:
-        schedule = Periodic(1.0 / self.state_rate_hz, time.monotonic())
-        next_diagnostics = 0.0
-        states = self._publishers["joint_states"]
-        tf = self._publishers["tf"]
-        while not stopping.is_set():
-            wait = schedule.next_deadline - time.monotonic()
-            if wait > 0 and stopping.wait(wait):
-                return
-            now = time.monotonic()
-            schedule.advance(now)
-            wall = time.time()
-            self.state_loop.run(partial(self._publish_state, states, tf, now, wall), stopping)
-            if now >= next_diagnostics:
-                next_diagnostics = now + DIAGNOSTICS_PERIOD_S
-                self.diagnostics_loop.run(partial(self._publish_diagnostics, wall), stopping)
+    def _tick(self, now: float) -> None:
+        wall = time.time()
+        if now >= self._next_diagnostics:  # guarded apart: a failing state still has its health
+            self._next_diagnostics = now + DIAGNOSTICS_PERIOD_S
+            self.diagnostics_loop.run(
+                partial(self._publish_diagnostics, wall), self._worker.stopping
+            )
+        self._publish_state(self._publishers["joint_states"], self._publishers["tf"], now, wall)
 
     def _publish_state(self, states: Publisher, tf: Publisher, now: float, wall: float) -> None:
         states.put(

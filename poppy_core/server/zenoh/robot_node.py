@@ -20,13 +20,12 @@ import socket
 import threading
 import time
 from dataclasses import replace
-from functools import partial
 from typing import TYPE_CHECKING, Any
 
 from poppy_core import checks, zenoh_wire
 from poppy_core.errors import PoppyError
 from poppy_core.motion.chains import robot_chains
-from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
+from poppy_core.schedule import RateMeter, TickGuard, Worker
 from poppy_core.server.errors import ApiError, refusal_kind
 from poppy_core.server.zenoh import described
 from poppy_core.server.zenoh.asgi_call import AsgiCaller
@@ -96,9 +95,12 @@ class ZenohRobotServer:
         self._seen: set[str] = set()
         self.intake = Intake(self.name, token)
         """The arrival checks of ``api`` and ``goals`` (signature, shape, start time, places)."""
-        self.state_loop = TickGuard(f"zenoh-state-{self.name}")
+        self._worker = Worker.periodic(f"zenoh-state-{name}", self.state_rate_hz, self._tick)
+        assert self._worker.ticker is not None
+        self.state_loop = self._worker.ticker.guard
+        """The state publication's failures (a raising tick is retried with backoff)."""
         self.health_loop = TickGuard(f"zenoh-health-{self.name}")
-        self._worker = Worker(f"zenoh-state-{name}", self._publish_loop)
+        self._next_health = 0.0
         self._lock = threading.Lock()
         self._declare_lock = threading.Lock()
         self._last_refusal = 0.0
@@ -129,6 +131,7 @@ class ZenohRobotServer:
         self._caller = AsgiCaller(self._app)
         with self._declare_lock:
             self._declared = self._declare()
+        self._next_health = 0.0
         self._worker.start()
         self._caller.submit(self._warm_up(self._caller))
 
@@ -205,19 +208,11 @@ class ZenohRobotServer:
 
     # -- publications ------------------------------------------------------------------------
 
-    def _publish_loop(self, stopping: threading.Event) -> None:
-        schedule = Periodic(1.0 / self.state_rate_hz, time.monotonic())
-        next_health = 0.0
-        while not stopping.is_set():
-            wait = schedule.next_deadline - time.monotonic()
-            if wait > 0 and stopping.wait(wait):
-                return
-            now = time.monotonic()
-            schedule.advance(now)
-            self.state_loop.run(partial(self._publish_state, now), stopping)
-            if now >= next_health:  # guarded apart: a failing state still has its health
-                next_health = now + HEALTH_PERIOD_S
-                self.health_loop.run(self._publish_health, stopping)
+    def _tick(self, now: float) -> None:
+        if now >= self._next_health:  # guarded apart: a failing state still has its health
+            self._next_health = now + HEALTH_PERIOD_S
+            self.health_loop.run(self._publish_health, self._worker.stopping)
+        self._publish_state(now)
 
     def _publish_state(self, now: float) -> None:
         self._publisher.put(self.state_message())
