@@ -38,7 +38,7 @@ Outcome = tuple[str, str]
 """(kind, what the surface said)."""
 Send = Callable[[Surfaces], Outcome]
 
-V1_KINDS = {422: "invalid", 400: "invalid", 404: "not_found"}
+V1_KINDS = {422: "invalid", 400: "invalid", 404: "not_found", 409: "conflict"}
 PYPOT_KINDS = {400: "invalid", 404: "not_found"}
 
 
@@ -507,3 +507,35 @@ def test_every_surface_gives_the_same_kind(
     assert eventually(lambda: abs(robot.m1.goal_position - limit) < 0.5), robot.m1.goal_position
     if surface in ("rest_v1", "zenoh_api") and case.name.startswith("goto"):
         assert json.loads(said)["positions"] == {"m1": limit}  # the answer says the clamp
+
+
+COMPLIANT_GOAL: dict[str, Any] = {
+    "rest_v1": rest_v1("PUT", "/api/v1/motors/m1/registers/goal_position", '{"value": 10}'),
+    "zenoh_goals": zenoh_goals("m1", 10.0),
+    "ros2": ros2_command("m1", 10.0),
+}
+"""A goal to a compliant motor on poppy's own surfaces (pypot's keep pypot's answer)."""
+
+
+@pytest.mark.parametrize("surface", sorted(COMPLIANT_GOAL))
+def test_a_goal_to_a_compliant_motor_is_refused_on_our_surfaces(
+    surfaces: Surfaces,  # noqa: F811  (the fixture imported above)
+    request: pytest.FixtureRequest,
+    surface: str,
+) -> None:
+    """The service's one rule: a compliant motor would not move, so the goal is a conflict
+    (v1's 409, the Zenoh stream's counted refusal, the ROS 2 node's Refusal), nothing set."""
+    robot = surfaces.robot
+    _reset_goal(robot)
+    robot.m1.compliant = True
+    try:
+        send: Any = COMPLIANT_GOAL[surface]
+        if surface in NETWORK:
+            kind, said = send(surfaces, request.getfixturevalue("network"))
+        else:
+            kind, said = send(surfaces)
+        assert kind == "conflict", f"{surface}: {kind}: {said}"
+        assert "compliant" in said, said
+        assert abs(robot.m1.goal_position) < 1.0
+    finally:
+        robot.m1.compliant = False

@@ -368,10 +368,12 @@ class ZenohRobotServer:
                 robot), not a goals message (nothing moved).
             ApiError: a bad goal (nothing moved).
             UnknownMotorError: an unknown motor (nothing moved).
+            CompliantMotorError: a goal to a compliant motor, which would not move it (the
+                service's rule for poppy's own surfaces; nothing moved).
         """
         goals = self.intake.goals(payload)
         with self._lock:
-            return self.service.set_goals(goals)
+            return self.service.set_goals(goals, refuse_compliant=True)
 
 
 def _refusal(status: int, detail: str) -> dict[str, Any]:
