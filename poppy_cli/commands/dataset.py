@@ -402,7 +402,7 @@ def _action_source(
         if runs:
             runs.pop().stop()
 
-    return episodes.Leader(lead, motors, start_teleop, stop_teleop)
+    return episodes.Teleoperated(lead, motors, start_teleop, stop_teleop)
 
 
 class _Live:

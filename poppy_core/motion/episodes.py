@@ -88,7 +88,7 @@ class ByHand:
         """The robot stays compliant between episodes (the student keeps moving it)."""
 
 
-class Leader:
+class Teleoperated:
     """Teleoperation: the action is the leader's present positions (``links``: follower motor
     -> leader motor, in the recorded order); ``start``/``stop`` run the teleoperation."""
 
