@@ -189,7 +189,9 @@ def test_moves_play_together_and_in_sequence(two_moves: Served) -> None:
     assert float(answer.text) == pytest.approx(max(first, second) / 0.25, abs=0.01)
     assert wait_until(lambda: {"first", "second"} <= set(moves.playing()))
     assert wait_until(lambda: not moves.playing(), timeout_s=30)
-    assert near(robot.m1.present_position, 30.0, 3) and near(robot.m2.present_position, -30.0, 3)
+    # each at its move's end (a read may be a sync period old: polled)
+    assert wait_until(lambda: near(robot.m1.present_position, 30.0, 3))
+    assert wait_until(lambda: near(robot.m2.present_position, -30.0, 3))
 
     # in sequence: the second starts when the first has ended
     home()
@@ -203,9 +205,10 @@ def test_moves_play_together_and_in_sequence(two_moves: Served) -> None:
 
     assert wait_until(second_playing, timeout_s=30)
     assert ("first",) in seen and ("first", "second") not in seen  # one after the other
-    assert near(robot.m1.present_position, 30.0, 3)  # the first had reached its end
+    # the first had reached its end (only the second moves now, and only m2)
+    assert wait_until(lambda: near(robot.m1.present_position, 30.0, 3))
     assert wait_until(lambda: not moves.playing() and not playlists.sequences(), timeout_s=30)
-    assert near(robot.m2.present_position, -30.0, 3)
+    assert wait_until(lambda: near(robot.m2.present_position, -30.0, 3))
 
     # "stop move" on a move of a sequence ends the sequence
     home()
