@@ -153,10 +153,14 @@ def test_connection_test_and_motor_index(snap: Served) -> None:
 
 def record_motion(served: Served, move: str, motor: str, target: float) -> None:
     """Record ``move`` on ``motor`` going from 0° to ``target``, through the Snap! routes."""
-    robot, _, http = served
+    robot, server, http = served
     robot.goto_position({motor: 0.0}, 0.3, wait=True)
     assert http.get(f"/primitive/MoveRecorder/{move}/start/{motor}").text == "Done!"
     robot.goto_position({motor: target}, 0.6, wait=True)
+    # the move ends at the target: stopped once the recorder sampled it there (a loaded machine
+    # ran the recorder late, and a move stopped at once ended at -23° instead of -30°)
+    recorder = server.service.moves._recorders[move]
+    assert wait_until(lambda: near(recorder.latest().get(motor, 0.0), target, 1))
     assert http.get(f"/primitive/MoveRecorder/{move}/stop").text == "Done!"
 
 
