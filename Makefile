@@ -23,10 +23,11 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/activate
 run: $(VENV)/.installed
 	$(BIN)/poppy demo
 
-# Parallel pytest workers, one per core of the 2-core machines we test on. Most tests wait more
-# than they compute, so 4 finish sooner, but then emulators served by a test miss the bus's
-# millisecond reply deadlines now and then; TEST_WORKERS=0 runs in one process.
-TEST_WORKERS ?= 2
+# Parallel pytest workers: two per core of the 2-core machines we test on, since most tests wait
+# (wire timing, servers, subprocesses) more than they compute. The `poppy` commands the tests run
+# wait for their emulators' replies as long as the load needs (POPPY_REPLY_FLOOR_S, see
+# docs/testing.md); TEST_WORKERS=2 for one per core, TEST_WORKERS=0 runs in one process.
+TEST_WORKERS ?= 4
 
 # The whole suite in parallel workers, a test module per worker (see tests/conftest.py); the
 # OpenGL tests run in a pytest process of their own.

@@ -66,6 +66,13 @@ QUANTITIES = [
     Quantity("goto_end_s", "a 1 s minjerk goto's end", "robot/test_robot_sim", 0.95, None),
     Quantity("speed2_s", "played_s of a 1 s move at speed 2", "motion/test_move_play", 0.5, 1.0),
     Quantity(
+        "loops2_s",
+        "played_s of a 1 s move at speed 2, 2 loops (speed 1: 2 s)",
+        "motion/test_move_play",
+        1.0,
+        2.0,
+    ),
+    Quantity(
         "twice_back_s",
         "played_s of a 1 s move, reversed, 2 loops",
         "cli/test_record_play_cmd",
@@ -116,6 +123,7 @@ def _one_round(raw: dict[str, list[float]]) -> None:
     with probe.ergo() as robot:
         keep("goto_end_s", probe.goto_end_s(robot))
         keep("speed2_s", probe.played_s(robot, speed=2.0))
+        keep("loops2_s", probe.played_s(robot, speed=2.0, loops=2))
         keep("twice_back_s", probe.played_s(robot, loops=2, backwards=True))
         keep("stopped_s", probe.stopped_after_s(robot))
         keep("grid_phase", probe.grid_phase(robot))

@@ -22,6 +22,8 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+from tests.helpers.waiting import load_factor
+
 TESTS = Path(__file__).resolve().parent
 SLOW_FOLDERS = {"cli", "creatures", "server", "sim", "teleop", "tui"}
 SLOW_MODULES = {
@@ -55,6 +57,8 @@ BROWSER_MODULES = {
 # pytest-timeout (120 s, by signal) stops a test that waits in Python. A thread stuck inside a
 # C library (an OpenGL driver, a serial ioctl) never sees the signal; this watchdog then prints
 # every thread's stack and exits, so CI reports where it hung instead of running out its budget.
+# Both limits say how long is too long on an idle machine: each test gets them times the load
+# factor measured when it starts (a busy machine makes a test late, not stuck).
 HANG_LIMIT_S = 600
 # Property tests run Hypothesis's default number of examples; `HYPOTHESIS_PROFILE=thorough`
 # runs ten times as many (before a release, or when a codec or parser changed). Neither has a
@@ -97,9 +101,24 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.xdist_group(group))
 
 
-@pytest.hookimpl(hookwrapper=True)
+def _timeout_s(item: pytest.Item) -> float:
+    """The test's pytest-timeout limit (its marker's, else the option's or the ini's), 0: none."""
+    marker = item.get_closest_marker("timeout")
+    if marker is not None and (marker.args or "timeout" in marker.kwargs):
+        value = marker.args[0] if marker.args else marker.kwargs["timeout"]
+    else:
+        value = item.config.getoption("timeout", None) or item.config.getini("timeout") or 0
+    return float(value)
+
+
+@pytest.hookimpl(hookwrapper=True, tryfirst=True)  # around pytest-timeout's, which reads the mark
 def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
-    faulthandler.dump_traceback_later(HANG_LIMIT_S, exit=True, file=sys.__stderr__)
+    factor = load_factor()
+    timeout_s = _timeout_s(item) * factor
+    if timeout_s > 0:
+        item.add_marker(pytest.mark.timeout(timeout_s), append=False)  # the closest mark wins
+    hang_s = max(HANG_LIMIT_S * factor, timeout_s + 60)
+    faulthandler.dump_traceback_later(hang_s, exit=True, file=sys.__stderr__)
     try:
         yield
     finally:

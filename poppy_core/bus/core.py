@@ -22,10 +22,10 @@ from poppy_core.bus.replies import ErrorBits, collect_replies
 from poppy_core.bus.results import BusStats
 from poppy_core.bus.timing import (
     DEFAULT_RETURN_DELAY_S,
-    MIN_REPLY_TIMEOUT_S,
     Deadline,
     LinkTiming,
     default_latency_s,
+    reply_floor_s,
 )
 from poppy_core.bus.transport import Transport
 from poppy_core.errors import BusTimeout, CorruptPacketError, PortError, ProtocolError
@@ -73,7 +73,7 @@ class BusCore:
         sync_read: bool | None = None,
         transport: Transport | None = None,
         timeout_s: float | None = None,
-        min_timeout_s: float = MIN_REPLY_TIMEOUT_S,
+        min_timeout_s: float | None = None,
     ) -> None:
         """Open a bus.
 
@@ -91,16 +91,19 @@ class BusCore:
             min_timeout_s: the shortest wait for a first reply. A motor that is there answers
                 long before it, so it only costs time when a reply is lost; it keeps a reply
                 that the OS delivered late (a loaded machine, a busy emulator) from being taken
-                for silence. Scans, which mostly wait for absent motors, pass 0.
+                for silence. Scans, which mostly wait for absent motors, pass 0. None: the
+                real adapter's 10 ms, or ``$POPPY_REPLY_FLOOR_S`` (``timing.reply_floor_s``).
             transport: an open ``Transport`` to use instead of opening ``port``; the bus then
                 sets its baud rate and protocol but does not close it.
 
         Raises:
             PortError: the port cannot be opened.
             ProtocolError: ``protocol`` is not 1 or 2.
+            ConfigError: ``$POPPY_REPLY_FLOOR_S`` is not a number of seconds.
         """
         if protocol not in (1, 2):
             raise ProtocolError(f"protocol must be 1 or 2, not {protocol}")
+        floor = reply_floor_s() if min_timeout_s is None else min_timeout_s
         self._protocol = protocol
         self._proto = protocol_for(protocol)
         self._owns_transport = transport is None
@@ -117,7 +120,7 @@ class BusCore:
         self._timing = LinkTiming(baudrate, return_delay_s, self._latency_s)
         self.retries = retries
         self.timeout_s = timeout_s
-        self.min_timeout_s = min_timeout_s
+        self.min_timeout_s = floor
         self.stats = BusStats()
         self._errors = ErrorBits(self._proto, port, self.stats)
         self.alarms = self._errors.alarms

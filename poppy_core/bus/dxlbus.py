@@ -15,7 +15,7 @@ from poppy_core.bus import groupread
 from poppy_core.bus.core import BusCore
 from poppy_core.bus.results import PingResult
 from poppy_core.bus.serial_line import AbsentLine
-from poppy_core.bus.timing import MIN_REPLY_TIMEOUT_S
+from poppy_core.bus.timing import reply_floor_s
 from poppy_core.bus.transport import Transport
 from poppy_core.errors import (
     BusTimeout,
@@ -118,7 +118,7 @@ class DxlBus(BusCore):
         whatever the ping had (a scan pings with no retry and no floor).
         """
         packet = ins.read(self._protocol, id, V1_MODEL_NUMBER_ADDRESS, V1_MODEL_INFO_LENGTH)
-        floor = max(self.min_timeout_s, MIN_REPLY_TIMEOUT_S)
+        floor = max(self.min_timeout_s, reply_floor_s())
         status = self._transact(
             packet, id, V1_MODEL_INFO_LENGTH, retries=max(1, self.retries), min_timeout_s=floor
         )

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from poppy_core.bus.dxlbus import DxlBus
 from poppy_core.bus.ports import list_ports
 from poppy_core.bus.settle import answers, ping_found, settle
+from poppy_core.bus.timing import MIN_REPLY_TIMEOUT_S
 from poppy_core.bus.transport import Transport, open_each
 from poppy_core.errors import PortError, SetupError
 from poppy_core.models import standard_baudrates
@@ -94,7 +95,16 @@ def patient_steps(
 def _search_bus(
     port: str, rate: int, protocol: int, transport: Transport, latency_s: float | None
 ) -> DxlBus:
-    bus = DxlBus(port, rate, protocol, latency_s=latency_s, transport=transport)
+    """A search's bus at one rate: the adapter's own floor, whatever ``$POPPY_REPLY_FLOOR_S``
+    says (a search mostly asks rates where nobody answers; late replies have their own steps)."""
+    bus = DxlBus(
+        port,
+        rate,
+        protocol,
+        latency_s=latency_s,
+        transport=transport,
+        min_timeout_s=MIN_REPLY_TIMEOUT_S,
+    )
     bus.adaptive_latency = True
     return bus
 

@@ -30,6 +30,7 @@ import time
 from dataclasses import dataclass
 
 from poppy_core.bus.ports import read_ftdi_latency_ms
+from poppy_core.errors import ConfigError
 from poppy_core.protocol import DxlProtocol, protocol_for
 
 # A UART frame is 1 start bit, 8 data bits, 1 stop bit (e-manual "Protocol 1.0"/"Protocol 2.0":
@@ -44,6 +45,12 @@ VIRTUAL_LATENCY_S = 0.001
 MIN_MARGIN_S = 0.001
 # Shortest wait for the first reply of a transaction with motors known to be there (scans use 0).
 MIN_REPLY_TIMEOUT_S = 0.010
+# Raises that floor (seconds) for motors whose other end the OS may run late: an emulator or a
+# network bridge on a busy machine (the test suite sets it from the machine's load). Unset: the
+# real adapter's MIN_REPLY_TIMEOUT_S.
+REPLY_FLOOR_ENV = "POPPY_REPLY_FLOOR_S"
+# A floor past this is a typo, not a slow bridge.
+MAX_REPLY_FLOOR_S = 60.0
 MARGIN_FRACTION = 0.1
 
 # Quiet time after a search at one rate, before the next: every reply still coming (a slow
@@ -62,6 +69,32 @@ SILENCE_MIN_S = 0.05
 # Factory return delay of AX/MX/X servos: 250 x 2 µs (e-manual: "Return Delay Time", address 5
 # on protocol 1 models, 9 on X series).
 DEFAULT_RETURN_DELAY_S = 0.0005
+
+
+def reply_floor_s() -> float:
+    """The shortest wait for a first reply of motors known to be there: ``$POPPY_REPLY_FLOOR_S``
+    when set, else ``MIN_REPLY_TIMEOUT_S`` (read at each call: a bus reads it when it opens).
+
+    A floor below ``MIN_REPLY_TIMEOUT_S`` is taken as given (a fast bridge); scans, which mostly
+    wait for absent motors, keep their own floor of 0 whatever it says.
+
+    Raises:
+        ConfigError: the variable is not a number of seconds from 0 to ``MAX_REPLY_FLOOR_S``.
+    """
+    text = os.environ.get(REPLY_FLOOR_ENV, "").strip()
+    if not text:
+        return MIN_REPLY_TIMEOUT_S
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0.0 <= value <= MAX_REPLY_FLOOR_S:  # also refuses nan
+        raise ConfigError(
+            f"{REPLY_FLOOR_ENV}={text!r} is not a reply floor: give seconds from 0 to "
+            f"{MAX_REPLY_FLOOR_S:g} (e.g. 0.5), or unset it for the adapter's "
+            f"{MIN_REPLY_TIMEOUT_S * 1000:g} ms"
+        )
+    return value
 
 
 def byte_time_s(baudrate: int) -> float:

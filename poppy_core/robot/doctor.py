@@ -19,6 +19,7 @@ from poppy_core.bus.groupread import count_answers
 from poppy_core.bus.ports import DIALOUT_ADVICE, latency_advice, latency_timer_path
 from poppy_core.bus.ports import read_ftdi_latency_ms as read_latency
 from poppy_core.bus.scan import scan
+from poppy_core.bus.timing import reply_floor_s
 from poppy_core.errors import CorruptPacketError, PoppyError
 from poppy_core.models import ServoModel
 from poppy_core.robot.config import RobotConfig
@@ -244,9 +245,10 @@ def check_motors(config: RobotConfig, profile: str, port: str | None) -> list[Ch
     by_bus: dict[tuple[int, int], list[MotorTarget]] = {}
     for target in targets:
         by_bus.setdefault((target.baudrate, target.protocol), []).append(target)
+    floor = max(REPLY_TIMEOUT_S, reply_floor_s())
     for (rate, protocol), group in by_bus.items():
         try:
-            with DxlBus(port, rate, protocol, retries=2, min_timeout_s=REPLY_TIMEOUT_S) as bus:
+            with DxlBus(port, rate, protocol, retries=2, min_timeout_s=floor) as bus:
                 bus.adaptive_latency = True  # a slow adapter is learned from its late replies
                 checks.append(check_duplicates(bus, group, profile, port))
                 for target in group:

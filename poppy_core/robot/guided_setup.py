@@ -22,6 +22,7 @@ from poppy_core.bus.groupread import count_answers
 from poppy_core.bus.results import FoundMotor
 from poppy_core.bus.scan import PROTOCOLS, scan
 from poppy_core.bus.setup_reset import reset_motor
+from poppy_core.bus.timing import reply_floor_s
 from poppy_core.errors import PoppyError, SetupError
 from poppy_core.models import ServoModel, model_by_name, standard_baudrates
 from poppy_core.protocol import protocol_for
@@ -192,7 +193,8 @@ class GuidedSetup:
     def _bus(self, rate: int, protocol: int) -> DxlBus:
         """A bus that waits long for replies: setup is not timed, and a busy machine (or a
         slow adapter, learned from its late replies) answers late."""
-        bus = DxlBus(self.port, rate, protocol, retries=2, min_timeout_s=REPLY_TIMEOUT_S)
+        floor = max(REPLY_TIMEOUT_S, reply_floor_s())
+        bus = DxlBus(self.port, rate, protocol, retries=2, min_timeout_s=floor)
         bus.adaptive_latency = True
         return bus
 

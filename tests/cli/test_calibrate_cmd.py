@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 import yaml
 
-from tests.helpers.cli import POPPY, no_user_settings
+from tests.helpers.cli import POPPY, command_env, no_user_settings
 
 
 @pytest.fixture(autouse=True)
@@ -69,7 +69,7 @@ def test_an_interrupted_calibration_leaves_the_previous_one(poppy: Any, user_dir
     assert first.code == 0, first.stderr
     path = user_dirs / "ergo-jr" / "profile.yaml"
     before = path.read_text()
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    env = dict(os.environ, **command_env())
     proc = subprocess.Popen(
         [*POPPY, "calibrate", "--sim", "--profile", "ergo-jr"],
         stdin=subprocess.PIPE,

@@ -18,7 +18,7 @@ from poppy_cli.commands.emulate_hand import HandCommands, HandJoint
 from poppy_core.emulator import Hand, VirtualBus, build_bus_from_spec
 from poppy_core.emulator.control import ControlError
 from poppy_core.motion import Move, read_move, write_move
-from tests.helpers.cli import POPPY, no_user_settings
+from tests.helpers.cli import POPPY, command_env, no_user_settings
 from tests.helpers.processes import start
 from tests.helpers.waiting import eventually
 
@@ -103,7 +103,7 @@ def test_poppy_record_records_what_the_emulators_hand_does(
     """`poppy emulate --profile ergo-jr --control` on a pty, driven through its stdin, while
     `poppy record` on that pty records the motion the hand makes."""
     library = no_user_settings(tmp_path, monkeypatch, moves=True)
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    env = dict(os.environ, **command_env())
     emulator = subprocess.Popen(
         [*POPPY, "emulate", "--profile", "ergo-jr", "--control"],
         stdin=subprocess.PIPE,

@@ -18,15 +18,16 @@ from poppy_core.emulator import (
     serve_tcp,
 )
 from poppy_core.robot import build_steps
-from tests.helpers.waiting import scaled
+from tests.helpers.waiting import LOADED_REPLY_FLOOR_IDLE_S, scaled
 
 # The first-reply floor for a DxlBus whose other end is an emulator thread of the test process on
 # a pty: the bus's own floor (MIN_REPLY_TIMEOUT_S, 10 ms) is a real adapter's, and a busy machine
 # (two busy loops and more on two cores) runs that thread tens of milliseconds late now and then.
 # A test that checks what the replies say, not how fast they come, gives its bus this floor; it
 # costs nothing while the motors answer. Half a second on an idle machine, times the load factor
-# measured when the tests start (once per worker).
-LOADED_REPLY_FLOOR_S = scaled(0.5)
+# measured when the tests start (once per worker). The `poppy` commands a test runs get the same
+# floor through POPPY_REPLY_FLOOR_S (``tests.helpers.waiting.reply_floor_env``).
+LOADED_REPLY_FLOOR_S = scaled(LOADED_REPLY_FLOOR_IDLE_S)
 
 Emulate = Callable[..., AbstractContextManager[tuple[VirtualBus, str]]]
 

@@ -26,12 +26,19 @@ from typing import Any
 
 import pytest
 
-from tests.helpers.waiting import scaled
+from tests.helpers.waiting import reply_floor_env, scaled
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
-# What a `poppy` subprocess of the tests sees: a wide terminal, no colours.
-ENV = {"COLUMNS": "200", "NO_COLOR": "1"}
-WIDTH = int(ENV["COLUMNS"])
+# What a `poppy` subprocess of the tests sees: a wide terminal, no colours, and a first-reply
+# floor for motors that are an emulator on a busy machine (scaled by the load when this module is
+# imported; `command_env` measures it again for each command).
+WIDTH = 200
+ENV = {"COLUMNS": str(WIDTH), "NO_COLOR": "1", **reply_floor_env()}
+
+
+def command_env(env: Mapping[str, str] | None = None) -> dict[str, str]:
+    """``ENV`` with the reply floor scaled by the load measured now, then ``env``."""
+    return {**ENV, **reply_floor_env(), **(env or {})}
 
 
 @dataclass
@@ -55,7 +62,7 @@ def run_poppy_process(
     *args: str, timeout: float = 60, input: str | None = None, env: Mapping[str, str] | None = None
 ) -> Result:
     """Run `poppy ARGS...` as a subprocess (``env``: added to its environment)."""
-    full = dict(os.environ, **ENV, **(env or {}))
+    full = dict(os.environ, **command_env(env))
     proc = subprocess.run(
         [*POPPY, *args],
         capture_output=True,
@@ -82,7 +89,7 @@ def run_poppy(
     from poppy_cli.main import main
 
     stdout, stderr = _stream(), _stream()
-    with _as_a_process(args, stdout, stderr, input, {**ENV, **(env or {})}):
+    with _as_a_process(args, stdout, stderr, input, command_env(env)):
         try:
             main()
             code = 0

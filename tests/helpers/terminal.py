@@ -16,7 +16,7 @@ import sys
 import time
 from collections.abc import Mapping
 
-from tests.helpers.cli import ENV, POPPY
+from tests.helpers.cli import POPPY, command_env
 from tests.helpers.processes import start_on_pty
 from tests.helpers.waiting import scaled
 
@@ -36,7 +36,7 @@ class Terminal:
 
     def __init__(self, *args: str, env: Mapping[str, str] | None = None) -> None:
         # a hang is reported with its threads' stacks (``wait``)
-        full = dict(os.environ, **ENV, PYTHONFAULTHANDLER="1", **(env or {}))
+        full = dict(os.environ, PYTHONFAULTHANDLER="1", **command_env(env))
         self.proc, self.master, slave = start_on_pty(
             [sys.executable, "-c", _SHIM, *POPPY, *args], full
         )

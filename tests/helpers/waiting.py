@@ -17,6 +17,16 @@ MIN_TIMEOUT_S = 15.0
 # The load factor's bound: a machine this loaded is stuck, not busy, and a wait must end.
 MAX_LOAD_FACTOR = 8.0
 
+# The first-reply floor, on an idle machine, of a bus whose motors are an emulator thread (on a
+# pty or TCP) that a busy machine runs tens of milliseconds late now and then: the product's own
+# floor (10 ms) is a real adapter's. Times the load factor; it costs nothing while motors answer.
+LOADED_REPLY_FLOOR_IDLE_S = 0.5
+# The same for the `poppy` commands a test runs, through the product's POPPY_REPLY_FLOOR_S
+# (poppy_core.bus.timing.REPLY_FLOOR_ENV). Lower: some commands look for motors that are absent
+# on purpose (`doctor` on a one-motor kit waits the floor three times for each missing one).
+COMMAND_REPLY_FLOOR_IDLE_S = 0.2
+REPLY_FLOOR_ENV = "POPPY_REPLY_FLOOR_S"
+
 
 def _runnable_now() -> int:
     """Threads running or ready to run right now (``/proc/loadavg``'s 4th field), 0 if unknown.
@@ -46,6 +56,13 @@ def scaled(seconds: float) -> float:
     """``seconds`` (enough on an idle machine) times the load factor: a deadline that must be met
     by a thread of the test process or of the emulator it serves."""
     return seconds * load_factor()
+
+
+def reply_floor_env() -> dict[str, str]:
+    """The environment that gives a `poppy` command run by a test (in this process or another)
+    the loaded first-reply floor, scaled by the load measured now: its motors are an emulator
+    of the test (a thread, or a `poppy emulate` process) that a busy machine runs late."""
+    return {REPLY_FLOOR_ENV: f"{scaled(COMMAND_REPLY_FLOOR_IDLE_S):.3f}"}
 
 
 def eventually(check: Callable[[], bool], timeout_s: float = 3.0, interval_s: float = 0.01) -> bool:

@@ -21,6 +21,7 @@ from poppy_core.robot import Robot, RobotConfig, load_profile, with_ports
 from poppy_core.sensors import Camera
 from poppy_core.sensors.opencv_camera import OpenCVCamera
 from tests.helpers.bus import emulate_bus
+from tests.helpers.cli import command_env
 from tests.helpers.waiting import eventually
 from tests.sensors.test_camera import Unpluggable
 
@@ -129,7 +130,7 @@ def test_the_profile_camera_unplugged_starts_the_robot_and_the_creature(
 def test_poppy_serve_starts_without_its_camera_and_the_page_says_so(tmp_path: Path) -> None:
     if os.path.exists("/dev/video0"):
         pytest.skip("this machine has a /dev/video0: the profile's camera is plugged in")
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1", POPPY_MOVES_DIR=str(tmp_path))
+    env = dict(os.environ, **command_env(), POPPY_MOVES_DIR=str(tmp_path))
     with emulate_bus("XL-320:1-6", via="tcp") as (_bus, url):
         args = ["serve", "--http", "--http-port", "0", "--profile", "ergo-jr", "--port", url]
         proc = subprocess.Popen(

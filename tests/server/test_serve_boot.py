@@ -16,6 +16,7 @@ import pytest
 from poppy_core.emulator import serve_pty
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
+from tests.helpers.cli import command_env
 from tests.helpers.processes import reap, served_urls
 from tests.helpers.waiting import eventually
 
@@ -24,7 +25,7 @@ POPPY = [sys.executable, "-m", "poppy_cli"]
 
 def start_serving(*args: str) -> tuple[subprocess.Popen[str], list[str]]:
     """``poppy serve ARGS`` in a process, and the http:// URLs it printed."""
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    env = dict(os.environ, **command_env())
     proc = subprocess.Popen(
         [*POPPY, "serve", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
     )

@@ -13,14 +13,14 @@ from typing import Any
 
 import pytest
 
-from tests.helpers.cli import keyed, run_poppy
+from tests.helpers.cli import command_env, keyed, run_poppy
 from tests.helpers.processes import reap, start
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
 
 def _start(*args: str) -> subprocess.Popen[str]:
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    env = dict(os.environ, **command_env())
     return start([*POPPY, "serve", *args], env)
 
 
@@ -278,7 +278,7 @@ def test_a_signal_stops_a_remote_play_with_exit_130(served: Any, signum: int) ->
 
     frames = [{"m1": 10.0 * i / 2999} for i in range(3000)]  # a minute at 50 Hz
     save_move(Move.from_frames(50.0, frames), "remote_long")
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    env = dict(os.environ, **command_env())
     proc = start([*POPPY, "play", "remote_long", "--remote", served.url, "--json"], env)
     try:
         moves = served.app.state.service.moves

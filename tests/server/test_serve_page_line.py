@@ -9,6 +9,7 @@ import sys
 
 import httpx
 
+from tests.helpers.cli import command_env
 from tests.helpers.processes import reap
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -16,7 +17,7 @@ WAIT_S = 60.0
 
 
 def test_serve_sim_prints_the_page_with_the_3d_view() -> None:
-    env = dict(os.environ, COLUMNS="300", NO_COLOR="1")
+    env = dict(os.environ, **command_env({"COLUMNS": "300"}))
     command = [*POPPY, "serve", "--http", "--http-port", "0", "--sim", "--profile", "ergo-jr"]
     proc = subprocess.Popen(
         command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env

@@ -20,6 +20,7 @@ from poppy_core.motion import read_move
 from poppy_core.server import moves as moves_module
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
+from tests.helpers.cli import command_env
 from tests.helpers.processes import reap, start
 from tests.helpers.waiting import eventually
 
@@ -33,7 +34,10 @@ def test_sigterm_saves_the_rest_and_snap_recordings_and_says_where(tmp_path: Pat
     temp.mkdir()
     (library / "taken.move").write_text("a move of that name is already saved\n")
     env = dict(
-        os.environ, COLUMNS="300", NO_COLOR="1", POPPY_MOVES_DIR=str(library), TMPDIR=str(temp)
+        os.environ,
+        **command_env({"COLUMNS": "300"}),
+        POPPY_MOVES_DIR=str(library),
+        TMPDIR=str(temp),
     )
     proc = start(
         [

@@ -20,6 +20,7 @@ from poppy_core.emulator import Endpoint, serve_tcp
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from poppy_core.server.web.logs import LogBuffer, StderrWarnings, printable
+from tests.helpers.cli import command_env
 from tests.helpers.processes import reap, start
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -60,7 +61,7 @@ def served_bus() -> Iterator[Endpoint]:
 
 
 def test_a_lost_bus_is_a_warning_on_the_servers_stderr(served_bus: Endpoint) -> None:
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    env = dict(os.environ, **command_env())
     proc = start(
         [
             *POPPY,

@@ -153,10 +153,14 @@ def test_connection_test_and_motor_index(snap: Served) -> None:
 
 def record_motion(served: Served, move: str, motor: str, target: float) -> None:
     """Record ``move`` on ``motor`` going from 0° to ``target``, through the Snap! routes."""
-    robot, _, http = served
+    robot, server, http = served
     robot.goto_position({motor: 0.0}, 0.3, wait=True)
     assert http.get(f"/primitive/MoveRecorder/{move}/start/{motor}").text == "Done!"
     robot.goto_position({motor: target}, 0.6, wait=True)
+    # the move ends at the target: stopped once the recorder sampled it there (a loaded machine
+    # ran the recorder late, and a move stopped at once ended at -23° instead of -30°)
+    recorder = server.service.moves._recorders[move]
+    assert wait_until(lambda: near(recorder.latest().get(motor, 0.0), target, 1))
     assert http.get(f"/primitive/MoveRecorder/{move}/stop").text == "Done!"
 
 
@@ -189,7 +193,9 @@ def test_moves_play_together_and_in_sequence(two_moves: Served) -> None:
     assert float(answer.text) == pytest.approx(max(first, second) / 0.25, abs=0.01)
     assert wait_until(lambda: {"first", "second"} <= set(moves.playing()))
     assert wait_until(lambda: not moves.playing(), timeout_s=30)
-    assert near(robot.m1.present_position, 30.0, 3) and near(robot.m2.present_position, -30.0, 3)
+    # each at its move's end (a read may be a sync period old: polled)
+    assert wait_until(lambda: near(robot.m1.present_position, 30.0, 3))
+    assert wait_until(lambda: near(robot.m2.present_position, -30.0, 3))
 
     # in sequence: the second starts when the first has ended
     home()
@@ -203,9 +209,10 @@ def test_moves_play_together_and_in_sequence(two_moves: Served) -> None:
 
     assert wait_until(second_playing, timeout_s=30)
     assert ("first",) in seen and ("first", "second") not in seen  # one after the other
-    assert near(robot.m1.present_position, 30.0, 3)  # the first had reached its end
+    # the first had reached its end (only the second moves now, and only m2)
+    assert wait_until(lambda: near(robot.m1.present_position, 30.0, 3))
     assert wait_until(lambda: not moves.playing() and not playlists.sequences(), timeout_s=30)
-    assert near(robot.m2.present_position, -30.0, 3)
+    assert wait_until(lambda: near(robot.m2.present_position, -30.0, 3))
 
     # "stop move" on a move of a sequence ends the sequence
     home()

@@ -12,7 +12,7 @@ import urllib.request
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from tests.helpers.cli import run_poppy
+from tests.helpers.cli import command_env, run_poppy
 from tests.helpers.processes import start
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -20,7 +20,7 @@ TIMEOUT_S = 90
 
 
 def _env(moves: Path) -> dict[str, str]:
-    return dict(os.environ, COLUMNS="200", NO_COLOR="1", POPPY_MOVES_DIR=str(moves))
+    return dict(os.environ, **command_env(), POPPY_MOVES_DIR=str(moves))
 
 
 def _get(url: str) -> str:

@@ -18,7 +18,7 @@ import pytest
 
 from poppy_core.errors import ArgumentError, DownloadError
 from poppy_core.server.snap import release, unpack
-from tests.helpers.cli import POPPY, run_poppy
+from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.snap_release import Files, make_release, release_server, zip_folder
 
@@ -172,7 +172,7 @@ def _serve_snap(env: dict[str, str]) -> tuple[subprocess.Popen[str], dict[str, s
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=dict(os.environ, COLUMNS="200", NO_COLOR="1", **env),
+        env=dict(os.environ, **command_env(), **env),
     )
     assert proc.stdout is not None
     lines = [proc.stdout.readline().strip() for _ in range(4)]

@@ -12,6 +12,7 @@ from poppy_core.pypot import PoppyTorso
 from poppy_core.robot import Robot
 from poppy_core.server.zmqserver import ZmqRobotServer
 from tests.creatures.helpers import wait_until
+from tests.helpers.cli import command_env
 from tests.helpers.processes import reap, start
 
 zmq = pytest.importorskip("zmq")
@@ -154,7 +155,7 @@ def test_poppy_serve_zmq() -> None:
     import signal
     import sys
 
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    env = dict(os.environ, **command_env())
     proc = start(
         [
             sys.executable,

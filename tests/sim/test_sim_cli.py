@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from poppy_cli.options import normalise_sim_args
-from tests.helpers.cli import run_poppy
+from tests.helpers.cli import command_env, run_poppy
 
 ROOT = Path(__file__).resolve().parents[2]
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -24,7 +24,7 @@ NO_GL = "cannot render offscreen"
 def run(
     *args: str, timeout: float = 60, env: dict[str, str] | None = None
 ) -> subprocess.CompletedProcess[str]:
-    full = dict(os.environ, COLUMNS="200", NO_COLOR="1", **(env or {}))
+    full = dict(os.environ, **command_env(), **(env or {}))
     return subprocess.run(
         [*POPPY, *args], capture_output=True, text=True, timeout=timeout, env=full, check=False
     )
