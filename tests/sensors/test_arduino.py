@@ -13,8 +13,10 @@ from pathlib import Path
 import pytest
 
 from poppy_core import from_config
+from poppy_core.errors import SensorError
 from poppy_core.robot import RobotConfig, load_profile
 from poppy_core.sensors.arduino import ArduinoSensor
+from tests.helpers.sensor_rest import rest
 from tests.helpers.waiting import eventually
 
 
@@ -77,6 +79,14 @@ def test_sensor_dict_is_the_latest_line_the_board_printed(board: Board) -> None:
         assert health.connected and health.errors == 0 and health.kind == "ArduinoSensor"
 
 
+def test_no_line_yet_is_no_value_yet(board: Board) -> None:
+    with ArduinoSensor("arduino", str(board.link)) as sensor:
+        with pytest.raises(SensorError, match=r"^ArduinoSensor 'arduino' gave no value in 0.5 s$"):
+            sensor.wait_first(0.5)  # an open port with nothing printed yet is not an empty dict
+        assert sensor.health().connected and sensor.health().age_s is None
+        assert arrives(sensor, board, b'{"Time": 7}\n', {"Time": 7})
+
+
 def test_broken_lines_are_said_once_counted_and_skipped(
     board: Board, caplog: pytest.LogCaptureFixture
 ) -> None:
@@ -121,5 +131,8 @@ def test_a_pypot_config_entry_is_robot_dot_name(board: Board) -> None:
     }
     with from_config(RobotConfig.from_dict(data), sim=True) as robot:
         assert arrives(robot.arduino, board, b'{"light": 512}\n', {"light": 512})
+        with rest(robot) as client:
+            value = client.get("/sensors/arduino/registers/sensor_dict/value.json").json()
+            assert value == {"sensor_dict": {"light": 512}}
         assert robot.sensor_health()["arduino"].connected
     assert robot.arduino.closed

@@ -13,6 +13,7 @@ from poppy_core import from_config  # noqa: E402
 from poppy_core.errors import SensorError  # noqa: E402
 from poppy_core.robot import RobotConfig, load_profile  # noqa: E402
 from poppy_core.sensors.contact import ContactSensor  # noqa: E402
+from tests.helpers.sensor_rest import rest  # noqa: E402
 
 
 @pytest.fixture
@@ -57,6 +58,10 @@ def test_a_pypot_config_entry_is_robot_dot_name(
     with from_config(RobotConfig.from_dict(data), sim=True) as robot:
         factory.pin(22).drive_high()
         assert robot.bumper.contact is True
+        with rest(robot) as client:
+            assert client.get("/sensors/bumper/registers/contact/value.json").json() == {
+                "contact": True
+            }
         factory.pin(22).drive_low()
         assert robot.bumper.contact is False
         assert robot.sensor_health()["bumper"].connected

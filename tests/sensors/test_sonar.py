@@ -16,6 +16,7 @@ import pytest
 from poppy_core import from_config
 from poppy_core.robot import RobotConfig, load_profile
 from poppy_core.sensors.sonar import SonarSensor
+from tests.helpers.sensor_rest import rest
 from tests.helpers.waiting import eventually
 
 NOT_ANSWERING = 121  # EREMOTEIO: the I2C adapter saw no acknowledge
@@ -105,4 +106,10 @@ def test_a_pypot_config_entry_is_robot_dot_name(monkeypatch: pytest.MonkeyPatch)
     with from_config(RobotConfig.from_dict(data), sim=True) as robot:
         assert robot.sonar.distance == pytest.approx(0.57)
         assert opened == [3] and robot.sensor_health()["sonar"].connected
+        with rest(robot) as client:
+            assert client.get("/sensors/sonar/registers/list.json").json() == {
+                "registers": ["distance"]
+            }
+            value = client.get("/sensors/sonar/registers/distance/value.json").json()
+            assert value == {"distance": pytest.approx(0.57)}
     assert robot.sonar.closed
