@@ -11,13 +11,27 @@ from __future__ import annotations
 from collections.abc import Collection, Mapping
 from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, Strict
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    Strict,
+    model_validator,
+)
 from pydantic_core import PydanticCustomError
 
 from poppy_core.errors import ConfigError, SensorError
 from poppy_core.robot.config_format import config_error
 from poppy_core.sensors.camera import CameraCalibration, check_resolution
-from poppy_core.sensors.config import CAMERA_TYPES, NOT_YET, SUPPORTED_TYPES, SensorSpec
+from poppy_core.sensors.config import (
+    CAMERA_TYPES,
+    DEVICE_TYPES,
+    NOT_YET,
+    SUPPORTED_TYPES,
+    SensorSpec,
+)
 from poppy_core.sensors.faces import MAX_FACE_PX, MIN_FACE_PX
 from poppy_core.sensors.markers import FAMILIES
 
@@ -149,6 +163,24 @@ def _min_size(value: int) -> int:
     return value
 
 
+def _baud(value: int) -> int:
+    if value <= 0:
+        raise PydanticCustomError("baud", "must be a positive baud rate such as 115200")
+    return value
+
+
+def _bus_number(value: int) -> int:
+    if value < 0:
+        raise PydanticCustomError("i2c_pin", "must be an I2C bus number (1 is /dev/i2c-1)")
+    return value
+
+
+def _i2c_address(value: int) -> int:
+    if not 0x03 <= value <= 0x7F:
+        raise PydanticCustomError("address", "must be a 7-bit I2C address (112 is 0x70)")
+    return value
+
+
 def _reason(exc: Exception) -> str:
     return str(exc).split(": ", 1)[-1]
 
@@ -180,6 +212,25 @@ class SensorEntry(BaseModel):
     families: Annotated[list[Name], AfterValidator(_families)] | None = None
     min_size: Annotated[Annotated[int, Strict()], AfterValidator(_min_size)] | None = None
     cascade: Annotated[Name, AfterValidator(_non_empty)] | None = None
+    sync_freq: Positive | None = None
+    port: Annotated[Name, AfterValidator(_non_empty)] | None = None
+    baud: Annotated[Annotated[int, Strict()], AfterValidator(_baud)] | None = None
+    gpio_data: Annotated[int, Strict()] | Name | None = None
+    gpio_vcc: Annotated[int, Strict()] | Name | None = None
+    i2c_pin: Annotated[Annotated[int, Strict()], AfterValidator(_bus_number)] | None = None
+    address: Annotated[Annotated[int, Strict()], AfterValidator(_i2c_address)] | None = None
+
+    @model_validator(mode="after")
+    def _device_keys(self) -> SensorEntry:
+        needed = {"ArduinoSensor": "port", "ContactSensor": "gpio_data", "SonarSensor": "i2c_pin"}
+        key = needed.get(self.type)
+        if key is not None and getattr(self, key) is None:
+            raise PydanticCustomError(
+                "device",
+                "{kind} needs its '{key}' key (as in pypot's config)",
+                {"kind": self.type, "key": key},
+            )
+        return self
 
     def spec(self, name: str) -> SensorSpec:
         """The plain entry the sensors leaf builds from."""
@@ -200,8 +251,16 @@ class SensorEntry(BaseModel):
             "families": tuple(self.families) if self.families is not None else None,
             "min_size": self.min_size,
             "cascade": self.cascade,
+            "port": self.port,
+            "baud": self.baud,
+            "gpio_data": self.gpio_data,
+            "gpio_vcc": self.gpio_vcc,
+            "i2c_pin": self.i2c_pin,
+            "address": self.address,
         }
-        keep = {"rate_hz", "resolution", "calibration", "cascade"}
+        if self.type in DEVICE_TYPES:
+            given["rate_hz"] = self.sync_freq or self.freq
+        keep = {"rate_hz", "resolution", "calibration", "cascade", "gpio_vcc"}
         return SensorSpec(
             name, self.type, **{k: v for k, v in given.items() if v is not None or k in keep}
         )

@@ -1,9 +1,10 @@
-"""Sensors: cameras (OpenCV devices, blank, simulated in ``poppy_core.sim``), markers and faces.
+"""Sensors: cameras (OpenCV, blank, simulated in ``poppy_core.sim``), markers, faces, devices.
 
-Imports nothing of ours but ``errors``; OpenCV is imported on first use. The robot factory
-builds them from a config's ``sensors`` section (``build_sensors``).
+Imports nothing of ours but ``errors``; OpenCV, gpiozero and smbus2 are imported on first use.
+The robot factory builds them from a config's ``sensors`` section (``build_sensors``).
 """
 
+from poppy_core.sensors.arduino import ArduinoSensor
 from poppy_core.sensors.base import Sensor, SensorHealth, SensorLost
 from poppy_core.sensors.camera import Camera, CameraCalibration, DummyCamera, Frame
 from poppy_core.sensors.config import (
@@ -14,15 +15,19 @@ from poppy_core.sensors.config import (
     dummy_camera,
     opencv_camera,
 )
+from poppy_core.sensors.contact import ContactSensor
 from poppy_core.sensors.detector import FrameDetector, MarkerDetector
 from poppy_core.sensors.faces import Face, FaceDetector, FaceFinder
 from poppy_core.sensors.markers import Marker, MarkerFinder, MarkerPose, marker_image
+from poppy_core.sensors.sonar import SonarSensor
 
 __all__ = [
     "NOT_YET",
     "SUPPORTED_TYPES",
+    "ArduinoSensor",
     "Camera",
     "CameraCalibration",
+    "ContactSensor",
     "DummyCamera",
     "Face",
     "FaceDetector",
@@ -37,6 +42,7 @@ __all__ = [
     "SensorHealth",
     "SensorLost",
     "SensorSpec",
+    "SonarSensor",
     "build_sensors",
     "dummy_camera",
     "marker_image",

@@ -133,13 +133,18 @@ class Sensor:
         )
         self._last_good: float | None = None
         self._fatal = ""
+        self._bad_inputs = 0
         self._watching = False
         """The thread only reopens a device that was away at start (nobody read the sensor)."""
 
     # -- what subclasses implement -----------------------------------------------------------
 
-    def update(self) -> None:
+    def update(self) -> bool | None:
         """One background step (grab a frame, detect markers...).
+
+        Returns:
+            False when the step brought no value yet (a serial line still on its way): the
+            first read goes on waiting; anything else counts as a value.
 
         Raises:
             SensorLost: the device went away (``reconnect`` is then retried with backoff).
@@ -164,6 +169,17 @@ class Sensor:
         self._first.set()
         self._stop.set()
         self.wake()
+
+    def bad_input(self, reason: str) -> None:
+        """Count one bad input the device sent (a broken line) in health; the loop goes on.
+
+        The first one of a sensor is logged at WARNING, the others only counted.
+        """
+        if not self._bad_inputs:
+            logger.warning("%s %s: %s (further ones only counted)", self.kind, self._name, reason)
+        self._bad_inputs += 1
+        self._errors += 1
+        self._last_error = reason
 
     def wake(self) -> None:
         """Wake the threads waiting for a value (``Camera`` overrides it)."""
@@ -327,9 +343,11 @@ class Sensor:
             self._reopen(now)
             return not (self._connected and self._park())
         try:
-            self.update()
+            fresh = self.update()
         except SensorLost as exc:
             self._lost(str(exc))
+            return None
+        if fresh is False:
             return None
         now = self._clock()
         self._rate.tick(now)

@@ -6,6 +6,9 @@ pypot's form: ``{"camera": {"type": "OpenCVCamera", "index": -1, "fps": 20.0, "r
 ``cards``, ``dictionary``, ``marker_size``, ``families`` (marker detector), ``sim_camera`` (the
 MuJoCo camera a simulated robot renders for it; default: the sensor's name). A ``FaceDetector``
 (pypot's: ``cameras``, ``freq``) takes ``min_size`` (pixels) and ``cascade`` (an LBP cascade XML).
+The device sensors take pypot's keys: ``ArduinoSensor`` ``port``, ``baud``, ``sync_freq``;
+``ContactSensor`` ``gpio_data``, ``gpio_vcc``; ``SonarSensor`` ``i2c_pin``, ``address``,
+``sync_freq``.
 The section is checked where the rest of the config is (``poppy_core.robot.config_sections``,
 every problem at once); this leaf receives plain ``SensorSpec`` entries.
 """
@@ -16,6 +19,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
 from poppy_core.errors import SensorError
+from poppy_core.sensors.arduino import DEFAULT_BAUD, DEFAULT_SYNC_HZ, ArduinoSensor
 from poppy_core.sensors.base import Sensor
 from poppy_core.sensors.camera import (
     DEFAULT_FPS,
@@ -31,10 +35,13 @@ from poppy_core.sensors.faces import (
     FaceDetector,
 )
 from poppy_core.sensors.markers import DEFAULT_DICTIONARY, DEFAULT_MARKER_SIZE_M, FAMILIES
+from poppy_core.sensors.sonar import DEFAULT_ADDRESS, DEFAULT_SONAR_HZ, SonarSensor
 
 CAMERA_TYPES = ("OpenCVCamera", "DummyCamera")
 DETECTOR_TYPES = ("MarkerDetector", "FaceDetector")
-SUPPORTED_TYPES = (*CAMERA_TYPES, *DETECTOR_TYPES)
+DEVICE_TYPES = ("ArduinoSensor", "ContactSensor", "SonarSensor")
+"""Sensors on their own device (a serial port, a GPIO pin, an I2C bus), no camera."""
+SUPPORTED_TYPES = (*CAMERA_TYPES, *DETECTOR_TYPES, *DEVICE_TYPES)
 NOT_YET: dict[str, str] = {
     # pypot 5.0.2's pypot.sensor classes and the sensors the Poppy documentation names
     "KinectSensor": "Kinect",
@@ -44,9 +51,6 @@ NOT_YET: dict[str, str] = {
     "IMU": "IMU",
     "RazorIMU": "IMU",
     "ForceSensor": "force",
-    "ContactSensor": "contact",
-    "SonarSensor": "sonar",
-    "ArduinoSensor": "Arduino",
     "BlobDetector": "blob detector",
 }
 
@@ -73,11 +77,22 @@ class SensorSpec:
     families: tuple[str, ...] = FAMILIES
     min_size: int = DEFAULT_MIN_SIZE_PX
     cascade: str | None = None
+    port: str = ""
+    baud: int = DEFAULT_BAUD
+    gpio_data: int | str = 0
+    gpio_vcc: int | str | None = None
+    i2c_pin: int = 1
+    address: int = DEFAULT_ADDRESS
 
     @property
     def is_camera(self) -> bool:
         """Whether the entry is a camera (the others are detectors reading cameras)."""
         return self.type in CAMERA_TYPES
+
+    @property
+    def is_device(self) -> bool:
+        """Whether the entry is a sensor on its own device (no camera read)."""
+        return self.type in DEVICE_TYPES
 
 
 CameraMaker = Callable[[SensorSpec], Camera]
@@ -107,6 +122,20 @@ def dummy_camera(spec: SensorSpec) -> Camera:
     )
 
 
+def device_sensor(spec: SensorSpec) -> Sensor:
+    """The sensor of an Arduino, contact or sonar entry (its device opens on first use;
+    a contact sensor claims its pins now)."""
+    if spec.type == "ArduinoSensor":
+        return ArduinoSensor(spec.name, spec.port, spec.baud, spec.rate_hz or DEFAULT_SYNC_HZ)
+    if spec.type == "SonarSensor":
+        return SonarSensor(spec.name, spec.i2c_pin, spec.address, spec.rate_hz or DEFAULT_SONAR_HZ)
+    from poppy_core.sensors.contact import DEFAULT_CONTACT_HZ, ContactSensor
+
+    return ContactSensor(
+        spec.name, spec.gpio_data, spec.gpio_vcc, spec.rate_hz or DEFAULT_CONTACT_HZ
+    )
+
+
 def build_sensors(
     specs: Iterable[SensorSpec], make_camera: CameraMaker = opencv_camera
 ) -> dict[str, Sensor]:
@@ -123,7 +152,10 @@ def build_sensors(
             if spec.is_camera:
                 sensors[spec.name] = make_camera(spec)
         for spec in entries:
-            if spec.is_camera:
+            if spec.is_device:
+                sensors[spec.name] = device_sensor(spec)
+        for spec in entries:
+            if spec.is_camera or spec.is_device:
                 continue
             cameras = [sensors.get(c) for c in spec.cameras]
             if not cameras or not all(isinstance(c, Camera) for c in cameras):

@@ -10,6 +10,7 @@ import pytest
 from poppy_core import from_profile
 from poppy_core.errors import ConfigError
 from poppy_core.robot import RobotConfig, load_profile
+from poppy_core.robot.config_sections import sensor_specs
 from poppy_core.sensors import DummyCamera, MarkerDetector
 
 pytest.importorskip("cv2")
@@ -56,12 +57,34 @@ def test_sensors_not_built_yet_are_one_line_errors(kind: str, name: str) -> None
         ),
         ({"m1": {"type": "DummyCamera"}}, "sensor 'm1' has the name of a motor or group"),
         ({"cam": "OpenCVCamera"}, 'sensors.cam = "OpenCVCamera": must be a valid dictionary'),
+        ({"a": {"type": "ArduinoSensor"}}, "ArduinoSensor needs its 'port' key"),
+        ({"a": {"type": "ArduinoSensor", "port": "/dev/ttyACM0", "baud": 0}}, "baud = 0: must"),
+        ({"c": {"type": "ContactSensor"}}, "ContactSensor needs its 'gpio_data' key"),
+        ({"s": {"type": "SonarSensor", "address": 112}}, "SonarSensor needs its 'i2c_pin' key"),
+        (
+            {"s": {"type": "SonarSensor", "i2c_pin": 1, "address": 224}},
+            "sensors.s.address = 224: must be a 7-bit I2C address (112 is 0x70)",
+        ),
     ],
 )
 def test_bad_sensor_entries_are_one_line_errors(sensors: dict[str, Any], words: str) -> None:
     with pytest.raises(ConfigError) as caught:
         RobotConfig.from_dict(with_sensors(sensors), source="robot.json")
     assert words in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_pypot_device_sensor_entries_load_with_pypots_keys() -> None:
+    sensors = {
+        "arduino": {"type": "ArduinoSensor", "port": "/dev/ttyACM0", "baud": 1000000},
+        "bumper": {"type": "ContactSensor", "gpio_data": 17, "gpio_vcc": 27},
+        "sonar": {"type": "SonarSensor", "i2c_pin": 1, "address": 112, "sync_freq": 10.0},
+    }
+    config = RobotConfig.from_dict(with_sensors(sensors), source="robot.json")
+    specs = {spec.name: spec for spec in sensor_specs(config.sensors)}
+    assert (specs["arduino"].port, specs["arduino"].baud) == ("/dev/ttyACM0", 1000000)
+    assert (specs["bumper"].gpio_data, specs["bumper"].gpio_vcc) == (17, 27)
+    assert (specs["sonar"].i2c_pin, specs["sonar"].address, specs["sonar"].rate_hz) == (1, 112, 10)
+    assert config.to_pypot_dict()["sensors"] == sensors
 
 
 def test_pypot_sections_load_and_round_trip() -> None:
