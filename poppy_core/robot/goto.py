@@ -11,51 +11,25 @@ import threading
 import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TypeVar
 
 from poppy_core.errors import RobotClosedError
-from poppy_core.robot.motor_link import link_of
+from poppy_core.robot.goto_handle import GotoHandle as GotoHandle
+from poppy_core.robot.motor_link import GotoTarget, link_of
 from poppy_core.schedule import Worker
 from poppy_core.trajectory import MinimumJerk, check_goto, control_name, plan_goto
-
-if TYPE_CHECKING:
-    from poppy_core.robot.motor import Motor
 
 logger = logging.getLogger(__name__)
 
 DEFAULT_RATE_HZ = 50.0
 
 
-class GotoHandle:
-    """A running goto of one or several motors; done when every motor arrived or was cancelled."""
-
-    def __init__(self, count: int, duration_s: float) -> None:
-        self._left = count
-        self._done = threading.Event()
-        self.duration_s = duration_s
-        self.cancelled = False
-        if count == 0:
-            self._done.set()
-
-    @property
-    def done(self) -> bool:
-        """True once the motion is over (or cancelled)."""
-        return self._done.is_set()
-
-    def wait(self, timeout_s: float | None = None) -> bool:
-        """Block until the motion is over; False when ``timeout_s`` ran out first."""
-        return self._done.wait(timeout_s)
-
-    def _finish_one(self, cancelled: bool) -> None:
-        self.cancelled = self.cancelled or cancelled
-        self._left -= 1
-        if self._left <= 0:
-            self._done.set()
+_Target = TypeVar("_Target", bound=GotoTarget)
 
 
 @dataclass
 class _Move:
-    motor: Motor
+    motor: GotoTarget
     goal: float
     trajectory: MinimumJerk | None
     t0: float
@@ -88,7 +62,7 @@ class GotoRunner:
             return len(self._moves)
 
     def start(
-        self, targets: Mapping[Motor, float], duration_s: float, control: str | None
+        self, targets: Mapping[_Target, float], duration_s: float, control: str | None
     ) -> GotoHandle:
         """Start moving each motor to its target (degrees, user frame) in ``duration_s``.
 
@@ -136,12 +110,12 @@ class GotoRunner:
         with self._lock:
             return {move.motor.name: move.goal for move in self._moves.values()}
 
-    def cancel(self, motor: Motor) -> None:
+    def cancel(self, motor: GotoTarget) -> None:
         """Stop the goto of ``motor`` where it is (its goal stays the last one sent)."""
         with self._lock:
             self._cancel_locked(motor)
 
-    def _cancel_locked(self, motor: Motor) -> None:
+    def _cancel_locked(self, motor: GotoTarget) -> None:
         move = self._moves.pop(id(motor), None)
         if move is not None:
             move.handle._finish_one(cancelled=True)
@@ -180,7 +154,7 @@ class GotoRunner:
             return True
 
 
-def running_goals(motors: Iterable[Motor]) -> dict[str, float]:
+def running_goals(motors: Iterable[GotoTarget]) -> dict[str, float]:
     """Each of ``motors`` moving under a goto -> the goal it goes to (the page's 3D ghost)."""
     names = {motor.name for motor in motors}
     runners = {id(link_of(m).runner): link_of(m).runner for m in motors}

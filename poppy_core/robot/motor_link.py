@@ -6,23 +6,25 @@ A ``Motor`` owns one and keeps it off the user's tab completion: only the sync l
 through the motor is checked against its register and stays *pending* until a write cycle takes
 it (``take_pending``); reads from the servo arrive through ``update``. One reentrant lock per
 motor (``MotorLink.lock``) guards all of it; the ``Motor`` takes the same lock when a change
-spans several registers (compliance).
+spans several registers (compliance). The link names its motor and its goto runner by what it
+uses of them (``Linked``, ``GotoTarget``, ``Runner``), so it imports neither ``motor`` nor ``goto``.
 """
 
 from __future__ import annotations
 
 import threading
 from collections.abc import Callable, Iterable, Mapping
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol, TypeVar
 
 from poppy_core.errors import RegisterError, RobotClosedError
 from poppy_core.models import ServoModel
 
 if TYPE_CHECKING:
-    from poppy_core.robot.goto import GotoRunner
-    from poppy_core.robot.motor import Motor
+    from poppy_core.robot.goto_handle import GotoHandle
 
 SIValue = float | int | bool | str
+
+_Target = TypeVar("_Target", bound="GotoTarget")
 
 
 def _nothing() -> None:
@@ -54,7 +56,7 @@ class MotorLink:
         self,
         name: str,
         model: ServoModel,
-        runner: GotoRunner,
+        runner: Runner,
         *,
         on_position: Callable[[], None] = _nothing,
         set_goal: Callable[[float], None],
@@ -209,7 +211,66 @@ class MotorLink:
         self._closed = True
 
 
-def link_of(motor: Motor) -> MotorLink:
+class Linked(Protocol):
+    """What holds a ``MotorLink`` (a ``Motor``): all ``link_of`` needs of it."""
+
+    @property
+    def _link(self) -> MotorLink:
+        """The motor's link."""
+        ...
+
+
+class GotoTarget(Linked, Protocol):
+    """What the goto runner reads and sets of a motor it moves (a ``Motor`` gives it); its goals
+    go through the motor's link (``link_of``)."""
+
+    name: str
+    model: ServoModel
+    wheel_mode: bool
+
+    @property
+    def goto_behavior(self) -> str:
+        """The control of gotos that name none."""
+        ...
+
+    @property
+    def present_position(self) -> float:
+        """Position in degrees (user frame), as last read."""
+        ...
+
+    @property
+    def angle_limit(self) -> tuple[float, float]:
+        """(min, max) in degrees, user frame."""
+        ...
+
+    @property
+    def moving_speed(self) -> float:
+        """Speed limit toward the goal in deg/s."""
+        ...
+
+    @moving_speed.setter
+    def moving_speed(self, value: float) -> None: ...
+
+
+class Runner(Protocol):
+    """What a link's motor and its group need of the goto runner they share (a ``GotoRunner``)."""
+
+    def start(
+        self, targets: Mapping[_Target, float], duration_s: float, control: str | None
+    ) -> GotoHandle:
+        """Start moving each motor to its target (degrees, user frame) in ``duration_s``."""
+        ...
+
+    def goals(self) -> dict[str, float]:
+        """Each motor moving under a goto -> the goal it goes to (degrees, user frame)."""
+        ...
+
+    def cancel(self, motor: GotoTarget) -> None:
+        """Stop the goto of ``motor`` where it is."""
+        ...
+
+
+def link_of(motor: Linked) -> MotorLink:
     """The robot side of ``motor``: its cache, pending writes and online state (for the sync
     loops, the goto runner, start-up and the ``Robot``; a user script never needs it)."""
     return motor._link

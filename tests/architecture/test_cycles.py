@@ -12,8 +12,6 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("poppy_core", "poppy_cli")
 
@@ -136,12 +134,17 @@ def test_with_the_type_checkers_imports_a_circle_stays_in_one_folder() -> None:
     assert [c for c in circles if len({modules[name].parent for name in c}) > 1] == []
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="robot/motor.py, goto.py, motor_link.py, motor_compliance.py and motor_pypot.py: "
-    "motor_link types link_of's motor as Motor and its runner as GotoRunner, goto its targets "
-    "as Motor (type-checking imports only); left for the goto runner's rework (issue 36 item 4)",
-)
+WIDE_CIRCLES_LEFT = [
+    # The checks and the builders type the ServeSpec, Listen and ServerSet that servers.py makes
+    # with them (type-checking imports only). Taken apart: remove it here (the test then asks so).
+    [
+        "poppy_core.assembly.serve_checks",
+        "poppy_core.assembly.server_builders",
+        "poppy_core.assembly.servers",
+    ],
+]
+
+
 def test_with_the_type_checkers_imports_a_circle_is_two_files_at_most() -> None:
     circles, _ = _typed_circles()
-    assert [c for c in circles if len(c) > 2] == []
+    assert [c for c in circles if len(c) > 2] == WIDE_CIRCLES_LEFT
