@@ -17,7 +17,8 @@ from poppy_core.assembly.pypot_creatures import (
     PoppyHumanoid,
     PoppyTorso,
 )
-from poppy_core.assembly.servers import Listen, Server, ServerSet, ServeSpec, serve
+from poppy_core.assembly.serve_spec import Listen, ServeSpec
+from poppy_core.assembly.servers import Server, ServerSet, serve
 from poppy_core.zenoh_wire import ZenohSettings
 
 installed_poppy_creatures = MappingProxyType(

@@ -18,7 +18,8 @@ from os import PathLike
 from typing import Any, ClassVar
 
 from poppy_core.assembly.build import from_config, from_profile
-from poppy_core.assembly.servers import DEFAULT_PORTS, Listen, ServeSpec, serve
+from poppy_core.assembly.serve_spec import DEFAULT_PORTS, Listen, ServeSpec
+from poppy_core.assembly.servers import serve
 from poppy_core.creatures.registry import CREATURES, attach_creature
 from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.robot import Robot

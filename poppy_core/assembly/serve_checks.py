@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from poppy_core.errors import ArgumentError
 
 if TYPE_CHECKING:
-    from poppy_core.assembly.servers import Listen, ServeSpec
+    from poppy_core.assembly.serve_spec import Listen, ServeSpec
 
 KINDS = {"http": "HTTP", "ws": "WebSocket", "zmq": "ZMQ", "snap": "Snap!", "foxglove": "Foxglove"}
 """What each listening server is called in the lines below."""

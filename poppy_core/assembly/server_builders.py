@@ -6,7 +6,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from poppy_core.assembly.servers import Listen, Server, ServerSet, ServeSpec
+    from poppy_core.assembly.serve_spec import Listen, ServeSpec
+    from poppy_core.assembly.servers import Server, ServerSet
     from poppy_core.robot import Robot
     from poppy_core.ros2_wire import Ros2Settings
     from poppy_core.zenoh_wire import ZenohSettings

@@ -19,7 +19,7 @@ import httpx
 import pytest
 
 from poppy_core import from_profile
-from poppy_core.assembly.servers import Listen, ServeSpec, serve
+from poppy_core.assembly import Listen, ServeSpec, serve
 from tests.helpers.chromium import launched, needs_chromium, new_tab
 from tests.helpers.server import Served
 from tests.helpers.server import serve as serve_ergo
