@@ -24,7 +24,7 @@ import pyarrow as pa
 
 from poppy_core.dataset import feature_stats as stats
 from poppy_core.dataset import layout, tables
-from poppy_core.dataset.episodes import data_path, episode_rows, find_episode
+from poppy_core.dataset.rows import data_path, episode_rows, find_episode
 from poppy_core.errors import ArgumentError, FileError
 
 RENAME_EXCHANGE = 2
