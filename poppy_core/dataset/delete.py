@@ -222,9 +222,13 @@ def _swap(new: Path, root: Path) -> None:
     old = root.parent / f".{root.name}.old-{os.getpid()}"
     try:
         os.rename(root, old)
-        os.rename(new, root)
     except OSError as exc:
         raise FileError(f"cannot replace {root}: {exc.strerror}", path=str(root)) from None
+    try:
+        os.rename(new, root)
+    except BaseException:
+        os.rename(old, root)  # the dataset back in its place, as it was
+        raise
     os.rename(old, new)
 
 
