@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import errno
 import json
+import os
 import re
 from pathlib import Path
 
@@ -160,3 +162,25 @@ def test_a_dataset_packing_episodes_in_one_file_is_refused(tmp_path: Path) -> No
     with pytest.raises(ArgumentError, match="packs several episodes into one data file"):
         delete_episode(root, 0)
     assert snapshot(root) == before
+
+
+def test_a_failed_fallback_swap_puts_the_dataset_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    root = tmp_path / "ds"
+    record(root, [20, 25])
+    before = snapshot(root)
+    rename = os.rename
+
+    def failing(source: Path, target: Path) -> None:
+        if ".delete-" in Path(source).name:
+            raise OSError(errno.EXDEV, "simulated")
+        rename(source, target)
+
+    monkeypatch.setattr(delete_module, "_exchange", lambda a, b: False)
+    monkeypatch.setattr(delete_module.os, "rename", failing)
+    with pytest.raises(OSError, match="simulated"):
+        delete_episode(root, 0)
+    monkeypatch.undo()
+    assert snapshot(root) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ds"]
