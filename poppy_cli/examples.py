@@ -81,6 +81,16 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("dataset list ./dance", "one row per episode"),
         ("dataset list ./dance --json", "for scripts"),
     ),
+    "dataset replay": (
+        (
+            "dataset replay me/pick --episode 3 --profile ergo-jr -p /dev/ttyUSB1",
+            "ramp to the first frame, play the actions",
+        ),
+        ("dataset replay me/dance --root ./dance --episode 0 --sim --speed 0.5", "half speed"),
+    ),
+    "dataset delete-episode": (
+        ("dataset delete-episode me/pick --episode 3", "the later episodes move down"),
+    ),
     "calibrate": (
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0", "zeros and ranges into a user profile"),
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0 --check", "report the drift since"),

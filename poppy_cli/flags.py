@@ -175,7 +175,7 @@ FLAGS: dict[str, Flag] = {
     "--resolution": Flag(None, "WxH", "image size, e.g. 640x480"),
     "--marker": Flag(None, "ID", "an ArUco marker held in view of the simulated camera"),
     "--card": Flag(None, "CARD", "a Poppy card held in view of the simulated camera"),
-    # -- datasets (poppy dataset record)
+    # -- datasets (poppy dataset record, replay, delete-episode)
     "--root": Flag(None, "DIR", "the dataset's folder"),
     "--resume": Flag(None, None, "add episodes to the dataset there"),
     "--play": Flag(None, "MOVE", "actions: play this move each episode"),
@@ -183,6 +183,7 @@ FLAGS: dict[str, Flag] = {
     "--by-hand": Flag(None, None, "actions: the robot compliant, moved by hand"),
     "--episodes": Flag(None, "N", "episodes to record"),
     "--episode-s": Flag(None, "SECONDS", "length of an episode"),
+    "--episode": Flag(None, "K", "an episode of the dataset, by its number (from 0)"),
     "--reset-s": Flag(None, "SECONDS", "pause between episodes"),
     "--task": Flag(None, "TEXT", "what the episodes show, in words"),
     "--fps": Flag(None, "N", "frames per second"),

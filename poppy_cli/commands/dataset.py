@@ -1,4 +1,4 @@
-"""`poppy dataset record|info|list`: LeRobot datasets (v3.0) recorded from a robot.
+"""`poppy dataset record|info|list|replay|delete-episode`: LeRobot datasets (v3.0) from a robot.
 
 The format is ``poppy_core.dataset``; the recording loop ``poppy_core.motion.episodes``. This
 module checks the options (every refusal before a robot is built: one line, exit 2), builds
@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poppy_cli import complete
+from poppy_cli.commands import dataset_edit
 from poppy_cli.options import ConfigOpt, JsonOpt, JsonSummaryOpt, PortOpt, ProfileOpt, SimOpt
 from poppy_cli.output import console, err_console, print_json, printable
 
@@ -505,3 +506,7 @@ def _summary(root: Path) -> Any:
     from poppy_core.dataset.reader import read_summary
 
     return read_summary(root)
+
+
+app.command("replay")(dataset_edit.replay)
+app.command("delete-episode")(dataset_edit.delete_episode)

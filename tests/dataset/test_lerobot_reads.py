@@ -13,6 +13,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from poppy_core.dataset.delete import delete_episode
 from poppy_core.dataset.writer import DatasetWriter
 from tests.dataset.test_writer import SPEC, frame, killed_recording, record
 from tests.helpers.lerobot_venv import lerobot_python, run_oracle
@@ -123,3 +124,30 @@ def test_lerobot_loads_a_killed_recording(oracle: Path, tmp_path: Path) -> None:
     assert (seen["len"], seen["num_episodes"]) == (21, 2)
     assert [(i["episode_index"], i["frame_index"]) for i in seen["items"]] == [(0, 0), (1, 8)]
     assert SPEC.video_keys() == ["observation.images.top"]
+
+
+def test_lerobot_loads_a_dataset_after_an_episode_is_deleted(oracle: Path, tmp_path: Path) -> None:
+    root = tmp_path / "ds"
+    record(root, [20, 25, 15], ["pick the cube", "wave", "pick the cube"])
+    delete_episode(root, 1)
+    seen = run_oracle("load", str(root), "poppy/test", "0,19,20,34")
+    assert (seen["len"], seen["num_episodes"]) == (35, 2)
+    assert seen["tasks"] == ["pick the cube"]
+    assert seen["stats"] == json.loads((root / "meta/stats.json").read_text())
+    places = [(0, 0), (0, 19), (1, 0), (1, 14)]
+    for item, (episode, k) in zip(seen["items"], places, strict=True):
+        state, action, images = frame(k)
+        assert (item["episode_index"], item["frame_index"], item["index"]) == (
+            episode,
+            k,
+            20 * episode + k,
+        )
+        assert item["action"] == pytest.approx(action) and item["task"] == "pick the cube"
+        assert item["observation.state"] == pytest.approx(state)
+        # the moved video decodes at its new place
+        assert item["observation.images.top"]["pixel"] == pytest.approx(
+            images["top"][24, 32].tolist(), abs=6
+        )
+    for key, feature in seen["recomputed_stats"].items():
+        for name in ("min", "max", "mean", "std", "count"):
+            assert seen["stats"][key][name] == pytest.approx(feature[name]), (key, name)
