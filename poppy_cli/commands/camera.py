@@ -59,6 +59,19 @@ def _usage(message: str) -> None:
     raise typer.Exit(EXIT_USAGE)
 
 
+FRAME_S = 30.0
+"""The longest wait for a camera's next frame."""
+SIM_FIRST_FRAME_S = 180.0
+"""The longest wait for a simulated camera's first frame: it includes building the renderer,
+with a software renderer 2 s on an idle 2-core machine, 6 s beside four busy loops, past 30 s at
+load 20: a slow or busy machine is not a broken camera."""
+
+
+def _first_frame_s(sim: str | None) -> float:
+    """The wait for the first frame of the camera ``_source`` opens."""
+    return FRAME_S if sim is None else SIM_FIRST_FRAME_S
+
+
 @contextmanager
 def _source(
     device: str | None,
@@ -183,8 +196,8 @@ def snapshot(
         _usage(f"{target}: the image type comes from its name: use .png or .jpg")
     size = _resolution(resolution)
     with _source(device, profile, config_file, sim, size, marker, card) as (camera, _):
-        first = camera.next_frame(-1, timeout_s=30)
-        frame = camera.next_frame(first.number, timeout_s=30)  # rendered after the cards were put
+        first = camera.next_frame(-1, timeout_s=_first_frame_s(sim))
+        frame = camera.next_frame(first.number, timeout_s=FRAME_S)  # after the cards were put
         data = encode_image(frame.image, target.suffix.lower())
     written = write_file(target, data, replace=force)
     height, width = frame.image.shape[:2]
@@ -207,9 +220,9 @@ def detect(
     with _source(device, profile, config_file, sim, size, marker, card) as (camera, detector):
         assert detector is not None
         names = {i: name for name, ids in detector.card_ids.items() for i in ids}
-        number = camera.next_frame(-1, timeout_s=30).number
+        number = camera.next_frame(-1, timeout_s=_first_frame_s(sim)).number
         while True:
-            frame = camera.next_frame(number, timeout_s=30)
+            frame = camera.next_frame(number, timeout_s=FRAME_S)
             number = frame.number
             markers = detector.finder.find(frame.image, camera.calibration, camera.name)
             if json_output:

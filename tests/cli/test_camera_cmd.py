@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from tests.helpers.cli import run_poppy, run_poppy_process
+from tests.helpers.waiting import scaled
 
 pytest.importorskip("cv2")
 
@@ -26,7 +27,7 @@ def poppy_rendering(*args: str) -> subprocess.CompletedProcess[str]:
         [sys.executable, "-m", "poppy_cli", *args],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=scaled(120.0),
         check=False,
     )
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 from typing import Any
 
@@ -164,3 +165,37 @@ def test_a_chain_label_must_be_a_name() -> None:
     section["chains"]["chain"]["label"] = "arm"
     spec = kinematics_spec(KinematicsSection.model_validate(section))
     assert spec.chains[0].shown == "arm"
+
+
+class _LateMotor:
+    """A motor that reaches its goal ``late_s`` after it was made, or stops ``short`` of it."""
+
+    def __init__(self, goal: float, late_s: float, short: float = 0.0) -> None:
+        self.goal_position = goal
+        self._start = time.monotonic()
+        self._late_s = late_s
+        self._short = short
+
+    @property
+    def present_position(self) -> float:
+        done = min(1.0, (time.monotonic() - self._start) / self._late_s)
+        return (self.goal_position - self._short) * done
+
+
+def test_reach_reads_the_arm_once_late_motors_arrived() -> None:
+    # a busy machine runs the motors late: the arm is read where the move ended, not on the way
+    from poppy_cli.commands.reach import ARRIVED_DEG, _wait_for_arrival
+
+    motors = [_LateMotor(30.0, late_s=1.0), _LateMotor(-20.0, late_s=0.5)]
+    _wait_for_arrival(motors)  # type: ignore[arg-type]
+    assert all(abs(m.present_position - m.goal_position) <= ARRIVED_DEG for m in motors)
+
+
+def test_reach_stops_waiting_for_a_motor_that_stopped_short() -> None:
+    from poppy_cli.commands.reach import ARRIVAL_LIMIT_S, _wait_for_arrival
+
+    held = _LateMotor(30.0, late_s=0.3, short=5.0)  # held 5° before its goal
+    started = time.monotonic()
+    _wait_for_arrival([held])  # type: ignore[list-item]
+    assert time.monotonic() - started < ARRIVAL_LIMIT_S
+    assert held.present_position == pytest.approx(25.0)

@@ -21,6 +21,7 @@ from poppy_core.robot.factory import virtual_buses
 from tests.helpers.cli import Result, run_poppy
 from tests.helpers.processes import reap, served_urls
 from tests.helpers.recording import RecordingFake
+from tests.helpers.waiting import http_timeout
 
 SHOW = (
     "Id=poppy.service\nLoadState=loaded\nActiveState=active\nSubState=running\n"
@@ -334,9 +335,9 @@ def test_the_units_exec_start_run_as_is_serves_the_page(tmp_path: Path) -> None:
             urls = served_urls(proc.stdout)
             assert len(urls) == 2, proc.stderr.read() if proc.stderr else ""
             for url in urls:
-                page = httpx.get(url + "/", timeout=30)
+                page = httpx.get(url + "/", timeout=http_timeout(30))
                 assert page.status_code == 200 and "Release the motors" in page.text
-            motors = httpx.get(urls[1] + "/api/v1/motors", timeout=30).json()
+            motors = httpx.get(urls[1] + "/api/v1/motors", timeout=http_timeout(30)).json()
             assert all(m["online"] for m in motors)
             released = run_poppy("service", "release", "--remote", urls[1], "--json")
             assert released.code == 0, released.stderr
@@ -393,9 +394,11 @@ def test_the_installed_service_reads_its_token_and_options_from_its_files(
         try:
             assert proc.stdout is not None
             url = next(line.strip() for line in proc.stdout if line.startswith("http://"))
-            assert httpx.get(url + "/api/v1/motors", timeout=30).status_code == 401
+            assert httpx.get(url + "/api/v1/motors", timeout=http_timeout(30)).status_code == 401
             bearer = {"Authorization": f"Bearer {token}"}
-            shown = httpx.get(url + "/api/v1/settings", headers=bearer, timeout=30).json()
+            shown = httpx.get(
+                url + "/api/v1/settings", headers=bearer, timeout=http_timeout(30)
+            ).json()
             assert shown["token_required"] and shown["token_changeable"]
             assert shown["services"]["snap"] == {"on": False, "unit": None, "how": "settings"}
             assert shown["restarts"] is False  # run by hand, not by systemd

@@ -18,6 +18,7 @@ from poppy_core.motion import Move, MovePlayer, MoveRecorder
 from poppy_core.pypot import PoppyErgoJr, from_json
 from poppy_core.robot import Robot, from_remote, load_profile
 from tests.creatures.helpers import wait_until
+from tests.helpers.waiting import http_timeout
 
 
 @pytest.fixture(scope="module")
@@ -136,12 +137,12 @@ def test_use_snap_serves_the_snap_routes_until_close() -> None:
     robot = PoppyErgoJr(simulator="dummy", use_snap=True, snap_port=0)
     try:
         url = robot.snap.url
-        answer = httpx.get(f"{url}/motors/motors", timeout=10)
+        answer = httpx.get(f"{url}/motors/motors", timeout=http_timeout(10))
         assert answer.text == "m1/m2/m3/m4/m5/m6"
     finally:
         robot.close()
     with pytest.raises(httpx.TransportError):
-        httpx.get(f"{url}/motors/motors", timeout=2)
+        httpx.get(f"{url}/motors/motors", timeout=http_timeout(2))
 
 
 def test_refused_pypot_options_name_what_to_do() -> None:

@@ -25,6 +25,7 @@ from poppy_core.motion import Move
 from poppy_core.pypot import PoppyErgoJr, PoppyTorso, installed_poppy_creatures
 from poppy_core.robot import Robot
 from tests.creatures.helpers import wait_until
+from tests.helpers.waiting import http_timeout
 
 
 @pytest.fixture
@@ -139,7 +140,8 @@ def test_snap_run_returns_when_the_server_already_serves() -> None:
             runner.daemon = True
             runner.start()
             assert returned.wait(10.0), f"{server!r}.run() blocked"
-            assert "m1" in httpx.get(f"{server.url}{route}", timeout=10).text  # still serving
+            still_serving = httpx.get(f"{server.url}{route}", timeout=http_timeout(10))
+            assert "m1" in still_serving.text
 
 
 def test_moving_speed_beyond_the_top_is_capped_in_python_and_over_rest() -> None:
@@ -153,15 +155,20 @@ def test_moving_speed_beyond_the_top_is_capped_in_python_and_over_rest() -> None
             robot.m1.moving_speed = float("nan")
         robot.m2.moving_speed = 50
         url = f"{robot.http.url}/motor/m2/register/moving_speed/value.json"
-        answer = httpx.post(url, json=10000, timeout=10)
+        answer = httpx.post(url, json=10000, timeout=http_timeout(10))
         assert answer.status_code < 300, answer.text
         assert robot.m2.moving_speed == pytest.approx(top)
         refused = httpx.post(
-            url, content=b"NaN", timeout=10, headers={"content-type": "application/json"}
+            url,
+            content=b"NaN",
+            timeout=http_timeout(10),
+            headers={"content-type": "application/json"},
         )
         assert refused.status_code == 400 and robot.m2.moving_speed == pytest.approx(top)
         pid = httpx.post(
-            f"{robot.http.url}/motor/m3/register/pid/value.json", json=[100, 2, 0], timeout=10
+            f"{robot.http.url}/motor/m3/register/pid/value.json",
+            json=[100, 2, 0],
+            timeout=http_timeout(10),
         )
         assert pid.status_code < 300, pid.text
         assert robot.m3.pid[0] == pytest.approx(254 / 8)  # the P gain register's top
@@ -186,6 +193,6 @@ def test_a_bound_only_server_serves_in_run_until_close() -> None:
 
 def _answers(url: str) -> bool:
     try:
-        return "m1" in httpx.get(url, timeout=2).text
+        return "m1" in httpx.get(url, timeout=http_timeout(2)).text
     except httpx.TransportError:
         return False

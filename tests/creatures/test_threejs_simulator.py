@@ -13,6 +13,7 @@ import pytest
 
 from poppy_core.errors import ConfigError
 from poppy_core.pypot import PoppyErgoJr, PoppyHumanoid, PoppyTorso
+from tests.helpers.waiting import http_timeout
 
 
 @pytest.mark.parametrize(
@@ -30,7 +31,7 @@ def test_threejs_serves_the_virtual_robot_and_prints_its_page(
         url = found.group(1)
         assert found.group(1).endswith(f":{robot.http.port}/")
         assert not any(m.compliant for m in robot.motors)  # virtual servos hold, as pypot's
-        with httpx.Client(base_url=url, timeout=10.0) as client:
+        with httpx.Client(base_url=url, timeout=http_timeout(10.0)) as client:
             assert 'id="view3d"' in client.get("/").text
             model = client.get("/api/v1/model").json()
             assert motor in model["joints"]

@@ -24,6 +24,7 @@ sys.modules["cv2"] = None
 from poppy_core.pypot import PoppyErgoJr
 from poppy_core.errors import MissingExtraError
 from tests.helpers.bus import emulate_bus
+from tests.helpers.waiting import http_timeout
 
 def report(robot):
     health = {n: h.as_dict() for n, h in robot.sensor_health().items()}
@@ -48,7 +49,7 @@ def rest(robot):
 
     server = ServerThread(create_app(robot)).start()
     try:
-        with httpx.Client(base_url=server.url, timeout=20.0) as http:
+        with httpx.Client(base_url=server.url, timeout=http_timeout(20.0)) as http:
             path = "/sensors/marker_detector/registers/markers/value.json"
             markers = http.get(path)
             health = http.get("/api/v1/sensors/health").json()["marker_detector"]

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from poppy_core.remote.zenoh_fleet import Fleet
+from poppy_core.remote.zenoh_fleet import DEFAULT_TIMEOUT_S, Fleet
 from poppy_core.zenoh_wire import ZenohSettings as Settings
+from tests.helpers.waiting import scaled
 from tests.helpers.zenoh_served import TOKEN, Served, connect_to
 
 
@@ -31,6 +32,9 @@ def two(moves: Path) -> Iterator[tuple[Served, Served]]:
 
 @pytest.fixture
 def fleet(two: tuple[Served, Served]) -> Iterator[Fleet]:
-    with Fleet(Settings(connect=connect_to(*two)), token=TOKEN) as client:
+    # its answers wait the product's timeout times the load factor: a loaded machine answered
+    # a start after it once (both outcomes "no answer")
+    timeout_s = scaled(DEFAULT_TIMEOUT_S)
+    with Fleet(Settings(connect=connect_to(*two)), token=TOKEN, timeout_s=timeout_s) as client:
         assert client.wait_for(["jr-a", "jr-b"]) == ["jr-a", "jr-b"]
         yield client

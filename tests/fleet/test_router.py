@@ -19,7 +19,7 @@ from poppy_core.robot import from_remote
 from poppy_core.zenoh_wire import mode_of
 from tests.helpers.cli import ENV, POPPY, run_poppy
 from tests.helpers.processes import read_until, reap
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 from tests.helpers.zenoh_router import Router
 from tests.helpers.zenoh_served import TOKEN, Served
 
@@ -170,7 +170,7 @@ def test_the_page_lists_the_fleet_it_sees_through_the_router(
             url = f"{servers.http.url}/api/v1/web/fleet"
 
             def listed() -> list[str]:
-                return sorted(r["name"] for r in httpx.get(url, timeout=5).json())
+                return sorted(r["name"] for r in httpx.get(url, timeout=http_timeout(5)).json())
 
             assert eventually(lambda: listed() == ["jr-a", "jr-b", "jr-page"], timeout_s=20)
         finally:

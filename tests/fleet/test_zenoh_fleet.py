@@ -25,7 +25,7 @@ from poppy_core.zenoh_wire import ZenohSettings as Settings
 from poppy_core.zenoh_wire import check_name, pack_state, session_config, unpack_state
 from tests.helpers.cli import ENV, POPPY, run_poppy
 from tests.helpers.processes import reap
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 from tests.helpers.zenoh_served import TOKEN, Served, connect_to, free_endpoint
 
 pytest.importorskip("zenoh")
@@ -374,7 +374,7 @@ def test_the_page_lists_the_robots_its_fleet_sees(moves: Path) -> None:
             url = f"{servers.http.url}/api/v1/web/fleet"
 
             def listed() -> list[dict[str, Any]]:
-                return list(httpx.get(url, timeout=5).json())
+                return list(httpx.get(url, timeout=http_timeout(5)).json())
 
             assert eventually(lambda: [r["name"] for r in listed()] == ["jr-a", "jr-b"], 10)
             rows = {r["name"]: r for r in listed()}

@@ -58,6 +58,13 @@ def scaled(seconds: float) -> float:
     return seconds * load_factor()
 
 
+def http_timeout(idle_s: float = 10.0) -> float:
+    """The timeout of an HTTP client of a test (``httpx.Client(timeout=http_timeout())``):
+    ``idle_s``, enough for an answer of a server the test runs on an idle machine, times the load
+    factor measured now. httpx's own default (5 s) is a fixed deadline a busy machine misses."""
+    return scaled(idle_s)
+
+
 def reply_floor_env() -> dict[str, str]:
     """The environment that gives a `poppy` command run by a test (in this process or another)
     the loaded first-reply floor, scaled by the load measured now: its motors are an emulator

@@ -22,7 +22,7 @@ from poppy_core.sensors import Camera
 from poppy_core.sensors.opencv_camera import OpenCVCamera
 from tests.helpers.bus import emulate_bus
 from tests.helpers.cli import command_env
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 from tests.sensors.test_camera import Unpluggable
 
 cv2 = pytest.importorskip("cv2")
@@ -177,7 +177,7 @@ def test_the_mjpeg_stream_of_an_absent_camera_is_503_at_once(
     served = serve_robot(robot)
     url = next(served).url
     try:
-        with httpx.Client(base_url=url, timeout=30.0) as http:
+        with httpx.Client(base_url=url, timeout=http_timeout(30.0)) as http:
             answer = http.get("/api/v1/sensors/camera/stream.mjpg")
         assert answer.status_code == 503, answer.text
         detail = answer.json()["detail"]

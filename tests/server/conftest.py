@@ -9,6 +9,7 @@ import httpx
 import pytest
 
 from tests.helpers.server import Served, serve
+from tests.helpers.waiting import http_timeout
 
 __all__ = ["Served", "serve"]  # for tests of other helpers that still import them from here
 
@@ -38,5 +39,5 @@ def client(served: Served) -> Iterator[httpx.Client]:
     keep-alive timeout (5 s) closes it: a request sent on a connection the server is closing at
     that moment is reset (seen after a test's 5 s goto)."""
     limits = httpx.Limits(keepalive_expiry=2.0)
-    with httpx.Client(base_url=served.url, timeout=10.0, limits=limits) as http:
+    with httpx.Client(base_url=served.url, timeout=http_timeout(10.0), limits=limits) as http:
         yield http

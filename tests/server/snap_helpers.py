@@ -10,6 +10,7 @@ from poppy_core import from_profile
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, start_snap_server
 from tests.helpers.waiting import eventually as wait_until
+from tests.helpers.waiting import http_timeout
 
 __all__ = ["Served", "near", "served_ergo", "wait_until"]
 
@@ -22,7 +23,9 @@ def served_ergo() -> Iterator[Served]:
     robot = from_profile("ergo-jr", sim=True)
     server = start_snap_server(robot, port=0)
     try:
-        with httpx.Client(base_url=f"http://127.0.0.1:{server.port}", timeout=20.0) as http:
+        with httpx.Client(
+            base_url=f"http://127.0.0.1:{server.port}", timeout=http_timeout(20.0)
+        ) as http:
             yield robot, server, http
     finally:
         server.stop()

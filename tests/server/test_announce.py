@@ -15,7 +15,7 @@ from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServerSet, ServeSpec, serve
 from poppy_core.remote.discovery import AnnouncedRobot, discover, resolve
 from poppy_core.robot import Robot
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 
 pytest.importorskip("zeroconf")
 
@@ -76,7 +76,7 @@ def test_a_taken_name_gets_a_suffix_and_the_server_answers_to_it(robots: list[Ro
         assert second.announcer is not None and second.announcer.name == f"{name}-2"
         assert second.http is not None
         port = second.http.port
-        with httpx.Client(base_url=f"http://127.0.0.1:{port}") as http:
+        with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=http_timeout()) as http:
             for host in (f"{name}-2.local:{port}", f"{name}-2"):
                 assert http.get("/api/v1/robot", headers={"Host": host}).status_code == 200
             assert http.get("/api/v1/robot", headers={"Host": "other.local"}).status_code == 400
@@ -90,7 +90,7 @@ def test_nothing_is_announced_unless_asked(robots: list[Robot]) -> None:
         assert servers.announcer is None
         assert servers.http is not None and servers.snap is not None
         for port, path in ((servers.http.port, "/api/v1/robot"), (servers.snap.port, "/ip/")):
-            with httpx.Client(base_url=f"http://127.0.0.1:{port}") as http:
+            with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=http_timeout()) as http:
                 for host in ("quiet.local", "evil.example"):
                     answer = http.get(path, headers={"Host": f"{host}:{port}"})
                     # named, every server answers its name (Snap!'s blocks call poppy.local)

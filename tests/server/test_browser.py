@@ -27,6 +27,7 @@ import pytest
 
 from poppy_core.server import OriginPolicy
 from tests.helpers.server import Served, serve
+from tests.helpers.waiting import http_timeout
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 pytestmark = pytest.mark.skipif(CHROMIUM is None, reason="needs Debian's chromium")
@@ -238,7 +239,9 @@ def test_no_spelling_of_a_state_changing_get_works_from_another_site(
         for name in ("sinus", "cosinus", "square"):
             getattr(robot, name).stop()
     # each spelling does reach its route: a script (no Sec-Fetch-Site) drives sinus through it
-    with httpx.Client(base_url=robot_for_localhost.url, follow_redirects=True) as http:
+    with httpx.Client(
+        base_url=robot_for_localhost.url, follow_redirects=True, timeout=http_timeout()
+    ) as http:
         for i in range(len(spellings["start"])):
             for action in ("start", "pause", "resume", "stop"):
                 path = spellings[action][i].replace(f"/{TARGETS[action]}", "/sinus")

@@ -12,6 +12,7 @@ import pytest
 from poppy_core import from_profile
 from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app
+from tests.helpers.waiting import http_timeout
 
 
 @pytest.fixture(scope="module")
@@ -29,7 +30,7 @@ def ergo(moves_folder: str) -> Iterator[tuple[str, Robot]]:
 
 @pytest.fixture
 def http(ergo: tuple[str, Robot]) -> Iterator[httpx.Client]:
-    with httpx.Client(base_url=ergo[0], timeout=20.0) as client:
+    with httpx.Client(base_url=ergo[0], timeout=http_timeout(20.0)) as client:
         yield client
 
 

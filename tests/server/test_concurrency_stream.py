@@ -13,7 +13,7 @@ import pytest
 from websockets.sync.client import connect
 
 from tests.helpers.server import Served
-from tests.helpers.waiting import eventually, scaled
+from tests.helpers.waiting import eventually, http_timeout, scaled
 
 
 def test_gets_are_answered_while_a_waiting_goto_runs(served: Served, client: httpx.Client) -> None:
@@ -26,7 +26,7 @@ def test_gets_are_answered_while_a_waiting_goto_runs(served: Served, client: htt
     target = -30.0 if before > 0 else 30.0
 
     def slow_goto() -> None:
-        with httpx.Client(base_url=served.url, timeout=10.0 + goto_s) as http:
+        with httpx.Client(base_url=served.url, timeout=http_timeout(10.0) + goto_s) as http:
             t0 = time.monotonic()
             body = {"position": target, "duration": goto_s, "wait": True}
             result["answer"] = http.post("/motors/m1/goto.json", json=body)
@@ -95,7 +95,7 @@ def test_stream_keeps_its_rate_under_http_load(served: Served) -> None:
     stop = threading.Event()
 
     def hammer() -> None:
-        with httpx.Client(base_url=served.url, timeout=10.0) as http:
+        with httpx.Client(base_url=served.url, timeout=http_timeout(10.0)) as http:
             while not stop.is_set():
                 http.get("/robot.json")
 

@@ -23,6 +23,7 @@ from poppy_core.server import ServerThread, create_app
 from poppy_core.server.snap import start_snap_server
 from poppy_core.server.zmqserver import start_zmq_server
 from tests.helpers.cli import run_poppy
+from tests.helpers.waiting import http_timeout
 
 HUGE = "9" * 400
 """An integer JSON parses and ``float()`` cannot hold (OverflowError)."""
@@ -58,8 +59,10 @@ def surfaces(moves_folder: str) -> Iterator[Surfaces]:
     zmq = start_zmq_server(robot, port=0, start=False)  # requests are answered by reply_to
     try:
         with (
-            httpx.Client(base_url=server.url, timeout=20.0) as http,
-            httpx.Client(base_url=f"http://127.0.0.1:{snap.port}", timeout=20.0) as snap_http,
+            httpx.Client(base_url=server.url, timeout=http_timeout(20.0)) as http,
+            httpx.Client(
+                base_url=f"http://127.0.0.1:{snap.port}", timeout=http_timeout(20.0)
+            ) as snap_http,
         ):
             ws_url = server.url.replace("http://", "ws://") + "/api/v1/ws"
             yield Surfaces(robot, http, ws_url, snap_http, zmq)

@@ -17,6 +17,7 @@ from websockets.sync.client import connect
 
 from poppy_core import from_profile
 from poppy_core.server import ServerThread, create_app
+from tests.helpers.waiting import eventually, scaled
 
 WAIT_S = 15.0  # upper bound for what should take well under a second
 
@@ -26,6 +27,20 @@ def strict(moves_folder: str) -> Iterator[ServerThread]:
     """A served Ergo Jr with a 0.5 s header deadline and at most 20 connections."""
     robot = from_profile("ergo-jr", sim=True)
     server = ServerThread(create_app(robot), header_timeout_s=0.5, max_connections=20).start()
+    yield server
+    server.stop()
+    robot.close()
+
+
+@pytest.fixture
+def capped(moves_folder: str) -> Iterator[ServerThread]:
+    """A served Ergo Jr with at most 20 connections, whose idle ones stay open while a test runs:
+    its header deadline (30 s times the load factor) outlives the test even on a busy machine,
+    where a 0.5 s one closed idle sockets before the connection beyond the cap came."""
+    robot = from_profile("ergo-jr", sim=True)
+    server = ServerThread(
+        create_app(robot), header_timeout_s=scaled(30.0), max_connections=20
+    ).start()
     yield server
     server.stop()
     robot.close()
@@ -47,30 +62,30 @@ def _closed_within(sock: socket.socket, seconds: float) -> bytes:
 def test_slow_headers_are_cut(strict: ServerThread) -> None:
     with socket.create_connection(("127.0.0.1", strict.port)) as sock:
         sock.sendall(b"GET /robot.json HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # never ends
-        answer = _closed_within(sock, WAIT_S)
+        answer = _closed_within(sock, scaled(WAIT_S))
     assert answer.startswith(b"HTTP/1.1 408")
     assert b'"error": "the request\'s headers did not arrive within 0.5 s"' in answer
 
 
 def test_idle_connections_are_closed(strict: ServerThread) -> None:
     with socket.create_connection(("127.0.0.1", strict.port)) as sock:
-        assert _closed_within(sock, WAIT_S) == b""
+        assert _closed_within(sock, scaled(WAIT_S)) == b""
 
 
 def test_slow_headers_after_a_keep_alive_answer_are_cut(strict: ServerThread) -> None:
     with socket.create_connection(("127.0.0.1", strict.port)) as sock:
         sock.sendall(b"GET /motors/list.json HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
-        sock.settimeout(WAIT_S)
+        sock.settimeout(scaled(WAIT_S))
         assert sock.recv(4096).startswith(b"HTTP/1.1 200")
         sock.sendall(b"GET /motors/list.json HTTP/1.1\r\n")
         for _ in range(3):  # a byte now and then does not keep it open
             time.sleep(0.2)
             sock.sendall(b"X")
-        assert b"408" in _closed_within(sock, WAIT_S)
+        assert b"408" in _closed_within(sock, scaled(WAIT_S))
 
 
 def test_long_requests_and_websockets_outlive_the_header_deadline(strict: ServerThread) -> None:
-    with httpx.Client(base_url=strict.url, timeout=WAIT_S) as http:
+    with httpx.Client(base_url=strict.url, timeout=scaled(WAIT_S)) as http:
         http.put("/api/v1/robot/compliant", json={"compliant": False})
         body = {"positions": {"m1": 5}, "duration_s": 1.2, "wait": True}
         answer = http.post("/api/v1/gotos", json=body)  # answers after 1.2 s > 0.5 s
@@ -79,16 +94,16 @@ def test_long_requests_and_websockets_outlive_the_header_deadline(strict: Server
     with connect(strict.url.replace("http://", "ws://") + "/api/v1/ws?rate_hz=10") as ws:
         end = time.monotonic() + 1.5
         while time.monotonic() < end:
-            assert "m1" in ws.recv(timeout=5)
+            assert "m1" in ws.recv(timeout=scaled(5.0))
 
 
-def test_a_connection_beyond_the_cap_gets_a_clear_503(strict: ServerThread) -> None:
-    with httpx.Client(base_url=strict.url, timeout=WAIT_S) as http:
+def test_a_connection_beyond_the_cap_gets_a_clear_503(capped: ServerThread) -> None:
+    with httpx.Client(base_url=capped.url, timeout=scaled(WAIT_S)) as http:
         assert http.get("/motors/list.json").status_code == 200  # the client's own connection
-        idle = [socket.create_connection(("127.0.0.1", strict.port)) for _ in range(19)]
+        # accepted in the order they were made (the listen queue), so before the 21st below
+        idle = [socket.create_connection(("127.0.0.1", capped.port)) for _ in range(19)]
         try:
-            time.sleep(0.2)  # the server has accepted them
-            with httpx.Client(base_url=strict.url, timeout=WAIT_S) as other:
+            with httpx.Client(base_url=capped.url, timeout=scaled(WAIT_S)) as other:
                 refused = other.get("/motors/list.json")
             assert refused.status_code == 503
             assert refused.json()["error"] == "too many connections: this server accepts 20 at once"
@@ -96,13 +111,12 @@ def test_a_connection_beyond_the_cap_gets_a_clear_503(strict: ServerThread) -> N
         finally:
             for sock in idle:
                 sock.close()
-    deadline = time.monotonic() + WAIT_S
-    while True:  # the slots come back once the idle sockets are gone
-        with httpx.Client(base_url=strict.url, timeout=WAIT_S) as other:
-            if other.get("/motors/list.json").status_code == 200:
-                break
-        assert time.monotonic() < deadline
-        time.sleep(0.1)
+
+    def a_slot_came_back() -> bool:  # once the idle sockets are gone
+        with httpx.Client(base_url=capped.url, timeout=scaled(WAIT_S)) as other:
+            return other.get("/motors/list.json").status_code == 200
+
+    assert eventually(a_slot_came_back, timeout_s=WAIT_S, interval_s=0.1)
 
 
 def _open_fds() -> int:
@@ -119,7 +133,7 @@ def test_a_flood_of_idle_sockets_does_not_exhaust_file_descriptors(moves_folder:
         time.sleep(2.0)  # accepted, refused ones answered and closed after their linger
         held_by_server = _open_fds() - before - len(flood)
         assert held_by_server <= 60, held_by_server
-        with httpx.Client(base_url=server.url, timeout=WAIT_S) as http:
+        with httpx.Client(base_url=server.url, timeout=scaled(WAIT_S)) as http:
             assert http.get("/motors/list.json").status_code == 503
         for sock in flood:
             sock.close()
@@ -137,7 +151,7 @@ def _refused_head(port: int, head: bytes) -> bytes:
         except (BrokenPipeError, ConnectionResetError):
             pass  # closed once the limit was passed: the answer is already on its way
         try:
-            return _closed_within(sock, WAIT_S)
+            return _closed_within(sock, scaled(WAIT_S))
         except ConnectionResetError:
             raise AssertionError("the connection was reset without an answer") from None
 
@@ -151,7 +165,7 @@ def test_request_headers_have_a_size_and_a_count_limit(strict: ServerThread) -> 
     many = start + b"".join(b"X-%d: 1\r\n" % i for i in range(200)) + b"\r\n"
     assert _refused_head(strict.port, many).startswith(b"HTTP/1.1 431")
     # what browsers and scripts send passes: 95 headers (54 KiB) on a kept-alive connection
-    with httpx.Client(base_url=strict.url) as http:
+    with httpx.Client(base_url=strict.url, timeout=scaled(WAIT_S)) as http:
         headers = {f"X-{i}": "b" * 600 for i in range(90)}  # and httpx's 5
         for _ in range(2):
             assert http.get("/robot.json", headers=headers).status_code == 200

@@ -14,7 +14,7 @@ import pytest
 
 from poppy_core.server.routers import v1_sensors
 from tests.helpers.server import Served
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 
 cv2 = pytest.importorskip("cv2")
 
@@ -99,7 +99,7 @@ def test_viewers_waiting_for_frames_hold_no_thread_of_the_pool(
 
     async def scenario() -> tuple[int, int]:
         opened = await asyncio.gather(*(open_viewer(served.url, 15) for _ in range(viewers)))
-        async with httpx.AsyncClient(base_url=served.url, timeout=30.0) as http:
+        async with httpx.AsyncClient(base_url=served.url, timeout=http_timeout(30.0)) as http:
             # both run in the pool: with a thread held per viewer they would wait 90 s
             described = await http.get("/api/v1/sensors/camera")
             snapshot = await http.get("/api/v1/sensors/camera/frame.jpg")

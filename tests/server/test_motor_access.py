@@ -21,7 +21,7 @@ from poppy_core.emulator import Endpoint, serve_pty
 from poppy_core.robot import Robot, load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.bus import LOADED_REPLY_FLOOR_S
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 
 TOKEN = "s3cret"
 AUTH = {"Authorization": f"Bearer {TOKEN}"}
@@ -74,7 +74,9 @@ def robot(bus_port: str, moves_folder: str) -> Iterator[Robot]:
 def client(robot: Robot) -> Iterator[httpx.Client]:
     with serve(robot, ServeSpec(http=Listen(), token=TOKEN)) as servers:
         assert servers.http is not None
-        with httpx.Client(base_url=servers.http.url, timeout=30.0, headers=AUTH) as http:
+        with httpx.Client(
+            base_url=servers.http.url, timeout=http_timeout(30.0), headers=AUTH
+        ) as http:
             yield http
 
 

@@ -22,7 +22,7 @@ from poppy_core.robot import Robot
 from poppy_core.server import moves as moves_module
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 
 LONG = Move(10.0, ["m1"], [[0.0]] * 600)  # a minute: still playing when the test stops it
 
@@ -123,7 +123,7 @@ def test_over_http_a_second_play_is_refused_on_v1_and_left_alone_on_pypots_route
 ) -> None:
     with (
         serve(robot, ServeSpec(http=Listen())) as servers,
-        httpx.Client(base_url=servers.http.url, timeout=10.0) as client,  # type: ignore[union-attr]
+        httpx.Client(base_url=servers.http.url, timeout=http_timeout(10.0)) as client,  # type: ignore[union-attr]
     ):
         assert client.post("/api/v1/moves/long/play", json={"speed": 1}).status_code == 202
         again = client.post("/api/v1/moves/long/play", json={"speed": 2})

@@ -22,6 +22,7 @@ from poppy_core.server import OriginPolicy
 from poppy_core.server.host_names import is_ip, is_loopback, normalize_origin, split_host
 from poppy_core.server.origins import Verdict
 from tests.helpers.server import Served, serve
+from tests.helpers.waiting import http_timeout
 
 EVIL = "https://evil.example"
 SNAP = "https://snap.berkeley.edu"
@@ -56,7 +57,7 @@ def _ws(served: Served) -> str:
 )
 def test_rebinding_host_names_are_refused(served: Served, host: str) -> None:
     led = served.robot.m2.led
-    with httpx.Client(base_url=served.url, headers={"Host": host}) as http:
+    with httpx.Client(base_url=served.url, headers={"Host": host}, timeout=http_timeout()) as http:
         for method, path, body in [
             ("GET", "/robot.json", None),  # answered by the fast path when allowed
             ("GET", "/motors/m1/registers/present_position/value.json", None),
@@ -89,13 +90,13 @@ def test_raw_socket_with_a_forged_host(served: Served) -> None:
     "host", ["127.0.0.1", "LOCALHOST", "[::1]", "robot.localhost", "192.168.1.20", "[fe80::1]"]
 )
 def test_loopback_names_and_addresses_are_answered(served: Served, host: str) -> None:
-    with httpx.Client(base_url=served.url) as http:
+    with httpx.Client(base_url=served.url, timeout=http_timeout()) as http:
         answer = http.get("/motors/list.json", headers={"Host": f"{host}:{_port(served)}"})
     assert answer.status_code == 200
 
 
 def test_allowed_host_names(snap_allowed: Served) -> None:
-    with httpx.Client(base_url=snap_allowed.url) as http:
+    with httpx.Client(base_url=snap_allowed.url, timeout=http_timeout()) as http:
         assert http.get("/robot.json", headers={"Host": "poppy.local:8080"}).status_code == 200
         assert http.get("/robot.json", headers={"Host": "poppy.example"}).status_code == 400
 
@@ -138,7 +139,7 @@ def test_simple_cross_site_posts_are_refused(
 ) -> None:
     before = (served.robot.m3.led, served.robot.m3.goal_position, served.robot.sinus.amplitude)
     headers = {"Origin": EVIL, "Content-Type": content_type, "Sec-Fetch-Site": "cross-site"}
-    with httpx.Client(base_url=served.url) as http:
+    with httpx.Client(base_url=served.url, timeout=http_timeout()) as http:
         answer = http.post(path, content=body, headers=headers)
         assert answer.status_code == 403, answer.text
         assert "access-control-allow-origin" not in answer.headers
@@ -149,7 +150,7 @@ def test_simple_cross_site_posts_are_refused(
 
 
 def test_cross_site_reads_and_preflights_are_refused(served: Served) -> None:
-    with httpx.Client(base_url=served.url) as http:
+    with httpx.Client(base_url=served.url, timeout=http_timeout()) as http:
         read = http.get("/robot.json", headers={"Origin": EVIL})
         assert read.status_code == 403 and "access-control-allow-origin" not in read.headers
         preflight = http.options(
@@ -164,7 +165,7 @@ def test_cross_site_reads_and_preflights_are_refused(served: Served) -> None:
 
 def test_links_and_images_cannot_start_a_primitive(served: Served) -> None:
     # <img src=".../primitives/sinus/start.json">: a GET without Origin, Sec-Fetch-Site cross-site
-    with httpx.Client(base_url=served.url) as http:
+    with httpx.Client(base_url=served.url, timeout=http_timeout()) as http:
         spellings = (  # every spelling reaching the route (chromium tries them: test_browser)
             "/primitives/sinus/start.json",
             "/primitive/sinus/start.json",
@@ -187,7 +188,7 @@ def test_links_and_images_cannot_start_a_primitive(served: Served) -> None:
 
 def test_the_servers_own_pages_are_answered(served: Served) -> None:
     port = _port(served)
-    with httpx.Client(base_url=served.url) as http:
+    with httpx.Client(base_url=served.url, timeout=http_timeout()) as http:
         for origin in (f"http://127.0.0.1:{port}", f"http://localhost:{port}"):
             headers = {"Origin": origin, "Content-Type": "application/json"}
             answer = http.post(
@@ -206,7 +207,7 @@ def test_the_servers_own_pages_are_answered(served: Served) -> None:
 
 
 def test_an_allowed_origin_gets_cors(snap_allowed: Served) -> None:
-    with httpx.Client(base_url=snap_allowed.url) as http:
+    with httpx.Client(base_url=snap_allowed.url, timeout=http_timeout()) as http:
         read = http.get(
             "/motors/m1/registers/present_position/value.json", headers={"Origin": SNAP}
         )
@@ -236,7 +237,7 @@ def test_an_allowed_origin_gets_cors(snap_allowed: Served) -> None:
 
 
 def test_open_cors_is_pypots_but_keeps_the_host_check(open_cors: Served) -> None:
-    with httpx.Client(base_url=open_cors.url) as http:
+    with httpx.Client(base_url=open_cors.url, timeout=http_timeout()) as http:
         answer = http.post(
             "/motors/m6/registers/led/value.json",
             content=b'"pink"',
@@ -281,7 +282,7 @@ def test_a_refused_origin_is_reported_once_with_the_option_to_allow_it(moves_fol
     lines: list[str] = []
     policy = OriginPolicy(report=lines.append)
     for served in serve(moves_folder, policy=policy):
-        with httpx.Client(base_url=served.url) as http:
+        with httpx.Client(base_url=served.url, timeout=http_timeout()) as http:
             for _ in range(3):
                 http.get("/robot.json", headers={"Origin": "https://Snap.Berkeley.edu:443"})
             http.get("/robot.json", headers={"Host": "evil.example"})

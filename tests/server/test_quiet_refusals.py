@@ -16,6 +16,7 @@ from websockets.sync.client import connect
 from poppy_core import from_profile
 from poppy_core.robot import Robot
 from poppy_core.server import ServerThread, create_app
+from tests.helpers.waiting import http_timeout
 
 TOKEN = "pässwörd-ключ-🤖"
 
@@ -73,7 +74,7 @@ def test_a_refused_websocket_handshake_is_answered_and_logs_no_error(
         assert refused.value.response.status_code == status
         assert b'"error"' in refused.value.response.body
     # the error would be logged as the app returns, just after the answer: give it the time
-    with httpx.Client(base_url=with_token.url) as http:
+    with httpx.Client(base_url=with_token.url, timeout=http_timeout()) as http:
         assert http.get("/robot.json", params={"token": TOKEN}).status_code == 200
     time.sleep(1.0)  # nothing is logged in that time (the error came at once)
     assert not errors.records, errors.records[0].getMessage()
@@ -95,7 +96,7 @@ def test_a_client_leaving_right_after_teleop_stop_logs_no_error(
 
 
 def test_a_non_ascii_token_matches_however_it_is_carried(with_token: ServerThread) -> None:
-    with httpx.Client(base_url=with_token.url) as http:
+    with httpx.Client(base_url=with_token.url, timeout=http_timeout()) as http:
         bearer = b"Bearer " + TOKEN.encode()
         assert http.get("/robot.json", headers={"Authorization": bearer}).status_code == 200
         assert http.get("/robot.json", params={"token": TOKEN}).status_code == 200

@@ -19,6 +19,7 @@ from poppy_core.server import moves as moves_module
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from tests.helpers.server import Served, serve
+from tests.helpers.waiting import http_timeout
 
 
 def test_a_failed_save_keeps_the_recording(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -75,7 +76,7 @@ def test_rest_save_on_a_full_disk_is_507_then_works(
     server = serve(str(full_library))
     served: Served = next(server)
     try:
-        with httpx.Client(base_url=served.url, timeout=10.0) as client:
+        with httpx.Client(base_url=served.url, timeout=http_timeout(10.0)) as client:
             assert client.post("/api/v1/moves/wave/record", json={}).status_code == 202
             time.sleep(1)
             answer = client.post("/api/v1/moves/wave/save")

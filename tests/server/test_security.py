@@ -11,6 +11,7 @@ from websockets.sync.client import connect
 
 from poppy_core.server import OriginPolicy
 from tests.helpers.server import Served, serve
+from tests.helpers.waiting import http_timeout
 
 TOKEN = "s3cret-token"
 
@@ -35,7 +36,7 @@ def guarded(moves_folder: str) -> Iterator[Served]:
     ],
 )
 def test_every_route_needs_the_token(guarded: Served, method: str, path: str) -> None:
-    with httpx.Client(base_url=guarded.url) as http:
+    with httpx.Client(base_url=guarded.url, timeout=http_timeout()) as http:
         refused = http.request(method, path, content=b"true")
         assert refused.status_code == 401
         assert refused.headers["www-authenticate"] == "Bearer"
@@ -47,7 +48,7 @@ def test_every_route_needs_the_token(guarded: Served, method: str, path: str) ->
 
 
 def test_token_in_header_or_query(guarded: Served) -> None:
-    with httpx.Client(base_url=guarded.url) as http:
+    with httpx.Client(base_url=guarded.url, timeout=http_timeout()) as http:
         header = {"Authorization": f"Bearer {TOKEN}"}
         assert http.get("/motors/list.json", headers=header).status_code == 200
         assert http.get(f"/motors/list.json?token={TOKEN}").status_code == 200
@@ -78,7 +79,7 @@ def test_websocket_token_as_a_subprotocol(guarded: Served) -> None:
 
 
 def test_cors_only_for_the_allowed_origin(guarded: Served) -> None:
-    with httpx.Client(base_url=guarded.url) as http:
+    with httpx.Client(base_url=guarded.url, timeout=http_timeout()) as http:
         allowed = http.options("/robot.json", headers={"Origin": "http://app.local"})
         assert allowed.status_code == 204
         assert allowed.headers["access-control-allow-origin"] == "http://app.local"
@@ -124,7 +125,7 @@ def test_errors_never_500(client: httpx.Client) -> None:
 
 
 def test_docs_pass_the_token_to_the_schema(guarded: Served) -> None:
-    with httpx.Client(base_url=guarded.url) as http:
+    with httpx.Client(base_url=guarded.url, timeout=http_timeout()) as http:
         page = http.get(f"/docs?token={TOKEN}")
         assert page.status_code == 200
         assert f"/openapi.json?token={TOKEN}" in page.text

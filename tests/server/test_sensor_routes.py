@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from tests.helpers.server import Served
+from tests.helpers.waiting import http_timeout
 
 cv2 = pytest.importorskip("cv2")
 
@@ -77,7 +78,7 @@ def test_v1_sensors_describe_and_report_health(client: httpx.Client) -> None:
 
 def test_the_mjpeg_stream_sends_jpeg_parts(served: Served) -> None:
     with (
-        httpx.Client(base_url=served.url, timeout=10.0) as http,
+        httpx.Client(base_url=served.url, timeout=http_timeout(10.0)) as http,
         http.stream("GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 30}) as answer,
     ):
         assert answer.status_code == 200
@@ -112,7 +113,7 @@ def test_the_mjpeg_stream_waits_between_tries_of_a_camera_failed_for_good(
 
     monkeypatch.setattr(camera, "wait_frame", failed_for_good)
     with (
-        httpx.Client(base_url=served.url, timeout=10.0) as http,
+        httpx.Client(base_url=served.url, timeout=http_timeout(10.0)) as http,
         http.stream("GET", "/api/v1/sensors/camera/stream.mjpg", params={"fps": 30}) as answer,
     ):
         assert answer.status_code == 200

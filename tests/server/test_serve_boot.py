@@ -18,7 +18,7 @@ from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.cli import command_env
 from tests.helpers.processes import reap, served_urls
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -76,25 +76,25 @@ def test_a_missing_port_is_served_anyway_then_its_motors_are_picked_up(
     proc, urls = served_waiting
     assert len(urls) == 2 and urls[0] != urls[1], urls
     for url in urls:  # the page on both ports, from one server
-        page = httpx.get(url + "/", timeout=30)
+        page = httpx.get(url + "/", timeout=http_timeout(30))
         assert page.status_code == 200 and "Release the motors" in page.text
-    access = httpx.get(urls[1] + "/api/v1/motors/access", timeout=30).json()
+    access = httpx.get(urls[1] + "/api/v1/motors/access", timeout=http_timeout(30)).json()
     message = f"no motors on {missing_port} — is the power on?"
     assert access["no_motors"] == [{"port": missing_port, "message": message}]
-    motors = httpx.get(urls[0] + "/api/v1/motors", timeout=30).json()
+    motors = httpx.get(urls[0] + "/api/v1/motors", timeout=http_timeout(30)).json()
     assert [m["online"] for m in motors] == [False] * 6
 
     (virtual,) = virtual_buses(load_profile("ergo-jr")).values()
     with serve_pty(virtual, link=missing_port):  # the power comes on
 
         def all_online() -> bool:
-            found = httpx.get(urls[0] + "/api/v1/motors", timeout=30).json()
+            found = httpx.get(urls[0] + "/api/v1/motors", timeout=http_timeout(30)).json()
             return all(m["online"] for m in found)
 
         assert eventually(all_online, timeout_s=30)
 
         def no_missing_port() -> bool:  # the access report follows the motors' health
-            access = httpx.get(urls[0] + "/api/v1/motors/access", timeout=30).json()
+            access = httpx.get(urls[0] + "/api/v1/motors/access", timeout=http_timeout(30)).json()
             return access["no_motors"] == []
 
         assert eventually(no_missing_port, timeout_s=30)
@@ -109,10 +109,16 @@ def test_one_page_of_each_port_may_use_the_other(
     port = urls[0].rsplit(":", 1)[1]
     # a page of port A calling port B: the server's own, so no refusal
     answer = httpx.post(
-        urls[1] + "/api/v1/motors/release", headers={"Origin": f"http://127.0.0.1:{port}"}
+        urls[1] + "/api/v1/motors/release",
+        headers={"Origin": f"http://127.0.0.1:{port}"},
+        timeout=http_timeout(),
     )
     assert answer.status_code == 200, answer.text
-    foreign = httpx.post(urls[1] + "/api/v1/motors/take", headers={"Origin": "http://evil.test"})
+    foreign = httpx.post(
+        urls[1] + "/api/v1/motors/take",
+        headers={"Origin": "http://evil.test"},
+        timeout=http_timeout(),
+    )
     assert foreign.status_code == 403
     stop(proc)
 

@@ -11,6 +11,7 @@ import httpx
 
 from tests.helpers.cli import command_env
 from tests.helpers.processes import reap
+from tests.helpers.waiting import http_timeout
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 WAIT_S = 60.0
@@ -27,7 +28,7 @@ def test_serve_sim_prints_the_page_with_the_3d_view() -> None:
         lines = [proc.stdout.readline().strip() for _ in range(3)]
         assert lines[0].startswith("http://127.0.0.1:") and lines[1].startswith("docs: ")
         assert lines[2] == f"page: {lines[0]}/ (with the 3D view)"
-        with httpx.Client(timeout=10.0) as client:
+        with httpx.Client(timeout=http_timeout(10.0)) as client:
             assert 'id="view3d"' in client.get(f"{lines[0]}/").text
             assert client.get(f"{lines[0]}/api/v1/model").status_code == 200
         proc.send_signal(signal.SIGTERM)

@@ -22,7 +22,7 @@ from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
 from tests.helpers.cli import command_env
 from tests.helpers.processes import reap, start
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 WAIT_S = 60.0
@@ -61,7 +61,7 @@ def test_sigterm_saves_the_rest_and_snap_recordings_and_says_where(tmp_path: Pat
         assert http.startswith("http://127.0.0.1:")
         proc.stdout.readline()
         snap = proc.stdout.readline().strip().removeprefix("snap: ")
-        with httpx.Client(timeout=10.0) as client:
+        with httpx.Client(timeout=http_timeout(10.0)) as client:
             answer = client.post(f"{http}/records/rest_take/record.json", json={"motors": "m1"})
             assert answer.status_code == 202, answer.text
             assert client.post(f"{http}/records/taken/record.json").status_code == 202

@@ -22,6 +22,7 @@ from poppy_core.server.settings_os import (
 )
 from tests.helpers.fake_tools import FakeTools
 from tests.helpers.server import Served, serve
+from tests.helpers.waiting import http_timeout
 
 TOKEN = "s3cret"
 BEARER = {"Authorization": f"Bearer {TOKEN}"}
@@ -232,7 +233,7 @@ def test_small_rules() -> None:
 def test_a_change_without_the_token_is_refused_and_runs_nothing(
     fake: FakeTools, with_token: Served
 ) -> None:
-    with httpx.Client(base_url=with_token.url, timeout=30) as http:
+    with httpx.Client(base_url=with_token.url, timeout=http_timeout(30)) as http:
         for method, path, body in [
             ("PUT", "/api/v1/settings/name", {"name": "ergo-2"}),
             ("POST", "/api/v1/settings/wifi/join", {"ssid": "Home Wifi", "password": "pw123456"}),
@@ -249,7 +250,7 @@ def test_a_change_without_the_token_is_refused_and_runs_nothing(
 def test_a_server_without_a_token_shows_settings_read_only(
     fake: FakeTools, without_token: Served
 ) -> None:
-    with httpx.Client(base_url=without_token.url, timeout=30) as http:
+    with httpx.Client(base_url=without_token.url, timeout=http_timeout(30)) as http:
         shown = http.get("/api/v1/settings").json()
         assert shown["editable"] is False and "--token" in shown["reason"]
         answer = http.put("/api/v1/settings/name", json={"name": "ergo-2"})
@@ -261,7 +262,7 @@ def test_with_the_token_the_robot_is_renamed_and_answers_its_new_name(
     fake: FakeTools, with_token: Served
 ) -> None:
     port = with_token.url.rsplit(":", 1)[1]
-    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=http_timeout(30)) as http:
         shown = http.get("/api/v1/settings").json()
         assert shown["editable"] is True and shown["reason"] is None
         assert shown["token_required"] is True and shown["version"]
@@ -281,7 +282,7 @@ def test_with_the_token_the_robot_is_renamed_and_answers_its_new_name(
 
 def test_wifi_and_services_from_the_routes(fake: FakeTools, with_token: Served) -> None:
     with_token.app.state.settings.served.name = "ergo-2"  # the access point is named after it
-    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=http_timeout(30)) as http:
         wifi = http.get("/api/v1/settings/wifi").json()
         assert [n["ssid"] for n in wifi["networks"]] == ["Class:room", "Home Wifi", "Cafe"]
         assert http.post(
@@ -338,7 +339,7 @@ def test_wifi_and_services_from_the_routes(fake: FakeTools, with_token: Served) 
 def test_bad_changes_are_refused_in_one_line_and_run_nothing(
     fake: FakeTools, with_token: Served, method: str, path: str, body: object, status: int
 ) -> None:
-    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=http_timeout(30)) as http:
         answer = http.request(method, path, json=body)
     assert answer.status_code == status, answer.text
     detail = answer.json()["detail"]
@@ -350,7 +351,7 @@ def test_a_64_hex_digit_key_and_printable_ascii_are_wpa_passwords(
     fake: FakeTools, with_token: Served
 ) -> None:
     key = "0123456789abcdef" * 4
-    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=http_timeout(30)) as http:
         for password in (key, "a b~c!d{e}"):
             answer = http.post(
                 "/api/v1/settings/wifi/join", json={"ssid": "Home Wifi", "password": password}
@@ -368,7 +369,7 @@ def test_elsewhere_the_settings_are_read_only_with_the_reason(
 ) -> None:
     fake.alone(monkeypatch)
     fake.remove("nmcli")
-    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=http_timeout(30)) as http:
         shown = http.get("/api/v1/settings").json()
         assert shown["editable"] is False and "nmcli not found" in shown["reason"]
         assert shown["services"]["jupyter"]["on"] is None
@@ -385,7 +386,7 @@ def test_an_unnamed_robot_s_access_point_is_named_after_the_machine_or_poppy(
 
     with_token.app.state.settings.served.name = None
     body = {"on": True, "password": "hotspot-pw"}
-    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=http_timeout(30)) as http:
         monkeypatch.setattr(settings_os.socket, "gethostname", lambda: "Ergo-9.lan")
         assert http.put("/api/v1/settings/wifi/hotspot", json=body).json()["ssid"] == "ergo-9"
         # the machine's robot name, as Zenoh's default name makes it (one rule)

@@ -18,6 +18,7 @@ from poppy_core.server import serve_options
 from poppy_core.server.settings_os import SystemTools, unit_of
 from tests.helpers.fake_tools import FakeTools
 from tests.helpers.server import Served, serve
+from tests.helpers.waiting import http_timeout
 
 TOKEN = "s3cret-token-1"
 BEARER = {"Authorization": f"Bearer {TOKEN}"}
@@ -78,7 +79,7 @@ def test_snap_and_zmq_are_switched_in_the_file_and_the_service_restarts(
         folder / "serve.json", serve_options.ServeOptions(snap=True, zmq=True)
     )
     caplog.set_level(logging.WARNING, logger="poppy_core.server.settings")
-    with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=served.url, headers=BEARER, timeout=http_timeout(30)) as http:
         shown = http.get("/api/v1/settings").json()
         assert shown["services"]["zmq"]["how"] == "settings" and shown["restarts"] is True
         assert shown["token_changeable"] is True
@@ -100,7 +101,7 @@ def test_zmq_is_not_turned_on_from_the_page_of_a_robot_requiring_a_token(
     # pypot's ZMQ API has no token: served on the robot's address, it would let anyone on the
     # network move a robot whose page and API require one. The page says why, and refuses.
     served, folder = appliance
-    with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=served.url, headers=BEARER, timeout=http_timeout(30)) as http:
         zmq = http.get("/api/v1/settings").json()["services"]["zmq"]
         assert "ZMQ API has no token" in zmq["reason"] and zmq["on"] is False
         answer = http.put("/api/v1/settings/services/zmq", json={"on": True})
@@ -116,7 +117,7 @@ def test_the_token_is_changed_in_its_file_readable_by_its_owner_only(
 ) -> None:
     served, folder = appliance
     caplog.set_level(logging.INFO)
-    with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=served.url, headers=BEARER, timeout=http_timeout(30)) as http:
         answer = http.put("/api/v1/settings/token", json={"token": "a-new-token-42"})
         assert answer.status_code == 200, answer.text
         assert answer.json() == {"changed": True, "restarting": True}
@@ -144,7 +145,7 @@ def test_a_change_without_the_token_or_a_bad_token_writes_and_runs_nothing(
     status: int,
 ) -> None:
     served, folder = appliance
-    with httpx.Client(base_url=served.url, timeout=30) as http:
+    with httpx.Client(base_url=served.url, timeout=http_timeout(30)) as http:
         answer = http.put(path, json=body, headers=headers)
     assert answer.status_code == status, answer.text
     assert options(folder) == {"snap": True, "zmq": False}
@@ -158,7 +159,7 @@ def test_outside_the_service_the_change_applies_at_the_next_start(
     served, folder = appliance
     settings = served.app.state.settings
     monkeypatch.setattr(settings, "system", SystemTools(cgroup="0::/user.slice/session-2.scope"))
-    with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=served.url, headers=BEARER, timeout=http_timeout(30)) as http:
         assert http.get("/api/v1/settings").json()["restarts"] is False
         answer = http.put("/api/v1/settings/services/snap", json={"on": False})
         assert answer.json() == {"service": "snap", "on": False, "restarting": False}
@@ -173,7 +174,7 @@ def test_a_refused_restart_says_the_change_is_saved(
     refused = "Failed to restart poppy.service: Interactive authentication required.\n"
     fake.canned[" ".join(RESTART)] = {"err": refused, "code": 1}
     fake.save()
-    with httpx.Client(base_url=served.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=served.url, headers=BEARER, timeout=http_timeout(30)) as http:
         answer = http.put("/api/v1/settings/services/snap", json={"on": False})
     assert answer.status_code == 409
     detail = answer.json()["detail"]
@@ -185,7 +186,7 @@ def test_a_refused_restart_says_the_change_is_saved(
 def test_a_server_without_the_files_says_how_to_get_them(
     fake: FakeTools, with_token: Served
 ) -> None:
-    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=30) as http:
+    with httpx.Client(base_url=with_token.url, headers=BEARER, timeout=http_timeout(30)) as http:
         shown = http.get("/api/v1/settings").json()
         assert shown["services"]["snap"]["how"] == "serve --snap"
         assert shown["token_changeable"] is False

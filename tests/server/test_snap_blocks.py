@@ -17,6 +17,7 @@ from poppy_core.server.snap import robot_facts, start_snap_server
 from poppy_core.server.snap.catalog import BLOCKS, SnapBlock
 from poppy_core.server.snap.examples import project_names
 from poppy_core.server.snap.routing import TextRouter
+from tests.helpers.waiting import http_timeout
 from tests.server.snap_helpers import Served, near, served_ergo, wait_until
 
 
@@ -130,7 +131,9 @@ def test_blocks_follow_the_robot_served(moves_folder: str) -> None:
     with from_profile("torso", sim=True) as robot:
         server = start_snap_server(robot, port=0)
         try:
-            xml = httpx.get(f"http://127.0.0.1:{server.port}/snap-blocks.xml", timeout=20).text
+            xml = httpx.get(
+                f"http://127.0.0.1:{server.port}/snap-blocks.xml", timeout=http_timeout(20)
+            ).text
         finally:
             server.stop()
     root = ET.fromstring(xml)

@@ -25,6 +25,7 @@ from poppy_core.server.snap import SnapServer, start_snap_server
 from tests.helpers import pypot_files
 from tests.helpers.pypot_files import snap_project_files
 from tests.helpers.snap_xml import Project, UrlBlock
+from tests.helpers.waiting import http_timeout
 from tests.server.snap_helpers import near, wait_until
 
 HOST = "127.0.0.1"
@@ -349,7 +350,9 @@ def replay(moves_folder: str) -> Iterator[Replay]:
     robot = from_profile("ergo-jr", sim=True)
     server = start_snap_server(robot, port=0)
     try:
-        with httpx.Client(base_url=f"http://{HOST}:{server.port}", timeout=30.0) as http:
+        with httpx.Client(
+            base_url=f"http://{HOST}:{server.port}", timeout=http_timeout(30.0)
+        ) as http:
             yield Replay(robot, server, http, {}, [])
     finally:
         server.stop()

@@ -21,6 +21,7 @@ from poppy_core import from_profile
 from poppy_core.motion import SimplePosture, list_moves, load_move
 from poppy_core.robot import Robot
 from poppy_core.server.snap import SnapServer, start_snap_server
+from tests.helpers.waiting import http_timeout
 from tests.server.snap_helpers import near, served_ergo, wait_until
 
 SESSION = json.loads((Path(__file__).parent / "data" / "snap_session.json").read_text())
@@ -253,14 +254,19 @@ def test_a_token_is_needed_and_carried_by_the_blocks(moves_folder: str) -> None:
         server = start_snap_server(robot, port=0, token="s3cret/+")
         try:
             base = f"http://127.0.0.1:{server.port}"
-            assert httpx.get(f"{base}/motors/motors", timeout=20).status_code == 401
-            assert httpx.get(f"{base}/snap-blocks.xml", timeout=20).status_code == 401
-            ok = httpx.get(f"{base}/motors/motors", params={"token": "s3cret/+"}, timeout=20)
+            assert httpx.get(f"{base}/motors/motors", timeout=http_timeout(20)).status_code == 401
+            assert httpx.get(f"{base}/snap-blocks.xml", timeout=http_timeout(20)).status_code == 401
+            ok = httpx.get(
+                f"{base}/motors/motors", params={"token": "s3cret/+"}, timeout=http_timeout(20)
+            )
             assert ok.text == "m1/m2/m3/m4/m5/m6"
             assert server.editor_url.endswith("/snap-blocks.xml?token=s3cret%2F%2B")
-            xml = httpx.get(server.blocks_url, timeout=20).text
+            xml = httpx.get(server.blocks_url, timeout=http_timeout(20)).text
             assert xml.count("<l>?token=s3cret%2F%2B</l>") >= 20  # every block's URL
             header = {"Authorization": "Bearer s3cret/+"}
-            assert httpx.get(f"{base}/ip/", headers=header, timeout=20).text == "127.0.0.1"
+            assert (
+                httpx.get(f"{base}/ip/", headers=header, timeout=http_timeout(20)).text
+                == "127.0.0.1"
+            )
         finally:
             server.stop()

@@ -23,7 +23,7 @@ from poppy_core.assembly import Listen, ServeSpec, serve
 from tests.helpers.chromium import launched, needs_chromium, new_tab
 from tests.helpers.server import Served
 from tests.helpers.server import serve as serve_ergo
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 
 pytestmark = needs_chromium
 
@@ -83,7 +83,7 @@ def box(page: Any, selector: str) -> dict[str, float]:
 
 
 def test_the_name_is_in_the_header_the_tab_and_about(browser: Any, jr1: Any) -> None:
-    about = httpx.get(jr1.http.url + "/api/v1/web/about").json()
+    about = httpx.get(jr1.http.url + "/api/v1/web/about", timeout=http_timeout()).json()
     assert (about["name"], about["creature"]) == ("jr1", "ergo-jr")
     page = open_page(browser, jr1.http.url)
     try:
@@ -171,10 +171,11 @@ def test_the_jupyter_link_shows_only_while_a_jupyter_answers(browser: Any, serve
     jupyter = listening(FakeJupyter)
     try:
         state.web_notebook_port = other.server_address[1]
-        assert httpx.get(served.url + "/api/v1/web/about").json()["notebook"] is None
+        about = served.url + "/api/v1/web/about"
+        assert httpx.get(about, timeout=http_timeout()).json()["notebook"] is None
         port = jupyter.server_address[1]
         state.web_notebook_port = port
-        assert httpx.get(served.url + "/api/v1/web/about").json()["notebook"] == {
+        assert httpx.get(about, timeout=http_timeout()).json()["notebook"] == {
             "port": port,
             "path": "/notebooks/discover-your-robot.ipynb",
         }
@@ -342,7 +343,7 @@ def test_settings_are_one_click_from_the_header(
 
 
 def test_an_ideal_sim_camera_panel_says_no_camera(browser: Any, served: Served) -> None:
-    about = httpx.get(served.url + "/api/v1/web/about").json()
+    about = httpx.get(served.url + "/api/v1/web/about", timeout=http_timeout()).json()
     assert about["camera_views"] == [] and about["cameras"] == ["camera"]  # a DummyCamera
     page = open_page(browser, served.url)
     try:

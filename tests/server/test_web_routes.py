@@ -10,6 +10,7 @@ import httpx
 import pytest
 
 from poppy_core.server.web import static_folder
+from tests.helpers.waiting import http_timeout
 from tests.server.conftest import Served, serve
 
 
@@ -110,7 +111,7 @@ def with_token(moves_folder: str) -> Iterator[Served]:
 
 
 def test_with_a_token_only_the_page_is_public(with_token: Served) -> None:
-    with httpx.Client(base_url=with_token.url, timeout=10.0) as http:
+    with httpx.Client(base_url=with_token.url, timeout=http_timeout(10.0)) as http:
         assert http.get("/").status_code == 200
         assert http.get("/web/app.js").status_code == 200
         for path in ("/api/v1/web/about", "/api/v1/web/logs", "/routes", "/robot.json"):

@@ -20,7 +20,7 @@ import pytest
 from poppy_core import from_profile
 from tests.helpers.chromium import CHROMIUM, HEADLESS_ARGS, needs_chromium, new_tab, playwright_api
 from tests.helpers.server import serve_robot
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, http_timeout
 from tests.server.conftest import Served
 
 Image = pytest.importorskip("PIL.Image", reason="needs pillow to read the screenshots")
@@ -109,7 +109,7 @@ def move_and_compare(page: Any, robot: Any, motor: str, by_deg: float) -> int:
 
 def tips_match_the_chains(page: Any, served: Served) -> None:
     """Each chain's tip as the view draws it is where the server's kinematics put it (1 mm)."""
-    with httpx.Client(base_url=served.url, timeout=10.0) as client:
+    with httpx.Client(base_url=served.url, timeout=http_timeout(10.0)) as client:
 
         def apart() -> float:
             drawn = page.evaluate("() => window.poppy.view.tips()")
