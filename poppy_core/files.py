@@ -243,6 +243,21 @@ def write_file(
     return target
 
 
+def place_file(temp: Path, target: Path, *, replace: bool) -> None:
+    """Put a finished temporary file (written beside ``target``, by a writer of its own: a
+    recording streamed to disk) where it goes, as ``write_file`` does: synced first, never over
+    a file without ``replace``, then the folder synced.
+
+    Raises:
+        FileError: ``target`` exists and ``replace`` is False.
+        OSError: the file system refused (the caller names the file: ``file_error``).
+    """
+    with open(temp, "rb") as stream:
+        os.fsync(stream.fileno())
+    _put_in_place(temp, target, replace)
+    _sync_folder(target.parent)
+
+
 def _put_in_place(temp: Path, target: Path, replace: bool) -> None:
     if replace:
         # Checked again here: a FIFO or link that appeared since is refused, not replaced.

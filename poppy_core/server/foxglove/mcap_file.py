@@ -11,7 +11,6 @@ the recording failed).
 from __future__ import annotations
 
 import contextlib
-import errno
 import os
 import secrets
 from pathlib import Path
@@ -21,7 +20,7 @@ import foxglove
 from foxglove import Context
 
 from poppy_core.errors import FileError
-from poppy_core.files import file_error, output_path
+from poppy_core.files import file_error, output_path, place_file
 from poppy_core.server.foxglove.publisher import FoxglovePublisher
 
 if TYPE_CHECKING:
@@ -94,7 +93,7 @@ class McapRecording:
             try:
                 writer.close()
                 self.publisher.close()
-                _place(self._temp, self.path, self.replace)
+                place_file(self._temp, self.path, replace=self.replace)
             except OSError as exc:
                 raise file_error(exc, self.path, "write") from None
             except RuntimeError as exc:  # the SDK's FoxgloveError (a full disk...)
@@ -110,28 +109,3 @@ class McapRecording:
     def __exit__(self, *exc: object) -> None:
         if self._writer is not None:
             self.stop()
-
-
-def _place(temp: Path, target: Path, replace: bool) -> None:
-    """Move the finished ``temp`` to ``target`` (never over a file without ``replace``)."""
-    with open(temp, "rb") as stream:
-        os.fsync(stream.fileno())
-    if replace:
-        os.replace(temp, target)
-        return
-    try:
-        os.link(temp, target)
-    except FileExistsError:
-        raise FileError(
-            f"{target} already exists: pass --force to replace it",
-            path=str(target),
-            errno=errno.EEXIST,
-        ) from None
-    except OSError as exc:
-        if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.EXDEV, errno.EMLINK):
-            raise
-        if target.exists():
-            raise FileError(
-                f"{target} already exists: pass --force to replace it", path=str(target)
-            ) from None
-        os.rename(temp, target)
