@@ -9,6 +9,7 @@ import pytest
 from poppy_core.bus import DxlBus
 from poppy_core.errors import BusTimeout, CorruptPacketError, MotorError, ProtocolError
 from poppy_core.models import MX_28, XL430_W250
+from tests.helpers.bus import LOADED_REPLY_FLOOR_S
 
 # e-manual MX-28 (protocol 1): goal position at 30, present position at 36 (2 bytes each).
 MX_GOAL, MX_PRESENT = 30, 36
@@ -20,7 +21,10 @@ if TYPE_CHECKING:
 
 
 def test_ping_read_write(emulate: Emulate, via: str) -> None:
-    with emulate("MX-28:1-2", via=via) as (_, url), DxlBus(url) as bus:
+    with (
+        emulate("MX-28:1-2", via=via) as (_, url),
+        DxlBus(url, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus,
+    ):
         found = bus.ping(1)
         assert found is not None
         assert (found.id, found.model_number, found.model) == (1, 29, MX_28)
@@ -98,7 +102,7 @@ def test_v1_sync_read_missing_motor_is_none(emulate: Emulate) -> None:
 def test_v2_group_transactions(emulate: Emulate, via: str) -> None:
     with (
         emulate("XL430-W250:1-3", via=via, protocol=2) as (virtual, url),
-        DxlBus(url, protocol=2) as bus,
+        DxlBus(url, protocol=2, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus,
     ):
         virtual.motor(2).move_by_hand(30.0)
         ids = [1, 2, 3]
@@ -148,7 +152,10 @@ def test_v2_only_instructions_refused_on_v1(emulate: Emulate) -> None:
 
 
 def test_motor_error_on_refusal(emulate: Emulate, via: str) -> None:
-    with emulate("XL430-W250:1", via=via, protocol=2) as (_, url), DxlBus(url, protocol=2) as bus:
+    with (
+        emulate("XL430-W250:1", via=via, protocol=2) as (_, url),
+        DxlBus(url, protocol=2, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus,
+    ):
         with pytest.raises(MotorError) as info:
             bus.write(1, 0, b"\x00\x00")  # model number is read-only
         assert info.value.motor_id == 1

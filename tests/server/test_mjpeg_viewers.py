@@ -26,10 +26,21 @@ POOL = 40
 async def open_viewer(url: str, fps: float) -> tuple[asyncio.StreamReader, asyncio.StreamWriter]:
     """A viewer of the stream that has read the headers of its first JPEG part."""
     where = urlsplit(url)
-    reader, writer = await asyncio.open_connection(where.hostname, where.port)
-    writer.write(f"GET {STREAM}?fps={fps:g} HTTP/1.1\r\nHost: {where.netloc}\r\n\r\n".encode())
-    await writer.drain()
-    await asyncio.wait_for(reader.readuntil(b"Content-Type: image/jpeg"), 60.0)
+    for attempt in (1, 2):
+        reader, writer = await asyncio.open_connection(where.hostname, where.port)
+        request = f"GET {STREAM}?fps={fps:g} HTTP/1.1\r\nHost: {where.netloc}\r\n\r\n"
+        writer.write(request.encode())
+        await writer.drain()
+        try:
+            await asyncio.wait_for(reader.readuntil(b"Content-Type: image/jpeg"), 60.0)
+        except asyncio.IncompleteReadError:
+            # seen once in a clean-clone run with four workers: the stream's headers, then its
+            # end before the first part; one more viewer asks again (the note of stop 34)
+            writer.close()
+            if attempt == 2:
+                raise
+            continue
+        break
     return reader, writer
 
 
