@@ -70,9 +70,19 @@ def test_the_motors_go_through_the_recorded_positions_in_order(dataset: Path) ->
         watcher.start()
         try:  # no --root: LeRobot's place for me/wave ($HF_LEROBOT_HOME/me/wave)
             result = run_poppy(
-                "dataset", "replay", "me/wave", "--episode", "1", "--profile", "ergo-jr",
-                "--port", url, "--speed", "2", "--json",
-            )  # fmt: skip
+                "dataset",
+                "replay",
+                "me/wave",
+                "--episode",
+                "1",
+                "--profile",
+                "ergo-jr",
+                "--port",
+                url,
+                "--speed",
+                "2",
+                "--json",
+            )
         finally:
             done.set()
             watcher.join()
@@ -172,9 +182,18 @@ def test_delete_episode(three: Path) -> None:
     ]
     # what was episode 2 replays as episode 1
     replayed = run_poppy(
-        "dataset", "replay", "me/three", "--root", str(three), "--episode", "1", "--sim",
-        "--profile", "ergo-jr", "--json",
-    )  # fmt: skip
+        "dataset",
+        "replay",
+        "me/three",
+        "--root",
+        str(three),
+        "--episode",
+        "1",
+        "--sim",
+        "--profile",
+        "ergo-jr",
+        "--json",
+    )
     assert replayed.code == 0 and replayed.json()["frames"] == 6
     text = run_poppy(
         "dataset", "delete-episode", "me/three", "--root", str(three), "--episode", "0"

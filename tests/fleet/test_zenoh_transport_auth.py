@@ -94,9 +94,23 @@ def _certificates(folder: Path) -> tuple[Path, Path, Path]:
     ca, ca_key = folder / "ca.pem", folder / "ca-key.pem"
     key, csr, cert = folder / "robot-key.pem", folder / "robot.csr", folder / "robot.pem"
     ec = ("-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes")
-    _openssl("req", "-x509", *ec, "-keyout", ca_key, "-out", ca, "-days", "1",
-             "-subj", "/CN=poppy test CA", "-addext", "basicConstraints=critical,CA:TRUE",
-             "-addext", "keyUsage=critical,keyCertSign,cRLSign")  # fmt: skip
+    _openssl(
+        "req",
+        "-x509",
+        *ec,
+        "-keyout",
+        ca_key,
+        "-out",
+        ca,
+        "-days",
+        "1",
+        "-subj",
+        "/CN=poppy test CA",
+        "-addext",
+        "basicConstraints=critical,CA:TRUE",
+        "-addext",
+        "keyUsage=critical,keyCertSign,cRLSign",
+    )
     _openssl("req", *ec, "-keyout", key, "-out", csr, "-subj", "/CN=localhost")
     extensions = folder / "robot.ext"
     extensions.write_text(
@@ -106,8 +120,24 @@ def _certificates(folder: Path) -> tuple[Path, Path, Path]:
         "extendedKeyUsage=serverAuth,clientAuth\n",
         encoding="utf-8",
     )
-    _openssl("x509", "-req", "-in", csr, "-CA", ca, "-CAkey", ca_key, "-set_serial", "1",
-             "-days", "1", "-out", cert, "-extfile", extensions)  # fmt: skip
+    _openssl(
+        "x509",
+        "-req",
+        "-in",
+        csr,
+        "-CA",
+        ca,
+        "-CAkey",
+        ca_key,
+        "-set_serial",
+        "1",
+        "-days",
+        "1",
+        "-out",
+        cert,
+        "-extfile",
+        extensions,
+    )
     return ca, key, cert
 
 
@@ -177,18 +207,37 @@ ACCESS_CONTROL: dict[str, Any] = {
     "enabled": True,
     "default_permission": "deny",
     "rules": [
-        {"id": "all", "permission": "allow", "flows": ["egress", "ingress"],
-         "messages": _EVERYTHING + _LIVELINESS, "key_exprs": ["poppy/**"]},
-        {"id": "presence", "permission": "allow", "flows": ["egress", "ingress"],
-         "messages": ["reply", *_LIVELINESS], "key_exprs": ["poppy/*"]},
-        {"id": "states", "permission": "allow", "flows": ["egress", "ingress"],
-         "messages": ["put", "declare_subscriber"], "key_exprs": ["poppy/*/state"]},
+        {
+            "id": "all",
+            "permission": "allow",
+            "flows": ["egress", "ingress"],
+            "messages": _EVERYTHING + _LIVELINESS,
+            "key_exprs": ["poppy/**"],
+        },
+        {
+            "id": "presence",
+            "permission": "allow",
+            "flows": ["egress", "ingress"],
+            "messages": ["reply", *_LIVELINESS],
+            "key_exprs": ["poppy/*"],
+        },
+        {
+            "id": "states",
+            "permission": "allow",
+            "flows": ["egress", "ingress"],
+            "messages": ["put", "declare_subscriber"],
+            "key_exprs": ["poppy/*/state"],
+        },
     ],
-    "subjects": [{"id": "teachers", "usernames": ["teacher"]},
-                 {"id": "pupils", "usernames": ["pupil"]}],
-    "policies": [{"rules": ["all"], "subjects": ["teachers"]},
-                 {"rules": ["presence", "states"], "subjects": ["pupils"]}],
-}  # fmt: skip
+    "subjects": [
+        {"id": "teachers", "usernames": ["teacher"]},
+        {"id": "pupils", "usernames": ["pupil"]},
+    ],
+    "policies": [
+        {"rules": ["all"], "subjects": ["teachers"]},
+        {"rules": ["presence", "states"], "subjects": ["pupils"]},
+    ],
+}
 
 
 def test_access_control_lets_a_pupil_watch_the_states_but_not_query_the_robot(
