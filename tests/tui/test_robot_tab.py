@@ -159,7 +159,8 @@ async def test_record_then_play_a_move(moves_dir: Path) -> None:
         )
         # the app hears of the end through a message: let it handle it
         await wait_for(pilot, lambda: "wave: played" in notes(app), what="the note")
-        assert moves.query_one("#play-progress", ProgressBar).progress == pytest.approx(1.0)
+        bar = moves.query_one("#play-progress", ProgressBar)
+        await wait_for(pilot, lambda: bar.progress == pytest.approx(1.0), what="a full bar")
 
 
 @run_async
