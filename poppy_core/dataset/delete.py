@@ -19,12 +19,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pyarrow as pa
 
 from poppy_core.dataset import feature_stats as stats
 from poppy_core.dataset import layout, tables
-from poppy_core.dataset.rows import data_path, episode_rows, find_episode
+from poppy_core.dataset.rows import data_path, episode_rows, find_episode, stats_of_row
 from poppy_core.errors import ArgumentError, FileError
 
 RENAME_EXCHANGE = 2
@@ -133,7 +132,7 @@ def _rebuild(
                 if target != work / old_video[key]:
                     target.parent.mkdir(parents=True, exist_ok=True)
                     os.replace(work / old_video[key], target)
-        episode_stats.append(_stats_of_row(row))
+        episode_stats.append(stats_of_row(row))
         start += length
     tables.write_table(work / layout.TASKS_PATH, tables.tasks_table(tasks))
     for path in (work / layout.EPISODES_DIR).glob("*/*.parquet"):
@@ -192,15 +191,6 @@ def _video(row: dict[str, Any], key: str) -> Path:
             file_index=int(row[f"videos/{key}/file_index"]),
         )
     )
-
-
-def _stats_of_row(row: dict[str, Any]) -> dict[str, stats.Stats]:
-    found: dict[str, stats.Stats] = {}
-    for column, value in row.items():
-        if column.startswith("stats/") and value is not None:
-            key, _, name = column.removeprefix("stats/").rpartition("/")
-            found.setdefault(key, {})[name] = np.asarray(value)
-    return found
 
 
 def _unlink(path: Path) -> None:

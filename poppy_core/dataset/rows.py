@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from poppy_core.dataset import feature_stats as stats
 from poppy_core.dataset import layout, tables
 from poppy_core.errors import ArgumentError
 
@@ -71,3 +72,13 @@ def read_actions(root: Path, episode: int) -> EpisodeActions:
         raise ArgumentError(f"episode {episode} has no frame in its data file", field="episode")
     positions = np.asarray([values for _, values in frames], dtype=np.float64)
     return EpisodeActions(episode, layout.check_fps(int(info.get("fps") or 0)), motors, positions)
+
+
+def stats_of_row(row: dict[str, Any]) -> dict[str, stats.Stats]:
+    """An episode's stats back from its ``stats/<feature>/<name>`` columns."""
+    found: dict[str, stats.Stats] = {}
+    for column, value in row.items():
+        if column.startswith("stats/") and value is not None:
+            key, _, name = column.removeprefix("stats/").rpartition("/")
+            found.setdefault(key, {})[name] = np.asarray(value)
+    return found

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from poppy_core.dataset import feature_stats as stats
 from poppy_core.dataset import layout, tables
 from poppy_core.dataset.layout import DatasetSpec
+from poppy_core.dataset.rows import stats_of_row
 from poppy_core.dataset.video import VideoWriter, pick_codec, video_info
 from poppy_core.errors import ArgumentError, FileError
 
@@ -107,7 +108,7 @@ class DatasetWriter:
         tasks_path = self.root / layout.TASKS_PATH
         if tasks_path.exists():
             self.tasks = tables.read_tasks(tasks_path)
-        self._episode_stats = [_stats_of_row(row) for row in self.episodes]
+        self._episode_stats = [stats_of_row(row) for row in self.episodes]
         self._remove_leftovers()
         self._write_summary()
 
@@ -301,16 +302,6 @@ class DatasetWriter:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-def _stats_of_row(row: dict[str, Any]) -> dict[str, stats.Stats]:
-    """An episode's stats back from its ``stats/<feature>/<name>`` columns."""
-    found: dict[str, stats.Stats] = {}
-    for column, value in row.items():
-        if column.startswith("stats/") and value is not None:
-            key, _, name = column.removeprefix("stats/").rpartition("/")
-            found.setdefault(key, {})[name] = np.asarray(value)
-    return found
 
 
 def default_root(repo_id: str) -> Path:
