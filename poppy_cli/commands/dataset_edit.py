@@ -68,8 +68,7 @@ def replay(
     The motors turn stiff. Ctrl-C or SIGTERM stops where the motors are (exit 130, after the
     summary). The dataset's joints must be motors of the robot.
     """
-    from poppy_cli.commands.play import _run, fmt_limits
-    from poppy_cli.output import warn_line
+    from poppy_cli.commands.play import _run, warn_clamped
     from poppy_cli.robots import robot_config, start_robot
     from poppy_core.dataset.rows import read_actions
     from poppy_core.motion import Move, MovePlayer
@@ -90,11 +89,7 @@ def replay(
     )
     with start_robot(config, sim) as robot:
         player = MovePlayer(robot, move, speed=speed)
-        for motor, beyond in player.clamped.items():
-            warn_line(
-                f"{motor}: the episode goes {beyond:.1f}° past its angle limits "
-                f"{fmt_limits(robot.motor(motor).angle_limit)}: played at the limit"
-            )
+        warn_clamped(player, robot, "the episode")
         stop = threading.Event()
         for signum in (signal.SIGINT, signal.SIGTERM):
             signal.signal(signum, lambda *_: stop.set())

@@ -31,6 +31,7 @@ from poppy_cli.robots import robot_config, start_robot
 
 if TYPE_CHECKING:
     from poppy_core.motion import MovePlayer, PlayProgress
+    from poppy_core.robot import Robot
 
 
 def play(
@@ -75,11 +76,7 @@ def play(
         )
     with start_robot(config, sim) as robot:
         player = MovePlayer(robot, move, speed=speed, backwards=reverse, loops=loop)
-        for motor, beyond in player.clamped.items():
-            warn_line(
-                f"{motor}: the move goes {beyond:.1f}° past its angle limits "
-                f"{fmt_limits(robot.motor(motor).angle_limit)}: played at the limit"
-            )
+        warn_clamped(player, robot, "the move")
         stop = threading.Event()
         for signum in (signal.SIGINT, signal.SIGTERM):
             signal.signal(signum, lambda *_: stop.set())
@@ -145,3 +142,12 @@ def _run(player: MovePlayer, stop: threading.Event, *, show: bool) -> None:
 def _raise_error(player: MovePlayer) -> None:
     if player.error is not None:
         raise player.error
+
+
+def warn_clamped(player: MovePlayer, robot: Robot, what: str) -> None:
+    """One line per motor that ``what`` (the move, the episode) takes past its angle limits."""
+    for motor, beyond in player.clamped.items():
+        warn_line(
+            f"{motor}: {what} goes {beyond:.1f}° past its angle limits "
+            f"{fmt_limits(robot.motor(motor).angle_limit)}: played at the limit"
+        )
