@@ -20,6 +20,7 @@ from typing import Any
 
 import pytest
 
+from tests.helpers.cli import command_env
 from tests.helpers.processes import read_until, start_on_pty
 
 _SCRIPT = """
@@ -57,7 +58,7 @@ def _rest(master: int, proc: Any) -> str:
 
 
 def _asking(started: list[tuple[Any, int]], question: str) -> tuple[Any, int]:
-    env = dict(os.environ, NO_COLOR="1")
+    env = dict(os.environ, **command_env())
     proc, master, slave = start_on_pty([sys.executable, "-c", _SCRIPT, question], env)
     os.close(slave)
     started.append((proc, master))

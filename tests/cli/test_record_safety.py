@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 
 from poppy_core.motion import read_move
-from tests.helpers.cli import POPPY
+from tests.helpers.cli import POPPY, command_env
 from tests.helpers.processes import read_until, start, start_on_pty
 from tests.helpers.terminal import CTRL_C, Terminal
 
@@ -111,7 +111,7 @@ def test_two_recordings_of_one_name_at_once(
 def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
     with tmpfs(tmp_path / "full", "32k") as library:
         (library / "filler").write_bytes(b"\0" * 28_000)
-        env = dict(os.environ, POPPY_MOVES_DIR=str(library), COLUMNS="200")
+        env = dict(os.environ, **command_env({"POPPY_MOVES_DIR": str(library), "COLUMNS": "200"}))
         proc, parent, child = start_on_pty([*POPPY, "record", "wave", *SIM, "--duration", "6"], env)
         os.close(child)
         try:

@@ -18,7 +18,7 @@ import pytest
 from poppy_core.dataset.layout import DatasetSpec
 from poppy_core.dataset.writer import DatasetWriter
 from tests.helpers.bus import emulate_bus
-from tests.helpers.cli import no_user_settings, run_poppy
+from tests.helpers.cli import command_env, no_user_settings, run_poppy
 from tests.helpers.processes import start
 
 pytestmark = pytest.mark.slow
@@ -109,7 +109,7 @@ def test_the_motors_go_through_the_recorded_positions_in_order(dataset: Path) ->
 def test_a_signal_during_replay_exits_130_after_the_summary(tmp_path: Path) -> None:
     root = tmp_path / "long"
     write_dataset(root, frames=600)  # 60 s
-    env = dict(os.environ, COLUMNS="200", NO_COLOR="1")
+    env = dict(os.environ, **command_env({"COLUMNS": "200"}))
     argv = [sys.executable, "-m", "poppy_cli", "dataset", "replay", "me/long", "--root", str(root)]
     proc = start(
         [*argv, "--episode", "1", "--sim", "--profile", "ergo-jr", "--json"],

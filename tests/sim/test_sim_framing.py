@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.helpers.cli import POPPY
+from tests.helpers.cli import POPPY, command_env
 from tests.helpers.processes import read_until
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -87,7 +87,7 @@ def test_a_move_render_shows_its_frames_and_time_left_on_a_terminal(tmp_path: Pa
     frames = [{"m1": 60.0 * i / 10} for i in range(11)]
     move_file = write_move(Move.from_frames(10, frames), tmp_path / "turn.move.json")
     out = tmp_path / "turn.gif"
-    env = dict(os.environ, COLUMNS="120", TERM="xterm", NO_COLOR="1")
+    env = dict(os.environ, **command_env({"COLUMNS": "120", "TERM": "xterm"}))
     parent, child = pty.openpty()
     proc = subprocess.Popen(
         [

@@ -10,6 +10,7 @@ import sys
 import time
 import urllib.request
 
+from tests.helpers.cli import command_env
 from tests.helpers.processes import start
 
 
@@ -23,7 +24,7 @@ def test_tui_serve_answers_a_browser_on_loopback() -> None:
     port = _free_port()
     proc = start(
         [sys.executable, "-m", "poppy_cli", "tui", "--serve", "--sim", "--http-port", str(port)],
-        dict(os.environ, NO_COLOR="1"),
+        dict(os.environ, **command_env()),
     )
     try:
         page = ""
