@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import logging
+import math
+import time
 from collections.abc import Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar
 
 from poppy_core import checks
+from poppy_core.creatures.alarm import AlarmSound
 from poppy_core.motion import LoopPrimitive
 
 if TYPE_CHECKING:
@@ -31,6 +35,8 @@ TEMPERATURE_LIMIT_C = 55.0
 TEMPERATURE_CHECK_HZ = 1.0
 # A hot motor is reported again only after cooling this far below the limit.
 TEMPERATURE_HYSTERESIS_C = 2.0
+# The alarm sounds when a motor gets too hot, then this often while one stays too hot.
+ALARM_REPEAT_S = 10.0
 
 
 def _torque_motors(robot: Robot) -> list[str]:
@@ -127,15 +133,20 @@ def _percent(name: str, value: float) -> float:
 
 
 class TemperatureMonitor(LoopPrimitive):
-    """Warns (a log warning) when a motor gets too hot; started by default (looping).
+    """Warns when a motor gets too hot, with a sound as pypot did; started by default (looping).
 
-    pypot played a sound; here the warning goes to the ``poppy_core.creatures.safety`` logger
-    and ``hot_motors`` lists the motors above the limit.
+    The warning goes to the ``poppy_core.creatures.safety`` logger (the robot's page shows it in
+    its log), ``hot_motors`` lists the motors above the limit, and the alarm sound plays when a
+    motor gets too hot, then every ``ALARM_REPEAT_S`` while one stays too hot (pypot played it at
+    every check, every 2 s). A machine without audio says so once in the log.
 
     Args:
         robot: the robot.
         freq: checks per second.
-        temperature_limit: °C above which a motor is too hot.
+        temperature_limit: °C above which a motor is too hot (``temp_limit``: pypot's name).
+        player: the program that plays the sound (pypot: ``'aplay'``; None: the first of
+            aplay, paplay, pw-play and afplay found).
+        sound: the WAV file played (None: poppy's own tone).
     """
 
     properties: ClassVar[Sequence[str]] = ("temperature_limit", "update_freq", "hot_motors")
@@ -145,10 +156,16 @@ class TemperatureMonitor(LoopPrimitive):
         robot: Robot,
         freq: float = TEMPERATURE_CHECK_HZ,
         temperature_limit: float = TEMPERATURE_LIMIT_C,
+        player: str | None = None,
+        sound: str | Path | None = None,
+        *,
+        temp_limit: float | None = None,
     ) -> None:
         super().__init__(robot, freq)
-        self.temperature_limit = temperature_limit
+        self.temperature_limit = temperature_limit if temp_limit is None else temp_limit
         self.hot_motors: list[str] = []
+        self.alarm = AlarmSound(player, sound)
+        self._last_alarm = -math.inf
 
     @property
     def temperature_limit(self) -> float:
@@ -160,19 +177,50 @@ class TemperatureMonitor(LoopPrimitive):
         checks.positive(value, "temperature_limit")
         self._limit = float(value)
 
+    @property
+    def temp_limit(self) -> float:
+        """pypot's name for ``temperature_limit``."""
+        return self.temperature_limit
+
+    @temp_limit.setter
+    def temp_limit(self, value: float) -> None:
+        self.temperature_limit = value
+
+    @property
+    def player(self) -> str | None:
+        """The program that plays the alarm (None: found on the PATH)."""
+        return self.alarm.player
+
+    @player.setter
+    def player(self, value: str | None) -> None:
+        self.alarm.player = value
+
+    @property
+    def sound(self) -> str | Path | None:
+        """The alarm's WAV file (None: poppy's own tone)."""
+        return self.alarm.sound
+
+    @sound.setter
+    def sound(self, value: str | Path | None) -> None:
+        self.alarm.sound = value
+
     def setup(self) -> None:
         """Forget earlier reports."""
         self.hot_motors = []
+        self._last_alarm = -math.inf
 
     def update(self) -> None:
-        """Check every motor; warn once per motor each time it goes above the limit."""
+        """Check every motor; warn once per motor each time it goes above the limit, and sound
+        the alarm while one is too hot."""
         hot = list(self.hot_motors)
+        new = False
         for motor in self.real_robot.motors:
             if not motor.online:
                 continue
             temperature = motor.present_temperature
             if temperature > self.temperature_limit and motor.name not in hot:
                 hot.append(motor.name)
+                new = True
                 logger.warning(
                     "%s is too hot: %.0f °C (limit %.0f °C): let it cool down (turn it compliant)",
                     motor.name,
@@ -185,3 +233,11 @@ class TemperatureMonitor(LoopPrimitive):
                 hot.remove(motor.name)
                 logger.info("%s cooled down: %.0f °C", motor.name, temperature)
         self.hot_motors = hot
+        now = time.monotonic()
+        if hot and (new or now - self._last_alarm >= ALARM_REPEAT_S):
+            self._last_alarm = now
+            self.alarm.play()
+
+    def teardown(self) -> None:
+        """Let a sound still playing end."""
+        self.alarm.close()

@@ -58,6 +58,7 @@ def test_temperature_monitoring_warns_about_a_hot_motor(
 ) -> None:
     monitor = humanoid.temperature_monitoring
     monitor.update_freq = 10.0
+    monitor.player = "true"  # the alarm's sound: played silently
     monitor.start()  # restart at the new rate
     hot = virtual(humanoid, "r_knee_y")  # on the lower body's bus
     with caplog.at_level(logging.WARNING, logger="poppy_core.creatures.safety"):
