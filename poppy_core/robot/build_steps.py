@@ -27,7 +27,15 @@ from poppy_core.robot.startup import ReturnDelayConsent
 from poppy_core.robot.sync import BusSync, loops_for
 from poppy_core.robot.virtual import start_emulators, start_simulation
 from poppy_core.sensors import Sensor
-from poppy_core.sensors.config import CameraMaker, build_sensors, dummy_camera, opencv_camera
+from poppy_core.sensors.config import (
+    CameraMaker,
+    ImuMaker,
+    build_sensors,
+    device_imu,
+    dummy_camera,
+    opencv_camera,
+    still_imu,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -219,7 +227,8 @@ class BuildSteps:
 
     def build_sensors(self) -> None:
         """The config's sensors: real devices, the MuJoCo scene, or blank frames (ideal sim)."""
-        self.sensors = build_sensors(sensor_specs(self.config.sensors), self._camera_maker())
+        specs = sensor_specs(self.config.sensors)
+        self.sensors = build_sensors(specs, self._camera_maker(), self._imu_maker())
 
     def _camera_maker(self) -> CameraMaker:
         if self.mode == "mujoco":
@@ -229,6 +238,15 @@ class BuildSteps:
         if self.mode is not None:
             return dummy_camera
         return opencv_camera
+
+    def _imu_maker(self) -> ImuMaker:
+        if self.mode == "mujoco":
+            from poppy_core.sim.imu import sim_imu_maker
+
+            return sim_imu_maker(self.simulation)
+        if self.mode is not None:
+            return still_imu
+        return device_imu
 
     def robot(self) -> Robot:
         """The robot of everything built so far; it owns them from now on (sync not started)."""

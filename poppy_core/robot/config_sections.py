@@ -205,6 +205,7 @@ class SensorEntry(BaseModel):
     resolution: Annotated[Any, AfterValidator(_resolution)] = None
     calibration: Annotated[Any, AfterValidator(_calibration)] = None
     sim_camera: Name | None = None
+    sim_body: Name | None = None
     cameras: list[Name] | None = None
     cards: dict[Name, MarkerIds] = Field(default_factory=dict)
     dictionary: Name | None = None
@@ -222,7 +223,13 @@ class SensorEntry(BaseModel):
 
     @model_validator(mode="after")
     def _device_keys(self) -> SensorEntry:
-        needed = {"ArduinoSensor": "port", "ContactSensor": "gpio_data", "SonarSensor": "i2c_pin"}
+        needed = {
+            "ArduinoSensor": "port",
+            "ContactSensor": "gpio_data",
+            "SonarSensor": "i2c_pin",
+            "RazorIMU": "port",
+            "BNO055": "i2c_pin",
+        }
         key = needed.get(self.type)
         if key is not None and getattr(self, key) is None:
             raise PydanticCustomError(
@@ -244,6 +251,7 @@ class SensorEntry(BaseModel):
             ),
             "source": next((s for s in (self.index, self.device) if s is not None), 0),
             "sim_camera": self.sim_camera or name,
+            "sim_body": self.sim_body,
             "cameras": tuple(self.cameras or ()),
             "cards": {card: list(ids) for card, ids in self.cards.items()},
             "dictionary": self.dictionary,

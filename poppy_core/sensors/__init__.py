@@ -1,4 +1,4 @@
-"""Sensors: cameras (OpenCV, blank, simulated in ``poppy_core.sim``), markers, faces, devices.
+"""Sensors: cameras (OpenCV, blank, simulated in ``poppy_core.sim``), markers, faces, devices, IMUs.
 
 Imports nothing of ours but ``errors``; OpenCV, gpiozero and smbus2 are imported on first use.
 The robot factory builds them from a config's ``sensors`` section (``build_sensors``).
@@ -6,6 +6,7 @@ The robot factory builds them from a config's ``sensors`` section (``build_senso
 
 from poppy_core.sensors.arduino import ArduinoSensor
 from poppy_core.sensors.base import Sensor, SensorHealth, SensorLost
+from poppy_core.sensors.bno055 import BNO055
 from poppy_core.sensors.camera import Camera, CameraCalibration, DummyCamera, Frame
 from poppy_core.sensors.config import (
     NOT_YET,
@@ -18,10 +19,12 @@ from poppy_core.sensors.config import (
 from poppy_core.sensors.contact import ContactSensor
 from poppy_core.sensors.detector import FrameDetector, MarkerDetector
 from poppy_core.sensors.faces import Face, FaceDetector, FaceFinder
+from poppy_core.sensors.imu import Imu, RazorIMU, StillIMU
 from poppy_core.sensors.markers import Marker, MarkerFinder, MarkerPose, marker_image
 from poppy_core.sensors.sonar import SonarSensor
 
 __all__ = [
+    "BNO055",
     "NOT_YET",
     "SUPPORTED_TYPES",
     "ArduinoSensor",
@@ -34,15 +37,18 @@ __all__ = [
     "FaceFinder",
     "Frame",
     "FrameDetector",
+    "Imu",
     "Marker",
     "MarkerDetector",
     "MarkerFinder",
     "MarkerPose",
+    "RazorIMU",
     "Sensor",
     "SensorHealth",
     "SensorLost",
     "SensorSpec",
     "SonarSensor",
+    "StillIMU",
     "build_sensors",
     "dummy_camera",
     "marker_image",

@@ -8,7 +8,9 @@ MuJoCo camera a simulated robot renders for it; default: the sensor's name). A `
 (pypot's: ``cameras``, ``freq``) takes ``min_size`` (pixels) and ``cascade`` (an LBP cascade XML).
 The device sensors take pypot's keys: ``ArduinoSensor`` ``port``, ``baud``, ``sync_freq``;
 ``ContactSensor`` ``gpio_data``, ``gpio_vcc``; ``SonarSensor`` ``i2c_pin``, ``address``,
-``sync_freq``.
+``sync_freq``. The IMUs: ``RazorIMU`` ``port``, ``baud`` (57600), ``sync_freq``; ``BNO055``
+``i2c_pin``, ``address`` (0x28), ``sync_freq``; both take ``sim_body`` (the MuJoCo body a
+simulated robot's IMU rides; default ``head``).
 The section is checked where the rest of the config is (``poppy_core.robot.config_sections``,
 every problem at once); this leaf receives plain ``SensorSpec`` entries.
 """
@@ -21,6 +23,7 @@ from dataclasses import dataclass, field
 from poppy_core.errors import SensorError
 from poppy_core.sensors.arduino import DEFAULT_BAUD, DEFAULT_SYNC_HZ, ArduinoSensor
 from poppy_core.sensors.base import Sensor
+from poppy_core.sensors.bno055 import BNO055, DEFAULT_BNO055_ADDRESS, DEFAULT_BNO055_HZ
 from poppy_core.sensors.camera import (
     DEFAULT_FPS,
     DEFAULT_RESOLUTION,
@@ -34,12 +37,14 @@ from poppy_core.sensors.faces import (
     DEFAULT_MIN_SIZE_PX,
     FaceDetector,
 )
+from poppy_core.sensors.imu import RAZOR_BAUD, RAZOR_HZ, Imu, RazorIMU, StillIMU
 from poppy_core.sensors.markers import DEFAULT_DICTIONARY, DEFAULT_MARKER_SIZE_M, FAMILIES
 from poppy_core.sensors.sonar import DEFAULT_ADDRESS, DEFAULT_SONAR_HZ, SonarSensor
 
 CAMERA_TYPES = ("OpenCVCamera", "DummyCamera")
 DETECTOR_TYPES = ("MarkerDetector", "FaceDetector")
-DEVICE_TYPES = ("ArduinoSensor", "ContactSensor", "SonarSensor")
+IMU_TYPES = ("RazorIMU", "BNO055")
+DEVICE_TYPES = ("ArduinoSensor", "ContactSensor", "SonarSensor", *IMU_TYPES)
 """Sensors on their own device (a serial port, a GPIO pin, an I2C bus), no camera."""
 SUPPORTED_TYPES = (*CAMERA_TYPES, *DETECTOR_TYPES, *DEVICE_TYPES)
 NOT_YET: dict[str, str] = {
@@ -48,8 +53,6 @@ NOT_YET: dict[str, str] = {
     "OptiTrackClient": "OptiTrack",
     "OptiBridgeServer": "OptiTrack",
     "TrackedObject": "OptiTrack",
-    "IMU": "IMU",
-    "RazorIMU": "IMU",
     "ForceSensor": "force",
     "BlobDetector": "blob detector",
 }
@@ -70,6 +73,7 @@ class SensorSpec:
     calibration: CameraCalibration | None = None
     source: int | str = 0
     sim_camera: str | None = None
+    sim_body: str | None = None
     cameras: tuple[str, ...] = ()
     cards: Mapping[str, list[int]] = field(default_factory=dict)
     dictionary: str = DEFAULT_DICTIONARY
@@ -78,16 +82,21 @@ class SensorSpec:
     min_size: int = DEFAULT_MIN_SIZE_PX
     cascade: str | None = None
     port: str = ""
-    baud: int = DEFAULT_BAUD
+    baud: int | None = None
     gpio_data: int | str = 0
     gpio_vcc: int | str | None = None
     i2c_pin: int = 1
-    address: int = DEFAULT_ADDRESS
+    address: int | None = None
 
     @property
     def is_camera(self) -> bool:
         """Whether the entry is a camera (the others are detectors reading cameras)."""
         return self.type in CAMERA_TYPES
+
+    @property
+    def is_imu(self) -> bool:
+        """Whether the entry is an IMU (simulated in a MuJoCo world)."""
+        return self.type in IMU_TYPES
 
     @property
     def is_device(self) -> bool:
@@ -97,6 +106,8 @@ class SensorSpec:
 
 CameraMaker = Callable[[SensorSpec], Camera]
 """Makes the camera of one config entry: real, dummy or simulated."""
+ImuMaker = Callable[[SensorSpec], Imu]
+"""Makes the IMU of one config entry: real (its device), still (ideal) or simulated."""
 
 
 def opencv_camera(spec: SensorSpec) -> Camera:
@@ -122,13 +133,28 @@ def dummy_camera(spec: SensorSpec) -> Camera:
     )
 
 
+def device_imu(spec: SensorSpec) -> Imu:
+    """The IMU of an entry on its real device (opened on first use)."""
+    if spec.type == "BNO055":
+        address = spec.address or DEFAULT_BNO055_ADDRESS
+        return BNO055(spec.name, spec.i2c_pin, address, spec.rate_hz or DEFAULT_BNO055_HZ)
+    return RazorIMU(spec.name, spec.port, spec.baud or RAZOR_BAUD, spec.rate_hz or RAZOR_HZ)
+
+
+def still_imu(spec: SensorSpec) -> Imu:
+    """The IMU of an entry on a robot without physics (the ideal simulation): level, still."""
+    return StillIMU(spec.name, spec.rate_hz or RAZOR_HZ)
+
+
 def device_sensor(spec: SensorSpec) -> Sensor:
     """The sensor of an Arduino, contact or sonar entry (its device opens on first use;
     a contact sensor claims its pins now)."""
     if spec.type == "ArduinoSensor":
-        return ArduinoSensor(spec.name, spec.port, spec.baud, spec.rate_hz or DEFAULT_SYNC_HZ)
+        baud = spec.baud or DEFAULT_BAUD
+        return ArduinoSensor(spec.name, spec.port, baud, spec.rate_hz or DEFAULT_SYNC_HZ)
     if spec.type == "SonarSensor":
-        return SonarSensor(spec.name, spec.i2c_pin, spec.address, spec.rate_hz or DEFAULT_SONAR_HZ)
+        address = spec.address or DEFAULT_ADDRESS
+        return SonarSensor(spec.name, spec.i2c_pin, address, spec.rate_hz or DEFAULT_SONAR_HZ)
     from poppy_core.sensors.contact import DEFAULT_CONTACT_HZ, ContactSensor
 
     return ContactSensor(
@@ -137,7 +163,9 @@ def device_sensor(spec: SensorSpec) -> Sensor:
 
 
 def build_sensors(
-    specs: Iterable[SensorSpec], make_camera: CameraMaker = opencv_camera
+    specs: Iterable[SensorSpec],
+    make_camera: CameraMaker = opencv_camera,
+    make_imu: ImuMaker = device_imu,
 ) -> dict[str, Sensor]:
     """The sensors of checked entries, cameras first; none started yet; in the entries' order.
 
@@ -152,7 +180,9 @@ def build_sensors(
             if spec.is_camera:
                 sensors[spec.name] = make_camera(spec)
         for spec in entries:
-            if spec.is_device:
+            if spec.is_imu:
+                sensors[spec.name] = make_imu(spec)
+            elif spec.is_device:
                 sensors[spec.name] = device_sensor(spec)
         for spec in entries:
             if spec.is_camera or spec.is_device:

@@ -22,6 +22,7 @@ SHARED_MODULE_NAMES = {
     "app.py": "server/app.py (the REST+WS app), server/snap/app.py (the Snap! app)",
     "base.py": "protocol/base.py (a protocol's contract), sensors/base.py (a sensor's)",
     "camera.py": "sensors/camera.py (a camera sensor), sim/camera.py (MuJoCo's rendering of it)",
+    "imu.py": "sensors/imu.py (the IMUs and their frame), sim/imu.py (MuJoCo's IMU)",
     "catalog.py": "models/catalog.py (servo models), server/snap/catalog.py (Snap! blocks)",
     "config.py": "robot/config.py (the robot config), sensors/config.py (its sensors section)",
     "errors.py": "errors.py (the typed errors), server/errors.py (their HTTP mapping)",

@@ -39,6 +39,9 @@ HASHES = {
     "sensor_msgs/msg/CompressedImage": (
         "RIHS01_15640771531571185e2efc8a100baf923961a4d15d5569652e6cb6691e8e371a"
     ),
+    "sensor_msgs/msg/Imu": (
+        "RIHS01_7d9a00ff131080897a5ec7e26e315954b8eae3353c3f995c55faf71574000b5b"
+    ),
     "std_srvs/srv/SetBool": (
         "RIHS01_abe9e4bb6b41b40e6789712c00ec8871923e089af3f667a79992a428cff2da0a"
     ),

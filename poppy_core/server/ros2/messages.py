@@ -1,4 +1,4 @@
-"""The node's messages made from the robot: joint states, transforms, diagnostics, images."""
+"""The node's messages made from the robot: joint states, transforms, diagnostics, images, IMUs."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from poppy_core.zenoh_wire import finite_or_nan
 if TYPE_CHECKING:
     from poppy_core.kinematics import JointDescription
     from poppy_core.robot import Robot
+    from poppy_core.sensors import Imu
 
 OK, WARN, ERROR = 0, 1, 2
 """diagnostic_msgs/DiagnosticStatus levels."""
@@ -154,6 +155,34 @@ def compressed_image(jpeg: bytes, frame: str, now: float | None = None) -> Any:
         header=header(frame, now),
         format="jpeg",
         data=np.frombuffer(jpeg, dtype=np.uint8),
+    )
+
+
+def imu(sensor: Imu, frame: str, now: float | None = None) -> Any:
+    """A sensor_msgs/Imu of an IMU's last values (orientation, rad/s, m/s²); what the device
+    does not measure has -1 as its covariance's first element, as the message asks."""
+    import numpy as np
+
+    w, x, y, z = sensor.quaternion
+    rates, accel = sensor.angular_velocity, sensor.acceleration
+    unknown = np.zeros(9)
+    unknown[0] = -1.0
+
+    def vector(values: dict[str, float] | None, scale: float) -> Any:
+        v = values or {"x": 0.0, "y": 0.0, "z": 0.0}
+        return types.message(
+            "geometry_msgs/msg/Vector3", x=v["x"] * scale, y=v["y"] * scale, z=v["z"] * scale
+        )
+
+    return types.message(
+        types.IMU,
+        header=header(frame, now),
+        orientation=types.message("geometry_msgs/msg/Quaternion", x=x, y=y, z=z, w=w),
+        orientation_covariance=np.zeros(9),
+        angular_velocity=vector(rates, math.radians(1)),
+        angular_velocity_covariance=np.zeros(9) if rates is not None else unknown.copy(),
+        linear_acceleration=vector(accel, 1.0),
+        linear_acceleration_covariance=np.zeros(9) if accel is not None else unknown.copy(),
     )
 
 

@@ -4,8 +4,9 @@ It declares on the server set's Zenoh session, under rmw_zenoh's keys (``wire``)
 ``joint_states`` (every sync cycle), ``tf`` (with it), ``robot_description`` and ``tf_static``
 (transient local: Zenoh advanced publishers with a cache of one sample, which rmw_zenoh's
 transient-local subscriptions query), ``diagnostics`` (every second) and, while a camera runs,
-``camera/image_raw/compressed``; subscriptions ``joint_trajectory`` and ``joint_command``;
-services ``~/set_compliant``, ``~/stop`` and per primitive ``~/<primitive>/start`` and
+``camera/image_raw/compressed``, ``<imu>/data`` for each IMU (sensor_msgs/Imu, with the
+state); subscriptions ``joint_trajectory`` and ``joint_command``; services
+``~/set_compliant``, ``~/stop`` and per primitive ``~/<primitive>/start`` and
 ``~/<primitive>/stop``; and the liveliness token of the node and of each of those entities.
 The entities are declared by ``entities.Entities``; the commands are the service's operations
 (``commands.Commands``). Every sample and reply carries rmw_zenoh's attachment. Publications
@@ -141,6 +142,11 @@ class Ros2Node:
                 wire.SENSOR_QOS,
                 topic="camera/image_raw/compressed",
             )
+        for imu in self._imus():
+            entities.publisher(
+                f"imu:{imu.name}", types.IMU, wire.SENSOR_QOS, topic=f"{imu.name}/data"
+            )
+            imu.start()  # a small device read at its own rate (a camera is never opened here)
         entities.subscription("joint_trajectory", types.JOINT_TRAJECTORY, self._on_trajectory)
         entities.subscription("joint_command", types.JOINT_STATE, self._on_command)
         entities.service("~/set_compliant", types.SET_BOOL, self._set_compliant)
@@ -221,6 +227,10 @@ class Ros2Node:
                 partial(self._publish_diagnostics, wall), self._worker.stopping
             )
         self._publish_state(self._publishers["joint_states"], self._publishers["tf"], now, wall)
+        for imu in self._imus():
+            if imu.health().age_s is not None:  # a value read: the properties do not wait
+                message = messages.imu(imu, imu.name, wall)
+                self._publishers[f"imu:{imu.name}"].put(types.serialize(message, types.IMU))
 
     def _publish_state(self, states: Publisher, tf: Publisher, now: float, wall: float) -> None:
         states.put(
@@ -254,6 +264,11 @@ class Ros2Node:
         from poppy_core.sensors import Camera
 
         return [s for s in self.robot.sensors if isinstance(s, Camera)]
+
+    def _imus(self) -> list[Any]:
+        from poppy_core.sensors import Imu
+
+        return [s for s in self.robot.sensors if isinstance(s, Imu)]
 
     def _camera_loop(self, stopping: threading.Event) -> None:
         camera = self._cameras()[0]
