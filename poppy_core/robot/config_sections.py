@@ -24,6 +24,7 @@ from pydantic_core import PydanticCustomError
 
 from poppy_core.errors import ConfigError, SensorError
 from poppy_core.robot.config_format import config_error
+from poppy_core.sensors.blobs import check_filters
 from poppy_core.sensors.camera import CameraCalibration, check_resolution
 from poppy_core.sensors.config import (
     CAMERA_TYPES,
@@ -163,6 +164,20 @@ def _min_size(value: int) -> int:
     return value
 
 
+def _filters(value: dict[str, Any]) -> dict[str, Any]:
+    try:
+        check_filters(value)
+    except SensorError as exc:
+        raise PydanticCustomError("filters", "{why}", {"why": _reason(exc)}) from None
+    return value
+
+
+def _min_radius(value: int) -> int:
+    if value < 1:
+        raise PydanticCustomError("min_radius", "must be at least 1 pixel")
+    return value
+
+
 def _baud(value: int) -> int:
     if value <= 0:
         raise PydanticCustomError("baud", "must be a positive baud rate such as 115200")
@@ -213,6 +228,8 @@ class SensorEntry(BaseModel):
     families: Annotated[list[Name], AfterValidator(_families)] | None = None
     min_size: Annotated[Annotated[int, Strict()], AfterValidator(_min_size)] | None = None
     cascade: Annotated[Name, AfterValidator(_non_empty)] | None = None
+    filters: Annotated[dict[str, Any], AfterValidator(_filters)] | None = None
+    min_radius: Annotated[Annotated[int, Strict()], AfterValidator(_min_radius)] | None = None
     sync_freq: Positive | None = None
     port: Annotated[Name, AfterValidator(_non_empty)] | None = None
     baud: Annotated[Annotated[int, Strict()], AfterValidator(_baud)] | None = None
@@ -228,6 +245,7 @@ class SensorEntry(BaseModel):
             "ContactSensor": "gpio_data",
             "SonarSensor": "i2c_pin",
             "RazorIMU": "port",
+            "BlobDetector": "filters",
             "BNO055": "i2c_pin",
         }
         key = needed.get(self.type)
@@ -259,6 +277,8 @@ class SensorEntry(BaseModel):
             "families": tuple(self.families) if self.families is not None else None,
             "min_size": self.min_size,
             "cascade": self.cascade,
+            "filters": check_filters(self.filters, name) if self.filters else None,
+            "min_radius": self.min_radius,
             "port": self.port,
             "baud": self.baud,
             "gpio_data": self.gpio_data,

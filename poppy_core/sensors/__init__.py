@@ -1,4 +1,4 @@
-"""Sensors: cameras (OpenCV, blank, simulated in ``poppy_core.sim``), markers, faces, devices, IMUs.
+"""Sensors: cameras (OpenCV, blank, simulated), markers, faces, blobs, devices, IMUs.
 
 Imports nothing of ours but ``errors``; OpenCV, gpiozero and smbus2 are imported on first use.
 The robot factory builds them from a config's ``sensors`` section (``build_sensors``).
@@ -6,6 +6,7 @@ The robot factory builds them from a config's ``sensors`` section (``build_senso
 
 from poppy_core.sensors.arduino import ArduinoSensor
 from poppy_core.sensors.base import Sensor, SensorHealth, SensorLost
+from poppy_core.sensors.blobs import Blob, BlobDetector
 from poppy_core.sensors.bno055 import BNO055
 from poppy_core.sensors.camera import Camera, CameraCalibration, DummyCamera, Frame
 from poppy_core.sensors.config import (
@@ -28,6 +29,8 @@ __all__ = [
     "NOT_YET",
     "SUPPORTED_TYPES",
     "ArduinoSensor",
+    "Blob",
+    "BlobDetector",
     "Camera",
     "CameraCalibration",
     "ContactSensor",

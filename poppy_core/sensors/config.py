@@ -6,6 +6,7 @@ pypot's form: ``{"camera": {"type": "OpenCVCamera", "index": -1, "fps": 20.0, "r
 ``cards``, ``dictionary``, ``marker_size``, ``families`` (marker detector), ``sim_camera`` (the
 MuJoCo camera a simulated robot renders for it; default: the sensor's name). A ``FaceDetector``
 (pypot's: ``cameras``, ``freq``) takes ``min_size`` (pixels) and ``cascade`` (an LBP cascade XML).
+A ``BlobDetector`` (pypot's: ``cameras``, ``freq``, ``filters``) takes ``min_radius`` (pixels).
 The device sensors take pypot's keys: ``ArduinoSensor`` ``port``, ``baud``, ``sync_freq``;
 ``ContactSensor`` ``gpio_data``, ``gpio_vcc``; ``SonarSensor`` ``i2c_pin``, ``address``,
 ``sync_freq``. The IMUs: ``RazorIMU`` ``port``, ``baud`` (57600), ``sync_freq``; ``BNO055``
@@ -23,6 +24,7 @@ from dataclasses import dataclass, field
 from poppy_core.errors import SensorError
 from poppy_core.sensors.arduino import DEFAULT_BAUD, DEFAULT_SYNC_HZ, ArduinoSensor
 from poppy_core.sensors.base import Sensor
+from poppy_core.sensors.blobs import DEFAULT_BLOB_FREQ_HZ, DEFAULT_MIN_RADIUS_PX, BlobDetector
 from poppy_core.sensors.bno055 import BNO055, DEFAULT_BNO055_ADDRESS, DEFAULT_BNO055_HZ
 from poppy_core.sensors.camera import (
     DEFAULT_FPS,
@@ -42,7 +44,7 @@ from poppy_core.sensors.markers import DEFAULT_DICTIONARY, DEFAULT_MARKER_SIZE_M
 from poppy_core.sensors.sonar import DEFAULT_ADDRESS, DEFAULT_SONAR_HZ, SonarSensor
 
 CAMERA_TYPES = ("OpenCVCamera", "DummyCamera")
-DETECTOR_TYPES = ("MarkerDetector", "FaceDetector")
+DETECTOR_TYPES = ("MarkerDetector", "FaceDetector", "BlobDetector")
 IMU_TYPES = ("RazorIMU", "BNO055")
 DEVICE_TYPES = ("ArduinoSensor", "ContactSensor", "SonarSensor", *IMU_TYPES)
 """Sensors on their own device (a serial port, a GPIO pin, an I2C bus), no camera."""
@@ -54,7 +56,6 @@ NOT_YET: dict[str, str] = {
     "OptiBridgeServer": "OptiTrack",
     "TrackedObject": "OptiTrack",
     "ForceSensor": "force",
-    "BlobDetector": "blob detector",
 }
 
 
@@ -81,6 +82,8 @@ class SensorSpec:
     families: tuple[str, ...] = FAMILIES
     min_size: int = DEFAULT_MIN_SIZE_PX
     cascade: str | None = None
+    filters: Mapping[str, tuple[int, int]] = field(default_factory=dict)
+    min_radius: int = DEFAULT_MIN_RADIUS_PX
     port: str = ""
     baud: int | None = None
     gpio_data: int | str = 0
@@ -203,6 +206,14 @@ def build_sensors(
                     dictionary=spec.dictionary,
                     marker_size=spec.marker_size,
                     families=spec.families,
+                )
+            elif spec.type == "BlobDetector":
+                sensors[spec.name] = BlobDetector(
+                    spec.name,
+                    readable,
+                    spec.rate_hz or DEFAULT_BLOB_FREQ_HZ,
+                    filters=spec.filters,
+                    min_radius=spec.min_radius,
                 )
             elif spec.type == "FaceDetector":
                 sensors[spec.name] = FaceDetector(

@@ -27,7 +27,7 @@ def with_sensors(sensors: dict[str, Any]) -> dict[str, Any]:
     [
         ("KinectSensor", "Kinect"),
         ("OptiTrackClient", "OptiTrack"),
-        ("BlobDetector", "blob detector"),
+        ("TrackedObject", "OptiTrack"),
         ("ForceSensor", "force"),
     ],
 )
