@@ -231,7 +231,8 @@ class SensorEntry(BaseModel):
     filters: Annotated[dict[str, Any], AfterValidator(_filters)] | None = None
     min_radius: Annotated[Annotated[int, Strict()], AfterValidator(_min_radius)] | None = None
     sync_freq: Positive | None = None
-    port: Annotated[Name, AfterValidator(_non_empty)] | None = None
+    port: Annotated[Name, AfterValidator(_non_empty)] | Annotated[int, Strict()] | None = None
+    addr: Annotated[Name, AfterValidator(_non_empty)] | None = None
     baud: Annotated[Annotated[int, Strict()], AfterValidator(_baud)] | None = None
     gpio_data: Annotated[int, Strict()] | Name | None = None
     gpio_vcc: Annotated[int, Strict()] | Name | None = None
@@ -247,6 +248,7 @@ class SensorEntry(BaseModel):
             "RazorIMU": "port",
             "BlobDetector": "filters",
             "BNO055": "i2c_pin",
+            "KinectSensor": "addr",
         }
         key = needed.get(self.type)
         if key is not None and getattr(self, key) is None:
@@ -255,6 +257,13 @@ class SensorEntry(BaseModel):
                 "{kind} needs its '{key}' key (as in pypot's config)",
                 {"kind": self.type, "key": key},
             )
+        tcp = self.type == "KinectSensor"
+        if tcp and not (isinstance(self.port, int) and 0 < self.port < 65536):
+            raise PydanticCustomError(
+                "port", "KinectSensor needs its 'port': the server's TCP port (1-65535)"
+            )
+        if not tcp and isinstance(self.port, int):
+            raise PydanticCustomError("port", "'port' must be a serial device such as /dev/ttyACM0")
         return self
 
     def spec(self, name: str) -> SensorSpec:
@@ -279,7 +288,9 @@ class SensorEntry(BaseModel):
             "cascade": self.cascade,
             "filters": check_filters(self.filters, name) if self.filters else None,
             "min_radius": self.min_radius,
-            "port": self.port,
+            "port": self.port if isinstance(self.port, str) else None,
+            "tcp_port": self.port if isinstance(self.port, int) else None,
+            "addr": self.addr,
             "baud": self.baud,
             "gpio_data": self.gpio_data,
             "gpio_vcc": self.gpio_vcc,

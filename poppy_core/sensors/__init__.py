@@ -21,6 +21,7 @@ from poppy_core.sensors.contact import ContactSensor
 from poppy_core.sensors.detector import FrameDetector, MarkerDetector
 from poppy_core.sensors.faces import Face, FaceDetector, FaceFinder
 from poppy_core.sensors.imu import Imu, RazorIMU, StillIMU
+from poppy_core.sensors.kinect import KinectSensor, Skeleton
 from poppy_core.sensors.markers import Marker, MarkerFinder, MarkerPose, marker_image
 from poppy_core.sensors.sonar import SonarSensor
 
@@ -41,6 +42,7 @@ __all__ = [
     "Frame",
     "FrameDetector",
     "Imu",
+    "KinectSensor",
     "Marker",
     "MarkerDetector",
     "MarkerFinder",
@@ -50,6 +52,7 @@ __all__ = [
     "SensorHealth",
     "SensorLost",
     "SensorSpec",
+    "Skeleton",
     "SonarSensor",
     "StillIMU",
     "build_sensors",

@@ -9,8 +9,9 @@ MuJoCo camera a simulated robot renders for it; default: the sensor's name). A `
 A ``BlobDetector`` (pypot's: ``cameras``, ``freq``, ``filters``) takes ``min_radius`` (pixels).
 The device sensors take pypot's keys: ``ArduinoSensor`` ``port``, ``baud``, ``sync_freq``;
 ``ContactSensor`` ``gpio_data``, ``gpio_vcc``; ``SonarSensor`` ``i2c_pin``, ``address``,
-``sync_freq``. The IMUs: ``RazorIMU`` ``port``, ``baud`` (57600), ``sync_freq``; ``BNO055``
-``i2c_pin``, ``address`` (0x28), ``sync_freq``; both take ``sim_body`` (the MuJoCo body a
+``sync_freq``; ``KinectSensor`` ``addr``, ``port`` (the skeleton server's ZMQ port). The
+IMUs: ``RazorIMU`` ``port``, ``baud`` (57600), ``sync_freq``; ``BNO055`` ``i2c_pin``,
+``address`` (0x28), ``sync_freq``; both take ``sim_body`` (the MuJoCo body a
 simulated robot's IMU rides; default ``head``).
 The section is checked where the rest of the config is (``poppy_core.robot.config_sections``,
 every problem at once); this leaf receives plain ``SensorSpec`` entries.
@@ -40,18 +41,18 @@ from poppy_core.sensors.faces import (
     FaceDetector,
 )
 from poppy_core.sensors.imu import RAZOR_BAUD, RAZOR_HZ, Imu, RazorIMU, StillIMU
+from poppy_core.sensors.kinect import DEFAULT_KINECT_HZ, KinectSensor
 from poppy_core.sensors.markers import DEFAULT_DICTIONARY, DEFAULT_MARKER_SIZE_M, FAMILIES
 from poppy_core.sensors.sonar import DEFAULT_ADDRESS, DEFAULT_SONAR_HZ, SonarSensor
 
 CAMERA_TYPES = ("OpenCVCamera", "DummyCamera")
 DETECTOR_TYPES = ("MarkerDetector", "FaceDetector", "BlobDetector")
 IMU_TYPES = ("RazorIMU", "BNO055")
-DEVICE_TYPES = ("ArduinoSensor", "ContactSensor", "SonarSensor", *IMU_TYPES)
-"""Sensors on their own device (a serial port, a GPIO pin, an I2C bus), no camera."""
+DEVICE_TYPES = ("ArduinoSensor", "ContactSensor", "SonarSensor", "KinectSensor", *IMU_TYPES)
+"""Sensors on their own device (a serial port, a GPIO pin, an I2C bus, a server), no camera."""
 SUPPORTED_TYPES = (*CAMERA_TYPES, *DETECTOR_TYPES, *DEVICE_TYPES)
 NOT_YET: dict[str, str] = {
     # pypot 5.0.2's pypot.sensor classes and the sensors the Poppy documentation names
-    "KinectSensor": "Kinect",
     "OptiTrackClient": "OptiTrack",
     "OptiBridgeServer": "OptiTrack",
     "TrackedObject": "OptiTrack",
@@ -85,6 +86,8 @@ class SensorSpec:
     filters: Mapping[str, tuple[int, int]] = field(default_factory=dict)
     min_radius: int = DEFAULT_MIN_RADIUS_PX
     port: str = ""
+    addr: str = ""
+    tcp_port: int = 0
     baud: int | None = None
     gpio_data: int | str = 0
     gpio_vcc: int | str | None = None
@@ -155,6 +158,8 @@ def device_sensor(spec: SensorSpec) -> Sensor:
     if spec.type == "ArduinoSensor":
         baud = spec.baud or DEFAULT_BAUD
         return ArduinoSensor(spec.name, spec.port, baud, spec.rate_hz or DEFAULT_SYNC_HZ)
+    if spec.type == "KinectSensor":
+        return KinectSensor(spec.name, spec.addr, spec.tcp_port, spec.rate_hz or DEFAULT_KINECT_HZ)
     if spec.type == "SonarSensor":
         address = spec.address or DEFAULT_ADDRESS
         return SonarSensor(spec.name, spec.i2c_pin, address, spec.rate_hz or DEFAULT_SONAR_HZ)

@@ -37,6 +37,8 @@ def json_value(value: Any, sensor: str) -> Any:
         return [json_value(v, sensor) for v in value]
     if hasattr(value, "as_dict"):
         return value.as_dict()
+    if isinstance(value, dict):
+        return {str(k): json_value(v, sensor) for k, v in value.items()}
     if isinstance(value, np.generic):
         return value.item()
     return value

@@ -146,7 +146,7 @@ def test_validate_lists_chains_and_sensors_problems_one_line_each(
     data["kinematics"] = {"model": "", "chains": {"arm": {"motors": ["m1"]}}}
     data["sensors"] = {
         "camera": {"type": "OpenCVCamera", "resolution": [640]},
-        "imu": {"type": "KinectSensor"},
+        "imu": {"type": "ForceSensor"},
     }
     bad, lines = _validate_refused(poppy, tmp_path, data)
     assert any("sensors.camera.resolution = [640]: must be [width, " in line for line in lines)

@@ -25,7 +25,7 @@ def with_sensors(sensors: dict[str, Any]) -> dict[str, Any]:
 @pytest.mark.parametrize(
     ("kind", "name"),
     [
-        ("KinectSensor", "Kinect"),
+        ("OptiBridgeServer", "OptiTrack"),
         ("OptiTrackClient", "OptiTrack"),
         ("TrackedObject", "OptiTrack"),
         ("ForceSensor", "force"),
