@@ -53,13 +53,14 @@ def fleet_serve(
     """Serve the teacher's page: every robot of the fleet, live; play, run and Stop for all."""
     from poppy_core.errors import ConfigError, PoppyError
     from poppy_core.remote.zenoh_client import client_settings
+    from poppy_core.remote.zenoh_fleet import Fleet
     from poppy_core.server.teacher import TeacherServer, exposure
 
     token = _token(token, token_file)
     try:
         settings = client_settings(tuple(connect or ()), zenoh_config, zenoh_scout)
         server = TeacherServer(
-            settings,
+            lambda: Fleet(settings, token=token),
             host=host,
             port=http_port,
             token=token,

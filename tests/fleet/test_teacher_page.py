@@ -18,6 +18,7 @@ import pytest
 
 from poppy_core.motion.move import Move
 from poppy_core.motion.move_library import save_move
+from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.zenoh_wire import ZenohSettings
 from tests.helpers.chromium import launched, needs_chromium, new_tab
 from tests.helpers.cli import ENV, POPPY, command_env
@@ -58,7 +59,7 @@ def robots(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Served, S
 @pytest.fixture(scope="module")
 def teacher(robots: tuple[Served, Served]) -> Iterator[TeacherServer]:
     settings = ZenohSettings(connect=connect_to(*robots))
-    with TeacherServer(settings, token=TOKEN) as server:
+    with TeacherServer(lambda: Fleet(settings, token=TOKEN), token=TOKEN) as server:
         yield server
 
 
@@ -272,7 +273,8 @@ def test_the_page_plays_a_move_on_both_robots_together_and_stop_stops_both(
             ),
             timeout_s=WAIT_S,
         ), "the cards say what the robots do (live over Zenoh)"
-        assert page.inner_text("#message") == f"playing {MOVE}: jr1, jr2"
+        assert page.inner_text("#message") == f"play {MOVE}: jr1, jr2, started together"
+        assert page.inner_text("#robot-jr1 .outcome") == f"play {MOVE}: done"
         page.click("#stop-all")
         assert eventually(lambda: not _playing(jr1) and not _playing(jr2), timeout_s=WAIT_S), (
             "both stopped"
@@ -379,3 +381,65 @@ def test_poppy_fleet_serve_refuses_a_bad_origin_and_a_busy_port(
     busy = run_poppy("fleet", "serve", "--http-port", str(teacher.port), *args)
     assert busy.code == 1 and "already in use" in busy.stderr, busy.stderr
     assert len(busy.stderr.strip().splitlines()) == 1
+
+
+MEAN_PIXEL = """img => {
+  const canvas = document.createElement("canvas");
+  canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
+  const context = canvas.getContext("2d");
+  context.drawImage(img, 0, 0);
+  const data = context.getImageData(0, 0, canvas.width, canvas.height).data;
+  let sum = 0;
+  for (let i = 0; i < data.length; i += 4) sum += data[i] + data[i + 1] + data[i + 2];
+  return sum / (data.length / 4) / 3;
+}"""
+
+
+@needs_chromium
+@pytest.mark.gl
+def test_a_card_shows_the_simulated_camera_when_its_button_is_clicked(browser: Any) -> None:
+    pytest.importorskip("mujoco")
+    from poppy_core import from_profile
+    from poppy_core.assembly import ServeSpec, serve
+    from poppy_core.errors import SensorError
+    from tests.helpers.zenoh_served import free_endpoint
+
+    robot = from_profile("ergo-jr", sim="mujoco")
+    try:
+        robot.camera.latest(timeout_s=30)
+    except SensorError as exc:
+        robot.close()
+        pytest.skip(f"no OpenGL for offscreen rendering here ({exc}); `make sim-deps`")
+    endpoint = free_endpoint()
+    servers = serve(robot, ServeSpec(zenoh=ZenohSettings(listen=(endpoint,)), name="jr3"))
+    try:
+        settings = ZenohSettings(connect=(endpoint,))
+        with TeacherServer(lambda: Fleet(settings)) as teacher:
+            context, page = new_tab(browser, WAIT_S * 1000)
+            try:
+                page.goto(teacher.url + "/")
+                button = page.locator("#robot-jr3 .camera button")
+                button.wait_for()
+                assert button.inner_text() == "Camera: camera"
+                image = page.locator("#robot-jr3 .camera img")
+                assert image.is_hidden()  # nothing asked before the click
+                shown: list[str] = []
+
+                def seen() -> bool:  # a new frame each click (a first one may still be black)
+                    if image.is_hidden() or image.get_attribute("src") in shown:
+                        return False
+                    shown.append(image.get_attribute("src") or "")
+                    if image.evaluate("i => i.complete && i.naturalWidth") and (
+                        image.evaluate(MEAN_PIXEL) > 20
+                    ):
+                        return True
+                    button.click()
+                    return False
+
+                button.click()
+                assert eventually(seen, timeout_s=WAIT_S, interval_s=0.1), "a picture, not black"
+            finally:
+                context.close()
+    finally:
+        servers.stop()
+        robot.close()

@@ -5,7 +5,7 @@ token, the Host and Origin checks, the body limit, the page's security headers a
 from __future__ import annotations
 
 import threading
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Callable
 from contextlib import asynccontextmanager
 from importlib.resources import files
 from typing import TYPE_CHECKING, Any
@@ -26,7 +26,6 @@ if TYPE_CHECKING:
     from fastapi import FastAPI
 
     from poppy_core.remote.zenoh_fleet import Fleet
-    from poppy_core.zenoh_wire import ZenohSettings
 
 TEACHER_PREFIX = "/teacher/"
 """Where the teacher's page's own assets are (the robot page's are at ``/web/``: its style, its
@@ -123,7 +122,8 @@ class TeacherServer:
     """The teacher's page served in a thread over a fleet it opens: ``start``, ``stop``.
 
     Args:
-        zenoh: how to join the robots' network.
+        open_fleet: opens the robots' fleet (``Fleet(settings, token=...)``: the token it signs
+            the commands with); called once the port is bound, closed on ``stop``.
         host: address to listen on (loopback by default).
         port: HTTP port (0 picks a free one: read ``port`` once started).
         token: the page's token, which also signs every command to the robots.
@@ -134,7 +134,7 @@ class TeacherServer:
 
     def __init__(
         self,
-        zenoh: ZenohSettings,
+        open_fleet: Callable[[], Fleet],
         *,
         host: str = "127.0.0.1",
         port: int = 0,
@@ -143,7 +143,7 @@ class TeacherServer:
         allow_hosts: tuple[str, ...] = (),
         report: Any = None,
     ) -> None:
-        self.zenoh = zenoh
+        self.open_fleet = open_fleet
         self.host = host
         self.port = port
         self.token = token
@@ -174,14 +174,12 @@ class TeacherServer:
 
         Raises:
             ListenError: the address or port cannot be used.
-            ConfigError: Zenoh's settings are refused.
+            PoppyError: the fleet cannot be opened (Zenoh's settings refused, no router).
         """
-        from poppy_core.remote.zenoh_fleet import Fleet
-
         sockets = bind_sockets(self.host, self.port)  # a busy port is said before Zenoh waits
         try:
             self.port = int(sockets[0].getsockname()[1])
-            self.fleet = Fleet(self.zenoh, token=self.token)
+            self.fleet = self.open_fleet()
             app = create_teacher_app(self.fleet, token=self.token, policy=self.policy)
             self.thread = ServerThread(app, self.host, self.port, sockets=sockets).start()
         except BaseException:

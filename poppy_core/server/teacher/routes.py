@@ -38,9 +38,11 @@ PUSH_PERIOD_S = 0.25
 KEEPALIVE_S = 5.0
 """The stream sends the cards at least this often, news or not (the page sees it is alive)."""
 MAX_ROBOTS = 256
+FRAME_TIMEOUT_S = 10.0
+"""How long a robot has to answer a camera's frame: the first one starts its camera."""
 
 
-class Selection(BaseModel):
+class FleetSelection(BaseModel):
     """The robots a command goes to."""
 
     robots: list[str] = Field(
@@ -48,7 +50,7 @@ class Selection(BaseModel):
     )
 
 
-class PlayRequest(Selection):
+class FleetPlayRequest(FleetSelection):
     """A move of each robot's library, played by the robots together."""
 
     move: str = Field(..., min_length=1, max_length=128)
@@ -60,13 +62,13 @@ class PlayRequest(Selection):
     )
 
 
-class RunRequest(Selection):
+class FleetRunRequest(FleetSelection):
     """A primitive started on the robots together."""
 
     primitive: str = Field(..., min_length=1, max_length=128)
 
 
-class StopRequest(BaseModel):
+class FleetStopRequest(BaseModel):
     """The robots to stop: every robot here when none are named."""
 
     robots: list[str] | None = Field(None, max_length=MAX_ROBOTS)
@@ -118,7 +120,7 @@ def robots(request: Request) -> list[dict[str, Any]]:
 
 
 @router.post("/play", summary="Play a move on the robots selected, all starting together")
-async def play(body: PlayRequest, request: Request) -> dict[str, Any]:
+async def play(body: FleetPlayRequest, request: Request) -> dict[str, Any]:
     """Each robot plays the move of its own library at the fleet's shared start; each answers
     (a refusal in REST's words)."""
     data: dict[str, Any] = {"speed": 1.0, "backwards": False}
@@ -130,7 +132,7 @@ async def play(body: PlayRequest, request: Request) -> dict[str, Any]:
 
 
 @router.post("/run", summary="Start a primitive on the robots selected, all together")
-async def run(body: RunRequest, request: Request) -> dict[str, Any]:
+async def run(body: FleetRunRequest, request: Request) -> dict[str, Any]:
     """Each robot starts the primitive at the fleet's shared start."""
     path = f"/api/v1/primitives/{quote(body.primitive, safe='')}/start"
     names = _names(body.robots)
@@ -138,7 +140,7 @@ async def run(body: RunRequest, request: Request) -> dict[str, Any]:
 
 
 @router.post("/stop", summary="Stop: primitives and moves stopped, motors held, on every robot")
-async def stop(body: StopRequest, request: Request) -> dict[str, Any]:
+async def stop(body: FleetStopRequest, request: Request) -> dict[str, Any]:
     """Every robot here (or those named): the robot page's Stop, at once (no shared start)."""
     watch: FleetWatch = request.app.state.watch
     fleet = _fleet(request)
@@ -164,7 +166,9 @@ async def frame(name: str, camera: str, request: Request) -> Response:
     path = f"/api/v1/sensors/{quote(camera, safe='')}/frame.jpg"
 
     def ask() -> Outcome:
-        return _fleet(request).command([robot], "GET", path, together=False)[0]
+        fleet = _fleet(request)
+        timeout_s = max(fleet.timeout_s, FRAME_TIMEOUT_S)
+        return fleet.command([robot], "GET", path, together=False, timeout_s=timeout_s)[0]
 
     outcome = await run_in_threadpool(ask)
     if not outcome.ok:

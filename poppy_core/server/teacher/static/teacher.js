@@ -89,6 +89,8 @@ async function thumbnail(name, camera, image, card) {
     if (image.src) URL.revokeObjectURL(image.src);
     image.src = URL.createObjectURL(await response.blob());
     image.hidden = false;
+    card.parts.outcome.textContent = `${camera}: the picture of ${new Date().toLocaleTimeString()}`;
+    card.parts.outcome.className = "outcome muted";
     return;
   }
 }
@@ -144,12 +146,13 @@ function report(answer, what) {
   for (const outcome of answer.outcomes) {
     const card = cards.get(outcome.name);
     if (!card) continue;
-    card.parts.outcome.textContent = outcome.ok ? what : outcome.message;
+    card.parts.outcome.textContent = outcome.ok ? `${what}: done` : outcome.message;
     card.parts.outcome.className = `outcome ${outcome.ok ? "muted" : "error"}`;
   }
   const done = answer.outcomes.filter((outcome) => outcome.ok).map((outcome) => outcome.name);
   const lines = [];
-  if (done.length) lines.push(`${what}: ${done.join(", ")}`);
+  const together = answer.start_at !== null && done.length > 1 ? ", started together" : "";
+  if (done.length) lines.push(`${what}: ${done.join(", ")}${together}`);
   for (const outcome of failed) lines.push(`${outcome.name}: ${outcome.message}`);
   say(lines.join(" · "), failed.length > 0);
 }
@@ -168,17 +171,17 @@ document.getElementById("play-form").addEventListener("submit", (event) => {
   const ramp = document.getElementById("ramp").value;
   const body = { move, robots: [...selected] };
   if (ramp !== "") body.ramp_s = Number(ramp);
-  command("/api/v1/fleet/play", body, `playing ${move}`);
+  command("/api/v1/fleet/play", body, `play ${move}`);
 });
 
 document.getElementById("run-form").addEventListener("submit", (event) => {
   event.preventDefault();
   const primitive = document.getElementById("primitive-choice").value;
-  command("/api/v1/fleet/run", { primitive, robots: [...selected] }, `${primitive} started`);
+  command("/api/v1/fleet/run", { primitive, robots: [...selected] }, `start ${primitive}`);
 });
 
 function stopAll() {
-  command("/api/v1/fleet/stop", {}, "stopped, motors held");
+  command("/api/v1/fleet/stop", {}, "stop (motors held)");
 }
 
 document.getElementById("stop-all").addEventListener("click", stopAll);
