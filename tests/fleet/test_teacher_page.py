@@ -443,3 +443,27 @@ def test_a_card_shows_the_simulated_camera_when_its_button_is_clicked(browser: A
     finally:
         servers.stop()
         robot.close()
+
+
+def test_a_robot_that_leaves_keeps_its_card_marked_gone_and_is_not_stopped(
+    moves: Path,
+) -> None:
+    jr9 = Served("jr9", token=None)
+    settings = ZenohSettings(connect=(jr9.endpoint,))
+    try:
+        with TeacherServer(lambda: Fleet(settings)) as teacher:
+            http = httpx.Client(base_url=teacher.url, timeout=http_timeout(10))
+
+            def card() -> dict[str, Any]:
+                cards = {c["name"]: c for c in http.get("/api/v1/fleet/robots").json()}
+                return cards.get("jr9", {})
+
+            assert eventually(lambda: card().get("health") == "ok", timeout_s=WAIT_S)
+            jr9.close()
+            assert eventually(lambda: card().get("alive") is False, timeout_s=WAIT_S)
+            assert card()["health"] == "left the network" and card()["ok"] is False
+            stop = http.post("/api/v1/fleet/stop", json={})
+            assert stop.status_code == 409 and stop.json()["detail"] == "no robot on Zenoh to stop"
+            http.close()
+    finally:
+        jr9.close()

@@ -65,6 +65,7 @@ def create_teacher_app(
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        watch.start()
         try:
             yield
         finally:

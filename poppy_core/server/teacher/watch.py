@@ -93,6 +93,8 @@ class FleetWatch:
 
     Args:
         fleet: the fleet (its session stays the caller's; ``close`` only stops the worker).
+
+    The subscriptions are made at once; ``start`` starts describing the robots.
     """
 
     def __init__(self, fleet: Fleet) -> None:
@@ -104,6 +106,9 @@ class FleetWatch:
         fleet.on_presence(self._presence)
         fleet.on_health(self._health)
         fleet.on_state(self._state)
+
+    def start(self) -> None:
+        """Describe the robots as they come (a worker thread)."""
         self._worker.start()
 
     def snapshot(self) -> list[dict[str, Any]]:
