@@ -137,10 +137,18 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
         ("fleet list --connect tcp/192.168.1.10:7447", "the robots on Zenoh"),
         ("fleet play wave --all", "every robot plays a move, starting together"),
         ("fleet stop --all", "the Stop button of every robot"),
+        ("fleet serve", "the teacher's page: every robot's card, play and Stop for all"),
     ),
     "fleet discover": (
         ("fleet discover", "listen 3 s on every interface"),
         ("fleet discover --timeout 1 --interface 127.0.0.1 --json", "this machine's only"),
+    ),
+    "fleet serve": (
+        ("fleet serve", "the teacher's page on http://127.0.0.1:8090/, robots via a local router"),
+        (
+            "fleet serve --host 0.0.0.0 --token-file ~/.poppy-token",
+            "on the classroom's network, with the robots' token",
+        ),
     ),
     "fleet router": (
         ("fleet router", "a Zenoh router on port 7447 of every interface, until Ctrl-C"),

@@ -118,15 +118,19 @@ class Fleet:
         body: Any = None,
         *,
         together: bool = True,
+        timeout_s: float | None = None,
     ) -> list[Outcome]:
         """Send one v1 request to every robot of ``names`` at once; with ``together`` each runs
         it at the same wall-clock time (``START_LEAD_S`` from now) and this returns once that
         time has come (a start is answered when armed, before it). A robot that does not
-        answer within the timeout gets an outcome saying so (never a hang).
+        answer within the timeout (``timeout_s``, else the fleet's) gets an outcome saying so
+        (never a hang).
         """
         start_at = time.time() + START_LEAD_S if together else None
         self.last_start_at = start_at
-        timeout = self.timeout_s + (START_LEAD_S if together else 0.0)
+        timeout = (self.timeout_s if timeout_s is None else timeout_s) + (
+            START_LEAD_S if together else 0.0
+        )
         pending = []
         for name in names:
             payload = zenoh_wire.api_request(

@@ -149,6 +149,8 @@ class ServerThread:
         max_connections: see ``uvicorn_server``.
         alias_ports: more ports on ``host`` serving the same app (the appliance's 8080 beside
             its 80); 0 picks a free one. Read them in ``ports`` after ``bind``.
+        sockets: sockets already bound and listening (``bind_sockets``), served instead of
+            binding ``port``: a caller that must know the port is free before it builds the app.
     """
 
     def __init__(
@@ -160,14 +162,15 @@ class ServerThread:
         header_timeout_s: float = HEADER_TIMEOUT_S,
         max_connections: int = MAX_CONNECTIONS,
         alias_ports: tuple[int, ...] = (),
+        sockets: list[socket.socket] | None = None,
     ) -> None:
         self.host = host
         self.alias_ports = alias_ports
         self.server = uvicorn_server(
             app, host, port, header_timeout_s=header_timeout_s, max_connections=max_connections
         )
-        self.port = port
-        self._sockets: list[socket.socket] | None = None
+        self._sockets: list[socket.socket] | None = sockets
+        self.port = int(sockets[0].getsockname()[1]) if sockets else port
         self._worker = Worker("uvicorn", self._run)
 
     @property

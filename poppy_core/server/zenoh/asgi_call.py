@@ -10,6 +10,7 @@ under way and lets each of them answer before the loop ends.
 from __future__ import annotations
 
 import asyncio
+import base64
 import json
 import logging
 import threading
@@ -20,6 +21,8 @@ logger = logging.getLogger(__name__)
 
 HOST = "127.0.0.1"
 """The Host header of a request over Zenoh: a loopback name, which the Host check answers."""
+BINARY_TYPES = frozenset({"image/jpeg", "image/png", "application/octet-stream"})
+"""Answers sent over Zenoh in base64 (JSON carries no bytes): a camera's frame."""
 
 
 class AsgiCaller:
@@ -57,8 +60,9 @@ class AsgiCaller:
         client: str = "zenoh",
     ) -> tuple[int, Any]:
         """The status and decoded JSON answer of ``method path`` (``body`` sent as JSON);
-        ``client`` is who the app sees asking (its logs name it). A route that raises gives
-        500 and the failure's line (the app's own 500 when it sent one first)."""
+        ``client`` is who the app sees asking (its logs name it). A binary answer (a camera's
+        frame) is ``{"media_type", "base64"}``. A route that raises gives 500 and the
+        failure's line (the app's own 500 when it sent one first)."""
         import httpx
 
         headers = {"host": HOST, "accept": "application/json"}
@@ -88,6 +92,10 @@ class AsgiCaller:
         if failure and not data:
             exc = failure[0]
             return 500, {"detail": f"the route failed: {type(exc).__name__}: {exc}"}
+        media_type = response.headers.get("content-type", "").split(";")[0].strip()
+        if data and media_type in BINARY_TYPES:
+            encoded = base64.b64encode(data).decode("ascii")
+            return response.status_code, {"media_type": media_type, "base64": encoded}
         try:
             return response.status_code, json.loads(data) if data else None
         except ValueError:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from poppy_core.server.web.about_parts import camera_views
+
 if TYPE_CHECKING:
     from poppy_core.robot import Robot
 
@@ -26,6 +28,13 @@ def motors(robot: Robot) -> list[dict[str, Any]]:
         }
         for m in robot.motors
     ]
+
+
+def cameras(robot: Robot) -> dict[str, Any]:
+    """The cameras with a picture (name and label, as the robot's page shows them) and what a
+    viewer says without one (an ideal simulation's black frames are no picture)."""
+    views, no_camera = camera_views(robot)
+    return {"cameras": views, "no_camera": no_camera}
 
 
 def _jsonable(value: Any) -> Any:

@@ -253,7 +253,8 @@ class ZenohRobotServer:
         }
 
     def description(self) -> dict[str, Any]:
-        """Creature, motors (with limits), groups, primitives, moves, chains, host, endpoints."""
+        """Creature, motors (with limits), groups, primitives, moves, chains, cameras (those
+        with a picture, else ``no_camera`` says why), host, endpoints."""
         robot = self.service.robot
         return {
             "version": zenoh_wire.STATE_VERSION,
@@ -269,6 +270,7 @@ class ZenohRobotServer:
             "primitives": list(self.service.primitives()),
             "moves": self.service.moves.names(),
             "chains": list(robot_chains(robot)),
+            **described.cameras(robot),
             "health": self.health(),
         }
 
