@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import asyncio
 import threading
-from collections.abc import Iterator
+from collections.abc import AsyncIterator, Iterator
 from types import SimpleNamespace
 from typing import Any, cast
 from urllib.parse import urlsplit
@@ -14,6 +14,7 @@ from urllib.parse import urlsplit
 import httpx
 import pytest
 
+from poppy_core.errors import SensorError
 from poppy_core.sensors import DummyCamera
 from poppy_core.server.routers import v1_sensors
 from poppy_core.server.sensors import SensorService
@@ -227,3 +228,36 @@ def test_the_viewers_the_snapshots_ros2_and_foxglove_share_one_encoding_of_a_fra
     published = camera.encoded(frame, ".jpg")  # what ROS 2 and Foxglove ask
     assert snapshot == viewer == published and snapshot.startswith(b"\xff\xd8")
     assert len(calls) == 1
+
+
+def test_a_viewer_of_a_lost_camera_that_leaves_is_released(
+    served: Served, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    camera = next(s for s in served.robot.sensors if s.name == "camera")
+    tries: list[int] = []
+    ended: list[bool] = []
+
+    async def lost(after: int = 0, timeout_s: float = 0.0) -> Any:
+        tries.append(after)
+        raise SensorError("camera 'camera' gave no new frame in 5 s", sensor="camera")
+
+    real_mjpeg = v1_sensors.mjpeg
+
+    async def watched(*args: Any) -> AsyncIterator[bytes]:
+        try:
+            async for part in real_mjpeg(*args):
+                yield part
+        finally:
+            ended.append(True)
+
+    monkeypatch.setattr(camera, "wait_frame", lost)
+    monkeypatch.setattr(v1_sensors, "mjpeg", watched)
+
+    async def scenario() -> tuple[bool, bool]:
+        _, writer = await ask_stream(served.url, 15)
+        waiting = await asyncio.to_thread(eventually, lambda: len(tries) >= 2, 30.0)
+        writer.close()  # no part was sent meanwhile: the stream notices the client left
+        released = await asyncio.to_thread(eventually, lambda: ended == [True], 30.0)
+        return waiting, released
+
+    assert asyncio.run(scenario()) == (True, True)
