@@ -4,7 +4,8 @@ A frame is a numpy array ``(height, width, 3)`` of ``uint8`` in OpenCV's BGR ord
 cameras give (``cv2.imwrite("f.png", robot.camera.frame)`` works). ``camera.frame`` is a copy
 of the latest frame (draw on it freely); ``latest()`` is the shared, read-only one.
 ``encoded(frame, ".jpg", q)`` encodes a frame once for every reader asking the same format and
-quality; ``await wait_frame(after)`` waits for a new frame in an event loop, holding no thread.
+quality (through ``encode``, which a camera with its own encoder overrides); ``await
+wait_frame(after)`` waits for a new frame in an event loop, holding no thread.
 """
 
 from __future__ import annotations
@@ -26,6 +27,9 @@ from poppy_core.sensors.opencv import encode_image
 
 DEFAULT_RESOLUTION = (640, 480)
 DEFAULT_FPS = 20.0
+JPEG_QUALITY = 80
+"""The JPEG quality every reader of a frame gets unless it asks another (the MJPEG viewers,
+snapshots, ROS 2, Foxglove): one encoding of each frame serves them all."""
 
 
 @dataclass(frozen=True)
@@ -285,7 +289,15 @@ class Camera(Sensor):
 
     # -- one encoding per frame, format and quality ---------------------------------------------
 
-    def encoded(self, frame: Frame, ext: str = ".jpg", quality: int = 85) -> bytes:
+    def encode(self, image: np.ndarray, ext: str, quality: int) -> bytes:
+        """``image`` as ``.jpg`` or ``.png`` bytes (a camera with its own encoder overrides this).
+
+        Raises:
+            SensorError: an unknown format, or the frame could not be encoded.
+        """
+        return encode_image(image, ext, quality)
+
+    def encoded(self, frame: Frame, ext: str = ".jpg", quality: int = JPEG_QUALITY) -> bytes:
         """``frame`` as ``.jpg`` or ``.png`` bytes, encoded once for the latest frame's readers.
 
         The first reader asking a (format, quality) of the latest frame encodes it; readers
@@ -293,52 +305,72 @@ class Camera(Sensor):
         encoded for its reader alone.
 
         Raises:
-            SensorError: an unknown format, or OpenCV could not encode it.
+            SensorError: an unknown format, or the frame could not be encoded.
         """
         future, mine = self._claim(frame, ext, quality)
-        if not mine:
-            return future.result()
-        return self._encode_into(future, frame, ext, quality)
+        if mine:
+            self._encode_into(future, frame, ext, quality)
+        return future.result()
 
-    async def encoded_async(self, frame: Frame, ext: str = ".jpg", quality: int = 85) -> bytes:
-        """``encoded`` for a coroutine: one thread encodes; the others await, holding none."""
+    async def encoded_async(
+        self, frame: Frame, ext: str = ".jpg", quality: int = JPEG_QUALITY
+    ) -> bytes:
+        """``encoded`` for a coroutine: one worker thread encodes, every reader awaits it
+        holding no thread; a reader cancelled meanwhile (its client left) leaves the encoding
+        to the others."""
         future, mine = self._claim(frame, ext, quality)
         if mine:
-            return await asyncio.to_thread(self._encode_into, future, frame, ext, quality)
+            # not awaited by this reader: its cancellation must not cancel (or, still queued,
+            # drop) the encoding the other readers wait for
+            try:
+                asyncio.get_running_loop().run_in_executor(
+                    None, self._encode_into, future, frame, ext, quality
+                )
+            except RuntimeError:  # the loop's executor is shut down: encode here
+                self._encode_into(future, frame, ext, quality)
         if future.done():  # the usual case: another viewer's encoding of this frame is ready
             return future.result()
+        # the future runs (see _claim): a cancelled reader's wrap cannot cancel it for all
         return await asyncio.wrap_future(future)
 
     def _claim(
         self, frame: Frame, ext: str, quality: int
     ) -> tuple[concurrent.futures.Future[bytes], bool]:
-        """The encoding of ``frame`` to wait for, and whether the caller must make it."""
+        """The encoding of ``frame`` to wait for, and whether the caller must make it.
+
+        The future is marked running at once: nobody can cancel it (``asyncio.wrap_future``
+        passes a waiter's cancellation on to a pending one, which would leave every reader of
+        this frame a cancelled encoding).
+        """
         key = (ext, quality)
         with self._encodings_lock:
             if frame.number > self._encoded_number:
                 self._encodings = {}
                 self._encoded_number = frame.number
-            elif frame.number < self._encoded_number:
-                return concurrent.futures.Future(), True
-            future = self._encodings.get(key)
+            future = self._encodings.get(key) if frame.number == self._encoded_number else None
             if future is not None:
                 return future, False
-            future = self._encodings[key] = concurrent.futures.Future()
+            future = concurrent.futures.Future()
+            future.set_running_or_notify_cancel()
+            if frame.number == self._encoded_number:  # an older frame: its reader's alone
+                self._encodings[key] = future
             return future, True
 
     def _encode_into(
         self, future: concurrent.futures.Future[bytes], frame: Frame, ext: str, quality: int
-    ) -> bytes:
+    ) -> None:
+        """Settle ``future`` with the encoding (or its error, which the next reader retries)."""
         try:
-            data = encode_image(frame.image, ext, quality)
+            data = self.encode(frame.image, ext, quality)
         except BaseException as exc:
-            future.set_exception(exc)
-            with self._encodings_lock:  # the next reader tries again
+            with self._encodings_lock:
                 if self._encodings.get((ext, quality)) is future:
                     del self._encodings[(ext, quality)]
-            raise
+            future.set_exception(exc)
+            if not isinstance(exc, Exception):
+                raise
+            return
         future.set_result(data)
-        return data
 
 
 def _settle(future: asyncio.Future[None]) -> None:

@@ -4,6 +4,7 @@ in an event loop without a thread."""
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import threading
 from typing import Any
 
@@ -102,3 +103,104 @@ def test_waiting_for_a_frame_of_a_camera_failed_for_good_raises_at_once() -> Non
     with pytest.raises(SensorError, match="no such camera"):
         asyncio.run(camera.wait_frame(0, 60.0))
     camera.close()
+
+
+class CountingCamera(DummyCamera):
+    """A camera double whose encoder counts its calls and can be held mid-encoding."""
+
+    def __init__(self) -> None:
+        super().__init__("camera", (64, 48))
+        self.calls: list[tuple[int, str, int]] = []
+        self.entered = threading.Event()
+        self.go = threading.Event()
+        self.go.set()
+        self._calls_lock = threading.Lock()
+
+    def encode(self, image: Any, ext: str, quality: int) -> bytes:
+        with self._calls_lock:
+            self.calls.append((int(image[0, 0, 0]), ext, quality))
+        self.entered.set()
+        assert self.go.wait(60.0)
+        return f"{ext}:{quality}:{int(image[0, 0, 0])}".encode()
+
+    def grab(self) -> Any:
+        frame = self._black.copy()
+        frame[0, 0, 0] = (1 if self._latest is None else self._latest.number + 1) % 256
+        return frame
+
+
+def test_a_double_counts_one_encode_per_frame_and_quality_for_many_consumers() -> None:
+    camera = CountingCamera()
+    for number in (1, 2, 3):
+        camera.update()
+        frame = camera.latest()
+        assert frame.number == number
+        results: list[bytes] = []
+        go = threading.Barrier(12)
+
+        def read(quality: int, frame: Any, go: Any, results: list[bytes]) -> None:
+            go.wait()
+            results.append(camera.encoded(frame, ".jpg", quality))
+
+        readers = [
+            threading.Thread(target=read, args=(80 if i % 2 else 50, frame, go, results))
+            for i in range(12)
+        ]
+        for reader in readers:
+            reader.start()
+
+        async def many(frame: Any = frame) -> list[bytes]:
+            return await asyncio.gather(
+                *(camera.encoded_async(frame, ".jpg", 80 if i % 2 else 50) for i in range(40))
+            )
+
+        results += asyncio.run(many())
+        for reader in readers:
+            reader.join(30)
+        assert sorted(set(results)) == [f".jpg:{q}:{number}".encode() for q in (50, 80)]
+        assert len(results) == 52
+    assert sorted(camera.calls) == [(n, ".jpg", q) for n in (1, 2, 3) for q in (50, 80)]
+
+
+def test_a_reader_cancelled_while_its_frame_is_encoded_leaves_the_encoding_to_the_others() -> None:
+    camera = CountingCamera()
+    camera.update()
+    frame = camera.latest()
+    camera.go.clear()
+
+    async def scenario() -> tuple[list[bytes], bytes]:
+        readers = [asyncio.ensure_future(camera.encoded_async(frame, ".jpg", 80)) for _ in range(6)]
+        assert await asyncio.to_thread(camera.entered.wait, 60.0)
+        await asyncio.sleep(0)  # every reader has claimed or is waiting for the encoding
+        for leaving in readers[:3]:  # the claimer and two waiters: their clients left
+            leaving.cancel()
+        camera.go.set()
+        stayed = await asyncio.gather(*readers[3:])
+        return stayed, await camera.encoded_async(frame, ".jpg", 80)  # a later reader too
+
+    stayed, later = asyncio.run(scenario())
+    assert stayed == [b".jpg:80:1"] * 3 and later == b".jpg:80:1"
+    assert camera.calls == [(1, ".jpg", 80)]
+
+
+def test_a_first_reader_cancelled_before_its_encoding_started_still_serves_the_others() -> None:
+    camera = CountingCamera()
+    camera.update()
+    frame = camera.latest()
+    busy = threading.Event()
+
+    async def scenario() -> bytes:
+        loop = asyncio.get_running_loop()
+        with concurrent.futures.ThreadPoolExecutor(1) as pool:
+            loop.set_default_executor(pool)
+            blocker = loop.run_in_executor(None, busy.wait, 60.0)  # the one worker is taken
+            first = asyncio.ensure_future(camera.encoded_async(frame, ".jpg", 80))
+            other = asyncio.ensure_future(camera.encoded_async(frame, ".jpg", 80))
+            await asyncio.sleep(0)  # both asked: the first's encoding waits for the worker
+            first.cancel()
+            busy.set()
+            await blocker
+            return await asyncio.wait_for(other, 60.0)
+
+    assert asyncio.run(scenario()) == b".jpg:80:1"
+    assert camera.calls == [(1, ".jpg", 80)]

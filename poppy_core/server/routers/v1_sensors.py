@@ -11,6 +11,7 @@ from starlette.concurrency import run_in_threadpool
 from poppy_core import checks
 from poppy_core.errors import SensorError
 from poppy_core.sensors import Camera
+from poppy_core.sensors.camera import JPEG_QUALITY
 from poppy_core.server.routers.pypot_sensors import sensors_of
 from poppy_core.server.schemas import Problem
 from poppy_core.server.sensors import IMAGE_TYPES
@@ -18,7 +19,8 @@ from poppy_core.server.sensors import IMAGE_TYPES
 router = APIRouter(tags=["sensors"], responses={404: {"model": Problem}, 503: {"model": Problem}})
 
 BOUNDARY = "frame"
-MJPEG_QUALITY = 80
+MJPEG_QUALITY = JPEG_QUALITY
+"""The snapshots', ROS 2's and Foxglove's quality too: one JPEG of a frame serves them all."""
 FRAME_WAIT_S = 5.0
 LOST_CAMERA_RETRY_S = 0.5
 """The stream's pause before asking a failed camera again (it may fail at once every time)."""
