@@ -27,7 +27,7 @@ from poppy_core.robot import Robot
 from poppy_core.schedule import Gate
 from poppy_core.server.start_time import StartTimes, check_start_at, wait_until
 from tests.helpers.cli import run_poppy
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, scaled
 from tests.helpers.zenoh_served import TOKEN, Served
 
 LEAD_S = 0.3
@@ -136,7 +136,7 @@ def test_a_fleet_stop_before_the_start_time_means_nothing_starts(
     for served in two:
         dance = served.servers.service.primitive("dance")
         dance.setup = lambda name=served.name: ran.append(name)  # type: ignore[method-assign]
-    start_at = time.time() + 2.0
+    start_at = time.time() + min(scaled(2.0), 30.0)  # time to arm and stop, at this load
     started = [_send(fleet, s.name, "/api/v1/primitives/dance/start", start_at) for s in two]
     assert eventually(
         lambda: all("dance" in s.servers.service.running_primitives() for s in two)
@@ -184,7 +184,7 @@ def test_the_fleet_stop_before_the_start_time_cancels_an_armed_move(
     for served in two:
         served.robot.compliant = False
         before[served.name] = {m.name: m.goal_position for m in served.robot.motors}
-    start_at = time.time() + 2.0
+    start_at = time.time() + min(scaled(2.0), 30.0)  # time to arm and stop, at this load
     body = {"speed": 1.0, "backwards": False}
     played = [_send(fleet, s.name, "/api/v1/moves/wave/play", start_at, body) for s in two]
     assert eventually(lambda: all(s.servers.service.moves.playing() == ["wave"] for s in two))
