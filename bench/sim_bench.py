@@ -227,7 +227,8 @@ def sim_benchmark(ctx: BenchContext) -> BenchResult:
             f"{GYM_STEPS} steps of random actions of `gymnasium.make(id)` (its wrappers "
             f"included), and of `gymnasium.make_vec(id, num_envs={VECTOR_ENVS})` in sync mode "
             "(one process) and async mode (one process per env), against `mj_step` alone on "
-            "the same model, ten steps per env step; not pinned, median of "
+            "the same model, ten steps per env step; steps per CPU second of the process "
+            "(the async mode: per wall second), median of "
             f"{ctx.repeat} rounds, the four measured in turns."
         ),
         tables=[

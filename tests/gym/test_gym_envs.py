@@ -235,6 +235,7 @@ def test_the_module_id_form_registers_on_the_way() -> None:
         ({"render_mode": "human"}, "render_mode must be one of rgb_array"),
         ({"chain": "leg"}, "the robot has no chain 'leg' (chains: chain)"),
         ({"control_hz": 0}, "control_hz and max_delta_deg must be positive"),
+        ({"camera": "eye"}, "camera must be one of front, side, top, camera, not 'eye'"),
     ],
 )
 def test_bad_options_are_one_clear_line(kwargs: dict[str, Any], words: str) -> None:

@@ -52,7 +52,7 @@ class PoppyEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         visualization_width, visualization_height: the size of ``render()``'s images.
 
     Raises:
-        ArgumentError: an unknown obs_type, action_type or render_mode, a bad number.
+        ArgumentError: an unknown obs_type, action_type, render_mode or camera, a bad number.
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 50}  # noqa: RUF012
@@ -84,6 +84,9 @@ class PoppyEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
             raise ArgumentError("control_hz and max_delta_deg must be positive")
         self.world = ServoWorld(robot, 1.0 / control_hz, self.objects)
         self.metadata = {**self.metadata, "render_fps": round(1.0 / self.world.control_period_s)}
+        cameras = self.world.cameras()
+        for name, field in ((camera, "camera"), (render_camera, "render_camera")):
+            _choice(name, cameras, field)
         self.camera = camera
         self.pixels_size = (int(observation_width), int(observation_height))
         self.render_camera = render_camera

@@ -34,7 +34,7 @@ class PushCubeEnv(PoppyEnv):
 
     Args:
         robot: the profile (one standing on the table: ``ergo-jr``).
-        chain: the chain whose tip pushes.
+        chain: the chain whose tip pushes (None: the profile's first).
         success_m: the cube's distance to the goal counted as there.
         **options: ``PoppyEnv``'s.
     """
@@ -49,7 +49,7 @@ class PushCubeEnv(PoppyEnv):
     def __init__(
         self,
         robot: str = "ergo-jr",
-        chain: str = "chain",
+        chain: str | None = None,
         success_m: float = 0.02,
         **options: Any,
     ) -> None:

@@ -15,11 +15,13 @@ class ChainTip:
     """Where a chain's tip is, by forward kinematics of the world's joint angles (metres, in the
     chain's base frame: the robot's base link, fixed in the world)."""
 
-    def __init__(self, world: ServoWorld, chain: str) -> None:
+    def __init__(self, world: ServoWorld, chain: str | None = None) -> None:
+        if chain is None and world.chains:
+            chain = next(iter(world.chains))
         if chain not in world.chains:
             known = ", ".join(world.chains) or "none"
             raise ArgumentError(f"the robot has no chain {chain!r} (chains: {known})")
-        self.chain = world.chains[chain]
+        self.chain = world.chains[str(chain)]
         self._index = [world.names.index(name) for name in self.chain.names]
 
     def of(self, pose_deg: np.ndarray) -> np.ndarray:
@@ -39,7 +41,8 @@ class ReachEnv(PoppyEnv):
 
     Args:
         robot: the profile.
-        chain: the chain whose tip reaches (the profile's ``kinematics.chains``).
+        chain: the chain whose tip reaches (the profile's ``kinematics.chains``; None: its
+            first).
         success_m: the distance counted as reached.
         target_spread: how far from the start pose (0..1 of the way to the limits) the
             target's pose is drawn.
@@ -51,7 +54,7 @@ class ReachEnv(PoppyEnv):
     def __init__(
         self,
         robot: str = "ergo-jr",
-        chain: str = "chain",
+        chain: str | None = None,
         success_m: float = 0.02,
         target_spread: float = 0.5,
         **options: Any,

@@ -155,6 +155,12 @@ class ServoWorld:
         body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, chain.base)
         return np.array(self.data.xpos[body]), np.array(self.data.xmat[body]).reshape(3, 3)
 
+    def cameras(self) -> list[str]:
+        """The model's cameras (``camera`` is the robot's own; ``front``, ``side``, ``top``)."""
+        model = self.model
+        names = (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i) for i in range(model.ncam))
+        return [name for name in names if name]
+
     def render(self, camera: str, width: int, height: int) -> np.ndarray:
         """An RGB image (height × width × 3) of the world now from ``camera``, drawn as the
         simulated camera draws (``sim.camera``: no shadows, reflections or skybox, which cost
