@@ -219,6 +219,34 @@ def test_make_vec_stacks_the_envs(make: Any) -> None:
         envs.close()
 
 
+def test_make_vec_async_runs_each_env_in_a_process_of_its_own() -> None:
+    envs = gym.make_vec("poppy/ErgoJrReach-v0", num_envs=2, vectorization_mode="async")
+    try:
+        obs, _ = envs.reset(seed=4)
+        assert obs["agent_pos"].shape == (2, 6)
+        _, reward, *_ = envs.step(envs.action_space.sample())
+        assert reward.shape == (2,)
+    finally:
+        envs.close()
+
+
+def test_goals_are_reached_at_the_servos_speed(make: Any) -> None:
+    """A far goal is followed at the servo's no-load speed (the sim's servo model), not at once."""
+    from poppy_core.models import model_by_name
+
+    env = make("poppy/ErgoJrReach-v0")
+    env.reset(seed=0)
+    world = env.unwrapped.world
+    speed_dps = model_by_name("XL-320").no_load_speed_dps
+    goal = world.goal.astype(np.float32)
+    goal[0] = 90.0
+    obs, *_ = env.step(goal)
+    assert 0.0 < obs["agent_pos"][0] <= speed_dps * world.control_period_s + 1.0
+    for _ in range(50):
+        obs, *_ = env.step(goal)
+    assert abs(float(obs["agent_pos"][0]) - 90.0) < 2.0
+
+
 def test_the_module_id_form_registers_on_the_way() -> None:
     env = gym.make("poppy_core.learning.envs:poppy/TorsoReach-v0")
     try:
