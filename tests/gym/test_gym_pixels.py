@@ -85,3 +85,52 @@ def test_make_vec_stacks_pictures(pixels_env: Any) -> None:
         assert obs["pixels"].shape == (2, 48, 64, 3)
     finally:
         envs.close()
+
+
+# LeRobot's own reading of a Gymnasium observation (lerobot/envs/utils.py), in its venv
+LEROBOT_READS = """
+import json, sys
+import numpy as np
+from lerobot.envs.utils import preprocess_observation
+batch = preprocess_observation(dict(np.load(sys.argv[1])))
+print(json.dumps({key: [list(value.shape), str(value.dtype)] for key, value in batch.items()}))
+"""
+
+
+def test_lerobot_reads_the_observations(pixels_env: Any, tmp_path: Any) -> None:
+    import json
+    import os
+    import subprocess
+
+    from tests.helpers.lerobot_venv import lerobot_python
+
+    python = lerobot_python()
+    envs = gym.make_vec(
+        "poppy/ErgoJrPushCube-v0",
+        num_envs=2,
+        vectorization_mode="sync",
+        obs_type="pixels_agent_pos",
+        observation_width=64,
+        observation_height=48,
+    )
+    try:
+        obs, _ = envs.reset(seed=0)
+    finally:
+        envs.close()
+    np.savez(tmp_path / "obs.npz", **obs)
+    env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    done = subprocess.run(
+        [str(python), "-c", LEROBOT_READS, str(tmp_path / "obs.npz")],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+        env=env,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    shapes = json.loads(done.stdout.strip().splitlines()[-1])
+    assert shapes == {
+        "observation.image": [[2, 3, 48, 64], "torch.float32"],
+        "observation.environment_state": [[2, 9], "torch.float32"],
+        "observation.state": [[2, 6], "torch.float32"],
+    }
