@@ -10,12 +10,14 @@ from typing import Any
 import numpy as np
 import pytest
 
+# poppy_core first: it picks MuJoCo's OpenGL backend (MUJOCO_GL) before mujoco is imported
+from poppy_core.errors import ArgumentError
+
 pytest.importorskip("mujoco")
 gym = pytest.importorskip("gymnasium")
 
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 
-from poppy_core.errors import ArgumentError  # noqa: E402
 from poppy_core.learning.envs import ENVS  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
