@@ -17,6 +17,7 @@ import time
 from typing import Any
 
 from bench.registry import REPO_ROOT, BenchContext, BenchResult, Table, register
+from bench.sim_gym import GYM_STEPS, VECTOR_ENVS, gym_table
 from bench.stats import summary
 from poppy_core.emulator import VirtualBus, VirtualMotor
 from poppy_core.models import model_by_name
@@ -141,7 +142,10 @@ def _one_core() -> set[int] | None:
     return before
 
 
-@register("sim", "MuJoCo real-time factor: plant alone and full stack (Ergo Jr, Humanoid)")
+@register(
+    "sim",
+    "MuJoCo: real-time factor of the plant and the full stack; Gymnasium env steps per second",
+)
 def sim_benchmark(ctx: BenchContext) -> BenchResult:
     """Measure both real-time factors for each robot and compare with the goals."""
     raw: dict[str, Any] = {"plant_rtf": {}, "full_stack": {}}
@@ -205,6 +209,8 @@ def sim_benchmark(ctx: BenchContext) -> BenchResult:
                 "yes" if ok else "**no**",
             ]
         )
+    logger.info("sim: Gymnasium environments")
+    gym_rates, raw["gym"] = gym_table(ctx.repeat)
     cores = os.cpu_count() or 1
     return BenchResult(
         name="sim",
@@ -217,7 +223,13 @@ def sim_benchmark(ctx: BenchContext) -> BenchResult:
             "sim='mujoco')` (robot → bus → pty → emulator → MuJoCo, the physics thread at real "
             f"time, the sync loops running) for {FULL_STACK_S:.0f} s of wall time with the "
             "goals of every motor moving: simulated / wall time, and each ≥ 10 Hz loop's "
-            "measured rate against its target."
+            "measured rate against its target. Gymnasium environments (docs/learning.md): "
+            f"{GYM_STEPS} steps of random actions of `gymnasium.make(id)` (its wrappers "
+            f"included), and of `gymnasium.make_vec(id, num_envs={VECTOR_ENVS})` in sync mode "
+            "(one process) and async mode (one process per env), against `mj_step` alone on "
+            "the same model, ten steps per env step; steps per CPU second of the process "
+            "(the async mode: per wall second), median of "
+            f"{ctx.repeat} rounds, the four measured in turns."
         ),
         tables=[
             Table(
@@ -241,6 +253,7 @@ def sim_benchmark(ctx: BenchContext) -> BenchResult:
                 ],
                 stack_rows,
             ),
+            gym_rates,
         ],
         notes=[
             "Where the plant's time goes (cProfile, Humanoid): `mj_step` is the largest cost; "
@@ -261,6 +274,13 @@ def sim_benchmark(ctx: BenchContext) -> BenchResult:
             "compilation, posed from the physics' state. The plant is timed with the profile's "
             "model and with the same model stripped of its meshes, in pairs run one after the "
             "other, so a loaded machine slows both alike and the ratio compares them.",
+            "Gymnasium: an env step runs the model in process (no emulator, bus or thread): "
+            "the goals go to the simulation's servo model (`sim/drive.py`, the ramp at the "
+            "servo's speed feeding MuJoCo's position actuators), then ten `mj_step`, then the "
+            "reward's forward kinematics and the observation. Random actions keep the ramp "
+            "busy at every step (the servo model's costliest case); the gap to bare `mj_step` "
+            "is that Python work. The async mode pays a pipe round trip per step and has "
+            f"{cores} cores for its {VECTOR_ENVS} processes here.",
         ],
         passed=passed,
         raw=raw,

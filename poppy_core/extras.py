@@ -28,6 +28,7 @@ EXTRAS: dict[str, str] = {
     "notebook": "Jupyter notebooks (`poppy notebook`)",
     "appliance": "the robot's name on the network (mDNS/DNS-SD with zeroconf)",
     "dataset": "LeRobot datasets (pyarrow, PyAV)",
+    "gym": "Gymnasium environments on the simulation (gymnasium, MuJoCo)",
 }
 """Extra -> what it brings (pyproject.toml's ``[project.optional-dependencies]``)."""
 

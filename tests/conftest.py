@@ -25,7 +25,7 @@ from hypothesis import settings
 from tests.helpers.waiting import load_factor
 
 TESTS = Path(__file__).resolve().parent
-SLOW_FOLDERS = {"cli", "creatures", "server", "sim", "teleop", "tui"}
+SLOW_FOLDERS = {"cli", "creatures", "gym", "server", "sim", "teleop", "tui"}
 SLOW_MODULES = {
     "emulator/test_emulator_threads.py",
     "kinematics/test_sim_chain.py",
@@ -36,6 +36,7 @@ SLOW_MODULES = {
 # of their own (`-m gl`): a render stuck in the driver would otherwise take the whole run with it
 # (it happened when mujoco was imported before MUJOCO_GL was set; see docs/simulation.md).
 GL_MODULES = {
+    "gym/test_gym_pixels.py",
     "sim/test_sim_camera.py",
     "sim/test_sim_meshes.py",
     "sim/test_sim_plant.py",

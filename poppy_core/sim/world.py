@@ -119,16 +119,8 @@ class Simulation(Observing, Placing):
         its plant): the exchange takes each lock once for all the motors sharing it.
         """
         with self._lock:
-            qpos, dof, actuator = self._resolve(link.joint)
-            joint = Joint(
-                qpos=qpos,
-                dof=dof,
-                actuator=actuator,
-                stall_nm=float(self.model.actuator_forcerange[actuator][1]),
-                kp=float(self.model.actuator_gainprm[actuator][0]),
-                kv=float(-self.model.actuator_biasprm[actuator][2]),
-            )
-            target_rad = float(self.data.qpos[qpos])
+            joint = self.servo_joint(link.joint)
+            target_rad = float(self.data.qpos[joint.qpos])
             binding = _Binding(motor, link, MotorPort(motor), self._drive.add(joint, target_rad))
             self._bindings.append(binding)
             for lock, members in self._groups:
@@ -141,6 +133,26 @@ class Simulation(Observing, Placing):
         with motor.lock:
             motor.set_state(position, 0.0, 0.0, False)
             motor.table.set_si("goal_position", position)
+
+    def servo_joint(self, joint: str) -> Joint:
+        """Where joint ``joint`` and its actuator are in the model, with the servo constants the
+        model holds now (stall torque, gains; a fresh world's are the profile's servo's): what a
+        ``Drive`` needs to move it.
+
+        Raises:
+            ConfigError: the model has no such joint or actuator.
+        """
+        with self._lock:
+            qpos, dof, actuator = self._resolve(joint)
+            model = self.model
+            return Joint(
+                qpos=qpos,
+                dof=dof,
+                actuator=actuator,
+                stall_nm=float(model.actuator_forcerange[actuator][1]),
+                kp=float(model.actuator_gainprm[actuator][0]),
+                kv=float(-model.actuator_biasprm[actuator][2]),
+            )
 
     def set_joint_deg(self, joint: str, angle_deg: float) -> None:
         """Put joint ``joint`` at ``angle_deg`` (the motor's own angle), at rest."""

@@ -56,6 +56,9 @@ ALLOWED: dict[str, set[str]] = {
     "creatures": {"robot", "motion", "models", "kinematics"},
     "kinematics": set(),
     "server": {"robot", "motion", "creatures", "models", "kinematics", "sensors"},
+    # Gymnasium environments on the simulation: a profile's MuJoCo world (robot, sim), its
+    # chains (motion) stepped through the sim's servo model
+    "learning": {"robot", "motion", "sim", "models", "kinematics"},
     "remote": set(),
     # the loop machinery, a package of leaves (pacing, worker, closing): nothing but the leaves
     "schedule": set(),

@@ -1,0 +1,1 @@
+"""Learning: Gymnasium environments on the MuJoCo simulation (``poppy_core.learning.envs``)."""
