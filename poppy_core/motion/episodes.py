@@ -147,9 +147,11 @@ class EpisodeRecorder:
         episode: int,
         stop: threading.Event,
         on_tick: Callable[[Progress], None] | None = None,
+        discard: threading.Event | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> EpisodeSaved | None:
-        """One episode of ``duration_s`` (or until ``stop``); None when it has no frame."""
+        """One episode of ``duration_s`` (or until ``stop``); None when it has no frame, or
+        when ``discard`` is set at its end (its frames dropped: it is recorded again)."""
         self.writer.begin_episode(task)
         period = 1.0 / self.fps
         start = clock()
@@ -179,7 +181,7 @@ class EpisodeRecorder:
                 self.writer.add_frame(last_state, last_action or last_state, last_images)
         finally:
             self.source.end()
-        if self.writer.frames == 0:
+        if self.writer.frames == 0 or (discard is not None and discard.is_set()):
             self.writer.discard_episode()
             return None
         return self.writer.save_episode()
