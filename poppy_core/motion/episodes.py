@@ -172,13 +172,20 @@ class EpisodeRecorder:
                 images = self.images()
                 if pending is not None:
                     last_state, last_action, last_images = pending
-                    self.writer.add_frame(last_state, last_action or state, last_images)
+                    self.writer.add_frame(last_state, last_action or state, last_images, live=True)
                 pending = (state, action, images)
                 if on_tick is not None:
-                    on_tick(Progress(episode, now - start, self.writer.frames, schedule.missed))
+                    on_tick(
+                        Progress(
+                            episode,
+                            now - start,
+                            self.writer.frames,
+                            schedule.missed + self.writer.video_dropped,
+                        )
+                    )
             if pending is not None:
                 last_state, last_action, last_images = pending
-                self.writer.add_frame(last_state, last_action or last_state, last_images)
+                self.writer.add_frame(last_state, last_action or last_state, last_images, live=True)
         finally:
             self.source.end()
         if self.writer.frames == 0 or (discard is not None and discard.is_set()):
