@@ -260,3 +260,17 @@ def test_a_killed_recording_keeps_its_finished_episodes(tmp_path: Path) -> None:
     writer.add_frame(*frame(0))
     assert writer.save_episode().index == 2
     assert os.path.exists(root / "videos/observation.images.top/chunk-000/file-002.mp4")
+
+
+def test_a_robot_of_one_motor_is_recorded_and_read_back(tmp_path: Path) -> None:
+    from poppy_core.dataset.rows import read_actions
+
+    root = tmp_path / "ds"
+    with DatasetWriter.create(root, DatasetSpec(30, ("m1",), {}, None)) as writer:
+        writer.begin_episode("one joint")
+        for k in range(5):
+            writer.add_frame([float(k)], [k + 0.5])
+        writer.save_episode()
+    actions = read_actions(root, 0)
+    assert actions.motors == ("m1",)
+    assert actions.positions.tolist() == [[k + 0.5] for k in range(5)]
