@@ -19,6 +19,7 @@ import subprocess
 import sys
 import tempfile
 import threading
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -40,6 +41,31 @@ class EncodedVideo:
     frames: int
     filled: int
     stats: ImageStats
+
+
+def _read(
+    stdout: IO[bytes] | None,
+    free: collections.deque[int],
+    freed: threading.Event,
+    replies: queue.Queue[list[Any] | None],
+) -> None:
+    """The worker's replies: freed slots into ``free``, the others into ``replies``."""
+    assert stdout is not None
+    for line in stdout:
+        message = json.loads(line)
+        if message[0] == "free":
+            free.append(int(message[1]))
+            freed.set()
+        else:
+            replies.put(message)
+    replies.put(None)
+    freed.set()
+
+
+def _close_stdin(proc: subprocess.Popen[bytes]) -> None:
+    if proc.stdin is not None:
+        with contextlib.suppress(OSError):
+            proc.stdin.close()
 
 
 class VideoEncoder:
@@ -72,24 +98,18 @@ class VideoEncoder:
                 stdout=subprocess.PIPE,
                 env=env,
             )
-            self._reader = threading.Thread(target=self._read, name=f"encoder {name}", daemon=True)
+            self._reader = threading.Thread(
+                target=_read,
+                args=(self._proc.stdout, self._free, self._freed, self._replies),
+                name=f"encoder {name}",
+                daemon=True,
+            )
             self._reader.start()
+            # a writer dropped without close: its worker ends once its stdin does
+            self._finalizer = weakref.finalize(self, _close_stdin, self._proc)
             self._expect("ready", START_TIMEOUT_S)
         finally:
             os.unlink(ring_path)  # both mapped it (or it failed): nothing to leave behind
-
-    def _read(self) -> None:
-        stdout: IO[bytes] | None = self._proc.stdout
-        assert stdout is not None
-        for line in stdout:
-            message = json.loads(line)
-            if message[0] == "free":
-                self._free.append(int(message[1]))
-                self._freed.set()
-            else:
-                self._replies.put(message)
-        self._replies.put(None)
-        self._freed.set()
 
     def _send(self, *command: Any) -> None:
         stdin = self._proc.stdin
@@ -165,6 +185,7 @@ class VideoEncoder:
 
     def close(self) -> None:
         """End the process (an open video is abandoned)."""
+        self._finalizer.detach()
         with contextlib.suppress(FileError):
             self._send("quit")
         if self._proc.stdin is not None:

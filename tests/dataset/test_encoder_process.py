@@ -3,6 +3,7 @@ could not take are dropped, counted, and stood in for by the last one (a frame a
 
 from __future__ import annotations
 
+import gc
 import os
 import signal
 from pathlib import Path
@@ -71,3 +72,14 @@ def test_a_writer_fed_faster_than_real_time_waits_and_drops_nothing(tmp_path: Pa
     assert (saved.frames, saved.video_dropped) == (40, 0)
     frames = decoded(root / "videos/observation.images.top/chunk-000/file-000.mp4")
     assert [abs(g - 20 * (k % 12)) <= 6 for k, (_, g) in enumerate(frames)] == [True] * 40
+
+
+def test_a_writer_dropped_without_close_ends_its_encoder(tmp_path: Path) -> None:
+    writer = DatasetWriter.create(tmp_path / "ds", SPEC)
+    writer.begin_episode("dropped")
+    writer.add_frame([0, 0], [0, 0], {"top": image(0)})
+    writer.save_episode()
+    worker = writer._encoders["top"]._proc
+    del writer
+    gc.collect()
+    assert eventually(lambda: worker.poll() is not None, timeout_s=10)
