@@ -9,6 +9,7 @@ from pathlib import Path
 
 from bench import (
     camera_bench,
+    dataset_bench,
     emulator_bench,
     fleet_bench,
     ik_bench,
@@ -50,6 +51,7 @@ _MODULES = (
     fleet_bench,
     ros2_bench,
     timing_bench,
+    dataset_bench,
 )
 
 
@@ -68,7 +70,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-peers", action="store_true", help="measure poppy only")
     parser.add_argument("--list", action="store_true", help="list the benchmarks and exit")
     parser.add_argument(
-        "--minutes", type=float, default=None, help="duration of the soak, per robot (default 10)"
+        "--minutes",
+        type=float,
+        default=None,
+        help="duration of the soak, per robot (default 10), and of the dataset episode (default 5)",
     )
     parser.add_argument(
         "--baseline",

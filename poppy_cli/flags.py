@@ -115,7 +115,9 @@ FLAGS: dict[str, Flag] = {
     "--foxglove": Flag(None, None, "serve the robot to the Foxglove app (foxglove-sdk)"),
     "--foxglove-port": Flag(None, "PORT", "TCP port of the Foxglove WebSocket server"),
     "--mcap": Flag(None, "FILE", "also write what Foxglove shows to this MCAP file"),
-    "--connect": Flag(None, "ENDPOINT", "`--zenoh-connect`'s other name in `fleet` and `teleop`"),
+    "--connect": Flag(
+        None, "ENDPOINT", "`--zenoh-connect`'s other name in `fleet`, `teleop`, `dataset record`"
+    ),
     "--listen": Flag(None, "ENDPOINT", "Zenoh endpoint the router listens on"),
     "--all": Flag(None, None, "every robot of the fleet"),
     "--robots": Flag(None, "NAMES", "robots of the fleet, comma-separated"),

@@ -1,10 +1,11 @@
-"""Remove an episode from a dataset poppy wrote, renumbering the rest, all at once or not at all.
+"""Remove an episode from a dataset, renumbering the rest, all at once or not at all.
 
 The new dataset is built in a hidden folder beside the old one (unchanged files hard-linked,
 renumbered data files rewritten, videos renamed one place down), then swapped in with one
 rename (``renameat2(RENAME_EXCHANGE)`` on Linux; elsewhere two renames). Until the swap the
 dataset is untouched; a run killed before it leaves only the hidden folder, which the next
-run removes.
+run removes. A dataset packing several episodes a file (LeRobot's own writer) is rebuilt by
+``delete_packed``; poppy's own (an episode a file) keeps that layout, the files moved down.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import pyarrow as pa
 
 from poppy_core.dataset import feature_stats as stats
 from poppy_core.dataset import layout, tables
+from poppy_core.dataset.delete_packed import rebuild_packed
 from poppy_core.dataset.rows import data_path, episode_rows, find_episode, stats_of_row
 from poppy_core.errors import ArgumentError, FileError
 
@@ -60,13 +62,13 @@ def delete_episode(root: Path, episode: int) -> EpisodeDeleted:
             field="episode",
         )
     video_keys = [k for k, ft in info.get("features", {}).items() if ft.get("dtype") == "video"]
-    _check_one_file_each(rows, video_keys)
+    packed = _packs_episodes(rows, video_keys)
     for stale in root.parent.glob(f".{root.name}.delete-*"):
         shutil.rmtree(stale, ignore_errors=True)
     work = root.parent / f".{root.name}.delete-{os.getpid()}"
     try:
         shutil.copytree(root, work, symlinks=True, copy_function=_link_or_copy)
-        kept = _rebuild(root, work, info, rows, episode, video_keys)
+        kept = _rebuild(root, work, info, rows, episode, video_keys, packed)
         _swap(work, root)
     finally:
         shutil.rmtree(work, ignore_errors=True)
@@ -86,6 +88,7 @@ def _rebuild(
     rows: list[dict[str, Any]],
     episode: int,
     video_keys: list[str],
+    packed: bool,
 ) -> list[dict[str, Any]]:
     """Write the dataset without ``episode`` into ``work`` (a linked copy of ``root``)."""
     old_tasks = tables.read_tasks(root / layout.TASKS_PATH)
@@ -93,6 +96,26 @@ def _rebuild(
     used = {task for row in kept for task in row.get("tasks") or ()}
     tasks = [task for task in old_tasks if task in used]
     task_map = {old_tasks.index(task): new for new, task in enumerate(tasks)}
+    if packed:
+        kept, episode_stats, start = rebuild_packed(
+            root, work, rows, episode, task_map, _video, video_keys
+        )
+    else:
+        episode_stats, start = _move_down(root, work, rows, kept, episode, task_map, video_keys)
+    _write_meta(work, info, kept, tasks, episode_stats, start)
+    return kept
+
+
+def _move_down(
+    root: Path,
+    work: Path,
+    rows: list[dict[str, Any]],
+    kept: list[dict[str, Any]],
+    episode: int,
+    task_map: dict[int, int],
+    video_keys: list[str],
+) -> tuple[list[dict[str, stats.Stats]], int]:
+    """poppy's layout (an episode a file): the later episodes' files move one place down."""
     for row in rows:
         if int(row["episode_index"]) == episode:
             _unlink(data_path(work, row))
@@ -134,6 +157,18 @@ def _rebuild(
                     os.replace(work / old_video[key], target)
         episode_stats.append(stats_of_row(row))
         start += length
+    return episode_stats, start
+
+
+def _write_meta(
+    work: Path,
+    info: dict[str, Any],
+    kept: list[dict[str, Any]],
+    tasks: list[str],
+    episode_stats: list[dict[str, stats.Stats]],
+    start: int,
+) -> None:
+    """Tasks, the episodes table, stats.json and info.json of the dataset left."""
     tables.write_table(work / layout.TASKS_PATH, tables.tasks_table(tasks))
     for path in (work / layout.EPISODES_DIR).glob("*/*.parquet"):
         path.unlink()
@@ -151,7 +186,6 @@ def _rebuild(
         splits={"train": f"0:{len(kept)}"},
     )
     tables.write_json(work / layout.INFO_PATH, info)
-    return kept
 
 
 def _renumbered(frames: pa.Table, episode: int, start: int, task_map: dict[int, int]) -> pa.Table:
@@ -169,18 +203,11 @@ def _renumbered(frames: pa.Table, episode: int, start: int, task_map: dict[int, 
     return frames
 
 
-def _check_one_file_each(rows: list[dict[str, Any]], video_keys: list[str]) -> None:
-    """Each episode in its own data and video files, as poppy writes them."""
-    places: dict[str, list[Path]] = {"data": [data_path(Path(), row) for row in rows]}
-    for key in video_keys:
-        places[key] = [_video(row, key) for row in rows]
-    for what, paths in places.items():
-        if len(set(paths)) != len(paths):
-            raise ArgumentError(
-                f"this dataset packs several episodes into one {what} file (LeRobot's own "
-                "writer does): poppy deletes episodes only from datasets it recorded",
-                field="root",
-            )
+def _packs_episodes(rows: list[dict[str, Any]], video_keys: list[str]) -> bool:
+    """True when a data or video file holds several episodes (LeRobot's writer lays them so)."""
+    places: list[list[Path]] = [[data_path(Path(), row) for row in rows]]
+    places += [[_video(row, key) for row in rows] for key in video_keys]
+    return any(len(set(paths)) != len(paths) for paths in places)
 
 
 def _video(row: dict[str, Any], key: str) -> Path:

@@ -71,6 +71,7 @@ def read_actions(root: Path, episode: int) -> EpisodeActions:
     if not frames:
         raise ArgumentError(f"episode {episode} has no frame in its data file", field="episode")
     positions = np.asarray([values for _, values in frames], dtype=np.float64)
+    positions = positions.reshape(len(frames), len(motors))  # one joint: a scalar column
     return EpisodeActions(episode, layout.check_fps(int(info.get("fps") or 0)), motors, positions)
 
 

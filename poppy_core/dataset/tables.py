@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -65,8 +66,8 @@ def frames_table(columns: dict[str, Any], features: dict[str, Any]) -> pa.Table:
             continue
         kind = pa.float32() if feature["dtype"] == "float32" else pa.int64()
         values = columns[key]
-        if feature["shape"] == [1]:
-            arrays[key] = pa.array(values, type=kind)
+        if feature["shape"] == [1]:  # a scalar column, as LeRobot stores shape (1,) features
+            arrays[key] = pa.array(np.asarray(values).reshape(-1), type=kind)
         else:
             size = int(feature["shape"][0])
             flat = pa.array(values.reshape(-1), type=kind)

@@ -2,15 +2,13 @@
 
 Facts from LeRobot 0.4.4's ``video_utils.py``: libsvtav1 with g=2, crf=30, preset 12, yuv420p,
 and what ``get_video_info`` puts in info.json. Frame k is stamped k/fps exactly (time base
-1/fps, pts k). Frames are encoded on a thread of their own, fed through a bounded queue.
+1/fps, pts k). ``Mp4File`` encodes where it is called: ``encoder`` runs it in a process of its own.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-import queue
-import threading
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -44,20 +42,14 @@ def codec_options(codec: str) -> dict[str, str]:
     return options
 
 
-class VideoWriter:
-    """Encodes RGB frames (height x width x 3, uint8) into one MP4 file on a worker thread."""
+class Mp4File:
+    """RGB frames (height x width x 3, uint8) encoded into one MP4 file, frame k at pts k."""
 
     def __init__(self, path: Path, fps: int, width: int, height: int, codec: str) -> None:
         self.path = path
-        self.fps = fps
-        self.width = width
-        self.height = height
-        self.codec = codec
         self.frames = 0
-        self.error: BaseException | None = None
         # SVT-AV1 prints its banner on stderr unless told otherwise (1: errors only)
         os.environ.setdefault("SVT_LOG", "1")
-        self._queue: queue.Queue[NDArray[np.uint8] | None] = queue.Queue(maxsize=max(4, 2 * fps))
         self._container: Any = av.open(str(path), "w", format="mp4")
         stream: Any = self._container.add_stream(codec, rate=fps, options=codec_options(codec))
         stream.pix_fmt = "yuv420p"
@@ -65,57 +57,30 @@ class VideoWriter:
         stream.height = height
         self._stream: Any = stream
         self._time_base = Fraction(1, fps)
-        self._thread = threading.Thread(target=self._run, name=f"video {path.name}", daemon=True)
-        self._thread.start()
 
-    def add(self, frame: NDArray[np.uint8]) -> None:
-        """Queue one frame (blocks while the encoder is two seconds behind)."""
-        if self.error is not None:
-            raise PoppyError(f"encoding {self.path.name} failed: {self.error}")
-        self._queue.put(np.ascontiguousarray(frame))
+    def encode(self, frame: NDArray[np.uint8]) -> None:
+        """The next frame."""
+        picture = av.VideoFrame.from_ndarray(frame, format="rgb24")
+        picture.pts = self.frames
+        picture.time_base = self._time_base
+        for packet in self._stream.encode(picture):
+            self._container.mux(packet)
+        self.frames += 1
 
-    def finish(self) -> int:
-        """Encode what is queued, close the file; the number of frames written."""
-        self._queue.put(None)
-        self._thread.join()
-        if self.error is not None:
-            raise PoppyError(f"encoding {self.path.name} failed: {self.error}")
-        return self.frames
-
-    def abandon(self) -> None:
-        """Stop encoding and remove the file."""
-        with contextlib.suppress(queue.Empty):
-            while True:
-                self._queue.get_nowait()
-        self._queue.put(None)
-        self._thread.join()
-        with contextlib.suppress(OSError):
-            os.unlink(self.path)
-
-    def _run(self) -> None:
+    def finish(self) -> None:
+        """Flush the encoder and close the file."""
         try:
-            while (frame := self._queue.get()) is not None:
-                if self.error is None:
-                    self._encode(frame)
-            if self.error is None:
-                for packet in self._stream.encode(None):
-                    self._container.mux(packet)
-        except (av.error.FFmpegError, ValueError, OSError) as exc:
-            self.error = exc
-        finally:
-            with contextlib.suppress(av.error.FFmpegError, OSError):
-                self._container.close()
-
-    def _encode(self, frame: NDArray[np.uint8]) -> None:
-        try:
-            picture = av.VideoFrame.from_ndarray(frame, format="rgb24")
-            picture.pts = self.frames
-            picture.time_base = self._time_base
-            for packet in self._stream.encode(picture):
+            for packet in self._stream.encode(None):
                 self._container.mux(packet)
-            self.frames += 1
-        except (av.error.FFmpegError, ValueError, OSError) as exc:
-            self.error = exc
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        with contextlib.suppress(av.error.FFmpegError, OSError):
+            self._container.close()
+
+
+ENCODING_ERRORS = (av.error.FFmpegError, ValueError, OSError)
 
 
 def video_info(path: Path, fps: int) -> dict[str, Any]:

@@ -20,9 +20,10 @@ from numpy.typing import NDArray
 
 from poppy_core.dataset import feature_stats as stats
 from poppy_core.dataset import layout, tables
+from poppy_core.dataset.encoder import VideoEncoder
 from poppy_core.dataset.layout import DatasetSpec
 from poppy_core.dataset.rows import stats_of_row
-from poppy_core.dataset.video import VideoWriter, pick_codec, video_info
+from poppy_core.dataset.video import pick_codec, video_info
 from poppy_core.errors import ArgumentError, FileError
 
 LEFTOVER = re.compile(r"\..+\.(tmp|recording)$")
@@ -36,6 +37,8 @@ class EpisodeSaved:
     frames: int
     duration_s: float
     task: str
+    video_dropped: int = 0
+    """Camera frames the encoders could not take in time (the last one stands in for each)."""
 
 
 class DatasetWriter:
@@ -52,8 +55,8 @@ class DatasetWriter:
         self._task: str | None = None
         self._states: list[list[float]] = []
         self._actions: list[list[float]] = []
-        self._videos: dict[str, VideoWriter] = {}
-        self._image_stats: dict[str, stats.ImageStats] = {}
+        self._encoders: dict[str, VideoEncoder] = {}
+        self._videos: dict[str, VideoEncoder] = {}
 
     # -- opening ---------------------------------------------------------------------------
 
@@ -135,7 +138,7 @@ class DatasetWriter:
             for path in sorted((self.root / folder).rglob("*")):
                 stray = path.suffix in (".parquet", ".mp4") and path not in named
                 if path.is_file() and (stray or LEFTOVER.fullmatch(path.name)):
-                    path.unlink()
+                    path.unlink(missing_ok=True)  # an encoder's process may remove its own
 
     # -- recording -------------------------------------------------------------------------
 
@@ -160,17 +163,23 @@ class DatasetWriter:
             path = self._video_path(layout.IMAGES + name, position)
             path = path.with_name(f".{path.name}.{os.getpid()}.recording")
             path.parent.mkdir(parents=True, exist_ok=True)
-            self._videos[name] = VideoWriter(path, self.spec.fps, width, height, self.codec)
-            self._image_stats[name] = stats.ImageStats()
+            if name not in self._encoders:
+                slots = max(4, self.spec.fps)  # a second of frames
+                self._encoders[name] = VideoEncoder(name, height, width, slots)
+            self._encoders[name].open(path, self.spec.fps, self.codec)
+            self._videos[name] = self._encoders[name]
 
     def add_frame(
         self,
         state: Any,
         action: Any,
         images: dict[str, NDArray[np.uint8]] | None = None,
+        *,
+        live: bool = False,
     ) -> None:
         """One frame: the state and the action (degrees, in the spec's motor order), and an RGB
-        image (height x width x 3, uint8) from every camera."""
+        image (height x width x 3, uint8) from every camera. ``live``: never wait for an
+        encoder a second behind, drop the image instead (the last one stands in for it)."""
         if not self.recording:
             raise ArgumentError("no episode is open: call begin_episode first")
         count = len(self.spec.motors)
@@ -192,8 +201,7 @@ class DatasetWriter:
                     field="images",
                 )
         for name, image in images.items():
-            self._videos[name].add(image)
-            self._image_stats[name].add(image)
+            self._videos[name].add(image, drop=live)
         self._states.append(state_row)
         self._actions.append(action_row)
 
@@ -202,7 +210,6 @@ class DatasetWriter:
         for video in self._videos.values():
             video.abandon()
         self._videos.clear()
-        self._image_stats.clear()
         self._task = None
         self._states, self._actions = [], []
 
@@ -242,13 +249,16 @@ class DatasetWriter:
         features = self.spec.features()
         data_path = self.root / layout.DATA_PATH.format(chunk_index=chunk, file_index=file)
         tables.write_table(data_path, tables.frames_table(columns, features))
+        video_dropped = 0
         for name, video in self._videos.items():
             key = layout.IMAGES + name
-            if video.finish() != length:
-                raise FileError(f"camera {name}: {video.frames} frames encoded of {length}")
+            encoded = video.finish()
+            if encoded.frames != length or video.path is None:
+                raise FileError(f"camera {name}: {encoded.frames} frames encoded of {length}")
+            video_dropped += encoded.filled
             final = self._video_path(key, index)
             os.replace(video.path, final)
-            episode_stats[key] = self._image_stats[name].result()
+            episode_stats[key] = encoded.stats.result()
             row[f"videos/{key}/chunk_index"] = chunk
             row[f"videos/{key}/file_index"] = file
             row[f"videos/{key}/from_timestamp"] = 0.0
@@ -256,7 +266,6 @@ class DatasetWriter:
             if "info" not in self.info["features"][key]:
                 self.info["features"][key]["info"] = video_info(final, self.spec.fps)
         self._videos.clear()
-        self._image_stats.clear()
         for key, feature_stats in episode_stats.items():
             for name, value in feature_stats.items():
                 row[f"stats/{key}/{name}"] = value.tolist()
@@ -270,7 +279,7 @@ class DatasetWriter:
         self._write_summary()
         self._task = None
         self._states, self._actions = [], []
-        return EpisodeSaved(index, length, length / self.spec.fps, task)
+        return EpisodeSaved(index, length, length / self.spec.fps, task, video_dropped)
 
     def _write_summary(self) -> None:
         """stats.json, then info.json, from the episode rows."""
@@ -292,10 +301,18 @@ class DatasetWriter:
             video_key=key, chunk_index=chunk, file_index=file
         )
 
+    @property
+    def video_dropped(self) -> int:
+        """Camera frames of the open episode that the encoders could not take in time."""
+        return sum(video.dropped for video in self._videos.values())
+
     def close(self) -> None:
-        """Drop an episode still open (it was not saved)."""
+        """Drop an episode still open (it was not saved); end the encoders' processes."""
         if self.recording:
             self.discard_episode()
+        for encoder in self._encoders.values():
+            encoder.close()
+        self._encoders.clear()
 
     def __enter__(self) -> DatasetWriter:
         return self

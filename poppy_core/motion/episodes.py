@@ -147,9 +147,11 @@ class EpisodeRecorder:
         episode: int,
         stop: threading.Event,
         on_tick: Callable[[Progress], None] | None = None,
+        discard: threading.Event | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> EpisodeSaved | None:
-        """One episode of ``duration_s`` (or until ``stop``); None when it has no frame."""
+        """One episode of ``duration_s`` (or until ``stop``); None when it has no frame, or
+        when ``discard`` is set at its end (its frames dropped: it is recorded again)."""
         self.writer.begin_episode(task)
         period = 1.0 / self.fps
         start = clock()
@@ -170,16 +172,23 @@ class EpisodeRecorder:
                 images = self.images()
                 if pending is not None:
                     last_state, last_action, last_images = pending
-                    self.writer.add_frame(last_state, last_action or state, last_images)
+                    self.writer.add_frame(last_state, last_action or state, last_images, live=True)
                 pending = (state, action, images)
                 if on_tick is not None:
-                    on_tick(Progress(episode, now - start, self.writer.frames, schedule.missed))
+                    on_tick(
+                        Progress(
+                            episode,
+                            now - start,
+                            self.writer.frames,
+                            schedule.missed + self.writer.video_dropped,
+                        )
+                    )
             if pending is not None:
                 last_state, last_action, last_images = pending
-                self.writer.add_frame(last_state, last_action or last_state, last_images)
+                self.writer.add_frame(last_state, last_action or last_state, last_images, live=True)
         finally:
             self.source.end()
-        if self.writer.frames == 0:
+        if self.writer.frames == 0 or (discard is not None and discard.is_set()):
             self.writer.discard_episode()
             return None
         return self.writer.save_episode()

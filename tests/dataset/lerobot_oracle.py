@@ -5,7 +5,9 @@ length, features, stats, the frames asked for (decoded at their timestamps by Le
 default decoder), and the stats LeRobot's ``compute_episode_stats``/``aggregate_stats``
 compute from the frames it loaded. ``python lerobot_oracle.py write ROOT SPEC``: the dataset
 LeRobot's ``create/add_frame/save_episode/finalize`` write for the same features (SPEC: JSON of
-fps, robot_type, features, frames). One JSON object on stdout.
+fps, robot_type, features, frames; or ``episodes``, their lengths, and their ``tasks``: frame k
+of episode e holds k + 40 e everywhere, LeRobot packing the episodes into one file). One JSON
+object on stdout.
 """
 
 from __future__ import annotations
@@ -78,15 +80,19 @@ def write(root: str, spec: dict) -> dict:
     dataset = LeRobotDataset.create(
         "poppy/oracle", spec["fps"], features, root=root, robot_type=spec["robot_type"]
     )
-    for k in range(spec["frames"]):
-        frame = {"task": "pick the cube"}
-        for key, ft in features.items():
-            if ft["dtype"] == "video":
-                frame[key] = np.full(ft["shape"], k % 256, dtype=np.uint8)
-            else:
-                frame[key] = np.full(ft["shape"], float(k), dtype=np.float32)
-        dataset.add_frame(frame)
-    dataset.save_episode()
+    lengths = spec.get("episodes") or [spec["frames"]]
+    tasks = spec.get("tasks") or ["pick the cube"] * len(lengths)
+    for episode, length in enumerate(lengths):
+        for k in range(length):
+            frame = {"task": tasks[episode]}
+            value = k + 40 * episode  # episode 0: every value k, every pixel k
+            for key, ft in features.items():
+                if ft["dtype"] == "video":
+                    frame[key] = np.full(ft["shape"], value % 256, dtype=np.uint8)
+                else:
+                    frame[key] = np.full(ft["shape"], float(value), dtype=np.float32)
+            dataset.add_frame(frame)
+        dataset.save_episode()
     dataset.finalize()
     with open(f"{root}/meta/info.json", encoding="utf-8") as file:
         return json.load(file)

@@ -9,7 +9,6 @@ import re
 from pathlib import Path
 
 import numpy as np
-import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
@@ -148,20 +147,6 @@ def test_the_swap_without_renameat2(tmp_path: Path, monkeypatch: pytest.MonkeyPa
     delete_episode(root, 0)
     assert json.loads((root / "meta/info.json").read_text())["total_frames"] == 25
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ds"]
-
-
-def test_a_dataset_packing_episodes_in_one_file_is_refused(tmp_path: Path) -> None:
-    root = tmp_path / "ds"
-    record(root, [20, 25])
-    path = root / TABLES[1]
-    rows = pq.read_table(path).to_pylist()
-    for row in rows:  # as LeRobot's writer lays them out: both episodes in file-000
-        row["data/file_index"] = 0
-    pq.write_table(pa.Table.from_pylist(rows), path)
-    before = snapshot(root)
-    with pytest.raises(ArgumentError, match="packs several episodes into one data file"):
-        delete_episode(root, 0)
-    assert snapshot(root) == before
 
 
 def test_a_failed_fallback_swap_puts_the_dataset_back(

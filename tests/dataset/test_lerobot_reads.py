@@ -151,3 +151,39 @@ def test_lerobot_loads_a_dataset_after_an_episode_is_deleted(oracle: Path, tmp_p
     for key, feature in seen["recomputed_stats"].items():
         for name in ("min", "max", "mean", "std", "count"):
             assert seen["stats"][key][name] == pytest.approx(feature[name]), (key, name)
+
+
+def test_an_episode_is_deleted_from_a_dataset_lerobot_packed(oracle: Path, tmp_path: Path) -> None:
+    root = tmp_path / "lerobot"
+    features = {
+        "observation.state": {"dtype": "float32", "shape": [3], "names": ["a", "b", "c"]},
+        "action": {"dtype": "float32", "shape": [3], "names": ["a", "b", "c"]},
+        "observation.images.top": {
+            "dtype": "video",
+            "shape": [48, 64, 3],
+            "names": ["height", "width", "channels"],
+        },
+    }
+    spec = {
+        "fps": 30,
+        "robot_type": "ergo-jr",
+        "features": features,
+        "episodes": [12, 10, 8],
+        "tasks": ["pick", "wave", "pick"],
+    }
+    run_oracle("write", str(root), json.dumps(spec))
+    assert sorted(p.name for p in (root / "data/chunk-000").iterdir()) == ["file-000.parquet"]
+    done = delete_episode(root, 1)
+    assert (done.frames, done.episodes_left, done.frames_left, done.tasks_left) == (10, 2, 20, 1)
+    seen = run_oracle("load", str(root), "poppy/oracle", "0,11,12,19")
+    assert (seen["len"], seen["num_episodes"], seen["tasks"]) == (20, 2, ["pick"])
+    places = [(0, 0, 0), (0, 11, 11), (1, 0, 80), (1, 7, 87)]  # episode 2's values: k + 80
+    for item, (episode, k, value) in zip(seen["items"], places, strict=True):
+        assert (item["episode_index"], item["frame_index"]) == (episode, k)
+        assert item["index"] == 12 * episode + k and item["task_index"] == 0
+        assert item["action"] == pytest.approx([value] * 3)
+        # the video is the same file: the episode left decodes at its own span
+        assert item["observation.images.top"]["pixel"] == pytest.approx([value] * 3, abs=6)
+    for key, feature in seen["recomputed_stats"].items():
+        for name in ("min", "max", "mean", "std", "count"):
+            assert seen["stats"][key][name] == pytest.approx(feature[name]), (key, name)

@@ -1,4 +1,4 @@
-"""`poppy dataset replay|delete-episode`: play an episode's actions on a robot, remove an episode.
+"""`poppy dataset replay`: play an episode's actions on a robot.
 
 Every refusal (no such episode, a bad speed, joints the robot lacks) comes before a robot is
 built: one line, exit 2. The replay is ``poppy play``'s player on a move made of the episode's
@@ -10,44 +10,12 @@ from __future__ import annotations
 import signal
 import threading
 from pathlib import Path
-from typing import Any
 
 import typer
 
+from poppy_cli.commands.dataset.checks import EpisodeOpt, RootOpt, core, dataset_folder
 from poppy_cli.options import ConfigOpt, JsonSummaryOpt, PortOpt, ProfileOpt, SimOpt, finite
 from poppy_cli.output import EXIT_INTERRUPTED, console, err_console, print_json, printable
-
-RootOpt = typer.Option(
-    None, "--root", help="Its folder. [default: $HF_LEROBOT_HOME/REPO_ID, as LeRobot's]"
-)
-EpisodeOpt = typer.Option(..., "--episode", min=0, help="The episode's number (from 0).")
-
-
-def _core(call: Any, hint: str) -> Any:
-    """A core check; its ArgumentError becomes a usage error (exit 2) on ``hint``."""
-    from poppy_core.errors import ArgumentError
-
-    try:
-        return call()
-    except ArgumentError as exc:
-        raise typer.BadParameter(str(exc), param_hint=hint) from None
-
-
-def _folder(repo_id: str, root: Path | None) -> Path:
-    """The dataset's folder (--root, else LeRobot's), refused unless it holds a dataset."""
-    from poppy_core.dataset import layout
-    from poppy_core.dataset.writer import default_root
-    from poppy_core.extras import require
-
-    require("pyarrow", extra="dataset")
-    _core(lambda: layout.check_repo_id(repo_id), "REPO_ID")
-    folder = Path(root).expanduser() if root is not None else default_root(repo_id)
-    if not (folder / layout.INFO_PATH).is_file():
-        raise typer.BadParameter(
-            f"{folder} holds no dataset (no {layout.INFO_PATH}): give its folder with --root",
-            param_hint="--root",
-        )
-    return folder
 
 
 def replay(
@@ -73,8 +41,8 @@ def replay(
     from poppy_core.dataset.rows import read_actions
     from poppy_core.motion import Move, MovePlayer
 
-    folder = _folder(repo_id, root)
-    actions = _core(lambda: read_actions(folder, episode), "--episode")
+    folder = dataset_folder(repo_id, root)
+    actions = core(lambda: read_actions(folder, episode), "--episode")
     config = robot_config(profile, config_file, port)
     missing = [m for m in actions.motors if m not in config.motors]
     if missing:
@@ -83,7 +51,7 @@ def replay(
             f"({', '.join(config.motors)}): replay it on the robot it was recorded with",
             param_hint="--profile",
         )
-    move = _core(
+    move = core(
         lambda: Move(actions.fps, actions.motors, actions.positions, metadata={"episode": episode}),
         "--episode",
     )
@@ -120,37 +88,3 @@ def replay(
         )
     if stop.is_set():
         raise typer.Exit(EXIT_INTERRUPTED)
-
-
-def delete_episode(
-    repo_id: str = typer.Argument(..., help="The dataset's name, user/name."),
-    episode: int = EpisodeOpt,
-    root: Path | None = RootOpt,
-    json_output: bool = JsonSummaryOpt,
-) -> None:
-    """Remove an episode; the later ones move one number down (indices, tasks, stats, videos).
-
-    The new dataset is built beside the old one and swapped in at once: an interrupted
-    deletion leaves the dataset as it was.
-    """
-    from poppy_core.dataset.delete import delete_episode as delete
-
-    folder = _folder(repo_id, root)
-    done = _core(lambda: delete(folder, episode), "--episode")
-    if json_output:
-        print_json(
-            {
-                "root": str(folder),
-                "deleted": done.episode,
-                "frames": done.frames,
-                "total_episodes": done.episodes_left,
-                "total_frames": done.frames_left,
-                "total_tasks": done.tasks_left,
-            }
-        )
-        return
-    console.print(
-        f"deleted episode {done.episode} ({done.frames} frames); {done.episodes_left} episodes, "
-        f"{done.frames_left} frames left",
-        highlight=False,
-    )
