@@ -31,7 +31,13 @@ from bench.procs import child, free_port, served_ergo
 from bench.registry import BenchContext, BenchResult, Table, register
 from bench.scan_baseline import BASELINE_CLIENT, baseline_label
 from bench.server_baseline import baseline_cpu_table, baseline_rps_table, calls_table
-from bench.server_cpu import call_counts, cpu_per_request, thread_cpu_ns
+from bench.server_cpu import (
+    background_cpu,
+    call_counts,
+    cpu_per_request,
+    net_of_background,
+    thread_cpu_ns,
+)
 from bench.side_by_side import measure_sides, median_cells, percentile
 
 CLIENTS = 4
@@ -218,14 +224,18 @@ def _run(port: int, name: str, pid: int | None = None) -> dict[str, Any]:
         mover = threading.Thread(target=_goto_loop, args=(port, stop))
         mover.start()
         time.sleep(0.1)
-    before = thread_cpu_ns(pid) if pid is not None else {}
     try:
+        idle_ns_per_s = background_cpu(pid) if pid is not None else 0.0
+        before = thread_cpu_ns(pid) if pid is not None else {}
+        t0 = time.monotonic()
         if wrk is not None:
             result = _load_wrk(wrk, port, method, path, body)
         else:
             result = _load(port, method, path, body)
         if pid is not None:
-            result.update(cpu_per_request(before, thread_cpu_ns(pid), result.get("requests", 0)))
+            background = idle_ns_per_s * (time.monotonic() - t0)
+            spent = cpu_per_request(before, thread_cpu_ns(pid), result.get("requests", 0))
+            result.update(spent, **net_of_background(spent, background, result.get("requests", 0)))
     finally:
         stop.set()
         if mover is not None:

@@ -3,9 +3,11 @@
 On a shared machine a 2-second wrk run ranges over a factor of 10 from one run to the next; the
 CPU a server spends per request it served moves far less (load steals time, not work). It is
 read from ``/proc/PID/task/*/schedstat`` (nanoseconds on the CPU, per thread) before and after
-each run: the whole process (its sync loops and emulator included), and its busiest thread
-(the one serving HTTP). The calls per request are counted by ``bench/server_calls.py`` in each
-checkout's own interpreter, without a network: the same code answers the same way every time.
+each run: the whole process (its sync loops and emulator included), the same less the CPU the
+process spent per second without requests just before the run (its background: a server that
+serves fewer requests in a run would otherwise carry more of it per request), and its busiest
+thread (the one serving HTTP). The calls per request are counted by ``bench/server_calls.py``
+in each checkout's own interpreter, without a network: the same code answers the same way.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import json
 import os
 import subprocess
 import tempfile
+import time
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +25,8 @@ from bench.registry import BENCH_DIR, POPPY_PYTHON, REPO_ROOT
 CALL_REQUESTS = 500
 """Requests per route counted (after 50 not counted)."""
 CALLS_TIMEOUT_S = 300.0
+IDLE_S = 0.5
+"""How long a server's CPU is read with no request before each run (its background)."""
 
 
 def thread_cpu_ns(pid: int) -> dict[str, int]:
@@ -50,6 +55,25 @@ def cpu_per_request(before: dict[str, int], after: dict[str, int], requests: int
         "cpu_us": sum(spent) / requests / 1e3,
         "serving_cpu_us": max(spent) / requests / 1e3,
     }
+
+
+def background_cpu(pid: int, seconds: float = IDLE_S) -> float:
+    """Nanoseconds of CPU per second process ``pid`` spends with no request to answer (its
+    sync loops, the emulator, a goto under way), over ``seconds``."""
+    before = thread_cpu_ns(pid)
+    t0 = time.monotonic()
+    time.sleep(seconds)
+    after = thread_cpu_ns(pid)
+    spent = sum(ns - before.get(task, 0) for task, ns in after.items())
+    return spent / (time.monotonic() - t0)
+
+
+def net_of_background(spent: dict[str, Any], background_ns: float, requests: int) -> dict[str, Any]:
+    """``net_cpu_us``: the process's CPU per request less what it spends without requests
+    (``background_ns`` over the run), the share that grows when a server serves fewer."""
+    if "cpu_us" not in spent or not requests:
+        return {}
+    return {"net_cpu_us": spent["cpu_us"] - background_ns / requests / 1e3}
 
 
 def call_counts(folder: Path | None = None) -> dict[str, Any]:
