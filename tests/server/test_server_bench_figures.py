@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import os
 import threading
-import time
 
 from bench.server_baseline import baseline_cpu_table, calls_table
 from bench.server_cpu import cpu_per_request, net_of_background, thread_cpu_ns
+from tests.helpers.waiting import eventually
 
 
 def test_cpu_per_request_counts_every_thread_and_names_the_busiest() -> None:
@@ -28,15 +28,15 @@ def test_this_process_threads_are_read_from_proc() -> None:
         while not stop.is_set():
             sum(range(1000))
 
+    before = sum(thread_cpu_ns(os.getpid()).values())
     worker = threading.Thread(target=spin)
-    before = thread_cpu_ns(os.getpid())
     worker.start()
-    time.sleep(0.2)
-    stop.set()
-    worker.join()
-    after = thread_cpu_ns(os.getpid())
-    assert len(after) >= 2
-    assert sum(after.values()) > sum(before.values())
+    try:
+        assert eventually(lambda: len(thread_cpu_ns(os.getpid())) >= 2)
+        assert eventually(lambda: sum(thread_cpu_ns(os.getpid()).values()) > before)
+    finally:
+        stop.set()
+        worker.join()
 
 
 def _runs(cpu: list[float]) -> dict[str, object]:
