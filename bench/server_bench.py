@@ -30,7 +30,14 @@ from bench import side_by_side
 from bench.procs import child, free_port, served_ergo
 from bench.registry import BenchContext, BenchResult, Table, register
 from bench.scan_baseline import BASELINE_CLIENT, baseline_label
-from bench.server_baseline import baseline_rps_table
+from bench.server_baseline import baseline_cpu_table, baseline_rps_table, calls_table
+from bench.server_cpu import (
+    background_cpu,
+    call_counts,
+    cpu_per_request,
+    net_of_background,
+    thread_cpu_ns,
+)
 from bench.side_by_side import measure_sides, median_cells, percentile
 
 CLIENTS = 4
@@ -76,7 +83,7 @@ def _wait_listening(port: int, proc: subprocess.Popen[str]) -> None:
 
 
 @contextmanager
-def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
+def _server(kind: str, ctx: BenchContext) -> Iterator[tuple[int, int]]:
     """``kind``: "poppy", "pypot", or BASELINE_CLIENT (poppy run from the --baseline checkout)."""
     port = free_port()
     flags = ("--http", "--http-port", str(port))
@@ -87,7 +94,7 @@ def _server(kind: str, ctx: BenchContext) -> Iterator[int]:
         args, where = served_ergo(kind, ctx, PYPOT_SERVER, port, *flags), {}
     with child(args, **where) as proc:
         _wait_listening(port, proc)
-        yield port
+        yield port, proc.pid
 
 
 def _load(port: int, method: str, path: str, body: bytes | None) -> dict[str, Any]:
@@ -205,8 +212,9 @@ def _goto_loop(port: int, stop: threading.Event) -> None:
     conn.close()
 
 
-def _run(port: int, name: str) -> dict[str, Any]:
-    """One run of scenario ``name`` on the server at ``port``, with the load average at start."""
+def _run(port: int, name: str, pid: int | None = None) -> dict[str, Any]:
+    """One run of scenario ``name`` on the server at ``port``, with the load average at start
+    and, given the server's ``pid``, the CPU it spent per request (``server_cpu``)."""
     method, path, body = SCENARIOS[name]
     wrk = shutil.which("wrk")
     load1 = os.getloadavg()[0]
@@ -217,10 +225,17 @@ def _run(port: int, name: str) -> dict[str, Any]:
         mover.start()
         time.sleep(0.1)
     try:
+        idle_ns_per_s = background_cpu(pid) if pid is not None else 0.0
+        before = thread_cpu_ns(pid) if pid is not None else {}
+        t0 = time.monotonic()
         if wrk is not None:
             result = _load_wrk(wrk, port, method, path, body)
         else:
             result = _load(port, method, path, body)
+        if pid is not None:
+            background = idle_ns_per_s * (time.monotonic() - t0)
+            spent = cpu_per_request(before, thread_cpu_ns(pid), result.get("requests", 0))
+            result.update(spent, **net_of_background(spent, background, result.get("requests", 0)))
     finally:
         stop.set()
         if mover is not None:
@@ -238,21 +253,24 @@ def _medians(runs_by_name: dict[str, list[dict[str, Any]]]) -> dict[str, Any]:
 
 
 def _measure(kind: str, ctx: BenchContext) -> dict[str, Any]:
-    with _server(kind, ctx) as port:
-        return _medians({name: [_run(port, name) for _ in range(ctx.repeat)] for name in SCENARIOS})
+    with _server(kind, ctx) as (port, pid):
+        return _medians(
+            {name: [_run(port, name, pid) for _ in range(ctx.repeat)] for name in SCENARIOS}
+        )
 
 
 def _measure_beside_baseline(ctx: BenchContext) -> dict[str, Any]:
     """This poppy and the --baseline one, both served at once; in each round of each scenario
     one runs right after the other, the order swapping each round (baseline first in round 0)."""
     runs: dict[str, dict[str, list[dict[str, Any]]]] = {"poppy": {}, BASELINE_CLIENT: {}}
-    with _server(BASELINE_CLIENT, ctx) as base_port, _server("poppy", ctx) as port:
-        ports = {"poppy": port, BASELINE_CLIENT: base_port}
+    with _server(BASELINE_CLIENT, ctx) as base, _server("poppy", ctx) as this:
+        servers = {"poppy": this, BASELINE_CLIENT: base}
         for name in SCENARIOS:
             for rep in range(ctx.repeat):
                 order = ("poppy", BASELINE_CLIENT) if rep % 2 else (BASELINE_CLIENT, "poppy")
                 for side in order:
-                    run = _run(ports[side], name)
+                    port, pid = servers[side]
+                    run = _run(port, name, pid)
                     run["rep"] = rep
                     runs[side].setdefault(name, []).append(run)
     return {side: _medians(by_name) for side, by_name in runs.items()}
@@ -261,11 +279,19 @@ def _measure_beside_baseline(ctx: BenchContext) -> dict[str, Any]:
 GOAL_RATIO = 2.0
 
 
+def _median_cpu(raw: dict[str, Any], side: str, name: str) -> str:
+    """The median over the runs of ``side`` of its process's CPU µs per request."""
+    runs = raw.get(side, {}).get(name, {}).get("runs", [])
+    spent = sorted(float(run["cpu_us"]) for run in runs if run.get("cpu_us"))
+    return f"{spent[len(spent) // 2]:.1f}" if spent else "-"
+
+
 @register("server", "REST requests/s and p50/p99 latency: poppy serve vs pypot's HTTP server")
 def server_bench(ctx: BenchContext) -> BenchResult:
     """Measure both servers on every scenario."""
     raw: dict[str, Any] = {"clients": CLIENTS, "duration_s": DURATION_S, "goto_s": GOTO_S}
     tables: list[Table] = []
+    label: str | None = None
     if ctx.baseline is not None:
         beside = _measure_beside_baseline(ctx)
         label = baseline_label(ctx.baseline)
@@ -275,11 +301,21 @@ def server_bench(ctx: BenchContext) -> BenchResult:
             return beside["poppy"] if kind == "poppy" else _measure(kind, ctx)
 
         sides, notes = measure_sides(ctx, measure, "server")
-        table, more = baseline_rps_table(raw[BASELINE_CLIENT], sides["poppy"], label)
-        tables.append(table)
-        notes += more
+        for make in (baseline_rps_table, baseline_cpu_table):
+            table, more = make(raw[BASELINE_CLIENT], sides["poppy"], label)
+            tables.append(table)
+            notes += more
+        raw["calls"] = {"poppy": call_counts(), BASELINE_CLIENT: call_counts(ctx.baseline)}
     else:
         sides, notes = measure_sides(ctx, _measure, "server")
+        raw["calls"] = {"poppy": call_counts()}
+    failed = [side for side, counted in raw["calls"].items() if "error" in counted]
+    if failed:
+        notes += [raw["calls"][side]["error"] for side in failed]
+    else:
+        table, more = calls_table(raw["calls"], label)
+        tables.append(table)
+        notes += more
     raw.update(sides)
     rows = [[name, *median_cells(raw, name)] for name in SCENARIOS]
     headers = side_by_side.headers()
@@ -296,6 +332,9 @@ def server_bench(ctx: BenchContext) -> BenchResult:
         verdicts.append(met)
         row += [f"{ratio:.1f}x", "pass" if met else "**FAIL**"]
     headers += ["poppy / pypot", f">= {GOAL_RATIO:g}x, lower p99"]
+    for row, name in zip(rows, SCENARIOS, strict=True):
+        row += [_median_cpu(raw, side, name) for side in ("poppy", "pypot")]
+    headers += ["poppy CPU µs/req", "pypot CPU µs/req"]
     notes.append(
         (
             f"Load: wrk, one thread, {CLIENTS} keep-alive connections"

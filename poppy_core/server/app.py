@@ -56,8 +56,7 @@ def create_app(
     Returns:
         The app; its lifespan stops the recordings and playbacks of its own service on shutdown.
     """
-    from fastapi import FastAPI
-
+    from poppy_core.server.front import GuardedAPI
     from poppy_core.server.routers import (
         pypot_ik,
         pypot_motion,
@@ -88,7 +87,7 @@ def create_app(
             if owns_service:
                 service.close()
 
-    app = FastAPI(
+    app = GuardedAPI(
         title="poppy robot API",
         version=API_VERSION,
         description=(
@@ -97,7 +96,7 @@ def create_app(
         ),
         lifespan=lifespan,
         docs_url=None,
-        **no_telemetry(FastAPI),
+        **no_telemetry(GuardedAPI),
     )
     policy = policy or OriginPolicy()
     app.state.service = service
@@ -130,13 +129,16 @@ def create_app(
     add_stream_routes(app)
     add_docs_route(app)
     app.add_middleware(LegacyPaths)  # innermost: the old spellings reach the routers rewritten
-    app.add_middleware(RegisterFastPath, service=service)
-    app.add_middleware(BodyLimitMiddleware, max_bytes=max_body_bytes)
-    if token:
-        app.add_middleware(TokenMiddleware, token=token, public=is_public)
-    # outermost: before the token and the fast path; which GETs change the robot is decided on
-    # the route each spelling reaches (LegacyPaths rewrites them later)
-    app.add_middleware(OriginGuard, policy=policy, changes_state=changes_state_as_routed(app))
+    changes_state = changes_state_as_routed(app)
+    # In front of FastAPI's layers (front.py), outermost first: the Host/Origin guard (which
+    # GETs change the robot is decided on the route each spelling reaches: LegacyPaths
+    # rewrites them later), the token, the body size, then pypot's fast path.
+    app.guard(
+        lambda inner: OriginGuard(inner, policy=policy, changes_state=changes_state),
+        *([lambda inner: TokenMiddleware(inner, token=token, public=is_public)] if token else []),
+        lambda inner: BodyLimitMiddleware(inner, max_bytes=max_body_bytes),
+        lambda inner: RegisterFastPath(inner, service=service),
+    )
     return app
 
 

@@ -35,13 +35,21 @@ STATE_REGISTERS = (
 """What the WebSocket stream sends for every motor (pypot's ws server fields)."""
 
 
+PLAIN: frozenset[type] = frozenset({int, str, bool, type(None)})
+"""Types whose values are JSON as they are (floats are not: NaN and infinities are not JSON)."""
+
+
 def jsonable(value: Any) -> Any:
     """``value`` as plain JSON data (tuples as lists, models by name, NaN/inf as None)."""
-    kind = type(value)
+    kind = type(value)  # the exact JSON types first, without isinstance (/robot.json's rebuild)
     if kind is float:
-        return value if math.isfinite(value) else None
+        return value if value - value == 0.0 else None  # finite (inf - inf and nan are nan)
     if kind is bool or kind is str or kind is int or value is None:
         return value
+    if kind is list or kind is tuple:
+        return [v if type(v) in PLAIN else jsonable(v) for v in value]
+    if kind is dict:
+        return {str(k): v if type(v) in PLAIN else jsonable(v) for k, v in value.items()}
     if isinstance(value, bool | str | int):
         return value
     if isinstance(value, float):
@@ -83,9 +91,10 @@ def motor_registers(motor: Motor) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for name in motor.registers:
         try:
-            out[name] = jsonable(getattr(motor, name))
+            value = getattr(motor, name)
         except RegisterError:
             continue
+        out[name] = value if type(value) in PLAIN else jsonable(value)
     return out
 
 

@@ -2,15 +2,13 @@
 
 import html
 import socket
-from typing import Any
 
 from fastapi import APIRouter, Request  # noqa: TID253 (the server room is FastAPI's)
 from fastapi.responses import HTMLResponse  # noqa: TID253
 
-from poppy_core import checks
-from poppy_core.errors import ArgumentError
 from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
+from poppy_core.server.pypot_goto import GOTOS_TIP, goto_number, goto_request
 from poppy_core.server.pypot_json import PypotJSON
 from poppy_core.server.pypot_values import pypot_value
 from poppy_core.server.routers.common import json_body, truthy, wait_goto
@@ -20,11 +18,6 @@ router = APIRouter(tags=["pypot"])
 GOTO_TIP = (
     '"position" (degrees) and "duration" (seconds) are required, "wait" is optional. '
     'Example: {"position": 90, "duration": 3, "wait": true}'
-)
-GOTOS_TIP = (
-    '"motors" (names), "positions" (degrees, one per motor) and "duration" (seconds) are '
-    'required, "wait" is optional. Example: {"motors": ["m1", "m2"], "positions": [90, 0], '
-    '"duration": 2}'
 )
 
 
@@ -123,21 +116,14 @@ async def set_register(motor: str, register: str, request: Request, service: Ser
     return PypotJSON({register: value}, status_code=202)
 
 
-def _float(value: Any, what: str, tip: str) -> float:
-    try:
-        return checks.number_from(value, what)
-    except ArgumentError as exc:
-        raise ApiError("invalid", str(exc), tip=tip) from None
-
-
 @router.post("/motors/{motor}/goto.json", status_code=202, summary="Move one motor")
 async def motor_goto(motor: str, request: Request, service: Service) -> PypotJSON:
     """202 ``{"motors": {motor: position}, "duration", "waiting"}`` (after the move if waiting)."""
     data = await json_body(request, tip=GOTO_TIP)
     if not isinstance(data, dict) or "position" not in data or "duration" not in data:
         raise ApiError("invalid", "cannot read the data given", tip=GOTO_TIP)
-    position = _float(data["position"], "position", GOTO_TIP)
-    duration = _float(data["duration"], "duration", GOTO_TIP)
+    position = goto_number(data["position"], "position", GOTO_TIP)
+    duration = goto_number(data["duration"], "duration", GOTO_TIP)
     wait = truthy(data.get("wait", False))
     handle = service.goto({motor: position}, duration)
     if wait:
@@ -150,20 +136,7 @@ async def motor_goto(motor: str, request: Request, service: Service) -> PypotJSO
 @router.post("/motors/goto.json", status_code=202, summary="Move several motors together")
 async def motors_goto(request: Request, service: Service) -> PypotJSON:
     """202 ``{"motors": {motor: position}, "duration", "waiting"}``."""
-    data = await json_body(request, tip=GOTOS_TIP)
-    if not isinstance(data, dict) or not {"motors", "positions", "duration"} <= set(data):
-        raise ApiError("invalid", "cannot read the data given", tip=GOTOS_TIP)
-    motors, positions = data["motors"], data["positions"]
-    if not isinstance(motors, list) or not isinstance(positions, list):
-        raise ApiError("invalid", "motors and positions must be lists", tip=GOTOS_TIP)
-    if len(motors) != len(positions):
-        raise ApiError("invalid", "not as many positions as motors", tip=GOTOS_TIP)
-    targets = {
-        str(m): _float(p, f"position of {m}", GOTOS_TIP)
-        for m, p in zip(motors, positions, strict=True)
-    }
-    duration = _float(data["duration"], "duration", GOTOS_TIP)
-    wait = truthy(data.get("wait", False))
+    targets, duration, wait = goto_request(await json_body(request, tip=GOTOS_TIP))
     handle = service.goto(targets, duration)
     if wait:
         await wait_goto(handle)
