@@ -422,3 +422,33 @@ def test_a_busy_zenoh_endpoint_is_one_clear_line(moves: Path) -> None:
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "Address already in use" in lines[0], lines
     assert " at /" not in lines[0]
+
+
+def test_a_robot_listening_on_every_interface_announces_its_addresses(
+    two: tuple[Served, Served], fleet: Fleet, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`poppy serve --host 0.0.0.0 --zenoh-listen tcp/0.0.0.0:7447`: its description names the
+    addresses a peer dials (this machine's), never the wildcard, and its page is a link."""
+    from poppy_core import checks
+    from poppy_core.server import reachable
+    from poppy_core.server.zenoh.web_fleet import announced_hosts
+
+    monkeypatch.setattr(reachable, "machine_addresses", lambda: ["192.0.2.7", "198.51.100.3"])
+    node = two[0].servers.zenoh
+    assert node is not None
+    node.endpoints = ("tcp/0.0.0.0:7447", "tcp/[::]:7448#iface=wlan0", "tcp/127.0.0.1:7449")
+    node.page = "http://0.0.0.0:8080"  # what the builder takes from an HTTP server on 0.0.0.0
+    described = fleet.describe(["jr-a"])["jr-a"]
+    assert described["endpoints"] == [
+        "tcp/192.0.2.7:7447",
+        "tcp/198.51.100.3:7447",
+        "tcp/192.0.2.7:7448#iface=wlan0",
+        "tcp/198.51.100.3:7448#iface=wlan0",
+        "tcp/127.0.0.1:7449",
+    ]
+    assert described["page"] == "http://192.0.2.7:8080"
+    assert checks.peer_page(described["page"], announced_hosts("jr-a", described))
+    result = run_poppy("fleet", "list", "--json", *_fleet_args(*two))
+    assert result.code == 0, result.stderr
+    rows = {row["name"]: row for row in result.json()}
+    assert "0.0.0.0" not in json.dumps(rows["jr-a"])

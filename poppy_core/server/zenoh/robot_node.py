@@ -27,6 +27,7 @@ from poppy_core.errors import PoppyError
 from poppy_core.motion.chains import robot_chains
 from poppy_core.schedule import RateMeter, TickGuard, Worker
 from poppy_core.server.errors import ApiError, refusal_kind
+from poppy_core.server.reachable import reachable_endpoints, reachable_url
 from poppy_core.server.zenoh import described
 from poppy_core.server.zenoh.asgi_call import AsgiCaller
 from poppy_core.server.zenoh.intake import ApiRequest, Intake
@@ -260,8 +261,9 @@ class ZenohRobotServer:
             "name": self.name,
             "creature": described.creature(robot),
             "host": socket.gethostname(),
-            "endpoints": list(self.endpoints),
-            "page": self.page,
+            # where a peer reaches it: a wildcard listener (0.0.0.0) is no address to dial
+            "endpoints": reachable_endpoints(self.endpoints),
+            "page": reachable_url(self.page),
             "token": self.token is not None,
             "state_rate_hz": self.state_rate_hz,
             "motors": described.motors(robot),
