@@ -323,8 +323,10 @@ class ZenohRobotServer:
             place = self.intake.hold(request.start_at)
         except Refused as exc:
             return _refusal(exc.status, exc.detail)
+        late = self._late_s(request)
         if STARTS.fullmatch(request.path):
             # armed now (checked, its thread made, held at a gate); the gate opens at start_at
+            # (one already past: it starts at once, and the reply says how late)
             if request.body is not None and not isinstance(request.body, dict):
                 self.intake.release(place)
                 return _refusal(422, "the body of a start is an object (or nothing)")
@@ -333,12 +335,28 @@ class ZenohRobotServer:
             if reply["status"] >= 400:
                 self.intake.release(place)
                 return reply
-            return {**reply, "start_at": request.start_at}
+            return {**reply, "start_at": request.start_at, **late}
         try:
             await asyncio.sleep(max(0.0, request.start_at - time.time()))
-            return await self._call(caller, request)
+            return {**await self._call(caller, request), **late}
         finally:
             self.intake.release(place)
+
+    def _late_s(self, request: ApiRequest) -> dict[str, float]:
+        """``{"late_s": S}`` for a request that came after its start time (it runs at once:
+        a fleet on a slow network still plays, a little behind), else nothing."""
+        assert request.start_at is not None
+        late = time.time() - request.start_at
+        if late <= 0:
+            return {}
+        logger.info(
+            "zenoh: %s: %s %s came %.3f s after its start time: run at once",
+            self.name,
+            request.method,
+            request.path,
+            late,
+        )
+        return {"late_s": round(late, 3)}
 
     async def _call(self, caller: AsgiCaller, request: ApiRequest) -> dict[str, Any]:
         """The app's answer: the request passed its arrival checks, so it carries the robot's
