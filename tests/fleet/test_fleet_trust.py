@@ -299,7 +299,7 @@ def test_sigterm_with_a_held_request_answers_it_and_ends_cleanly(moves: Any) -> 
     import signal
     import subprocess
 
-    from tests.helpers.cli import ENV, POPPY
+    from tests.helpers.cli import POPPY, command_env
     from tests.helpers.processes import read_until, reap
 
     endpoint = free_endpoint()
@@ -308,7 +308,7 @@ def test_sigterm_with_a_held_request_answers_it_and_ends_cleanly(moves: Any) -> 
         [*argv, "--token", TOKEN, "--profile", "ergo-jr", "--sim"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        env={**os.environ, **ENV},
+        env=dict(os.environ, **command_env()),
     )
     try:
         assert proc.stdout is not None and proc.stderr is not None

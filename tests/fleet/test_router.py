@@ -17,7 +17,7 @@ from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
 from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import from_remote
 from poppy_core.zenoh_wire import mode_of
-from tests.helpers.cli import ENV, POPPY, run_poppy
+from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import read_until, reap
 from tests.helpers.waiting import eventually, http_timeout
 from tests.helpers.zenoh_router import Router
@@ -204,7 +204,7 @@ def _serve_process(name: str, router: Router) -> subprocess.Popen[Any]:
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        env={**os.environ, **ENV},
+        env=dict(os.environ, **command_env()),
     )
 
 

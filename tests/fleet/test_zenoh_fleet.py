@@ -7,6 +7,7 @@ the fleet's client connects to them.
 from __future__ import annotations
 
 import json
+import os
 import socket
 import subprocess
 import time
@@ -23,7 +24,7 @@ from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import from_remote
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from poppy_core.zenoh_wire import check_name, pack_state, session_config, unpack_state
-from tests.helpers.cli import ENV, POPPY, run_poppy
+from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.waiting import eventually, http_timeout
 from tests.helpers.zenoh_served import TOKEN, Served, connect_to, free_endpoint
@@ -255,7 +256,7 @@ def test_a_killed_robot_leaves_the_fleet(moves: Path) -> None:
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        env={**__import__("os").environ, **ENV},
+        env=dict(os.environ, **command_env()),
     )
     try:
         # one endpoint: the teacher is the robot's Zenoh client, which opens only once the robot
