@@ -25,7 +25,7 @@ from poppy_core.protocol import (
     write,
 )
 from tests.helpers.bus import LOADED_REPLY_FLOOR_S
-from tests.helpers.waiting import eventually, within
+from tests.helpers.waiting import eventually, scaled, within
 
 XL320_TORQUE_ENABLE = 24
 XL320_PRESENT_POSITION = 37
@@ -58,7 +58,8 @@ def test_replies_are_written_whole_when_the_client_reads_late() -> None:
         decoder = PacketDecoder(2, "status")
         replies = 0
         quiet_since = time.monotonic()
-        while time.monotonic() - quiet_since < 1.5 and replies < count:
+        quiet_s = scaled(1.5)  # the emulator thread may wait that long for a core
+        while time.monotonic() - quiet_since < quiet_s and replies < count:
             chunk = port.read(65536)
             if chunk:
                 quiet_since = time.monotonic()
