@@ -28,6 +28,7 @@ from poppy_core.motion.chains import robot_chains
 from poppy_core.schedule import RateMeter, TickGuard, Worker
 from poppy_core.server.errors import ApiError, refusal_kind
 from poppy_core.server.reachable import reachable_endpoints, reachable_url
+from poppy_core.server.start_time import late_by
 from poppy_core.server.zenoh import described
 from poppy_core.server.zenoh.asgi_call import AsgiCaller
 from poppy_core.server.zenoh.intake import ApiRequest, Intake
@@ -343,20 +344,14 @@ class ZenohRobotServer:
             self.intake.release(place)
 
     def _late_s(self, request: ApiRequest) -> dict[str, float]:
-        """``{"late_s": S}`` for a request that came after its start time (it runs at once:
-        a fleet on a slow network still plays, a little behind), else nothing."""
-        assert request.start_at is not None
-        late = time.time() - request.start_at
-        if late <= 0:
-            return {}
-        logger.info(
-            "zenoh: %s: %s %s came %.3f s after its start time: run at once",
-            self.name,
-            request.method,
-            request.path,
-            late,
-        )
-        return {"late_s": round(late, 3)}
+        """``{"late_s": S}`` for a request that came after its start time (``late_by``), else
+        nothing."""
+        late = late_by(request.start_at or 0.0)
+        if late:
+            logger.info(
+                "zenoh: %s: %s came %.3f s late: run at once", self.name, request.path, late
+            )
+        return {"late_s": late} if late else {}
 
     async def _call(self, caller: AsgiCaller, request: ApiRequest) -> dict[str, Any]:
         """The app's answer: the request passed its arrival checks, so it carries the robot's
