@@ -160,7 +160,10 @@ def test_install_writes_the_settings_file_and_a_token_only_its_user_reads(
 
     # installed again: the options as its flags say, the token (maybe changed by the page) kept
     token.write_text("set-from-the-page\n")
-    again = fake.run("install", "--run-as", someone, "--zmq", "--require-token")
+    # (ZMQ beside a token only on loopback: it has no token of its own)
+    again = fake.run(
+        "install", "--run-as", someone, "--zmq", "--require-token", "--host", "127.0.0.1"
+    )
     assert again.code == 0, again.stderr
     assert json.loads(settings.read_text()) == {"snap": False, "zmq": True}
     assert token.read_text() == "set-from-the-page\n" and "token" not in again.stdout
