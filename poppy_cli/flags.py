@@ -121,6 +121,7 @@ FLAGS: dict[str, Flag] = {
     "--listen": Flag(None, "ENDPOINT", "Zenoh endpoint the router listens on"),
     "--all": Flag(None, None, "every robot of the fleet"),
     "--robots": Flag(None, "NAMES", "robots of the fleet, comma-separated"),
+    "--lead": Flag(None, "SECONDS", "seconds between a fleet command and its shared start"),
     "--snap": Flag(None, None, "serve pypot's Snap! routes and the Poppy blocks"),
     "--snap-port": Flag(None, "PORT", "TCP port of the Snap! server"),
     "--snap-dir": Flag(None, "DIR", "a downloaded Snap! to serve"),

@@ -43,6 +43,16 @@ RobotsOpt = typer.Option(None, "--robots", help="These robots, comma-separated: 
 TokenOpt = typer.Option(
     None, "--token", envvar="POPPY_TOKEN", help="The robots' token (poppy serve --token)."
 )
+LeadOpt = typer.Option(
+    None,
+    "--lead",
+    min=0.0,
+    max=30.0,
+    callback=finite,
+    help="Seconds between the command and the shared start (default: the slowest robot's "
+    "round trip times 3, at least 0.3). A robot the command reaches late starts at once and "
+    "says how late.",
+)
 
 
 def _fleet(
@@ -213,13 +223,24 @@ def _report(outcomes: list[Outcome], what: str, json_output: bool) -> None:
     if json_output:
         print_json(
             [
-                {"name": o.name, "ok": o.ok, "status": o.status, "message": o.message}
+                {
+                    "name": o.name,
+                    "ok": o.ok,
+                    "status": o.status,
+                    "message": o.message,
+                    "late_s": o.late_s,
+                }
                 for o in outcomes
             ]
         )
     else:
         for outcome in outcomes:
-            if outcome.ok:
+            if outcome.ok and outcome.late_s > 0:
+                console.print(
+                    f"{outcome.name}: {what}, {outcome.late_s:.2f} s late (the command came "
+                    "after the shared start: it started at once; --lead S gives more time)"
+                )
+            elif outcome.ok:
                 console.print(f"{outcome.name}: {what}")
             else:
                 error_line(f"{outcome.name}: {outcome.message}")
@@ -235,6 +256,7 @@ def fleet_run(
     zenoh_config: Path | None = ConfigOpt,
     zenoh_scout: bool = ScoutOpt,
     token: str | None = TokenOpt,
+    lead: float | None = LeadOpt,
     json_output: bool = JsonOpt,
 ) -> None:
     """Start a primitive on the robots, all at the same time."""
@@ -242,7 +264,7 @@ def fleet_run(
     with _fleet(connect, zenoh_config, zenoh_scout, token) as fleet:
         names = _targets(fleet, wanted)
         path = f"/api/v1/primitives/{_quoted(primitive)}/start"
-        outcomes = fleet.command(names, "POST", path)
+        outcomes = fleet.command(names, "POST", path, lead_s=lead)
     _report(outcomes, f"{primitive} started", json_output)
 
 
@@ -263,6 +285,7 @@ def fleet_play(
         help="Seconds to reach the first frame, the same on every robot: they play in phase "
         "wherever each one is (default: each its own, from its distance).",
     ),
+    lead: float | None = LeadOpt,
     json_output: bool = JsonOpt,
 ) -> None:
     """Play a move on the robots, all starting at the same time."""
@@ -273,7 +296,7 @@ def fleet_play(
     with _fleet(connect, zenoh_config, zenoh_scout, token) as fleet:
         names = _targets(fleet, wanted)
         path = f"/api/v1/moves/{_quoted(move)}/play"
-        outcomes = fleet.command(names, "POST", path, body)
+        outcomes = fleet.command(names, "POST", path, body, lead_s=lead)
     _report(outcomes, f"playing {move}", json_output)
 
 

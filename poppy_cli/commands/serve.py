@@ -208,6 +208,7 @@ def serve(
         require_foxglove()
     snap_dir = check_snap_options(snap, snap_dir, open_browser)
     from poppy_core.assembly import Listen, ServeSpec, serve
+    from poppy_core.assembly.serve_checks import require_extras
     from poppy_core.errors import ArgumentError
 
     try:  # the spec checks ports, name, origins and Host names, and warns of what it exposes
@@ -235,6 +236,7 @@ def serve(
     except ArgumentError as exc:
         flag = FLAGS.get(exc.field or "")
         _usage(f"{flag}: {exc}" if flag else str(exc))
+    require_extras(spec)  # a missing extra: one line now, not after the robot's start-up
     # SIGTERM is taken before anything serves: a client may stop the server as soon as its
     # address is printed (the default action, exit -15, when it came that early)
     stop = threading.Event()

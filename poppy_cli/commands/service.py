@@ -82,6 +82,7 @@ def install(
     from poppy_cli.service_files import files_of, write_files
     from poppy_cli.service_polkit import RULE_FILE, polkit_dir, rule_text
     from poppy_cli.systemd import Systemd, unit_dir
+    from poppy_core.assembly.serve_checks import LOOPBACK_HOSTS
     from poppy_core.checks import one_line, robot_name
     from poppy_core.errors import ArgumentError
     from poppy_core.files import write_file
@@ -98,6 +99,12 @@ def install(
         _usage("--port is empty: give the serial port (e.g. /dev/ttyAMA0) or auto")
     if user and run_as is not None:
         _usage("--run-as is for the system service: a --user service runs as you")
+    if zmq and token and host.strip("[]") not in LOOPBACK_HOSTS:
+        _usage(
+            f"--zmq with --require-token on {host}: pypot's ZMQ API has no token, anyone on the "
+            "network could move the robot; drop --zmq (the REST API and Zenoh ask for the "
+            "token), or serve on --host 127.0.0.1"
+        )
     load_profile(profile)  # an unknown profile: one line naming the known ones
     ports = tuple(http_ports or (units.USER_PORTS if user else units.SYSTEM_PORTS))
     run_as = None if user else _service_user(run_as, dry_run)

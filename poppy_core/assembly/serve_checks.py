@@ -154,3 +154,29 @@ def exposure(spec: ServeSpec) -> list[str]:
             "instead (e.g. https://snap.berkeley.edu)"
         )
     return lines
+
+
+def require_extras(spec: ServeSpec) -> None:
+    """Import the libraries of every server ``spec`` asks for (each serving extra brings the
+    ``server`` one), so that a missing extra is one line before a robot is built, not after its
+    start-up.
+
+    Raises:
+        MissingExtraError: the extra's one line (``poppy_core.extras.require``).
+    """
+    from poppy_core.assembly.serve_spec import PROTOCOLS
+    from poppy_core.extras import require
+
+    if not any(getattr(spec, name) is not None for name in PROTOCOLS):
+        return
+    require("fastapi", "uvicorn", extra="server", feature="the web servers")
+    if spec.zmq is not None:
+        require("zmq", extra="zmq", feature="pypot's ZMQ server")
+    if spec.zenoh is not None or spec.ros2 is not None:
+        require("zenoh", extra="fleet")
+    if spec.ros2 is not None:
+        require("rosbags", extra="ros2")
+    if spec.foxglove is not None:
+        require("foxglove", extra="foxglove")
+    if spec.announce:
+        require("zeroconf", extra="appliance")

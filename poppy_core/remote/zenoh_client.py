@@ -128,15 +128,21 @@ class ZenohClient(HttpClient):
 
 
 def answer_of(where: str, replies: list[Any], timeout_s: float, waited_s: float) -> tuple[int, Any]:
-    """The status and body of the one reply of a robot's ``api`` (errors for none or a bad one:
-    no reply before the timeout ran out is a robot that does not answer; none at once, a robot
-    no one serves)."""
+    """The status and body of the one reply of a robot's ``api`` (errors as ``reply_of``)."""
+    reply = reply_of(where, replies, timeout_s, waited_s)
+    return reply["status"], reply.get("body")
+
+
+def reply_of(where: str, replies: list[Any], timeout_s: float, waited_s: float) -> dict[str, Any]:
+    """The one reply of a robot's ``api``: ``{"status": int, "body", ...}`` (``start_at``,
+    ``late_s`` of a timed request). Errors for none or a bad one: no reply before the timeout
+    ran out is a robot that does not answer; none at once, a robot no one serves."""
     for reply in replies:
         if reply.ok is None:
             continue
         try:
             answer = json.loads(reply.ok.payload.to_bytes())
-            return int(answer["status"]), answer.get("body")
+            return {**answer, "status": int(answer["status"])}
         except (ValueError, KeyError, TypeError) as exc:
             raise CommunicationError(f"{where}: not a poppy answer ({exc})", port=where) from None
     if not replies and waited_s < timeout_s * 0.9:

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 from poppy_core import zenoh_wire
 from poppy_core.errors import BusTimeout, CommunicationError, ConfigError
-from poppy_core.remote.zenoh_client import answer_of, client_settings
+from poppy_core.remote.zenoh_client import client_settings, reply_of
 
 if TYPE_CHECKING:
     import zenoh
@@ -27,7 +27,12 @@ T = TypeVar("T")
 
 DEFAULT_TIMEOUT_S = 2.0
 START_LEAD_S = 0.3
-"""How far ahead a shared start is set: time for every robot to get the command."""
+"""The least lead of a shared start (how far ahead of now it is set) when it is measured."""
+LEAD_MARGIN = 3.0
+"""A measured lead is the slowest robot's round trip times this: the command is one round trip,
+and arming a start (a move loaded, a thread made) costs about another on a busy robot."""
+MAX_LEAD_S = 30.0
+"""The most lead a shared start gets (half what a robot accepts: ``MAX_START_DELAY_S``)."""
 
 
 @dataclass(frozen=True)
@@ -38,6 +43,9 @@ class Outcome:
     ok: bool
     status: int
     answer: Any
+    late_s: float = 0.0
+    """How late the command came for its shared start (0: in time); a late start runs at
+    once, and the outcome is still ok."""
 
     @property
     def message(self) -> str:
@@ -76,6 +84,8 @@ class Fleet:
         self._sender = zenoh_wire.sender_of(self.session)
         self.last_start_at: float | None = None
         """The shared start time of the last command sent ``together``."""
+        self.last_lead_s: float | None = None
+        """How far ahead of the command that start was set (measured, or given)."""
         if self._owned:  # a new session: let its links come up before the first query
             zenoh_wire.await_peers(self.session, settings, timeout_s)
 
@@ -110,6 +120,29 @@ class Fleet:
         }
         return {n: found[n] for n in sorted(found)}
 
+    def round_trip_s(self, names: Sequence[str]) -> float | None:
+        """The slowest round trip of a description query among the robots of ``names`` (asked
+        all at once), None when none answered within the timeout."""
+        began = time.monotonic()
+        pending = [
+            self.session.get(zenoh_wire.robot_key(name, "description"), timeout=self.timeout_s)
+            for name in names
+        ]
+        slowest = None
+        for handler in pending:  # each is read after the ones before: the last read is the max
+            if any(reply.ok is not None for reply in handler):
+                slowest = time.monotonic() - began
+        return slowest
+
+    def start_lead(self, names: Sequence[str]) -> float:
+        """How far ahead a shared start of ``names`` is set: the slowest robot's round trip
+        (``round_trip_s``) times ``LEAD_MARGIN``, at least ``START_LEAD_S``, at most
+        ``MAX_LEAD_S``; a robot that does not answer counts for nothing (its command will say
+        so)."""
+        measured = self.round_trip_s(names)
+        lead = START_LEAD_S if measured is None else measured * LEAD_MARGIN
+        return min(MAX_LEAD_S, max(START_LEAD_S, lead))
+
     def command(
         self,
         names: Sequence[str],
@@ -118,19 +151,23 @@ class Fleet:
         body: Any = None,
         *,
         together: bool = True,
+        lead_s: float | None = None,
         timeout_s: float | None = None,
     ) -> list[Outcome]:
         """Send one v1 request to every robot of ``names`` at once; with ``together`` each runs
-        it at the same wall-clock time (``START_LEAD_S`` from now) and this returns once that
-        time has come (a start is answered when armed, before it). A robot that does not
-        answer within the timeout (``timeout_s``, else the fleet's) gets an outcome saying so
-        (never a hang).
+        it at the same wall-clock time, ``lead_s`` from now (None: ``start_lead``, measured),
+        and this returns once that time has come (a start is answered when armed, before it).
+        A robot the command reaches after that time starts at once and its outcome says how
+        late (``late_s``). A robot that does not answer within the timeout (``timeout_s``, else
+        the fleet's) gets an outcome saying so (never a hang).
         """
-        start_at = time.time() + START_LEAD_S if together else None
+        lead = 0.0
+        if together:
+            lead = self.start_lead(names) if lead_s is None else lead_s
+        start_at = time.time() + lead if together else None
         self.last_start_at = start_at
-        timeout = (self.timeout_s if timeout_s is None else timeout_s) + (
-            START_LEAD_S if together else 0.0
-        )
+        self.last_lead_s = lead if together else None
+        timeout = (self.timeout_s if timeout_s is None else timeout_s) + lead
         pending = []
         for name in names:
             payload = zenoh_wire.api_request(
@@ -148,13 +185,14 @@ class Fleet:
         outcomes = []
         for name, handler in pending:
             try:
-                status, answer = answer_of(
-                    f"zenoh:{name}", list(handler), timeout, time.monotonic() - began
-                )
+                reply = reply_of(f"zenoh:{name}", list(handler), timeout, time.monotonic() - began)
             except (BusTimeout, CommunicationError) as exc:
                 outcomes.append(Outcome(name, False, 0, {"detail": str(exc)}))
                 continue
-            outcomes.append(Outcome(name, status < 400, status, answer))
+            status = reply["status"]
+            late = reply.get("late_s", 0.0)
+            late_s = float(late) if isinstance(late, int | float) and late > 0 else 0.0
+            outcomes.append(Outcome(name, status < 400, status, reply.get("body"), late_s))
         if start_at is not None:
             time.sleep(max(0.0, start_at - time.time()))
         return outcomes

@@ -48,6 +48,13 @@ def check_start_at(value: Any) -> float | None:
     return now + delay
 
 
+def late_by(start_at: float) -> float:
+    """How long ago ``start_at`` was, in seconds to the millisecond (0: still ahead). A start
+    that comes after its time runs at once (a fleet on a slow network still plays, a little
+    behind) and its answer says by how much."""
+    return max(0.0, round(time.time() - start_at, 3))
+
+
 def on_monotonic(start_at: float) -> float:
     """Wall-clock ``start_at`` on the ``time.monotonic()`` clock (the motion's)."""
     return time.monotonic() + (start_at - time.time())

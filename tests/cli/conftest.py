@@ -13,6 +13,7 @@ from poppy_core.emulator import VirtualBus
 from tests.helpers.bus import emulate_bus
 from tests.helpers.cli import POPPY, Result, run_poppy
 from tests.helpers.processes import start
+from tests.helpers.waiting import scaled
 
 __all__ = ["POPPY", "Result", "run_poppy"]
 
@@ -31,7 +32,7 @@ class Emulator:
     def stop(self, signum: int = signal.SIGINT) -> int:
         if self.proc.poll() is None:
             self.proc.send_signal(signum)
-        code = self.proc.wait(timeout=10)
+        code = self.proc.wait(timeout=scaled(10))
         for stream in (self.proc.stdout, self.proc.stderr):
             if stream is not None:
                 stream.close()

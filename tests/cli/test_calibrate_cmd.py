@@ -13,6 +13,7 @@ import pytest
 import yaml
 
 from tests.helpers.cli import POPPY, command_env, no_user_settings
+from tests.helpers.waiting import scaled
 
 
 @pytest.fixture(autouse=True)
@@ -85,7 +86,7 @@ def test_an_interrupted_calibration_leaves_the_previous_one(poppy: Any, user_dir
     proc.stdin.flush()
     time.sleep(0.5)
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=20)
+    _, err = proc.communicate(timeout=scaled(20))
     assert proc.returncode == 130, err
     assert path.read_text() == before
     assert sorted(p.name for p in path.parent.iterdir()) == ["profile.yaml"]

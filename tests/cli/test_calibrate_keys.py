@@ -13,6 +13,7 @@ import pytest
 from poppy_cli.commands.calibrate import RichAnswers
 from tests.helpers.cli import POPPY
 from tests.helpers.processes import read_until, start_on_pty
+from tests.helpers.waiting import scaled
 
 
 def _env(tmp_path: Path) -> dict[str, str]:
@@ -41,7 +42,7 @@ def test_enter_then_a_single_q_cancels_and_the_terminal_is_restored(tmp_path: Pa
         os.write(parent, b"q")  # one key, no Enter
         shown = read_until(parent, "nothing was written", timeout_s=30)
         assert "calibration cancelled" in shown, shown
-        assert proc.wait(timeout=30) == 1
+        assert proc.wait(timeout=scaled(30)) == 1
         lflag = termios.tcgetattr(child)[3]
         assert lflag & termios.ECHO and lflag & termios.ICANON  # back as it was
     finally:
@@ -60,7 +61,7 @@ def test_q_at_the_posture_cancels_at_once(tmp_path: Path) -> None:
         os.write(parent, b"q")
         shown = read_until(parent, "nothing was written", timeout_s=30)
         assert "calibration cancelled" in shown, shown
-        assert proc.wait(timeout=30) == 1
+        assert proc.wait(timeout=scaled(30)) == 1
     finally:
         if proc.poll() is None:
             proc.kill()

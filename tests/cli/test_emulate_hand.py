@@ -20,7 +20,7 @@ from poppy_core.emulator.control import ControlError
 from poppy_core.motion import Move, read_move, write_move
 from tests.helpers.cli import POPPY, command_env, no_user_settings
 from tests.helpers.processes import start
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, scaled
 
 ARRIVED = re.compile(r"^m1 (39\.[7-9]|40\.[0-3])° \(held\), m2 -(29\.[7-9]|30\.[0-3])° \(held\)")
 
@@ -140,7 +140,7 @@ def test_poppy_record_records_what_the_emulators_hand_does(
         assert eventually(arrived, timeout_s=30.0, interval_s=0.2), "".join(said_by_emulator)
         time.sleep(1.0)  # the recorder reads the held pose at least once more (50 Hz)
         recorder.send_signal(signal.SIGINT)
-        _, stderr = recorder.communicate(timeout=30)
+        _, stderr = recorder.communicate(timeout=scaled(30))
         assert recorder.returncode == 0, stderr
     finally:
         if recorder is not None and recorder.poll() is None:
@@ -148,7 +148,7 @@ def test_poppy_record_records_what_the_emulators_hand_does(
         emulator.stdin.write("release all\n")
         emulator.stdin.flush()
         emulator.send_signal(signal.SIGINT)
-        emulator.wait(timeout=20)
+        emulator.wait(timeout=scaled(20))
         reader.join(10.0)
     err = "".join(said_by_emulator)
     assert emulator.returncode == 0, err

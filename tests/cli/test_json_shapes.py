@@ -135,7 +135,7 @@ PRIMITIVE = {
 }
 MS = {"p50": Opt(NUM), "p99": Opt(NUM), "max": Opt(NUM)}
 XYZ = [NUM]
-FLEET_OUTCOMES = [{"name": str, "ok": bool, "status": int, "message": str}]
+FLEET_OUTCOMES = [{"name": str, "ok": bool, "status": int, "message": str, "late_s": NUM}]
 
 SCHEMAS: dict[str, Any] = {
     "fleet list": [

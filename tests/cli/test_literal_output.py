@@ -12,6 +12,7 @@ import pytest
 
 from poppy_cli.output import LiteralConsole, console, err_console, error_line, printable, styled
 from tests.helpers.processes import reap
+from tests.helpers.waiting import scaled
 
 HOSTILE = "[red]m1:x:[/]"
 ESCAPE = "\x1b[2J"
@@ -155,14 +156,14 @@ def test_the_servers_suggestion_never_writes_a_clients_control_characters() -> N
     import socket
     import subprocess
 
-    from tests.helpers.cli import ENV, POPPY
+    from tests.helpers.cli import POPPY, command_env
 
     proc = subprocess.Popen(
         [*POPPY, "serve", "--http", "--sim", "--profile", "ergo-jr", "--http-port", "0"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=dict(__import__("os").environ, **ENV),
+        env=dict(__import__("os").environ, **command_env()),
     )
     try:
         assert proc.stdout is not None and proc.stderr is not None
@@ -178,7 +179,7 @@ def test_the_servers_suggestion_never_writes_a_clients_control_characters() -> N
                 sock.sendall(request)
                 assert sock.recv(100).startswith(b"HTTP/1.1 4")
         proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=30) == 0
+        assert proc.wait(timeout=scaled(30)) == 0
         err = proc.stderr.read()
     finally:
         reap(proc)

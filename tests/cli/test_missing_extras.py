@@ -16,6 +16,8 @@ import pytest
 from poppy_core.errors import MissingExtraError
 from poppy_core.extras import require
 from tests.helpers.bus import emulate_bus
+from tests.helpers.cli import command_env
+from tests.helpers.waiting import scaled
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -33,6 +35,8 @@ CASES = [
     ("sim", "mujoco", ["sim", "render", "-o", "{tmp}/out.png"]),
     ("server", "fastapi,uvicorn", ["serve", "--http", *ROBOT, "--http-port", "0"]),
     ("server", "fastapi,uvicorn", ["serve", "--snap", *ROBOT, "--snap-port", "0"]),
+    # said before the robot is built: no wait for a port or motors that would serve nothing
+    ("zmq", "zmq", ["serve", "--zmq", "--profile", "ergo-jr", "--port", "/dev/nope"]),
     ("zmq", "zmq", ["serve", "--zmq", *ROBOT, "--zmq-port", "0"]),
     ("fleet", "zenoh", ["serve", "--zenoh", *ROBOT, "--name", "jr"]),
     ("fleet", "zenoh", ["fleet", "list", "--connect", "tcp/127.0.0.1:9"]),
@@ -61,7 +65,7 @@ def test_a_missing_extra_is_one_line_naming_it(
         [sys.executable, "-c", RUN, blocked, *(a.format(tmp=tmp_path) for a in argv)],
         capture_output=True,
         text=True,
-        timeout=90,
+        timeout=scaled(90),
         env=env,
         cwd=tmp_path,
         check=False,
@@ -79,12 +83,13 @@ EVERY_EXTRA = (
 
 
 def _poppy_without_extras(argv: list[str], tmp_path: Path) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path)}
+    # its motors are an emulator thread of this process: the load's reply floor (command_env)
+    env = {**os.environ, **command_env({"PYTHONPATH": str(ROOT), "XDG_CONFIG_HOME": str(tmp_path)})}
     return subprocess.run(
         [sys.executable, "-c", RUN, EVERY_EXTRA, *argv],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=scaled(120),
         env=env,
         cwd=tmp_path,
         check=False,

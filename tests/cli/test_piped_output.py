@@ -11,6 +11,7 @@ import pytest
 from tests.cli.conftest import LinkedBus
 from tests.helpers import cli
 from tests.helpers.cli import POPPY, run_poppy
+from tests.helpers.waiting import reply_floor_env, scaled
 
 
 @pytest.fixture
@@ -47,8 +48,9 @@ def test_a_title_wider_than_its_table_stays_on_one_line(narrow: None, ergo_jr: L
 
 def test_demo_piped_ends_each_table_with_a_newline() -> None:
     env = {k: v for k, v in os.environ.items() if k not in ("COLUMNS", "LINES")}
+    env.update(reply_floor_env())
     proc = subprocess.run(
-        [*POPPY, "demo", "--quick"], capture_output=True, text=True, timeout=120, env=env
+        [*POPPY, "demo", "--quick"], capture_output=True, text=True, timeout=scaled(120), env=env
     )
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()

@@ -22,6 +22,7 @@ import pytest
 
 from tests.helpers.cli import command_env
 from tests.helpers.processes import read_until, start_on_pty
+from tests.helpers.waiting import scaled
 
 _SCRIPT = """
 import signal, sys, threading, time
@@ -79,7 +80,7 @@ def test_a_signal_taken_by_another_thread_ends_the_question(
     proc.send_signal(signum)
     shown = _rest(master, proc)
     try:
-        ended = proc.wait(timeout=30)
+        ended = proc.wait(timeout=scaled(30))
     except subprocess.TimeoutExpired:
         raise AssertionError(f"still at the question 60 s after the signal: {shown!r}") from None
     assert ended == code, shown
@@ -96,7 +97,7 @@ def test_confirm_reads_the_answer_typed(
     proc, master = _asking(started, "confirm")
     os.write(master, typed)
     shown = _rest(master, proc)
-    assert proc.wait(timeout=30) == 0, shown
+    assert proc.wait(timeout=scaled(30)) == 0, shown
     assert f"answer: {answer}" in shown
     if typed.startswith(b"maybe"):
         assert "Error: invalid input" in shown
@@ -106,7 +107,7 @@ def test_ask_reads_the_line_typed(started: list[tuple[Any, int]]) -> None:
     proc, master = _asking(started, "ask")
     os.write(master, b"the left arm\n")
     shown = _rest(master, proc)
-    assert proc.wait(timeout=30) == 0, shown
+    assert proc.wait(timeout=scaled(30)) == 0, shown
     assert "answer: the left arm" in shown
 
 
@@ -114,5 +115,5 @@ def test_the_end_of_input_at_a_question_aborts(started: list[tuple[Any, int]]) -
     proc, master = _asking(started, "confirm")
     os.write(master, b"\x04")  # Ctrl-D on an empty line: the end of input
     shown = _rest(master, proc)
-    assert proc.wait(timeout=30) == 1, shown
+    assert proc.wait(timeout=scaled(30)) == 1, shown
     assert "error: aborted" in shown and "answer:" not in shown

@@ -35,7 +35,7 @@ import typer
 from poppy_cli.main import app
 from tests.helpers.cli import POPPY, run_poppy_process
 from tests.helpers.terminal import CTRL_C, Terminal
-from tests.helpers.waiting import MIN_TIMEOUT_S, eventually
+from tests.helpers.waiting import MIN_TIMEOUT_S, eventually, reply_floor_env
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(600)]
 
@@ -250,6 +250,9 @@ class Tour:
         env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")])
         env["NO_COLOR"] = "1"
         env["BROWSER"] = "true"  # `--open` runs `true URL`: no browser on the test machine
+        # the motors are `poppy emulate` processes a busy machine runs late: the commands wait
+        # for their first replies as long as the load measured now needs (POPPY_REPLY_FLOOR_S)
+        env.update(reply_floor_env())
         return env
 
     def problem(self, step: Step | str, what: str) -> None:

@@ -17,6 +17,7 @@ import pytest
 from poppy_core.motion import Move, read_move, save_move
 from tests.helpers.cli import command_env, keyed, no_user_settings
 from tests.helpers.processes import start
+from tests.helpers.waiting import scaled
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -43,7 +44,7 @@ def test_signal_during_record_keeps_a_valid_file(signum: int, library: Path) -> 
     recording = time.monotonic()
     time.sleep(1.5)
     proc.send_signal(signum)
-    stdout, stderr = proc.communicate(timeout=20)
+    stdout, stderr = proc.communicate(timeout=scaled(20))
     ended = time.monotonic()
     assert proc.returncode == 0, stderr
     path = Path(stdout.strip().splitlines()[-1])  # the path alone on the last line
@@ -61,7 +62,7 @@ def test_killed_recording_keeps_the_last_checkpoint(library: Path) -> None:
     proc = start_recording("crash", "--sim", "--profile", "ergo-jr", "--freq", "25")
     time.sleep(2.5)
     proc.kill()  # no handler runs: only the checkpoints are on disk
-    proc.communicate(timeout=20)
+    proc.communicate(timeout=scaled(20))
     move = read_move(library / "crash.move")
     assert move.framerate == 25 and len(move.motors) == 6
     assert move.duration_s >= 0.9
@@ -155,7 +156,7 @@ def test_a_signal_during_play_exits_130_after_the_summary(signum: int) -> None:
     line = proc.stderr.readline()
     assert line.startswith("playing long"), line + proc.stderr.read()
     proc.send_signal(signum)
-    stdout, stderr = proc.communicate(timeout=20)
+    stdout, stderr = proc.communicate(timeout=scaled(20))
     assert proc.returncode == 130, stderr
     summary = json.loads(stdout)
     assert summary["completed"] is False and summary["played_s"] < 60

@@ -16,6 +16,7 @@ from poppy_core.motion import read_move
 from tests.helpers.cli import POPPY, command_env
 from tests.helpers.processes import read_until, start, start_on_pty
 from tests.helpers.terminal import CTRL_C, Terminal
+from tests.helpers.waiting import scaled
 
 SIM = ("--sim", "--profile", "ergo-jr")
 
@@ -103,7 +104,7 @@ def test_two_recordings_of_one_name_at_once(
         assert "another poppy process" in second.stderr and str(first.pid) in second.stderr
     finally:
         first.terminate()
-        first.communicate(timeout=20)
+        first.communicate(timeout=scaled(20))
     assert first.returncode == 0
     assert len(read_move(tmp_path / "moves" / "same.move")) > 0  # the first take, untouched
 
@@ -122,7 +123,7 @@ def test_on_a_terminal_another_place_is_asked_for(tmp_path: Path) -> None:
             os.write(parent, f"{tmp_path}\n".encode())
             tail = read_until(parent, "recorded")
             assert "recorded" in tail, tail[-2000:]
-            assert proc.wait(timeout=30) == 0
+            assert proc.wait(timeout=scaled(30)) == 0
         finally:
             if proc.poll() is None:
                 proc.kill()

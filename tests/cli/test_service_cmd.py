@@ -160,7 +160,10 @@ def test_install_writes_the_settings_file_and_a_token_only_its_user_reads(
 
     # installed again: the options as its flags say, the token (maybe changed by the page) kept
     token.write_text("set-from-the-page\n")
-    again = fake.run("install", "--run-as", someone, "--zmq", "--require-token")
+    # (ZMQ beside a token only on loopback: it has no token of its own)
+    again = fake.run(
+        "install", "--run-as", someone, "--zmq", "--require-token", "--host", "127.0.0.1"
+    )
     assert again.code == 0, again.stderr
     assert json.loads(settings.read_text()) == {"snap": False, "zmq": True}
     assert token.read_text() == "set-from-the-page\n" and "token" not in again.stdout
@@ -258,6 +261,8 @@ def test_a_failing_systemctl_is_one_line(fake: Fake, someone: str) -> None:
         (("--user", "--run-as", "pi"), "--run-as is for the system service", 2),
         (("--profile", "no-such-robot"), "no-such-robot", 1),
         (("--http-port", "70000"), "'--http-port': Input should be less than or equal to 65535", 2),
+        (("--zmq", "--require-token"), "--zmq with --require-token on 0.0.0.0", 2),
+        (("--zmq", "--require-token", "--dry-run"), "pypot's ZMQ API has no token", 2),
     ],
 )
 def test_bad_install_options_are_one_line(
@@ -487,3 +492,11 @@ def test_the_polkit_rule_answers_as_polkit_would_ask(tmp_path: Path) -> None:
     )
     out = subprocess.run([node, str(probe)], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["yes", "yes", "no", "no", "yes", "no"]
+
+
+def test_zmq_with_a_token_is_served_on_loopback_only(fake: Fake) -> None:
+    result = fake.run(
+        "install", "--user", "--dry-run", "--zmq", "--require-token", "--host", "127.0.0.1"
+    )
+    assert result.code == 0, result.stderr
+    assert "--host 127.0.0.1" in result.stdout and "--token-file" in result.stdout

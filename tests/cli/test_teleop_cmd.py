@@ -18,6 +18,7 @@ from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.cli import POPPY, Result, command_env, no_user_settings
 from tests.helpers.processes import start
+from tests.helpers.waiting import scaled
 
 
 @pytest.fixture(autouse=True)
@@ -57,7 +58,7 @@ def run_with_hand(args: list[str], hand: VirtualBus, timeout_s: float = 60.0) ->
         for k, motor in enumerate(hand.motors):
             motor.move_by_hand(20.0 + 25.0 * math.sin(2.0 * t + k))
         time.sleep(0.01)
-    stdout, stderr = proc.communicate(timeout=20)
+    stdout, stderr = proc.communicate(timeout=scaled(20))
     return Result(proc.returncode, stdout, stderr)
 
 

@@ -20,6 +20,7 @@ from poppy_core.dataset.writer import DatasetWriter
 from tests.helpers.bus import emulate_bus
 from tests.helpers.cli import command_env, no_user_settings, run_poppy
 from tests.helpers.processes import start
+from tests.helpers.waiting import scaled
 
 pytestmark = pytest.mark.slow
 MOTORS = tuple(f"m{i}" for i in range(1, 7))
@@ -120,7 +121,7 @@ def test_a_signal_during_replay_exits_130_after_the_summary(tmp_path: Path) -> N
     line = proc.stderr.readline()
     assert line.startswith("replaying episode 1"), line + proc.stderr.read()
     proc.send_signal(signal.SIGINT)
-    stdout, stderr = proc.communicate(timeout=30)
+    stdout, stderr = proc.communicate(timeout=scaled(30))
     assert proc.returncode == 130, stderr
     summary = json.loads(stdout)
     assert summary["completed"] is False and summary["played_s"] < 60

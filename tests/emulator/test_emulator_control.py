@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import re
-import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import pytest
 
 from poppy_core.bus import DxlBus
 from poppy_core.emulator import EmulatorServer, build_bus_from_spec, serve_tcp
 from poppy_core.emulator.control import ControlError, EmulatorControl, ScheduledUnplug
+from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.waiting import eventually
 
 
 @pytest.fixture
@@ -22,13 +23,9 @@ def served() -> Iterator[tuple[EmulatorControl, EmulatorServer]]:
     server.stop()
 
 
-def _until(check: object, timeout_s: float = 3.0) -> bool:
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        if check():  # type: ignore[operator]
-            return True
-        time.sleep(0.01)
-    return False
+def _until(check: Callable[[], object], timeout_s: float = 3.0) -> bool:
+    """``eventually``: the emulator's timers and threads run late on a busy machine."""
+    return eventually(lambda: bool(check()), timeout_s)
 
 
 def test_fault_commands_set_the_knobs(served: tuple[EmulatorControl, EmulatorServer]) -> None:
@@ -71,8 +68,10 @@ def test_bad_commands_are_one_line_errors(
 
 def test_unplug_for_a_while_then_back(served: tuple[EmulatorControl, EmulatorServer]) -> None:
     control, server = served
-    with DxlBus(server.url, 1_000_000, 2) as bus:
-        assert control.execute("unplug 2 0.3") == "motor 2 unplugged for 0.3 s"
+    with DxlBus(server.url, 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus:
+        # unplugged for longer than a ping's wait at the loaded floor, tries and retry included
+        away_s = round(6 * LOADED_REPLY_FLOOR_S, 1)
+        assert control.execute(f"unplug 2 {away_s}") == f"motor 2 unplugged for {away_s:g} s"
         assert bus.ping(2) is None
         assert _until(lambda: bus.ping(2) is not None)
         control.execute("unplug 3")
@@ -115,7 +114,7 @@ def test_motors_sharing_an_id_are_plugged_by_their_place() -> None:
         for place in (1, 2, 3):
             assert control.execute(f"unplug #{place}") == f"motor #{place} unplugged"
         assert "unplugged: #1, #2, #3" in control.execute("status")
-        with DxlBus(server.url, protocol=2) as bus:
+        with DxlBus(server.url, protocol=2, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus:
             assert bus.broadcast_ping() == []
             assert control.execute("plug #2") == "motor #2 plugged"
             assert [p.id for p in bus.broadcast_ping()] == [1]

@@ -24,7 +24,8 @@ from poppy_core.protocol import (
     sync_write,
     write,
 )
-from tests.helpers.waiting import eventually, within
+from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.waiting import eventually, scaled, within
 
 XL320_TORQUE_ENABLE = 24
 XL320_PRESENT_POSITION = 37
@@ -57,7 +58,8 @@ def test_replies_are_written_whole_when_the_client_reads_late() -> None:
         decoder = PacketDecoder(2, "status")
         replies = 0
         quiet_since = time.monotonic()
-        while time.monotonic() - quiet_since < 1.5 and replies < count:
+        quiet_s = scaled(1.5)  # the emulator thread may wait that long for a core
+        while time.monotonic() - quiet_since < quiet_s and replies < count:
             chunk = port.read(65536)
             if chunk:
                 quiet_since = time.monotonic()
@@ -84,12 +86,12 @@ def test_pty_line_lost_and_back_under_its_link(tmp_path: Path) -> None:
     with serve_pty(bus, link=link) as server:
         first = server.url
         assert os.readlink(link) == first
-        with DxlBus(str(link), 1_000_000, 2) as dxl:
+        with DxlBus(str(link), 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as dxl:
             _lose_the_line(server, dxl)
             assert not link.exists()
         assert eventually(lambda: server.connected and link.exists())
         assert os.readlink(link) == server.url
-        with DxlBus(str(link), 1_000_000, 2) as dxl:
+        with DxlBus(str(link), 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as dxl:
             assert dxl.ping(1) is not None
     assert not link.exists()
 
@@ -98,13 +100,13 @@ def test_tcp_line_lost_and_back_on_the_same_port() -> None:
     bus = build_bus_from_spec("XL-320:1", protocol=2)
     with serve_tcp(bus) as server:
         url = server.url
-        with DxlBus(url, 1_000_000, 2) as dxl:
+        with DxlBus(url, 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as dxl:
             _lose_the_line(server, dxl)
         with pytest.raises(PortError):
             DxlBus(url, 1_000_000, 2)
         assert eventually(lambda: server.connected)
         assert server.url == url
-        with DxlBus(url, 1_000_000, 2) as dxl:
+        with DxlBus(url, 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as dxl:
             assert dxl.ping(1) is not None
 
 

@@ -25,7 +25,7 @@ from poppy_core import zenoh_auth, zenoh_wire
 from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from tests.helpers.waiting import eventually
-from tests.helpers.zenoh_served import TOKEN, Served, free_endpoint
+from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served, free_endpoint
 
 zenoh = pytest.importorskip("zenoh")
 
@@ -94,7 +94,7 @@ def test_a_stranger_answering_the_api_learns_nothing_that_drives_a_robot(
     a, b = two
     a.robot.compliant = False
     endpoints = (a.endpoint, b.endpoint, stranger.endpoint)
-    with Fleet(Settings(connect=endpoints), token=TOKEN) as fleet:
+    with Fleet(Settings(connect=endpoints), token=TOKEN, timeout_s=FLEET_TIMEOUT_S) as fleet:
         assert fleet.wait_for(["jr-a", "jr-b"]) == ["jr-a", "jr-b"]
         outcomes = fleet.command(
             ["jr-a"], "POST", "/api/v1/web/stop", {"then": "hold"}, together=False
@@ -113,7 +113,7 @@ def test_a_stranger_answering_the_api_learns_nothing_that_drives_a_robot(
         assert not any(secret in payload for secret in secrets), payload
     # what the stranger got does not drive a robot: replayed, it is refused and nothing moves
     a.robot.compliant = False
-    with Fleet(Settings(connect=(a.endpoint,))) as plain:
+    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
         for payload in requests:
             answer = _ask(plain.session, "jr-a", payload)
             assert answer["status"] == 401, answer
@@ -130,7 +130,7 @@ def test_a_request_kept_stale_or_for_another_robot_or_badly_signed_is_refused(
     a, _ = two
     a.robot.compliant = False
     compliant = {"method": "PUT", "path": "/api/v1/robot/compliant", "body": {"compliant": True}}
-    with Fleet(Settings(connect=(a.endpoint,))) as plain:
+    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
         session = plain.session
         for_b = zenoh_wire.api_request(
             "PUT", compliant["path"], compliant["body"], token=TOKEN, robot="jr-b"
@@ -188,7 +188,7 @@ def test_unauthenticated_armed_starts_are_refused_on_arrival_not_at_their_start_
     start_at = time.time() + 50.0
     payload = zenoh_wire.api_request("POST", "/api/v1/primitives/dance/start", start_at=start_at)
     key = zenoh_wire.robot_key("jr-a", "api")
-    with Fleet(Settings(connect=(a.endpoint,))) as plain:
+    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
         handlers = [plain.session.get(key, payload=payload, timeout=45.0) for _ in range(300)]
         statuses = []
         for handler in handlers:
@@ -220,7 +220,7 @@ def test_requests_held_for_a_start_time_are_capped_and_answered_when_the_robot_s
     start_at = time.time() + 40.0
     key = zenoh_wire.robot_key("jr-c", "api")
     try:
-        with Fleet(Settings(connect=(served.endpoint,))) as plain:
+        with Fleet(Settings(connect=(served.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
             handlers = []
             for _ in range(4):
                 payload = zenoh_wire.api_request(
@@ -299,7 +299,7 @@ def test_sigterm_with_a_held_request_answers_it_and_ends_cleanly(moves: Any) -> 
     import signal
     import subprocess
 
-    from tests.helpers.cli import ENV, POPPY
+    from tests.helpers.cli import POPPY, command_env
     from tests.helpers.processes import read_until, reap
 
     endpoint = free_endpoint()
@@ -308,18 +308,23 @@ def test_sigterm_with_a_held_request_answers_it_and_ends_cleanly(moves: Any) -> 
         [*argv, "--token", TOKEN, "--profile", "ergo-jr", "--sim"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        env={**os.environ, **ENV},
+        env=dict(os.environ, **command_env()),
     )
     try:
         assert proc.stdout is not None and proc.stderr is not None
         assert "poppy/jr-t" in read_until(proc.stdout.fileno(), "poppy/jr-t", 60, proc)
-        with Fleet(Settings(connect=(endpoint,))) as plain:
+        with Fleet(Settings(connect=(endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
             assert plain.wait_for(["jr-t"], timeout_s=30) == ["jr-t"]
             held = zenoh_wire.api_request(
                 "GET", "/api/v1/motors", token=TOKEN, start_at=time.time() + 30, robot="jr-t"
             )
             handler = plain.session.get("poppy/jr-t/api", payload=held, timeout=25.0)
-            time.sleep(1.0)  # the request reaches the robot and waits there
+
+            def holding() -> bool:  # the request reached the robot and waits there
+                described = plain.describe(["jr-t"]).get("jr-t", {})
+                return bool(described.get("health", {}).get("held"))
+
+            assert eventually(holding)
             proc.send_signal(signal.SIGTERM)
             replies = [json.loads(r.ok.payload.to_bytes()) for r in handler if r.ok is not None]
         assert replies == [{"status": 503, "body": {"detail": "the robot is stopping"}}]

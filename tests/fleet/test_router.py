@@ -17,17 +17,20 @@ from poppy_core.assembly import Listen, ServeSpec, ZenohSettings, serve
 from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import from_remote
 from poppy_core.zenoh_wire import mode_of
-from tests.helpers.cli import ENV, POPPY, run_poppy
+from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import read_until, reap
 from tests.helpers.waiting import eventually, http_timeout
 from tests.helpers.zenoh_router import Router
-from tests.helpers.zenoh_served import TOKEN, Served
+from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served
 
 pytest.importorskip("zenoh")
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def router() -> Iterator[Router]:
+    """One router process for the module's tests (a process start each was most of their
+    setup): it keeps nothing of a test's robots once their sessions close. A test that stops or
+    restarts its router starts one of its own."""
     started = Router()
     try:
         yield started
@@ -47,7 +50,9 @@ def pair(moves: Path, router: Router) -> Iterator[tuple[Served, Served]]:
 
 @pytest.fixture
 def teacher(router: Router, pair: tuple[Served, Served]) -> Iterator[Fleet]:
-    with Fleet(ZenohSettings(connect=(router.endpoint,)), token=TOKEN) as client:
+    with Fleet(
+        ZenohSettings(connect=(router.endpoint,)), token=TOKEN, timeout_s=FLEET_TIMEOUT_S
+    ) as client:
         assert client.wait_for(["jr-a", "jr-b"], timeout_s=30) == ["jr-a", "jr-b"]
         yield client
 
@@ -183,7 +188,7 @@ def test_a_router_and_a_robot_linked_directly_make_one_fleet(
     direct = Served("jr-c")  # listens; not on the router
     try:
         settings = ZenohSettings(connect=(router.endpoint, direct.endpoint))
-        with Fleet(settings, token=TOKEN) as client:
+        with Fleet(settings, token=TOKEN, timeout_s=FLEET_TIMEOUT_S) as client:
             names = ["jr-a", "jr-b", "jr-c"]
             assert client.wait_for(names, timeout_s=30) == names
             outcomes = client.command(
@@ -204,7 +209,7 @@ def _serve_process(name: str, router: Router) -> subprocess.Popen[Any]:
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        env={**os.environ, **ENV},
+        env=dict(os.environ, **command_env()),
     )
 
 
@@ -216,18 +221,21 @@ def test_a_robot_started_before_its_router_joins_when_the_router_comes(moves: Pa
         waited = read_until(proc.stderr.fileno(), "waiting for it", 60, proc)
         assert "no Zenoh router answers at" in waited, waited
         router.start()
-        with Fleet(ZenohSettings(connect=(router.endpoint,))) as client:
+        with Fleet(ZenohSettings(connect=(router.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as client:
             assert client.wait_for(["early"], timeout_s=30) == ["early"]
     finally:
         reap(proc)
         router.kill()
 
 
-def test_robots_and_the_router_restarting_rejoin(moves: Path, router: Router) -> None:
+def test_robots_and_the_router_restarting_rejoin(moves: Path) -> None:
+    router = Router()  # its own: restarted here
     proc = _serve_process("phoenix", router)
     steady = Served("steady", router=router.endpoint)
     try:
-        with Fleet(ZenohSettings(connect=(router.endpoint,)), token=TOKEN) as client:
+        with Fleet(
+            ZenohSettings(connect=(router.endpoint,)), token=TOKEN, timeout_s=FLEET_TIMEOUT_S
+        ) as client:
             assert client.wait_for(["phoenix", "steady"], timeout_s=60) == ["phoenix", "steady"]
             reap(proc)  # the robot restarts
             assert eventually(lambda: "phoenix" not in client.names(), timeout_s=15)
@@ -242,6 +250,7 @@ def test_robots_and_the_router_restarting_rejoin(moves: Path, router: Router) ->
     finally:
         reap(proc)
         steady.close()
+        router.kill()
 
 
 def test_the_router_refuses_a_busy_port_in_one_line(router: Router) -> None:

@@ -22,7 +22,7 @@ from poppy_core.motion.move import Move
 from poppy_core.motion.move_library import save_move
 from poppy_core.motion.player import MovePlayer
 from poppy_core.remote.zenoh_client import answer_of
-from poppy_core.remote.zenoh_fleet import Fleet
+from poppy_core.remote.zenoh_fleet import LEAD_MARGIN, START_LEAD_S, Fleet
 from poppy_core.robot import Robot
 from poppy_core.schedule import Gate
 from poppy_core.server.start_time import StartTimes, check_start_at, wait_until
@@ -31,6 +31,7 @@ from tests.helpers.waiting import eventually, scaled
 from tests.helpers.zenoh_served import TOKEN, Served
 
 LEAD_S = 0.3
+PRIMITIVE_START = "/api/v1/primitives/dance/start"
 
 
 class Stamp(Primitive):
@@ -126,7 +127,7 @@ def test_a_gate_opens_or_is_cancelled_whichever_comes_first() -> None:
 def _send(fleet: Fleet, name: str, path: str, start_at: float | None, body: Any = None) -> Any:
     payload = zenoh_wire.api_request("POST", path, body, token=TOKEN, start_at=start_at, robot=name)
     key = zenoh_wire.robot_key(name, "api")
-    return fleet.session.get(key, payload=payload, timeout=10.0)
+    return fleet.session.get(key, payload=payload, timeout=scaled(10.0))
 
 
 def test_a_fleet_stop_before_the_start_time_means_nothing_starts(
@@ -269,3 +270,59 @@ def test_a_bad_ramp_is_refused_and_plays_nothing(two: tuple[Served, Served], fle
     outcomes = fleet.command(["jr-a"], "POST", "/api/v1/moves/wave/play", body, together=False)
     assert outcomes[0].status == 422 and "ramp_s" in outcomes[0].message
     assert all(s.servers.service.moves.playing() == [] for s in two)
+
+
+def test_a_start_time_already_past_starts_at_once_and_says_how_late(
+    two: tuple[Served, Served], fleet: Fleet
+) -> None:
+    """A classroom on a bad Wi-Fi still plays: the robot the command reaches after its start
+    time starts at once, answers ok, and says by how much it was late."""
+    a, _ = two
+    began: list[float] = []
+    dance = a.servers.service.primitive("dance")
+    dance.setup = lambda: began.append(time.time())  # type: ignore[method-assign]
+    start_at = time.time() - 2.0  # the command came two seconds after its start time
+    answer = json.loads(
+        next(iter(_send(fleet, a.name, PRIMITIVE_START, start_at))).ok.payload.to_bytes()
+    )
+    assert answer["status"] == 200
+    assert answer["late_s"] >= 2.0
+    assert eventually(lambda: began != [])  # started, not armed for a time gone
+    fleet.command([a.name], "POST", "/api/v1/primitives/dance/stop", together=False)
+
+
+def test_fleet_play_with_no_lead_plays_on_every_robot_and_says_how_late(
+    two: tuple[Served, Served], fleet: Fleet
+) -> None:
+    save_move(Move.from_frames(10.0, [{"m1": 30.0 + i} for i in range(5)]), "wave")
+    args = [arg for s in two for arg in ("--connect", s.endpoint)]
+    result = run_poppy(
+        "fleet", "play", "wave", "--all", "--lead", "0", "--token", TOKEN, "--json", *args
+    )
+    assert result.code == 0, result.stderr
+    rows = {row["name"]: row for row in result.json()}
+    assert all(row["ok"] and row["late_s"] > 0 for row in rows.values()), rows
+    result = run_poppy("fleet", "stop", "--all", "--token", TOKEN, *args)
+    assert result.code == 0, result.stderr
+    outcomes = fleet.command(["jr-a"], "POST", PRIMITIVE_START, lead_s=0.0)
+    assert outcomes[0].ok and outcomes[0].late_s > 0
+    fleet.command(["jr-a"], "POST", "/api/v1/primitives/dance/stop", together=False)
+
+
+def test_the_start_lead_follows_the_slowest_robot_s_round_trip(
+    two: tuple[Served, Served], fleet: Fleet
+) -> None:
+    assert fleet.start_lead(["jr-a", "jr-b"]) >= START_LEAD_S  # the floor on a quick network
+    b = two[1].servers.zenoh
+    assert b is not None
+    described = b.description
+
+    def slow() -> dict[str, Any]:  # a robot on a bad Wi-Fi: half a second to answer
+        time.sleep(0.5)
+        return described()
+
+    b.description = slow  # type: ignore[method-assign]
+    outcomes = fleet.command(["jr-a", "jr-b"], "POST", PRIMITIVE_START)
+    assert [o.ok for o in outcomes] == [True, True]
+    assert fleet.last_lead_s is not None and fleet.last_lead_s >= 0.5 * LEAD_MARGIN
+    fleet.command(["jr-a", "jr-b"], "POST", "/api/v1/primitives/dance/stop", together=False)

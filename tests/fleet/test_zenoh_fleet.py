@@ -7,6 +7,7 @@ the fleet's client connects to them.
 from __future__ import annotations
 
 import json
+import os
 import socket
 import subprocess
 import time
@@ -23,10 +24,10 @@ from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import from_remote
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from poppy_core.zenoh_wire import check_name, pack_state, session_config, unpack_state
-from tests.helpers.cli import ENV, POPPY, run_poppy
+from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.waiting import eventually, http_timeout
-from tests.helpers.zenoh_served import TOKEN, Served, connect_to, free_endpoint
+from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served, connect_to, free_endpoint
 
 pytest.importorskip("zenoh")
 
@@ -170,7 +171,7 @@ def test_bad_commands_are_refused_with_the_rest_wording_and_move_nothing(
         together=False,
     )[0]
     assert nan.status == 422
-    with Fleet(Settings(connect=connect_to(a))) as no_token:
+    with Fleet(Settings(connect=connect_to(a)), timeout_s=FLEET_TIMEOUT_S) as no_token:
         refused = no_token.command(
             ["jr-a"], "POST", "/api/v1/robot/compliant", {"compliant": True}, together=False
         )[0]
@@ -255,14 +256,14 @@ def test_a_killed_robot_leaves_the_fleet(moves: Path) -> None:
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        env={**__import__("os").environ, **ENV},
+        env=dict(os.environ, **command_env()),
     )
     try:
         # one endpoint: the teacher is the robot's Zenoh client, which opens only once the robot
         # listens (3 s at most): wait for the robot's process to come up first, however loaded
         host, port = endpoint.removeprefix("tcp/").rsplit(":", 1)
         assert eventually(lambda: _listening(host, int(port)), timeout_s=60)
-        with Fleet(Settings(connect=(endpoint,))) as client:
+        with Fleet(Settings(connect=(endpoint,)), timeout_s=FLEET_TIMEOUT_S) as client:
             assert client.wait_for(["doomed"], timeout_s=60) == ["doomed"]
             proc.kill()
             assert eventually(lambda: "doomed" not in client.names(), timeout_s=15)
@@ -422,3 +423,33 @@ def test_a_busy_zenoh_endpoint_is_one_clear_line(moves: Path) -> None:
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "Address already in use" in lines[0], lines
     assert " at /" not in lines[0]
+
+
+def test_a_robot_listening_on_every_interface_announces_its_addresses(
+    two: tuple[Served, Served], fleet: Fleet, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`poppy serve --host 0.0.0.0 --zenoh-listen tcp/0.0.0.0:7447`: its description names the
+    addresses a peer dials (this machine's), never the wildcard, and its page is a link."""
+    from poppy_core import checks
+    from poppy_core.server import reachable
+    from poppy_core.server.zenoh.web_fleet import announced_hosts
+
+    monkeypatch.setattr(reachable, "machine_addresses", lambda: ["192.0.2.7", "198.51.100.3"])
+    node = two[0].servers.zenoh
+    assert node is not None
+    node.endpoints = ("tcp/0.0.0.0:7447", "tcp/[::]:7448#iface=wlan0", "tcp/127.0.0.1:7449")
+    node.page = "http://0.0.0.0:8080"  # what the builder takes from an HTTP server on 0.0.0.0
+    described = fleet.describe(["jr-a"])["jr-a"]
+    assert described["endpoints"] == [
+        "tcp/192.0.2.7:7447",
+        "tcp/198.51.100.3:7447",
+        "tcp/192.0.2.7:7448#iface=wlan0",
+        "tcp/198.51.100.3:7448#iface=wlan0",
+        "tcp/127.0.0.1:7449",
+    ]
+    assert described["page"] == "http://192.0.2.7:8080"
+    assert checks.peer_page(described["page"], announced_hosts("jr-a", described))
+    result = run_poppy("fleet", "list", "--json", *_fleet_args(*two))
+    assert result.code == 0, result.stderr
+    rows = {row["name"]: row for row in result.json()}
+    assert "0.0.0.0" not in json.dumps(rows["jr-a"])

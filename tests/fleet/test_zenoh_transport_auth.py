@@ -21,7 +21,7 @@ from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from tests.helpers.cli import run_poppy
 from tests.helpers.waiting import eventually
-from tests.helpers.zenoh_served import TOKEN, free_endpoint
+from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, free_endpoint
 
 pytest.importorskip("zenoh")
 
@@ -55,7 +55,11 @@ def test_a_peer_without_the_credentials_cannot_join_nor_read_the_state(
         zenoh=ZenohSettings(listen=(endpoint,), config_file=robot_config), name="jr-s", token=TOKEN
     )
     with from_profile("ergo-jr", sim=True) as robot, serve(robot, spec):
-        with Fleet(Settings(connect=(endpoint,), config_file=teacher), token=TOKEN) as fleet:
+        with Fleet(
+            Settings(connect=(endpoint,), config_file=teacher),
+            token=TOKEN,
+            timeout_s=FLEET_TIMEOUT_S,
+        ) as fleet:
             assert fleet.wait_for(["jr-s"]) == ["jr-s"]
             states: list[int] = []
             fleet.on_state(lambda name, state: states.append(state.seq))
@@ -68,13 +72,13 @@ def test_a_peer_without_the_credentials_cannot_join_nor_read_the_state(
         # with nothing else to reach, a session without a file is the robot's Zenoh client:
         # refused at the door, it never opens
         with pytest.raises(ConfigError, match="no Zenoh router or robot answers"):
-            Fleet(Settings(connect=(endpoint,)))
+            Fleet(Settings(connect=(endpoint,)), timeout_s=FLEET_TIMEOUT_S)
         strangers = (
             Settings(connect=(endpoint,), mode="peer"),
             Settings(connect=(endpoint,), config_file=wrong),
         )
         for stranger in strangers:
-            with Fleet(stranger) as outsider:
+            with Fleet(stranger, timeout_s=FLEET_TIMEOUT_S) as outsider:
                 got = threading.Event()
                 outsider.on_state(lambda name, state, got=got: got.set())
                 assert not list(outsider.session.info.peers_zid())  # not linked at all
@@ -168,7 +172,11 @@ def test_over_tls_a_peer_without_the_classrooms_ca_cannot_join_nor_read_the_stat
     own_ca = _tls_config(tmp_path / "own-ca.json5", {"root_ca_certificate": str(other_ca)})
     spec = ServeSpec(zenoh=ZenohSettings(config_file=robot_config), name="jr-t", token=TOKEN)
     with from_profile("ergo-jr", sim=True) as robot, serve(robot, spec):
-        with Fleet(Settings(connect=(endpoint,), config_file=teacher), token=TOKEN) as fleet:
+        with Fleet(
+            Settings(connect=(endpoint,), config_file=teacher),
+            token=TOKEN,
+            timeout_s=FLEET_TIMEOUT_S,
+        ) as fleet:
             assert fleet.wait_for(["jr-t"]) == ["jr-t"]
             states: list[int] = []
             fleet.on_state(lambda name, state: states.append(state.seq))
@@ -183,14 +191,14 @@ def test_over_tls_a_peer_without_the_classrooms_ca_cannot_join_nor_read_the_stat
         # (no CA: the robot's certificate is not trusted) as over plain TCP (no TLS handshake)
         for door in (endpoint, plain):
             with pytest.raises(ConfigError, match="no Zenoh router or robot answers"):
-                Fleet(Settings(connect=(door,)))
+                Fleet(Settings(connect=(door,)), timeout_s=FLEET_TIMEOUT_S)
         strangers = (
             Settings(connect=(endpoint,), mode="peer"),  # TLS, no CA
             Settings(connect=(endpoint,), config_file=own_ca),  # TLS, its own CA
             Settings(connect=(plain,), mode="peer"),  # plain TCP at the TLS port
         )
         for stranger in strangers:
-            with Fleet(stranger) as outsider:
+            with Fleet(stranger, timeout_s=FLEET_TIMEOUT_S) as outsider:
                 got = threading.Event()
                 outsider.on_state(lambda name, state, got=got: got.set())
                 assert not list(outsider.session.info.peers_zid())  # not linked at all
@@ -255,13 +263,19 @@ def test_access_control_lets_a_pupil_watch_the_states_but_not_query_the_robot(
         zenoh=ZenohSettings(listen=(endpoint,), config_file=robot_config), name="jr-s", token=TOKEN
     )
     with from_profile("ergo-jr", sim=True) as robot, serve(robot, spec):
-        with Fleet(Settings(connect=(endpoint,), config_file=teacher), token=TOKEN) as fleet:
+        with Fleet(
+            Settings(connect=(endpoint,), config_file=teacher),
+            token=TOKEN,
+            timeout_s=FLEET_TIMEOUT_S,
+        ) as fleet:
             assert fleet.wait_for(["jr-s"]) == ["jr-s"]
             assert fleet.describe()["jr-s"]["name"] == "jr-s"
             (motors,) = fleet.command(["jr-s"], "GET", "/api/v1/motors", together=False)
             assert motors.ok, motors.message
         # the pupil has the token, but access control stops its queries at the robot
-        with Fleet(Settings(connect=(endpoint,), config_file=pupil), token=TOKEN) as watcher:
+        with Fleet(
+            Settings(connect=(endpoint,), config_file=pupil), token=TOKEN, timeout_s=FLEET_TIMEOUT_S
+        ) as watcher:
             assert watcher.wait_for(["jr-s"]) == ["jr-s"]
             states: list[int] = []
             watcher.on_state(lambda name, state: states.append(state.seq))

@@ -24,7 +24,7 @@ from poppy_core.errors import ArgumentError
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ListenError
 from tests.foxglove_app.client import FoxgloveClient
-from tests.helpers.cli import ENV, POPPY, run_poppy
+from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.waiting import eventually, scaled
 
@@ -217,7 +217,7 @@ def test_poppy_serve_foxglove_says_where_serves_and_stops_on_sigterm() -> None:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env={**os.environ, **ENV},
+        env=dict(os.environ, **command_env()),
     )
     try:
         assert proc.stdout is not None and proc.stderr is not None

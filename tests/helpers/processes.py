@@ -11,7 +11,7 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
-from tests.helpers.waiting import scaled
+from tests.helpers.waiting import REPLY_FLOOR_ENV, reply_floor_env, scaled
 
 
 def read_until(
@@ -48,25 +48,43 @@ def reap(proc: subprocess.Popen[Any]) -> None:
             stream.close()
 
 
+def with_reply_floor(env: Mapping[str, str] | None) -> dict[str, str]:
+    """``env`` (None: this process's) with the first-reply floor of a `poppy` child whose
+    motors are an emulator (``POPPY_REPLY_FLOOR_S``): the one measured now, or the one ``env``
+    gives when higher (``tests.helpers.cli.ENV`` carries the floor of the load at its import,
+    which a load come since makes short)."""
+    full = dict(os.environ if env is None else env)
+    measured = reply_floor_env()[REPLY_FLOOR_ENV]
+    try:
+        given = float(full.get(REPLY_FLOOR_ENV, ""))
+    except ValueError:
+        given = 0.0
+    if given < float(measured):
+        full[REPLY_FLOOR_ENV] = measured
+    return full
+
+
 def start(
     argv: Sequence[str], env: Mapping[str, str] | None = None, *, stdin: int | None = None
 ) -> subprocess.Popen[str]:
     """``argv`` started with its stdout and stderr piped as text (``env``: its environment,
-    None for this process's; ``stdin``: e.g. ``subprocess.DEVNULL``)."""
+    None for this process's; either way with the load's reply floor, ``with_reply_floor``;
+    ``stdin``: e.g. ``subprocess.DEVNULL``)."""
     return subprocess.Popen(
         list(argv),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         stdin=stdin,
         text=True,
-        env=None if env is None else dict(env),
+        env=with_reply_floor(env),
     )
 
 
 def start_on_pty(
     argv: Sequence[str], env: Mapping[str, str] | None = None
 ) -> tuple[subprocess.Popen[bytes], int, int]:
-    """``argv`` started on a new pseudo-terminal (its stdin, stdout and stderr).
+    """``argv`` started on a new pseudo-terminal (its stdin, stdout and stderr), with the
+    load's reply floor in ``env`` (``with_reply_floor``).
 
     Returns:
         The process, the pty's master side (read what it prints, write what it types) and its
@@ -78,7 +96,7 @@ def start_on_pty(
         stdin=slave,
         stdout=slave,
         stderr=slave,
-        env=None if env is None else dict(env),
+        env=with_reply_floor(env),
         close_fds=True,
     )
     return proc, master, slave

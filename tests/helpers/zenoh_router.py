@@ -8,7 +8,7 @@ import subprocess
 import sys
 from typing import Any
 
-from tests.helpers.cli import ENV, POPPY
+from tests.helpers.cli import POPPY, command_env
 from tests.helpers.processes import read_until, reap
 from tests.helpers.zenoh_served import free_endpoint
 
@@ -36,7 +36,7 @@ class Router:
             argv,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
-            env={**os.environ, **ENV},
+            env=dict(os.environ, **command_env()),
         )
         assert self.proc.stdout is not None
         seen = read_until(self.proc.stdout.fileno(), "listening on", 60, self.proc)

@@ -6,9 +6,14 @@ import socket
 
 from poppy_core import from_profile
 from poppy_core.assembly import ServerSet, ServeSpec, ZenohSettings, serve
+from poppy_core.remote.zenoh_fleet import DEFAULT_TIMEOUT_S
 from poppy_core.robot import Robot
+from tests.helpers.waiting import scaled
 
 TOKEN = "s3cret"
+# A test's fleet client waits for answers the product's timeout times the load factor measured
+# when this module is imported (a loaded machine answered after the fixed 2 s).
+FLEET_TIMEOUT_S = scaled(DEFAULT_TIMEOUT_S)
 
 
 def free_endpoint() -> str:

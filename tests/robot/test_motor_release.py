@@ -15,9 +15,16 @@ from poppy_core.errors import PortError, RobotClosedError, SetupError
 from poppy_core.models import model_by_name
 from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
+from tests.helpers.bus import robot_buses_wait_for_a_loaded_emulator
 from tests.helpers.waiting import eventually
 
 XL320 = model_by_name("XL-320")
+
+
+@pytest.fixture(autouse=True)
+def loaded_floor(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The emulator thread on a pty answers late on a busy machine: no motor is lost for that."""
+    robot_buses_wait_for_a_loaded_emulator(monkeypatch)
 
 
 @pytest.fixture

@@ -24,7 +24,7 @@ from poppy_core.assembly import ServeSpec, serve
 from poppy_core.ros2_wire import Ros2Settings
 from poppy_core.zenoh_wire import ZenohSettings
 from tests.helpers.processes import read_until, reap
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, scaled
 from tests.helpers.zenoh_router import Router
 from tests.ros2.rmw_client import Client, Collector
 
@@ -62,7 +62,7 @@ def test_an_independent_ros2_client_sees_and_drives_the_robot_through_the_router
     servers = serve(robot, spec)
     try:
         assert robot.compliant
-        out, err = client.communicate(timeout=240)
+        out, err = client.communicate(timeout=scaled(240))
         assert client.returncode == 0, err[-3000:]
         summary: dict[str, Any] = json.loads(out.strip().splitlines()[-1])
         assert summary["names"] == ["m1", "m2", "m3", "m4", "m5", "m6"]

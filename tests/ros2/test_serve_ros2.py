@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip("zenoh")
 pytest.importorskip("rosbags")
 
-from tests.helpers.cli import ENV, POPPY, run_poppy
+from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.waiting import eventually
 from tests.ros2 import rmw_client as rmw
@@ -38,7 +38,7 @@ def test_poppy_serve_ros2_serves_the_node_in_its_namespace_and_domain() -> None:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env={**os.environ, **ENV, "ROS_DOMAIN_ID": "3"},
+        env=dict(os.environ, **command_env({"ROS_DOMAIN_ID": "3"})),
     )
     try:
         assert proc.stdout is not None

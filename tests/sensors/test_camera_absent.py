@@ -22,7 +22,7 @@ from poppy_core.sensors import Camera
 from poppy_core.sensors.opencv_camera import OpenCVCamera
 from tests.helpers.bus import emulate_bus
 from tests.helpers.cli import command_env
-from tests.helpers.waiting import eventually, http_timeout
+from tests.helpers.waiting import eventually, http_timeout, scaled
 from tests.sensors.test_camera import Unpluggable
 
 cv2 = pytest.importorskip("cv2")
@@ -144,7 +144,7 @@ def test_poppy_serve_starts_without_its_camera_and_the_page_says_so(tmp_path: Pa
         try:
             assert proc.stdout is not None
             http_url = proc.stdout.readline().strip()
-            assert http_url.startswith("http://127.0.0.1:"), proc.communicate(timeout=30)
+            assert http_url.startswith("http://127.0.0.1:"), proc.communicate(timeout=scaled(30))
             with urllib.request.urlopen(f"{http_url}/api/v1/web/about", timeout=20) as answer:
                 sensors = json.load(answer)["sensors"]
             camera, detector = sensors["camera"], sensors["marker_detector"]
@@ -155,7 +155,7 @@ def test_poppy_serve_starts_without_its_camera_and_the_page_says_so(tmp_path: Pa
                 assert json.load(answer)["motors"] == [f"m{i}" for i in range(1, 7)]
         finally:
             proc.send_signal(signal.SIGTERM)
-            _, err = proc.communicate(timeout=60)
+            _, err = proc.communicate(timeout=scaled(60))
     assert proc.returncode == 0, err
     lines = [line for line in err.splitlines() if "camera" in line]
     assert len(lines) == 1 and "is not available" in lines[0], err

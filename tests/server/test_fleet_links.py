@@ -78,3 +78,22 @@ def test_the_fleet_route_drops_the_pages_no_peer_may_link(monkeypatch: pytest.Mo
         "jr-c": None,
         "jr-d": None,
     }
+
+
+def test_only_a_wildcard_listener_is_replaced_by_the_machine_s_addresses() -> None:
+    from poppy_core.server.reachable import reachable_endpoints, reachable_url
+
+    mine = ["192.0.2.7", "fe80::2"]
+    assert reachable_endpoints(["tcp/127.0.0.1:7447", "tcp/192.168.1.7:1"], mine) == [
+        "tcp/127.0.0.1:7447",
+        "tcp/192.168.1.7:1",
+    ]
+    assert reachable_endpoints(["tcp/[::]:7447"], mine) == [
+        "tcp/192.0.2.7:7447",
+        "tcp/[fe80::2]:7447",
+    ]
+    assert reachable_endpoints(["tcp/0.0.0.0:7447"], []) == ["tcp/0.0.0.0:7447"]  # no address
+    assert reachable_url("http://0.0.0.0:8080/x", mine) == "http://192.0.2.7:8080/x"
+    assert reachable_url("http://[::]", ["fe80::2"]) == "http://[fe80::2]"
+    assert reachable_url("http://127.0.0.1:8080", mine) == "http://127.0.0.1:8080"
+    assert reachable_url(None, mine) is None

@@ -22,10 +22,10 @@ from typing import Any
 import pytest
 
 from poppy_cli.commands import notebook as notebook_cmd
-from tests.helpers.cli import ENV, POPPY, run_poppy
+from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.server import Served, serve
-from tests.helpers.waiting import eventually
+from tests.helpers.waiting import eventually, scaled
 
 nbformat = pytest.importorskip("nbformat")
 nbclient = pytest.importorskip("nbclient")
@@ -167,7 +167,7 @@ def test_poppy_notebook_serves_jupyter_on_loopback(
         allow = {"ServerApp": {"allow_root": True}}
         (config / "jupyter_server_config.json").write_text(json.dumps(allow))
     args = ["notebook", "--port", str(port), "--dir", str(tmp_path / "nb"), "--no-browser"]
-    env = dict(os.environ, **ENV, **jupyter_dirs)
+    env = dict(os.environ, **command_env(jupyter_dirs))
     proc = subprocess.Popen(
         [*POPPY, *args], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env
     )
@@ -184,6 +184,6 @@ def test_poppy_notebook_serves_jupyter_on_loopback(
         assert proc.poll() is None, proc.stderr.read() if proc.stderr else ""
         assert (tmp_path / "nb" / notebook_cmd.FIRST_NOTEBOOK).is_file()
         proc.send_signal(signal.SIGTERM)
-        proc.wait(timeout=60)
+        proc.wait(timeout=scaled(60))
     finally:
         reap(proc)

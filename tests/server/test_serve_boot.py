@@ -18,7 +18,7 @@ from poppy_core.robot import load_profile
 from poppy_core.robot.factory import virtual_buses
 from tests.helpers.cli import command_env
 from tests.helpers.processes import reap, served_urls
-from tests.helpers.waiting import eventually, http_timeout
+from tests.helpers.waiting import eventually, http_timeout, scaled
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -37,7 +37,7 @@ def stop(proc: subprocess.Popen[str]) -> str:
     """SIGTERM, the exit code checked; what it said on stderr."""
     try:
         proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=30) == 0
+        assert proc.wait(timeout=scaled(30)) == 0
         assert proc.stderr is not None
         return proc.stderr.read()
     finally:

@@ -15,6 +15,7 @@ import pytest
 
 from tests.helpers.cli import command_env, keyed, run_poppy
 from tests.helpers.processes import reap, start
+from tests.helpers.waiting import scaled
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
 
@@ -43,7 +44,7 @@ def test_serve_prints_urls_and_stops(signum: int) -> None:
             assert "present_position" in ws.recv(timeout=2)
         t0 = time.monotonic()
         proc.send_signal(signum)
-        code = proc.wait(timeout=15)
+        code = proc.wait(timeout=scaled(15))
         assert time.monotonic() - t0 < 15
         assert code == 0
         assert proc.stderr is not None and "stopped" in proc.stderr.read()
@@ -259,7 +260,7 @@ def test_both_websockets_apply_the_origin_rules_and_say_how_to_allow_one() -> No
                 with connect(endpoint, origin=origin) as ws:
                     assert "present_position" in ws.recv(timeout=5)
         proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=15) == 0
+        assert proc.wait(timeout=scaled(15)) == 0
         assert proc.stderr is not None
         err = proc.stderr.read()
         hints = [line for line in err.splitlines() if "evil.example" in line]
@@ -284,7 +285,7 @@ def test_a_signal_stops_a_remote_play_with_exit_130(served: Any, signum: int) ->
         moves = served.app.state.service.moves
         assert eventually(lambda: "remote_long" in moves.playing(), timeout_s=60), proc.stderr
         proc.send_signal(signum)
-        stdout, stderr = proc.communicate(timeout=30)
+        stdout, stderr = proc.communicate(timeout=scaled(30))
     finally:
         if proc.poll() is None:
             proc.kill()

@@ -28,6 +28,7 @@ from poppy_core.server.snap import SnapServer, start_snap_server
 from poppy_core.server.snap.release import installed, release_digest
 from tests.helpers.cli import run_poppy
 from tests.helpers.snap_release import Files, make_release, release_server, zip_folder
+from tests.helpers.waiting import scaled
 from tests.server.snap_helpers import near, wait_until
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -78,7 +79,7 @@ def browser() -> Iterator[list[subprocess.Popen[bytes]]]:
     yield started
     for proc in started:
         proc.terminate()
-        proc.wait(timeout=20)
+        proc.wait(timeout=scaled(20))
         shutil.rmtree(str(proc.args[-2]).removeprefix("--user-data-dir="), ignore_errors=True)
 
 

@@ -14,6 +14,7 @@ from poppy_core.server.zmqserver import ZmqRobotServer
 from tests.creatures.helpers import wait_until
 from tests.helpers.cli import command_env
 from tests.helpers.processes import reap, start
+from tests.helpers.waiting import scaled
 
 zmq = pytest.importorskip("zmq")
 TIMEOUT_MS = 10_000
@@ -186,7 +187,7 @@ def test_poppy_serve_zmq() -> None:
             socket.close()
             context.term()
         proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=15) == 0
+        assert proc.wait(timeout=scaled(15)) == 0
     finally:
         reap(proc)
 

@@ -15,6 +15,7 @@ import pytest
 
 from poppy_cli.options import normalise_sim_args
 from tests.helpers.cli import command_env, run_poppy
+from tests.helpers.waiting import scaled
 
 ROOT = Path(__file__).resolve().parents[2]
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -56,7 +57,7 @@ class SimProcess:
         """Stop it; its exit code and stderr."""
         if self.proc.poll() is None:
             self.proc.send_signal(signum)
-        _, err = self.proc.communicate(timeout=15)
+        _, err = self.proc.communicate(timeout=scaled(15))
         return self.proc.returncode, err
 
 

@@ -14,6 +14,7 @@ import pytest
 
 from tests.helpers.cli import POPPY, command_env
 from tests.helpers.processes import read_until
+from tests.helpers.waiting import scaled
 
 ROOT = Path(__file__).resolve().parents[2]
 ASPECT = 640 / 480  # the default render size
@@ -112,7 +113,7 @@ def test_a_move_render_shows_its_frames_and_time_left_on_a_terminal(tmp_path: Pa
     os.close(child)
     try:
         shown = read_until(parent, None, 240, proc)
-        code = proc.wait(timeout=60)
+        code = proc.wait(timeout=scaled(60))
     finally:
         if proc.poll() is None:
             proc.kill()

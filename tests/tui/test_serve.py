@@ -12,6 +12,7 @@ import urllib.request
 
 from tests.helpers.cli import command_env
 from tests.helpers.processes import start
+from tests.helpers.waiting import scaled
 
 
 def _free_port() -> int:
@@ -48,7 +49,7 @@ def test_tui_serve_answers_a_browser_on_loopback() -> None:
     finally:
         proc.send_signal(signal.SIGINT)
         try:
-            proc.wait(timeout=10)
+            proc.wait(timeout=scaled(10))
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()

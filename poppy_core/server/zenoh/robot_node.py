@@ -27,6 +27,8 @@ from poppy_core.errors import PoppyError
 from poppy_core.motion.chains import robot_chains
 from poppy_core.schedule import RateMeter, TickGuard, Worker
 from poppy_core.server.errors import ApiError, refusal_kind
+from poppy_core.server.reachable import reachable_endpoints, reachable_url
+from poppy_core.server.start_time import late_by
 from poppy_core.server.zenoh import described
 from poppy_core.server.zenoh.asgi_call import AsgiCaller
 from poppy_core.server.zenoh.intake import ApiRequest, Intake
@@ -261,8 +263,9 @@ class ZenohRobotServer:
             "name": self.name,
             "creature": described.creature(robot),
             "host": socket.gethostname(),
-            "endpoints": list(self.endpoints),
-            "page": self.page,
+            # where a peer reaches it: a wildcard listener (0.0.0.0) is no address to dial
+            "endpoints": reachable_endpoints(self.endpoints),
+            "page": reachable_url(self.page),
             "token": self.token is not None,
             "state_rate_hz": self.state_rate_hz,
             "motors": described.motors(robot),
@@ -323,8 +326,10 @@ class ZenohRobotServer:
             place = self.intake.hold(request.start_at)
         except Refused as exc:
             return _refusal(exc.status, exc.detail)
+        late = self._late_s(request)
         if STARTS.fullmatch(request.path):
             # armed now (checked, its thread made, held at a gate); the gate opens at start_at
+            # (one already past: it starts at once, and the reply says how late)
             if request.body is not None and not isinstance(request.body, dict):
                 self.intake.release(place)
                 return _refusal(422, "the body of a start is an object (or nothing)")
@@ -333,12 +338,22 @@ class ZenohRobotServer:
             if reply["status"] >= 400:
                 self.intake.release(place)
                 return reply
-            return {**reply, "start_at": request.start_at}
+            return {**reply, "start_at": request.start_at, **late}
         try:
             await asyncio.sleep(max(0.0, request.start_at - time.time()))
-            return await self._call(caller, request)
+            return {**await self._call(caller, request), **late}
         finally:
             self.intake.release(place)
+
+    def _late_s(self, request: ApiRequest) -> dict[str, float]:
+        """``{"late_s": S}`` for a request that came after its start time (``late_by``), else
+        nothing."""
+        late = late_by(request.start_at or 0.0)
+        if late:
+            logger.info(
+                "zenoh: %s: %s came %.3f s late: run at once", self.name, request.path, late
+            )
+        return {"late_s": late} if late else {}
 
     async def _call(self, caller: AsgiCaller, request: ApiRequest) -> dict[str, Any]:
         """The app's answer: the request passed its arrival checks, so it carries the robot's
