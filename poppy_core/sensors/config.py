@@ -199,7 +199,11 @@ def device_sensor(spec: SensorSpec) -> Sensor:
 
 
 def optitrack_sensor(spec: SensorSpec) -> Sensor:
-    """The OptiTrack client, bridge server or bridge client of an entry (nothing opened yet)."""
+    """The OptiTrack client, bridge server or bridge client of an entry.
+
+    A bridge server starts at once: it serves other machines and nobody here reads it, so the
+    first use that starts the other sensors would never come.
+    """
     if spec.type == "OptiBridgeClient":
         rate = spec.rate_hz or DEFAULT_BRIDGE_HZ
         return OptiBridgeClient(spec.name, spec.addr, spec.tcp_port, spec.obj_names, rate)
@@ -211,7 +215,7 @@ def optitrack_sensor(spec: SensorSpec) -> Sensor:
     port = spec.tcp_port or COMMAND_PORT
     rate_hz = spec.rate_hz or DEFAULT_OPTITRACK_HZ
     if spec.type == "OptiBridgeServer":
-        return OptiBridgeServer(
+        bridge = OptiBridgeServer(
             spec.name,
             spec.addr,
             port,
@@ -221,6 +225,8 @@ def optitrack_sensor(spec: SensorSpec) -> Sensor:
             bridge_port=spec.bridge_port,
             **natnet,
         )
+        bridge.start()
+        return bridge
     return OptiTrackClient(spec.name, spec.addr, port, spec.obj_names, rate_hz, **natnet)
 
 
@@ -229,7 +235,8 @@ def build_sensors(
     make_camera: CameraMaker = opencv_camera,
     make_imu: ImuMaker = device_imu,
 ) -> dict[str, Sensor]:
-    """The sensors of checked entries, cameras first; none started yet; in the entries' order.
+    """The sensors of checked entries, cameras first, in the entries' order; none started yet
+    but an OptiTrack bridge server (``optitrack_sensor``).
 
     Raises:
         SensorError: a sensor cannot be made: a bad camera index, face detection without

@@ -180,6 +180,7 @@ class OptiTrackClient(Sensor):
         self._sockets: list[socket.socket] = []
         self._version: tuple[int, int] | None = None
         self._names: dict[int, str] | None = None
+        self._names_stale = False
         self._next_connect = 0.0
         self._next_modeldef = 0.0
         self._next_keepalive = 0.0
@@ -233,13 +234,16 @@ class OptiTrackClient(Sensor):
         if self._version is None and now >= self._next_connect:
             command.sendto(natnet.connect_message(), server)
             self._next_connect = now + ASK_EVERY_S
-        elif self._version is not None and self._names is None and now >= self._next_modeldef:
+        elif self._version is not None and self._asking_names() and now >= self._next_modeldef:
             command.sendto(natnet.request(natnet.NAT_REQUEST_MODELDEF), server)
             self._next_modeldef = now + ASK_EVERY_S
         if self.multicast is None and now >= self._next_keepalive:
             for sock in self._sockets:
                 sock.sendto(natnet.request(natnet.NAT_KEEPALIVE), server)
             self._next_keepalive = now + ASK_EVERY_S
+
+    def _asking_names(self) -> bool:
+        return self._names is None or self._names_stale
 
     def _take(self, packet: bytes) -> bool:
         """One message; True when it was a frame read with the bodies' names known."""
@@ -255,6 +259,7 @@ class OptiTrackClient(Sensor):
                 return False  # frames before the server said its version cannot be read
             if message_id == natnet.NAT_MODELDEF:
                 self._names = natnet.parse_model_def(payload, self._version)
+                self._names_stale = False
                 return False
             if message_id != natnet.NAT_FRAMEOFDATA:
                 return False
@@ -268,7 +273,7 @@ class OptiTrackClient(Sensor):
         for body in bodies:
             name = names.get(body.id)
             if name is None:
-                self._names = None  # a rigid body added in Motive: ask for the names again
+                self._names_stale = True  # a body added in Motive: ask for the names again
             elif body.valid and name in self.obj_names:
                 self._store.put(name, tracked(body.position, body.quaternion))
         return True
@@ -291,7 +296,7 @@ class OptiTrackClient(Sensor):
                 f"cannot listen for NatNet on {self.local_addr}:{self.data_port}: {exc}"
             ) from None
         self._sockets = opened
-        self._version, self._names = None, None
+        self._version, self._names, self._names_stale = None, None, False
         self._next_connect = self._next_modeldef = self._next_keepalive = 0.0
 
     def reconnect(self) -> None:

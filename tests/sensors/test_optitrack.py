@@ -332,6 +332,30 @@ def test_a_pypot_config_entry_reads_through_rest(motive: FakeMotive) -> None:
     assert value["tracked_objects"]["robot"]["position"] == [0.5, 1.0, -2.0]
 
 
+def test_a_bridge_server_in_a_config_serves_unread(motive: FakeMotive) -> None:
+    port = free_port(socket.SOCK_STREAM)
+    data = load_profile("torso").to_pypot_dict()
+    data["sensors"] = {
+        "bridge": {
+            "type": "OptiBridgeServer",
+            "addr": LOOPBACK,
+            "port": motive.port,
+            "obj_names": ["robot", "ball"],
+            "data_port": motive.data_port,
+            "multicast": False,
+            "local_addr": LOOPBACK,
+            "bridge_host": LOOPBACK,
+            "bridge_port": port,
+        },
+        "far": {"type": "OptiBridgeClient", "addr": LOOPBACK, "port": port, "obj_names": ["ball"]},
+    }
+    config = RobotConfig.from_dict(data, source="robot.json")
+    with from_config(config, sim=True) as robot:
+        assert robot.bridge.running  # started with the robot: it serves other machines
+        assert streamed_until(motive, robot.far, "ball", [ROBOT, BALL])
+        assert set(robot.far.tracked_objects) == {"ball"}
+
+
 @pytest.mark.parametrize(
     ("entry", "said"),
     [
