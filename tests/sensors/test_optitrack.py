@@ -20,7 +20,13 @@ from poppy_core.errors import ConfigError
 from poppy_core.robot import RobotConfig, load_profile
 from poppy_core.sensors import natnet
 from poppy_core.sensors.optibridge import OptiBridgeClient, OptiBridgeServer, decode, encode
-from poppy_core.sensors.optitrack import OptiTrackClient, TrackedObject, quat2euler, tracked
+from poppy_core.sensors.optitrack import (
+    MULTICAST_GROUP,
+    OptiTrackClient,
+    TrackedObject,
+    quat2euler,
+    tracked,
+)
 from tests.helpers.sensor_rest import rest
 from tests.helpers.waiting import eventually
 
@@ -203,6 +209,42 @@ def test_the_named_objects_are_tracked(version: tuple[int, int]) -> None:
             assert opti.natnet_version == version and opti.server_name == "Motive"
     finally:
         motive.close()
+
+
+def test_multicast_frames_are_read_on_the_group_joined(motive: FakeMotive) -> None:
+    """Motive's default mode. The frames go to the group on the loopback interface with a TTL
+    of 0: they never leave the machine."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        group = socket.inet_aton(MULTICAST_GROUP) + socket.inet_aton(LOOPBACK)
+        try:
+            probe.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, group)
+        except OSError:
+            pytest.skip("no multicast on this machine's loopback")
+    sender = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+    sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(LOOPBACK))
+    sender.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+    opti = OptiTrackClient(
+        "optitrack",
+        LOOPBACK,
+        motive.port,
+        ("robot",),
+        data_port=motive.data_port,
+        multicast=MULTICAST_GROUP,
+        local_addr=LOOPBACK,
+    )
+    try:
+        with opti:
+
+            def seen() -> bool:
+                packet = frame(1, [ROBOT], motive.version)
+                sender.sendto(packet, (MULTICAST_GROUP, motive.data_port))
+                return "robot" in opti.tracked_objects
+
+            assert eventually(seen, timeout_s=10, interval_s=0.02), opti.health().last_error
+            assert natnet.NAT_KEEPALIVE not in motive.asked  # multicast: no keep-alives
+    finally:
+        sender.close()
 
 
 def test_recent_objects_are_those_received_in_the_last_20_ms(motive: FakeMotive) -> None:
