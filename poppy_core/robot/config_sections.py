@@ -8,6 +8,7 @@ and ``poppy_core.sensors.config``.
 
 from __future__ import annotations
 
+import ipaddress
 from collections.abc import Collection, Mapping
 from typing import Annotated, Any, Literal
 
@@ -30,11 +31,19 @@ from poppy_core.sensors.config import (
     CAMERA_TYPES,
     DEVICE_TYPES,
     NOT_YET,
+    OPTITRACK_TYPES,
     SUPPORTED_TYPES,
     SensorSpec,
 )
 from poppy_core.sensors.faces import MAX_FACE_PX, MIN_FACE_PX
 from poppy_core.sensors.markers import FAMILIES
+from poppy_core.sensors.optitrack import MULTICAST_GROUP
+
+NETWORK_TYPES = ("KinectSensor", *OPTITRACK_TYPES)
+"""Sensors whose integer ``port`` is a TCP or UDP port (the others' is a serial device)."""
+SERVER_PORT_TYPES = ("KinectSensor", "OptiBridgeClient")
+"""Their ``port`` is required: the server's TCP port."""
+VRPN_PORT = 3883
 
 Name = Annotated[str, Strict()]
 Finite = Annotated[float, Strict(), Field(allow_inf_nan=False)]
@@ -196,6 +205,29 @@ def _i2c_address(value: int) -> int:
     return value
 
 
+def _tcp_port(value: int) -> int:
+    if not 0 < value < 65536:
+        raise PydanticCustomError("port", "must be a port number (1-65535)")
+    return value
+
+
+def _ipv4(value: str) -> str:
+    try:
+        ipaddress.IPv4Address(value)
+    except ValueError:
+        raise PydanticCustomError("ipv4", "must be an IPv4 address such as 192.168.1.10") from None
+    return value
+
+
+def _multicast_group(value: str) -> str:
+    if not ipaddress.IPv4Address(_ipv4(value)).is_multicast:
+        raise PydanticCustomError(
+            "multicast",
+            "must be a multicast group such as 239.255.42.99, or false for unicast",
+        )
+    return value
+
+
 def _reason(exc: Exception) -> str:
     return str(exc).split(": ", 1)[-1]
 
@@ -238,6 +270,12 @@ class SensorEntry(BaseModel):
     gpio_vcc: Annotated[int, Strict()] | Name | None = None
     i2c_pin: Annotated[Annotated[int, Strict()], AfterValidator(_bus_number)] | None = None
     address: Annotated[Annotated[int, Strict()], AfterValidator(_i2c_address)] | None = None
+    obj_names: Annotated[list[Name], Field(min_length=1)] | None = None
+    data_port: Annotated[Annotated[int, Strict()], AfterValidator(_tcp_port)] | None = None
+    multicast: Annotated[Name, AfterValidator(_multicast_group)] | Literal[False] | None = None
+    local_addr: Annotated[Name, AfterValidator(_ipv4)] | None = None
+    bridge_host: Annotated[Name, AfterValidator(_non_empty)] | None = None
+    bridge_port: Annotated[Annotated[int, Strict()], AfterValidator(_tcp_port)] | None = None
 
     @model_validator(mode="after")
     def _device_keys(self) -> SensorEntry:
@@ -249,22 +287,48 @@ class SensorEntry(BaseModel):
             "BlobDetector": "filters",
             "BNO055": "i2c_pin",
             "KinectSensor": "addr",
+            "OptiTrackClient": "addr",
+            "OptiBridgeServer": "addr",
+            "OptiBridgeClient": "addr",
         }
-        key = needed.get(self.type)
-        if key is not None and getattr(self, key) is None:
-            raise PydanticCustomError(
-                "device",
-                "{kind} needs its '{key}' key (as in pypot's config)",
-                {"kind": self.type, "key": key},
-            )
-        tcp = self.type == "KinectSensor"
-        if tcp and not (isinstance(self.port, int) and 0 < self.port < 65536):
-            raise PydanticCustomError(
-                "port", "KinectSensor needs its 'port': the server's TCP port (1-65535)"
-            )
-        if not tcp and isinstance(self.port, int):
-            raise PydanticCustomError("port", "'port' must be a serial device such as /dev/ttyACM0")
+        keys = [needed[self.type]] if self.type in needed else []
+        if self.type in OPTITRACK_TYPES:
+            keys.append("obj_names")
+        if self.type == "OptiBridgeServer":
+            keys += ["bridge_host", "bridge_port"]
+        for key in keys:
+            if getattr(self, key) is None:
+                raise PydanticCustomError(
+                    "device",
+                    "{kind} needs its '{key}' key (as in pypot's config)",
+                    {"kind": self.type, "key": key},
+                )
+        self._check_port()
         return self
+
+    def _check_port(self) -> None:
+        """An integer port for the network sensors, a serial device for the others."""
+        number = self.port if isinstance(self.port, int) else None
+        valid = number is not None and 0 < number < 65536
+        if self.type in SERVER_PORT_TYPES and not valid:
+            raise PydanticCustomError(
+                "port",
+                "{kind} needs its 'port': the server's TCP port (1-65535)",
+                {"kind": self.type},
+            )
+        if self.type in OPTITRACK_TYPES and self.type not in SERVER_PORT_TYPES:
+            if self.port is not None and not valid:
+                raise PydanticCustomError(
+                    "port", "must be Motive's NatNet command port (1-65535, 1510 by default)"
+                )
+            if self.port == VRPN_PORT:
+                raise PydanticCustomError(
+                    "port",
+                    "3883 is VRPN's port (pypot's old wire); poppy reads Motive's NatNet "
+                    "stream: give its command port (1510 by default) or leave 'port' out",
+                )
+        if self.type not in NETWORK_TYPES and number is not None:
+            raise PydanticCustomError("port", "'port' must be a serial device such as /dev/ttyACM0")
 
     def spec(self, name: str) -> SensorSpec:
         """The plain entry the sensors leaf builds from."""
@@ -296,10 +360,16 @@ class SensorEntry(BaseModel):
             "gpio_vcc": self.gpio_vcc,
             "i2c_pin": self.i2c_pin,
             "address": self.address,
+            "obj_names": tuple(self.obj_names) if self.obj_names is not None else None,
+            "data_port": self.data_port,
+            "multicast": None if self.multicast is False else (self.multicast or MULTICAST_GROUP),
+            "local_addr": self.local_addr,
+            "bridge_host": self.bridge_host,
+            "bridge_port": self.bridge_port,
         }
         if self.type in DEVICE_TYPES:
             given["rate_hz"] = self.sync_freq or self.freq
-        keep = {"rate_hz", "resolution", "calibration", "cascade", "gpio_vcc"}
+        keep = {"rate_hz", "resolution", "calibration", "cascade", "gpio_vcc", "multicast"}
         return SensorSpec(
             name, self.type, **{k: v for k, v in given.items() if v is not None or k in keep}
         )

@@ -140,7 +140,7 @@ class VrepNames:
         simulation = _world(self, "track_objects")
         for name in _names(names):
             simulation.get_object_position(_body_name(simulation, name))  # known, or an error
-            self.attach(name, TrackedObject(simulation, _body_name(simulation, name)))
+            self.attach(name, WorldObject(simulation, _body_name(simulation, name)))
 
     def track_collisions(self: VrepHost, names: Any) -> None:
         """pypot's ``tracked_collisions``: ``robot.<name>.colliding`` of each body (a body
@@ -148,7 +148,7 @@ class VrepNames:
         simulation = _world(self, "track_collisions")
         for name in _names(names):
             simulation.get_object_position(_body_name(simulation, name))
-            self.attach(name, TrackedObject(simulation, _body_name(simulation, name)))
+            self.attach(name, WorldObject(simulation, _body_name(simulation, name)))
 
 
 def _add(
@@ -174,7 +174,7 @@ def _world(host: VrepHost, call: str) -> Any:
     return host.simulation
 
 
-class TrackedObject:
+class WorldObject:
     """A tracked object or collision (pypot's ``ObjectTracker``, ``VrepCollisionDetector``):
     its pose and contacts, read when asked."""
 

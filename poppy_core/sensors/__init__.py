@@ -1,4 +1,4 @@
-"""Sensors: cameras (OpenCV, blank, simulated), markers, faces, blobs, devices, IMUs.
+"""Sensors: cameras (OpenCV, blank, simulated), markers, faces, blobs, devices, IMUs, OptiTrack.
 
 Imports nothing of ours but ``errors``; OpenCV, gpiozero and smbus2 are imported on first use.
 The robot factory builds them from a config's ``sensors`` section (``build_sensors``).
@@ -23,6 +23,8 @@ from poppy_core.sensors.faces import Face, FaceDetector, FaceFinder
 from poppy_core.sensors.imu import Imu, RazorIMU, StillIMU
 from poppy_core.sensors.kinect import KinectSensor, Skeleton
 from poppy_core.sensors.markers import Marker, MarkerFinder, MarkerPose, marker_image
+from poppy_core.sensors.optibridge import OptiBridgeClient, OptiBridgeServer
+from poppy_core.sensors.optitrack import OptiTrackClient, TrackedObject
 from poppy_core.sensors.sonar import SonarSensor
 
 __all__ = [
@@ -47,6 +49,9 @@ __all__ = [
     "MarkerDetector",
     "MarkerFinder",
     "MarkerPose",
+    "OptiBridgeClient",
+    "OptiBridgeServer",
+    "OptiTrackClient",
     "RazorIMU",
     "Sensor",
     "SensorHealth",
@@ -55,6 +60,7 @@ __all__ = [
     "Skeleton",
     "SonarSensor",
     "StillIMU",
+    "TrackedObject",
     "build_sensors",
     "dummy_camera",
     "marker_image",

@@ -9,7 +9,13 @@ MuJoCo camera a simulated robot renders for it; default: the sensor's name). A `
 A ``BlobDetector`` (pypot's: ``cameras``, ``freq``, ``filters``) takes ``min_radius`` (pixels).
 The device sensors take pypot's keys: ``ArduinoSensor`` ``port``, ``baud``, ``sync_freq``;
 ``ContactSensor`` ``gpio_data``, ``gpio_vcc``; ``SonarSensor`` ``i2c_pin``, ``address``,
-``sync_freq``; ``KinectSensor`` ``addr``, ``port`` (the skeleton server's ZMQ port). The
+``sync_freq``; ``KinectSensor`` ``addr``, ``port`` (the skeleton server's ZMQ port);
+``OptiTrackClient`` ``addr`` (Motive's host), ``port`` (its NatNet command port, 1510),
+``obj_names``, and poppy's ``data_port`` (1511), ``multicast`` (the group, 239.255.42.99;
+``false``: unicast), ``local_addr`` (the interface to listen on, 0.0.0.0);
+``OptiBridgeServer`` the same plus ``bridge_host``, ``bridge_port`` (its ZMQ PUB socket);
+``OptiBridgeClient`` (pypot's ``optibridge.OptiTrackClient``) ``addr``, ``port``,
+``obj_names``. The
 IMUs: ``RazorIMU`` ``port``, ``baud`` (57600), ``sync_freq``; ``BNO055`` ``i2c_pin``,
 ``address`` (0x28), ``sync_freq``; both take ``sim_body`` (the MuJoCo body a
 simulated robot's IMU rides; default ``head``).
@@ -21,6 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 from poppy_core.errors import SensorError
 from poppy_core.sensors.arduino import DEFAULT_BAUD, DEFAULT_SYNC_HZ, ArduinoSensor
@@ -43,19 +50,32 @@ from poppy_core.sensors.faces import (
 from poppy_core.sensors.imu import RAZOR_BAUD, RAZOR_HZ, Imu, RazorIMU, StillIMU
 from poppy_core.sensors.kinect import DEFAULT_KINECT_HZ, KinectSensor
 from poppy_core.sensors.markers import DEFAULT_DICTIONARY, DEFAULT_MARKER_SIZE_M, FAMILIES
+from poppy_core.sensors.optibridge import DEFAULT_BRIDGE_HZ, OptiBridgeClient, OptiBridgeServer
+from poppy_core.sensors.optitrack import (
+    COMMAND_PORT,
+    DATA_PORT,
+    DEFAULT_OPTITRACK_HZ,
+    MULTICAST_GROUP,
+    OptiTrackClient,
+)
 from poppy_core.sensors.sonar import DEFAULT_ADDRESS, DEFAULT_SONAR_HZ, SonarSensor
 
 CAMERA_TYPES = ("OpenCVCamera", "DummyCamera")
 DETECTOR_TYPES = ("MarkerDetector", "FaceDetector", "BlobDetector")
 IMU_TYPES = ("RazorIMU", "BNO055")
-DEVICE_TYPES = ("ArduinoSensor", "ContactSensor", "SonarSensor", "KinectSensor", *IMU_TYPES)
+OPTITRACK_TYPES = ("OptiTrackClient", "OptiBridgeServer", "OptiBridgeClient")
+DEVICE_TYPES = (
+    "ArduinoSensor",
+    "ContactSensor",
+    "SonarSensor",
+    "KinectSensor",
+    *OPTITRACK_TYPES,
+    *IMU_TYPES,
+)
 """Sensors on their own device (a serial port, a GPIO pin, an I2C bus, a server), no camera."""
 SUPPORTED_TYPES = (*CAMERA_TYPES, *DETECTOR_TYPES, *DEVICE_TYPES)
 NOT_YET: dict[str, str] = {
     # pypot 5.0.2's pypot.sensor classes and the sensors the Poppy documentation names
-    "OptiTrackClient": "OptiTrack",
-    "OptiBridgeServer": "OptiTrack",
-    "TrackedObject": "OptiTrack",
     "ForceSensor": "force",
 }
 
@@ -93,6 +113,12 @@ class SensorSpec:
     gpio_vcc: int | str | None = None
     i2c_pin: int = 1
     address: int | None = None
+    obj_names: tuple[str, ...] = ()
+    data_port: int = DATA_PORT
+    multicast: str | None = MULTICAST_GROUP
+    local_addr: str = "0.0.0.0"
+    bridge_host: str = ""
+    bridge_port: int = 0
 
     @property
     def is_camera(self) -> bool:
@@ -160,6 +186,8 @@ def device_sensor(spec: SensorSpec) -> Sensor:
         return ArduinoSensor(spec.name, spec.port, baud, spec.rate_hz or DEFAULT_SYNC_HZ)
     if spec.type == "KinectSensor":
         return KinectSensor(spec.name, spec.addr, spec.tcp_port, spec.rate_hz or DEFAULT_KINECT_HZ)
+    if spec.type in OPTITRACK_TYPES:
+        return optitrack_sensor(spec)
     if spec.type == "SonarSensor":
         address = spec.address or DEFAULT_ADDRESS
         return SonarSensor(spec.name, spec.i2c_pin, address, spec.rate_hz or DEFAULT_SONAR_HZ)
@@ -170,12 +198,45 @@ def device_sensor(spec: SensorSpec) -> Sensor:
     )
 
 
+def optitrack_sensor(spec: SensorSpec) -> Sensor:
+    """The OptiTrack client, bridge server or bridge client of an entry.
+
+    A bridge server starts at once: it serves other machines and nobody here reads it, so the
+    first use that starts the other sensors would never come.
+    """
+    if spec.type == "OptiBridgeClient":
+        rate = spec.rate_hz or DEFAULT_BRIDGE_HZ
+        return OptiBridgeClient(spec.name, spec.addr, spec.tcp_port, spec.obj_names, rate)
+    natnet: dict[str, Any] = {
+        "data_port": spec.data_port,
+        "multicast": spec.multicast,
+        "local_addr": spec.local_addr,
+    }
+    port = spec.tcp_port or COMMAND_PORT
+    rate_hz = spec.rate_hz or DEFAULT_OPTITRACK_HZ
+    if spec.type == "OptiBridgeServer":
+        bridge = OptiBridgeServer(
+            spec.name,
+            spec.addr,
+            port,
+            spec.obj_names,
+            rate_hz,
+            bridge_host=spec.bridge_host,
+            bridge_port=spec.bridge_port,
+            **natnet,
+        )
+        bridge.start()
+        return bridge
+    return OptiTrackClient(spec.name, spec.addr, port, spec.obj_names, rate_hz, **natnet)
+
+
 def build_sensors(
     specs: Iterable[SensorSpec],
     make_camera: CameraMaker = opencv_camera,
     make_imu: ImuMaker = device_imu,
 ) -> dict[str, Sensor]:
-    """The sensors of checked entries, cameras first; none started yet; in the entries' order.
+    """The sensors of checked entries, cameras first, in the entries' order; none started yet
+    but an OptiTrack bridge server (``optitrack_sensor``).
 
     Raises:
         SensorError: a sensor cannot be made: a bad camera index, face detection without

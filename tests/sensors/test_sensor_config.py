@@ -24,12 +24,7 @@ def with_sensors(sensors: dict[str, Any]) -> dict[str, Any]:
 
 @pytest.mark.parametrize(
     ("kind", "name"),
-    [
-        ("OptiBridgeServer", "OptiTrack"),
-        ("OptiTrackClient", "OptiTrack"),
-        ("TrackedObject", "OptiTrack"),
-        ("ForceSensor", "force"),
-    ],
+    [("ForceSensor", "force")],
 )
 def test_sensors_not_built_yet_are_one_line_errors(kind: str, name: str) -> None:
     with pytest.raises(ConfigError) as caught:
