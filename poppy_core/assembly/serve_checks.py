@@ -19,6 +19,10 @@ LOOPBACK_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
 ANY_INTERFACE = frozenset({"", "0.0.0.0", "::"})
 ANY_ORIGIN = "*"
 
+PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh", "ros2", "foxglove")
+"""pypot's attribute names of the servers (``robot.http``...), ``zenoh``, ``ros2`` and
+``foxglove``, in the order they start."""
+
 
 def check_ports(spec: ServeSpec) -> None:
     """Refuse a port given twice: an HTTP port among its aliases, or two servers on one port
@@ -164,7 +168,6 @@ def require_extras(spec: ServeSpec) -> None:
     Raises:
         MissingExtraError: the extra's one line (``poppy_core.extras.require``).
     """
-    from poppy_core.assembly.serve_spec import PROTOCOLS
     from poppy_core.extras import require
 
     if not any(getattr(spec, name) is not None for name in PROTOCOLS):

@@ -26,9 +26,6 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-PROTOCOLS = ("http", "ws", "zmq", "snap", "zenoh", "ros2", "foxglove")
-"""pypot's attribute names of the servers (``robot.http``...), ``zenoh``, ``ros2`` and
-``foxglove``, in the order they start."""
 DEFAULT_PORTS = {"http": 8080, "ws": 9009, "zmq": 6768, "snap": 6969}
 """pypot's default ports (``zmq``: the documentation's ZMQ example)."""
 LOOPBACK = "127.0.0.1"

@@ -17,7 +17,8 @@ import logging
 from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING, Any, Protocol, cast
 
-from poppy_core.assembly.serve_spec import PROTOCOLS, ServeSpec
+from poppy_core.assembly.serve_checks import PROTOCOLS
+from poppy_core.assembly.serve_spec import ServeSpec
 from poppy_core.assembly.server_builders import (
     add_foxglove,
     add_http,

@@ -20,7 +20,7 @@ from poppy_core.errors import ConfigError, PortError, RegisterError, SetupError
 from poppy_core.models import model_by_name
 from poppy_core.robot import startup
 from poppy_core.robot.config import RobotConfig
-from poppy_core.robot.config_sections import sensor_specs
+from poppy_core.robot.config_sensors import sensor_specs
 from poppy_core.robot.motor import Motor
 from poppy_core.robot.robot import Robot
 from poppy_core.robot.startup import ReturnDelayConsent

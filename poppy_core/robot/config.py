@@ -27,7 +27,8 @@ from poppy_core.robot.config_checks import (
     whole_config_problems,
 )
 from poppy_core.robot.config_format import DEFAULT_SOURCE, config_error, validation_problems
-from poppy_core.robot.config_sections import KinematicsSection, SensorEntry, sensor_problems
+from poppy_core.robot.config_sections import KinematicsSection
+from poppy_core.robot.config_sensors import SensorEntry, sensor_problems
 from poppy_core.robot.frames import user_limits
 
 Degrees = Annotated[float, Strict(), Field(allow_inf_nan=False)]

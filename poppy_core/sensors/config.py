@@ -19,7 +19,7 @@ The device sensors take pypot's keys: ``ArduinoSensor`` ``port``, ``baud``, ``sy
 IMUs: ``RazorIMU`` ``port``, ``baud`` (57600), ``sync_freq``; ``BNO055`` ``i2c_pin``,
 ``address`` (0x28), ``sync_freq``; both take ``sim_body`` (the MuJoCo body a
 simulated robot's IMU rides; default ``head``).
-The section is checked where the rest of the config is (``poppy_core.robot.config_sections``,
+The section is checked where the rest of the config is (``poppy_core.robot.config_sensors``,
 every problem at once); this leaf receives plain ``SensorSpec`` entries.
 """
 
@@ -82,7 +82,7 @@ NOT_YET: dict[str, str] = {
 
 @dataclass(frozen=True)
 class SensorSpec:
-    """One entry of the section, already checked (``poppy_core.robot.config_sections``).
+    """One entry of the section, already checked (``poppy_core.robot.config_sensors``).
 
     ``rate_hz`` is a camera's ``fps`` or a detector's ``freq`` (None: the kind's default);
     ``source`` a camera's ``index`` or ``device``; the rest as the module's docstring says.

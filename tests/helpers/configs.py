@@ -6,7 +6,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from poppy_core.robot import RobotConfig
-from poppy_core.robot.config_sections import sensor_specs
+from poppy_core.robot.config_sensors import sensor_specs
 from poppy_core.sensors import SensorSpec
 
 

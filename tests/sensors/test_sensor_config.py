@@ -10,7 +10,7 @@ import pytest
 from poppy_core import from_profile
 from poppy_core.errors import ConfigError
 from poppy_core.robot import RobotConfig, load_profile
-from poppy_core.robot.config_sections import sensor_specs
+from poppy_core.robot.config_sensors import sensor_specs
 from poppy_core.sensors import DummyCamera, MarkerDetector
 
 pytest.importorskip("cv2")
