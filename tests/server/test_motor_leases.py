@@ -120,6 +120,13 @@ def test_teleop_holds_its_motors_until_its_connection_is_lost(
         )
         play = http.post("/api/v1/moves/on m2/play", json={"speed": 1})
         assert play.status_code == 409 and "m2 is driven by teleop" in play.text
+        # pypot's play route is never refused: the move owns the motors that were free
+        pypot = http.post("/records/long/play.json", json={"speed": "1.0"})
+        assert pypot.status_code == 202, pypot.text
+        shown = owners(http)
+        assert shown["m1"] == "move long from 127.0.0.1"
+        assert shown["m2"] == "teleop from 127.0.0.1"
+        assert http.post("/records/long/stop.json").status_code == 202
         # the client's own goals go on
         ws.send(json.dumps({"type": "teleop.goals", "positions": {"m2": 20.0}}))
     # the connection dropped without teleop.stop: its lease ends with it
@@ -194,16 +201,15 @@ def _stream(servers: ServerSet, session: Any, goals: dict[str, float]) -> tuple[
     node: Any = servers.servers["zenoh"]
     payload = zenoh_wire.goals_message(goals, sender="tester")
     refused = node.refused_goals
-    target = servers.service.robot.motor(next(iter(goals)))
-    for _ in range(50):  # a first message of a new publisher may find no route yet: again
+    (motor, degrees), *_ = goals.items()
+    target = servers.service.robot.motor(motor)
+
+    def handled() -> bool:
+        return node.refused_goals > refused or abs(target.goal_position - degrees) < 0.5
+
+    for _ in range(3):  # a first message of a new publisher may find no route yet: again
         session.put("poppy/jr1/goals", payload)
-        if eventually(
-            lambda: (
-                node.refused_goals > refused
-                or abs(target.goal_position - next(iter(goals.values()))) < 0.5
-            ),
-            timeout_s=0.2,
-        ):
+        if eventually(handled, timeout_s=3.0):
             break
     if node.refused_goals > refused:
         assert node.last_refusal is not None
@@ -282,10 +288,18 @@ def test_a_ros2_trajectory_leases_its_joints_and_teleops_motors_refuse_ros2(
         connect(ws_url(servers)) as ws,
     ):
         assert ask(ws, {"type": "teleop.start", "motors": ["m2"]})["type"] == "teleop.started"
-        for _ in range(20):  # a first message of a new publisher may find no route yet
-            client.publish("/joint_command", JOINT_STATE, _joint_command(["m2"], np.array([0.3])))
-            if eventually(lambda: bool(refusals), timeout_s=0.5):
+        m2 = servers.service.robot.m2
+        aimed = node.joints.to_motor("m2", 0.3)  # where the command would send it (degrees)
+        command = _joint_command(["m2"], np.array([0.3]))
+
+        def handled() -> bool:
+            return bool(refusals) or abs(m2.goal_position - aimed) < 0.5
+
+        for _ in range(3):  # a first message of a new publisher may find no route yet: again
+            client.publish("/joint_command", JOINT_STATE, command)
+            if eventually(handled, timeout_s=3.0):
                 break
+        assert refusals, f"the command was taken: m2 aims at {m2.goal_position}"
         assert refusals[-1].error == "conflict"
         assert refusals[-1].reason.startswith("m2 is driven by teleop from 127.0.0.1")
 
