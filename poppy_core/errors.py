@@ -36,6 +36,8 @@ The tree (catch the bases, raise the leaves)::
     ├── MissingExtraError         a feature whose optional dependencies (an extra, e.g.
     │                             ``poppy[sim]``) are not installed; carries ``extra``, ``module``
     ├── PrimitiveError            a primitive's thread died; carries ``primitive`` and ``failure``
+    ├── MotorLeasedError          a goal for a motor another owner drives (teleop, a move...);
+    │                             carries ``motors`` and ``owner`` (servers answer 409)
     ├── ControllerError           a controller's setup failed (pypot's ``MotorsController``);
     │                             also a ``RuntimeError``
     └── CalibrationCancelled      the user cancelled a calibration (nothing was written)
@@ -328,6 +330,15 @@ class PrimitiveError(PoppyError):
         super().__init__(message)
         self.primitive = primitive
         self.failure = failure
+
+
+class MotorLeasedError(PoppyError):
+    """A goal refused: another owner holds the motor's lease (``motion/leases.py``)."""
+
+    def __init__(self, message: str, *, motors: list[str], owner: str) -> None:
+        super().__init__(message)
+        self.motors = motors
+        self.owner = owner
 
 
 class CalibrationCancelled(PoppyError):

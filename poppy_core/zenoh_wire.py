@@ -383,6 +383,8 @@ def goals_message(
     message: dict[str, Any] = {"goals": dict(goals)}
     if token:
         return zenoh_auth.sign(token, check_name(robot or ""), message, sender)
+    if sender:  # unsigned: the robot still names the goal stream's owner after it
+        message["from"] = sender
     return json.dumps(message).encode()
 
 

@@ -25,6 +25,7 @@ from websockets.sync.client import connect
 
 from poppy_core.errors import ArgumentError, PoppyError, UnknownNameError
 from poppy_core.motion import attached_primitive, load_move
+from poppy_core.motion.leases import motor_leases
 from tests.helpers.cli import run_poppy
 from tests.helpers.waiting import eventually
 from tests.helpers.zenoh_served import free_endpoint
@@ -475,6 +476,9 @@ PAIRS = [
 def _reset_goal(robot: Any) -> None:
     # stiff: the v1 API refuses a goal to a compliant motor (409) before any argument rule
     robot.compliant = False
+    # no owner: a goal stream or a trajectory of the case before would own m1 (409); each
+    # surface is asked about the argument alone (ownership: tests/server/test_motor_leases.py)
+    motor_leases(robot).release_all()
     robot.m1.goal_position = 0.0
     assert eventually(lambda: abs(robot.m1.goal_position) < 1.0)
 

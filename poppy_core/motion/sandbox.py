@@ -311,6 +311,10 @@ class MockupRobot:
         name = motor if isinstance(motor, str) else motor.name
         return self.motor(name)
 
+    def goal_motors(self) -> list[str]:
+        """The motors this sandbox asks a goal position of (a running goto included)."""
+        return [name for name, motor in self._motors.items() if motor._has_goal()]
+
     @property
     def compliant(self) -> bool:
         """True when every motor is (as requested, else really) compliant."""

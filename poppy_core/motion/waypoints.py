@@ -77,8 +77,9 @@ class WaypointFollower:
         self._wake = threading.Event()
         self._worker = Worker(name, self._follow)
 
-    def follow(self, waypoints: Waypoints) -> None:
-        """Follow ``waypoints`` (replacing the running ones) from where the goals are now."""
+    def follow(self, waypoints: Waypoints) -> Waypoints:
+        """Follow ``waypoints`` (replacing the running ones) from where the goals are now; the
+        waypoints followed (given a start time when they had none)."""
         if waypoints.start is None:
             waypoints = Waypoints(
                 waypoints.motors, waypoints.times, waypoints.points, time.monotonic()
@@ -88,6 +89,7 @@ class WaypointFollower:
             self._first = tuple(self.robot.motor(n).goal_position for n in waypoints.motors)
         self._worker.start()
         self._wake.set()
+        return waypoints
 
     def stop(self) -> bool:
         """Stop following (the motors hold their goals); True when something was followed."""
@@ -99,6 +101,11 @@ class WaypointFollower:
     def following(self) -> bool:
         """True while waypoints are followed."""
         return self._plan is not None
+
+    @property
+    def current(self) -> Waypoints | None:
+        """The waypoints followed now (None once they ran out or were stopped)."""
+        return self._plan
 
     def close(self) -> None:
         """Stop and end the worker."""

@@ -19,11 +19,14 @@ logger = logging.getLogger(__name__)
 
 
 def halt_activity(service: RobotService) -> tuple[list[str], list[str]]:
-    """Stop every primitive running and every move playing; their names."""
+    """Stop every primitive running, every move playing, every teleoperation and the
+    trajectory, and free every motor's lease (``motion/leases.py``); the primitives' and the
+    moves' names."""
     stopped = service.running_primitives()
     for name in stopped:
         service.primitive(name).halt(wait=True)
     moves = service.moves.stop_all()  # a playback being started too
+    service.release_leases("the robot was stopped")
     return stopped, moves
 
 

@@ -23,6 +23,7 @@ from poppy_core.errors import (
     FileError,
     MissingExtraError,
     MotorError,
+    MotorLeasedError,
     PoppyError,
     RegisterError,
     RobotClosedError,
@@ -119,7 +120,7 @@ def from_poppy_error(exc: PoppyError) -> ApiError:
     ``UnknownNameError`` (motor, group, primitive, move, card) is ``not_found``; an
     ``ArgumentError``, ``RegisterError`` or other ``ConfigError`` is ``invalid``; bus trouble,
     a closed robot, a sensor that does not answer or a feature whose extra is not installed is
-    ``unavailable``; a file is ``storage``.
+    ``unavailable``; a file is ``storage``; a motor another owner drives is ``conflict``.
     """
     if isinstance(exc, UnknownNameError):
         return ApiError("not_found", str(exc), tip=NAME_TIPS.get(exc.kind, ""))
@@ -133,6 +134,8 @@ def from_poppy_error(exc: PoppyError) -> ApiError:
         return ApiError("unavailable", str(exc))
     if isinstance(exc, FileError):
         return ApiError("storage", str(exc))
+    if isinstance(exc, MotorLeasedError):
+        return ApiError("conflict", str(exc))
     return ApiError("invalid", str(exc))
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import logging
 import threading
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -34,6 +34,7 @@ from poppy_core.motion import (
     save_move,
     write_move,
 )
+from poppy_core.motion.leases import Lease, MotorLeases, motor_leases
 from poppy_core.robot import Robot
 from poppy_core.server.errors import ApiError
 from poppy_core.server.start_time import StartTimes, check_start_at
@@ -72,11 +73,15 @@ class MoveService:
     Args:
         robot: the robot.
         starts: where a play with a ``start_at`` is armed (the service's; its own without one).
+        leases: who drives each motor (the robot's ``motor_leases`` without one).
     """
 
-    def __init__(self, robot: Robot, starts: StartTimes | None = None) -> None:
+    def __init__(
+        self, robot: Robot, starts: StartTimes | None = None, leases: MotorLeases | None = None
+    ) -> None:
         self.robot = robot
         self.starts = starts if starts is not None else StartTimes()
+        self.leases = leases if leases is not None else motor_leases(robot)
         self._lock = threading.Lock()
         self._recorders: dict[str, MoveRecorder] = {}
         self._players: dict[str, MovePlayer] = {}
@@ -248,6 +253,8 @@ class MoveService:
         refuse_playing: bool = False,
         *,
         start_at: float | None = None,
+        writer: Hashable | None = None,
+        client: str = "",
     ) -> MovePlayer:
         """Play a library move; ``ramp_s``: the ramp to its first frame (None: from the
         distance; give it to a fleet's robots so that, wherever each one is, they play in phase
@@ -260,7 +267,12 @@ class MoveService:
         ``ApiError("conflict")``. The check, the start and the registration are one step, so two
         plays at once never start two players, and ``stop`` reaches the one started.
 
+        The playback leases the move's motors until it ends (``client``: who asked). With a
+        ``writer`` (a strict surface: v1, Zenoh) a motor another owner drives refuses the play;
+        without (pypot's routes, Snap!, ZMQ) it plays anyway, leasing the motors free.
+
         Raises:
+            MotorLeasedError: with a ``writer``, a motor another owner drives (nothing starts).
             ApiError: bad name, no such move, a move that cannot be played, already playing
                 (``refuse_playing``), or the service closed.
             ArgumentError: a ``start_at`` too far from now.
@@ -288,7 +300,14 @@ class MoveService:
                 raise ApiError("invalid", str(exc)) from None
             except ValueError as exc:
                 raise ApiError("invalid", f"cannot play {name!r}: {exc}") from None
-            player.start(gate=self.starts.gate(when))  # with a start_at: armed now
+            lease = Lease("move", name, client, stop=f"POST /api/v1/moves/{name}/stop")
+            self.leases.take(lease, list(move.motors), strict=writer is not None)
+            try:
+                player.start(gate=self.starts.gate(when))  # with a start_at: armed now
+            except BaseException:
+                self.leases.release(lease)
+                raise
+            lease.alive = lambda: player.playing
             with self._lock:
                 self._players[name] = player  # a stop before the start time finds it, cancels it
         return player

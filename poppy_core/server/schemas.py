@@ -63,6 +63,12 @@ class MotorInfo(BaseModel):
     online: bool
     errors: int = Field(description="failed reads so far")
     registers: dict[str, JsonValue]
+    owner: str | None = Field(
+        None,
+        description="who drives its goal (``teleop from 192.168.1.20``, ``move wave from "
+        "127.0.0.1``, ``trajectory from ROS 2``, ``primitive sinus``): the v1 API, Zenoh and "
+        "ROS 2 goals for it are refused (409) until it ends; null when none",
+    )
 
 
 class RegisterValue(BaseModel):

@@ -9,10 +9,11 @@ from __future__ import annotations
 import json
 import logging
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Hashable, Mapping, Sequence
 from typing import Any
 
 from poppy_core.motion import Primitive, attach_builtins, attached_primitive, attached_primitives
+from poppy_core.motion.leases import Lease, motor_leases
 from poppy_core.motion.play_plan import write_rate_hz
 from poppy_core.motion.waypoints import WaypointFollower, Waypoints
 from poppy_core.robot import GotoHandle, Motor, Robot
@@ -44,11 +45,13 @@ class RobotService:
             attach_builtins(robot)
         self.starts = StartTimes()
         """The starts armed for a shared start time (``start_at``)."""
-        self.moves = MoveService(robot, self.starts)
+        self.leases = motor_leases(robot)
+        """Who drives each motor's goal (``motion/leases.py``): strict writers are checked."""
+        self.moves = MoveService(robot, self.starts, self.leases)
         self.follower = WaypointFollower(robot, write_rate_hz(robot), "trajectory")
         """The trajectory followed (``follow``): one at a time, the next replaces it."""
-        self.teleop = TeleopRegistry()
-        """Which WebSocket connection teleoperates which motor."""
+        self.teleop = TeleopRegistry(self.leases)
+        """Which WebSocket connection teleoperates which motor (a lease each)."""
         self._description: tuple[float, bytes] | None = None
         self.compliant_goals = CompliantGoals()
         """Goals to compliant motors: refused on v1, logged once per motor either way."""
@@ -86,39 +89,56 @@ class RobotService:
         return values.read_register(self.motor(motor), register)
 
     def write(
-        self, motor: str, register: str, value: Any, *, refuse_compliant: bool = False
+        self,
+        motor: str,
+        register: str,
+        value: Any,
+        *,
+        refuse_compliant: bool = False,
+        writer: Hashable | None = None,
     ) -> Any:
         """Check then write a register; returns the value written.
+
+        ``writer``: who writes, for a strict surface (v1, Zenoh, ROS 2): a goal for a motor
+        another owner leases is refused. None: pypot's plain write (last write wins).
 
         Raises:
             CompliantMotorError: with ``refuse_compliant`` (the v1 API), a goal to a compliant
                 motor (written otherwise, as pypot does, and logged once).
+            MotorLeasedError: with a ``writer``, a goal for a motor another owner drives.
         """
         found = self.motor(motor)
         checked = values.check_write(found, register, value)
         if register in GOAL_REGISTERS:
-            self._goals([found], refuse_compliant)
+            self._goals([found], refuse_compliant, writer)
         values.apply_checked(found, register, checked)
         if register == "compliant" and checked is False:
             self.compliant_goals.stiff([found.name])
         return values.jsonable(checked)
 
-    def _goals(self, motors: Sequence[Motor], refuse_compliant: bool) -> None:
-        """Goals for ``motors``: refused when one is compliant and ``refuse_compliant``, else
-        noted (the log names a compliant motor once)."""
+    def _goals(
+        self, motors: Sequence[Motor], refuse_compliant: bool, writer: Hashable | None = None
+    ) -> None:
+        """Goals for ``motors``: refused when another owner leases one (``writer`` given: a
+        strict surface) or when one is compliant and ``refuse_compliant``, else noted (the log
+        names a compliant motor once)."""
+        if writer is not None:
+            self.leases.check([m.name for m in motors], writer)
         if refuse_compliant:
             self.compliant_goals.refuse(motors)
         for motor in motors:
             self.compliant_goals.note(motor)
 
     def write_many(
-        self, commands: Any, *, refuse_compliant: bool = False
+        self, commands: Any, *, refuse_compliant: bool = False, writer: Hashable | None = None
     ) -> dict[str, dict[str, Any]]:
         """Apply ``{motor: {register: value}}`` after checking every value (all or nothing).
 
         Raises:
             CompliantMotorError: with ``refuse_compliant``, a goal to a compliant motor that the
                 same command does not make stiff (nothing is written then).
+            MotorLeasedError: with a ``writer`` (as ``write``), a goal for a motor another
+                owner drives (nothing is written then).
         """
         if not isinstance(commands, Mapping):
             raise ApiError("invalid", "expected an object {motor: {register: value}}")
@@ -131,7 +151,7 @@ class RobotService:
                 checked.append(
                     (motor, str(register), values.check_write(motor, str(register), value))
                 )
-        self._goals([self.motor(str(m)) for m in goal_motors(commands)], refuse_compliant)
+        self._goals([self.motor(str(m)) for m in goal_motors(commands)], refuse_compliant, writer)
         out: dict[str, dict[str, Any]] = {}
         for motor, register, value in checked:
             values.apply_checked(motor, register, value)
@@ -167,6 +187,7 @@ class RobotService:
         control: str = "minjerk",
         *,
         refuse_compliant: bool = False,
+        writer: Hashable | None = None,
     ) -> GotoHandle:
         """Start a goto of several motors after checking every target and the duration.
 
@@ -179,11 +200,12 @@ class RobotService:
             ApiError: no motor.
             CompliantMotorError: with ``refuse_compliant`` (the v1 API), a compliant motor (it
                 would not move; pypot's routes start the goto, and the log names it once).
+            MotorLeasedError: with a ``writer`` (as ``write``), a motor another owner drives.
         """
         duration = goto_duration(duration_s)
         control = control_name(control)
         targets = self.targets(positions)
-        self._goals([self.motor(name) for name in targets], refuse_compliant)
+        self._goals([self.motor(name) for name in targets], refuse_compliant, writer)
         return self.robot.goto_position(targets, duration, control=control, wait=False)
 
     def targets(self, positions: Mapping[str, Any]) -> dict[str, float]:
@@ -206,6 +228,8 @@ class RobotService:
         *,
         refuse_compliant: bool = False,
         replace_trajectory: bool = False,
+        writer: Hashable | None = None,
+        lease: Lease | None = None,
     ) -> dict[str, float]:
         """Check every goal (``targets``: the limit rule), then set them all (or none).
 
@@ -213,15 +237,22 @@ class RobotService:
             positions: motor name -> degrees.
             refuse_compliant: refuse a goal to a compliant motor (v1's rule, ROS 2's).
             replace_trajectory: the goals end the trajectory followed (ROS 2's joint command).
+            writer: who writes (a strict surface, as ``write``); None: pypot's plain write.
+            lease: a goal stream's lease, taken (or kept) for these motors (Zenoh's goals):
+                its holder is the writer.
 
         Raises:
             UnknownMotorError: an unknown motor (nothing moved).
             ApiError: no motor, or a goal that is not a finite number (nothing moved).
             CompliantMotorError: with ``refuse_compliant``, a compliant motor (nothing moved).
+            MotorLeasedError: a motor another owner drives (nothing moved).
         """
         targets = self.targets(positions)
         motors = [self.motor(name) for name in targets]
-        self._goals(motors, refuse_compliant)
+        self._goals(motors, refuse_compliant, writer)
+        if lease is not None:
+            self.leases.take(lease, list(targets))
+            lease.touch()
         if replace_trajectory:
             self.follower.stop()
         for motor in motors:
@@ -236,16 +267,22 @@ class RobotService:
         *,
         start_at: float | None = None,
         refuse_compliant: bool = True,
+        writer: Hashable | None = None,
+        client: str = "",
     ) -> Waypoints | None:
         """Follow a trajectory (replacing the one followed): ``points[i]`` (degrees, one per
         motor) is due ``times[i]`` seconds after ``start_at`` (wall clock; None: now). Every
         point is checked first (``targets``: the limit rule); no point stops the trajectory.
+
+        The trajectory leases its motors (``client`` names who sent it) until it ends, is
+        stopped or replaced; with a ``writer``, motors another owner drives refuse it.
 
         Raises:
             UnknownMotorError: an unknown motor (nothing moved).
             ApiError: a point that is not one finite number per motor, times going back.
             ArgumentError: a ``start_at`` too far from now (``check_start_at``).
             CompliantMotorError: with ``refuse_compliant``, a compliant motor (nothing moved).
+            MotorLeasedError: with a ``writer``, a motor another owner drives (nothing moved).
         """
         if not points:
             self.follower.stop()
@@ -263,16 +300,28 @@ class RobotService:
                 raise ApiError("invalid", f"point {index} goes back in time")
             goals = self.targets(dict(zip(names, point, strict=True)))
             checked.append(tuple(goals[n] for n in names))
-        self._goals([self.motor(n) for n in names], refuse_compliant)
+        self._goals([self.motor(n) for n in names], refuse_compliant, writer)
         when = check_start_at(start_at)
         start = None if when is None or when <= time.time() else on_monotonic(when)
         waypoints = Waypoints(names, tuple(float(t) for t in times), tuple(checked), start)
-        self.follower.follow(waypoints)
-        return waypoints
+        lease = Lease("trajectory", client=client, holder=writer)
+        self.leases.take(lease, names, strict=writer is not None)
+        followed = self.follower.follow(waypoints)
+        lease.alive = lambda: self.follower.current is followed
+        return followed
 
     def stop_following(self) -> bool:
         """Stop the trajectory followed (the motors hold their goals); True when one was."""
         return self.follower.stop()
+
+    def release_leases(self, reason: str) -> list[str]:
+        """The robot-wide stop's part: end every teleoperation and the trajectory, and free
+        every lease (moves and primitives are stopped by the caller); the owners released."""
+        owners = sorted({lease.label for lease in self.leases.owners().values()})
+        self.teleop.close(reason)
+        self.follower.stop()
+        self.leases.release_all()
+        return owners
 
     # -- primitives ------------------------------------------------------------------------------
 

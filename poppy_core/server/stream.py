@@ -78,7 +78,8 @@ async def stream(websocket: WebSocket, service: RobotService, rate_hz: float | s
             with contextlib.suppress(RuntimeError):
                 asyncio.run_coroutine_threadsafe(_send_quietly(send, data), loop)
 
-    channel = TeleopChannel(service.robot, service.teleop, notify)
+    peer = websocket.client
+    channel = TeleopChannel(service.robot, service.teleop, notify, peer.host if peer else "")
     try:
         await _receive_commands(websocket, send, service, channel)
     except (WebSocketDisconnect, WebSocketDisconnected):

@@ -17,7 +17,10 @@ the newest goals at once (a burst of late messages collapses into the newest) an
 motors where they are when no goals came for ``watchdog_s`` or the connection closes; the next
 goals resume with a ramp. A motor is teleoperated by one connection at a time, except that a
 client reconnecting with the same ``client`` id takes its motors over from its old connection
-(which the server may not have seen close yet).
+(which the server may not have seen close yet): a session leases its motors
+(``motion/leases.py``), so a motor a move, a trajectory or a Zenoh goal stream drives refuses it,
+and its motors refuse their goals while it lasts; the lease ends with the session (the client's
+``teleop.stop``, the connection closed, the robot-wide stop).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from poppy_core import checks
+from poppy_core.motion.leases import STOP_ALL, Lease, MotorLeases
 from poppy_core.motion.teleop.goal_stream import GoalStream, GoalStreamChange
 from poppy_core.robot import Robot
 from poppy_core.schedule import Worker
@@ -43,55 +47,64 @@ Notify = Callable[[dict[str, Any]], None]
 
 
 class TeleopRegistry:
-    """Which connection teleoperates which motor (a motor has one owner at a time)."""
+    """The WebSocket teleoperations of a robot: each session holds a lease on its motors
+    (``motion/leases.py``: a motor has one owner at a time, whatever drives it)."""
 
-    def __init__(self) -> None:
+    def __init__(self, leases: MotorLeases) -> None:
+        self.leases = leases
         self._lock = threading.Lock()
-        self._owners: dict[str, TeleopChannel] = {}
+        self._channels: dict[TeleopChannel, Lease] = {}
 
     def claim(self, channel: TeleopChannel, motors: list[str]) -> None:
-        """Give ``motors`` to ``channel`` (taking them from an older connection of its client).
+        """Lease ``motors`` to ``channel`` (taking them from an older connection of its client).
 
         Raises:
-            ApiError: ``conflict`` when another client teleoperates one of them.
+            MotorLeasedError: another owner (another client's teleoperation, a move, a
+                trajectory...) drives one of them.
         """
+        owners = self.leases.owners()
         with self._lock:
-            owners = {self._owners[m] for m in motors if m in self._owners} - {channel}
-        for owner in owners:
-            if channel.client and owner.client == channel.client:
-                owner.close("the client reconnected")
+            older = [
+                other
+                for other, lease in self._channels.items()
+                if other is not channel and any(owners.get(m) is lease for m in motors)
+            ]
+        for other in older:
+            if channel.client and other.client == channel.client:
+                other.close("the client reconnected")
+        lease = Lease(
+            "teleop",
+            client=channel.address,
+            holder=channel,
+            stop=f"teleop.stop from its client, or {STOP_ALL}",
+        )
+        self.leases.take(lease, motors)
         with self._lock:
-            taken = [m for m in motors if self._owners.get(m, channel) is not channel]
-            if taken:
-                raise ApiError(
-                    "conflict",
-                    f"{', '.join(taken)} already teleoperated by another connection",
-                    tip="stop the other teleoperation first",
-                )
-            for motor in motors:
-                self._owners[motor] = channel
+            self._channels[channel] = lease
 
     def release(self, channel: TeleopChannel) -> None:
         """Free the motors of ``channel``."""
         with self._lock:
-            for motor in [m for m, c in self._owners.items() if c is channel]:
-                del self._owners[motor]
+            lease = self._channels.pop(channel, None)
+        if lease is not None:
+            self.leases.release(lease)
 
     def states(self) -> dict[str, str]:
         """Motor -> the state of the session teleoperating it (``following``, ``held``...)."""
         with self._lock:
-            owners = dict(self._owners)
+            leases = {lease: channel for channel, lease in self._channels.items()}
         return {
             motor: channel.session.state if channel.session is not None else "idle"
-            for motor, channel in owners.items()
+            for motor, lease in self.leases.owners().items()
+            if (channel := leases.get(lease)) is not None
         }
 
-    def close(self) -> None:
-        """Stop every session (server shutdown)."""
+    def close(self, reason: str = "the server stops") -> None:
+        """Stop every session (server shutdown, the robot-wide stop)."""
         with self._lock:
-            channels = set(self._owners.values())
+            channels = list(self._channels)
         for channel in channels:
-            channel.close("the server stops")
+            channel.close(reason)
 
 
 class TeleopChannel:
@@ -101,12 +114,16 @@ class TeleopChannel:
         robot: the robot served.
         registry: the motors' owners (shared by the connections).
         notify: sends a message to this connection (thread-safe; may drop it once closed).
+        address: where the connection comes from (the lease's client: ``teleop from ADDR``).
     """
 
-    def __init__(self, robot: Robot, registry: TeleopRegistry, notify: Notify) -> None:
+    def __init__(
+        self, robot: Robot, registry: TeleopRegistry, notify: Notify, address: str = ""
+    ) -> None:
         self.robot = robot
         self.registry = registry
         self.notify = notify
+        self.address = address
         self.session: GoalStream | None = None
         self.client = ""
         """The id the client gave (a reconnecting client takes its motors back)."""

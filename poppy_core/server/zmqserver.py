@@ -175,7 +175,9 @@ class ZmqRequests:
     def start_move_player(
         self, move_name: str, speed: float = 1.0, backwards: bool = False
     ) -> float:
-        player = self.service.moves.play(move_name, checks.number(speed, "speed"), bool(backwards))
+        player = self.service.moves.play(
+            move_name, checks.number(speed, "speed"), bool(backwards), client="ZMQ"
+        )
         return player.duration_s
 
 

@@ -111,7 +111,7 @@ def test_two_websocket_clients_cannot_teleoperate_one_motor(
     with connect(first_url) as first, connect(ergo_served_twice[second]) as other:
         assert _teleop(first, "m1").get("type") == "teleop.started"
         refused = _teleop(other, "m1")
-        assert "already teleoperated by another connection" in str(refused.get("error")), refused
+        assert "m1 is driven by teleop from 127.0.0.1" in str(refused.get("error")), refused
 
 
 def test_a_busy_port_stops_the_servers_already_bound() -> None:

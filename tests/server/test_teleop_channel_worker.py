@@ -8,6 +8,7 @@ from typing import Any
 
 import pytest
 
+from poppy_core.motion.leases import MotorLeases
 from poppy_core.motion.teleop.goal_stream import GoalStream
 from poppy_core.robot import Robot
 from poppy_core.server.teleop_channel import TeleopChannel, TeleopRegistry
@@ -24,7 +25,7 @@ def test_an_error_in_the_channel_loop_is_logged_once_and_the_motors_are_freed(
         raise RuntimeError("the goals would not go")
 
     monkeypatch.setattr(GoalStream, "push", broken)
-    registry = TeleopRegistry()
+    registry = TeleopRegistry(MotorLeases(ergo))
     sent: list[dict[str, Any]] = []
     channel = TeleopChannel(ergo, registry, sent.append)
     with caplog.at_level(logging.WARNING):
@@ -37,5 +38,6 @@ def test_an_error_in_the_channel_loop_is_logged_once_and_the_motors_are_freed(
     channel.close("the test ends")
     channel.close("again")  # twice is safe
     assert registry.states() == {}
+    assert registry.leases.owners() == {}
     failed = [r for r in caplog.records if r.getMessage().startswith("teleop channel failed")]
     assert len(failed) == 1

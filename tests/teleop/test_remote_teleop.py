@@ -151,7 +151,7 @@ def test_websocket_messages_are_checked(served: Served) -> None:
         assert started["type"] == "teleop.started" and started["motors"] == ["m1", "m2"]
         assert set(started["positions"]) == {"m1", "m2"}
         taken = _ask(other, {"type": "teleop.start", "motors": ["m2", "m3"]})
-        assert "m2 already teleoperated" in taken["error"]
+        assert "m2 is driven by teleop from 127.0.0.1" in taken["error"]
         for bad, words in [
             ({"m3": 1.0}, "'m3' is not teleoperated"),
             ({"m1": "up"}, "m1 must be a number"),

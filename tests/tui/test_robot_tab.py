@@ -200,3 +200,27 @@ async def test_playback_stops_and_bad_input_is_refused(moves_dir: Path) -> None:
         await wait_for(pilot, lambda: moves.player is None, what="stopped")
         assert player.stopped and not player.playing
         assert "slow: stopped" in notes(app)
+
+
+@run_async
+async def test_the_motors_view_shows_who_drives_each_motor(moves_dir: Path) -> None:
+    """A primitive running owns the motors it drives (``motion/leases.py``): the Motors view's
+    "driven by" column names it, and empties once it stopped."""
+    from poppy_core.motion import Sinus
+
+    app = sim_app()
+    async with app.run_test(size=SIZE) as pilot:
+        panel, robot = await open_sim(pilot, app)
+        table = panel.query_one("#robot-table", DataTable)
+        sinus = Sinus(robot, 50.0, [robot.m3], amp=10.0, freq=0.5)
+        sinus.start()
+        try:
+            await wait_for(
+                pilot,
+                lambda: table.get_cell("m3", "driven by") == "primitive sinus",
+                what="m3 driven by sinus",
+            )
+            assert table.get_cell("m1", "driven by") == ""
+        finally:
+            sinus.stop()
+        await wait_for(pilot, lambda: table.get_cell("m3", "driven by") == "", what="freed")

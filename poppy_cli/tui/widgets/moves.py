@@ -250,10 +250,17 @@ class MovesPanel(Vertical):
     def _start_player(self, robot: Robot, path: Path, speed: float) -> None:
         """Load the move and start its player (reading the file stays off the UI thread)."""
         from poppy_core.motion import MovePlayer, load_move
+        from poppy_core.motion.leases import Lease, motor_leases
 
         try:
             player = MovePlayer(robot, load_move(path), speed, on_progress=self._on_progress)
+            # shown as the motors' owner ("move NAME from poppy tui") while it plays; a
+            # Python-side player writes as pypot's do (never refused)
+            lease = Lease(
+                "move", path.stem, "poppy tui", stop="Stop in the TUI", alive=lambda: player.playing
+            )
             player.start()
+            motor_leases(robot).take(lease, list(player.played.motors), strict=False)
         except (PoppyError, ValueError, RuntimeError) as exc:
             self.post_message(BusFailed(f"cannot play {path.stem}: {exc}"))
             return

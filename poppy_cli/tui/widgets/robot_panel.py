@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from poppy_core.robot.factory import SimMode
 
 REFRESH_S = 0.1
-COLUMNS = ("motor", "id", "pos °", "goal °", "speed", "load %", "temp", "compliant")
+COLUMNS = ("motor", "id", "pos °", "goal °", "speed", "load %", "temp", "compliant", "driven by")
 HEALTH_COLUMNS = ("bus", "link", "present Hz", "goals Hz", "timeouts", "retries", "offline")
 
 
@@ -147,10 +147,14 @@ class RobotPanel(Vertical):
         self.query_one("#robot-group", Select).set_options(groups)
         self.notify(f"robot {message.title}: {len(message.robot.motors)} motors")
 
-    def _cells(self, name: str) -> tuple[str, ...]:
+    def _cells(self, name: str, owners: dict[str, str] | None = None) -> tuple[str, ...]:
+        """A motor's row; ``owners``: who drives each motor's goal (``motion/leases.py``: a
+        primitive running, a move playing), read once per refresh."""
         assert self.robot is not None
         motor = self.robot.motor(name)
         link = "" if motor.online else " offline"
+        if owners is None:
+            owners = self._owners()
         return (
             name,
             str(motor.id),
@@ -160,7 +164,14 @@ class RobotPanel(Vertical):
             fixed(motor.present_load, 0),
             fixed(motor.present_temperature, 0),
             ("yes" if motor.compliant else "no") + link,
+            owners.get(name, ""),
         )
+
+    def _owners(self) -> dict[str, str]:
+        from poppy_core.motion.leases import motor_leases
+
+        assert self.robot is not None
+        return motor_leases(self.robot).labels()
 
     def _health_rows(self) -> dict[str, tuple[str, ...]]:
         """Controller -> its health cells (``Robot.health``: no I/O)."""
@@ -185,8 +196,9 @@ class RobotPanel(Vertical):
         if self.robot is None or self.robot.closed:
             return
         table = self.query_one("#robot-table", DataTable)
+        owners = self._owners()
         for motor in self.robot.motors:
-            for column, text in zip(COLUMNS, self._cells(motor.name), strict=True):
+            for column, text in zip(COLUMNS, self._cells(motor.name, owners), strict=True):
                 set_cell(table, motor.name, column, text)
         health = self.query_one("#health-table", DataTable)
         for controller, cells in self._health_rows().items():

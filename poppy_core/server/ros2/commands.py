@@ -7,7 +7,9 @@ number refuses the whole command (nothing moves); a goal beyond a motor's angle 
 clamped to them (the limit rule, as ros2_control's saturation joint limiter does); a compliant
 motor refuses it, the refusal saying to call ``set_compliant``. A trajectory runs on the motion
 room's follower (``motion/waypoints.py``), at its ``header.stamp`` (a start time ahead, checked
-as every ``start_at``; 0 or a past stamp: now); the next trajectory replaces it.
+as every ``start_at``; 0 or a past stamp: now); the next trajectory replaces it. A trajectory
+leases its motors (``trajectory from ROS 2``) until it ends or is stopped; ROS 2's commands are
+a strict writer: a motor another owner drives (a teleoperation, a move...) refuses them.
 """
 
 from __future__ import annotations
@@ -26,6 +28,9 @@ if TYPE_CHECKING:
     from poppy_core.server.service import RobotService
 
 COMPLIANT_TIP = "call the node's set_compliant service with data: false first"
+ROS2_WRITER = "ROS 2"
+"""The node's commands and trajectories as one writer: a joint command passes its own
+trajectory's lease (and replaces the trajectory), as the next trajectory does."""
 
 
 class CommandRefused(ArgumentError):
@@ -81,7 +86,10 @@ class Commands:
     def command(self, names: Sequence[str], radians: Sequence[Any]) -> dict[str, float]:
         """Set the goals of a joint command (all or none); it replaces a running trajectory."""
         return self.service.set_goals(
-            self.degrees(names, radians), refuse_compliant=True, replace_trajectory=True
+            self.degrees(names, radians),
+            refuse_compliant=True,
+            replace_trajectory=True,
+            writer=ROS2_WRITER,
         )
 
     def follow(self, message: Any) -> Waypoints | None:
@@ -102,7 +110,9 @@ class Commands:
         wall = float(stamp.sec) + float(stamp.nanosec) * 1e-9
         # 0 or a past stamp (a node on simulated time stamps seconds since its start): now
         start_at = wall if wall > time.time() else None
-        return self.service.follow(names, times, points, start_at=start_at)
+        return self.service.follow(
+            names, times, points, start_at=start_at, writer=ROS2_WRITER, client=ROS2_WRITER
+        )
 
     def stop(self) -> bool:
         """Stop the trajectory followed (the motors hold their goals)."""

@@ -15,6 +15,10 @@ WAIT_MARGIN_S = 2.0
 
 MISSING = object()
 
+V1_WRITER = "v1"
+"""The writer of the v1 API's goals (``RobotService.write``'s ``writer``): a strict surface,
+whose goals a motor leased by another owner refuses (409). It never holds a lease itself."""
+
 CHANGES_STATE: dict[str, Any] = {"x-changes-state": True}
 """``openapi_extra`` of a GET route that changes the robot (pypot's primitive controls): a page
 of another site may not reach it through a link or an image, whatever spelling of the path it
@@ -46,3 +50,10 @@ async def wait_goto(handle: GotoHandle) -> bool:
 def truthy(value: Any) -> bool:
     """pypot's reading of ``wait``: true for ``true``, ``"true"``, ``"True"`` and ``1``."""
     return str(value) in {"true", "True", "1"}
+
+
+def client_of(request: Request) -> str:
+    """Where a request comes from, for a lease's label: its address (``zenoh:HOST (zenoh ZID)``
+    through Zenoh's ``api``), "" when unknown."""
+    client = request.client
+    return client.host if client is not None else ""

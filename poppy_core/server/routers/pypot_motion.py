@@ -12,7 +12,7 @@ from poppy_core.server.deps import Service
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import pypot_positions
 from poppy_core.server.pypot_json import PypotJSON
-from poppy_core.server.routers.common import CHANGES_STATE, json_body
+from poppy_core.server.routers.common import CHANGES_STATE, client_of, json_body
 
 router = APIRouter(tags=["pypot"])
 
@@ -81,7 +81,8 @@ async def play(move: str, request: Request, service: Service) -> PypotJSON:
         raise ApiError("invalid", str(exc), tip=SPEED_TIP) from None
     if speed == 0:
         raise ApiError("invalid", "the speed must be a finite, non-zero number", tip=SPEED_TIP)
-    service.moves.play(move, abs(speed), speed < 0)  # on the event loop: see IN ORDER above
+    # on the event loop: see IN ORDER above; pypot's play is never refused (no writer)
+    service.moves.play(move, abs(speed), speed < 0, client=client_of(request))
     return PypotJSON({move: "started replay"}, status_code=202)
 
 

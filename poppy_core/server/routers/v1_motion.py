@@ -4,9 +4,10 @@ from functools import partial
 
 from fastapi import APIRouter, Query  # noqa: TID253 (the server room is FastAPI's)
 from starlette.concurrency import run_in_threadpool
+from starlette.requests import Request
 
 from poppy_core.server.deps import Service
-from poppy_core.server.routers.common import wait_goto
+from poppy_core.server.routers.common import V1_WRITER, client_of, wait_goto
 from poppy_core.server.schemas import (
     GotoRequest,
     GotoResult,
@@ -38,7 +39,9 @@ router = APIRouter(responses=ERRORS)
 async def goto(body: GotoRequest, service: Service) -> GotoResult:
     """Starts the motion; with ``wait`` answers once it is over (other requests go on)."""
     targets = service.targets(body.positions)  # clamped to the angle limits: the answer says so
-    handle = service.goto(targets, body.duration_s, body.control, refuse_compliant=True)
+    handle = service.goto(
+        targets, body.duration_s, body.control, refuse_compliant=True, writer=V1_WRITER
+    )
     waited = await wait_goto(handle) if body.wait else False
     return GotoResult(
         positions=targets,
@@ -178,10 +181,16 @@ def save(move: str, service: Service) -> MoveInfo:
 
 
 @router.post("/moves/{move}/play", tags=["moves"], status_code=202, summary="Play a move")
-async def play(move: str, body: PlayRequest, service: Service) -> MovesStatus:
-    """Starts playing; a move already playing is refused (409): stop it first."""
+async def play(move: str, body: PlayRequest, service: Service, request: Request) -> MovesStatus:
+    """Starts playing; a move already playing, or one whose motors another owner drives
+    (teleop, another move, a trajectory...), is refused (409): stop it first."""
     await run_in_threadpool(
-        partial(service.moves.play, start_at=body.start_at),
+        partial(
+            service.moves.play,
+            start_at=body.start_at,
+            writer=V1_WRITER,
+            client=client_of(request),
+        ),
         move,
         body.speed,
         body.backwards,

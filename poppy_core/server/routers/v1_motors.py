@@ -6,14 +6,17 @@ from fastapi import APIRouter, Body  # noqa: TID253 (the server room is FastAPI'
 from pydantic import JsonValue
 
 from poppy_core.server.deps import Service
+from poppy_core.server.routers.common import V1_WRITER
 from poppy_core.server.schemas import MotorInfo, Problem, RegisterValue, ValueBody
 from poppy_core.server.values import motor_registers
 
 router = APIRouter(tags=["motors"], responses={404: {"model": Problem}, 422: {"model": Problem}})
 
 
-def _info(service: Service, name: str) -> MotorInfo:
+def _info(service: Service, name: str, owners: dict[str, str] | None = None) -> MotorInfo:
     motor = service.motor(name)
+    if owners is None:
+        owners = service.leases.labels()
     return MotorInfo(
         name=motor.name,
         id=motor.id,
@@ -21,13 +24,15 @@ def _info(service: Service, name: str) -> MotorInfo:
         online=motor.online,
         errors=motor.errors,
         registers=motor_registers(motor),
+        owner=owners.get(motor.name),
     )
 
 
 @router.get("/motors", summary="Every motor and its registers")
 async def motors(service: Service) -> list[MotorInfo]:
     """The motors in config order."""
-    return [_info(service, name) for name in service.motor_names()]
+    owners = service.leases.labels()
+    return [_info(service, name, owners) for name in service.motor_names()]
 
 
 @router.patch("/motors", summary="Write registers of several motors (all or nothing)")
@@ -38,7 +43,9 @@ async def write_many(
     ),
 ) -> dict[str, dict[str, JsonValue]]:
     """Every value is checked before any is written; answers the values written."""
-    written: dict[str, dict[str, Any]] = service.write_many(commands, refuse_compliant=True)
+    written: dict[str, dict[str, Any]] = service.write_many(
+        commands, refuse_compliant=True, writer=V1_WRITER
+    )
     return written
 
 
@@ -65,7 +72,7 @@ async def write_register(
     motor: str, register: str, body: ValueBody, service: Service
 ) -> RegisterValue:
     """Checks the value (type, range, limits) before the motor gets it."""
-    value = service.write(motor, register, body.value, refuse_compliant=True)
+    value = service.write(motor, register, body.value, refuse_compliant=True, writer=V1_WRITER)
     return RegisterValue(motor=motor, register=register, value=value)
 
 

@@ -62,7 +62,7 @@ class Playlists:
         players: list[MovePlayer] = []
         try:
             for name in names:
-                players.append(self.moves.play(name, speed))
+                players.append(self.moves.play(name, speed, client="Snap!"))
         except (ApiError, PoppyError):
             for player in players:  # all or none
                 player.stop()
@@ -72,7 +72,7 @@ class Playlists:
     def in_sequence(self, names: Sequence[str], speed: float) -> float:
         """Start the first move now and each next one when the one before ends; the total (s)."""
         total = self._check(names) / speed
-        first = self.moves.play(names[0], speed)
+        first = self.moves.play(names[0], speed, client="Snap!")
         rest = list(names[1:])
         worker = Worker(
             f"snap-sequence-{names[0]}",
@@ -112,7 +112,7 @@ class Playlists:
                         return
                 if cancel.is_set() or player.stopped or player.error is not None:
                     return  # stopped ("stop move", the server closing) or failed
-                player = self.moves.play(current, speed)
+                player = self.moves.play(current, speed, client="Snap!")
         except (ApiError, PoppyError) as exc:
             logger.warning("a sequence of moves stopped at %r: %s", current, exc)
         finally:

@@ -274,7 +274,7 @@ class SnapRobot:
 
     def play(self, move: str, speed: str = "1", backwards: bool = False) -> str:
         """``/primitive/MovePlayer/<move>/start[/<speed>[/backwards]]``: its duration (s)."""
-        player = self.service.moves.play(move, _speed(speed), backwards)
+        player = self.service.moves.play(move, _speed(speed), backwards, client="Snap!")
         return number_text(player.duration_s)
 
     def play_together(self, moves: str, speed: str = "1") -> str:

@@ -98,9 +98,11 @@ def led_values(motor: Motor) -> list[str | bool]:
     return accepted or [False, True]
 
 
-def motor_details(motor: Motor) -> dict[str, Any]:
-    """What the stream does not send: goal, voltage, compliance, online, limits."""
+def motor_details(motor: Motor, owner: str | None = None) -> dict[str, Any]:
+    """What the stream does not send: goal, voltage, compliance, online, limits, and who
+    drives its goal (``owner``: a lease's label, ``motion/leases.py``)."""
     return {
+        "owner": owner,
         "id": motor.id,
         "model": motor.model.name,
         "goal_position": jsonable(motor.goal_position),
@@ -147,7 +149,8 @@ async def motors_route(
 ) -> dict[str, Any]:
     """The slow columns of the motor table (the stream has the fast ones), in config order,
     and the groups."""
-    motors = {m.name: motor_details(m) for m in service.robot.motors}
+    owners = service.leases.labels()
+    motors = {m.name: motor_details(m, owners.get(m.name)) for m in service.robot.motors}
     if leds:
         for motor in service.robot.motors:
             motors[motor.name]["leds"] = led_values(motor)

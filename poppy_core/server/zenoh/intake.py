@@ -74,17 +74,11 @@ class Intake:
             start_at = check_start_at(message.get("start_at"))
         except ArgumentError as exc:
             raise Refused(422, str(exc)) from None
-        sender = message.get("from")
-        return ApiRequest(
-            str(method),
-            path,
-            message.get("body"),
-            start_at,
-            f"zenoh:{sender}" if isinstance(sender, str) and sender else "zenoh",
-        )
+        return ApiRequest(str(method), path, message.get("body"), start_at, _sender(message))
 
-    def goals(self, payload: bytes) -> dict[str, Any]:
-        """The goals (motor -> degrees, unchecked values) of a ``goals`` message.
+    def goals(self, payload: bytes) -> tuple[dict[str, Any], str]:
+        """The goals (motor -> degrees, unchecked values) of a ``goals`` message, and who sent
+        them (``zenoh:HOST (zenoh ZID)``, ``zenoh`` when the message does not say).
 
         Raises:
             Refused: as ``api``, or 400 for a message without ``goals``.
@@ -93,7 +87,7 @@ class Intake:
         goals = message.get("goals")
         if not isinstance(goals, dict):
             raise Refused(400, 'expected {"goals": {motor: degrees}}')
-        return goals
+        return goals, _sender(message)
 
     def _open(self, payload: bytes) -> dict[str, Any]:
         if len(payload) > MAX_BODY_BYTES:
@@ -151,3 +145,8 @@ class Intake:
         now = time.time()
         with self._lock:
             return sum(1 for t in self._held if t > now)
+
+
+def _sender(message: dict[str, Any]) -> str:
+    sender = message.get("from")
+    return f"zenoh:{sender}" if isinstance(sender, str) and sender else "zenoh"

@@ -5,7 +5,9 @@ the state every sync cycle (``zenoh_wire.pack_state``) and the health every seco
 ``poppy/NAME/description`` and ``poppy/NAME/api`` (v1 REST requests run through the REST app
 in-process by httpx's ASGITransport: the same service operations, token, checks and refusal
 wording as HTTP, optionally at a shared wall-clock ``start_at``, which a start gets as its
-route's explicit ``start_at``) and takes goal positions as a stream on ``poppy/NAME/goals``. Every
+route's explicit ``start_at``) and takes goal positions as a stream on ``poppy/NAME/goals`` (a
+stream leases its motors, labelled with its sender, until it is silent for
+``GOAL_STREAM_LAPSE_S``: goals for motors another owner drives are refused). Every
 publication drops rather than waits (Zenoh's ``CongestionControl.DROP``): a subscriber that
 cannot keep up never slows the robot.
 """
@@ -25,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 from poppy_core import checks, zenoh_wire
 from poppy_core.errors import PoppyError
 from poppy_core.motion.chains import robot_chains
+from poppy_core.motion.leases import Lease
 from poppy_core.schedule import RateMeter, TickGuard, Worker
 from poppy_core.server.errors import ApiError, refusal_kind
 from poppy_core.server.reachable import reachable_endpoints, reachable_url
@@ -44,6 +47,8 @@ logger = logging.getLogger(__name__)
 DEFAULT_STATE_RATE_HZ = 50.0
 """The sync loop's default rate: one state message per cycle."""
 HEALTH_PERIOD_S = 1.0
+GOAL_STREAM_LAPSE_S = 1.0
+"""A goal stream's lease ends this long after its last goals (the sender lost or done)."""
 STARTS = re.compile(r"/api/v1/(primitives/[^/?]+/start|moves/[^/?]+/play)")
 """The requests whose action is armed for ``start_at`` (the route's own ``start_at`` argument,
 put in the body: ``start_time``); any other request with a ``start_at`` is sent to the app at
@@ -95,6 +100,8 @@ class ZenohRobotServer:
         self.page: str | None = None
         """The robot's web page (``http://...``), when it serves one, for the fleet's pages."""
         self._seen: set[str] = set()
+        self._streams: dict[str, Lease] = {}
+        """The goal streams' leases, by sender."""
         self.intake = Intake(self.name, token)
         """The arrival checks of ``api`` and ``goals`` (signature, shape, start time, places)."""
         self._worker = Worker.periodic(f"zenoh-state-{name}", self.state_rate_hz, self._tick)
@@ -388,9 +395,22 @@ class ZenohRobotServer:
             CompliantMotorError: a goal to a compliant motor, which would not move it (the
                 service's rule for poppy's own surfaces; nothing moved).
         """
-        goals = self.intake.goals(payload)
+        goals, sender = self.intake.goals(payload)
         with self._lock:
-            return self.service.set_goals(goals, refuse_compliant=True)
+            lease = self._streams.get(sender)
+            if lease is None or not lease.live():
+                lease = Lease(
+                    "goal stream",
+                    client=sender,
+                    holder=("zenoh", sender),
+                    stop=f"stop sending: it ends {GOAL_STREAM_LAPSE_S:g} s after its last goals",
+                    lapse_s=GOAL_STREAM_LAPSE_S,
+                )
+                self._streams = {k: v for k, v in self._streams.items() if v.live()}
+                self._streams[sender] = lease
+            return self.service.set_goals(
+                goals, refuse_compliant=True, writer=lease.holder, lease=lease
+            )
 
 
 def _refusal(status: int, detail: str) -> dict[str, Any]:

@@ -78,6 +78,9 @@ function motorRow(name, info, leds) {
   // a compliant motor's goal moves nothing (the v1 API refuses it with a 409): said where it is set
   const freeNote = el("small", { className: "muted free-note", textContent: "compliant: make it stiff to move it" });
   freeNote.hidden = !info.compliant;
+  // who drives its goal (a teleoperation, a move, a trajectory...): the sliders' goals are refused
+  const ownerNote = el("small", { className: "muted owner-note" });
+  ownerNote.hidden = true;
   slider.addEventListener("input", () => { goalText.value = slider.value; });
   slider.addEventListener("change", () => setGoal(name, Number(slider.value), slider));
   const compliant = el("input", { type: "checkbox", checked: info.compliant });
@@ -100,11 +103,11 @@ function motorRow(name, info, leds) {
   const tr = el("tr", { id: `motor-${name}` },
     el("th", { scope: "row" }, name, el("small", { className: "muted", textContent: ` ${info.id} · ${info.model}` })),
     cells.present_position,
-    el("td", {}, el("span", { className: "goal" }, slider, goalText), freeNote),
+    el("td", {}, el("span", { className: "goal" }, slider, goalText), freeNote, ownerNote),
     cells.present_speed, cells.present_load, cells.present_temperature, cells.present_voltage,
     el("td", {}, compliant), el("td", {}, led), online);
   tr.dataset.motor = name;
-  rows.set(name, { cells, slider, goalText, freeNote, compliant, led, online });
+  rows.set(name, { cells, slider, goalText, freeNote, ownerNote, compliant, led, online });
   return tr;
 }
 
@@ -166,6 +169,8 @@ function applyDetails(motors, withCompliance = true) {
       row.slider.value = String(info.goal_position);
       row.goalText.value = fmt(info.goal_position);
     }
+    row.ownerNote.textContent = info.owner ? `${name}: ${info.owner}` : "";
+    row.ownerNote.hidden = !info.owner;
     row.online.textContent = info.online ? "●" : "offline";
     row.online.className = info.online ? "online ok" : "online bad";
   }
