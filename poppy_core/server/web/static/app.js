@@ -6,6 +6,7 @@ import { buildTable, onFrame, refresh, stats } from "./motors.js";
 import { refreshMoves, setupRecorder } from "./moves.js";
 import { notebookLink, notes } from "./notebook.js";
 import { refreshPrimitives } from "./primitives.js";
+import { setupSensors } from "./sensors.js";
 import { setupSettings } from "./settings.js";
 import { count, el, every, say } from "./ui.js";
 import { setupView, viewFrame } from "./view-panel.js";
@@ -174,6 +175,7 @@ async function main() {
   buildTable(motors, details);
   setupRecorder(motors);
   showCameras(about);
+  setupSensors(about);
   showChains(about.chains);
   rateMeter();
   every(1, tickUptime);
