@@ -3,7 +3,8 @@
 ``python plugin_probe.py contract FOLLOWER_PORT LEADER_PORT``: the types LeRobot's registries
 hold after ``register_third_party_plugins``, the features while disconnected, and a follower
 and a leader driven through LeRobot's factories on the ports given (the test's emulators).
-One JSON object on stdout.
+``python plugin_probe.py served URL``: a follower on a robot `poppy serve` serves. One JSON
+object on stdout.
 """
 
 from __future__ import annotations
@@ -77,6 +78,23 @@ def contract(follower_port: str, leader_port: str) -> dict[str, Any]:
     return out
 
 
+def served(url: str) -> dict[str, Any]:
+    """A follower on a robot served by `poppy serve --http` (``url``)."""
+    from lerobot.robots import RobotConfig, make_robot_from_config
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+    config = RobotConfig.get_choice_class("poppy_ergo_jr")(port=url, id="served")
+    robot = make_robot_from_config(config)
+    robot.connect()
+    out: dict[str, Any] = {"calibrated": robot.is_calibrated}
+    out["observation"] = robot.get_observation()
+    out["sent"] = robot.send_action({"m1.pos": 500.0, "m2.pos": 20.0})
+    robot.disconnect()
+    return out
+
+
 if __name__ == "__main__":
-    result = contract(sys.argv[2], sys.argv[3]) if sys.argv[1] == "contract" else {}
+    commands = {"contract": contract, "served": served}
+    result = commands[sys.argv[1]](*sys.argv[2:])
     sys.stdout.write(json.dumps(result) + "\n")

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from tests.helpers.bus import emulate_bus
+from tests.helpers.server import serve
 from tests.lerobot_plugin.conftest import LeRobot
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(600)]
@@ -95,3 +96,22 @@ def test_types_features_torque_limits_and_calibration(lerobot: LeRobot) -> None:
     # the leader's m1, put at 30° by hand, read through its LeRobot calibration's offset
     assert seen["leader_calibrated"] is True
     assert seen["leader_action"]["m1.pos"] == pytest.approx(30.0 - 10 * XL320_STEP, abs=0.3)
+
+
+def test_a_served_robot_is_driven_over_http(lerobot: LeRobot, tmp_path: Path) -> None:
+    served = serve(str(tmp_path))
+    robot = next(served)
+    try:
+        seen = lerobot.probe("served", robot.url)
+        m1, m2 = robot.robot.motor("m1"), robot.robot.motor("m2")
+        goals = (m1.goal_position, m2.goal_position)
+        compliant = [m.compliant for m in robot.robot.motors]
+    finally:
+        served.close()
+    assert seen["calibrated"] is True  # the server's config is its calibration
+    assert set(seen["observation"]) == {f"m{i}.pos" for i in range(1, 7)}
+    # clamped by the plugin (and by the server: poppy's one rule)
+    assert seen["sent"] == {"m1.pos": 150.0, "m2.pos": 20.0}
+    assert goals[1] == pytest.approx(20.0, abs=XL320_STEP)
+    assert goals[0] == pytest.approx(150.0, abs=XL320_STEP)
+    assert compliant == [True] * 6  # disconnected: torque off

@@ -151,10 +151,10 @@ class PoppyRobot(Robot):
                 )
 
     def configure(self) -> None:
-        """Stiff joints, holding where they are."""
+        """Stiff joints, holding where they are (a compliant joint takes no goal)."""
         here = self._link.positions(self.joints)
-        self._link.send({n: link_clamp(v, self._limits[n]) for n, v in here.items()})
         self._link.set_compliant(self.joints, False)
+        self._link.send({n: link_clamp(v, self._limits[n]) for n, v in here.items()})
 
     @check_if_not_connected
     def get_observation(self) -> RobotObservation:
