@@ -50,7 +50,10 @@ DATASET_DEPS=("datasets>=4.0.0,<5.0.0" "huggingface-hub>=0.34.2,<0.36.0" "av>=15
 # diffusers is imported by lerobot.policies (groot) whatever the policy
 CLI_DEPS=("opencv-python-headless>=4.9.0,<4.13.0" "rerun-sdk>=0.24.0,<0.27.0"
     "pyserial>=3.5,<4.0" "imageio[ffmpeg]>=2.34.0,<3.0.0" "gymnasium>=1.1.1,<2.0.0"
-    "diffusers>=0.27.2,<0.36.0")
+    "diffusers>=0.27.2,<0.36.0"
+    # builds the plugin without isolation (tests/lerobot_plugin/conftest.py): no wheel package
+    # needed from 70.1 on; `pip freeze` leaves setuptools out of the constraints
+    "setuptools>=71")
 # poppy's runtime dependencies for the plugin: core + sim extra + Zenoh (zenoh:NAME robots)
 mapfile -t POPPY_DEPS < <("$PYTHON" - "$HERE/../pyproject.toml" <<'PY'
 import sys
