@@ -1,0 +1,161 @@
+"""The one place the plugin reaches a Poppy robot: built by poppy, served, or simulated.
+
+``open_link(fields, config)`` gives a :class:`LocalLink` (poppy's ``from_config`` on a serial
+port or the simulation) or a :class:`RemoteLink` (``poppy_core.remote.RemoteRobot`` on
+``http://`` or ``zenoh:``). Both read present positions, write goals clamped to the joints'
+angle limits (poppy's one rule, ``trajectory.clamp_goal``), set compliance and give frames.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+DEFAULT_PROFILES = {
+    "poppy_ergo_jr": "ergo-jr",
+    "poppy_torso": "torso",
+    "poppy_humanoid": "humanoid",
+}
+FIRST_FRAME_S = 30.0
+SIM_PORTS = {"sim": "mujoco", "sim:mujoco": "mujoco", "sim:ideal": "ideal"}
+
+
+def is_remote(port: str) -> bool:
+    """True for a robot served by `poppy serve` (HTTP or Zenoh)."""
+    return port.startswith(("http://", "https://", "zenoh:"))
+
+
+def load_config(profile: str, kind: str) -> Any:
+    """Poppy's config of ``profile`` (a name or a file), or of the type's own profile."""
+    from pathlib import Path
+
+    from poppy_core.robot import load_config as load_file
+    from poppy_core.robot import load_profile
+
+    name = profile or DEFAULT_PROFILES[kind]
+    path = Path(name).expanduser()
+    return load_file(path) if path.is_file() else load_profile(name)
+
+
+def joints(config: Any, group: str) -> list[str]:
+    """The joints the device uses: the group's, or every motor of the config."""
+    if not group:
+        return list(config.motors)
+    if group not in config.motorgroups and group not in config.motors:
+        raise ValueError(
+            f"no motor group {group!r} (groups: {', '.join(config.motorgroups) or 'none'})"
+        )
+    return config.resolve_group(group)
+
+
+def limits_of(config: Any, names: Sequence[str]) -> dict[str, tuple[float, float] | None]:
+    """Each joint's angle limits in the user frame (None: a wheel)."""
+    return {
+        n: None if config.motors[n].wheel_mode else config.motors[n].user_angle_limit for n in names
+    }
+
+
+class LocalLink:
+    """A robot poppy builds in this process: a serial port, or the simulation."""
+
+    def __init__(self, config: Any, port: str, cameras: Sequence[str]) -> None:
+        from poppy_core import from_config
+        from poppy_core.robot import with_ports
+
+        sim = SIM_PORTS.get(port, False)
+        if not sim:
+            config = with_ports(config, port, source="LeRobot config")
+        self.robot = from_config(config, sim=sim, sensors=bool(cameras), start_defaults=False)
+        self._cameras: dict[str, Any] = {}
+        try:
+            by_name = {s.name: s for s in self.robot.sensors}
+            for name in cameras:
+                if name not in by_name:
+                    raise ValueError(
+                        f"the robot has no camera {name!r} "
+                        f"(sensors: {', '.join(by_name) or 'none'})"
+                    )
+                self._cameras[name] = by_name[name]
+        except BaseException:
+            self.robot.close()
+            raise
+
+    def positions(self, names: Sequence[str]) -> dict[str, float]:
+        return {n: float(self.robot.motor(n).present_position) for n in names}
+
+    def send(self, goals: Mapping[str, float]) -> None:
+        for name, value in goals.items():
+            self.robot.motor(name).goal_position = value
+
+    def set_compliant(self, names: Sequence[str], compliant: bool) -> None:
+        for name in names:
+            self.robot.motor(name).compliant = compliant
+
+    def frame(self, name: str, timeout_s: float = FIRST_FRAME_S) -> np.ndarray:
+        """The camera's latest frame, RGB (poppy's are BGR, as OpenCV's); the first waits up to
+        ``timeout_s`` (a camera opening, a renderer made on a busy computer)."""
+        image = self._cameras[name].latest(timeout_s).image
+        return np.ascontiguousarray(image[..., ::-1])
+
+    def start_primitive(self, name: str) -> Any:
+        primitive = getattr(self.robot, name, None)
+        if primitive is None or not hasattr(primitive, "start"):
+            raise ValueError(f"the robot has no primitive {name!r}")
+        primitive.start()
+        return primitive
+
+    def close(self) -> None:
+        self.robot.close()
+
+
+class RemoteLink:
+    """A robot served by `poppy serve --http` or `--zenoh` (``RemoteRobot``): its server
+    clamps goals too, and owns its cameras and calibration."""
+
+    def __init__(self, port: str, names: Sequence[str], cameras: Sequence[str]) -> None:
+        import os
+
+        from poppy_core.remote import RemoteRobot
+
+        if cameras:
+            raise ValueError(
+                "a served robot's own cameras cannot be observed through LeRobot: "
+                "give LeRobot cameras (--robot.cameras) instead"
+            )
+        self.robot = RemoteRobot(port, token=os.environ.get("POPPY_TOKEN") or None)
+        missing = [n for n in names if n not in {m.name for m in self.robot.motors}]
+        if missing:
+            self.robot.close()
+            raise ValueError(f"the robot at {port} lacks the motors {', '.join(missing)}")
+
+    def positions(self, names: Sequence[str]) -> dict[str, float]:
+        state = self.robot.state()
+        return {n: float(state[n]["present_position"]) for n in names}
+
+    def send(self, goals: Mapping[str, float]) -> None:
+        for name, value in goals.items():
+            self.robot.motor(name).goal_position = value
+
+    def set_compliant(self, names: Sequence[str], compliant: bool) -> None:
+        for name in names:
+            self.robot.motor(name).compliant = compliant
+
+    def frame(self, name: str, timeout_s: float = FIRST_FRAME_S) -> np.ndarray:
+        raise KeyError(name)
+
+    def start_primitive(self, name: str) -> Any:
+        primitive = getattr(self.robot, name)
+        primitive.start()
+        return primitive
+
+    def close(self) -> None:
+        self.robot.close()
+
+
+def open_link(config: Any, port: str, names: Sequence[str], cameras: Sequence[str]) -> Any:
+    """The robot at ``port`` (see the config's ``port`` field)."""
+    if is_remote(port):
+        return RemoteLink(port, names, cameras)
+    return LocalLink(config, port, cameras)

@@ -1,0 +1,108 @@
+"""Fixtures: LeRobot 0.4.4 (its venv, tests/helpers/lerobot_venv.py) with the Poppy plugin.
+
+The venv is shared by every clone, so the plugin is never installed there: each test session
+builds it from this clone into a folder of its own (``pip install --target``, no network) and
+runs LeRobot with that folder and this clone first on PYTHONPATH.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.helpers.cli import command_env
+from tests.helpers.lerobot_venv import ROOT, lerobot_python
+from tests.helpers.pypot_files import needed
+
+PLUGIN = ROOT / "plugins" / "lerobot_robot_poppy"
+PROBE = Path(__file__).with_name("plugin_probe.py")
+CLI_MARK = "rerun-sdk"
+"""In the venv's stamp once bench/setup_lerobot.sh added LeRobot's command-line deps."""
+
+
+@dataclass
+class LeRobot:
+    """LeRobot's venv with the plugin: ``run`` one of its command lines, ``probe`` the plugin."""
+
+    python: Path
+    env: dict[str, str]
+    home: Path
+
+    def run(self, script: str, *args: str, timeout: float = 900) -> str:
+        """``python -m lerobot.scripts.SCRIPT ARGS`` (what ``lerobot-record``... run); its
+        output, asserted to end with exit code 0."""
+        done = subprocess.run(
+            [str(self.python), "-m", f"lerobot.scripts.{script}", *args],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            check=False,
+            env=self.env,
+        )
+        output = done.stdout + done.stderr
+        assert done.returncode == 0, output[-4000:]
+        return output
+
+    def probe(self, *args: str, timeout: float = 600) -> dict[str, Any]:
+        """tests/lerobot_plugin/plugin_probe.py's JSON answer."""
+        done = subprocess.run(
+            [str(self.python), str(PROBE), *args],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            check=False,
+            env=self.env,
+        )
+        assert done.returncode == 0, done.stderr[-4000:]
+        answer: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
+        return answer
+
+
+@pytest.fixture(scope="session")
+def lerobot(tmp_path_factory: pytest.TempPathFactory) -> LeRobot:
+    python = lerobot_python()
+    if CLI_MARK not in (python.parent.parent / ".installed").read_text():
+        needed(
+            "LeRobot's venv lacks its command-line deps and poppy's: "
+            "run `bash bench/setup_lerobot.sh` again"
+        )
+    base = tmp_path_factory.mktemp("lerobot-plugin")
+    source, site = base / "source", base / "site"
+    # built from a copy: setuptools leaves build/ and *.egg-info beside the sources
+    shutil.copytree(PLUGIN, source, ignore=shutil.ignore_patterns("build", "*.egg-info"))
+    subprocess.run(
+        [
+            str(python),
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            "--no-deps",
+            "--no-build-isolation",
+            "--no-index",
+            "--target",
+            str(site),
+            str(source),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=600,
+    )
+    env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    env.update(command_env())
+    env.update(
+        PYTHONPATH=f"{ROOT}{os.pathsep}{site}",
+        HF_LEROBOT_HOME=str(base / "lerobot"),  # datasets and calibration files
+        HF_HUB_OFFLINE="1",  # everything is on disk: never reach for the hub
+        HF_DATASETS_CACHE=str(base / "hf-cache"),
+        MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"),
+    )
+    return LeRobot(python, env, base / "lerobot")

@@ -1,0 +1,100 @@
+"""Run inside LeRobot's venv with the plugin installed: what LeRobot makes of the Poppy types.
+
+``python plugin_probe.py contract FOLLOWER_PORT LEADER_PORT``: the types LeRobot's registries
+hold after ``register_third_party_plugins``, the features while disconnected, and a follower
+and a leader driven through LeRobot's factories on the ports given (the test's emulators).
+``python plugin_probe.py served URL``: a follower on a robot `poppy serve` serves. One JSON
+object on stdout.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from typing import Any
+
+
+def contract(follower_port: str, leader_port: str) -> dict[str, Any]:
+    from lerobot.robots import RobotConfig, make_robot_from_config
+    from lerobot.teleoperators import TeleoperatorConfig, make_teleoperator_from_config
+    from lerobot.utils.constants import HF_LEROBOT_CALIBRATION
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+    out: dict[str, Any] = {
+        "robots": sorted(k for k in RobotConfig.get_known_choices() if k.startswith("poppy")),
+        "teleops": sorted(
+            k for k in TeleoperatorConfig.get_known_choices() if k.startswith("poppy")
+        ),
+        "calibration_root": str(HF_LEROBOT_CALIBRATION),
+    }
+    features = {}
+    for kind in out["robots"]:
+        robot = make_robot_from_config(RobotConfig.get_choice_class(kind)(port="sim", id="x"))
+        features[kind] = {
+            "class": type(robot).__name__,
+            "observation": list(robot.observation_features),
+            "action": list(robot.action_features),
+            "connected": robot.is_connected,
+        }
+    for kind in out["teleops"]:
+        teleop = make_teleoperator_from_config(
+            TeleoperatorConfig.get_choice_class(kind)(port="sim", id="x")
+        )
+        features[kind] = {"class": type(teleop).__name__, "action": list(teleop.action_features)}
+    camera = RobotConfig.get_choice_class("poppy_ergo_jr")(
+        port="sim", id="x", robot_cameras=["camera"], robot_camera_resolution=[64, 48]
+    )
+    features["with_camera"] = make_robot_from_config(camera).observation_features["camera"]
+    out["features"] = features
+
+    config = RobotConfig.get_choice_class("poppy_ergo_jr")
+    follower = make_robot_from_config(
+        config(port=follower_port, id="follower", disable_torque_on_disconnect=False)
+    )
+    out["calibrated_before"] = follower.is_calibrated
+    follower.connect()
+    out["calibrated_after"] = follower.is_calibrated
+    out["calibration_file"] = str(follower.calibration_fpath)
+    out["observation"] = follower.get_observation()
+    out["sent_beyond_limits"] = follower.send_action({"m1.pos": 500.0, "m3.pos": -500.0})
+    follower.config.max_relative_target = 5.0
+    here = follower.get_observation()["m4.pos"]
+    out["sent_capped"] = follower.send_action({"m4.pos": here + 40.0})
+    out["present_m4"] = here
+    try:
+        follower.send_action({"m9.pos": 0.0})
+    except ValueError as exc:
+        out["unknown_key"] = str(exc)
+    follower.disconnect()
+    out["connected_after_disconnect"] = follower.is_connected
+
+    leader_config = TeleoperatorConfig.get_choice_class("poppy_ergo_jr_leader")
+    leader = make_teleoperator_from_config(leader_config(port=leader_port, id="leader"))
+    leader.connect()
+    out["leader_calibrated"] = leader.is_calibrated
+    out["leader_action"] = leader.get_action()
+    leader.disconnect()
+    return out
+
+
+def served(url: str) -> dict[str, Any]:
+    """A follower on a robot served by `poppy serve --http` (``url``)."""
+    from lerobot.robots import RobotConfig, make_robot_from_config
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+    config = RobotConfig.get_choice_class("poppy_ergo_jr")(port=url, id="served")
+    robot = make_robot_from_config(config)
+    robot.connect()
+    out: dict[str, Any] = {"calibrated": robot.is_calibrated}
+    out["observation"] = robot.get_observation()
+    out["sent"] = robot.send_action({"m1.pos": 500.0, "m2.pos": 20.0})
+    robot.disconnect()
+    return out
+
+
+if __name__ == "__main__":
+    commands = {"contract": contract, "served": served}
+    result = commands[sys.argv[1]](*sys.argv[2:])
+    sys.stdout.write(json.dumps(result) + "\n")
