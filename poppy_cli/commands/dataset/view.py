@@ -1,0 +1,85 @@
+"""`poppy dataset view`: an episode exported for a viewer (Foxglove's MCAP).
+
+The refusals (no dataset, no such episode, no export asked, a file there without --force)
+come before anything is written; the file is put in place whole.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from poppy_cli.commands.dataset.checks import EpisodeOpt, RootOpt, core, dataset_folder, usage
+from poppy_cli.options import JsonSummaryOpt, profile_option
+from poppy_cli.output import console, print_json, printable, warn_line
+
+
+def view(
+    repo_id: str = typer.Argument(..., help="The dataset's name, user/name."),
+    root: Path | None = RootOpt,
+    episode: int = EpisodeOpt,
+    mcap: Path | None = typer.Option(
+        None, "--mcap", help="Write the episode to this MCAP file (Foxglove: Open local file)."
+    ),
+    force: bool = typer.Option(False, "--force", "-f", help="Replace an existing file."),
+    profile: str | None = profile_option(
+        "The robot's model (URDF, joint frames). [default: the dataset's robot_type]"
+    ),
+    json_output: bool = JsonSummaryOpt,
+) -> None:
+    """Export an episode for a viewer: --mcap FILE for Foxglove (state, action, camera, the
+    robot's 3D model, the task), stamped with the dataset's frame timestamps."""
+    if mcap is None:
+        raise usage("give --mcap FILE: the file to write the episode to")
+    from poppy_core.extras import require
+    from poppy_core.files import output_path
+
+    require("foxglove", extra="foxglove")
+    folder = dataset_folder(repo_id, root)
+    from poppy_core.dataset.episode import read_episode
+
+    chosen = core(lambda: read_episode(folder, episode), "--episode")
+    output_path(mcap, replace=force)
+    config = _robot_model(profile, chosen.robot_type)
+    from poppy_core.server.foxglove.dataset_file import write_episode_mcap
+
+    written = write_episode_mcap(chosen, mcap, config, replace=force)
+    summary = {
+        "root": str(folder),
+        "episode": episode,
+        "frames": len(chosen),
+        "mcap": str(written.path),
+        "messages": written.messages,
+    }
+    if json_output:
+        print_json(summary)
+        return
+    console.print(
+        f"episode {episode} ({len(chosen)} frames) of {printable(str(folder))} as MCAP for "
+        f"Foxglove: {printable(str(written.path))}",
+        soft_wrap=True,
+        highlight=False,
+        markup=False,
+    )
+
+
+def _robot_model(profile: str | None, robot_type: str | None) -> Any:
+    """The config of ``profile`` (an unknown one: exit 1 with a suggestion), else of the
+    dataset's robot_type when it names a profile here, else None (said once)."""
+    from poppy_core.errors import ConfigError
+    from poppy_core.robot.profiles import load_profile
+
+    if profile is not None:
+        return load_profile(profile)
+    if robot_type:
+        try:
+            return load_profile(robot_type)
+        except ConfigError:
+            pass
+    warn_line(
+        f"no robot model: the dataset's robot_type {robot_type or '(none)'} is no profile here; "
+        "joint angles are written without the URDF (give --profile)"
+    )
+    return None
