@@ -97,6 +97,7 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
             "dataset view me/dance --root ./dance --episode 0 --mcap dance.mcap --force",
             "replace the file",
         ),
+        ("dataset view me/pick --episode 3 --rerun pick-3.rrd", "for Rerun: rerun pick-3.rrd"),
     ),
     "calibrate": (
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0", "zeros and ranges into a user profile"),

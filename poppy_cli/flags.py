@@ -190,6 +190,7 @@ FLAGS: dict[str, Flag] = {
     "--task": Flag(None, "TEXT", "what the episodes show, in words"),
     "--fps": Flag(None, "N", "frames per second"),
     "--no-cameras": Flag(None, None, "record no camera"),
+    "--rerun": Flag(None, "FILE", "write the episode to this Rerun file (.rrd)"),
     # -- Click's own
     "--help": Flag(None, None, "show the help and exit"),
 }

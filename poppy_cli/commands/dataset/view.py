@@ -1,7 +1,7 @@
-"""`poppy dataset view`: an episode exported for a viewer (Foxglove's MCAP).
+"""`poppy dataset view`: an episode exported for a viewer (Foxglove's MCAP, Rerun's .rrd).
 
-The refusals (no dataset, no such episode, no export asked, a file there without --force)
-come before anything is written; the file is put in place whole.
+The refusals (no dataset, no such episode, no export asked, a file there without --force, an
+extra not installed) come before anything is written; each file is put in place whole.
 """
 
 from __future__ import annotations
@@ -23,42 +23,59 @@ def view(
     mcap: Path | None = typer.Option(
         None, "--mcap", help="Write the episode to this MCAP file (Foxglove: Open local file)."
     ),
+    rerun: Path | None = typer.Option(
+        None, "--rerun", help="Write the episode to this Rerun file (.rrd: rerun FILE)."
+    ),
     force: bool = typer.Option(False, "--force", "-f", help="Replace an existing file."),
     profile: str | None = profile_option(
         "The robot's model (URDF, joint frames). [default: the dataset's robot_type]"
     ),
     json_output: bool = JsonSummaryOpt,
 ) -> None:
-    """Export an episode for a viewer: --mcap FILE for Foxglove (state, action, camera, the
-    robot's 3D model, the task), stamped with the dataset's frame timestamps."""
-    if mcap is None:
-        raise usage("give --mcap FILE: the file to write the episode to")
+    """Export an episode for a viewer, stamped with the dataset's frame timestamps: --mcap FILE
+    for Foxglove (state, action, camera, the robot's 3D model, the task), --rerun FILE.rrd for
+    Rerun (state and action per motor, camera, task)."""
+    if mcap is None and rerun is None:
+        raise usage("give --mcap FILE or --rerun FILE.rrd: the file to write the episode to")
+    if mcap is not None and rerun is not None and mcap.expanduser() == rerun.expanduser():
+        raise usage("--mcap and --rerun name the same file: give two files", "--rerun")
     from poppy_core.extras import require
     from poppy_core.files import output_path
 
-    require("foxglove", extra="foxglove")
+    if mcap is not None:
+        require("foxglove", extra="foxglove")
+    if rerun is not None:
+        require("rerun", extra="rerun")
     folder = dataset_folder(repo_id, root)
     from poppy_core.dataset.episode import read_episode
 
     chosen = core(lambda: read_episode(folder, episode), "--episode")
-    output_path(mcap, replace=force)
-    config = _robot_model(profile, chosen.robot_type)
-    from poppy_core.server.foxglove.dataset_file import write_episode_mcap
+    for path in (mcap, rerun):
+        if path is not None:
+            output_path(path, replace=force)
+    summary: dict[str, Any] = {"root": str(folder), "episode": episode, "frames": len(chosen)}
+    lines = []
+    if mcap is not None:
+        from poppy_core.server.foxglove.dataset_file import write_episode_mcap
 
-    written = write_episode_mcap(chosen, mcap, config, replace=force)
-    summary = {
-        "root": str(folder),
-        "episode": episode,
-        "frames": len(chosen),
-        "mcap": str(written.path),
-        "messages": written.messages,
-    }
+        config = _robot_model(profile, chosen.robot_type)
+        written = write_episode_mcap(chosen, mcap, config, replace=force)
+        summary.update(mcap=str(written.path), messages=written.messages)
+        lines.append(f"MCAP for Foxglove: {printable(str(written.path))}")
+    if rerun is not None:
+        from poppy_core.dataset.rerun_file import write_episode_rrd
+
+        recording = write_episode_rrd(
+            chosen, rerun, name=f"{repo_id} episode {episode}", replace=force
+        )
+        summary.update(rerun=str(recording.path), rows=recording.rows)
+        lines.append(f"Rerun recording: {printable(str(recording.path))}")
     if json_output:
         print_json(summary)
         return
     console.print(
-        f"episode {episode} ({len(chosen)} frames) of {printable(str(folder))} as MCAP for "
-        f"Foxglove: {printable(str(written.path))}",
+        f"episode {episode} ({len(chosen)} frames) of {printable(str(folder))}: "
+        + "; ".join(lines),
         soft_wrap=True,
         highlight=False,
         markup=False,
