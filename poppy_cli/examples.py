@@ -91,6 +91,14 @@ EXAMPLES: dict[str, tuple[Example, ...]] = {
     "dataset delete-episode": (
         ("dataset delete-episode me/pick --episode 3", "the later episodes move down"),
     ),
+    "dataset view": (
+        ("dataset view me/pick --episode 3 --mcap pick-3.mcap", "for Foxglove: Open local file"),
+        (
+            "dataset view me/dance --root ./dance --episode 0 --mcap dance.mcap --force",
+            "replace the file",
+        ),
+        ("dataset view me/pick --episode 3 --rerun pick-3.rrd", "for Rerun: rerun pick-3.rrd"),
+    ),
     "calibrate": (
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0", "zeros and ranges into a user profile"),
         ("calibrate --profile ergo-jr -p /dev/ttyUSB0 --check", "report the drift since"),

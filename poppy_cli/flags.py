@@ -114,7 +114,7 @@ FLAGS: dict[str, Flag] = {
     "--ros-namespace": Flag(None, "NS", "the ROS 2 node's namespace, e.g. /lab"),
     "--foxglove": Flag(None, None, "serve the robot to the Foxglove app (foxglove-sdk)"),
     "--foxglove-port": Flag(None, "PORT", "TCP port of the Foxglove WebSocket server"),
-    "--mcap": Flag(None, "FILE", "also write what Foxglove shows to this MCAP file"),
+    "--mcap": Flag(None, "FILE", "write what Foxglove shows to this MCAP file"),
     "--connect": Flag(
         None, "ENDPOINT", "`--zenoh-connect`'s other name in `fleet`, `teleop`, `dataset record`"
     ),
@@ -178,7 +178,7 @@ FLAGS: dict[str, Flag] = {
     "--resolution": Flag(None, "WxH", "image size, e.g. 640x480"),
     "--marker": Flag(None, "ID", "an ArUco marker held in view of the simulated camera"),
     "--card": Flag(None, "CARD", "a Poppy card held in view of the simulated camera"),
-    # -- datasets (poppy dataset record, replay, delete-episode)
+    # -- datasets (poppy dataset record, replay, view, delete-episode)
     "--root": Flag(None, "DIR", "the dataset's folder"),
     "--resume": Flag(None, None, "add episodes to the dataset there"),
     "--play": Flag(None, "MOVE", "actions: play this move each episode"),
@@ -191,6 +191,7 @@ FLAGS: dict[str, Flag] = {
     "--task": Flag(None, "TEXT", "what the episodes show, in words"),
     "--fps": Flag(None, "N", "frames per second"),
     "--no-cameras": Flag(None, None, "record no camera"),
+    "--rerun": Flag(None, "FILE", "write the episode to this Rerun file (.rrd)"),
     # -- Click's own
     "--help": Flag(None, None, "show the help and exit"),
 }

@@ -22,12 +22,13 @@ EXTRAS: dict[str, str] = {
     "zmq": "pypot's ZMQ server",
     "fleet": "Zenoh fleets (serve --zenoh, poppy fleet, zenoh: remote robots)",
     "ros2": "ROS 2 over rmw_zenoh (serve --ros2)",
-    "foxglove": "Foxglove without ROS (serve --foxglove, record --mcap)",
+    "foxglove": "Foxglove without ROS (serve --foxglove, record --mcap, dataset view --mcap)",
     "tui": "the terminal app",
     "plot": "plots (matplotlib)",
     "notebook": "Jupyter notebooks (`poppy notebook`)",
     "appliance": "the robot's name on the network (mDNS/DNS-SD with zeroconf)",
     "dataset": "LeRobot datasets (pyarrow, PyAV)",
+    "rerun": "Rerun recordings of a dataset's episodes (dataset view --rerun)",
     "gym": "Gymnasium environments on the simulation (gymnasium, MuJoCo)",
 }
 """Extra -> what it brings (pyproject.toml's ``[project.optional-dependencies]``)."""

@@ -97,3 +97,27 @@ def video_info(path: Path, fps: int) -> dict[str, Any]:
             "video.channels": 3,
             "has_audio": len(container.streams.audio) > 0,
         }
+
+
+class JpegEncoder:
+    """RGB frames as JPEG bytes (PyAV's MJPEG encoder): a video's frames as single pictures,
+    for the exports (Foxglove's compressed images)."""
+
+    def __init__(self) -> None:
+        self._context: Any = None
+        self._size: tuple[int, int] | None = None
+        self._pts = 0
+
+    def encode(self, frame: NDArray[np.uint8]) -> bytes:
+        """``frame`` (height x width x 3, RGB) as one JPEG picture."""
+        height, width = frame.shape[:2]
+        if self._size != (height, width):
+            context: Any = av.CodecContext.create("mjpeg", "w")
+            context.width, context.height = width, height
+            context.pix_fmt = "yuvj420p"
+            context.time_base = Fraction(1, 30)
+            self._context, self._size = context, (height, width)
+        picture = av.VideoFrame.from_ndarray(frame, format="rgb24").reformat(format="yuvj420p")
+        picture.pts = self._pts  # the encoder refuses a picture without a new pts
+        self._pts += 1
+        return b"".join(bytes(packet) for packet in self._context.encode(picture))

@@ -55,7 +55,8 @@ ALLOWED: dict[str, set[str]] = {
     "motion": {"robot", "models", "kinematics", "dataset"},
     "creatures": {"robot", "motion", "models", "kinematics"},
     "kinematics": set(),
-    "server": {"robot", "motion", "creatures", "models", "kinematics", "sensors"},
+    # Foxglove writes a recorded dataset's episode as MCAP (`poppy dataset view --mcap`)
+    "server": {"robot", "motion", "creatures", "models", "kinematics", "sensors", "dataset"},
     # Gymnasium environments on the simulation: a profile's MuJoCo world (robot, sim), its
     # chains (motion) stepped through the sim's servo model
     "learning": {"robot", "motion", "sim", "models", "kinematics"},

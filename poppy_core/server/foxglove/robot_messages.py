@@ -8,6 +8,7 @@ does), so the 3D panel's URDF layer moves the robot from ``/tf``.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -86,18 +87,37 @@ def transform(joint: JointDescription, radians: float, now: float) -> FrameTrans
     )
 
 
+def positions_joint_states(
+    joints: UrdfJoints, degrees: Mapping[str, float], now: float
+) -> JointStates:
+    """Recorded positions (motor name -> degrees, user frame) as joint angles (rad) alone: a
+    dataset's state or action (``poppy dataset view --mcap``); a value not finite is left out."""
+    return JointStates(
+        timestamp=stamp(now),
+        joints=[
+            JointState(name=name, position=_finite(joints.to_joint(name, value)))
+            for name, value in degrees.items()
+        ],
+    )
+
+
 def frame_transforms(robot: Robot, joints: UrdfJoints, now: float) -> FrameTransforms:
-    """Every joint's transform: the fixed ones, and the moving ones at the motors' present
-    angles (a joint without a motor, or not read yet, at 0). The fixed ones ride along each
-    time: a file opened in the middle, or a client that came late, has the whole tree."""
-    motors = {m.name: m for m in robot.motors}
+    """Every joint's transform at the motors' present angles (``positions_transforms``)."""
+    degrees = {m.name: finite_or_nan(m.present_position) for m in robot.motors}
+    return positions_transforms(joints, degrees, now)
+
+
+def positions_transforms(
+    joints: UrdfJoints, degrees: Mapping[str, float], now: float
+) -> FrameTransforms:
+    """Every joint's transform: the fixed ones, and the moving ones at the motors' angles
+    (``degrees``: motor name -> degrees; a joint without a motor, or not read yet, at 0). The
+    fixed ones ride along each time: a file opened in the middle, or a client that came late,
+    has the whole tree."""
     out = [transform(j, 0.0, now) for j in joints.fixed()]
     for joint in joints.moving():
-        motor = motors.get(joint.name)
-        angle = 0.0
-        if motor is not None:
-            degrees = finite_or_nan(motor.present_position)
-            angle = joints.to_joint(joint.name, degrees) if math.isfinite(degrees) else 0.0
+        value = degrees.get(joint.name, math.nan)
+        angle = joints.to_joint(joint.name, value) if math.isfinite(value) else 0.0
         out.append(transform(joint, angle, now))
     return FrameTransforms(transforms=out)
 

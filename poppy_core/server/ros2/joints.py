@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -22,6 +23,7 @@ if TYPE_CHECKING:
     from poppy_core.kinematics import JointDescription, KinematicDescription
     from poppy_core.kinematics.transforms import Matrix
     from poppy_core.robot import Robot
+    from poppy_core.robot.config import RobotConfig
 
 logger = logging.getLogger(__name__)
 
@@ -46,10 +48,21 @@ class UrdfJoints:
     """The motors of ``robot`` as URDF joints, and the URDF itself (None without one)."""
 
     def __init__(self, robot: Robot) -> None:
-        self.frames: dict[str, JointFrame] = {m.name: JointFrame() for m in robot.motors}
+        self._load(robot.config, [m.name for m in robot.motors])
+
+    @classmethod
+    def of_config(cls, config: RobotConfig | None, motors: Iterable[str]) -> UrdfJoints:
+        """The joints of ``motors`` as ``config`` (a profile's) describes them, without a robot
+        (``poppy dataset view --mcap``): a motor the config lacks keeps the plain frame
+        (its degrees as radians)."""
+        joints = cls.__new__(cls)
+        joints._load(config, list(motors))
+        return joints
+
+    def _load(self, config: RobotConfig | None, motors: list[str]) -> None:
+        self.frames: dict[str, JointFrame] = {name: JointFrame() for name in motors}
         self.description: KinematicDescription | None = None
         self.urdf: str | None = None
-        config = robot.config
         if config is None:
             return
         from poppy_core.motion.chains import group_expander, kinematics_of
