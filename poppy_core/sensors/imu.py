@@ -17,14 +17,12 @@ rates in rad/s with y and z negated).
 
 from __future__ import annotations
 
-import contextlib
 import math
 import threading
 from typing import Any, ClassVar
 
-from poppy_core.errors import SensorError
-from poppy_core.sensors.arduino import MAX_LINE_BYTES, PortOpener, open_serial
-from poppy_core.sensors.base import Sensor, SensorLost
+from poppy_core.sensors.base import Sensor
+from poppy_core.sensors.serial_lines import PortOpener, SerialLines, open_serial
 
 GRAVITY = 9.80665
 RAZOR_BAUD = 57600
@@ -152,30 +150,12 @@ class RazorIMU(Imu):
         super().__init__(name, rate_hz)
         self.port = port
         self.baud = baud
-        self._opener = opener
-        self._serial: Any = None
-        self._pending = b""
+        self._lines = SerialLines(port, baud, self.bad_input, opener)
 
     def update(self) -> bool | None:
-        if self._serial is None:
-            self._open()
-        try:
-            data = self._serial.read(self._serial.in_waiting or 1)
-        except (OSError, ValueError) as exc:
-            self._drop()
-            raise SensorLost(f"{self.port}: {exc}") from None
-        return self._take(data)
-
-    def _take(self, data: bytes) -> bool:
-        *lines, self._pending = (self._pending + data).split(b"\n")
-        if len(self._pending) > MAX_LINE_BYTES:
-            self._pending = b""
-            self.bad_input(f"{self.port}: a line longer than {MAX_LINE_BYTES} bytes, dropped")
         fresh = False
-        for raw in lines:
-            line = raw.strip()
-            if line:
-                fresh = self._line(line) or fresh
+        for line in self._lines.read():
+            fresh = self._line(line) or fresh
         return fresh
 
     def _line(self, line: bytes) -> bool:
@@ -201,24 +181,8 @@ class RazorIMU(Imu):
         self._set(angles, rates, accel)
         return True
 
-    def _open(self) -> None:
-        try:
-            self._serial = self._opener(self.port, self.baud)
-        except (OSError, ValueError) as exc:
-            raise SensorLost(f"cannot open {self.port}: {exc}") from None
-        self._pending = b""
-
     def reconnect(self) -> None:
-        try:
-            self._open()
-        except SensorLost as exc:
-            raise SensorError(str(exc), sensor=self.name) from None
-
-    def _drop(self) -> None:
-        serial, self._serial = self._serial, None
-        if serial is not None:
-            with contextlib.suppress(OSError, ValueError):
-                serial.close()
+        self._lines.reopen(self.name)
 
     def release(self) -> None:
-        self._drop()
+        self._lines.close()
