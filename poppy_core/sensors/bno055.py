@@ -20,11 +20,11 @@ from __future__ import annotations
 import contextlib
 import struct
 import threading
-from collections.abc import Callable
 from typing import Any
 
 from poppy_core.errors import SensorError
 from poppy_core.sensors.base import SensorLost
+from poppy_core.sensors.i2c import BusOpener, open_smbus
 from poppy_core.sensors.imu import Imu
 
 DEFAULT_BNO055_ADDRESS = 0x28
@@ -42,18 +42,6 @@ EUL_DATA = 0x1A
 ACC_LSB = 100.0
 GYR_LSB = 16.0
 EUL_LSB = 16.0
-
-BusOpener = Callable[[int], Any]
-"""Opens I2C bus number N: an ``smbus2.SMBus``-like object."""
-
-
-def open_smbus(bus: int) -> Any:
-    """/dev/i2c-<bus> through smbus2."""
-    try:
-        import smbus2
-    except ImportError:
-        raise SensorError("BNO055 needs smbus2: pip install 'poppy[i2c]'") from None
-    return smbus2.SMBus(bus)
 
 
 def _triple(data: list[int], scale: float) -> tuple[float, float, float]:

@@ -16,11 +16,11 @@ import contextlib
 import statistics
 import threading
 from collections import deque
-from collections.abc import Callable
 from typing import Any, ClassVar
 
 from poppy_core.errors import SensorError
 from poppy_core.sensors.base import Sensor, SensorLost
+from poppy_core.sensors.i2c import BusOpener, open_smbus
 
 DEFAULT_ADDRESS = 0x70
 DEFAULT_SONAR_HZ = 50.0
@@ -31,18 +31,6 @@ RANGE_LOW_REGISTER = 3
 RANGING_S = 0.07
 """The SRF-02 ranges for up to 65 ms; the result is read after this."""
 MEDIAN_OF = 5
-
-BusOpener = Callable[[int], Any]
-"""Opens I2C bus number N: an ``smbus2.SMBus``-like object."""
-
-
-def open_smbus(bus: int) -> Any:
-    """/dev/i2c-<bus> through smbus2."""
-    try:
-        import smbus2
-    except ImportError:
-        raise SensorError("SonarSensor needs smbus2: pip install 'poppy[i2c]'") from None
-    return smbus2.SMBus(bus)
 
 
 class SonarSensor(Sensor):
