@@ -50,15 +50,17 @@ class LeRobot:
         assert done.returncode == 0, output[-4000:]
         return output
 
-    def probe(self, *args: str, timeout: float = 600) -> dict[str, Any]:
-        """tests/lerobot_plugin/plugin_probe.py's JSON answer."""
+    def probe(
+        self, *args: str, timeout: float = 600, env: dict[str, str] | None = None
+    ) -> dict[str, Any]:
+        """tests/lerobot_plugin/plugin_probe.py's JSON answer (``env``: more variables)."""
         done = subprocess.run(
             [str(self.python), str(PROBE), *args],
             capture_output=True,
             text=True,
             timeout=timeout,
             check=False,
-            env=self.env,
+            env={**self.env, **(env or {})},
         )
         assert done.returncode == 0, done.stderr[-4000:]
         answer: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])

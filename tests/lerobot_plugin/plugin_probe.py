@@ -3,8 +3,12 @@
 ``python plugin_probe.py contract FOLLOWER_PORT LEADER_PORT``: the types LeRobot's registries
 hold after ``register_third_party_plugins``, the features while disconnected, and a follower
 and a leader driven through LeRobot's factories on the ports given (the test's emulators).
-``python plugin_probe.py served URL``: a follower on a robot `poppy serve` serves. One JSON
-object on stdout.
+``python plugin_probe.py served URL``: a follower on a robot `poppy serve` serves.
+``python plugin_probe.py zenoh NAME ENDPOINT``: a follower, then a leader, on the robot served
+on Zenoh as ``poppy/NAME``, listening on ENDPOINT.
+``python plugin_probe.py bodies TORSO_PORT HUMANOID_PORTS``: a Torso and a Humanoid
+(``CONTROLLER=PORT,...``) connected, observed and sent an action.
+One JSON object on stdout.
 """
 
 from __future__ import annotations
@@ -94,7 +98,86 @@ def served(url: str) -> dict[str, Any]:
     return out
 
 
+def zenoh(name: str, endpoint: str) -> dict[str, Any]:
+    """A follower, then a leader, on ``zenoh:NAME`` reached at ``endpoint`` only."""
+    import time
+
+    from lerobot.robots import RobotConfig, make_robot_from_config
+    from lerobot.teleoperators import TeleoperatorConfig, make_teleoperator_from_config
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+    port, connect = f"zenoh:{name}", [endpoint]
+    config = RobotConfig.get_choice_class("poppy_ergo_jr")
+    robot = make_robot_from_config(config(port=port, zenoh_connect=connect, id="zenoh"))
+    robot.connect()
+    out: dict[str, Any] = {"calibrated": robot.is_calibrated}
+    out["observation"] = robot.get_observation()
+    out["sent"] = robot.send_action({"m1.pos": 500.0, "m2.pos": 20.0})
+    # the served robot moves to the goals: seen in the observations (generous: a busy machine)
+    deadline = time.monotonic() + 30.0
+    while time.monotonic() < deadline:
+        seen = robot.get_observation()
+        if abs(seen["m1.pos"] - 150.0) < 2.0 and abs(seen["m2.pos"] - 20.0) < 2.0:
+            break
+        time.sleep(0.05)
+    out["reached"] = seen
+    robot.disconnect()
+    leader_config = TeleoperatorConfig.get_choice_class("poppy_ergo_jr_leader")
+    leader = make_teleoperator_from_config(
+        leader_config(port=port, zenoh_connect=connect, id="zenoh-leader")
+    )
+    leader.connect()
+    out["leader_action"] = leader.get_action()
+    leader.disconnect()
+    return out
+
+
+def bodies(torso_port: str, humanoid_ports: str) -> dict[str, Any]:
+    """A Torso on ``torso_port`` and a Humanoid on ``humanoid_ports`` (one per bus): keys, an
+    action, read back."""
+    import time
+
+    from lerobot.robots import RobotConfig, make_robot_from_config
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+    out: dict[str, Any] = {}
+    for kind, port, action in (
+        ("poppy_torso", torso_port, {"l_elbow_y.pos": -40.0, "head_z.pos": 20.0}),
+        ("poppy_humanoid", humanoid_ports, {"r_elbow_y.pos": -40.0, "l_knee_y.pos": 30.0}),
+    ):
+        config = RobotConfig.get_choice_class(kind)
+        robot = make_robot_from_config(config(port=port, id=kind))
+        robot.connect()
+        observation = robot.get_observation()
+        sent = robot.send_action(action)
+        deadline = time.monotonic() + 30.0
+        while time.monotonic() < deadline:
+            reached = robot.get_observation()
+            if all(abs(reached[k] - v) < 2.0 for k, v in sent.items()):
+                break
+            time.sleep(0.05)
+        out[kind] = {
+            "features": list(robot.observation_features),
+            "observation": list(observation),
+            "sent": sent,
+            "reached": {k: reached[k] for k in sent},
+            "calibration": {k: vars(v) for k, v in robot.calibration.items()},
+        }
+        robot.disconnect()
+    refused = {}
+    for port in ("/dev/ttyUSB0", "upper_body_controller=/dev/ttyUSB0,legs=/dev/ttyUSB1"):
+        robot = make_robot_from_config(RobotConfig.get_choice_class("poppy_humanoid")(port=port))
+        try:
+            robot.connect()
+        except ValueError as exc:
+            refused[port] = str(exc)
+    out["refused"] = refused
+    return out
+
+
 if __name__ == "__main__":
-    commands = {"contract": contract, "served": served}
+    commands = {"contract": contract, "served": served, "zenoh": zenoh, "bodies": bodies}
     result = commands[sys.argv[1]](*sys.argv[2:])
     sys.stdout.write(json.dumps(result) + "\n")

@@ -13,7 +13,9 @@ from lerobot.teleoperators import TeleoperatorConfig
 class PoppyFields:
     """What a Poppy robot or leader is reached through (both config kinds share it)."""
 
-    # Where the robot is: a serial port (/dev/ttyUSB0, or a pyserial URL), `http://HOST:PORT`
+    # Where the robot is: a serial port (/dev/ttyUSB0, or a pyserial URL; a robot of several
+    # buses, the Humanoid: `upper_body_controller=/dev/ttyUSB0,lower_body_controller=...`),
+    # `http://HOST:PORT`
     # of `poppy serve --http`, `zenoh:NAME` of `poppy serve --zenoh --name NAME`, `sim` (the
     # MuJoCo simulation of `poppy sim`) or `sim:ideal` (ideal servos, no physics).
     port: str
@@ -22,6 +24,10 @@ class PoppyFields:
     profile: str = ""
     # Only the joints of this motor group (`l_arm`, `arms`...); empty: every joint.
     group: str = ""
+    # `zenoh:NAME` only: the Zenoh endpoints to connect to (`[tcp/192.168.1.20:7447]`, the
+    # robot's `--zenoh-listen` or a router); empty: POPPY_ZENOH_CONNECT, else
+    # tcp/127.0.0.1:7447. Scouting stays off.
+    zenoh_connect: list[str] = field(default_factory=list)
 
 
 @dataclass(kw_only=True)

@@ -57,6 +57,26 @@ def limits_of(config: Any, names: Sequence[str]) -> dict[str, tuple[float, float
     }
 
 
+def ports_of(port: str, config: Any) -> str | dict[str, str]:
+    """``port``, or controller -> port from ``CONTROLLER=PORT,CONTROLLER=PORT`` (a robot of
+    several buses, the Humanoid's ``upper_body_controller`` and ``lower_body_controller``)."""
+    parts = [p.strip() for p in port.split(",")]
+    pairs = [p.partition("=") for p in parts]
+    several = len(config.controllers) > 1
+    if len(parts) < 2 and not several and not (pairs[0][1] and pairs[0][0] in config.controllers):
+        return port
+    ports: dict[str, str] = {}
+    for name, sep, value in pairs:
+        if not sep or name not in config.controllers or not value:
+            raise ValueError(
+                f"port {port!r}: this robot has {len(config.controllers)} buses: give "
+                "CONTROLLER=PORT for each, comma-separated "
+                f"(controllers: {', '.join(config.controllers)})"
+            )
+        ports[name] = value
+    return ports
+
+
 class LocalLink:
     """A robot poppy builds in this process: a serial port, or the simulation."""
 
@@ -66,7 +86,7 @@ class LocalLink:
 
         sim = SIM_PORTS.get(port, False)
         if not sim:
-            config = with_ports(config, port, source="LeRobot config")
+            config = with_ports(config, ports_of(port, config), source="LeRobot config")
         self.robot = from_config(config, sim=sim, sensors=bool(cameras), start_defaults=False)
         self._cameras: dict[str, Any] = {}
         try:
@@ -114,17 +134,28 @@ class RemoteLink:
     """A robot served by `poppy serve --http` or `--zenoh` (``RemoteRobot``): its server
     clamps goals too, and owns its cameras and calibration."""
 
-    def __init__(self, port: str, names: Sequence[str], cameras: Sequence[str]) -> None:
+    def __init__(
+        self,
+        port: str,
+        names: Sequence[str],
+        cameras: Sequence[str],
+        zenoh_connect: Sequence[str] = (),
+    ) -> None:
         import os
 
         from poppy_core.remote import RemoteRobot
+        from poppy_core.remote.zenoh_client import client_settings
 
         if cameras:
             raise ValueError(
                 "a served robot's own cameras cannot be observed through LeRobot: "
                 "give LeRobot cameras (--robot.cameras) instead"
             )
-        self.robot = RemoteRobot(port, token=os.environ.get("POPPY_TOKEN") or None)
+        if zenoh_connect and not port.startswith("zenoh:"):
+            raise ValueError(f"zenoh_connect is for a zenoh:NAME port, not {port}")
+        zenoh = client_settings(tuple(zenoh_connect)) if port.startswith("zenoh:") else None
+        token = os.environ.get("POPPY_TOKEN") or None
+        self.robot = RemoteRobot(port, token=token, zenoh=zenoh)
         missing = [n for n in names if n not in {m.name for m in self.robot.motors}]
         if missing:
             self.robot.close()
@@ -154,8 +185,16 @@ class RemoteLink:
         self.robot.close()
 
 
-def open_link(config: Any, port: str, names: Sequence[str], cameras: Sequence[str]) -> Any:
-    """The robot at ``port`` (see the config's ``port`` field)."""
+def open_link(
+    config: Any,
+    port: str,
+    names: Sequence[str],
+    cameras: Sequence[str],
+    zenoh_connect: Sequence[str] = (),
+) -> Any:
+    """The robot at ``port`` (see the config's ``port`` and ``zenoh_connect`` fields)."""
     if is_remote(port):
-        return RemoteLink(port, names, cameras)
+        return RemoteLink(port, names, cameras, zenoh_connect)
+    if zenoh_connect:
+        raise ValueError(f"zenoh_connect is for a zenoh:NAME port, not {port}")
     return LocalLink(config, port, cameras)

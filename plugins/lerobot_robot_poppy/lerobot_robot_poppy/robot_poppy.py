@@ -126,7 +126,11 @@ class PoppyRobot(Robot):
             config = calibration.apply(config, self.calibration)
         self._limits = link.limits_of(config, self.joints)
         self._link = link.open_link(
-            config, self.config.port, self.joints, list(self._robot_cameras)
+            config,
+            self.config.port,
+            self.joints,
+            list(self._robot_cameras),
+            self.config.zenoh_connect,
         )
         try:
             for cam in self.cameras.values():

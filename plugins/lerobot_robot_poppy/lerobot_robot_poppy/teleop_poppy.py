@@ -79,7 +79,9 @@ class PoppyLeader(Teleoperator):
         config = self.poppy_config
         if self.calibration and not link.is_remote(self.config.port):
             config = calibration.apply(config, self.calibration)
-        self._link = link.open_link(config, self.config.port, self.joints, [])
+        self._link = link.open_link(
+            config, self.config.port, self.joints, [], self.config.zenoh_connect
+        )
         try:
             self.configure()
         except BaseException:
