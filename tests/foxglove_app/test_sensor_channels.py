@@ -4,6 +4,8 @@ Foxglove WebSocket client and recorded to MCAP (every channel decodes)."""
 
 from __future__ import annotations
 
+import io
+import json
 import math
 from collections.abc import Iterator
 from pathlib import Path
@@ -16,19 +18,23 @@ pytest.importorskip("mcap_protobuf")
 pytest.importorskip("zmq")
 pytest.importorskip("cv2")
 
+import foxglove
+from foxglove.messages import SceneEntityDeletionType
+
 from poppy_core import from_config
 from poppy_core.assembly import Listen, ServeSpec, serve
 from poppy_core.robot import Robot, RobotConfig, load_profile
 from poppy_core.sensors.blobs import Blob
-from poppy_core.sensors.kinect import JOINTS
-from poppy_core.server.foxglove import McapRecording
+from poppy_core.sensors.imu import StillIMU, quaternion_of
+from poppy_core.sensors.kinect import JOINTS, parse_skeleton
+from poppy_core.server.foxglove import FoxglovePublisher, McapRecording
 from poppy_core.server.foxglove.robot_messages import image_annotations
-from poppy_core.server.foxglove.sensor_messages import BONES
+from poppy_core.server.foxglove.sensor_messages import BONES, imu_transform, skeletons_scene
 from tests.foxglove_app.client import FoxgloveClient
-from tests.foxglove_app.test_detections_and_health import decoded
+from tests.foxglove_app.test_detections_and_health import decoded, robot_of
 from tests.foxglove_app.test_mcap import read_back
 from tests.helpers.waiting import eventually
-from tests.sensors.test_kinect import FakeServer
+from tests.sensors.test_kinect import FakeServer, joints_array
 
 SENSOR_TOPICS = {"/kinect/skeletons", "/imu/imu", "/imu/imu/values"}
 
@@ -183,3 +189,49 @@ def test_a_recording_holds_the_sensor_channels(tmp_path: Path, kinect_server: Fa
     check_imu(messages["/imu/imu"][-1], messages["/imu/imu/values"][-1])
     check_blob(next(a for a in reversed(messages["/camera/detections"]) if a.circles))
     assert math.isfinite(messages["/imu/imu/values"][-1]["acceleration"]["z"])
+
+
+def test_a_user_no_longer_tracked_is_deleted_from_the_scene() -> None:
+    skeleton = parse_skeleton(
+        json.dumps({"shape": [20, 10], "timestamp": 1.0, "user_index": 2}).encode(),
+        ",".join(repr(float(v)) for v in joints_array(2).flat).encode(),
+    )
+    scene = decoded(skeletons_scene({2: skeleton}, [5], "kinect", 1_800_000_000.0))
+    assert [e.id for e in scene.entities] == ["user 2"]
+    [deletion] = scene.deletions
+    assert deletion.id == "user 5" and deletion.type == SceneEntityDeletionType.MatchingId.value
+
+
+def test_a_turned_imu_turns_its_frame() -> None:
+    """Yaw 90° (counter-clockwise about z): the IMU's x axis along the reference's y."""
+    transform = decoded(imu_transform(quaternion_of(90.0, 0.0, 0.0), "imu", 1_800_000_000.0))
+    q = transform.rotation
+    half = math.sqrt(0.5)
+    assert (q.x, q.y, q.z, q.w) == pytest.approx((0.0, 0.0, half, half))
+
+
+class FailedImu(StillIMU):
+    """An IMU that read values, then failed for good: its registers raise."""
+
+    def update(self) -> bool | None:
+        super().update()
+        self.fail("the device is gone for good")
+        return None
+
+
+def test_a_failed_imu_holds_no_joint_state_back() -> None:
+    imu = FailedImu("imu", 50.0)
+    context = foxglove.Context()
+    stream = io.BytesIO()
+    publisher = FoxglovePublisher(robot_of(imu), context, "jr1", state_rate_hz=50)
+    writer = foxglove.open_mcap(stream, context=context)
+    try:
+        publisher.start()
+        assert eventually(lambda: imu.health().age_s is not None, 30)
+        published = publisher.published
+        assert eventually(lambda: publisher.published > published + 20, 30)
+        assert publisher.state_loop.failures == 0
+    finally:
+        publisher.close()
+        writer.close()
+        imu.close()

@@ -76,20 +76,23 @@ class SensorChannels:
     def publish(self, wall: float) -> None:
         """Log each sensor's values that changed (or are a second old), if it has some."""
         for name, (kinect, scene) in self.kinects.items():
-            if self._ready(kinect, scene):
-                self._publish_skeletons(name, kinect, scene, wall)
+            try:
+                if self._ready(kinect, scene):
+                    self._publish_skeletons(name, kinect, scene, wall)
+            except SensorError:  # failed for good or closed: its health says why
+                continue
         for name, (imu, transform, values) in self.imus.items():
-            if self._ready(imu, transform, values):
-                self._publish_imu(name, imu, transform, values, wall)
+            try:
+                if self._ready(imu, transform, values):
+                    self._publish_imu(name, imu, transform, values, wall)
+            except SensorError:
+                continue
 
     def _ready(self, sensor: Any, *channels: Any) -> bool:
         """Someone listens, the sensor runs (started here) and it has read a value."""
         if not any(c.has_sinks() for c in channels):
             return False
-        try:
-            sensor.start()  # idempotent and quick: its thread reads the device
-        except SensorError:  # closed with the robot
-            return False
+        sensor.start()  # idempotent and quick: its thread reads the device
         return sensor.health().age_s is not None
 
     def _due(self, name: str, value: Any, wall: float) -> bool:
