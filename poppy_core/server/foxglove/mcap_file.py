@@ -2,10 +2,10 @@
 (``poppy record --mcap FILE``).
 
 The file gets what a Foxglove client would (``FoxglovePublisher``: joint states, transforms, the
-URDF, health, cameras and detections) and the URDF's meshes embedded (``/robot_model``), written
-by foxglove-sdk's MCAP writer into a temporary file beside the target, put in place when the
-recording stops: a file at the target is always a whole MCAP file (the one there before, when
-the recording failed).
+URDF, health, cameras and detections, skeletons, IMUs) and the URDF's meshes embedded
+(``/robot_model``), written by foxglove-sdk's MCAP writer into a temporary file beside the
+target, put in place when the recording stops: a file at the target is always a whole MCAP file
+(the one there before, when the recording failed).
 """
 
 from __future__ import annotations

@@ -14,7 +14,9 @@ channel someone watches, never otherwise. Channels:
   embedded, one entity per link, logged once (a file has no server to fetch them from);
 - ``/health`` (``foxglove.Log``): every bus and sensor once at the start, then each change;
 - per camera ``/NAME/image`` (``foxglove.CompressedImage``, the camera's shared JPEG) and, with
-  a marker or face detector on it, ``/NAME/detections`` (``foxglove.ImageAnnotations``).
+  a marker, face or blob detector on it, ``/NAME/detections`` (``foxglove.ImageAnnotations``);
+- per Kinect sensor ``/NAME/skeletons`` (``foxglove.SceneUpdate``), per IMU ``/NAME/imu``
+  (``foxglove.FrameTransform``) and ``/NAME/imu/values`` (JSON): ``SensorChannels``.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from poppy_core.schedule import Periodic, RateMeter, TickGuard, Worker
 from poppy_core.server.foxglove import robot_messages as messages
 from poppy_core.server.foxglove.assets import RobotAssets
 from poppy_core.server.foxglove.model_scene import model_scene
+from poppy_core.server.foxglove.sensor_channels import SensorChannels
 from poppy_core.server.ros2.joints import UrdfJoints
 
 if TYPE_CHECKING:
@@ -130,6 +133,7 @@ class FoxglovePublisher:
                 self.detections[camera.name] = ImageAnnotationsChannel(
                     f"/{camera.name}/detections", context=context
                 )
+        self.sensors = SensorChannels(robot, context)
         self._worker = Worker(f"foxglove-{name}", self._publish_loop)
         self._camera_workers = [
             Worker(f"foxglove-camera-{cam}", partial(self._camera_loop, cam))
@@ -144,6 +148,7 @@ class FoxglovePublisher:
     def _channels(self) -> list[Any]:
         channels: list[Any] = [self.states, self.health, self.tf, self.description, self.model]
         channels += [c for _, c in self.cameras.values()] + list(self.detections.values())
+        channels += self.sensors.channels()
         return [c for c in channels if c is not None]
 
     @property
@@ -192,6 +197,7 @@ class FoxglovePublisher:
                 next_description = now
                 self._health = {}  # every part's line again, for the newcomer
                 self._detected = {}
+                self.sensors.reset()
                 self._model_sent = False
             self.state_loop.run(partial(self._publish_state, now, wall), stopping)
             if now >= next_description:
@@ -201,6 +207,7 @@ class FoxglovePublisher:
                 next_health = now + HEALTH_PERIOD_S
                 self.state_loop.run(partial(self._publish_health, wall), stopping)
             self.state_loop.run(partial(self._publish_detections, wall), stopping)
+            self.state_loop.run(partial(self.sensors.publish, wall), stopping)
 
     def _publish_state(self, now: float, wall: float) -> None:
         if self.states.has_sinks():

@@ -12,8 +12,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from foxglove.messages import Color as FoxgloveColor
 from foxglove.messages import (
+    CircleAnnotation,
     CompressedImage,
     FrameTransform,
     FrameTransforms,
@@ -30,6 +30,7 @@ from foxglove.messages import (
     Timestamp,
     Vector3,
 )
+from foxglove.messages import Color as FoxgloveColor
 
 from poppy_core.server.ros2.joints import UrdfJoints, joint_transform, matrix_quaternion
 from poppy_core.zenoh_wire import finite_or_nan
@@ -40,6 +41,7 @@ if TYPE_CHECKING:
 
 MARKER_COLOUR = FoxgloveColor(r=0.1, g=0.8, b=0.2, a=1.0)
 FACE_COLOUR = FoxgloveColor(r=1.0, g=0.6, b=0.0, a=1.0)
+BLOB_COLOUR = FoxgloveColor(r=0.2, g=0.5, b=1.0, a=1.0)
 WHITE = FoxgloveColor(r=1.0, g=1.0, b=1.0, a=1.0)
 
 
@@ -128,13 +130,14 @@ def compressed_image(jpeg: bytes, frame: str, now: float) -> CompressedImage:
 
 
 def image_annotations(found: list[Any], now: float) -> ImageAnnotations:
-    """Markers (their outline and id) and faces (their box) as annotations over the image;
-    anything else a detector finds is left out."""
+    """Markers (their outline and id), faces (their box) and blobs (their circle) as
+    annotations over the image; anything else a detector finds is left out."""
     at = stamp(now)
-    points, texts = [], []
+    points, circles, texts = [], [], []
     for thing in found:
         corners = getattr(thing, "corners", None)
         rect = getattr(thing, "rect", None)
+        radius = getattr(thing, "radius", None)
         if corners is not None:
             outline = [Point2(x=float(x), y=float(y)) for x, y in corners]
             colour, label = MARKER_COLOUR, f"{getattr(thing, 'family', 'marker')} {thing.id}"
@@ -147,6 +150,19 @@ def image_annotations(found: list[Any], now: float) -> ImageAnnotations:
                 Point2(x=x, y=y + h),
             ]
             colour, label = FACE_COLOUR, "face"
+        elif radius is not None and getattr(thing, "center", None) is not None:
+            x, y = (float(v) for v in thing.center)
+            circles.append(
+                CircleAnnotation(
+                    timestamp=at,
+                    position=Point2(x=x, y=y),
+                    diameter=2.0 * float(radius),
+                    thickness=2.0,
+                    outline_color=BLOB_COLOUR,
+                )
+            )
+            texts.append(_label(at, Point2(x=x, y=y - float(radius)), "blob", BLOB_COLOUR))
+            continue
         else:
             continue
         points.append(
@@ -158,17 +174,19 @@ def image_annotations(found: list[Any], now: float) -> ImageAnnotations:
                 thickness=2.0,
             )
         )
-        texts.append(
-            TextAnnotation(
-                timestamp=at,
-                position=outline[0],
-                text=label,
-                font_size=14.0,
-                text_color=WHITE,
-                background_color=colour,
-            )
-        )
-    return ImageAnnotations(timestamp=at, points=points, texts=texts)
+        texts.append(_label(at, outline[0], label, colour))
+    return ImageAnnotations(timestamp=at, points=points, circles=circles, texts=texts)
+
+
+def _label(at: Timestamp, where: Point2, text: str, colour: FoxgloveColor) -> TextAnnotation:
+    return TextAnnotation(
+        timestamp=at,
+        position=where,
+        text=text,
+        font_size=14.0,
+        text_color=WHITE,
+        background_color=colour,
+    )
 
 
 @dataclass(frozen=True)
