@@ -1,15 +1,16 @@
 """Who drives each motor's goal: one lease per motor, as ros2_control claims command interfaces.
 
 A lease is held by what streams goals for a while (a teleoperation, a trajectory, a goal stream,
-a move playing, a primitive running) on the motors it drives, labelled with its kind and its
-client (``m2: teleop from 192.168.1.20``). The service asks this registry before a goal of a
-strict surface (v1, Zenoh, ROS 2, the WebSocket's teleoperation) is written: a motor another owner
-holds refuses it (``MotorLeasedError``, 409). pypot's plain writes (its routes, Snap!, ZMQ,
-``motor.goal_position = x``) are never refused: last write wins, as in pypot. A lease ends when
-its owner is released (stop, a closed connection), or lapses by itself once its owner is done
-(``alive`` False: the player ended, the trajectory ran out) or silent (``lapse_s`` after its last
-``touch``). Running primitives are read from the primitive manager (the motors each asks a goal
-of); their goals are combined by the manager, as pypot's are, so they never refuse each other.
+a move playing, a primitive running, a v1 chain goto) on the motors it drives, labelled with its
+kind and its client (``m2: teleop from 192.168.1.20``). The service asks this registry before a
+goal of a strict surface (v1, its chain gotos, Zenoh, ROS 2, the WebSocket's teleoperation) is
+written: a motor another owner holds refuses it (``MotorLeasedError``, 409). pypot's plain writes
+(its routes, Snap!, ZMQ, ``motor.goal_position = x``) are never refused: last write wins, as in
+pypot. A lease ends when its owner is released (stop, a closed connection), or lapses by itself
+once its owner is done (``alive`` False: the player ended, the trajectory ran out) or silent
+(``lapse_s`` after its last ``touch``). Running primitives are read from the primitive manager
+(the motors each asks a goal of); their goals are combined by the manager, as pypot's are, so
+they never refuse each other.
 """
 
 from __future__ import annotations
@@ -34,8 +35,8 @@ class Lease:
     """One owner of motor goals.
 
     Args:
-        kind: ``teleop``, ``trajectory``, ``goal stream``, ``move``, ``primitive``.
-        name: the move's or the primitive's name ("" for the others).
+        kind: ``teleop``, ``trajectory``, ``goal stream``, ``move``, ``primitive``, ``chain``.
+        name: the move's or the primitive's name, a chain's ``arm goto`` ("" for the others).
         client: who asked (an address, a Zenoh sender, ``ROS 2``); "" when unknown.
         holder: who may write through this lease (the same holder's goals pass); None: the
             lease itself.

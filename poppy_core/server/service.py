@@ -12,12 +12,16 @@ import time
 from collections.abc import Hashable, Mapping, Sequence
 from typing import Any
 
+from poppy_core.kinematics.chain import Orientation
+from poppy_core.kinematics.transforms import Vector
 from poppy_core.motion import Primitive, attach_builtins, attached_primitive, attached_primitives
+from poppy_core.motion.cartesian import RobotChain
 from poppy_core.motion.leases import Lease, motor_leases
 from poppy_core.motion.play_plan import write_rate_hz
 from poppy_core.motion.waypoints import WaypointFollower, Waypoints
 from poppy_core.robot import GotoHandle, Motor, Robot
 from poppy_core.server import primitive_calls, values
+from poppy_core.server.chain_gotos import ChainGotos, ChainMove, chain_holder
 from poppy_core.server.compliant_goals import GOAL_REGISTERS, CompliantGoals, goal_motors
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
@@ -52,6 +56,8 @@ class RobotService:
         """The trajectory followed (``follow``): one at a time, the next replaces it."""
         self.teleop = TeleopRegistry(self.leases)
         """Which WebSocket connection teleoperates which motor (a lease each)."""
+        self.chain_gotos = ChainGotos(self.leases)
+        """The v1 chain gotos running (a lease each)."""
         self._description: tuple[float, bytes] | None = None
         self.compliant_goals = CompliantGoals()
         """Goals to compliant motors: refused on v1, logged once per motor either way."""
@@ -310,16 +316,47 @@ class RobotService:
         lease.alive = lambda: self.follower.current is followed
         return followed
 
+    def chain_goto(
+        self,
+        chain: RobotChain,
+        position: Vector,
+        orientation: Orientation,
+        duration_s: float,
+        *,
+        linear: bool = False,
+        client: str = "",
+    ) -> tuple[dict[str, float], ChainMove]:
+        """A v1 chain goto (a strict writer): the angles solved and the motion started.
+
+        Its active motors go through the goal step (``_goals``), then it leases them until it
+        ends (``chain_gotos``; ``client`` names who asked).
+
+        Raises:
+            KinematicsError: out of reach (nothing moved).
+            MotorLeasedError: a motor another owner drives (nothing moved).
+        """
+        angles = chain.solve(position, orientation)
+        self._goals(chain.active_motors, False, chain_holder(chain, client))
+
+        def begin() -> ChainMove:
+            if linear:
+                return chain.goto_linear(position, orientation, duration=duration_s)
+            return chain.goto(position, orientation, duration=duration_s)
+
+        return angles, self.chain_gotos.start(chain, client, begin)
+
     def stop_following(self) -> bool:
         """Stop the trajectory followed (the motors hold their goals); True when one was."""
         return self.follower.stop()
 
     def release_leases(self, reason: str) -> list[str]:
-        """The robot-wide stop's part: end every teleoperation and the trajectory, and free
-        every lease (moves and primitives are stopped by the caller); the owners released."""
+        """The robot-wide stop's part: end every teleoperation, the trajectory and the chains'
+        straight moves, and free every lease (moves and primitives are stopped by the caller);
+        the owners released."""
         owners = sorted({lease.label for lease in self.leases.owners().values()})
         self.teleop.close(reason)
         self.follower.stop()
+        self.chain_gotos.stop_all()
         self.leases.release_all()
         return owners
 
@@ -437,7 +474,9 @@ class RobotService:
     # -- lifetime ----------------------------------------------------------------------------
 
     def close(self) -> None:
-        """Stop the recordings, playbacks, trajectory and teleoperations this server started."""
+        """Stop the recordings, playbacks, trajectory, chains' straight moves and
+        teleoperations this server started."""
         self.teleop.close()
         self.follower.close()
+        self.chain_gotos.stop_all()
         self.moves.close()

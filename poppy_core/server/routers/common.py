@@ -6,6 +6,7 @@ from typing import Any
 
 from starlette.requests import Request
 
+from poppy_core.motion.straight_line import LinearMove
 from poppy_core.robot import GotoHandle
 from poppy_core.server.jsonio import parse_json
 
@@ -37,7 +38,7 @@ async def json_body(request: Request, *, default: Any = MISSING, tip: str = "") 
     return parse_json(raw, tip=tip)
 
 
-async def wait_goto(handle: GotoHandle) -> bool:
+async def wait_goto(handle: GotoHandle | LinearMove) -> bool:
     """Wait (without blocking the event loop) until ``handle`` is done; False on timeout."""
     deadline = time.monotonic() + handle.duration_s + WAIT_MARGIN_S
     while not handle.done:

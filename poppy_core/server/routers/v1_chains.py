@@ -1,16 +1,18 @@
 """v1: kinematic chains (tip pose, forward kinematics, solve, cartesian gotos)."""
 
+from functools import partial
 from typing import Annotated, Any
 
 from fastapi import APIRouter  # noqa: TID253 (the server room is FastAPI's)
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 from starlette.concurrency import run_in_threadpool
+from starlette.requests import Request
 
 from poppy_core.checks import MAX_DURATION_S
 from poppy_core.kinematics import rotation_degrees
 from poppy_core.server.chain_lookup import chain_state, find_chain
 from poppy_core.server.deps import Service
-from poppy_core.server.routers.common import wait_goto
+from poppy_core.server.routers.common import client_of, wait_goto
 from poppy_core.server.schemas import Problem
 
 router = APIRouter(tags=["chains"], responses={404: {"model": Problem}, 422: {"model": Problem}})
@@ -125,18 +127,23 @@ async def solve(chain: str, body: SolveBody, service: Service) -> SolveAnswer:
     return SolveAnswer(chain=chain, angles=angles)
 
 
-@router.post("/chains/{chain}/goto", summary="Move the tip to a target")
-async def goto(chain: str, body: GotoBody, service: Service) -> GotoAnswer:
-    """Every active motor in one goto (or along a straight line with ``linear``)."""
+@router.post(
+    "/chains/{chain}/goto",
+    summary="Move the tip to a target",
+    responses={409: {"model": Problem}},
+)
+async def goto(chain: str, body: GotoBody, service: Service, request: Request) -> GotoAnswer:
+    """Every active motor in one goto (or along a straight line with ``linear``). A motor
+    another owner drives (a move, a teleoperation...) refuses it (409); while it runs, it
+    drives its motors (``chain arm goto from ADDRESS``): other v1 goals for them are refused."""
     found = find_chain(service.robot, chain)
-
-    def start() -> tuple[dict[str, float], Any]:
-        angles = found.solve(body.position, body.goal())
-        if body.linear:
-            return angles, found.goto_linear(body.position, body.goal(), duration=body.duration)
-        return angles, found.goto(body.position, body.goal(), duration=body.duration)
-
-    angles, handle = await run_in_threadpool(start)
+    angles, handle = await run_in_threadpool(
+        partial(service.chain_goto, linear=body.linear, client=client_of(request)),
+        found,
+        body.position,
+        body.goal(),
+        body.duration,
+    )
     if body.wait:
         await wait_goto(handle)
     return GotoAnswer(
