@@ -122,7 +122,10 @@ def _connection(config: Any, loop: asyncio.AbstractEventLoop) -> tuple[Any, Tran
 
 def _route(config: Any, route: str, count: int, top: int) -> dict[str, Any]:
     method, path, body, ttl = ROUTES[route]
-    service_module: Any = sys.modules["poppy_core.server.service"]
+    # the description's time to live: in service.py up to stop 35, then service_primitives.py
+    service_module: Any = sys.modules.get(
+        "poppy_core.server.service_primitives", sys.modules["poppy_core.server.service"]
+    )
     served_ttl = service_module.DESCRIPTION_TTL_S
     if ttl is not None:
         service_module.DESCRIPTION_TTL_S = ttl
