@@ -204,6 +204,15 @@ SCHEMAS: dict[str, Any] = {
         "joints": [str],
     },
     "dataset list": [{"episode": int, "frames": int, "duration_s": NUM, "tasks": [str]}],
+    "dataset view": {
+        "root": str,
+        "episode": int,
+        "frames": int,
+        "mcap?": str,
+        "messages?": Map(int),
+        "rerun?": str,
+        "rows?": Map(int),
+    },
     "dataset replay": {
         "root": str,
         "episode": int,
@@ -517,6 +526,8 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
                 "dataset list": (("dataset", "list", str(tmp / "ds")), ""),
                 "dataset replay": (("dataset", "replay", "poppy/json", "--root", str(tmp / "ds"),
                                     "--episode", "1", *SIM), ""),
+                "dataset view": (("dataset", "view", "poppy/json", "--root", str(tmp / "ds"),
+                                  "--episode", "1", "--mcap", str(tmp / "ep1.mcap")), ""),
                 "dataset delete-episode": (("dataset", "delete-episode", "poppy/json", "--root",
                                             str(tmp / "ds"), "--episode", "0"), ""),
                 "calibrate": (("calibrate", *SIM, "--motors", "m1,m2"), ANSWERS),
@@ -565,8 +576,9 @@ def outputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Any, ..
                 "camera detect": (("camera", "detect", "--sim", "mujoco", "--profile", "ergo-jr",
                                    "--marker", "3"), ""),
                 "fleet list": (("fleet", "list", *on_zenoh), ""),
-                "fleet run": (("fleet", "run", "sinus", "--all", *on_zenoh), ""),
+                # a move first: a primitive running drives the motors a v1 play would take
                 "fleet play": (("fleet", "play", "wave", "--robots", "jr-json", *on_zenoh), ""),
+                "fleet run": (("fleet", "run", "sinus", "--all", *on_zenoh), ""),
                 "fleet stop": (("fleet", "stop", "--all", *on_zenoh), ""),
             }
             # fmt: on
