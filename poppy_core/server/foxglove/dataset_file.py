@@ -20,7 +20,6 @@ put in place when whole.
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import secrets
 from dataclasses import dataclass
@@ -28,7 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import foxglove
-from foxglove import Channel, Context, Schema
+from foxglove import Channel, Context
 from foxglove.channels import (
     CompressedImageChannel,
     FrameTransformsChannel,
@@ -45,7 +44,7 @@ from poppy_core.files import file_error, output_path, place_file
 from poppy_core.server.foxglove import robot_messages as messages
 from poppy_core.server.foxglove.assets import RobotAssets
 from poppy_core.server.foxglove.model_scene import model_scene
-from poppy_core.server.foxglove.publisher import STRING_SCHEMA
+from poppy_core.server.foxglove.publisher import description_channel
 from poppy_core.server.ros2.joints import UrdfJoints
 
 if TYPE_CHECKING:
@@ -121,16 +120,7 @@ class _EpisodeChannels:
             if self.joints.urdf is not None:
                 self.assets = RobotAssets(Path(self.joints.description.source), self.joints.urdf)
                 self.model = SceneUpdateChannel("/robot_model", context=context)
-                self.description = Channel(
-                    "/robot_description",
-                    schema=Schema(
-                        name="std_msgs/String",
-                        encoding="jsonschema",
-                        data=json.dumps(STRING_SCHEMA).encode(),
-                    ),
-                    message_encoding="json",
-                    context=context,
-                )
+                self.description = description_channel(context)
         self.cameras = {
             video.camera: CompressedImageChannel(f"/{video.camera}/image", context=context)
             for video in episode.videos

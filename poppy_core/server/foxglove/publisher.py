@@ -64,6 +64,14 @@ STRING_SCHEMA = {"type": "object", "properties": {"data": {"type": "string"}}}
 URDF of ``/robot_description`` there)."""
 
 
+def description_channel(context: Context | None) -> Channel:
+    """The ``/robot_description`` channel: the URDF as a JSON std_msgs/String."""
+    schema = Schema(
+        name="std_msgs/String", encoding="jsonschema", data=json.dumps(STRING_SCHEMA).encode()
+    )
+    return Channel("/robot_description", schema=schema, message_encoding="json", context=context)
+
+
 class FoxglovePublisher:
     """The robot on Foxglove channels of ``context``.
 
@@ -112,16 +120,7 @@ class FoxglovePublisher:
             self.assets = RobotAssets(Path(self.joints.description.source), self.joints.urdf)
             if embed_model:
                 self.model = SceneUpdateChannel("/robot_model", context=context)
-            self.description = Channel(
-                "/robot_description",
-                schema=Schema(
-                    name="std_msgs/String",
-                    encoding="jsonschema",
-                    data=json.dumps(STRING_SCHEMA).encode(),
-                ),
-                message_encoding="json",
-                context=context,
-            )
+            self.description = description_channel(context)
         self.cameras: dict[str, tuple[Camera, CompressedImageChannel]] = {}
         self.detections: dict[str, ImageAnnotationsChannel] = {}
         for camera in self._cameras():
