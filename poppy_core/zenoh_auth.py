@@ -99,6 +99,11 @@ class Verifier:
         self._expiry: list[tuple[float, str]] = []  # a heap: (wall time it may go, nonce)
         self._lock = threading.Lock()
 
+    def seal(self, nonce: str, answer: dict[str, Any]) -> dict[str, Any]:
+        """``answer`` to the request of ``nonce``, signed with the robot's token
+        (``seal_reply``): the client knows it came from the robot."""
+        return seal_reply(self._key, nonce, answer)
+
     @property
     def remembered(self) -> int:
         """Nonces held now (at most ``max_nonces``)."""
@@ -157,3 +162,43 @@ class Verifier:
                 )
             self._seen.add(nonce)
             heapq.heappush(self._expiry, (until, nonce))
+
+
+# -- signed answers ------------------------------------------------------------------------------
+
+REPLY_MAC = "reply_mac"
+"""The field of an answer that carries its signature (a client of an older poppy ignores it)."""
+
+
+def _reply_text(nonce: str, answer: dict[str, Any]) -> bytes:
+    """What an answer's signature covers: the request's nonce (an answer kept from another
+    request does not fit this one) and the answer's fields, in one canonical JSON text."""
+    fields = {k: v for k, v in answer.items() if k != REPLY_MAC}
+    return b"poppy-reply\0" + nonce.encode() + b"\0" + json.dumps(fields, sort_keys=True).encode()
+
+
+def seal_reply(key: bytes, nonce: str, answer: dict[str, Any]) -> dict[str, Any]:
+    """``answer`` to the signed request ``nonce``, with its signature (``REPLY_MAC``) made with
+    the signing key ``key`` (``key_of(token)``)."""
+    mac = hmac.new(key, _reply_text(nonce, answer), hashlib.sha256).hexdigest()
+    return {**answer, REPLY_MAC: mac}
+
+
+def reply_checks(token: str, nonce: str, answer: dict[str, Any]) -> bool:
+    """True when ``answer`` was signed with ``token`` for the request of ``nonce``: it came from
+    a robot holding the token, for this request (not a stranger's answer, not a replayed one)."""
+    mac = answer.get(REPLY_MAC)
+    if not isinstance(mac, str):
+        return False
+    expected = hmac.new(key_of(token), _reply_text(nonce, answer), hashlib.sha256).hexdigest()
+    return hmac.compare_digest(expected.encode(), mac.encode("ascii", "replace"))
+
+
+def nonce_of(payload: bytes) -> str | None:
+    """The nonce of a signed message (None for one that is not signed)."""
+    try:
+        envelope = json.loads(payload)
+        nonce = json.loads(envelope["signed"])["nonce"] if is_signed(envelope) else None
+    except (ValueError, KeyError, TypeError):
+        return None
+    return nonce if isinstance(nonce, str) else None

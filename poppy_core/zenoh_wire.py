@@ -209,6 +209,45 @@ def open_session(
             time.sleep(0.25)
 
 
+class Answers:
+    """The answers to one query as they arrive (``ask``): ``wait`` returns them once the query
+    is over (every queryable answered, or Zenoh's timeout) or at a deadline of the caller's."""
+
+    def __init__(self) -> None:
+        self._replies: list[Any] = []
+        self._lock = threading.Lock()
+        self._over = threading.Event()
+
+    def add(self, reply: Any) -> None:
+        with self._lock:
+            self._replies.append(reply)
+
+    def over(self) -> None:
+        self._over.set()
+
+    def wait(self, timeout_s: float | None = None) -> list[Any]:
+        """The answers come within ``timeout_s`` (None: until the query is over)."""
+        self._over.wait(timeout_s)
+        with self._lock:
+            return list(self._replies)
+
+
+def ask(session: zenoh.Session, key: str, payload: bytes, timeout_s: float) -> Answers:
+    """A query of a robot's ``api`` whose every answer is kept (no consolidation: a second
+    session answering the same name is seen, never silently merged with the robot's)."""
+    import zenoh
+
+    answers = Answers()
+    session.get(
+        key,
+        zenoh.handlers.Callback(answers.add, answers.over),
+        payload=payload,
+        timeout=timeout_s,
+        consolidation=zenoh.ConsolidationMode.NONE,
+    )
+    return answers
+
+
 def zenoh_message(exc: BaseException) -> str:
     """Zenoh's error text without the places in its Rust sources it names."""
     text = re.sub(r"\s+at /\S+", "", str(exc)).replace("[", "").replace("]", "")

@@ -8,7 +8,9 @@ robots start within a sync period. With `--token` every command is signed, never
 
 from __future__ import annotations
 
+import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -140,12 +142,21 @@ def fleet_status(
     states: dict[str, RobotState] = {}
     health: dict[str, dict[str, Any]] = {}
     present: dict[str, bool] = {}
+    came = threading.Event()  # set by each message: the wait below looks again
+
+    def heard(into: dict[str, Any]) -> Callable[[str, Any], None]:
+        def put(name: str, value: Any) -> None:
+            into[name] = value
+            came.set()
+
+        return put
+
     with _fleet(connect, zenoh_config, zenoh_scout) as fleet:
-        fleet.on_presence(lambda name, alive: present.__setitem__(name, alive))
-        fleet.on_state(lambda name, state: states.__setitem__(name, state))
-        fleet.on_health(lambda name, data: health.__setitem__(name, data))
+        fleet.on_presence(heard(present))
+        fleet.on_state(heard(states))
+        fleet.on_health(heard(health))
         if not watch:
-            time.sleep(1.2)  # one health message of each robot
+            _await_each(fleet, came, present, lambda: [health, states])
             console.print(_status_table(present, states, health))
             return
         try:
@@ -155,6 +166,31 @@ def fleet_status(
                     live.update(_status_table(present, states, health))
         except KeyboardInterrupt:
             pass
+
+
+def _await_each(
+    fleet: Fleet,
+    came: threading.Event,
+    present: dict[str, bool],
+    seen: Callable[[], list[dict[str, Any]]],
+) -> None:
+    """Wait until each robot here (``fleet.names()`` and those ``present`` says came) has
+    sent its health and a state (``seen``): as soon as they came, or after a health period
+    and the fleet's measured answer time (``Fleet.answer_limit_s``), whichever is first: a
+    robot still silent shows ``?``, and a network with no robot is waited for that long."""
+    from poppy_core.server.zenoh.robot_node import HEALTH_PERIOD_S
+
+    names = set(fleet.names())
+    end = time.monotonic() + HEALTH_PERIOD_S + fleet.answer_limit_s(sorted(names))
+    while True:
+        wanted = names | {name for name, alive in dict(present).items() if alive}
+        if wanted and all(name in got for name in wanted for got in seen()):
+            return
+        left = end - time.monotonic()
+        if left <= 0:
+            return
+        came.wait(left)
+        came.clear()
 
 
 def _status_table(

@@ -92,6 +92,13 @@ class HttpClient:
         headers = dict(self._headers)
         if payload is not None:
             headers["Content-Type"] = "application/json"
+        status, data = self._send(method, path, payload, headers)
+        return self._decode(method, path, status, data)
+
+    def _send(
+        self, method: str, path: str, payload: bytes | None, headers: dict[str, str]
+    ) -> tuple[int, bytes]:
+        """One request's status and body (an idle keep-alive connection closed: tried again)."""
         for attempt in (1, 2):
             connection = self._connection()
             try:
@@ -116,7 +123,19 @@ class HttpClient:
                 ) from exc
         if response.will_close:
             self._drop()
-        return self._decode(method, path, response.status, data)
+        return response.status, data
+
+    def image(self, path: str) -> bytes:
+        """The bytes of a GET of ``path`` answered with an image (a camera's ``frame.png``).
+
+        Raises:
+            CommunicationError, BusTimeout, ConfigError: as ``request`` (an unknown camera, a
+                camera not available: the server's refusal).
+        """
+        status, data = self._send("GET", path, None, dict(self._headers))
+        if status >= 400:
+            self._decode("GET", path, status, data)  # raises the refusal's error
+        return data
 
     def _decode(self, method: str, path: str, status: int, data: bytes) -> Any:
         try:

@@ -281,6 +281,21 @@ class RemoteRobot:
             )
         return RemotePrimitive(self._client, name)
 
+    def camera_names(self) -> list[str]:
+        """The names of the served robot's cameras (its sensors of a camera type)."""
+        sensors = self._client.get(path_of("sensors"))
+        return [str(s["name"]) for s in sensors if str(s.get("type", "")).endswith("Camera")]
+
+    def camera_image(self, camera: str, ext: str = "png") -> bytes:
+        """The latest frame of the served robot's camera ``camera`` as a ``png`` or ``jpg``
+        file's bytes (the first waits for the camera to start, on the robot's side).
+
+        Raises:
+            ConfigError: no such camera, or it is not available (the server's refusal).
+            CommunicationError: the server cannot be reached.
+        """
+        return self._client.image(path_of("sensors", camera, f"frame.{ext}"))
+
     def close(self) -> None:
         """Close the connections (the served robot keeps running)."""
         self._client.close()

@@ -16,7 +16,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from poppy_core import zenoh_wire
+from poppy_core import zenoh_auth, zenoh_wire
 from poppy_core.errors import BusTimeout, CommunicationError, ConfigError
 from poppy_core.remote.zenoh_client import client_settings, reply_of
 
@@ -120,12 +120,13 @@ class Fleet:
         }
         return {n: found[n] for n in sorted(found)}
 
-    def round_trip_s(self, names: Sequence[str]) -> float | None:
+    def round_trip_s(self, names: Sequence[str], timeout_s: float | None = None) -> float | None:
         """The slowest round trip of a description query among the robots of ``names`` (asked
-        all at once), None when none answered within the timeout."""
+        all at once), None when none answered within ``timeout_s`` (else the fleet's)."""
         began = time.monotonic()
+        wait = self.timeout_s if timeout_s is None else timeout_s
         pending = [
-            self.session.get(zenoh_wire.robot_key(name, "description"), timeout=self.timeout_s)
+            self.session.get(zenoh_wire.robot_key(name, "description"), timeout=wait)
             for name in names
         ]
         slowest = None
@@ -143,6 +144,15 @@ class Fleet:
         lead = START_LEAD_S if measured is None else measured * LEAD_MARGIN
         return min(MAX_LEAD_S, max(START_LEAD_S, lead))
 
+    def answer_limit_s(self, names: Sequence[str]) -> float:
+        """How long the answers of a command not started together are awaited: the fleet's
+        timeout, or the slowest round trip of a description query (``round_trip_s``, given
+        ``LEAD_MARGIN`` times the fleet's timeout) times ``LEAD_MARGIN`` when that is longer,
+        at most ``MAX_LEAD_S``."""
+        measured = self.round_trip_s(names, self.timeout_s * LEAD_MARGIN)
+        longest = self.timeout_s if measured is None else measured * LEAD_MARGIN
+        return min(MAX_LEAD_S, max(self.timeout_s, longest))
+
     def command(
         self,
         names: Sequence[str],
@@ -158,8 +168,11 @@ class Fleet:
         it at the same wall-clock time, ``lead_s`` from now (None: ``start_lead``, measured),
         and this returns once that time has come (a start is answered when armed, before it).
         A robot the command reaches after that time starts at once and its outcome says how
-        late (``late_s``). A robot that does not answer within the timeout (``timeout_s``, else
-        the fleet's) gets an outcome saying so (never a hang).
+        late (``late_s``). A robot that does not answer within the timeout gets an outcome
+        saying so (never a hang): ``timeout_s``, else for a command ``together`` the fleet's
+        timeout, else (a stop) the answers are awaited as they arrive for the fleet's timeout or,
+        when longer, the slowest round trip of a description query sent right after the command
+        times ``LEAD_MARGIN`` (a loaded robot answers late, and is waited for: ``answer_limit_s``).
         """
         lead = 0.0
         if together:
@@ -168,6 +181,7 @@ class Fleet:
         self.last_start_at = start_at
         self.last_lead_s = lead if together else None
         timeout = (self.timeout_s if timeout_s is None else timeout_s) + lead
+        measure = timeout_s is None and not together
         pending = []
         for name in names:
             payload = zenoh_wire.api_request(
@@ -180,12 +194,19 @@ class Fleet:
                 sender=self._sender,
             )
             key = zenoh_wire.robot_key(name, "api")
-            pending.append((name, self.session.get(key, payload=payload, timeout=timeout)))
+            answers = zenoh_wire.ask(self.session, key, payload, MAX_LEAD_S if measure else timeout)
+            pending.append((name, zenoh_auth.nonce_of(payload), answers))
         began = time.monotonic()
+        if measure:
+            timeout = self.answer_limit_s(names)
         outcomes = []
-        for name, handler in pending:
+        for name, nonce, answers in pending:
             try:
-                reply = reply_of(f"zenoh:{name}", list(handler), timeout, time.monotonic() - began)
+                replies = answers.wait(max(0.0, began + timeout - time.monotonic()))
+                waited = time.monotonic() - began
+                reply = reply_of(
+                    f"zenoh:{name}", replies, timeout, waited, token=self.token, nonce=nonce
+                )
             except (BusTimeout, CommunicationError) as exc:
                 outcomes.append(Outcome(name, False, 0, {"detail": str(exc)}))
                 continue

@@ -325,15 +325,16 @@ class RobotService(PrimitiveOperations):
     ) -> tuple[dict[str, float], ChainMove]:
         """A v1 chain goto (a strict writer): the angles solved and the motion started.
 
-        Its active motors go through the goal step (``_goals``), then it leases them until it
-        ends (``chain_gotos``; ``client`` names who asked).
+        Its active motors go through the goal step (``_goals``, v1's rule: a compliant motor is
+        refused), then it leases them until it ends (``chain_gotos``; ``client`` names who asked).
 
         Raises:
             KinematicsError: out of reach (nothing moved).
             MotorLeasedError: a motor another owner drives (nothing moved).
+            CompliantMotorError: a compliant active motor (nothing moved).
         """
         angles = chain.solve(position, orientation)
-        self._goals(chain.active_motors, False, chain_holder(chain, client))
+        self._goals(chain.active_motors, True, chain_holder(chain, client))
 
         def begin() -> ChainMove:
             if linear:

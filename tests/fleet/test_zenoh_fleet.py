@@ -355,6 +355,23 @@ def test_remote_zenoh_works_where_remote_url_does(two: tuple[Served, Served]) ->
     assert "dance" in {p["name"] for p in result.json()}
 
 
+def test_a_served_camera_is_read_over_zenoh_as_over_http(two: tuple[Served, Served]) -> None:
+    """``RemoteRobot.camera_image`` over Zenoh: the ``frame.png`` route's bytes, the served
+    camera's frame pixel for pixel (what the LeRobot plugin's ``robot_cameras`` read)."""
+    import cv2
+    import numpy as np
+
+    from poppy_core.remote import RemoteRobot
+
+    a, _ = two
+    expected = next(s for s in a.robot.sensors if s.name == "camera").latest(10.0).image
+    with RemoteRobot("zenoh:jr-a", token=TOKEN, zenoh=ZenohSettings(connect=(a.endpoint,))) as rr:
+        assert rr.camera_names() == ["camera"]
+        png = rr.camera_image("camera")
+    decoded = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)
+    assert decoded.shape == expected.shape and (decoded == expected).all()
+
+
 def test_the_page_lists_the_robots_its_fleet_sees(moves: Path) -> None:
     """`/api/v1/web/fleet`: every robot on the network, with a link to the pages served."""
     import httpx

@@ -4,6 +4,7 @@
 hold after ``register_third_party_plugins``, the features while disconnected, and a follower
 and a leader driven through LeRobot's factories on the ports given (the test's emulators).
 ``python plugin_probe.py served URL``: a follower on a robot `poppy serve` serves.
+``python plugin_probe.py served_camera URL``: the same follower observing the robot's camera.
 ``python plugin_probe.py zenoh NAME ENDPOINT``: a follower, then a leader, on the robot served
 on Zenoh as ``poppy/NAME``, listening on ENDPOINT.
 ``python plugin_probe.py bodies TORSO_PORT HUMANOID_PORTS``: a Torso and a Humanoid
@@ -98,6 +99,28 @@ def served(url: str) -> dict[str, Any]:
     return out
 
 
+def served_camera(url: str) -> dict[str, Any]:
+    """A follower on a robot `poppy serve` serves, observing the robot's own camera."""
+    from lerobot.robots import RobotConfig, make_robot_from_config
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+    config = RobotConfig.get_choice_class("poppy_ergo_jr")
+    robot = make_robot_from_config(config(port=url, id="served-camera", robot_cameras=["camera"]))
+    out: dict[str, Any] = {
+        "features": {
+            k: list(v) for k, v in robot.observation_features.items() if isinstance(v, tuple)
+        }
+    }
+    robot.connect()
+    image = robot.get_observation()["camera"]
+    out["shape"] = list(image.shape)
+    out["dtype"] = str(image.dtype)
+    out["pixels"] = {f"{y},{x}": image[y, x].tolist() for y, x in ((0, 0), (10, 200), (300, 600))}
+    robot.disconnect()
+    return out
+
+
 def zenoh(name: str, endpoint: str) -> dict[str, Any]:
     """A follower, then a leader, on ``zenoh:NAME`` reached at ``endpoint`` only."""
     import time
@@ -178,6 +201,12 @@ def bodies(torso_port: str, humanoid_ports: str) -> dict[str, Any]:
 
 
 if __name__ == "__main__":
-    commands = {"contract": contract, "served": served, "zenoh": zenoh, "bodies": bodies}
+    commands = {
+        "contract": contract,
+        "served": served,
+        "served_camera": served_camera,
+        "zenoh": zenoh,
+        "bodies": bodies,
+    }
     result = commands[sys.argv[1]](*sys.argv[2:])
     sys.stdout.write(json.dumps(result) + "\n")

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tests.helpers.bus import emulate_bus
@@ -115,3 +116,28 @@ def test_a_served_robot_is_driven_over_http(lerobot: LeRobot, tmp_path: Path) ->
     assert goals[1] == pytest.approx(20.0, abs=XL320_STEP)
     assert goals[0] == pytest.approx(150.0, abs=XL320_STEP)
     assert compliant == [True] * 6  # disconnected: torque off
+
+
+def test_a_served_robots_own_camera_is_observed_through_lerobot(
+    lerobot: LeRobot, tmp_path: Path
+) -> None:
+    """``robot_cameras`` on a served robot: the frames of its camera (its ``frame.png``
+    route), RGB, as LeRobot's observation; the served camera here draws a known pattern."""
+    served = serve(str(tmp_path))
+    robot = next(served)
+    try:
+        camera = next(s for s in robot.robot.sensors if s.name == "camera")
+        pattern = camera._black  # the simulated camera's frame (BGR), drawn on
+        height, width = pattern.shape[:2]
+        ys, xs = np.mgrid[0:height, 0:width]
+        pattern[..., 0] = xs % 256  # blue
+        pattern[..., 1] = ys % 256  # green
+        pattern[..., 2] = 77  # red
+        seen = lerobot.probe("served_camera", robot.url)
+    finally:
+        served.close()
+    assert seen["features"]["camera"] == [height, width, 3]
+    assert seen["shape"] == [height, width, 3] and seen["dtype"] == "uint8"
+    for where, rgb in seen["pixels"].items():
+        y, x = map(int, where.split(","))
+        assert rgb == [77, y % 256, x % 256], where  # RGB, as LeRobot's cameras give

@@ -58,6 +58,39 @@ def test_a_robot_served_on_zenoh_is_followed_and_leads(lerobot: LeRobot, on_zeno
         assert seen["leader_action"][f"{name}.pos"] == pytest.approx(value, abs=1.0), name
 
 
+def test_the_plugin_through_a_router_with_a_stranger_answering_for_the_robot(
+    lerobot: LeRobot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The topology users deploy: the robot and LeRobot connected only to a router process
+    (``zenoh_connect`` is the router), and a stranger's session on it that answers every
+    robot's ``api`` (``tests/fleet/test_router_stranger.py``'s ``Stranger``): the plugin takes
+    only the robot's signed answers, so it observes and drives the real robot."""
+    pytest.importorskip("zenoh")
+    from tests.fleet.test_router_stranger import Stranger
+    from tests.helpers.zenoh_router import Router
+
+    monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path))
+    router = Router()
+    served = stranger = None
+    try:
+        served = Served("jr-lerobot", router=router.endpoint)
+        stranger = Stranger(router.endpoint)
+        robot = served.robot
+        seen = lerobot.probe("zenoh", served.name, router.endpoint, env={"POPPY_TOKEN": TOKEN})
+        goals = (robot.motor("m1").goal_position, robot.motor("m2").goal_position)
+        assert stranger.asked("poppy/jr-lerobot/api")  # the stranger answered the plugin too
+    finally:
+        for opened in (stranger, served):
+            if opened is not None:
+                opened.close()
+        router.kill()
+    assert list(seen["observation"]) == [f"m{i}.pos" for i in range(1, 7)]
+    assert seen["sent"] == {"m1.pos": 150.0, "m2.pos": 20.0}
+    assert goals == pytest.approx((150.0, 20.0), abs=XL320_STEP)
+    assert seen["reached"]["m1.pos"] == pytest.approx(150.0, abs=2.0)
+    assert seen["leader_action"]["m1.pos"] == pytest.approx(150.0, abs=2.0)
+
+
 def spec_of(profile: str, controller: str) -> str:
     """The motors of ``profile``'s ``controller`` as an emulator spec: ``MX-28:ID/ID,...``."""
     config = load_profile(profile)

@@ -11,6 +11,7 @@ import httpx
 import pytest
 
 from tests.helpers.server import Served
+from tests.server.test_motor_leases import owners
 
 LOGGER = "poppy_core.server.compliant_goals"
 
@@ -81,3 +82,25 @@ def test_pypot_routes_keep_pypot_s_answers_and_the_log_says_it_once_per_period(
     client.post("/motors/m4/registers/compliant/value.json", content="true")
     client.post("/motors/m4/registers/goal_position/value.json", content="12.5")
     assert len(_warnings(caplog)) == 2  # a new period of compliance: named again
+
+
+def test_v1_chain_goto_refuses_compliant_motors_and_pypots_ik_goto_still_writes(
+    client: httpx.Client, free: Served
+) -> None:
+    """A chain goto is a v1 goal as ``POST /api/v1/gotos`` is: one compliant active motor
+    refuses it (409, the same line), nothing moved; pypot's IK route keeps pypot's answer."""
+    arm = [f"m{i}" for i in range(1, 7)]
+    free.robot.compliant = False
+    free.robot.m3.compliant = True
+    before = {name: free.robot.motor(name).goal_position for name in arm}
+    body = {"position": [0.1, -0.1, 0.12], "duration": 0.5}
+    for extra in ({}, {"linear": True}):
+        answer = client.post("/api/v1/chains/chain/goto", json={**body, **extra})
+        assert answer.status_code == 409, answer.text
+        (detail,) = answer.json()["detail"].splitlines()
+        assert detail.startswith("m3 is compliant (torque off), so a goal would not move it")
+    assert {name: free.robot.motor(name).goal_position for name in arm} == before
+    assert all(owner is None for owner in owners(client).values())  # a refused goto leases nothing
+
+    pypot = client.post("/ik/chain/goto.json", json={"xyz": body["position"], "duration": "0.5"})
+    assert pypot.status_code == 200, pypot.text

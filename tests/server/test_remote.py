@@ -142,3 +142,18 @@ def test_from_remote_without_a_host_reaches_the_robot_of_the_environment(
     monkeypatch.setenv("POPPY_ROBOT_URL", served.url)
     with from_remote() as robot:
         assert robot.url == served.url and [m.name for m in robot.motors][:1] == ["m1"]
+
+
+def test_a_served_camera_s_frame_is_read_as_an_image(remote: RemoteRobot, served: Served) -> None:
+    import cv2
+    import numpy as np
+
+    assert remote.camera_names() == ["camera"]
+    camera = next(s for s in served.robot.sensors if s.name == "camera")
+    expected = camera.latest(10.0).image
+    png = remote.camera_image("camera", "png")
+    assert png.startswith(b"\x89PNG")
+    decoded = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)
+    assert decoded.shape == expected.shape and (decoded == expected).all()
+    with pytest.raises(ConfigError, match="Sensor 'nope' does not exist"):
+        remote.camera_image("nope")

@@ -37,7 +37,8 @@ class PoppyFollowerFields(PoppyFields):
     # LeRobot's cameras (OpenCV, RealSense...), each observed as `NAME` (H, W, 3) RGB.
     cameras: dict[str, CameraConfig] = field(default_factory=dict)
     # The robot's own cameras (the profile's `sensors`, e.g. the Ergo Jr's `camera`); under
-    # `sim` they are rendered by MuJoCo from where the real one sits.
+    # `sim` they are rendered by MuJoCo from where the real one sits; on a served robot they are
+    # the server's (its `frame.png` route, over HTTP or Zenoh).
     robot_cameras: list[str] = field(default_factory=list)
     # [width, height] of the robot's own cameras (a small one for a policy on a CPU, say);
     # empty: the profile's (640x480 on the Ergo Jr).

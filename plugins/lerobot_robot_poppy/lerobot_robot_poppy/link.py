@@ -132,7 +132,8 @@ class LocalLink:
 
 class RemoteLink:
     """A robot served by `poppy serve --http` or `--zenoh` (``RemoteRobot``): its server
-    clamps goals too, and owns its cameras and calibration."""
+    clamps goals too, and owns its cameras (read through its ``frame.png`` route) and
+    calibration."""
 
     def __init__(
         self,
@@ -146,11 +147,6 @@ class RemoteLink:
         from poppy_core.remote import RemoteRobot
         from poppy_core.remote.zenoh_client import client_settings
 
-        if cameras:
-            raise ValueError(
-                "a served robot's own cameras cannot be observed through LeRobot: "
-                "give LeRobot cameras (--robot.cameras) instead"
-            )
         if zenoh_connect and not port.startswith("zenoh:"):
             raise ValueError(f"zenoh_connect is for a zenoh:NAME port, not {port}")
         zenoh = client_settings(tuple(zenoh_connect)) if port.startswith("zenoh:") else None
@@ -160,6 +156,16 @@ class RemoteLink:
         if missing:
             self.robot.close()
             raise ValueError(f"the robot at {port} lacks the motors {', '.join(missing)}")
+        self._cameras = list(cameras)
+        if cameras:
+            served = self.robot.camera_names()
+            unknown = [n for n in cameras if n not in served]
+            if unknown:
+                self.robot.close()
+                raise ValueError(
+                    f"the robot at {port} has no camera {unknown[0]!r} "
+                    f"(cameras: {', '.join(served) or 'none'})"
+                )
 
     def positions(self, names: Sequence[str]) -> dict[str, float]:
         state = self.robot.state()
@@ -174,7 +180,17 @@ class RemoteLink:
             self.robot.motor(name).compliant = compliant
 
     def frame(self, name: str, timeout_s: float = FIRST_FRAME_S) -> np.ndarray:
-        raise KeyError(name)
+        """The served camera's latest frame, RGB: its ``frame.png`` route (over HTTP or
+        Zenoh, lossless), decoded; the first waits for the camera on the robot's side."""
+        import cv2
+
+        if name not in self._cameras:
+            raise KeyError(name)
+        data = np.frombuffer(self.robot.camera_image(name, "png"), np.uint8)
+        image = cv2.imdecode(data, cv2.IMREAD_COLOR)
+        if image is None:
+            raise ValueError(f"camera {name!r}: the robot's frame is not a PNG image")
+        return np.ascontiguousarray(image[..., ::-1])
 
     def start_primitive(self, name: str) -> Any:
         primitive = getattr(self.robot, name)

@@ -134,7 +134,8 @@ async def solve(chain: str, body: SolveBody, service: Service) -> SolveAnswer:
 )
 async def goto(chain: str, body: GotoBody, service: Service, request: Request) -> GotoAnswer:
     """Every active motor in one goto (or along a straight line with ``linear``). A motor
-    another owner drives (a move, a teleoperation...) refuses it (409); while it runs, it
+    another owner drives (a move, a teleoperation...) or a compliant one refuses it (409, as
+    ``POST /api/v1/gotos`` does); while it runs, it
     drives its motors (``chain arm goto from ADDRESS``): other v1 goals for them are refused."""
     found = find_chain(service.robot, chain)
     angles, handle = await run_in_threadpool(

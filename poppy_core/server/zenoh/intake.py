@@ -37,6 +37,8 @@ class ApiRequest:
     start_at: float | None
     sender: str
     """Who sent it, for the robot's log (``HOST (zenoh ZID)`` of a signed request)."""
+    nonce: str = ""
+    """The nonce of a request checked against the robot's token (its answer is signed)."""
 
 
 class Intake:
@@ -74,7 +76,16 @@ class Intake:
             start_at = check_start_at(message.get("start_at"))
         except ArgumentError as exc:
             raise Refused(422, str(exc)) from None
-        return ApiRequest(str(method), path, message.get("body"), start_at, _sender(message))
+        nonce = str(message["nonce"]) if self.verifier is not None else ""
+        return ApiRequest(str(method), path, message.get("body"), start_at, _sender(message), nonce)
+
+    def seal(self, request: ApiRequest, answer: dict[str, Any]) -> dict[str, Any]:
+        """The answer to ``request``, signed with the robot's token when the request was
+        checked against it (``zenoh_auth.seal_reply``): a client holding the token knows the
+        robot answered, not a stranger answering ``poppy/NAME/api`` on the same network."""
+        if self.verifier is None or not request.nonce:
+            return answer
+        return self.verifier.seal(request.nonce, answer)
 
     def goals(self, payload: bytes) -> tuple[dict[str, Any], str]:
         """The goals (motor -> degrees, unchecked values) of a ``goals`` message, and who sent

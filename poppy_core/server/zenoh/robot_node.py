@@ -319,7 +319,8 @@ class ZenohRobotServer:
     async def api(self, caller: AsgiCaller, payload: bytes) -> dict[str, Any]:
         """The reply to one ``api`` request: ``{"status", "body"}`` (a refusal: REST's, or
         400/401/413/422/429 of its arrival), plus ``start_at`` when a start was armed for that
-        time (answered on arrival: the start itself happens at ``start_at``).
+        time (answered on arrival: the start itself happens at ``start_at``), signed when the
+        request was signed with the robot's token (``reply_mac``).
 
         Everything is checked on arrival (``Intake``: shape, signature, start time, a place
         among the requests held), before the robot holds anything for a start time."""
@@ -327,6 +328,11 @@ class ZenohRobotServer:
             request = self.intake.api(payload)
         except Refused as exc:
             return _refusal(exc.status, exc.detail)
+        return self.intake.seal(request, await self._run(caller, request))
+
+    async def _run(self, caller: AsgiCaller, request: ApiRequest) -> dict[str, Any]:
+        """The answer to a request that passed its arrival checks: run now, armed for its
+        start time, or run at that time."""
         if request.start_at is None:
             return await self._call(caller, request)
         try:
