@@ -3,7 +3,6 @@ through the chains' forward kinematics."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator, Mapping
 from typing import Any, ClassVar
 
@@ -17,6 +16,7 @@ from poppy_core.errors import ArgumentError
 from poppy_core.robot import Robot, RobotConfig, load_profile
 from poppy_core.sensors import Sensor, Skeleton
 from poppy_core.sensors.kinect import JOINTS, Point2D, Point3D, Quaternion, SkeletonJoint
+from tests.helpers.arms import angle_deg, robot_arms, robot_frame
 from tests.helpers.waiting import eventually
 
 Vec = tuple[float, float, float]
@@ -72,43 +72,6 @@ class FakeSkeletons(Sensor):
     @property
     def tracked_skeleton(self) -> dict[Any, Skeleton]:
         return dict(self.skeletons)
-
-
-def arm_directions(chain: Any, angles: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
-    """A chain's upper arm and forearm (unit vectors, base frame) by forward kinematics."""
-    arm = [m.name for m in chain.active_motors]
-    frames = chain.model.frames(dict(angles))
-    shoulder, elbow, hand = (frames[n][:3, 3] for n in (arm[1], arm[-1], "tip"))
-    upper, fore = elbow - shoulder, hand - elbow
-    return upper / np.linalg.norm(upper), fore / np.linalg.norm(fore)
-
-
-def robot_frame(chain: Any) -> np.ndarray:
-    """Rows forward, left, up in the chain's base frame: at the zero posture the upper arm hangs
-    down and the forearm points forward (the profiles' calibration posture)."""
-    present = {m.name: m.present_position for m in chain.motors}
-    arm = [m.name for m in chain.active_motors]
-    hanging, ahead = arm_directions(chain, {**present, **dict.fromkeys(arm, 0.0)})
-    up = -hanging
-    forward = ahead - up * (ahead @ up)
-    forward /= np.linalg.norm(forward)
-    return np.array([forward, np.cross(up, forward), up])
-
-
-def robot_arms(robot: Robot) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each robot arm's (upper arm, forearm) in the robot's (forward, left, up)."""
-    out = {}
-    for side, chain in (("left", robot.l_arm_chain), ("right", robot.r_arm_chain)):
-        frame = robot_frame(chain)
-        upper, fore = arm_directions(chain, {m.name: m.present_position for m in chain.motors})
-        out[side] = (frame @ upper, frame @ fore)
-    return out
-
-
-def angle_deg(a: Any, b: Any) -> float:
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    cos = float(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)))
-    return math.degrees(math.acos(max(-1.0, min(1.0, cos))))
 
 
 @pytest.fixture(scope="module")

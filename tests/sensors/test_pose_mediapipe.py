@@ -3,7 +3,6 @@ scikit-image's ``astronaut()``: the joints where she is, left and right the righ
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -11,9 +10,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-from poppy_core.sensors import DummyCamera, PoseSkeleton, build_sensors, opencv_camera
-from poppy_core.sensors.pose import PoseWorker, pose_python, skeleton_from_landmarks
+from poppy_core.sensors import DummyCamera, PoseSkeleton
+from poppy_core.sensors.config import build_sensors, opencv_camera
+from poppy_core.sensors.pose import PoseWorker, skeleton_from_landmarks
 from tests.helpers.configs import checked_sensors
+from tests.helpers.pose import mediapipe_python
 from tests.helpers.waiting import eventually
 
 cv2 = pytest.importorskip("cv2")
@@ -21,17 +22,6 @@ skimage_data = pytest.importorskip("skimage.data")
 
 FACE_BOX = (170, 50, 290, 175)
 """Where her face is in the 512x512 picture (x0, y0, x1, y1), as tests/sensors/test_faces.py."""
-
-
-def mediapipe_python() -> Path:
-    """The pose venv's interpreter; CI makes it (.ci/run), elsewhere its absence skips."""
-    python = pose_python()
-    if python is None:
-        why = "no MediaPipe Pose venv: python -m poppy_core.sensors.pose_venv"
-        if os.environ.get("CI"):
-            pytest.fail(why)
-        pytest.skip(why)
-    return python
 
 
 def astronaut_bgr() -> np.ndarray:
