@@ -17,6 +17,7 @@ from poppy_core.robot import Robot, RobotConfig, load_profile
 from poppy_core.sensors import Sensor, Skeleton
 from poppy_core.sensors.kinect import JOINTS, Point2D, Point3D, Quaternion, SkeletonJoint
 from tests.helpers.arms import angle_deg, robot_arms, robot_frame
+from tests.helpers.sensor_rest import rest
 from tests.helpers.waiting import eventually
 
 Vec = tuple[float, float, float]
@@ -184,15 +185,19 @@ def _config(kinect_port: int) -> RobotConfig:
     return RobotConfig.from_dict(data, source="robot.json")
 
 
-def test_a_humanoid_with_a_kinect_gets_mimic_and_it_follows() -> None:
+def test_a_humanoid_with_a_kinect_gets_mimic_started_through_rest() -> None:
     pytest.importorskip("zmq")
     with from_config(_config(9), sim=True, start_defaults=False) as robot:
         assert isinstance(robot.mimic, Mimic) and robot.mimic.source is robot.kinect
         robot.kinect.tracked_skeleton = skeleton(SIDEWAYS_BENT, user=2)  # as the server's
         robot.mimic.mirror = False
         robot.mimic.smoothing = 0.0
-        robot.mimic.start()
-        try:
-            assert eventually(lambda: follows(robot, SIDEWAYS_BENT, 8.0), timeout_s=20.0)
-        finally:
-            robot.mimic.stop()
+        with rest(robot) as client:
+            assert client.get("/primitive/mimic/start.json").status_code < 300
+            try:
+                assert eventually(lambda: follows(robot, SIDEWAYS_BENT, 8.0), timeout_s=20.0)
+                running = client.get("/primitives/running/list.json").json()["running_primitives"]
+                assert "mimic" in running
+            finally:
+                assert client.get("/primitive/mimic/stop.json").status_code < 300
+        assert eventually(lambda: robot.mimic.state == "stopped", timeout_s=10.0)
