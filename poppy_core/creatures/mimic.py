@@ -6,8 +6,9 @@ joints (shoulder_y, shoulder_x, arm_z, elbow_y) are solved through its kinematic
 the same way, within the motors' angle limits. Mirrored by default (``mirror=True``): facing the
 robot, a person who raises the right arm sees the robot raise its left arm, as a mirror does;
 with ``mirror=False`` each robot arm copies the person's arm of the same side. The goals are
-smoothed (each update moves ``1 - smoothing`` of the way to the new one) and reached by a
-minimum-jerk goto of two update periods. Nobody tracked: the arms stay where they are.
+smoothed (each new skeleton moves them ``1 - smoothing`` of the way to its solution) and
+reached by a minimum-jerk goto of two update periods. Nobody tracked, or no new skeleton since
+the last update: the arms keep their goals.
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 
 MIMIC_HZ = 10.0
+RESEED_ERROR = 0.15
+"""A solution this far from the wanted directions (the residual's norm) is tried again from the
+zero posture (a local minimum of the least squares)."""
 ARMS = {"left": "l_arm_chain", "right": "r_arm_chain"}
 """The robot's arm -> the chain that carries it."""
 
@@ -94,6 +98,7 @@ class Mimic(LoopPrimitive):
         """The last joint goals sent (degrees)."""
         self.solvers: dict[str, ArmSolver] = {}
         self._warned = False
+        self._followed: Any = None
 
     @property
     def smoothing(self) -> float:
@@ -132,6 +137,7 @@ class Mimic(LoopPrimitive):
         self.goals = {}
         self.targets = {}
         self._warned = False
+        self._followed = None
 
     def skeleton(self) -> Any | None:
         """The followed person's latest skeleton (None: nobody tracked)."""
@@ -150,8 +156,9 @@ class Mimic(LoopPrimitive):
 
     def update(self) -> None:
         skeleton = self.skeleton()
-        if skeleton is None:
+        if skeleton is None or skeleton is self._followed:  # nobody, or nothing new
             return
+        self._followed = skeleton
         arms = person_arms(skeleton)
         present = {m.name: m.present_position for m in self.real_robot.motors}
         goals: dict[str, float] = {}
@@ -161,8 +168,10 @@ class Mimic(LoopPrimitive):
             upper, fore = robot_arm_for(arms, side, self.mirror)
             want = (frame.T @ upper, frame.T @ fore)
             self.targets[side] = want
-            seeds = [self.goals or present, dict.fromkeys(solver.arm, 0.0)]
-            angles, _ = solver.solve(want, torso, seeds)
+            angles, error = solver.solve(want, torso, [self.goals or present])
+            if error > RESEED_ERROR:  # stuck away from it: try again from the zero posture
+                again = solver.solve(want, torso, [dict.fromkeys(solver.arm, 0.0)])
+                angles = min((angles, error), again, key=lambda found: found[1])[0]
             for name, angle in angles.items():
                 previous = self.goals.get(name)
                 keep = 0.0 if previous is None else self._smoothing
