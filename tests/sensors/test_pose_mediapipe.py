@@ -3,6 +3,9 @@ scikit-image's ``astronaut()``: the joints where she is, left and right the righ
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -13,6 +16,7 @@ import pytest
 from poppy_core.sensors import DummyCamera, PoseSkeleton
 from poppy_core.sensors.config import build_sensors, opencv_camera
 from poppy_core.sensors.pose import PoseWorker, skeleton_from_landmarks
+from tests.helpers.cli import command_env
 from tests.helpers.configs import checked_sensors
 from tests.helpers.pose import mediapipe_python
 from tests.helpers.waiting import eventually
@@ -124,3 +128,19 @@ def test_a_config_entry_on_a_video_file(tmp_path: Path) -> None:
     finally:
         for sensor in reversed(list(sensors.values())):
             sensor.close()
+
+
+def test_making_the_venv_again_keeps_it() -> None:
+    python = mediapipe_python()
+    env = dict(os.environ, **command_env({"POPPY_POSE_VENV": str(python.parent.parent)}))
+    made = subprocess.run(
+        [sys.executable, "-m", "poppy_core.sensors.pose_venv"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+    assert made.returncode == 0, made.stderr
+    assert made.stdout.strip() == f"pose venv: {python.parent.parent} (mediapipe==0.10.21)"
+    assert made.stderr == ""  # nothing installed: the stamp says it holds MediaPipe 0.10.21
