@@ -149,6 +149,10 @@ class Mimic(LoopPrimitive):
                 self._warned = True
             return None
         if not skeletons:
+            health = self.source.health()
+            if not health.ok and not self._warned:  # a Kinect away, no MediaPipe, a lost camera
+                logger.warning("mimic: %s %s: %s", health.kind, health.name, health.last_error)
+                self._warned = True
             return None
         if self.user is not None:
             return skeletons.get(self.user)

@@ -14,7 +14,7 @@ from poppy_core.creatures import Mimic
 from poppy_core.creatures.arm_directions import person_arms
 from poppy_core.errors import ArgumentError
 from poppy_core.robot import Robot, RobotConfig, load_profile
-from poppy_core.sensors import Sensor, Skeleton
+from poppy_core.sensors import DummyCamera, PoseSkeleton, Sensor, Skeleton
 from poppy_core.sensors.kinect import JOINTS, Point2D, Point3D, Quaternion, SkeletonJoint
 from tests.helpers.arms import angle_deg, robot_arms, robot_frame
 from tests.helpers.sensor_rest import rest
@@ -201,3 +201,22 @@ def test_a_humanoid_with_a_kinect_gets_mimic_started_through_rest() -> None:
             finally:
                 assert client.get("/primitive/mimic/stop.json").status_code < 300
         assert eventually(lambda: robot.mimic.state == "stopped", timeout_s=10.0)
+
+
+def test_a_source_that_is_not_well_is_said_once(
+    torso: Robot, tmp_path: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    camera = DummyCamera("camera", (64, 48), 10.0)
+    source = PoseSkeleton("pose", camera, python=str(tmp_path / "no" / "python"))
+    mimic = Mimic(torso, source)
+    torso.attach_primitive(mimic, "mimic_unwell")
+    with camera, source:
+        mimic.start()
+        try:
+            assert eventually(
+                lambda: any(r.name.endswith("mimic") for r in caplog.records), timeout_s=20.0
+            )
+        finally:
+            mimic.stop()
+    said = [r.getMessage() for r in caplog.records if r.name.endswith("mimic")]
+    assert len(said) == 1 and "no interpreter" in said[0] and mimic.goals == {}
