@@ -9,6 +9,7 @@ from poppy_core.creatures.ergo_jr import Dance, Jump, SafePowerUp
 from poppy_core.creatures.face_tracking import FaceTracking
 from poppy_core.creatures.head_follow import HeadFollow
 from poppy_core.creatures.interaction import ArmsCopyMotion, ArmsTurnCompliant
+from poppy_core.creatures.mimic import Mimic
 from poppy_core.creatures.postures import CreaturePosture
 from poppy_core.creatures.registry import (
     CREATURES,
@@ -37,6 +38,7 @@ __all__ = [
     "Jump",
     "LimitTorque",
     "MarkerFollow",
+    "Mimic",
     "SafePowerUp",
     "TemperatureMonitor",
     "TrackingFeedback",

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 from poppy_core.creatures import body, ergo_demos, ergo_jr, interaction, postures, safety
 from poppy_core.creatures.face_tracking import FaceTracking
 from poppy_core.creatures.head_follow import HeadFollow
+from poppy_core.creatures.mimic import ARMS, Mimic
 from poppy_core.creatures.tracking import MarkerFollow, TrackingFeedback
 from poppy_core.errors import ConfigError, RegisterError
 from poppy_core.motion import Primitive, primitive_manager
@@ -233,7 +234,8 @@ def attach_creature(robot: Robot, kind: str, *, start_defaults: bool = True) -> 
     ``robot.l_arm_chain``...) come from the config's ``kinematics`` section, or the creature's
     profile; a simulated Ergo Jr (MuJoCo) also gets ``head_follow``, an Ergo Jr with a marker
     detector ``tracking_feedback`` and ``marker_follow``, one with a face detector
-    ``face_tracking``.
+    ``face_tracking``; a Torso or Humanoid with a skeleton sensor (Kinect, camera pose)
+    ``mimic``.
 
     Args:
         robot: the robot.
@@ -277,6 +279,10 @@ def attach_creature(robot: Robot, kind: str, *, start_defaults: bool = True) -> 
     if known == "ergo-jr" and faces and "chain" in chains:
         attached["face_tracking"] = FaceTracking(robot, "chain", faces[0])
         robot.attach_primitive(attached["face_tracking"], "face_tracking")
+    skeletons = [s for s in robot.sensors if "tracked_skeleton" in s.registers]
+    if known in ("torso", "humanoid") and skeletons and set(ARMS.values()) <= set(chains):
+        attached["mimic"] = Mimic(robot, skeletons[0])
+        robot.attach_primitive(attached["mimic"], "mimic")
     creature = Creature(known, spec.goto_control, attached)
     robot.attach("creature", creature)
     if start_defaults and not robot.closed:

@@ -174,6 +174,8 @@ class SensorEntry(BaseModel):
     sim_camera: Name | None = None
     sim_body: Name | None = None
     cameras: list[Name] | None = None
+    camera: Name | None = None
+    python: Annotated[Name, AfterValidator(non_empty)] | None = None
     cards: dict[Name, MarkerIds] = Field(default_factory=dict)
     dictionary: Name | None = None
     marker_size: Positive | None = None
@@ -263,7 +265,8 @@ class SensorEntry(BaseModel):
             "source": next((s for s in (self.index, self.device) if s is not None), 0),
             "sim_camera": self.sim_camera or name,
             "sim_body": self.sim_body,
-            "cameras": tuple(self.cameras or ()),
+            "cameras": (self.camera,) if self.camera else tuple(self.cameras or ()),
+            "python": self.python,
             "cards": {card: list(ids) for card, ids in self.cards.items()},
             "dictionary": self.dictionary,
             "marker_size": self.marker_size,
@@ -330,9 +333,24 @@ def sensor_problems(
                     show_value=False,
                 )
             )
-        if kind(entry) not in ("MarkerDetector", "FaceDetector"):
+        if kind(entry) not in ("MarkerDetector", "FaceDetector", "PoseSkeleton"):
             continue
         cameras = entry.cameras if isinstance(entry, SensorEntry) else entry.get("cameras")
+        field = "cameras"
+        if kind(entry) == "PoseSkeleton":
+            camera = entry.camera if isinstance(entry, SensorEntry) else entry.get("camera")
+            if camera is not None or not isinstance(cameras, list) or len(cameras) != 1:
+                cameras, field = [camera], "camera"
+                if not isinstance(camera, str) or not camera:
+                    problems.append(
+                        config_error(
+                            source,
+                            f"sensors.{name}.camera",
+                            camera,
+                            "must name the camera sensor it looks through",
+                        )
+                    )
+                    continue
         if not isinstance(cameras, list) or not cameras:
             problems.append(
                 config_error(
@@ -345,8 +363,8 @@ def sensor_problems(
                 problems.append(
                     config_error(
                         source,
-                        f"sensors.{name}.cameras",
-                        cameras,
+                        f"sensors.{name}.{field}",
+                        cameras if field == "cameras" else camera,
                         f"{camera!r} is not a camera here",
                     )
                 )

@@ -21,10 +21,11 @@ from poppy_core.sensors.contact import ContactSensor
 from poppy_core.sensors.detector import FrameDetector, MarkerDetector
 from poppy_core.sensors.faces import Face, FaceDetector, FaceFinder
 from poppy_core.sensors.imu import Imu, RazorIMU, StillIMU
-from poppy_core.sensors.kinect import KinectSensor, Skeleton
+from poppy_core.sensors.kinect import KinectSensor, Skeleton, skeleton_sensors
 from poppy_core.sensors.markers import Marker, MarkerFinder, MarkerPose, marker_image
 from poppy_core.sensors.optibridge import OptiBridgeClient, OptiBridgeServer
 from poppy_core.sensors.optitrack import OptiTrackClient, TrackedObject
+from poppy_core.sensors.pose import PoseSkeleton
 from poppy_core.sensors.sonar import SonarSensor
 
 __all__ = [
@@ -52,6 +53,7 @@ __all__ = [
     "OptiBridgeClient",
     "OptiBridgeServer",
     "OptiTrackClient",
+    "PoseSkeleton",
     "RazorIMU",
     "Sensor",
     "SensorHealth",
@@ -65,4 +67,5 @@ __all__ = [
     "dummy_camera",
     "marker_image",
     "opencv_camera",
+    "skeleton_sensors",
 ]

@@ -15,7 +15,9 @@ The device sensors take pypot's keys: ``ArduinoSensor`` ``port``, ``baud``, ``sy
 ``false``: unicast), ``local_addr`` (the interface to listen on, 0.0.0.0);
 ``OptiBridgeServer`` the same plus ``bridge_host``, ``bridge_port`` (its ZMQ PUB socket);
 ``OptiBridgeClient`` (pypot's ``optibridge.OptiTrackClient``) ``addr``, ``port``,
-``obj_names``. The
+``obj_names``. A ``PoseSkeleton`` (a person's skeleton from a camera, MediaPipe Pose) takes
+``camera`` (its camera's name; or ``cameras`` with one name), ``freq`` and ``python`` (an
+interpreter with MediaPipe 0.10.21; default: the pose venv's). The
 IMUs: ``RazorIMU`` ``port``, ``baud`` (57600), ``sync_freq``; ``BNO055`` ``i2c_pin``,
 ``address`` (0x28), ``sync_freq``; both take ``sim_body`` (the MuJoCo body a
 simulated robot's IMU rides; default ``head``).
@@ -58,10 +60,11 @@ from poppy_core.sensors.optitrack import (
     MULTICAST_GROUP,
     OptiTrackClient,
 )
+from poppy_core.sensors.pose import DEFAULT_POSE_FREQ_HZ, PoseSkeleton
 from poppy_core.sensors.sonar import DEFAULT_ADDRESS, DEFAULT_SONAR_HZ, SonarSensor
 
 CAMERA_TYPES = ("OpenCVCamera", "DummyCamera")
-DETECTOR_TYPES = ("MarkerDetector", "FaceDetector", "BlobDetector")
+DETECTOR_TYPES = ("MarkerDetector", "FaceDetector", "BlobDetector", "PoseSkeleton")
 IMU_TYPES = ("RazorIMU", "BNO055")
 OPTITRACK_TYPES = ("OptiTrackClient", "OptiBridgeServer", "OptiBridgeClient")
 DEVICE_TYPES = (
@@ -119,6 +122,7 @@ class SensorSpec:
     local_addr: str = "0.0.0.0"
     bridge_host: str = ""
     bridge_port: int = 0
+    python: str | None = None
 
     @property
     def is_camera(self) -> bool:
@@ -280,6 +284,14 @@ def build_sensors(
                     spec.rate_hz or DEFAULT_BLOB_FREQ_HZ,
                     filters=spec.filters,
                     min_radius=spec.min_radius,
+                )
+            elif spec.type == "PoseSkeleton":
+                if len(readable) != 1:
+                    raise SensorError(
+                        f"sensor {spec.name!r}: a PoseSkeleton reads one camera", sensor=spec.name
+                    )
+                sensors[spec.name] = PoseSkeleton(
+                    spec.name, readable[0], spec.rate_hz or DEFAULT_POSE_FREQ_HZ, python=spec.python
                 )
             elif spec.type == "FaceDetector":
                 sensors[spec.name] = FaceDetector(

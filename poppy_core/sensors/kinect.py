@@ -17,7 +17,7 @@ import json
 import logging
 import threading
 from collections import namedtuple
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
@@ -133,6 +133,11 @@ def parse_skeleton(header: bytes, values: bytes) -> Skeleton:
             )
         )
     return Skeleton(timestamp, user, *joints)
+
+
+def skeleton_sensors(sensors: Iterable[Sensor]) -> list[Sensor]:
+    """The sensors that give skeletons (``tracked_skeleton``): Kinects and camera poses."""
+    return [s for s in sensors if "tracked_skeleton" in s.registers]
 
 
 SocketOpener = Callable[[str, int], Any]

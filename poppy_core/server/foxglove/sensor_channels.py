@@ -1,6 +1,7 @@
-"""``SensorChannels``: the Kinects' skeletons and the IMUs on Foxglove channels.
+"""``SensorChannels``: the skeletons (Kinect, camera pose) and the IMUs on Foxglove channels.
 
-Per Kinect sensor ``/NAME/skeletons`` (``foxglove.SceneUpdate``); per IMU ``/NAME/imu``
+Per skeleton sensor (``KinectSensor``, ``PoseSkeleton``: a ``tracked_skeleton`` register)
+``/NAME/skeletons`` (``foxglove.SceneUpdate``); per IMU ``/NAME/imu``
 (``foxglove.FrameTransform``, its orientation) and ``/NAME/imu/values`` (JSON
 ``poppy.ImuValues``: yaw, pitch, roll, the quaternion, rates and accelerations). A sensor is
 started when a sink wants one of its channels; its messages go out once it has a value (its
@@ -27,16 +28,15 @@ REPEAT_PERIOD_S = 1.0
 
 
 class SensorChannels:
-    """The channels of ``robot``'s Kinect sensors and IMUs on ``context``."""
+    """The channels of ``robot``'s skeleton sensors and IMUs on ``context``."""
 
     def __init__(self, robot: Robot, context: Context) -> None:
-        from poppy_core.sensors import Imu, KinectSensor
+        from poppy_core.sensors import Imu, skeleton_sensors
 
         sensors = list(robot.sensors)
         self.kinects = {
             s.name: (s, SceneUpdateChannel(f"/{s.name}/skeletons", context=context))
-            for s in sensors
-            if isinstance(s, KinectSensor)
+            for s in skeleton_sensors(sensors)
         }
         values_schema = Schema(
             name="poppy.ImuValues",

@@ -189,3 +189,32 @@ def imu(sensor: Imu, frame: str, now: float | None = None) -> Any:
 def string(text: str) -> Any:
     """A std_msgs/String."""
     return types.message(types.STRING, data=text)
+
+
+def skeletons_tf(skeletons: dict[Any, Any], frame: str, now: float | None = None) -> Any:
+    """A tf2_msgs/TFMessage of tracked skeletons (a Kinect's, a camera pose's): per user and
+    joint a transform from ``frame`` (the sensor's) to ``<frame>/user_<id>/<joint>``, the
+    joint's position (m) and orientation."""
+    import numpy as np
+
+    out = []
+    for user, skeleton in skeletons.items():
+        for name in skeleton.joints:
+            joint = getattr(skeleton, name)
+            q = np.asarray(joint.orientation, dtype=float)
+            norm = float(np.linalg.norm(q))
+            x, y, z, w = (float(v) for v in (q / norm if norm > 0 else (0.0, 0.0, 0.0, 1.0)))
+            px, py, pz = (float(v) for v in joint.position)
+            out.append(
+                types.message(
+                    "geometry_msgs/msg/TransformStamped",
+                    header=header(frame, now),
+                    child_frame_id=f"{frame}/user_{user}/{name}",
+                    transform=types.message(
+                        "geometry_msgs/msg/Transform",
+                        translation=types.message("geometry_msgs/msg/Vector3", x=px, y=py, z=pz),
+                        rotation=types.message("geometry_msgs/msg/Quaternion", x=x, y=y, z=z, w=w),
+                    ),
+                )
+            )
+    return types.message(types.TF_MESSAGE, transforms=out)

@@ -5,7 +5,8 @@ It declares on the server set's Zenoh session, under rmw_zenoh's keys (``wire``)
 (transient local: Zenoh advanced publishers with a cache of one sample, which rmw_zenoh's
 transient-local subscriptions query), ``diagnostics`` (every second) and, while a camera runs,
 ``camera/image_raw/compressed``, ``<imu>/data`` for each IMU (sensor_msgs/Imu, with the
-state); subscriptions ``joint_trajectory`` and ``joint_command``; services
+state), the tracked skeletons on ``tf`` (a frame per user and joint, under the sensor's);
+subscriptions ``joint_trajectory`` and ``joint_command``; services
 ``~/set_compliant``, ``~/stop`` and per primitive ``~/<primitive>/start`` and
 ``~/<primitive>/stop``; and the liveliness token of the node and of each of those entities.
 The entities are declared by ``entities.Entities``; the commands are the service's operations
@@ -147,6 +148,9 @@ class Ros2Node:
                 f"imu:{imu.name}", types.IMU, wire.SENSOR_QOS, topic=f"{imu.name}/data"
             )
             imu.start()  # a small device read at its own rate (a camera is never opened here)
+        for sensor in self._skeleton_sensors():
+            if sensor.kind == "KinectSensor":
+                sensor.start()  # a network read; a camera pose waits for its first reader
         entities.subscription("joint_trajectory", types.JOINT_TRAJECTORY, self._on_trajectory)
         entities.subscription("joint_command", types.JOINT_STATE, self._on_command)
         entities.service("~/set_compliant", types.SET_BOOL, self._set_compliant)
@@ -231,6 +235,12 @@ class Ros2Node:
             if imu.health().age_s is not None:  # a value read: the properties do not wait
                 message = messages.imu(imu, imu.name, wall)
                 self._publishers[f"imu:{imu.name}"].put(types.serialize(message, types.IMU))
+        for sensor in self._skeleton_sensors():
+            if sensor.running and sensor.health().age_s is not None:  # reading does not start it
+                skeletons = sensor.tracked_skeleton
+                if skeletons:
+                    message = messages.skeletons_tf(skeletons, sensor.name, wall)
+                    self._publishers["tf"].put(types.serialize(message, types.TF_MESSAGE))
 
     def _publish_state(self, states: Publisher, tf: Publisher, now: float, wall: float) -> None:
         states.put(
@@ -264,6 +274,11 @@ class Ros2Node:
         from poppy_core.sensors import Camera
 
         return [s for s in self.robot.sensors if isinstance(s, Camera)]
+
+    def _skeleton_sensors(self) -> list[Any]:
+        from poppy_core.sensors import skeleton_sensors
+
+        return skeleton_sensors(self.robot.sensors)
 
     def _imus(self) -> list[Any]:
         from poppy_core.sensors import Imu

@@ -1,5 +1,5 @@
 // The sensors panel: every sensor that is not a camera (detectors, IMUs, sonar, Arduino, contact,
-// Kinect), its kind, its health and its registers' values, read twice a second.
+// Kinect, camera pose), its kind, its health and its registers' values, read twice a second.
 // Values come from /api/v1/sensors/<name> (every register in one request), health from
 // /api/v1/sensors/health; a sensor whose read fails shows the server's reason, nothing else breaks.
 import { ApiError, get } from "./api.js";
