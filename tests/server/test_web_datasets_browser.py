@@ -170,3 +170,29 @@ def test_the_video_played_is_what_poppy_writes(home: Path) -> None:
     with av.open(str(path)) as container:
         name = container.streams.video[0].codec_context.name
     assert ("av1" in name or "dav1d" in name) == (pick_codec() == AV1), name
+
+
+def test_with_a_token_the_video_is_read_with_it_and_no_url_holds_it(
+    browser: Any, home: Path
+) -> None:
+    token = "player-token-7"
+    for served in serve_robot(from_profile("ergo-jr", sim=True), token=token):
+        context = browser.new_context(viewport={"width": 1280, "height": 900})
+        context.add_init_script(f"localStorage.setItem('poppy-token', '{token}')")
+        page = context.new_page()
+        page.set_default_timeout(WAIT_S * 1000)
+        urls: list[str] = []
+        page.on("request", lambda request: urls.append(request.url))
+        page.goto(served.url + "/#dataset=me/wave&episode=1")
+        wait(page, OPENED, "the episode to open")
+        source = page.evaluate("() => document.querySelector('#datasets video').src")
+        assert source.startswith("blob:"), source
+        wait(
+            page,
+            "() => document.querySelector('#datasets video').readyState >= 2",
+            "a decoded picture from the blob",
+        )
+        assert page.evaluate("() => window.poppy.datasets.videoErrors()") == [None]
+        assert any("/video/top" in url for url in urls), urls
+        assert not [url for url in urls if token in url], urls
+        context.close()
