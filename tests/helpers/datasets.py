@@ -39,19 +39,20 @@ def image(k: int) -> np.ndarray:
     return picture
 
 
-def write_dataset(root: Path, robot_type: str | None = "ergo-jr") -> None:
-    """EPISODES recorded with one camera, ``top``, then packed (``pack_videos``)."""
+def write_dataset(root: Path, robot_type: str | None = "ergo-jr", codec: str | None = None) -> None:
+    """EPISODES recorded with one camera, ``top``, then packed (``pack_videos``) with
+    ``codec`` (default: the one poppy's writer picks)."""
     spec = DatasetSpec(FPS, MOTORS, {"top": SIZE}, robot_type)
-    with DatasetWriter.create(root, spec) as writer:
+    with DatasetWriter.create(root, spec, codec) as writer:
         for frames, task in EPISODES:
             writer.begin_episode(task)
             for k in range(frames):
                 writer.add_frame(state(k), action(k), {"top": image(k)})
             writer.save_episode()
-    pack_videos(root)
+    pack_videos(root, codec or pick_codec())
 
 
-def pack_videos(root: Path) -> None:
+def pack_videos(root: Path, codec: str) -> None:
     """Every episode's frames of each camera in file-000 one after the other, each episode's
     from/to timestamps naming its span there (LeRobot v3.0's concatenated files)."""
     import av
@@ -76,7 +77,7 @@ def pack_videos(root: Path) -> None:
             path.unlink()
         packed = root / layout.VIDEO_PATH.format(video_key=key, chunk_index=0, file_index=0)
         height, width = pictures[0].shape[:2]
-        out = Mp4File(packed.with_suffix(".tmp.mp4"), fps, width, height, pick_codec())
+        out = Mp4File(packed.with_suffix(".tmp.mp4"), fps, width, height, codec)
         for picture in pictures:
             out.encode(picture)
         out.finish()

@@ -17,6 +17,7 @@ pytest.importorskip("pyarrow")
 pytest.importorskip("av")
 
 from poppy_core import from_profile
+from poppy_core.dataset.video import H264
 from tests.helpers.chromium import CHROMIUM, needs_chromium, new_tab, playwright_api
 from tests.helpers.datasets import EPISODES, FPS, MOTORS, state, write_dataset
 from tests.helpers.server import Served, serve_robot
@@ -46,7 +47,8 @@ PLOT_INK = """() => {
 @pytest.fixture(scope="module")
 def home(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     folder = tmp_path_factory.mktemp("lerobot")
-    write_dataset(folder / "me" / "wave")
+    write_dataset(folder / "me" / "wave")  # AV1 where PyAV encodes it
+    write_dataset(folder / "me" / "wave264", codec=H264)  # the writer's fallback
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("HF_LEROBOT_HOME", str(folder))
         yield folder
@@ -82,15 +84,16 @@ def drawn_degrees(page: Any) -> dict[str, float]:
     return page.evaluate("() => window.poppy.view.degrees()")
 
 
+@pytest.mark.parametrize("dataset", ["me/wave", "me/wave264"])
 def test_an_episode_plays_in_the_3d_view_the_video_and_the_plot(
-    browser: Any, served: Served, home: Path
+    browser: Any, served: Served, home: Path, dataset: str
 ) -> None:
     errors: list[str] = []
     _, page = new_tab(browser, WAIT_S * 1000)
     page.on("pageerror", lambda error: errors.append(str(error)))
     page.on("console", lambda m: errors.append(m.text) if "Security Policy" in m.text else None)
     start = {m.name: m.present_position for m in served.robot.motors}
-    page.goto(served.url + "/#dataset=me/wave&episode=1")
+    page.goto(served.url + f"/#dataset={dataset}&episode=1")
     wait(page, OPENED, "the episode to open in the 3D view")
     frames = EPISODES[1][0]
     before = EPISODES[0][0] / FPS  # the episode's span in the packed file
@@ -160,28 +163,32 @@ def test_an_episode_plays_in_the_3d_view_the_video_and_the_plot(
     assert not errors, errors
 
 
-def test_the_video_played_is_what_poppy_writes(home: Path) -> None:
-    """AV1 where this PyAV encodes it (libsvtav1), else H.264: the test above played it."""
+def test_the_videos_played_are_what_poppy_writes(home: Path) -> None:
+    """me/wave: AV1 where this PyAV encodes it (libsvtav1), else H.264; me/wave264: H.264."""
     import av
 
     from poppy_core.dataset.video import AV1, pick_codec
 
-    path = home / "me/wave/videos/observation.images.top/chunk-000/file-000.mp4"
-    with av.open(str(path)) as container:
-        name = container.streams.video[0].codec_context.name
-    assert ("av1" in name or "dav1d" in name) == (pick_codec() == AV1), name
+    def codec(name: str) -> str:
+        path = home / name / "videos/observation.images.top/chunk-000/file-000.mp4"
+        with av.open(str(path)) as container:
+            return str(container.streams.video[0].codec_context.name)
+
+    av1 = codec("me/wave")
+    assert ("av1" in av1 or "dav1d" in av1) == (pick_codec() == AV1), av1
+    assert codec("me/wave264") == "h264"
 
 
 def test_with_a_token_the_video_is_read_with_it_and_no_url_holds_it(
     browser: Any, home: Path
 ) -> None:
     token = "player-token-7"
+    urls: list[str] = []
     for served in serve_robot(from_profile("ergo-jr", sim=True), token=token):
         context = browser.new_context(viewport={"width": 1280, "height": 900})
         context.add_init_script(f"localStorage.setItem('poppy-token', '{token}')")
         page = context.new_page()
         page.set_default_timeout(WAIT_S * 1000)
-        urls: list[str] = []
         page.on("request", lambda request: urls.append(request.url))
         page.goto(served.url + "/#dataset=me/wave&episode=1")
         wait(page, OPENED, "the episode to open")
