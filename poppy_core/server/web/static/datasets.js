@@ -11,8 +11,9 @@ const BAND = 46; // the plot's height per joint (px)
 const LABEL = 56; // the plot's left margin for the joint names (px)
 const STATE = "#2563eb", ACTION = "#f97316";
 const DRIFT_S = 0.12; // a second camera this far from the first is seeked back in step
+const STALL_MS = 500; // a video whose time stands still this long while playing: the page's clock
 
-const status = { ready: false, datasets: [], episode: null, frame: 0, playing: false, plotDraws: 0, clock: "none" };
+const status = { ready: false, datasets: [], episode: null, frame: 0, playing: false, plotDraws: 0, clock: "none", ticks: { video: 0, page: 0 } };
 let player = null; // the episode being played (see open())
 
 function authorizedUrl(path) {
@@ -152,18 +153,29 @@ async function open(body, repoId, index) {
     clock.textContent = `${seconds(times[k] ?? 0)} / ${seconds(end)} · frame ${k + 1}/${n}`;
     if (seek) seekVideos(times[k] ?? 0);
   }
+  // The first video is the clock while its time moves; one that stalls (decoding starved, a
+  // seek that hangs) hands over to the page's clock, and is seeked back in step, for STALL_MS.
   function tick() {
     if (!state.playing || state.closed) return;
-    let t;
+    const now = performance.now();
+    let t = state.base.t + ((now - state.base.at) / 1000) * Number(speed.value);
+    let clockName = "page";
     if (master && videoOk(master) && !master.element.paused) {
-      t = master.element.currentTime - master.from_s;
-      status.clock = "video";
-      for (const v of videos) {
-        if (v !== master && videoOk(v) && Math.abs(v.element.currentTime - v.from_s - t) > DRIFT_S) v.element.currentTime = v.from_s + t;
+      const vt = master.element.currentTime - master.from_s;
+      if (vt !== state.videoT) { state.videoT = vt; state.videoAt = now; }
+      if (now - state.videoAt < STALL_MS) {
+        t = vt;
+        clockName = "video";
+        state.base = { t, at: now };
+      } else if (!master.element.seeking) {
+        master.element.currentTime = master.from_s + t;
+        state.videoAt = now;
       }
-    } else {
-      t = state.base.t + ((performance.now() - state.base.at) / 1000) * Number(speed.value);
-      status.clock = "page";
+    }
+    status.clock = clockName;
+    status.ticks[clockName] += 1;
+    for (const v of videos) {
+      if (v !== master && videoOk(v) && !v.element.seeking && Math.abs(v.element.currentTime - v.from_s - t) > DRIFT_S) v.element.currentTime = v.from_s + t;
     }
     if (t >= end - 0.5 / episode.fps) { show(n - 1, false); pause(); return; }
     const k = frameAt(times, t);
@@ -176,6 +188,7 @@ async function open(body, repoId, index) {
     state.playing = true; status.playing = true;
     playButton.textContent = "pause";
     state.base = { t: times[state.k], at: performance.now() };
+    state.videoT = null; state.videoAt = performance.now();
     for (const v of videos) {
       if (!videoOk(v)) continue;
       v.element.playbackRate = Number(speed.value);
