@@ -8,8 +8,10 @@ per chunk). Poppy's own addition is a ``unit`` on the joint features (degrees, a
 from __future__ import annotations
 
 import math
+import os
 import re
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from poppy_core.errors import ArgumentError
@@ -131,6 +133,16 @@ def empty_info(spec: DatasetSpec) -> dict[str, Any]:
         "video_path": VIDEO_PATH if spec.cameras else None,
         "features": spec.features(),
     }
+
+
+def lerobot_home() -> Path:
+    """LeRobot's datasets folder: $HF_LEROBOT_HOME, else $HF_HOME/lerobot, else
+    ~/.cache/huggingface/lerobot (LeRobot 0.4.4's ``HF_LEROBOT_HOME``)."""
+    home = os.environ.get("HF_LEROBOT_HOME")
+    if home:
+        return Path(home).expanduser()
+    hf_home = os.environ.get("HF_HOME") or str(Path.home() / ".cache" / "huggingface")
+    return Path(hf_home).expanduser() / "lerobot"
 
 
 def chunk_and_file(position: int) -> tuple[int, int]:

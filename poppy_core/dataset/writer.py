@@ -322,10 +322,5 @@ class DatasetWriter:
 
 
 def default_root(repo_id: str) -> Path:
-    """Where LeRobot looks for ``repo_id`` without --root: $HF_LEROBOT_HOME, else
-    $HF_HOME/lerobot, else ~/.cache/huggingface/lerobot."""
-    home = os.environ.get("HF_LEROBOT_HOME")
-    if home:
-        return Path(home).expanduser() / repo_id
-    hf_home = os.environ.get("HF_HOME") or str(Path.home() / ".cache" / "huggingface")
-    return Path(hf_home).expanduser() / "lerobot" / repo_id
+    """Where LeRobot looks for ``repo_id`` without --root (``layout.lerobot_home()``)."""
+    return layout.lerobot_home() / repo_id

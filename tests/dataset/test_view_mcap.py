@@ -158,7 +158,9 @@ def test_a_dataset_of_an_unknown_robot_gets_degrees_as_radians(tmp_path: Path) -
     [
         (("--episode", "2"), 2, "no episode 2 in this dataset (episodes: 0 to 1)"),
         (("--episode", "1", "--root", "/nonexistent/ds"), 2, "holds no dataset"),
-        (("--episode", "1", "--no-mcap"), 2, "give --mcap FILE"),
+        (("--episode", "9", "--no-mcap"), 2, "no episode 9 in this dataset (episodes: 0 to 1)"),
+        (("--no-mcap", "--force"), 2, "--force replaces an exported file"),
+        (("--rerun", "/tmp/never.rrd"), 2, "give --episode K"),
         (("--episode", "1", "--profile", "ergo-jx"), 1, "did you mean ergo-jr"),
         (("--episode", "1", "--mcap", "/nonexistent/folder/x.mcap"), 1, "/nonexistent/folder"),
     ],

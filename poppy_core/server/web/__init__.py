@@ -34,7 +34,7 @@ PAGE_HEADERS = {
     # through a decoy page); the one inline script is the import map, allowed by its hash
     "Content-Security-Policy": (
         f"default-src 'self'; script-src 'self'{_import_map_hash()}; "
-        "img-src 'self' blob: data:; connect-src 'self'; "
+        "img-src 'self' blob: data:; media-src 'self' blob:; connect-src 'self'; "
         "frame-ancestors 'none'; base-uri 'none'; form-action 'self'"
     ),
     "X-Frame-Options": "DENY",
@@ -57,6 +57,7 @@ def add_web_page(app: FastAPI) -> None:
     from starlette.responses import FileResponse, Response
     from starlette.staticfiles import StaticFiles
 
+    from poppy_core.server.web.datasets import router as datasets_router
     from poppy_core.server.web.robot_model import router as model_router
     from poppy_core.server.web.routes import router
 
@@ -79,6 +80,7 @@ def add_web_page(app: FastAPI) -> None:
     app.mount(STATIC_PREFIX, StaticFiles(directory=static_folder()), name="web")
     app.include_router(router, prefix="/api/v1")
     app.include_router(model_router, prefix="/api/v1")  # the 3D view's URDF and meshes
+    app.include_router(datasets_router, prefix="/api/v1")  # the episodes' player (read only)
 
 
 def add_link(app: FastAPI, name: str, url: str) -> None:

@@ -1,5 +1,6 @@
 // The robot's home page: fetches who the robot is, builds each part, keeps them live.
 import { api, get, onTokenAsked, openStream, post, tokenAsked } from "./api.js";
+import { setupDatasets } from "./datasets.js";
 import { showCameras, showChains } from "./extras.js";
 import { refreshFleet } from "./fleet.js";
 import { buildTable, onFrame, refresh, stats } from "./motors.js";
@@ -171,6 +172,7 @@ async function main() {
   ]);
   showAbout(about);
   setupView(about);
+  setupDatasets();
   const motors = Object.keys(details.motors); // in the robot's order
   buildTable(motors, details);
   setupRecorder(motors);

@@ -7,6 +7,9 @@ let lastFrame = null;
 let started = false;
 let firstFrame = null; // resolves with the page's first state frame
 const framed = new Promise((resolve) => { firstFrame = resolve; });
+let sceneReady = null; // resolves with the loaded view, or null when there is none
+const loaded = new Promise((resolve) => { sceneReady = resolve; });
+let shownAbout = null;
 
 export function viewFrame(data) {
   lastFrame = data;
@@ -31,6 +34,7 @@ async function start(panel, about) {
   if (!hasWebGL()) {
     line(panel, "No 3D view: this browser has no WebGL (the table below shows every motor).");
     window.poppy.view = { ready: false, fallback: true };
+    sceneReady(null);
     return;
   }
   line(panel, "Loading the 3D model…");
@@ -42,9 +46,11 @@ async function start(panel, about) {
     scene = await startView(panel.querySelector(".view-canvas"), about);
     line(panel, "Drag to turn, wheel or pinch to zoom, right-drag or two fingers to pan.");
     if (lastFrame) scene.frame(lastFrame);
+    sceneReady(scene);
   } catch (error) {
     line(panel, `No 3D view: ${error.message}`);
     window.poppy.view = { ready: false, error: error.message };
+    sceneReady(null);
   }
 }
 
@@ -53,6 +59,7 @@ async function start(panel, about) {
 export function setupView(about) {
   const panel = document.getElementById("view3d");
   if (!panel) return;
+  shownAbout = about;
   const toggle = el("button", { type: "button", textContent: "hide" });
   toggle.setAttribute("aria-controls", "view3d-canvas");
   toggle.setAttribute("aria-expanded", "true");
@@ -72,4 +79,13 @@ export function setupView(about) {
     if (onScreen && !canvas.hidden) requestAnimationFrame(() => start(panel, about));
     if (scene) scene.setVisible(onScreen && !canvas.hidden);
   }).observe(panel);
+}
+
+// The view for the datasets' player (datasets.js), loaded now if it was not yet: resolves with
+// { showEpisode(state, action), endEpisode() } or null (no WebGL, no model).
+export function episodeView() {
+  const panel = document.getElementById("view3d");
+  if (!panel || !shownAbout) return Promise.resolve(null);
+  start(panel, shownAbout);
+  return loaded;
 }

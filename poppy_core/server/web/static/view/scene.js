@@ -201,9 +201,17 @@ export async function startView(container, about) {
     }
   }
 
+  // an episode played by the datasets' panel poses the view instead of the live robot (the
+  // robot itself is never sent anything): its state drawn solid, its action as the ghost
+  let episode = null;
+  stats.episode = null;
+  // each joint as drawn now, in the robot's degrees (the inverse of angle())
+  stats.degrees = () => Object.fromEntries(Object.entries(model.joints).filter(([name]) => robot.joints[name])
+    .map(([name, j]) => [name, (robot.joints[name].angle * 180) / Math.PI / j.scale - j.offset_deg]));
+
   // the gotos under way (their goals as a ghost) and cartesian targets: read while it shows
   async function poll() {
-    if (!visible) return;
+    if (!visible || episode) return;
     try {
       const live = await get("/api/v1/model/goals");
       const away = Object.entries(live.goals).some(([name, goal]) => name in present && Math.abs(goal - present[name]) > GHOST_DEG);
@@ -247,6 +255,12 @@ export async function startView(container, about) {
 
   return {
     frame(data) {
+      if (episode) { // the live values are kept for when the episode ends, not drawn
+        for (const [name, state] of Object.entries(data)) {
+          if (typeof state?.present_position === "number") present[name] = state.present_position;
+        }
+        return;
+      }
       let moved = false; // a still robot is not drawn again (a tenth of a degree is nothing to see)
       for (const [name, state] of Object.entries(data)) {
         const degrees = state?.present_position;
@@ -261,5 +275,26 @@ export async function startView(container, about) {
       dirty = true;
     },
     setVisible(on) { visible = on; dirty = true; },
+    // draw a recorded frame: {joint: degrees} of the state and of the action (null: no ghost)
+    showEpisode(state, action) {
+      episode = { state, action };
+      stats.episode = episode;
+      pose(robot, state);
+      if (action) pose(ghost, action);
+      ghost.visible = Boolean(action);
+      stats.ghost = ghost.visible;
+      dirty = true;
+    },
+    // back to the live robot
+    endEpisode() {
+      if (!episode) return;
+      episode = null;
+      stats.episode = null;
+      ghost.visible = false;
+      stats.ghost = false;
+      pose(robot, present);
+      Object.assign(drawn, present);
+      dirty = true;
+    },
   };
 }
