@@ -120,6 +120,16 @@ class DatasetRecordings:
         current.session.controls.press(key)
         return current.state()
 
+    def stop(self) -> bool:
+        """Stop the recording under way as Esc does, without waiting; False when none was."""
+        from poppy_core.motion.recording_session import ESC
+
+        current = self._current
+        if current is None or not current.active or current.session is None:
+            return False
+        current.session.controls.press(ESC)
+        return True
+
     def start(self, request: DatasetRequest, client: str = "") -> dict[str, Any]:
         """Check ``request``, build the recording and start its thread; its state.
 

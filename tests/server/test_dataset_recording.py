@@ -24,6 +24,7 @@ from poppy_core.motion import Move, save_move
 from tests.helpers.cli import command_env
 from tests.helpers.lerobot_venv import run_oracle
 from tests.helpers.processes import reap, start
+from tests.helpers.server import serve_robot
 from tests.helpers.waiting import eventually, http_timeout
 
 pytestmark = pytest.mark.slow
@@ -271,3 +272,47 @@ def test_ctrl_c_of_poppy_serve_keeps_the_saved_episodes_loadable(tmp_path: Path)
     assert not [p for p in root.rglob("*") if p.name.startswith(".")]  # no leftover
     seen = run_oracle("load", str(root), "class/cut", "0")
     assert (seen["len"], seen["num_episodes"]) == (info["total_frames"], 2)
+
+
+def test_the_token_and_the_origin_guard_cover_the_routes(home: Path) -> None:
+    asked = {"repo_id": "class/guarded", "task": "t", "source": "by_hand", **QUICK}
+    cross_site = {"Origin": "https://evil.example", "Sec-Fetch-Site": "cross-site"}
+    served = serve_robot(from_profile("ergo-jr", sim=True), token="s3cret-recording")
+    url = next(served).url
+    try:
+        with httpx.Client(base_url=url, timeout=http_timeout(30.0)) as http:
+            for path in ("/api/v1/recording", "/api/v1/recording/stop"):
+                assert http.post(path, json=asked).status_code == 401
+            assert http.get("/api/v1/recording").status_code == 401
+            bearer = {"Authorization": "Bearer s3cret-recording"}
+            refused = http.post("/api/v1/recording", json=asked, headers=bearer | cross_site)
+            assert refused.status_code == 403, refused.text
+            assert not (home / "class/guarded").exists()
+            answer = http.post("/api/v1/recording", json=asked, headers=bearer)
+            assert answer.status_code == 200, answer.text
+            stopped = http.post("/api/v1/recording/stop", headers=bearer)
+            assert stopped.status_code == 200, stopped.text
+    finally:
+        served.close()
+    assert json.loads((home / "class/guarded/meta/info.json").read_text())["total_episodes"] <= 1
+
+
+def test_the_pages_stop_ends_the_recording_as_esc(http: httpx.Client, home: Path) -> None:
+    record(
+        http,
+        repo_id="class/halted",
+        task="wave",
+        source="move",
+        move="wave",
+        episodes=3,
+        episode_s=60,
+        **QUICK,
+    )
+    until(http, "frames", lambda s: s["frames"] >= 3)
+    answer = http.post("/api/v1/web/stop", json={"then": "hold"})
+    assert answer.status_code == 200, answer.text
+    ended = done(http)
+    assert [e["episode"] for e in ended["saved"]] == [0] and ended["error"] is None
+    assert http.get("/api/v1/moves/status").json()["playing"] == []
+    info = json.loads((home / "class/halted/meta/info.json").read_text())
+    assert info["total_episodes"] == 1
