@@ -88,6 +88,10 @@ def test_the_panel_records_with_the_keys(browser: Any, served: Served, home: Pat
         # Esc on the panel stopped the recording, not every motion (the page's Stop dialog)
         assert not tab.evaluate("() => document.getElementById('stop-dialog').open")
         assert tab.is_enabled("#dataset-start") and not tab.is_enabled("#dataset-stop")
+        # the same name again, without "Add to it": the server's one line on the status line
+        tab.click("#dataset-start")
+        eventually(lambda: "already exists" in tab.inner_text("#message"), "the refusal")
+        assert "error" in (tab.get_attribute("#message", "class") or "")
     finally:
         http.close()
         context.close()

@@ -316,3 +316,20 @@ def test_the_pages_stop_ends_the_recording_as_esc(http: httpx.Client, home: Path
     assert http.get("/api/v1/moves/status").json()["playing"] == []
     info = json.loads((home / "class/halted/meta/info.json").read_text())
     assert info["total_episodes"] == 1
+
+
+def test_a_primitive_runs_each_episode_and_a_running_one_is_refused(
+    http: httpx.Client, home: Path
+) -> None:
+    assert http.post("/api/v1/primitives/dance/start").status_code == 200
+    asked = {"repo_id": "class/dance", "task": "dance", "source": "primitive", **QUICK}
+    refused = http.post("/api/v1/recording", json={**asked, "primitive": "dance"})
+    assert refused.status_code == 409 and "dance is running" in refused.json()["detail"]
+    assert http.post("/api/v1/primitives/dance/stop").status_code == 200
+    record(http, **asked, primitive="dance", episodes=2, episode_s=1)
+    until(http, "the primitive running", lambda s: s["frames"] >= 2 or not s["active"])
+    ended = done(http)
+    assert [e["episode"] for e in ended["saved"]] == [0, 1]
+    assert http.get("/api/v1/primitives/dance").json()["state"] != "running"
+    data = rows(home / "class/dance")
+    assert data["episode_index"].count(1) == ended["saved"][1]["frames"]
