@@ -19,9 +19,10 @@ logger = logging.getLogger(__name__)
 
 
 def halt_activity(service: RobotService) -> tuple[list[str], list[str]]:
-    """Stop every primitive running, every move playing, every teleoperation and the
-    trajectory, and free every motor's lease (``motion/leases.py``); the primitives' and the
-    moves' names."""
+    """Stop every primitive running, every move playing, every teleoperation, the trajectory
+    and a dataset recording (as its Esc: the episode under way is saved), and free every motor's
+    lease (``motion/leases.py``); the primitives' and the moves' names."""
+    service.recordings.stop()  # first: its move or primitive is not started again
     stopped = service.running_primitives()
     for name in stopped:
         service.primitive(name).halt(wait=True)

@@ -66,6 +66,7 @@ def create_app(
         v1_chains,
         v1_motion,
         v1_motors,
+        v1_recording,
         v1_robot,
         v1_sensors,
         v1_settings,
@@ -122,6 +123,7 @@ def create_app(
         v1_motors.router,
         v1_motion.router,
         v1_chains.router,
+        v1_recording.router,
         v1_sensors.router,
         v1_settings.router,
     ):

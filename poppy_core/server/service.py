@@ -24,6 +24,7 @@ from poppy_core.server.chain_gotos import ChainGotos, ChainMove, chain_holder
 from poppy_core.server.compliant_goals import GOAL_REGISTERS, CompliantGoals, goal_motors
 from poppy_core.server.errors import ApiError
 from poppy_core.server.moves import MoveService
+from poppy_core.server.recordings import DatasetRecordings
 from poppy_core.server.service_primitives import PrimitiveOperations
 from poppy_core.server.start_time import StartTimes, check_start_at, on_monotonic
 from poppy_core.server.teleop_channel import TeleopRegistry
@@ -55,6 +56,8 @@ class RobotService(PrimitiveOperations):
         """Which WebSocket connection teleoperates which motor (a lease each)."""
         self.chain_gotos = ChainGotos(self.leases)
         """The v1 chain gotos running (a lease each)."""
+        self.recordings = DatasetRecordings(robot, self.moves, self.leases)
+        """The LeRobot dataset recorded from the page (one at a time)."""
         self._description: tuple[float, bytes] | None = None
         self.compliant_goals = CompliantGoals()
         """Goals to compliant motors: refused on v1, logged once per motor either way."""
@@ -362,7 +365,8 @@ class RobotService(PrimitiveOperations):
 
     def close(self) -> None:
         """Stop the recordings, playbacks, trajectory, chains' straight moves and
-        teleoperations this server started."""
+        teleoperations this server started; a dataset recording keeps its saved episodes."""
+        self.recordings.close()
         self.teleop.close()
         self.follower.close()
         self.chain_gotos.stop_all()

@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
 import typer
 
-MAX_EPISODE_S = 3600.0
 SOURCES = ("--play", "--primitive", "--by-hand", "--leader")
 
 
@@ -17,9 +15,15 @@ def usage(message: str, hint: str | None = None) -> typer.BadParameter:
 
 
 def seconds(value: float, name: str, low: float) -> float:
-    if not math.isfinite(value) or not low <= value <= MAX_EPISODE_S:
-        raise usage(f"{value!r}: give {low:g} to {MAX_EPISODE_S:g} seconds", name)
-    return value
+    from poppy_core.motion.recording_session import check_seconds
+
+    return float(core(lambda: check_seconds(value, name, low), name))
+
+
+def episode_count(episodes: int) -> int:
+    from poppy_core.motion.recording_session import check_episodes
+
+    return int(core(lambda: check_episodes(episodes), "--episodes"))
 
 
 def core(call: Any, hint: str) -> Any:

@@ -17,10 +17,10 @@ from contextlib import ExitStack
 from typing import Any
 
 from poppy_cli.output import err_console
+from poppy_core.motion.recording_session import ENTER, ESC, LEFT, RIGHT, Controls
 
 LIVE_EVERY_S = 0.25
 POLL_S = 0.1
-RIGHT, LEFT, ESC, ENTER = "right", "left", "esc", "enter"
 _SEQUENCES = {b"[C": RIGHT, b"OC": RIGHT, b"[D": LEFT, b"OD": LEFT}
 
 
@@ -51,29 +51,13 @@ def parse_keys(data: bytes) -> list[str]:
     return keys
 
 
-class Keys:
-    """What the keys (and SIGINT, SIGTERM) asked: ``ending`` ends the episode or reset under
-    way, ``rerecord`` drops that episode to record it again, ``stop`` ends the recording."""
+class Keys(Controls):
+    """The session's controls (``recording_session.Controls``) pressed by the keys of a
+    terminal, and by SIGINT and SIGTERM (stop)."""
 
     def __init__(self) -> None:
-        self.ending = threading.Event()
-        self.rerecord = threading.Event()
-        self.stop = threading.Event()
+        super().__init__()
         self.on_terminal = False
-
-    def press(self, key: str) -> None:
-        if key == LEFT:
-            self.rerecord.set()
-        elif key in (ESC, ENTER):
-            self.stop.set()
-        self.ending.set()
-
-    def next_part(self) -> None:
-        """An episode or a reset begins: the keys pressed before are spent."""
-        self.ending.clear()
-        self.rerecord.clear()
-        if self.stop.is_set():
-            self.ending.set()
 
     def install(self, stack: ExitStack) -> None:
         """SIGINT and SIGTERM stop; on a terminal, the keys are read (until ``stack`` closes)."""

@@ -9,7 +9,14 @@ from pathlib import Path
 import typer
 
 from poppy_cli import complete
-from poppy_cli.commands.dataset.checks import camera_specs, core, seconds, source_of, usage
+from poppy_cli.commands.dataset.checks import (
+    camera_specs,
+    core,
+    episode_count,
+    seconds,
+    source_of,
+    usage,
+)
 from poppy_cli.commands.dataset.recording import Plan, config_cameras, record_episodes
 from poppy_cli.commands.dataset.sources import ZENOH, load_move
 from poppy_cli.options import ConfigOpt, JsonSummaryOpt, PortOpt, ProfileOpt, SimOpt
@@ -83,8 +90,7 @@ def record(
     core(lambda: layout.check_repo_id(repo_id), "REPO_ID")
     core(lambda: layout.check_fps(fps), "--fps")
     core(lambda: layout.check_task(task), "--task")
-    if not 1 <= episodes <= 10_000:
-        raise usage(f"{episodes}: give 1 to 10000 episodes", "--episodes")
+    episode_count(episodes)
     seconds(episode_s, "--episode-s", 0.1)
     seconds(reset_s, "--reset-s", 0.0)
     source = source_of(play, primitive, by_hand, leader)

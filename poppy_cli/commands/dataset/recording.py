@@ -8,11 +8,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from poppy_cli.commands.dataset.checks import core, usage
-from poppy_cli.commands.dataset.live import Keys, Live
 from poppy_cli.commands.dataset.sources import action_source, open_leader
 from poppy_cli.output import err_console
 
 if TYPE_CHECKING:
+    from poppy_cli.commands.dataset.live import Keys, Live
     from poppy_core.dataset.layout import DatasetSpec
     from poppy_core.robot import RobotConfig
 
@@ -79,6 +79,7 @@ def open_writer(folder: Path, spec: DatasetSpec, resume: bool) -> Any:
 
 def record_episodes(config: RobotConfig, sim: str | None, plan: Plan) -> dict[str, Any]:
     """Build everything, record ``plan.episodes`` episodes; the summary."""
+    from poppy_cli.commands.dataset.live import Keys, Live
     from poppy_cli.robots import start_robot
     from poppy_core.dataset.layout import DatasetSpec
     from poppy_core.motion.episodes import EpisodeRecorder
@@ -145,31 +146,14 @@ def record_episodes(config: RobotConfig, sim: str | None, plan: Plan) -> dict[st
 
 
 def _episodes(recorder: Any, keys: Keys, live: Live, plan: Plan) -> tuple[list[Any], int]:
-    """The episodes, each followed by a reset but the last; the saved ones and frames dropped."""
-    saved: list[Any] = []
-    dropped = 0
-    number = 0
-    while number < plan.episodes and not keys.stop.is_set():
-        keys.next_part()
-        episode = recorder.record(
-            plan.task,
-            plan.episode_s,
-            episode=number,
-            stop=keys.ending,
-            discard=keys.rerecord,
-            on_tick=live.update,
-        )
-        again = keys.rerecord.is_set() and not keys.stop.is_set()
-        if episode is not None:
-            saved.append(episode)
-            dropped += live.dropped
-            live.done(episode)
-        elif again:
-            live.again(number)
-        if not again:
-            number += 1
-        if number < plan.episodes and plan.reset_s > 0 and not keys.stop.is_set():
-            keys.next_part()
-            live.reset(number, plan.reset_s)
-            keys.ending.wait(plan.reset_s)
-    return saved, dropped
+    """The session's episodes (``recording_session``); the saved ones and frames dropped."""
+    from poppy_core.motion.recording_session import RecordingSession, SessionPlan
+
+    session = RecordingSession(
+        recorder,
+        SessionPlan(plan.task, plan.episodes, plan.episode_s, plan.reset_s),
+        keys,
+        live,
+    )
+    saved = session.run()
+    return saved, session.dropped
