@@ -84,7 +84,7 @@ def _source(
 ) -> Iterator[tuple[Camera, MarkerDetector | None]]:
     """The camera (and a marker detector) of a device, or of a simulated robot."""
     from poppy_core.sensors import MarkerDetector
-    from poppy_core.sensors.opencv_camera import OpenCVCamera
+    from poppy_core.sensors.opencv_capture import OpenCVCamera
 
     if (marker is not None or card) and sim != "mujoco":
         _usage("--marker and --card put a card in a simulated scene: add --sim mujoco")
@@ -154,7 +154,7 @@ def _pose_for_camera(
 
 def list_cameras(json_output: bool = JsonOpt) -> None:
     """The video devices of this machine (V4L2), with their names."""
-    from poppy_core.sensors.opencv_camera import list_devices
+    from poppy_core.sensors.opencv_capture import list_devices
 
     devices = list_devices()
     if json_output:

@@ -155,7 +155,7 @@ def opencv_camera(spec: SensorSpec) -> Camera:
     fps = spec.rate_hz or DEFAULT_FPS
     if spec.type == "DummyCamera":
         return DummyCamera(spec.name, spec.resolution or DEFAULT_RESOLUTION, fps)
-    from poppy_core.sensors.opencv_camera import OpenCVCamera
+    from poppy_core.sensors.opencv_capture import OpenCVCamera
 
     return OpenCVCamera(
         spec.name, spec.source, fps, spec.resolution, calibration=spec.calibration, retry_open=True

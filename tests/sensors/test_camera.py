@@ -12,7 +12,7 @@ import pytest
 
 from poppy_core.errors import SensorError
 from poppy_core.sensors import DummyCamera, MarkerDetector, build_sensors, opencv_camera
-from poppy_core.sensors.opencv_camera import OpenCVCamera, list_devices
+from poppy_core.sensors.opencv_capture import OpenCVCamera, list_devices
 from tests.helpers.configs import checked_sensors
 from tests.helpers.waiting import eventually
 
@@ -200,3 +200,13 @@ def test_list_devices_reads_sysfs(tmp_path: Path) -> None:
         {"device": "/dev/video2", "index": 2, "name": "USB Camera: metadata"},
     ]
     assert list_devices(str(tmp_path / "none")) == []
+
+
+def test_the_packages_camera_maker_stays_a_function_once_the_camera_module_is_loaded() -> None:
+    # A submodule named like a name of its package replaces that name once imported: the
+    # module that opens OpenCV devices is not called `opencv_camera`, the package's maker is.
+    import poppy_core.sensors as sensors
+    import poppy_core.sensors.opencv_capture  # noqa: F401
+
+    assert callable(sensors.opencv_camera)
+    assert sensors.opencv_camera is opencv_camera

@@ -19,7 +19,7 @@ from poppy_core import from_config, from_profile
 from poppy_core.pypot import PoppyErgoJr
 from poppy_core.robot import Robot, RobotConfig, load_profile, with_ports
 from poppy_core.sensors import Camera
-from poppy_core.sensors.opencv_camera import OpenCVCamera
+from poppy_core.sensors.opencv_capture import OpenCVCamera
 from tests.helpers.bus import emulate_bus
 from tests.helpers.cli import command_env
 from tests.helpers.waiting import eventually, http_timeout, scaled

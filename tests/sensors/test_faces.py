@@ -16,9 +16,9 @@ from poppy_core.sensors import (
     FaceDetector,
     FaceFinder,
     build_sensors,
+    opencv_camera,
 )
-from poppy_core.sensors.config import opencv_camera  # the package's name is the submodule too
-from poppy_core.sensors.opencv_camera import OpenCVCamera
+from poppy_core.sensors.opencv_capture import OpenCVCamera
 from tests.helpers.configs import checked_sensors
 from tests.helpers.waiting import eventually
 

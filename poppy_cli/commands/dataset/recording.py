@@ -64,7 +64,7 @@ def make_camera(name: str, spec: str) -> Any:
     from poppy_core.extras import require
 
     require("cv2", extra="vision", feature="cameras")
-    from poppy_core.sensors.opencv_camera import OpenCVCamera
+    from poppy_core.sensors.opencv_capture import OpenCVCamera
 
     return OpenCVCamera(name, int(spec) if spec.isdigit() else spec, 30.0)
 
