@@ -23,20 +23,22 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/activate
 run: $(VENV)/.installed
 	$(BIN)/poppy demo
 
-# Parallel pytest workers: two per core of the 2-core machines we test on, since most tests wait
-# (wire timing, servers, subprocesses) more than they compute. The `poppy` commands the tests run
-# wait for their emulators' replies as long as the load needs (POPPY_REPLY_FLOOR_S, see
-# docs/testing.md); TEST_WORKERS=2 for one per core, TEST_WORKERS=0 runs in one process.
-TEST_WORKERS ?= 4
+# Parallel pytest workers: `auto` is three per core on an idle machine and two per core on a busy
+# one (tests/conftest.py), since most tests wait (wire timing, servers, subprocesses) more than
+# they compute. The `poppy` commands the tests run wait for their emulators' replies as long as
+# the load needs (POPPY_REPLY_FLOOR_S, see docs/testing.md); TEST_WORKERS=4 for four,
+# TEST_WORKERS=0 runs in one process.
+TEST_WORKERS ?= auto
 
 # The whole suite in parallel workers, a test module per worker (see tests/conftest.py); the
-# OpenGL tests run in a pytest process of their own.
+# OpenGL tests run in a pytest process of their own. mypy and that process run beside the
+# parallel suite, which mostly waits (tests/together.sh: their output follows the suite's, and
+# any failure fails `make test`).
 test: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
 	$(BIN)/ruff format --check poppy_core poppy_cli tests bench
-	$(BIN)/mypy
-	$(BIN)/pytest -m "not gl" -n $(TEST_WORKERS) --dist loadgroup
-	$(BIN)/pytest -m gl
+	sh tests/together.sh '$(BIN)/pytest -m "not gl" -n $(TEST_WORKERS) --dist loadgroup' \
+		'$(BIN)/mypy' '$(BIN)/pytest -m gl'
 
 # The inner loop (under 90 s on a quiet machine): lint, then every test not marked `slow`.
 test-fast: $(VENV)/.installed-test

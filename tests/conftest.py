@@ -22,7 +22,8 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
-from tests.helpers.waiting import load_factor
+from tests.helpers import timing
+from tests.helpers.waiting import load_factor, runnable_now
 
 TESTS = Path(__file__).resolve().parent
 SLOW_FOLDERS = {"cli", "creatures", "gym", "server", "sim", "teleop", "tui"}
@@ -84,9 +85,52 @@ settings.register_profile("thorough", max_examples=1000, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 
+# `make test` runs `-n auto`: on an idle machine three workers per core, since the suite mostly
+# waits (four workers on two cores kept them 49 % busy); two per core once the machine is busy
+# (its load, less the commands tests/together.sh started beside this run, is 1.5 per core or
+# more: CI's neighbours, busy loops), where more workers would only make each test later.
+# PYTEST_XDIST_AUTO_NUM_WORKERS=N overrides it.
+IDLE_WORKERS_PER_CORE = 3
+BUSY_WORKERS_PER_CORE = 2
+BUSY_LOAD_PER_CORE = 1.5
+
+
+@pytest.hookimpl(optionalhook=True)  # an xdist hook: unknown to a run with -p no:xdist
+def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
+    del config
+    override = os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS", "").strip()
+    if override.isdigit():
+        return int(override)
+    cores = os.cpu_count() or 1
+    beside = int(os.environ.get("TOGETHER_BESIDE", "0") or 0)  # mypy, the OpenGL tests
+    load = max(os.getloadavg()[0], float(runnable_now() - beside))
+    busy = load / cores >= BUSY_LOAD_PER_CORE
+    return (BUSY_WORKERS_PER_CORE if busy else IDLE_WORKERS_PER_CORE) * cores
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    timing.pytest_configure(config)
+    if getattr(config.option, "dist", "no") == "loadgroup":
+        # The workers' collection order (longest groups first, pytest_collection_modifyitems)
+        # is the order groups are handed out in: xdist must not sort them by test count.
+        config.option.loadscopereorder = False
+
+
+def _longest_groups_first(items: list[pytest.Item], groups: dict[pytest.Item, str]) -> None:
+    """Sorts ``items`` in the order their groups are handed out (``timing.handout_order``:
+    xdist hands a worker a whole group, and the long ones must not start last); each group's
+    tests keep their order."""
+    counts: dict[str, int] = {}
+    for item in items:
+        counts[groups[item]] = counts.get(groups[item], 0) + 1
+    rank = {group: index for index, group in enumerate(timing.handout_order(counts))}
+    items.sort(key=lambda item: rank[groups[item]])
+
+
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     grouped = config.pluginmanager.hasplugin("xdist")
+    groups: dict[pytest.Item, str] = {}
     for item in items:
         try:
             relative = Path(str(item.path)).resolve().relative_to(TESTS)
@@ -100,6 +144,9 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             module = relative.as_posix()
             group = "browser" if module in BROWSER_MODULES else module
             item.add_marker(pytest.mark.xdist_group(group))
+            groups[item] = group
+    if grouped and os.environ.get("PYTEST_XDIST_WORKER") and len(groups) == len(items):
+        _longest_groups_first(items, groups)
 
 
 def _timeout_s(item: pytest.Item) -> float:

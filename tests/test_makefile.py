@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 import shutil
 import subprocess
 from pathlib import Path
@@ -44,3 +45,45 @@ def test_make_installs_every_extra(target: str, extras: str, tmp_path: Path) -> 
     done = make_dry_run(target, tmp_path)
     install = [line for line in done.stdout.splitlines() if "pip install --quiet -e" in line]
     assert install and install[-1].endswith(f"-e '.{extras}'"), install
+
+
+def test_make_test_runs_mypy_and_the_gl_tests_beside_the_parallel_suite(tmp_path: Path) -> None:
+    """Every part of `make test` is still run: lint, then the suite, mypy and the OpenGL tests
+    at the same time (tests/together.sh, whose status is the first failing part's)."""
+    lines = make_dry_run("test", tmp_path).stdout.replace("\\\n", " ").splitlines()
+    together = next(line for line in lines if "tests/together.sh" in line)
+    assert "ruff check" in lines[lines.index(together) - 2]
+    assert "ruff format --check" in lines[lines.index(together) - 1]
+    parts = shlex.split(together)[2:]
+    assert parts[0].endswith('pytest -m "not gl" -n auto --dist loadgroup'), parts
+    assert [part.rsplit("/", 1)[-1] for part in parts[1:]] == ["mypy", "pytest -m gl"]
+
+
+def together(*commands: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        ["sh", str(ROOT / "tests" / "together.sh"), *commands],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+
+
+def test_together_fails_when_a_command_beside_the_main_one_fails() -> None:
+    done = together("echo main", 'sh -c "echo broken; exit 3"', "echo fine")
+    assert done.returncode == 3, done
+    assert done.stdout.splitlines() == [
+        "echo main",
+        "main",
+        "",
+        '==== sh -c "echo broken; exit 3" (exit 3) ====',
+        "broken",
+        "",
+        "==== echo fine (exit 0) ====",
+        "fine",
+    ]
+
+
+def test_together_exits_with_the_main_commands_failure_first() -> None:
+    assert together("exit 4", "false").returncode == 4
+    assert together("true", "true").returncode == 0

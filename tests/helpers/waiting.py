@@ -28,7 +28,7 @@ COMMAND_REPLY_FLOOR_IDLE_S = 0.2
 REPLY_FLOOR_ENV = "POPPY_REPLY_FLOOR_S"
 
 
-def _runnable_now() -> int:
+def runnable_now() -> int:
     """Threads running or ready to run right now (``/proc/loadavg``'s 4th field), 0 if unknown.
 
     The load averages lag: the 1-minute one takes a minute to see busy loops started beside the
@@ -49,7 +49,7 @@ def load_factor() -> float:
     except OSError:
         average = 0.0
     cores = os.cpu_count() or 1
-    return min(MAX_LOAD_FACTOR, max(1.0, max(average, float(_runnable_now())) / cores))
+    return min(MAX_LOAD_FACTOR, max(1.0, max(average, float(runnable_now())) / cores))
 
 
 def scaled(seconds: float) -> float:
