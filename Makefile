@@ -23,9 +23,9 @@ $(VENV)/.installed-test: pyproject.toml | $(BIN)/activate
 run: $(VENV)/.installed
 	$(BIN)/poppy demo
 
-# Parallel pytest workers: `auto` is three per core on an idle machine and two per core on a busy
-# one (tests/conftest.py), since most tests wait (wire timing, servers, subprocesses) more than
-# they compute. The `poppy` commands the tests run wait for their emulators' replies as long as
+# Parallel pytest workers: `auto` is two per core (tests/conftest.py), since most tests wait
+# (wire timing, servers, subprocesses) more than they compute; three per core made the idle
+# run slower. The `poppy` commands the tests run wait for their emulators' replies as long as
 # the load needs (POPPY_REPLY_FLOOR_S, see docs/testing.md); TEST_WORKERS=4 for four,
 # TEST_WORKERS=0 runs in one process.
 TEST_WORKERS ?= auto

@@ -85,12 +85,13 @@ settings.register_profile("thorough", max_examples=1000, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 
-# `make test` runs `-n auto`: on an idle machine three workers per core, since the suite mostly
-# waits (four workers on two cores kept them 49 % busy); two per core once the machine is busy
-# (its load, less the commands tests/together.sh started beside this run, is 1.5 per core or
-# more: CI's neighbours, busy loops), where more workers would only make each test later.
-# PYTEST_XDIST_AUTO_NUM_WORKERS=N overrides it.
-IDLE_WORKERS_PER_CORE = 3
+# `make test` runs `-n auto`: two workers per core, idle or busy (its load, less the commands
+# tests/together.sh started beside this run, 1.5 per core or more: CI's neighbours, busy
+# loops). Three per core were tried on an idle machine, since the suite mostly waits: the run
+# took 16 min 29 s where four workers took 13 min 31 s (load 6-13: the load-scaled waits and
+# the children's reply floors grew with it; docs/testing.md). PYTEST_XDIST_AUTO_NUM_WORKERS=N
+# overrides it.
+IDLE_WORKERS_PER_CORE = 2
 BUSY_WORKERS_PER_CORE = 2
 BUSY_LOAD_PER_CORE = 1.5
 

@@ -121,7 +121,9 @@ class FlushingClient:
     """
 
     def __init__(self, url: str, received: Callable[[], int]) -> None:
-        self.port = serial.Serial(url, 1_000_000, timeout=0.05, write_timeout=0.05)
+        # pyserial checks its write timeout after the write: a thread the busy machine ran late
+        # got "Write timeout" for bytes it had written, so the timeout follows the load
+        self.port = serial.Serial(url, 1_000_000, timeout=0.05, write_timeout=scaled(0.5))
         self.decoder = PacketDecoder(2, "status")
         self.received = received
 
@@ -138,7 +140,7 @@ class FlushingClient:
     def read(self, motor_id: int, address: int, length: int) -> bytes | None:
         self.send(encode_instruction(2, read(2, motor_id, address, length)))
         self.decoder.reset()
-        end = time.monotonic() + 0.5
+        end = time.monotonic() + scaled(0.5)
         while time.monotonic() < end:
             for packet in self.decoder.feed(self.port.read(max(1, self.port.in_waiting))):
                 if isinstance(packet, StatusPacket) and packet.id == motor_id:

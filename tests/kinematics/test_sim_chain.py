@@ -4,7 +4,6 @@ goto ends near its target (Ergo Jr, Torso, Humanoid arms); head_follow follows."
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -19,6 +18,7 @@ from poppy_core.motion.chains import chains_from_config
 from poppy_core.robot import Robot, load_profile
 from poppy_core.robot.frames import to_motor
 from tests.helpers.fixtures import ergo_fixture
+from tests.helpers.waiting import eventually
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -39,12 +39,7 @@ def _simulated_tip(robot: Robot) -> np.ndarray:
 
 
 def _wait_until(condition, timeout_s: float) -> bool:  # type: ignore[no-untyped-def]
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if condition():
-            return True
-        time.sleep(0.05)
-    return condition()
+    return eventually(lambda: bool(condition()), timeout_s=timeout_s, interval_s=0.05)
 
 
 @pytest.mark.parametrize("target", [(0.1, -0.1, 0.12), (0.0, -0.15, 0.08), (-0.12, 0.0, 0.15)])
@@ -151,7 +146,13 @@ def _goto_ends_near(robot: Robot, chain: RobotChain, target: np.ndarray) -> None
         return bool(np.linalg.norm(_chain_tip_in_sim(robot, chain) - target) < 0.005)
 
     assert _wait_until(near, 8.0), f"tip at {_chain_tip_in_sim(robot, chain)}, target {target}"
-    assert np.linalg.norm(chain.position - _chain_tip_in_sim(robot, chain)) < 0.01
+
+    def agrees() -> bool:  # the present positions a sync period late on a busy machine
+        return bool(np.linalg.norm(chain.position - _chain_tip_in_sim(robot, chain)) < 0.01)
+
+    assert _wait_until(agrees, 8.0), (
+        f"chain at {chain.position}, tip {_chain_tip_in_sim(robot, chain)}"
+    )
 
 
 @pytest.mark.parametrize("side", ["l", "r"])

@@ -123,8 +123,9 @@ def test_get_collision_state_and_tracked_collisions(poppy: Any) -> None:
 
 def test_tracked_objects_give_position_and_orientation(poppy: Any) -> None:
     poppy.track_objects(["ball"])
-    assert poppy.ball.position == poppy.get_object_position("ball")
-    assert poppy.ball.orientation == poppy.get_object_orientation("ball")
+    # the physics runs between the two reads: the ball may still be settling
+    assert poppy.ball.position == pytest.approx(poppy.get_object_position("ball"), abs=1e-4)
+    assert poppy.ball.orientation == pytest.approx(poppy.get_object_orientation("ball"), abs=1e-3)
     with pytest.raises(ConfigError, match="already"):
         poppy.track_objects(["tip"])  # the Ergo Jr's robot.tip is taken
 

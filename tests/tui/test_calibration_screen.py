@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
@@ -11,6 +12,19 @@ from textual.widgets import Button  # noqa: TID253  (a TUI test)
 from poppy_cli.tui.widgets.calibration import CalibrationScreen
 from tests.tui.conftest import run_async, wait_for
 from tests.tui.test_robot_tab import SIZE, hand, open_sim, sim_app
+
+
+def watching(screen: CalibrationScreen, motor: str) -> bool:
+    """Whether the range step shown is ``motor``'s (the previous one may still be shown)."""
+    watch = screen._watch
+    return watch is not None and any(r.motor == motor for r in watch.readings())
+
+
+def reading(screen: CalibrationScreen, motor: str) -> Any:
+    """The range step's live reading of ``motor`` (current, low, high, span)."""
+    watch = screen._watch
+    assert watch is not None, "no range step shown"
+    return next(r for r in watch.readings() if r.motor == motor)
 
 
 @pytest.fixture(autouse=True)
@@ -45,13 +59,26 @@ async def test_a_calibration_from_the_robot_tab_is_saved(user_dirs: Path) -> Non
         for step in range(6):  # one joint at a time: each swept through 60°
             await wait_for(
                 pilot,
-                lambda: step_title(screen) == "Ranges" and not go.disabled,
+                lambda m=f"m{step + 1}": (
+                    step_title(screen) == "Ranges" and not go.disabled and watching(screen, m)
+                ),
                 what=f"range step {step + 1}",
             )
             virtual = hand(robot, step + 1)
-            for angle in (-25.0, 35.0, 5.0):
+            motor = f"m{step + 1}"
+            at_posture = reading(screen, motor).current
+            # each position held until the sampler saw it (a busy machine runs it late)
+            for angle, span in ((-25.0, 29.0), (35.0, 59.0), (5.0, 59.0)):
                 virtual.move_by_hand(angle)
-                await pilot.pause(0.15)
+                now = reading(screen, motor)
+                await wait_for(
+                    pilot,
+                    lambda m=motor, a=angle, s=span, p=at_posture: (
+                        reading(screen, m).span >= s
+                        and (a != 5.0 or abs(reading(screen, m).current - p) < 1.0)
+                    ),
+                    what=f"{motor} sampled at {angle}° (now {now})",
+                )
             go.press()
         await wait_for(pilot, lambda: step_title(screen) in ("Review", "Question"), what="review")
         assert step_title(screen) == "Review", str(screen.query_one("#calibration-text").render())

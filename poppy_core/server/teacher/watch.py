@@ -59,7 +59,10 @@ class Card:
             "motors": len(described.get("motors", [])),
             "token": bool(described.get("token", False)),
             "health": _verdict(self.alive, health, state_age),
-            "ok": bool(health.get("ok", False)) and state_age is not None and state_age < STALE_S,
+            "ok": self.alive
+            and bool(health.get("ok", False))
+            and state_age is not None
+            and state_age < STALE_S,
             "offline": list(health.get("offline", [])),
             "state_hz": health.get("state_hz"),
             "temperature": self.temperature,
