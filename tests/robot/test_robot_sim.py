@@ -13,6 +13,7 @@ from poppy_core.robot import Robot
 from poppy_core.trajectory import MinimumJerk
 from tests.helpers import eventually
 from tests.helpers.fixtures import ergo_fixture
+from tests.helpers.waiting import load_factor
 
 CONTROLLER = "my_dxl_controller"
 
@@ -121,7 +122,9 @@ def test_unplugged_motor_does_not_slow_the_others(ergo: Robot) -> None:
     time.sleep(1.2)  # a full rate window without m4
     stats = ergo.sync_stats()[CONTROLLER]
     assert "m4" in stats.offline and stats.motor_errors["m4"] >= 3
-    assert stats.loops["present"].measured_hz > 30
+    # the rate itself is the soak bench's (`python -m bench soak` unplugs motors in turn): here
+    # the loop keeps its pace but for the load (at 4 busy loops it ran at 10.6 Hz, m4 or not)
+    assert stats.loops["present"].measured_hz > 30 / load_factor()
     virtual(ergo, 1).move_by_hand(-25.0)
     assert eventually(lambda: abs(ergo.m1.present_position + 25) < 0.5, 1.0)
     emulator.plug(4)

@@ -79,7 +79,8 @@ async def test_primitive_start_pause_stop(moves_dir: Path) -> None:
         await pilot.press("p")
         assert table.get_cell("dance", "state") == "paused" and dance.should_pause()
         await pilot.press("p")
-        assert dance.state == "running" and not dance.should_pause()
+        assert not dance.should_pause()
+        await wait_for(pilot, lambda: dance.state == "running", what="resumed")
         await pilot.press("x")
         await wait_for(
             pilot, lambda: dance.state == "stopped" and not dance.is_alive(), what="stopped"
