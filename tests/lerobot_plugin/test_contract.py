@@ -25,7 +25,7 @@ XL320_STEP = 300 / 1024  # degrees a position tick (poppy's register table)
 def test_types_features_torque_limits_and_calibration(lerobot: LeRobot) -> None:
     # the leader's calibration, as LeRobot keeps it: m1 10 ticks off (on the host: no register)
     calibration = lerobot.home / "calibration" / "teleoperators" / "poppy_ergo_jr_leader"
-    calibration.mkdir(parents=True)
+    calibration.mkdir(parents=True, exist_ok=True)  # another test may have made it
     ticks = {
         f"m{i}": {"id": i, "drive_mode": 0, "homing_offset": 0, "range_min": 0, "range_max": 1024}
         for i in range(1, 7)

@@ -11,6 +11,7 @@ from collections.abc import Callable, Mapping
 
 from poppy_core.emulator import VirtualMotor
 from poppy_core.robot import Robot
+from tests.helpers.waiting import scaled
 
 READ_S = 0.06
 """Long enough for the 50 Hz sync loop to read a new position at least twice."""
@@ -65,8 +66,9 @@ class Hand:
 def wait_for(
     condition: Callable[[], object], timeout_s: float = 5.0, period_s: float = 0.01
 ) -> bool:
-    """Poll ``condition()`` until it is true or ``timeout_s`` ran out (returns its last value)."""
-    deadline = time.monotonic() + timeout_s
+    """Poll ``condition()`` until it is true or ``timeout_s`` times the load factor ran out
+    (returns its last value)."""
+    deadline = time.monotonic() + scaled(timeout_s)
     while time.monotonic() < deadline:
         if condition():
             return True
