@@ -10,6 +10,7 @@ import pytest
 from poppy_core.remote.zenoh_fleet import DEFAULT_TIMEOUT_S, Fleet
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from tests.helpers.waiting import scaled
+from tests.helpers.zenoh_router import Router
 from tests.helpers.zenoh_served import TOKEN, Served, connect_to
 
 
@@ -17,6 +18,19 @@ from tests.helpers.zenoh_served import TOKEN, Served, connect_to
 def moves(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.setenv("POPPY_MOVES_DIR", str(tmp_path))
     return tmp_path
+
+
+@pytest.fixture(scope="module")
+def router() -> Iterator[Router]:
+    """One router process for a module's tests (a process start each was most of their setup):
+    it keeps nothing of a test's robots once their sessions close. A test that stops or
+    restarts its router starts one of its own."""
+    pytest.importorskip("zenoh")
+    started = Router()
+    try:
+        yield started
+    finally:
+        started.kill()
 
 
 @pytest.fixture

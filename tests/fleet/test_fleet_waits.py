@@ -36,15 +36,6 @@ def _late(answer: Callable[[Any, Any], None]) -> Callable[[Any, Any], None]:
     return late
 
 
-@pytest.fixture(scope="module")
-def router() -> Iterator[Router]:
-    started = Router()
-    try:
-        yield started
-    finally:
-        started.kill()
-
-
 @pytest.fixture
 def loaded(moves: Path, router: Router, monkeypatch: pytest.MonkeyPatch) -> Iterator[Served]:
     node = robot_node.ZenohRobotServer

@@ -26,18 +26,6 @@ from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served
 pytest.importorskip("zenoh")
 
 
-@pytest.fixture(scope="module")
-def router() -> Iterator[Router]:
-    """One router process for the module's tests (a process start each was most of their
-    setup): it keeps nothing of a test's robots once their sessions close. A test that stops or
-    restarts its router starts one of its own."""
-    started = Router()
-    try:
-        yield started
-    finally:
-        started.kill()
-
-
 @pytest.fixture
 def pair(moves: Path, router: Router) -> Iterator[tuple[Served, Served]]:
     a, b = Served("jr-a", router=router.endpoint), Served("jr-b", router=router.endpoint)

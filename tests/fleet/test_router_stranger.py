@@ -74,15 +74,6 @@ class Stranger:
         self.session.close()  # type: ignore[no-untyped-call]
 
 
-@pytest.fixture(scope="module")
-def router() -> Iterator[Router]:
-    started = Router()
-    try:
-        yield started
-    finally:
-        started.kill()
-
-
 @pytest.fixture
 def jr1(moves: Path, router: Router) -> Iterator[Served]:
     served = Served("jr1", router=router.endpoint)
