@@ -26,9 +26,12 @@ PATIENT_LATENCY_S = 0.15
 on time (a loaded Pi, an emulator under load) is then found at the common rates, for a few
 seconds more before a search that must fail."""
 PATIENT_RATES = 1
-"""How many of the first rates of the plan the patient look tries again: 1 Mbps, the rate of
-Poppy robots (each rate more costs about a second before a search that must fail, and a
-scan's pass over every ID again)."""
+"""How many of the first rates of the plan a scan's patient look tries again: 1 Mbps, the rate
+of Poppy robots (each rate more costs a scan's pass over every ID again)."""
+SEARCH_PATIENT_RATES = 2
+"""How many a search's patient look (``find_bus``) tries again: 1 Mbps and 57,600 bps, the
+factory rate of MX and X-series motors (a search asks only its few IDs: each rate costs about
+a second more before a search that must fail)."""
 
 
 def _answering(bus: DxlBus, wanted: list[int]) -> tuple[list[int], set[int]]:
@@ -75,21 +78,22 @@ def search_order(protocols: list[int], fixed: list[int] | None) -> list[tuple[in
 
 
 def patient_steps(
-    plan: list[tuple[int, list[int]]], learned_s: float | None
+    plan: list[tuple[int, list[int]]], learned_s: float | None, rates: int = PATIENT_RATES
 ) -> list[tuple[int, int, float]]:
     """The last, patient look of a search where nothing at all answered (``find_bus``, ``scan``).
 
     Args:
         plan: the search's rates, each with its protocols, first rates first (``search_order``).
         learned_s: the adapter latency learned by the search (None: nothing learned).
+        rates: how many of the plan's first rates to try again.
 
     Returns:
-        ``(rate, protocol, latency_s)`` to try again: the first ``PATIENT_RATES`` rates of the
-        plan, in each of their protocols, with a latency of ``PATIENT_LATENCY_S`` at least, so
-        that replies a busy machine made late are not taken for an empty bus.
+        ``(rate, protocol, latency_s)`` to try again: the first ``rates`` rates of the plan, in
+        each of their protocols, with a latency of ``PATIENT_LATENCY_S`` at least, so that
+        replies a busy machine made late are not taken for an empty bus.
     """
     patient_s = max(learned_s or 0.0, PATIENT_LATENCY_S)
-    return [(rate, p, patient_s) for rate, protocols in plan[:PATIENT_RATES] for p in protocols]
+    return [(rate, p, patient_s) for rate, protocols in plan[:rates] for p in protocols]
 
 
 def _search_bus(
@@ -136,7 +140,7 @@ def _search(
             closest.offer(bus, answered)
     if closest.count:  # some motors answered in time: the others are absent, not late
         return None
-    for rate, protocol, patient_s in patient_steps(plan, learned):
+    for rate, protocol, patient_s in patient_steps(plan, learned, SEARCH_PATIENT_RATES):
         bus = _search_bus(port, rate, protocol, transport, patient_s)
         if len(_answering(bus, wanted)[0]) == len(wanted):
             return bus
@@ -168,8 +172,8 @@ def find_bus(
     A motor that answers is asked again once the line has settled, so that a late reply (a
     slow adapter) is not taken for a motor at the next rate tried; a slower adapter than
     assumed is learned from its replies (see ``poppy_core.bus.latency``). When nothing at all
-    answered, the first rates are tried once more with a patient wait (``PATIENT_LATENCY_S``):
-    replies a busy machine made late are not taken for an empty bus.
+    answered, 1 Mbps and 57,600 bps are tried once more with a patient wait
+    (``PATIENT_LATENCY_S``): replies a busy machine made late are not taken for an empty bus.
 
     Raises:
         PortError: no serial port at all; the only port given (or every one) cannot be opened.

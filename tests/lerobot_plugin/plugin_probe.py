@@ -55,7 +55,8 @@ def contract(follower_port: str, leader_port: str) -> dict[str, Any]:
 
     config = RobotConfig.get_choice_class("poppy_ergo_jr")
     follower = make_robot_from_config(
-        config(port=follower_port, id="follower", disable_torque_on_disconnect=False)
+        # an id no other test connects: its calibration file is written by this first connect
+        config(port=follower_port, id="contract-follower", disable_torque_on_disconnect=False)
     )
     out["calibrated_before"] = follower.is_calibrated
     follower.connect()

@@ -73,7 +73,8 @@ def test_types_features_torque_limits_and_calibration(lerobot: LeRobot) -> None:
     # calibration: written where LeRobot keeps it on the first connect, from poppy's profile
     assert (seen["calibrated_before"], seen["calibrated_after"]) == (False, True)
     written = Path(seen["calibration_file"])
-    assert written == Path(seen["calibration_root"]) / "robots" / "poppy_ergo_jr" / "follower.json"
+    robots = Path(seen["calibration_root"]) / "robots"
+    assert written == robots / "poppy_ergo_jr" / "contract-follower.json"
     stored = json.loads(written.read_text())
     assert stored["m1"] == {
         "id": 1,
