@@ -206,7 +206,8 @@ class GuidedSetup:
 
     def find_single(self, target: MotorTarget, progress: Progress | None = None) -> FoundMotor:
         """The one motor on the bus, found at any ID and rate in the target's protocol (and,
-        if none answers there, in the other protocol, to name a wrong model).
+        if none answers there, in the other protocol, to name a wrong model; in protocol 1 from
+        the profile's rate, rate by rate until one answers, as ``_scan_protocol``).
 
         Raises:
             SetupError: no motor, several motors, or a motor of another model.
@@ -214,9 +215,12 @@ class GuidedSetup:
         say(progress, f"looking for {target.name} on {self.port}")
         found = self._scan_protocol(target)
         if not found:
-            others = [p for p in PROTOCOLS if p != target.protocol]
             say(progress, f"nothing in protocol {target.protocol}: trying the other")
-            found = scan(self.port, None, others)
+            for other in (p for p in PROTOCOLS if p != target.protocol):
+                rates = sorted(standard_baudrates(other), key=lambda r: r != target.baudrate)
+                found = self._scan_rates(other, rates)
+                if found:
+                    break
         if not found:
             raise SetupError(
                 f"nothing answers on {self.port} (every ID and standard rate, protocols 1 and "
@@ -260,11 +264,16 @@ class GuidedSetup:
         factory_bps = None if factory is None else target.servo.baudrate_bps(factory)
         rates = list(standard_baudrates(target.protocol))
         rates.sort(key=lambda r: (r != target.baudrate, r != factory_bps))
-        if protocol_for(target.protocol).has_broadcast_ping:
-            return scan(self.port, rates, [target.protocol])
+        return self._scan_rates(target.protocol, rates)
+
+    def _scan_rates(self, protocol: int, rates: list[int]) -> list[FoundMotor]:
+        """The motors answering in ``protocol`` at ``rates``: all of them with a broadcast ping;
+        without, rate by rate until one answers (patient at the first rate only)."""
+        if protocol_for(protocol).has_broadcast_ping:
+            return scan(self.port, rates, [protocol])
         for index, rate in enumerate(rates):
-            # patient at the profile's rate only: each empty rate would pay the patient look
-            found = scan(self.port, [rate], [target.protocol], patient=index == 0)
+            # patient at the first rate only: each empty rate would pay the patient look
+            found = scan(self.port, [rate], [protocol], patient=index == 0)
             if found:
                 return found
         return []

@@ -7,21 +7,21 @@ from collections.abc import Iterator
 import pytest
 
 from poppy_core.bus import Dxl320IO, DxlIO
-from poppy_core.emulator import build_bus_from_spec, ergo_jr_bus, serve_pty
+from poppy_core.emulator import build_bus_from_spec, ergo_jr_bus, serve_link
 from poppy_core.errors import ArgumentError, RegisterError
-from tests.helpers.bus import LOADED_REPLY_FLOOR_S
 from tests.helpers.waiting import eventually
 
 BAUD = 1_000_000
-# Every IO here talks to an emulator thread on a pty that a busy machine runs late: its known
-# motors' replies get the loaded floor (pypot's 50 ms default is a real adapter's; scans keep
-# their own floor of 0).
+# Every IO here talks to its motors on the in-process link (emu://): they answer in the
+# writer's thread, never late on a busy machine, so the IOs keep pypot's timeout (50 ms, what
+# each absent ID of a scan waits) instead of a pty emulator's loaded floor (up to 2 s each).
+# (A pty between a bus and its emulator is the subject of tests/emulator and tests/interop.)
 
 
 @pytest.fixture
 def mx_port() -> Iterator[str]:
-    """A protocol 1 bus with MX-28 motors 4, 5, 6 and an AX-12A 11, served on a pty."""
-    server = serve_pty(build_bus_from_spec("MX-28:4-6,AX-12A:11", protocol=1, baudrate=BAUD))
+    """A protocol 1 bus with MX-28 motors 4, 5, 6 and an AX-12A 11, served in-process."""
+    server = serve_link(build_bus_from_spec("MX-28:4-6,AX-12A:11", protocol=1, baudrate=BAUD))
     try:
         yield server.url
     finally:
@@ -31,7 +31,7 @@ def mx_port() -> Iterator[str]:
 def test_the_documentation_script(mx_port: str) -> None:
     # "Low-level API" example: read, enable torque, go to 90°, disable torque.
     my_id = 11
-    dxl_io = DxlIO(mx_port, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S)
+    dxl_io = DxlIO(mx_port, baudrate=BAUD)
     pos = dxl_io.get_present_position([my_id])
     assert isinstance(pos, tuple) and len(pos) == 1
     dxl_io.enable_torque([my_id])
@@ -44,7 +44,7 @@ def test_the_documentation_script(mx_port: str) -> None:
 
 
 def test_scan_and_group_calls(mx_port: str) -> None:
-    with DxlIO(mx_port, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S) as dxl_io:
+    with DxlIO(mx_port, baudrate=BAUD) as dxl_io:
         assert dxl_io.scan(range(20)) == [4, 5, 6, 11]
         assert dxl_io.scan([0, 1, 2, 3, 4]) == [4]
         assert dxl_io.get_model([4, 11]) == ("MX-28", "AX-12A")
@@ -63,7 +63,7 @@ def test_scan_and_group_calls(mx_port: str) -> None:
 
 
 def test_change_id_as_the_documentation(mx_port: str) -> None:
-    with DxlIO(mx_port, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S) as dxl_io:
+    with DxlIO(mx_port, baudrate=BAUD) as dxl_io:
         found = dxl_io.scan([4])
         assert 4 in found
         dxl_io.set_return_delay_time({4: 0})
@@ -72,9 +72,9 @@ def test_change_id_as_the_documentation(mx_port: str) -> None:
 
 
 def test_dxl320io_speaks_protocol_2() -> None:
-    server = serve_pty(ergo_jr_bus())
+    server = serve_link(ergo_jr_bus())
     try:
-        with Dxl320IO(server.url, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S) as io:
+        with Dxl320IO(server.url, baudrate=BAUD) as io:
             assert io.scan(range(8)) == [1, 2, 3, 4, 5, 6]
             assert io.get_model([1]) == ("XL-320",)
             io.switch_led_on([1])
@@ -89,7 +89,7 @@ def test_dxl320io_speaks_protocol_2() -> None:
 
 
 def test_bad_calls_are_one_line(mx_port: str) -> None:
-    with DxlIO(mx_port, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S) as dxl_io:
+    with DxlIO(mx_port, baudrate=BAUD) as dxl_io:
         with pytest.raises(ArgumentError, match=r"list of IDs"):
             dxl_io.get_present_position(4)  # type: ignore[arg-type]
         with pytest.raises(ArgumentError, match=r"\{id: value\}"):
@@ -162,7 +162,7 @@ def _close(answer: object, expected: object) -> bool:
 
 
 def test_wheel_and_joint_modes_as_pypot(mx_port: str) -> None:
-    with DxlIO(mx_port, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S) as dxl_io:
+    with DxlIO(mx_port, baudrate=BAUD) as dxl_io:
         assert dxl_io.get_control_mode([4, 11]) == PYPOT_ANSWERS["get_control_mode([4, 11])"]
         for motor_id in (5, 11):
             dxl_io.set_wheel_mode([motor_id])
@@ -182,7 +182,7 @@ def test_wheel_and_joint_modes_as_pypot(mx_port: str) -> None:
 
 
 def test_gains_margins_and_grouped_registers_as_pypot(mx_port: str) -> None:
-    with DxlIO(mx_port, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S) as dxl_io:
+    with DxlIO(mx_port, baudrate=BAUD) as dxl_io:
         for call, answer in (
             ("get_pid_gain([4])", dxl_io.get_pid_gain([4])),
             ("get_compliance_margin([11])", dxl_io.get_compliance_margin([11])),
@@ -231,7 +231,7 @@ def test_gains_margins_and_grouped_registers_as_pypot(mx_port: str) -> None:
 
 
 def test_control_table_as_pypot(mx_port: str) -> None:
-    with DxlIO(mx_port, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S) as dxl_io:
+    with DxlIO(mx_port, baudrate=BAUD) as dxl_io:
         mx, ax = dxl_io.get_control_table([4, 11])
     assert tuple(mx) == PYPOT_ANSWERS["get_control_table([4]) keys"]
     assert mx["model"] == "MX-28" and mx["id"] == 4 and mx["status return level"] == "always"
@@ -242,7 +242,7 @@ def test_control_table_as_pypot(mx_port: str) -> None:
 
 
 def test_speeds_positions_and_gains_beyond_their_range_are_capped_as_pypot(mx_port: str) -> None:
-    with DxlIO(mx_port, baudrate=BAUD, timeout=LOADED_REPLY_FLOOR_S) as dxl_io:
+    with DxlIO(mx_port, baudrate=BAUD) as dxl_io:
         dxl_io.set_moving_speed({4: 10000})
         (speed,) = dxl_io.get_moving_speed([4])
         recorded = PYPOT_ANSWERS["get_moving_speed([4]) after set_moving_speed({4: 10000})"]

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from poppy_cli.commands import doctor as doctor_cmd
+from poppy_core.bus.timing import MIN_REPLY_TIMEOUT_S, REPLY_FLOOR_ENV
 from poppy_core.emulator import VirtualBus, build_bus_from_spec, serve_link, serve_pty
 from poppy_core.robot.doctor_system import SystemProbe
 from poppy_core.robot.guided_setup import motor_targets
@@ -19,6 +20,10 @@ from poppy_core.robot.profiles import load_profile
 from tests.helpers.cli import Result, no_user_settings, run_poppy
 
 ERGO_JR = load_profile("ergo-jr")
+# The environment of a command whose motors are on the in-process link (emu://): they answer in
+# the writer's thread, never late, so the command keeps a real adapter's first-reply floor (the
+# loaded one is waited by every ping of an ID not taken yet, several per motor set up).
+ON_THE_LINK = {REPLY_FLOOR_ENV: str(MIN_REPLY_TIMEOUT_S)}
 
 
 class PlugOneAtATime(io.TextIOBase):
@@ -102,8 +107,8 @@ def machine(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Machine:
     return found
 
 
-def doctor(port: str) -> Result:
-    return run_poppy("doctor", "--profile", "ergo-jr", "--port", port, "--json")
+def doctor(port: str, env: dict[str, str] | None = None) -> Result:
+    return run_poppy("doctor", "--profile", "ergo-jr", "--port", port, "--json", env=env)
 
 
 def failures(result: Result) -> dict[str, list[str]]:
@@ -122,11 +127,19 @@ def test_a_kit_plugged_one_at_a_time_becomes_an_ergo_jr_that_doctor_passes(
     machine: Machine,
 ) -> None:
     bus = kit()
-    with serve_pty(bus) as server:
+    # set up on the in-process link; doctor looks at the same motors on a pty (its latency timer)
+    with serve_link(bus) as link, serve_pty(bus) as server:
         machine.latency(server.url, 1)
         stdin = PlugOneAtATime(bus)
         done = run_poppy(
-            "setup", "motors", "--profile", "ergo-jr", "--port", server.url, input=stdin
+            "setup",
+            "motors",
+            "--profile",
+            "ergo-jr",
+            "--port",
+            link.url,
+            input=stdin,
+            env=ON_THE_LINK,
         )
         assert done.code == 0, done.stderr
         assert stdin.prompts == 6
@@ -191,10 +204,13 @@ def test_doctor_passes_a_set_up_robot(robot: Callable[..., tuple[VirtualBus, str
     assert (result.code, result.json()["ok"]) == (0, True), result.stdout
 
 
-def test_doctor_names_a_missing_motor(robot: Callable[..., tuple[VirtualBus, str]]) -> None:
-    bus, port = robot(set_up_robot())
+def test_doctor_names_a_missing_motor(machine: Machine) -> None:
+    """On the in-process link: doctor pings a missing motor three times at the floor, then scans
+    for it, and a pty emulator needs the loaded floor."""
+    bus = set_up_robot()
     bus.detach(3)
-    fixes = failures(doctor(port))
+    with serve_link(bus) as server:
+        fixes = failures(doctor(server.url, env=ON_THE_LINK))
     assert list(fixes) == ["m3 (ID 3)"]
     assert "poppy setup motors --profile ergo-jr" in fixes["m3 (ID 3)"][0]
     assert "--motors m3" in fixes["m3 (ID 3)"][0]
@@ -207,7 +223,7 @@ def test_doctor_says_where_a_motor_at_another_rate_answers(machine: Machine) -> 
     bus = set_up_robot()
     bus.motor(5).table.set("baudrate", 1)  # XL-320 code 1: 57,600 bps (e-manual)
     with serve_link(bus) as server:
-        result = doctor(server.url)
+        result = doctor(server.url, env=ON_THE_LINK)
     fixes = failures(result)
     assert list(fixes) == ["m5 (ID 5)"]
     detail = next(c["detail"] for c in result.json()["checks"] if c["name"] == "m5 (ID 5)")
@@ -342,6 +358,7 @@ def setup_once(bus: VirtualBus, *places: int, options: tuple[str, ...] = ()) -> 
             "m1",
             *options,
             input="\n",
+            env=ON_THE_LINK,
         )
 
 
@@ -395,7 +412,9 @@ def test_setup_leaves_a_motor_already_right_as_it_is() -> None:
 def test_setup_stops_when_the_input_ends() -> None:
     bus = kit()
     with serve_link(bus) as server:
-        result = run_poppy("setup", "motors", "--profile", "ergo-jr", "--port", server.url)
+        result = run_poppy(
+            "setup", "motors", "--profile", "ergo-jr", "--port", server.url, env=ON_THE_LINK
+        )
     assert result.code == 1
     assert "input ended before m1 was set up" in result.stderr
 

@@ -9,6 +9,8 @@ import json
 import shutil
 import subprocess
 import threading
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +44,41 @@ def _config(path: Path, user: str | None = None, password: str | None = None, **
     return path
 
 
+def _side_by_side(*checks: Callable[[], None]) -> None:
+    """Run ``checks`` in threads at once, then raise the first failure: each waits out a link
+    that never comes (the fleet's timeout, scaled by the load), side by side rather than one
+    after the other."""
+    with ThreadPoolExecutor(len(checks)) as pool:
+        for future in [pool.submit(check) for check in checks]:
+            future.result()
+
+
+def _refused_at(door: str) -> Callable[[], None]:
+    """A session without a file is the robot's Zenoh client: refused at ``door``, it never
+    opens."""
+
+    def check() -> None:
+        with pytest.raises(ConfigError, match="no Zenoh router or robot answers"):
+            Fleet(Settings(connect=(door,)), timeout_s=FLEET_TIMEOUT_S)
+
+    return check
+
+
+def _sees_nothing(stranger: Settings) -> Callable[[], None]:
+    """A peer with ``stranger``'s settings is not linked, sees no robot and gets no state."""
+
+    def check() -> None:
+        with Fleet(stranger, timeout_s=FLEET_TIMEOUT_S) as outsider:
+            got = threading.Event()
+            outsider.on_state(lambda name, state: got.set())
+            assert not list(outsider.session.info.peers_zid())  # not linked at all
+            assert outsider.names() == []
+            assert not got.wait(1.0)  # 50 states a second flow to the teacher meanwhile
+            assert outsider.describe() == {}
+
+    return check
+
+
 def test_a_peer_without_the_credentials_cannot_join_nor_read_the_state(
     moves: Path, tmp_path: Path
 ) -> None:
@@ -69,22 +106,12 @@ def test_a_peer_without_the_credentials_cannot_join_nor_read_the_state(
         )
         assert result.code == 0, result.stderr
         assert [row["name"] for row in result.json()] == ["jr-s"]
-        # with nothing else to reach, a session without a file is the robot's Zenoh client:
-        # refused at the door, it never opens
-        with pytest.raises(ConfigError, match="no Zenoh router or robot answers"):
-            Fleet(Settings(connect=(endpoint,)), timeout_s=FLEET_TIMEOUT_S)
-        strangers = (
-            Settings(connect=(endpoint,), mode="peer"),
-            Settings(connect=(endpoint,), config_file=wrong),
+        # with nothing else to reach, a session without a file is the robot's Zenoh client
+        _side_by_side(
+            _refused_at(endpoint),
+            _sees_nothing(Settings(connect=(endpoint,), mode="peer")),
+            _sees_nothing(Settings(connect=(endpoint,), config_file=wrong)),
         )
-        for stranger in strangers:
-            with Fleet(stranger, timeout_s=FLEET_TIMEOUT_S) as outsider:
-                got = threading.Event()
-                outsider.on_state(lambda name, state, got=got: got.set())
-                assert not list(outsider.session.info.peers_zid())  # not linked at all
-                assert outsider.names() == []
-                assert not got.wait(1.0)  # 50 states a second flow to the teacher meanwhile
-                assert outsider.describe() == {}
 
 
 def _openssl(*args: str | Path) -> None:
@@ -189,22 +216,13 @@ def test_over_tls_a_peer_without_the_classrooms_ca_cannot_join_nor_read_the_stat
         plain = endpoint.replace("tls/", "tcp/", 1)
         # a session without a file is the robot's Zenoh client: refused at the door, over TLS
         # (no CA: the robot's certificate is not trusted) as over plain TCP (no TLS handshake)
-        for door in (endpoint, plain):
-            with pytest.raises(ConfigError, match="no Zenoh router or robot answers"):
-                Fleet(Settings(connect=(door,)), timeout_s=FLEET_TIMEOUT_S)
-        strangers = (
-            Settings(connect=(endpoint,), mode="peer"),  # TLS, no CA
-            Settings(connect=(endpoint,), config_file=own_ca),  # TLS, its own CA
-            Settings(connect=(plain,), mode="peer"),  # plain TCP at the TLS port
+        _side_by_side(
+            _refused_at(endpoint),
+            _refused_at(plain),
+            _sees_nothing(Settings(connect=(endpoint,), mode="peer")),  # TLS, no CA
+            _sees_nothing(Settings(connect=(endpoint,), config_file=own_ca)),  # TLS, its own CA
+            _sees_nothing(Settings(connect=(plain,), mode="peer")),  # plain TCP at the TLS port
         )
-        for stranger in strangers:
-            with Fleet(stranger, timeout_s=FLEET_TIMEOUT_S) as outsider:
-                got = threading.Event()
-                outsider.on_state(lambda name, state, got=got: got.set())
-                assert not list(outsider.session.info.peers_zid())  # not linked at all
-                assert outsider.names() == []
-                assert not got.wait(1.0)  # 50 states a second flow to the teacher meanwhile
-                assert outsider.describe() == {}
 
 
 # Zenoh's access control on the robot, per user: teachers do anything under poppy/**; pupils

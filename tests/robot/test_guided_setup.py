@@ -93,10 +93,35 @@ def test_a_protocol_1_search_is_patient_at_the_profile_s_rate_only(
 
     monkeypatch.setattr(guided, "scan", spy)
     torso = load_profile("torso")
-    virtual = build_bus_from_spec("MX-28:1", protocol=1, baudrate=115_200)
+    # the third rate searched (after the profile's and the factory's): the fewest scans that
+    # show the rates after the first are not patient (each rate scanned costs 1-2 s)
+    virtual = build_bus_from_spec("MX-28:1", protocol=1, baudrate=500_000)
     with serve_link(virtual) as server:
         flow = GuidedSetup(torso, server.url)
         found = flow.find_single(flow.targets[0])
-    assert (found.id, found.baudrate) == (1, 115_200)
+    assert (found.id, found.baudrate) == (1, 500_000)
     assert calls[0] == ([flow.targets[0].baudrate], True)  # the profile's rate, patient
     assert len(calls) >= 3 and all(not patient for _, patient in calls[1:])
+
+
+def test_a_wrong_model_of_protocol_1_is_named_after_the_first_rate_it_answers_at(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # each protocol 1 rate costs a scan of the 254 IDs (1-2 s): the other rates are not tried
+    import poppy_core.robot.guided_setup as guided
+
+    calls: list[tuple[list[int] | None, list[int]]] = []
+    real = guided.scan
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        calls.append((None if args[1] is None else list(args[1]), list(args[2])))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(guided, "scan", spy)
+    virtual = build_bus_from_spec("MX-28:1", protocol=1, baudrate=1_000_000)
+    with serve_link(virtual) as server:
+        flow = GuidedSetup(ERGO_JR, server.url, ["m1"])
+        with pytest.raises(SetupError, match="found an MX-28 at ID 1 at 1000000 bps, protocol 1"):
+            flow.find_single(flow.targets[0])
+    assert [protocols for _, protocols in calls] == [[2], [1]]
+    assert calls[1][0] == [1_000_000]  # the profile's rate, where it answers

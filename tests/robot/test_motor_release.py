@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -13,9 +14,9 @@ from poppy_core.bus import DxlBus
 from poppy_core.emulator import VirtualBus, serve_pty
 from poppy_core.errors import PortError, RobotClosedError, SetupError
 from poppy_core.models import model_by_name
-from poppy_core.robot import load_profile
+from poppy_core.robot import Robot, build_steps, load_profile
 from poppy_core.robot.factory import virtual_buses
-from tests.helpers.bus import robot_buses_wait_for_a_loaded_emulator
+from tests.helpers.bus import LOADED_REPLY_FLOOR_S, robot_buses_wait_for_a_loaded_emulator
 from tests.helpers.waiting import eventually
 
 XL320 = model_by_name("XL-320")
@@ -25,6 +26,22 @@ XL320 = model_by_name("XL-320")
 def loaded_floor(monkeypatch: pytest.MonkeyPatch) -> None:
     """The emulator thread on a pty answers late on a busy machine: no motor is lost for that."""
     robot_buses_wait_for_a_loaded_emulator(monkeypatch)
+
+
+def built_unplugged(monkeypatch: pytest.MonkeyPatch, **options: Any) -> Robot:
+    """``from_profile("ergo-jr", **options)`` while every motor is unplugged: the build pings
+    each one four times and none can answer, late or not, so those pings wait the product's own
+    floor (the loaded one made it 6 x 4 x up to 2 s); the robot's buses wait the loaded floor
+    again once built, for the motors that come."""
+    loaded = build_steps.DxlBus
+    monkeypatch.setattr(build_steps, "DxlBus", DxlBus)
+    try:
+        robot = from_profile("ergo-jr", sensors=False, **options)
+    finally:
+        monkeypatch.setattr(build_steps, "DxlBus", loaded)
+    for bus in robot.buses.values():
+        bus.min_timeout_s = LOADED_REPLY_FLOOR_S
+    return robot
 
 
 @pytest.fixture
@@ -101,12 +118,14 @@ def test_a_missing_port_is_refused_unless_waited_for(port: str, virtual: Virtual
             assert eventually(lambda: abs(robot.m4.present_position - 15.0) < 3.0)
 
 
-def test_motors_without_power_are_waited_for(on_pty: VirtualBus, port: str) -> None:
+def test_motors_without_power_are_waited_for(
+    on_pty: VirtualBus, port: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
     for motor in on_pty.motors:
         on_pty.unplug(motor.id)
     with pytest.raises(SetupError, match="missing motors"):
-        from_profile("ergo-jr", port=port, sensors=False)
-    with from_profile("ergo-jr", port=port, sensors=False, wait_for_motors=True) as robot:
+        built_unplugged(monkeypatch, port=port)
+    with built_unplugged(monkeypatch, port=port, wait_for_motors=True) as robot:
         assert not any(m.online for m in robot.motors)
         on_pty.motor(1).table.set("torque_enable", 1)  # stiff already (another program)
         for motor in on_pty.motors:  # the power comes on
@@ -117,13 +136,11 @@ def test_motors_without_power_are_waited_for(on_pty: VirtualBus, port: str) -> N
 
 
 def test_an_auto_port_with_no_motors_waits_on_the_port_searched(
-    on_pty: VirtualBus, port: str
+    on_pty: VirtualBus, port: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     for motor in on_pty.motors:
         on_pty.unplug(motor.id)
-    with from_profile(
-        "ergo-jr", port="auto", sensors=False, wait_for_motors=True, ports=[port]
-    ) as robot:
+    with built_unplugged(monkeypatch, port="auto", wait_for_motors=True, ports=[port]) as robot:
         assert robot.ports == [port] and not any(m.online for m in robot.motors)
         for motor in on_pty.motors:
             on_pty.plug(motor.id)
