@@ -9,7 +9,7 @@ import pytest
 from poppy_core.bus import DxlBus
 from poppy_core.errors import BusTimeout, CorruptPacketError, MotorError, ProtocolError
 from poppy_core.models import MX_28, XL430_W250
-from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.bus import loaded_reply_floor_s
 from tests.helpers.waiting import eventually
 
 # e-manual MX-28 (protocol 1): goal position at 30, present position at 36 (2 bytes each).
@@ -25,7 +25,7 @@ def loaded_floor(via: str) -> float | None:
     """The first-reply floor of a bus whose emulator is served ``via``: the loaded one for an
     emulator thread on a pty or TCP (a busy machine runs it late), the product's own on the
     in-process link (replies come in the writer's thread, never late)."""
-    return None if via == "link" else LOADED_REPLY_FLOOR_S
+    return None if via == "link" else loaded_reply_floor_s()
 
 
 def test_ping_read_write(emulate: Emulate, via: str) -> None:

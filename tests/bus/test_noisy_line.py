@@ -8,7 +8,7 @@ import threading
 from poppy_core.bus import DxlBus
 from poppy_core.emulator import FaultInjector, build_bus_from_spec, serve_pty
 from poppy_core.protocol import StatusPacket, ping
-from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.bus import loaded_reply_floor_s
 from tests.helpers.waiting import eventually
 
 MX_PRESENT = 36  # MX-28 present position (e-manual), 2 bytes
@@ -39,7 +39,7 @@ def test_a_garbled_usb2ax_reply_keeps_the_sync_read() -> None:
     ids = [1, 2, 3, 4, 5, 6]
     with (
         serve_pty(virtual) as server,
-        DxlBus(server.url, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus,
+        DxlBus(server.url, min_timeout_s=loaded_reply_floor_s()) as bus,
     ):
         expected = {i: bus.read(i, MX_PRESENT, 2) for i in ids}
         assert bus.sync_read(MX_PRESENT, 2, ids) == expected
@@ -54,7 +54,7 @@ def test_a_motor_garbled_in_every_group_reply_is_read_on_its_own() -> None:
     virtual = build_bus_from_spec("XL-320:1-3", protocol=2, faults=faults)
     with (
         serve_pty(virtual) as server,
-        DxlBus(server.url, protocol=2, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus,
+        DxlBus(server.url, protocol=2, min_timeout_s=loaded_reply_floor_s()) as bus,
     ):
         expected = {i: bus.read(i, XL_PRESENT, 2) for i in (1, 2, 3)}
         # the sync read: replies 1-3; its retry asks motor 2 alone: reply 4

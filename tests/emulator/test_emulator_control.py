@@ -10,7 +10,7 @@ import pytest
 from poppy_core.bus import DxlBus
 from poppy_core.emulator import EmulatorServer, build_bus_from_spec, serve_tcp
 from poppy_core.emulator.control import ControlError, EmulatorControl, ScheduledUnplug
-from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.bus import loaded_reply_floor_s
 from tests.helpers.waiting import eventually
 
 
@@ -82,9 +82,10 @@ def test_bad_commands_are_one_line_errors(
 
 def test_unplug_for_a_while_then_back(served: tuple[EmulatorControl, EmulatorServer]) -> None:
     control, server = served
-    with DxlBus(server.url, 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus:
+    floor_s = loaded_reply_floor_s()
+    with DxlBus(server.url, 1_000_000, 2, min_timeout_s=floor_s) as bus:
         # unplugged for longer than the ping that follows and its loaded floor, with a margin
-        away_s = round(3 * LOADED_REPLY_FLOOR_S, 1)
+        away_s = round(3 * floor_s, 1)
         assert control.execute(f"unplug 2 {away_s}") == f"motor 2 unplugged for {away_s:g} s"
         assert not _answers(bus, 2)
         assert _until(lambda: bus.ping(2) is not None)
@@ -128,7 +129,7 @@ def test_motors_sharing_an_id_are_plugged_by_their_place() -> None:
         for place in (1, 2, 3):
             assert control.execute(f"unplug #{place}") == f"motor #{place} unplugged"
         assert "unplugged: #1, #2, #3" in control.execute("status")
-        with DxlBus(server.url, protocol=2, min_timeout_s=LOADED_REPLY_FLOOR_S) as bus:
+        with DxlBus(server.url, protocol=2, min_timeout_s=loaded_reply_floor_s()) as bus:
             assert bus.broadcast_ping() == []
             assert control.execute("plug #2") == "motor #2 plugged"
             assert [p.id for p in bus.broadcast_ping()] == [1]

@@ -24,7 +24,7 @@ from poppy_core.protocol import (
     sync_write,
     write,
 )
-from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.bus import loaded_reply_floor_s
 from tests.helpers.waiting import eventually, scaled, within
 
 XL320_TORQUE_ENABLE = 24
@@ -86,12 +86,12 @@ def test_pty_line_lost_and_back_under_its_link(tmp_path: Path) -> None:
     with serve_pty(bus, link=link) as server:
         first = server.url
         assert os.readlink(link) == first
-        with DxlBus(str(link), 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as dxl:
+        with DxlBus(str(link), 1_000_000, 2, min_timeout_s=loaded_reply_floor_s()) as dxl:
             _lose_the_line(server, dxl)
             assert not link.exists()
         assert eventually(lambda: server.connected and link.exists())
         assert os.readlink(link) == server.url
-        with DxlBus(str(link), 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as dxl:
+        with DxlBus(str(link), 1_000_000, 2, min_timeout_s=loaded_reply_floor_s()) as dxl:
             assert dxl.ping(1) is not None
     assert not link.exists()
 
@@ -100,13 +100,13 @@ def test_tcp_line_lost_and_back_on_the_same_port() -> None:
     bus = build_bus_from_spec("XL-320:1", protocol=2)
     with serve_tcp(bus) as server:
         url = server.url
-        with DxlBus(url, 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as dxl:
+        with DxlBus(url, 1_000_000, 2, min_timeout_s=loaded_reply_floor_s()) as dxl:
             _lose_the_line(server, dxl)
         with pytest.raises(PortError):
             DxlBus(url, 1_000_000, 2)
         assert eventually(lambda: server.connected)
         assert server.url == url
-        with DxlBus(url, 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as dxl:
+        with DxlBus(url, 1_000_000, 2, min_timeout_s=loaded_reply_floor_s()) as dxl:
             assert dxl.ping(1) is not None
 
 

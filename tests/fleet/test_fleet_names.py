@@ -14,7 +14,7 @@ from poppy_core.errors import ArgumentError, ConfigError
 from poppy_core.remote.zenoh_client import robot_name as zenoh_url_name
 from poppy_core.server.host_names import robot_names
 from tests.helpers.cli import run_poppy
-from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, Served, connect_to, free_endpoint
+from tests.helpers.zenoh_served import Served, connect_to, fleet_timeout_s, free_endpoint
 
 pytest.importorskip("zenoh")
 
@@ -68,7 +68,7 @@ def test_a_robot_served_with_capitals_is_found_and_driven_lower_case(
 
     served = Served("Jr-Mixed", token=None)
     try:
-        with Fleet(ZenohSettings(connect=connect_to(served)), timeout_s=FLEET_TIMEOUT_S) as fleet:
+        with Fleet(ZenohSettings(connect=connect_to(served)), timeout_s=fleet_timeout_s()) as fleet:
             assert fleet.wait_for(["jr-mixed"], timeout_s=15) == ["jr-mixed"]
             (outcome,) = fleet.command(["JR-Mixed"], "GET", "/api/v1/motors", together=False)
             assert outcome.ok, outcome.message

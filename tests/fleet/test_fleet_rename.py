@@ -15,7 +15,7 @@ from poppy_core.zenoh_wire import ZenohSettings as Settings
 from tests.helpers.cli import run_poppy
 from tests.helpers.fake_tools import FakeTools
 from tests.helpers.waiting import eventually
-from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served, free_endpoint
+from tests.helpers.zenoh_served import TOKEN, Served, fleet_timeout_s, free_endpoint
 
 pytest.importorskip("zenoh")
 
@@ -33,7 +33,9 @@ def test_a_robot_renamed_over_zenoh_answers_its_new_key_and_the_log_names_the_pe
     )
     caplog.set_level(logging.WARNING, logger="poppy_core.server.settings")
     with from_profile("ergo-jr", sim=True) as robot, serve(robot, spec) as servers:
-        with Fleet(Settings(connect=(endpoint,)), token=TOKEN, timeout_s=FLEET_TIMEOUT_S) as fleet:
+        with Fleet(
+            Settings(connect=(endpoint,)), token=TOKEN, timeout_s=fleet_timeout_s()
+        ) as fleet:
             assert fleet.wait_for(["jr-old"]) == ["jr-old"]
             (renamed,) = fleet.command(
                 ["jr-old"], "PUT", "/api/v1/settings/name", {"name": "jr-new"}, together=False

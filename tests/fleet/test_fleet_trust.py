@@ -26,7 +26,7 @@ from poppy_core import zenoh_auth, zenoh_wire
 from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from tests.helpers.waiting import eventually
-from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served, free_endpoint
+from tests.helpers.zenoh_served import TOKEN, Served, fleet_timeout_s, free_endpoint
 
 zenoh = pytest.importorskip("zenoh")
 
@@ -95,7 +95,7 @@ def test_a_stranger_answering_the_api_learns_nothing_that_drives_a_robot(
     a, b = two
     a.robot.compliant = False
     endpoints = (a.endpoint, b.endpoint, stranger.endpoint)
-    with Fleet(Settings(connect=endpoints), token=TOKEN, timeout_s=FLEET_TIMEOUT_S) as fleet:
+    with Fleet(Settings(connect=endpoints), token=TOKEN, timeout_s=fleet_timeout_s()) as fleet:
         assert fleet.wait_for(["jr-a", "jr-b"]) == ["jr-a", "jr-b"]
         outcomes = fleet.command(
             ["jr-a"], "POST", "/api/v1/web/stop", {"then": "hold"}, together=False
@@ -114,7 +114,7 @@ def test_a_stranger_answering_the_api_learns_nothing_that_drives_a_robot(
         assert not any(secret in payload for secret in secrets), payload
     # what the stranger got does not drive a robot: replayed, it is refused and nothing moves
     a.robot.compliant = False
-    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
+    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=fleet_timeout_s()) as plain:
         for payload in requests:
             answer = _ask(plain.session, "jr-a", payload)
             assert answer["status"] == 401, answer
@@ -131,7 +131,7 @@ def test_a_request_kept_stale_or_for_another_robot_or_badly_signed_is_refused(
     a, _ = two
     a.robot.compliant = False
     compliant = {"method": "PUT", "path": "/api/v1/robot/compliant", "body": {"compliant": True}}
-    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
+    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=fleet_timeout_s()) as plain:
         session = plain.session
         for_b = zenoh_wire.api_request(
             "PUT", compliant["path"], compliant["body"], token=TOKEN, robot="jr-b"
@@ -191,7 +191,7 @@ def test_unauthenticated_armed_starts_are_refused_on_arrival_not_at_their_start_
     start_at = time.time() + 50.0
     payload = zenoh_wire.api_request("POST", "/api/v1/primitives/dance/start", start_at=start_at)
     key = zenoh_wire.robot_key("jr-a", "api")
-    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
+    with Fleet(Settings(connect=(a.endpoint,)), timeout_s=fleet_timeout_s()) as plain:
         handlers = [plain.session.get(key, payload=payload, timeout=45.0) for _ in range(300)]
         statuses = []
         for handler in handlers:
@@ -223,7 +223,7 @@ def test_requests_held_for_a_start_time_are_capped_and_answered_when_the_robot_s
     start_at = time.time() + 40.0
     key = zenoh_wire.robot_key("jr-c", "api")
     try:
-        with Fleet(Settings(connect=(served.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
+        with Fleet(Settings(connect=(served.endpoint,)), timeout_s=fleet_timeout_s()) as plain:
             handlers = []
             for _ in range(4):
                 payload = zenoh_wire.api_request(
@@ -316,7 +316,7 @@ def test_sigterm_with_a_held_request_answers_it_and_ends_cleanly(moves: Any) -> 
     try:
         assert proc.stdout is not None and proc.stderr is not None
         assert "poppy/jr-t" in read_until(proc.stdout.fileno(), "poppy/jr-t", 60, proc)
-        with Fleet(Settings(connect=(endpoint,)), timeout_s=FLEET_TIMEOUT_S) as plain:
+        with Fleet(Settings(connect=(endpoint,)), timeout_s=fleet_timeout_s()) as plain:
             assert plain.wait_for(["jr-t"], timeout_s=30) == ["jr-t"]
             held = zenoh_wire.api_request(
                 "GET", "/api/v1/motors", token=TOKEN, start_at=time.time() + 30, robot="jr-t"

@@ -21,7 +21,7 @@ from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import read_until, reap
 from tests.helpers.waiting import eventually, http_timeout
 from tests.helpers.zenoh_router import Router
-from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served
+from tests.helpers.zenoh_served import TOKEN, Served, fleet_timeout_s
 
 pytest.importorskip("zenoh")
 
@@ -39,7 +39,7 @@ def pair(moves: Path, router: Router) -> Iterator[tuple[Served, Served]]:
 @pytest.fixture
 def teacher(router: Router, pair: tuple[Served, Served]) -> Iterator[Fleet]:
     with Fleet(
-        ZenohSettings(connect=(router.endpoint,)), token=TOKEN, timeout_s=FLEET_TIMEOUT_S
+        ZenohSettings(connect=(router.endpoint,)), token=TOKEN, timeout_s=fleet_timeout_s()
     ) as client:
         assert client.wait_for(["jr-a", "jr-b"], timeout_s=30) == ["jr-a", "jr-b"]
         yield client
@@ -176,7 +176,7 @@ def test_a_router_and_a_robot_linked_directly_make_one_fleet(
     direct = Served("jr-c")  # listens; not on the router
     try:
         settings = ZenohSettings(connect=(router.endpoint, direct.endpoint))
-        with Fleet(settings, token=TOKEN, timeout_s=FLEET_TIMEOUT_S) as client:
+        with Fleet(settings, token=TOKEN, timeout_s=fleet_timeout_s()) as client:
             names = ["jr-a", "jr-b", "jr-c"]
             assert client.wait_for(names, timeout_s=30) == names
             outcomes = client.command(
@@ -209,7 +209,9 @@ def test_a_robot_started_before_its_router_joins_when_the_router_comes(moves: Pa
         waited = read_until(proc.stderr.fileno(), "waiting for it", 60, proc)
         assert "no Zenoh router answers at" in waited, waited
         router.start()
-        with Fleet(ZenohSettings(connect=(router.endpoint,)), timeout_s=FLEET_TIMEOUT_S) as client:
+        with Fleet(
+            ZenohSettings(connect=(router.endpoint,)), timeout_s=fleet_timeout_s()
+        ) as client:
             assert client.wait_for(["early"], timeout_s=30) == ["early"]
     finally:
         reap(proc)
@@ -222,7 +224,7 @@ def test_robots_and_the_router_restarting_rejoin(moves: Path) -> None:
     steady = Served("steady", router=router.endpoint)
     try:
         with Fleet(
-            ZenohSettings(connect=(router.endpoint,)), token=TOKEN, timeout_s=FLEET_TIMEOUT_S
+            ZenohSettings(connect=(router.endpoint,)), token=TOKEN, timeout_s=fleet_timeout_s()
         ) as client:
             assert client.wait_for(["phoenix", "steady"], timeout_s=60) == ["phoenix", "steady"]
             reap(proc)  # the robot restarts

@@ -26,7 +26,7 @@ from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.zenoh_wire import ZenohSettings
 from tests.helpers.waiting import eventually, http_timeout
 from tests.helpers.zenoh_router import Router
-from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served
+from tests.helpers.zenoh_served import TOKEN, Served, fleet_timeout_s
 
 zenoh = pytest.importorskip("zenoh")
 
@@ -95,7 +95,7 @@ def stranger(router: Router) -> Iterator[Stranger]:
 @pytest.fixture
 def laptop(router: Router, jr1: Served, stranger: Stranger) -> Iterator[Fleet]:
     settings = ZenohSettings(connect=(router.endpoint,))
-    with Fleet(settings, token=TOKEN, timeout_s=FLEET_TIMEOUT_S) as fleet:
+    with Fleet(settings, token=TOKEN, timeout_s=fleet_timeout_s()) as fleet:
         assert fleet.wait_for(["jr1", "jr9"], timeout_s=30) == ["jr1", "jr9"]
         yield fleet
 
@@ -127,7 +127,7 @@ def test_a_listening_stranger_reads_what_is_published_but_no_token(
     assert goals["goals"] == {"m1": 12.0}
     [request] = stranger.asked("poppy/jr1/api")
     assert json.loads(json.loads(request)["signed"])["path"] == "/api/v1/web/stop"
-    described = zenoh_wire.descriptions(stranger.session, FLEET_TIMEOUT_S)
+    described = zenoh_wire.descriptions(stranger.session, fleet_timeout_s())
     assert [m["name"] for m in described["jr1"]["motors"]][:2] == ["m1", "m2"]
     # not readable: the token, or anything the robot answers only to its token's holders
     everything = [p for _, p in stranger.published] + [p for _, p in stranger.queries]
@@ -135,7 +135,7 @@ def test_a_listening_stranger_reads_what_is_published_but_no_token(
         assert not any(secret in payload for secret in _secrets()), payload
     key = zenoh_wire.robot_key("jr1", "api")
     replies = zenoh_wire.ask(
-        stranger.session, key, zenoh_wire.api_request("GET", "/api/v1/motors"), FLEET_TIMEOUT_S
+        stranger.session, key, zenoh_wire.api_request("GET", "/api/v1/motors"), fleet_timeout_s()
     ).wait()
     answers = [json.loads(r.ok.payload.to_bytes()) for r in replies if r.ok is not None]
     robot_answers = [a for a in answers if a != FAKE]  # its own queryable answers it too
@@ -157,11 +157,11 @@ def test_a_stranger_answering_for_a_robot_is_not_taken_for_it(
     assert not ghost.ok
     assert "no answer signed with the token came (answered: 200)" in ghost.message
     # the remote robot of from_remote (and the LeRobot plugin's zenoh:NAME): the same
-    client = ZenohClient("jr1", TOKEN, FLEET_TIMEOUT_S, session=laptop.session)
+    client = ZenohClient("jr1", TOKEN, fleet_timeout_s(), session=laptop.session)
     read = client.request("GET", "/api/v1/motors")
     assert [m["name"] for m in read][:2] == ["m1", "m2"]
     with pytest.raises(CommunicationError, match="no answer signed with the token"):
-        ZenohClient("jr9", TOKEN, FLEET_TIMEOUT_S, session=laptop.session).request(
+        ZenohClient("jr9", TOKEN, fleet_timeout_s(), session=laptop.session).request(
             "GET", "/api/v1/motors"
         )
 
@@ -193,7 +193,7 @@ def test_what_a_stranger_recorded_replayed_later_drives_nothing_and_takes_no_lea
     try:
         put.put(goals)
         key = zenoh_wire.robot_key("jr1", "api")
-        replies = zenoh_wire.ask(stranger.session, key, request, FLEET_TIMEOUT_S).wait()
+        replies = zenoh_wire.ask(stranger.session, key, request, fleet_timeout_s()).wait()
     finally:
         put.undeclare()
     answers = [json.loads(r.ok.payload.to_bytes()) for r in replies if r.ok is not None]

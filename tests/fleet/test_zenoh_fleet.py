@@ -27,7 +27,7 @@ from poppy_core.zenoh_wire import check_name, pack_state, session_config, unpack
 from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.waiting import eventually, http_timeout
-from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, Served, connect_to, free_endpoint
+from tests.helpers.zenoh_served import TOKEN, Served, connect_to, fleet_timeout_s, free_endpoint
 
 pytest.importorskip("zenoh")
 
@@ -171,7 +171,7 @@ def test_bad_commands_are_refused_with_the_rest_wording_and_move_nothing(
         together=False,
     )[0]
     assert nan.status == 422
-    with Fleet(Settings(connect=connect_to(a)), timeout_s=FLEET_TIMEOUT_S) as no_token:
+    with Fleet(Settings(connect=connect_to(a)), timeout_s=fleet_timeout_s()) as no_token:
         refused = no_token.command(
             ["jr-a"], "POST", "/api/v1/robot/compliant", {"compliant": True}, together=False
         )[0]
@@ -263,7 +263,7 @@ def test_a_killed_robot_leaves_the_fleet(moves: Path) -> None:
         # listens (3 s at most): wait for the robot's process to come up first, however loaded
         host, port = endpoint.removeprefix("tcp/").rsplit(":", 1)
         assert eventually(lambda: _listening(host, int(port)), timeout_s=60)
-        with Fleet(Settings(connect=(endpoint,)), timeout_s=FLEET_TIMEOUT_S) as client:
+        with Fleet(Settings(connect=(endpoint,)), timeout_s=fleet_timeout_s()) as client:
             assert client.wait_for(["doomed"], timeout_s=60) == ["doomed"]
             proc.kill()
             assert eventually(lambda: "doomed" not in client.names(), timeout_s=15)

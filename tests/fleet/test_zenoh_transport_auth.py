@@ -23,7 +23,7 @@ from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from tests.helpers.cli import run_poppy
 from tests.helpers.waiting import eventually
-from tests.helpers.zenoh_served import FLEET_TIMEOUT_S, TOKEN, free_endpoint
+from tests.helpers.zenoh_served import TOKEN, fleet_timeout_s, free_endpoint
 
 pytest.importorskip("zenoh")
 
@@ -59,7 +59,7 @@ def _refused_at(door: str) -> Callable[[], None]:
 
     def check() -> None:
         with pytest.raises(ConfigError, match="no Zenoh router or robot answers"):
-            Fleet(Settings(connect=(door,)), timeout_s=FLEET_TIMEOUT_S)
+            Fleet(Settings(connect=(door,)), timeout_s=fleet_timeout_s())
 
     return check
 
@@ -68,7 +68,7 @@ def _sees_nothing(stranger: Settings) -> Callable[[], None]:
     """A peer with ``stranger``'s settings is not linked, sees no robot and gets no state."""
 
     def check() -> None:
-        with Fleet(stranger, timeout_s=FLEET_TIMEOUT_S) as outsider:
+        with Fleet(stranger, timeout_s=fleet_timeout_s()) as outsider:
             got = threading.Event()
             outsider.on_state(lambda name, state: got.set())
             assert not list(outsider.session.info.peers_zid())  # not linked at all
@@ -95,7 +95,7 @@ def test_a_peer_without_the_credentials_cannot_join_nor_read_the_state(
         with Fleet(
             Settings(connect=(endpoint,), config_file=teacher),
             token=TOKEN,
-            timeout_s=FLEET_TIMEOUT_S,
+            timeout_s=fleet_timeout_s(),
         ) as fleet:
             assert fleet.wait_for(["jr-s"]) == ["jr-s"]
             states: list[int] = []
@@ -202,7 +202,7 @@ def test_over_tls_a_peer_without_the_classrooms_ca_cannot_join_nor_read_the_stat
         with Fleet(
             Settings(connect=(endpoint,), config_file=teacher),
             token=TOKEN,
-            timeout_s=FLEET_TIMEOUT_S,
+            timeout_s=fleet_timeout_s(),
         ) as fleet:
             assert fleet.wait_for(["jr-t"]) == ["jr-t"]
             states: list[int] = []
@@ -284,7 +284,7 @@ def test_access_control_lets_a_pupil_watch_the_states_but_not_query_the_robot(
         with Fleet(
             Settings(connect=(endpoint,), config_file=teacher),
             token=TOKEN,
-            timeout_s=FLEET_TIMEOUT_S,
+            timeout_s=fleet_timeout_s(),
         ) as fleet:
             assert fleet.wait_for(["jr-s"]) == ["jr-s"]
             assert fleet.describe()["jr-s"]["name"] == "jr-s"
@@ -292,7 +292,9 @@ def test_access_control_lets_a_pupil_watch_the_states_but_not_query_the_robot(
             assert motors.ok, motors.message
         # the pupil has the token, but access control stops its queries at the robot
         with Fleet(
-            Settings(connect=(endpoint,), config_file=pupil), token=TOKEN, timeout_s=FLEET_TIMEOUT_S
+            Settings(connect=(endpoint,), config_file=pupil),
+            token=TOKEN,
+            timeout_s=fleet_timeout_s(),
         ) as watcher:
             assert watcher.wait_for(["jr-s"]) == ["jr-s"]
             states: list[int] = []

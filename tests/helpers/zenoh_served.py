@@ -11,9 +11,12 @@ from poppy_core.robot import Robot
 from tests.helpers.waiting import scaled
 
 TOKEN = "s3cret"
-# A test's fleet client waits for answers the product's timeout times the load factor measured
-# when this module is imported (a loaded machine answered after the fixed 2 s).
-FLEET_TIMEOUT_S = scaled(DEFAULT_TIMEOUT_S)
+
+
+def fleet_timeout_s() -> float:
+    """How long a test's fleet client waits for answers: the product's timeout times the load
+    factor measured now (a loaded machine answered after the fixed 2 s)."""
+    return scaled(DEFAULT_TIMEOUT_S)
 
 
 def free_endpoint() -> str:

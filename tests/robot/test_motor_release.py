@@ -16,7 +16,7 @@ from poppy_core.errors import PortError, RobotClosedError, SetupError
 from poppy_core.models import model_by_name
 from poppy_core.robot import Robot, build_steps, load_profile
 from poppy_core.robot.factory import virtual_buses
-from tests.helpers.bus import LOADED_REPLY_FLOOR_S, robot_buses_wait_for_a_loaded_emulator
+from tests.helpers.bus import loaded_reply_floor_s, robot_buses_wait_for_a_loaded_emulator
 from tests.helpers.waiting import eventually
 
 XL320 = model_by_name("XL-320")
@@ -40,7 +40,7 @@ def built_unplugged(monkeypatch: pytest.MonkeyPatch, **options: Any) -> Robot:
     finally:
         monkeypatch.setattr(build_steps, "DxlBus", loaded)
     for bus in robot.buses.values():
-        bus.min_timeout_s = LOADED_REPLY_FLOOR_S
+        bus.min_timeout_s = loaded_reply_floor_s()
     return robot
 
 

@@ -20,7 +20,7 @@ from poppy_core.assembly import Listen, ServeSpec, serve
 from poppy_core.emulator import Endpoint, serve_pty
 from poppy_core.robot import Robot, load_profile
 from poppy_core.robot.factory import virtual_buses
-from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.bus import loaded_reply_floor_s
 from tests.helpers.waiting import eventually, http_timeout
 
 TOKEN = "s3cret"
@@ -44,7 +44,7 @@ else:
 
 def read_from_another_process(port: str) -> dict[str, object]:
     done = subprocess.run(
-        [sys.executable, "-c", READER, port, str(LOADED_REPLY_FLOOR_S)],
+        [sys.executable, "-c", READER, port, str(loaded_reply_floor_s())],
         capture_output=True,
         text=True,
         timeout=60,

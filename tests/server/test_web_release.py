@@ -16,7 +16,7 @@ from poppy_core.emulator import Endpoint, VirtualBus, serve_pty
 from poppy_core.errors import PortError, SetupError
 from poppy_core.robot import Robot, load_profile
 from poppy_core.robot.factory import virtual_buses
-from tests.helpers.bus import LOADED_REPLY_FLOOR_S
+from tests.helpers.bus import loaded_reply_floor_s
 from tests.helpers.chromium import launched, needs_chromium
 from tests.helpers.waiting import eventually
 
@@ -87,7 +87,7 @@ def test_release_then_take_back_from_the_page(
                 banner = page.locator("#access-banner")
                 assert banner.is_visible() and f"Motors released: {port}" in banner.inner_text()
                 assert robot.released and robot.compliant
-                with DxlBus(port, 1_000_000, 2, min_timeout_s=LOADED_REPLY_FLOOR_S) as other:
+                with DxlBus(port, 1_000_000, 2, min_timeout_s=loaded_reply_floor_s()) as other:
                     assert other.ping(3) is not None
                 button.click()
                 page.wait_for_function(
