@@ -7,29 +7,31 @@ runs LeRobot with that folder and this clone first on PYTHONPATH.
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 import subprocess
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 from tests.helpers.cli import command_env
+from tests.helpers.json_lines import JsonChild
 from tests.helpers.lerobot_venv import ROOT, lerobot_python
 from tests.helpers.pypot_files import needed
 
 PLUGIN = ROOT / "plugins" / "lerobot_robot_poppy"
 PROBE = Path(__file__).with_name("plugin_probe.py")
+REMEMBERED_SOURCE = Path(__file__).with_name("remembered_source")
+"""Its sitecustomize.py makes LeRobot's argument parser seconds of CPU cheaper a command."""
 CLI_MARK = "rerun-sdk"
 """In the venv's stamp once bench/setup_lerobot.sh added LeRobot's command-line deps."""
 
 
 @dataclass
 class LeRobot:
-    """LeRobot's venv with the plugin: ``run`` one of its command lines, ``probe`` the plugin."""
+    """LeRobot's venv with the plugin: ``run`` one of its command lines."""
 
     python: Path
     env: dict[str, str]
@@ -37,34 +39,20 @@ class LeRobot:
 
     def run(self, script: str, *args: str, timeout: float = 900) -> str:
         """``python -m lerobot.scripts.SCRIPT ARGS`` (what ``lerobot-record``... run); its
-        output, asserted to end with exit code 0."""
+        output, asserted to end with exit code 0. ``inspect.getsource`` remembers its answers
+        there (``REMEMBERED_SOURCE``): the same parser and help, parsed in less CPU."""
+        path = f"{REMEMBERED_SOURCE}{os.pathsep}{self.env['PYTHONPATH']}"
         done = subprocess.run(
             [str(self.python), "-m", f"lerobot.scripts.{script}", *args],
             capture_output=True,
             text=True,
             timeout=timeout,
             check=False,
-            env=self.env,
+            env={**self.env, "PYTHONPATH": path},
         )
         output = done.stdout + done.stderr
         assert done.returncode == 0, output[-4000:]
         return output
-
-    def probe(
-        self, *args: str, timeout: float = 600, env: dict[str, str] | None = None
-    ) -> dict[str, Any]:
-        """tests/lerobot_plugin/plugin_probe.py's JSON answer (``env``: more variables)."""
-        done = subprocess.run(
-            [str(self.python), str(PROBE), *args],
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-            check=False,
-            env={**self.env, **(env or {})},
-        )
-        assert done.returncode == 0, done.stderr[-4000:]
-        answer: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
-        return answer
 
 
 @pytest.fixture(scope="session")
@@ -108,3 +96,14 @@ def lerobot(tmp_path_factory: pytest.TempPathFactory) -> LeRobot:
         MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"),
     )
     return LeRobot(python, env, base / "lerobot")
+
+
+@pytest.fixture(scope="session")
+def probe(lerobot: LeRobot) -> Iterator[JsonChild]:
+    """tests/lerobot_plugin/plugin_probe.py in LeRobot's venv, one process answering every
+    question of the session (``ask("contract", ...)``): a start costs seconds of CPU."""
+    child = JsonChild(lerobot.python, PROBE, lerobot.env)
+    try:
+        yield child
+    finally:
+        child.close()
