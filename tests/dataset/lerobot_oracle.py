@@ -7,13 +7,15 @@ compute from the frames it loaded. ``python lerobot_oracle.py write ROOT SPEC``:
 LeRobot's ``create/add_frame/save_episode/finalize`` write for the same features (SPEC: JSON of
 fps, robot_type, features, frames; or ``episodes``, their lengths, and their ``tasks``: frame k
 of episode e holds k + 40 e everywhere, LeRobot packing the episodes into one file). One JSON
-object on stdout.
+object on stdout. ``python lerobot_oracle.py serve``: the same commands, asked one JSON line
+each on stdin (tests/helpers/json_lines.py), in one process for a whole test module.
 """
 
 from __future__ import annotations
 
 import json
 import sys
+from functools import partial
 
 import numpy as np
 
@@ -98,11 +100,35 @@ def write(root: str, spec: dict) -> dict:
         return json.load(file)
 
 
+def command(name: str, root: str, argument: str, frames: str = "") -> dict:
+    """One command, its arguments as on the command line."""
+    if name == "load":
+        return load(root, argument, [int(i) for i in frames.split(",")] if frames else [])
+    assert name == "write", name
+    return write(root, json.loads(argument))
+
+
+def warm() -> None:
+    """LeRobot's dataset modules imported (torch...): most of a command's CPU."""
+    import lerobot.datasets.compute_stats
+    import lerobot.datasets.lerobot_dataset  # noqa: F401
+
+
+def load_serve():
+    """tests/helpers/json_lines.py's ``serve``, loaded by its path (the venv has a ``tests``)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "helpers" / "json_lines.py"
+    spec = importlib.util.spec_from_file_location("poppy_json_lines", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.serve
+
+
 if __name__ == "__main__":
-    command, root, argument = sys.argv[1:4]
-    if command == "load":
-        wanted = [int(i) for i in sys.argv[4].split(",")] if len(sys.argv) > 4 else []
-        result = load(root, argument, wanted)
+    if sys.argv[1] == "serve":
+        load_serve()({name: partial(command, name) for name in ("load", "write")}, warm)
     else:
-        result = write(root, json.loads(argument))
-    sys.stdout.write(json.dumps(result) + "\n")
+        sys.stdout.write(json.dumps(command(*sys.argv[1:])) + "\n")

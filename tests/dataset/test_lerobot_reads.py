@@ -1,12 +1,14 @@
 """LeRobot 0.4.4's own code (in bench/.venv-lerobot) reads what poppy writes, and writes the same.
 
-Each test records with poppy_core.dataset here, then runs tests/dataset/lerobot_oracle.py in
-LeRobot's venv (fails on CI without it, skips elsewhere: tests/helpers/lerobot_venv.py).
+Each test records with poppy_core.dataset here, then asks tests/dataset/lerobot_oracle.py, one
+process in LeRobot's venv for the module (fails on CI without it, skips elsewhere:
+tests/helpers/lerobot_venv.py).
 """
 
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -16,20 +18,26 @@ import pytest
 from poppy_core.dataset.delete import delete_episode
 from poppy_core.dataset.writer import DatasetWriter
 from tests.dataset.test_writer import SPEC, frame, killed_recording, record
-from tests.helpers.lerobot_venv import lerobot_python, run_oracle
+from tests.helpers.json_lines import JsonChild
+from tests.helpers.lerobot_venv import oracle_child
 
 pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def oracle() -> Path:
-    return lerobot_python()
+def oracle(tmp_path_factory: pytest.TempPathFactory) -> Iterator[JsonChild]:
+    """One LeRobot process answers the module's questions (a start costs seconds of CPU)."""
+    child = oracle_child(tmp_path_factory.mktemp("lerobot-oracle") / "hf-cache")
+    try:
+        yield child
+    finally:
+        child.close()
 
 
-def test_lerobot_loads_and_decodes_a_poppy_recording(oracle: Path, tmp_path: Path) -> None:
+def test_lerobot_loads_and_decodes_a_poppy_recording(oracle: JsonChild, tmp_path: Path) -> None:
     root = tmp_path / "ds"
     record(root, [20, 25], ["pick the cube", "wave"])
-    seen = run_oracle("load", str(root), "poppy/test", "0,19,20,21,44")
+    seen = oracle.ask("load", str(root), "poppy/test", "0,19,20,21,44")
     assert (seen["len"], seen["num_episodes"], seen["fps"]) == (45, 2, 30)
     info = json.loads((root / "meta/info.json").read_text())
     assert seen["features"] == info["features"]
@@ -49,10 +57,10 @@ def test_lerobot_loads_and_decodes_a_poppy_recording(oracle: Path, tmp_path: Pat
     assert seen["stats"] == json.loads((root / "meta/stats.json").read_text())
 
 
-def test_stats_agree_with_lerobots_own_computation(oracle: Path, tmp_path: Path) -> None:
+def test_stats_agree_with_lerobots_own_computation(oracle: JsonChild, tmp_path: Path) -> None:
     root = tmp_path / "ds"
     record(root, [30, 17])
-    seen = run_oracle("load", str(root), "poppy/test")
+    seen = oracle.ask("load", str(root), "poppy/test")
     mine, theirs = seen["stats"], seen["recomputed_stats"]
     for key, feature in theirs.items():
         assert set(mine[key]) == set(feature), key
@@ -66,7 +74,7 @@ def test_stats_agree_with_lerobots_own_computation(oracle: Path, tmp_path: Path)
             assert np.all(gap <= 0.05 * spread + 1e-9), (key, name, gap)
 
 
-def test_info_and_tables_match_what_lerobot_writes(oracle: Path, tmp_path: Path) -> None:
+def test_info_and_tables_match_what_lerobot_writes(oracle: JsonChild, tmp_path: Path) -> None:
     ours = tmp_path / "poppy"
     # the frames lerobot_oracle.py's `write` adds: every value k, every pixel k
     with DatasetWriter.create(ours, SPEC) as writer:
@@ -81,7 +89,7 @@ def test_info_and_tables_match_what_lerobot_writes(oracle: Path, tmp_path: Path)
     }
     spec = {"fps": 30, "robot_type": info["robot_type"], "features": features, "frames": 5}
     theirs = tmp_path / "lerobot"
-    lerobot_info = run_oracle("write", str(theirs), json.dumps(spec))
+    lerobot_info = oracle.ask("write", str(theirs), json.dumps(spec))
     assert list(info) == list(lerobot_info)
     for key, value in lerobot_info.items():
         if key != "features":
@@ -117,20 +125,22 @@ def test_info_and_tables_match_what_lerobot_writes(oracle: Path, tmp_path: Path)
             np.testing.assert_allclose(mine_value, their_value, err_msg=f"{key} {name}")
 
 
-def test_lerobot_loads_a_killed_recording(oracle: Path, tmp_path: Path) -> None:
+def test_lerobot_loads_a_killed_recording(oracle: JsonChild, tmp_path: Path) -> None:
     root = tmp_path / "ds"
     killed_recording(root)
-    seen = run_oracle("load", str(root), "poppy/test", "0,20")
+    seen = oracle.ask("load", str(root), "poppy/test", "0,20")
     assert (seen["len"], seen["num_episodes"]) == (21, 2)
     assert [(i["episode_index"], i["frame_index"]) for i in seen["items"]] == [(0, 0), (1, 8)]
     assert SPEC.video_keys() == ["observation.images.top"]
 
 
-def test_lerobot_loads_a_dataset_after_an_episode_is_deleted(oracle: Path, tmp_path: Path) -> None:
+def test_lerobot_loads_a_dataset_after_an_episode_is_deleted(
+    oracle: JsonChild, tmp_path: Path
+) -> None:
     root = tmp_path / "ds"
     record(root, [20, 25, 15], ["pick the cube", "wave", "pick the cube"])
     delete_episode(root, 1)
-    seen = run_oracle("load", str(root), "poppy/test", "0,19,20,34")
+    seen = oracle.ask("load", str(root), "poppy/test", "0,19,20,34")
     assert (seen["len"], seen["num_episodes"]) == (35, 2)
     assert seen["tasks"] == ["pick the cube"]
     assert seen["stats"] == json.loads((root / "meta/stats.json").read_text())
@@ -153,7 +163,9 @@ def test_lerobot_loads_a_dataset_after_an_episode_is_deleted(oracle: Path, tmp_p
             assert seen["stats"][key][name] == pytest.approx(feature[name]), (key, name)
 
 
-def test_an_episode_is_deleted_from_a_dataset_lerobot_packed(oracle: Path, tmp_path: Path) -> None:
+def test_an_episode_is_deleted_from_a_dataset_lerobot_packed(
+    oracle: JsonChild, tmp_path: Path
+) -> None:
     root = tmp_path / "lerobot"
     features = {
         "observation.state": {"dtype": "float32", "shape": [3], "names": ["a", "b", "c"]},
@@ -171,11 +183,11 @@ def test_an_episode_is_deleted_from_a_dataset_lerobot_packed(oracle: Path, tmp_p
         "episodes": [12, 10, 8],
         "tasks": ["pick", "wave", "pick"],
     }
-    run_oracle("write", str(root), json.dumps(spec))
+    oracle.ask("write", str(root), json.dumps(spec))
     assert sorted(p.name for p in (root / "data/chunk-000").iterdir()) == ["file-000.parquet"]
     done = delete_episode(root, 1)
     assert (done.frames, done.episodes_left, done.frames_left, done.tasks_left) == (10, 2, 20, 1)
-    seen = run_oracle("load", str(root), "poppy/oracle", "0,11,12,19")
+    seen = oracle.ask("load", str(root), "poppy/oracle", "0,11,12,19")
     assert (seen["len"], seen["num_episodes"], seen["tasks"]) == (20, 2, ["pick"])
     places = [(0, 0, 0), (0, 11, 11), (1, 0, 80), (1, 7, 87)]  # episode 2's values: k + 80
     for item, (episode, k, value) in zip(seen["items"], places, strict=True):

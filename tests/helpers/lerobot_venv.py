@@ -12,6 +12,7 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
+from tests.helpers.json_lines import JsonChild
 from tests.helpers.pypot_files import needed
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -27,11 +28,16 @@ def lerobot_python() -> Path:
     needed("LeRobot 0.4.4's venv is needed: run `bash bench/setup_lerobot.sh` (about 5 GB)")
 
 
-def run_oracle(*args: str, timeout: float = 600) -> dict[str, Any]:
-    """One command of tests/dataset/lerobot_oracle.py in LeRobot's venv: its JSON answer."""
+def _oracle_env(cache: Path) -> dict[str, str]:
     env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
     env["HF_HUB_OFFLINE"] = "1"  # a dataset on disk: LeRobot must never reach for the hub
-    env["HF_DATASETS_CACHE"] = str(Path(args[1]).parent / "hf-cache")
+    env["HF_DATASETS_CACHE"] = str(cache)
+    return env
+
+
+def run_oracle(*args: str, timeout: float = 600) -> dict[str, Any]:
+    """One command of tests/dataset/lerobot_oracle.py in LeRobot's venv: its JSON answer."""
+    env = _oracle_env(Path(args[1]).parent / "hf-cache")
     done = subprocess.run(
         [str(lerobot_python()), str(ORACLE), *args],
         capture_output=True,
@@ -43,3 +49,9 @@ def run_oracle(*args: str, timeout: float = 600) -> dict[str, Any]:
     assert done.returncode == 0, done.stderr[-3000:]
     result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
     return result
+
+
+def oracle_child(cache: Path) -> JsonChild:
+    """tests/dataset/lerobot_oracle.py started in LeRobot's venv for many commands (``ask``
+    them as ``run_oracle``'s arguments; ``close`` it): one Python start for a test module."""
+    return JsonChild(lerobot_python(), ORACLE, _oracle_env(cache))

@@ -7,64 +7,87 @@ runs LeRobot with that folder and this clone first on PYTHONPATH.
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 import subprocess
+import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 from tests.helpers.cli import command_env
+from tests.helpers.json_lines import JsonChild
 from tests.helpers.lerobot_venv import ROOT, lerobot_python
 from tests.helpers.pypot_files import needed
 
 PLUGIN = ROOT / "plugins" / "lerobot_robot_poppy"
 PROBE = Path(__file__).with_name("plugin_probe.py")
+REMEMBERED_SOURCE = Path(__file__).with_name("remembered_source")
+"""Its sitecustomize.py makes LeRobot's argument parser seconds of CPU cheaper a command."""
 CLI_MARK = "rerun-sdk"
 """In the venv's stamp once bench/setup_lerobot.sh added LeRobot's command-line deps."""
 
 
+class Running:
+    """A LeRobot command line started, its output to a file (no pipe to fill while the test
+    does something else); ``with`` it: killed if the test ends before ``wait``."""
+
+    def __init__(self, command: list[str], env: dict[str, str], timeout: float) -> None:
+        self.output = tempfile.TemporaryFile("w+")  # noqa: SIM115 (closed by __exit__)
+        self.process = subprocess.Popen(
+            command, stdout=self.output, stderr=subprocess.STDOUT, text=True, env=env
+        )
+        self.timeout = timeout
+
+    def wait(self) -> str:
+        """Its output, asserted to end with exit code 0."""
+        try:
+            self.process.wait(timeout=self.timeout)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+            raise AssertionError(f"not done in {self.timeout:.0f} s:\n{self._read()}") from None
+        output = self._read()
+        assert self.process.returncode == 0, output[-4000:]
+        return output
+
+    def _read(self) -> str:
+        self.output.seek(0)
+        return self.output.read()
+
+    def __enter__(self) -> Running:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+        self.output.close()
+
+
 @dataclass
 class LeRobot:
-    """LeRobot's venv with the plugin: ``run`` one of its command lines, ``probe`` the plugin."""
+    """LeRobot's venv with the plugin: ``run`` one of its command lines, or ``start`` it."""
 
     python: Path
     env: dict[str, str]
     home: Path
 
-    def run(self, script: str, *args: str, timeout: float = 900) -> str:
-        """``python -m lerobot.scripts.SCRIPT ARGS`` (what ``lerobot-record``... run); its
-        output, asserted to end with exit code 0."""
-        done = subprocess.run(
-            [str(self.python), "-m", f"lerobot.scripts.{script}", *args],
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-            check=False,
-            env=self.env,
-        )
-        output = done.stdout + done.stderr
-        assert done.returncode == 0, output[-4000:]
-        return output
+    def start(self, script: str, *args: str, timeout: float = 900) -> Running:
+        """``python -m lerobot.scripts.SCRIPT ARGS`` (what ``lerobot-record``... run) started:
+        two that need not wait for each other run side by side. ``inspect.getsource``
+        remembers its answers there (``REMEMBERED_SOURCE``): the same parser and help, parsed
+        in less CPU."""
+        path = f"{REMEMBERED_SOURCE}{os.pathsep}{self.env['PYTHONPATH']}"
+        command = [str(self.python), "-m", f"lerobot.scripts.{script}", *args]
+        return Running(command, {**self.env, "PYTHONPATH": path}, timeout)
 
-    def probe(
-        self, *args: str, timeout: float = 600, env: dict[str, str] | None = None
-    ) -> dict[str, Any]:
-        """tests/lerobot_plugin/plugin_probe.py's JSON answer (``env``: more variables)."""
-        done = subprocess.run(
-            [str(self.python), str(PROBE), *args],
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-            check=False,
-            env={**self.env, **(env or {})},
-        )
-        assert done.returncode == 0, done.stderr[-4000:]
-        answer: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
-        return answer
+    def run(self, script: str, *args: str, timeout: float = 900) -> str:
+        """``start`` then ``wait``: its output, asserted to end with exit code 0."""
+        with self.start(script, *args, timeout=timeout) as running:
+            return running.wait()
 
 
 @pytest.fixture(scope="session")
@@ -108,3 +131,14 @@ def lerobot(tmp_path_factory: pytest.TempPathFactory) -> LeRobot:
         MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"),
     )
     return LeRobot(python, env, base / "lerobot")
+
+
+@pytest.fixture(scope="session")
+def probe(lerobot: LeRobot) -> Iterator[JsonChild]:
+    """tests/lerobot_plugin/plugin_probe.py in LeRobot's venv, one process answering every
+    question of the session (``ask("contract", ...)``): a start costs seconds of CPU."""
+    child = JsonChild(lerobot.python, PROBE, lerobot.env)
+    try:
+        yield child
+    finally:
+        child.close()

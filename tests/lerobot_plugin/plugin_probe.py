@@ -9,7 +9,8 @@ and a leader driven through LeRobot's factories on the ports given (the test's e
 on Zenoh as ``poppy/NAME``, listening on ENDPOINT.
 ``python plugin_probe.py bodies TORSO_PORT HUMANOID_PORTS``: a Torso and a Humanoid
 (``CONTROLLER=PORT,...``) connected, observed and sent an action.
-One JSON object on stdout.
+One JSON object on stdout. ``python plugin_probe.py serve``: the same commands, asked one JSON
+line each on stdin (tests/helpers/json_lines.py), in one process for the test session.
 """
 
 from __future__ import annotations
@@ -52,6 +53,10 @@ def contract(follower_port: str, leader_port: str) -> dict[str, Any]:
     )
     features["with_camera"] = make_robot_from_config(camera).observation_features["camera"]
     out["features"] = features
+    out["help"] = field_help(
+        RobotConfig.get_choice_class("poppy_ergo_jr"),
+        TeleoperatorConfig.get_choice_class("poppy_ergo_jr_leader"),
+    )
 
     config = RobotConfig.get_choice_class("poppy_ergo_jr")
     follower = make_robot_from_config(
@@ -82,6 +87,21 @@ def contract(follower_port: str, leader_port: str) -> dict[str, Any]:
     out["leader_action"] = leader.get_action()
     leader.disconnect()
     return out
+
+
+def field_help(*configs: type) -> dict[str, dict[str, str | None]]:
+    """Each config field's help as LeRobot's parser (draccus) finds it for ``--help``."""
+    from dataclasses import fields
+
+    from draccus.wrappers.docstring import get_attribute_docstring, get_preferred_help_text
+
+    return {
+        config.__name__: {
+            f.name: get_preferred_help_text(get_attribute_docstring(config, f.name))
+            for f in fields(config)
+        }
+        for config in configs
+    }
 
 
 def served(url: str) -> dict[str, Any]:
@@ -201,6 +221,28 @@ def bodies(torso_port: str, humanoid_ports: str) -> dict[str, Any]:
     return out
 
 
+def warm() -> None:
+    """LeRobot's factories imported and the plugin registered: most of a command's CPU."""
+    import lerobot.robots
+    import lerobot.teleoperators  # noqa: F401
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+
+
+def load_serve() -> Any:
+    """tests/helpers/json_lines.py's ``serve``, loaded by its path (the venv has a ``tests``)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "helpers" / "json_lines.py"
+    spec = importlib.util.spec_from_file_location("poppy_json_lines", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.serve
+
+
 if __name__ == "__main__":
     commands = {
         "contract": contract,
@@ -209,5 +251,8 @@ if __name__ == "__main__":
         "zenoh": zenoh,
         "bodies": bodies,
     }
-    result = commands[sys.argv[1]](*sys.argv[2:])
-    sys.stdout.write(json.dumps(result) + "\n")
+    if sys.argv[1] == "serve":
+        load_serve()(commands, warm)
+    else:
+        result = commands[sys.argv[1]](*sys.argv[2:])
+        sys.stdout.write(json.dumps(result) + "\n")

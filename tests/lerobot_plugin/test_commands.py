@@ -4,7 +4,8 @@
 loaded by LeRobotDataset and read by poppy as its own; `lerobot-replay` on the emulated robot;
 a tiny ACT policy trained for a few steps on CPU from a simulation dataset, run by
 `lerobot-record --policy.path` on the simulated robot, then on the emulated one (sim to real).
-Short episodes at a low rate: the machine is shared.
+Short episodes at a low rate: the machine is shared. Commands that need not wait for each
+other run side by side (``LeRobot.start``).
 """
 
 from __future__ import annotations
@@ -33,6 +34,13 @@ SIM_LEADER = [
     "--teleop.id=leader",
     "--teleop.primitive=dance",  # a simulated leader has no hand to move it
 ]
+TELEOP_FOLLOWER = ["--robot.type=poppy_ergo_jr", "--robot.port=sim", "--robot.id=teleop-follower"]
+TELEOP_LEADER = [
+    "--teleop.type=poppy_ergo_jr_leader",
+    "--teleop.port=sim",
+    "--teleop.id=teleop-leader",
+    "--teleop.primitive=dance",
+]
 CAMERA = ["--robot.robot_cameras=[camera]", "--robot.robot_camera_resolution=[32,24]"]
 QUIET = ["--display_data=false", "--play_sounds=false"]
 XL320_STEP = 300 / 1024
@@ -58,20 +66,35 @@ def frames(root: Path) -> dict[str, np.ndarray]:
 
 
 def test_teleoperate_record_and_replay(lerobot: LeRobot, tmp_path: Path) -> None:
-    shown = lerobot.run(
-        "lerobot_teleoperate", *SIM_FOLLOWER, *SIM_LEADER, "--fps=5", "--teleop_time_s=2"
-    )
+    # teleoperated beside the recording (ids of their own: each writes its calibration files)
+    with lerobot.start(
+        "lerobot_teleoperate", *TELEOP_FOLLOWER, *TELEOP_LEADER, "--fps=5", "--teleop_time_s=2"
+    ) as teleoperating:
+        root = tmp_path / "sim-dance"
+        lerobot.run(
+            "lerobot_record", *SIM_FOLLOWER, *SIM_LEADER, *QUIET,
+            *dataset_args(root, "poppy/sim-dance", 1, 6),  # the dance's first 3 s go to 0°
+        )  # fmt: skip
+        shown = teleoperating.wait()
     # both connected on the simulation, the loop ran at its rate, both let go at the end
-    for line in ("follower PoppyErgoJr connected on sim", "leader PoppyErgoJrLeader connected"):
+    for line in (
+        "teleop-follower PoppyErgoJr connected on sim",
+        "teleop-leader PoppyErgoJrLeader connected",
+    ):
         assert line in shown
-    assert "Teleop loop time" in shown and "follower PoppyErgoJr disconnected" in shown
+    assert "Teleop loop time" in shown and "teleop-follower PoppyErgoJr disconnected" in shown
 
-    root = tmp_path / "sim-dance"
-    lerobot.run(
-        "lerobot_record", *SIM_FOLLOWER, *SIM_LEADER, *QUIET,
-        *dataset_args(root, "poppy/sim-dance", 1, 6),  # the dance's first 3 s go to 0°
-    )  # fmt: skip
-    seen: dict[str, Any] = run_oracle("load", str(root), "poppy/sim-dance", "0")
+    with emulate_bus("XL-320:1-6", protocol=2, via="pty") as (bus, port):
+        with lerobot.start(
+            "lerobot_replay", "--robot.type=poppy_ergo_jr", f"--robot.port={port}",
+            "--robot.id=robot", "--dataset.repo_id=poppy/sim-dance", f"--dataset.root={root}",
+            "--dataset.episode=0", "--dataset.fps=5", "--play_sounds=false",
+        ) as replaying:  # fmt: skip
+            # LeRobot's loader reads the episode meanwhile
+            seen: dict[str, Any] = run_oracle("load", str(root), "poppy/sim-dance", "0")
+            replaying.wait()
+        goal_m1 = bus.motor(1).goal_position_deg
+        torque = [m.torque_enabled for m in bus.motors]
     assert seen["num_episodes"] == 1 and seen["len"] >= 5
     info = json.loads((root / "meta/info.json").read_text())
     # the same features as `poppy dataset record` writes for an Ergo Jr (but poppy's unit)
@@ -85,14 +108,6 @@ def test_teleoperate_record_and_replay(lerobot: LeRobot, tmp_path: Path) -> None
     assert np.ptp(recorded["action"], axis=0).max() > 5.0
     assert np.ptp(recorded["observation.state"], axis=0).max() > 1.0
 
-    with emulate_bus("XL-320:1-6", protocol=2, via="pty") as (bus, port):
-        lerobot.run(
-            "lerobot_replay", "--robot.type=poppy_ergo_jr", f"--robot.port={port}",
-            "--robot.id=robot", "--dataset.repo_id=poppy/sim-dance", f"--dataset.root={root}",
-            "--dataset.episode=0", "--dataset.fps=5", "--play_sounds=false",
-        )  # fmt: skip
-        goal_m1 = bus.motor(1).goal_position_deg
-        torque = [m.torque_enabled for m in bus.motors]
     # the emulated robot was sent the episode's actions, the last one last (m1: direct, no
     # offset, so the motor frame is the dataset's); compliant once LeRobot disconnected
     assert goal_m1 == pytest.approx(recorded["action"][-1][0], abs=XL320_STEP)
@@ -125,28 +140,29 @@ def test_act_policy_from_simulation_runs_in_simulation_and_on_the_robot(
     policy = out / "checkpoints" / "last" / "pretrained_model"
     assert (policy / "model.safetensors").is_file()
 
-    in_sim = tmp_path / "eval-sim"
-    lerobot.run(
-        "lerobot_record", *SIM_FOLLOWER, *CAMERA, *QUIET, f"--policy.path={policy}",
-        *dataset_args(in_sim, "poppy/eval_sim", 1, 2),
-    )  # fmt: skip
-    ran = frames(in_sim)
-    assert len(ran["action"]) >= 3 and np.isfinite(ran["action"]).all()
-
     # the robot: the emulator on a pty, its camera a dummy one of the same size
     config = load_profile("ergo-jr").to_dict()
     config["sensors"] = {
         "camera": {"type": "DummyCamera", "resolution": [32, 24], "fps": 5.0},
     }
     profile = dump_config(RobotConfig.from_dict(config, source="test"), tmp_path / "robot.yaml")
-    on_robot = tmp_path / "eval-robot"
-    with emulate_bus("XL-320:1-6", protocol=2, via="pty") as (bus, port):
+    on_robot, in_sim = tmp_path / "eval-robot", tmp_path / "eval-sim"
+    with (
+        emulate_bus("XL-320:1-6", protocol=2, via="pty") as (bus, port),
+        lerobot.start(  # in the simulation, beside the robot
+            "lerobot_record", *SIM_FOLLOWER, *CAMERA, *QUIET, f"--policy.path={policy}",
+            *dataset_args(in_sim, "poppy/eval_sim", 1, 2),
+        ) as in_simulation,
+    ):  # fmt: skip
         lerobot.run(
             "lerobot_record", "--robot.type=poppy_ergo_jr", f"--robot.port={port}",
             "--robot.id=robot", f"--robot.profile={profile}", "--robot.robot_cameras=[camera]",
             *QUIET, f"--policy.path={policy}", *dataset_args(on_robot, "poppy/eval_robot", 1, 2),
         )  # fmt: skip
         goal_m1 = bus.motor(1).goal_position_deg
+        in_simulation.wait()
+    ran = frames(in_sim)
+    assert len(ran["action"]) >= 3 and np.isfinite(ran["action"]).all()
     acted = frames(on_robot)
     assert len(acted["action"]) >= 3 and np.isfinite(acted["action"]).all()
     # the policy's last action reached the robot (clamped to m1's limits, a tick of the servo)

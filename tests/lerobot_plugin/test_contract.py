@@ -1,7 +1,8 @@
 """The plugin follows LeRobot 0.4.4's Robot and Teleoperator contracts (on emulated Ergo Jrs).
 
 LeRobot's own registries and factories build the devices (``register_third_party_plugins``,
-``make_robot_from_config``), in LeRobot's venv; the motors are the test's emulators on ptys.
+``make_robot_from_config``), in LeRobot's venv (one process for all: ``probe``); the motors
+are the test's emulators on ptys.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import numpy as np
 import pytest
 
 from tests.helpers.bus import emulate_bus
+from tests.helpers.json_lines import JsonChild
 from tests.helpers.server import serve
 from tests.lerobot_plugin.conftest import LeRobot
 
@@ -22,7 +24,7 @@ ERGO_JR = "XL-320:1-6"
 XL320_STEP = 300 / 1024  # degrees a position tick (poppy's register table)
 
 
-def test_types_features_torque_limits_and_calibration(lerobot: LeRobot) -> None:
+def test_types_features_torque_limits_and_calibration(lerobot: LeRobot, probe: JsonChild) -> None:
     # the leader's calibration, as LeRobot keeps it: m1 10 ticks off (on the host: no register)
     calibration = lerobot.home / "calibration" / "teleoperators" / "poppy_ergo_jr_leader"
     calibration.mkdir(parents=True, exist_ok=True)  # another test may have made it
@@ -37,7 +39,7 @@ def test_types_features_torque_limits_and_calibration(lerobot: LeRobot) -> None:
         emulate_bus(ERGO_JR, protocol=2, via="pty") as (leader_bus, leader_port),
     ):
         leader_bus.motor(1).move_by_hand(30.0)
-        seen = lerobot.probe("contract", follower_port, leader_port)
+        seen = probe.ask("contract", follower_port, leader_port)
         follower_torque = [m.torque_enabled for m in follower_bus.motors]
         leader_torque = [m.torque_enabled for m in leader_bus.motors]
         follower_goals = {m.id: m.goal_position_deg for m in follower_bus.motors}
@@ -69,6 +71,16 @@ def test_types_features_torque_limits_and_calibration(lerobot: LeRobot) -> None:
     ]
     assert len(features["poppy_torso_leader"]["action"]) == 8
     assert features["with_camera"] == [48, 64, 3]
+    # `--help` describes the plugin's fields (LeRobot's parser reads them from the config
+    # classes' comments, following each class's first base: the Poppy fields come first)
+    follower_help, leader_help = (
+        seen["help"]["PoppyErgoJrConfig"],
+        seen["help"]["PoppyErgoJrLeaderConfig"],
+    )
+    assert "serial port" in follower_help["port"] and "serial port" in leader_help["port"]
+    assert "cameras" in follower_help["robot_cameras"]
+    assert "Torque off" in follower_help["disable_torque_on_disconnect"]
+    assert "primitive of the leader" in leader_help["primitive"]
 
     # calibration: written where LeRobot keeps it on the first connect, from poppy's profile
     assert (seen["calibrated_before"], seen["calibrated_after"]) == (False, True)
@@ -100,11 +112,11 @@ def test_types_features_torque_limits_and_calibration(lerobot: LeRobot) -> None:
     assert seen["leader_action"]["m1.pos"] == pytest.approx(30.0 - 10 * XL320_STEP, abs=0.3)
 
 
-def test_a_served_robot_is_driven_over_http(lerobot: LeRobot, tmp_path: Path) -> None:
+def test_a_served_robot_is_driven_over_http(probe: JsonChild, tmp_path: Path) -> None:
     served = serve(str(tmp_path))
     robot = next(served)
     try:
-        seen = lerobot.probe("served", robot.url)
+        seen = probe.ask("served", robot.url)
         m1, m2 = robot.robot.motor("m1"), robot.robot.motor("m2")
         goals = (m1.goal_position, m2.goal_position)
         compliant = [m.compliant for m in robot.robot.motors]
@@ -120,7 +132,7 @@ def test_a_served_robot_is_driven_over_http(lerobot: LeRobot, tmp_path: Path) ->
 
 
 def test_a_served_robots_own_camera_is_observed_through_lerobot(
-    lerobot: LeRobot, tmp_path: Path
+    probe: JsonChild, tmp_path: Path
 ) -> None:
     """``robot_cameras`` on a served robot: the frames of its camera (its ``frame.png``
     route), RGB, as LeRobot's observation; the served camera here draws a known pattern."""
@@ -134,7 +146,7 @@ def test_a_served_robots_own_camera_is_observed_through_lerobot(
         pattern[..., 0] = xs % 256  # blue
         pattern[..., 1] = ys % 256  # green
         pattern[..., 2] = 77  # red
-        seen = lerobot.probe("served_camera", robot.url)
+        seen = probe.ask("served_camera", robot.url)
     finally:
         served.close()
     assert seen["features"]["camera"] == [height, width, 3]

@@ -15,8 +15,8 @@ import pytest
 
 from poppy_core.robot import load_profile
 from tests.helpers.bus import emulate_bus
+from tests.helpers.json_lines import JsonChild
 from tests.helpers.zenoh_served import TOKEN, Served
-from tests.lerobot_plugin.conftest import LeRobot
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(600)]
 
@@ -35,9 +35,9 @@ def on_zenoh(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Served
         served.close()
 
 
-def test_a_robot_served_on_zenoh_is_followed_and_leads(lerobot: LeRobot, on_zenoh: Served) -> None:
+def test_a_robot_served_on_zenoh_is_followed_and_leads(probe: JsonChild, on_zenoh: Served) -> None:
     robot = on_zenoh.robot
-    seen = lerobot.probe("zenoh", on_zenoh.name, on_zenoh.endpoint, env={"POPPY_TOKEN": TOKEN})
+    seen = probe.ask("zenoh", on_zenoh.name, on_zenoh.endpoint, env={"POPPY_TOKEN": TOKEN})
     goals = (robot.motor("m1").goal_position, robot.motor("m2").goal_position)
     present = {m.name: m.present_position for m in robot.motors}
     compliant = [m.compliant for m in robot.motors]
@@ -59,7 +59,7 @@ def test_a_robot_served_on_zenoh_is_followed_and_leads(lerobot: LeRobot, on_zeno
 
 
 def test_the_plugin_through_a_router_with_a_stranger_answering_for_the_robot(
-    lerobot: LeRobot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    probe: JsonChild, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The topology users deploy: the robot and LeRobot connected only to a router process
     (``zenoh_connect`` is the router), and a stranger's session on it that answers every
@@ -76,7 +76,7 @@ def test_the_plugin_through_a_router_with_a_stranger_answering_for_the_robot(
         served = Served("jr-lerobot", router=router.endpoint)
         stranger = Stranger(router.endpoint)
         robot = served.robot
-        seen = lerobot.probe("zenoh", served.name, router.endpoint, env={"POPPY_TOKEN": TOKEN})
+        seen = probe.ask("zenoh", served.name, router.endpoint, env={"POPPY_TOKEN": TOKEN})
         goals = (robot.motor("m1").goal_position, robot.motor("m2").goal_position)
         assert stranger.asked("poppy/jr-lerobot/api")  # the stranger answered the plugin too
     finally:
@@ -101,7 +101,7 @@ def spec_of(profile: str, controller: str) -> str:
     return ",".join(f"{kind}:{'/'.join(map(str, ids))}" for kind, ids in by_type.items())
 
 
-def test_torso_and_humanoid_connect_observe_and_act(lerobot: LeRobot) -> None:
+def test_torso_and_humanoid_connect_observe_and_act(probe: JsonChild) -> None:
     upper, lower = "upper_body_controller", "lower_body_controller"
     with (
         emulate_bus(spec_of("torso", upper), protocol=1, via="pty") as (bus, port),
@@ -109,7 +109,7 @@ def test_torso_and_humanoid_connect_observe_and_act(lerobot: LeRobot) -> None:
         emulate_bus(spec_of("humanoid", lower), protocol=1, via="pty") as (legs, lower_port),
     ):
         humanoid_ports = f"{upper}={upper_port},{lower}={lower_port}"
-        seen = lerobot.probe("bodies", port, humanoid_ports)
+        seen = probe.ask("bodies", port, humanoid_ports)
         goal_elbow = bus.motor(44).goal_position_deg
         torque = {m.id: m.torque_enabled for m in bus.motors}
         goal_knee = legs.motor(14).goal_position_deg

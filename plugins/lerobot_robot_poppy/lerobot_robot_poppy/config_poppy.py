@@ -50,21 +50,24 @@ class PoppyFollowerFields(PoppyFields):
     disable_torque_on_disconnect: bool = True
 
 
+# The fields' class is the first base: LeRobot's parser (draccus) looks a field's `--help` up
+# in the class's source, then its first base's, and so on; RobotConfig first, it never found the
+# Poppy fields' comments and re-parsed typing.py for each (seconds of CPU a command start).
 @RobotConfig.register_subclass("poppy_ergo_jr")
 @dataclass(kw_only=True)
-class PoppyErgoJrConfig(RobotConfig, PoppyFollowerFields):
+class PoppyErgoJrConfig(PoppyFollowerFields, RobotConfig):
     """A Poppy Ergo Jr (6 XL-320) as a LeRobot robot."""
 
 
 @RobotConfig.register_subclass("poppy_torso")
 @dataclass(kw_only=True)
-class PoppyTorsoConfig(RobotConfig, PoppyFollowerFields):
+class PoppyTorsoConfig(PoppyFollowerFields, RobotConfig):
     """A Poppy Torso (MX-28/MX-64/AX-12A) as a LeRobot robot."""
 
 
 @RobotConfig.register_subclass("poppy_humanoid")
 @dataclass(kw_only=True)
-class PoppyHumanoidConfig(RobotConfig, PoppyFollowerFields):
+class PoppyHumanoidConfig(PoppyFollowerFields, RobotConfig):
     """A Poppy Humanoid as a LeRobot robot."""
 
 
@@ -80,13 +83,13 @@ class PoppyLeaderFields(PoppyFields):
 
 @TeleoperatorConfig.register_subclass("poppy_ergo_jr_leader")
 @dataclass(kw_only=True)
-class PoppyErgoJrLeaderConfig(TeleoperatorConfig, PoppyLeaderFields):
+class PoppyErgoJrLeaderConfig(PoppyLeaderFields, TeleoperatorConfig):
     """An Ergo Jr moved by hand, leading a `poppy_ergo_jr` follower."""
 
 
 @TeleoperatorConfig.register_subclass("poppy_torso_leader")
 @dataclass(kw_only=True)
-class PoppyTorsoLeaderConfig(TeleoperatorConfig, PoppyLeaderFields):
+class PoppyTorsoLeaderConfig(PoppyLeaderFields, TeleoperatorConfig):
     """A Torso's arms moved by hand, leading a `poppy_torso` follower."""
 
     group: str = "arms"
@@ -94,7 +97,7 @@ class PoppyTorsoLeaderConfig(TeleoperatorConfig, PoppyLeaderFields):
 
 @TeleoperatorConfig.register_subclass("poppy_humanoid_leader")
 @dataclass(kw_only=True)
-class PoppyHumanoidLeaderConfig(TeleoperatorConfig, PoppyLeaderFields):
+class PoppyHumanoidLeaderConfig(PoppyLeaderFields, TeleoperatorConfig):
     """A Humanoid's arms moved by hand, leading a `poppy_humanoid` follower."""
 
     group: str = "arms"
