@@ -44,8 +44,10 @@ def browser() -> Iterator[Any]:
     yield from launched()
 
 
-@pytest.fixture
-def page(browser: Any, served: Served) -> Iterator[Any]:
+@pytest.fixture(scope="module")
+def tab(browser: Any) -> Iterator[tuple[Any, list[str]]]:
+    """The module's tab and the errors its page reports (a new context costs the browser about
+    three times what loading the page again in this one does)."""
     context, opened = new_tab(browser, WAIT_S * 1000)
     errors: list[str] = []
     opened.on("pageerror", lambda error: errors.append(str(error)))
@@ -55,10 +57,20 @@ def page(browser: Any, served: Served) -> Iterator[Any]:
             errors.append(message.text) if "Content Security Policy" in message.text else None
         ),
     )
+    yield opened, errors
+    context.close()
+
+
+@pytest.fixture
+def page(tab: tuple[Any, list[str]], served: Served) -> Iterator[Any]:
+    """The home page loaded afresh in the module's tab (a new document, desktop size)."""
+    opened, errors = tab
+    errors.clear()
+    opened.set_viewport_size({"width": 1280, "height": 900})
     opened.goto(served.url + "/")
     opened.wait_for_function(LIVE)
     yield opened
-    context.close()
+    opened.goto("about:blank")  # the page's stream and polls end with the test
     assert not errors, errors
 
 
@@ -406,8 +418,9 @@ def creature(moves_folder: str) -> Iterator[Served]:
     yield from serve_robot(from_profile("ergo-jr", sim=True))
 
 
-def test_chain_jog(browser: Any, creature: Served) -> None:
-    context, tab = new_tab(browser, WAIT_S * 1000)
+def test_chain_jog(tab: tuple[Any, list[str]], creature: Served) -> None:
+    tab, _ = tab
+    tab.set_viewport_size({"width": 1280, "height": 900})
     tab.goto(creature.url + "/")
     tab.wait_for_function(READY)
     robot = creature.robot
@@ -425,7 +438,7 @@ def test_chain_jog(browser: Any, creature: Served) -> None:
     eventually(shown_in_mm, "the tip shown in millimetres")
     # the Ergo Jr's chain keeps pypot's name in the URLs, and is shown as what it is
     eventually(lambda: tab.inner_text("#chain-chain h3") == "arm", "the chain shown as arm")
-    context.close()
+    tab.goto("about:blank")
     robot.compliant = True
 
 
