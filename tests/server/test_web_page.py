@@ -98,6 +98,32 @@ def test_the_table_shows_every_motor_and_values_move_on_a_goto(page: Any, served
     robot.compliant = True
 
 
+# counts the motor table's DOM writes from now on, and the stream frames meanwhile
+COUNT_WRITES = """() => {
+  window.__writes = 0;
+  window.__framesAtStart = window.poppy.stats.frames;
+  new MutationObserver((records) => { window.__writes += records.length; }).observe(
+    document.querySelector("#motor-table tbody"),
+    { subtree: true, childList: true, characterData: true },
+  );
+}"""
+
+
+def test_a_still_robot_is_not_written_into_the_table_again_each_frame(
+    page: Any, served: Served
+) -> None:
+    # The table wrote its four live cells of each motor at every frame (20 a second), values
+    # unchanged or not: the page laid itself out again 20 times a second for nothing.
+    served.robot.compliant = True
+    page.evaluate(COUNT_WRITES)
+    counted = "() => [window.__writes, window.poppy.stats.frames - window.__framesAtStart]"
+    eventually(lambda: page.evaluate(counted)[1] >= 20, "20 frames of the stream")
+    writes, frames = page.evaluate(counted)
+    cells = 4 * len(served.robot.motors)  # what each frame used to rewrite
+    # a value that does change (a temperature, a load) is still written: two cells a frame at most
+    assert writes < 2 * frames, f"{writes} writes in {frames} frames (each rewrote {cells})"
+
+
 def test_compliance_toggles_change_the_robot(page: Any, served: Served) -> None:
     robot = served.robot
     robot.compliant = True
