@@ -27,7 +27,12 @@ Image = pytest.importorskip("PIL.Image", reason="needs pillow to read the screen
 pytestmark = needs_chromium
 
 WAIT_S = 60.0
-WEBGL_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+WEBGL_ARGS = [
+    "--no-sandbox",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--disable-gpu-compositing",
+]
 DRAWN = "() => window.poppy && window.poppy.view && window.poppy.view.frames > 0"
 
 
