@@ -36,22 +36,32 @@ def fake(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> FakeTools:
     return FakeTools(tmp_path, monkeypatch)
 
 
-def _settings_page(browser: Any, served: Served) -> tuple[Any, Any]:
+@pytest.fixture(scope="module")
+def tab(browser: Any) -> Iterator[Any]:
+    """The module's tab, the token put in its storage before each page's scripts run (a new
+    context costs the browser about three times what loading the page again in this one does)."""
     context = browser.new_context()
     context.add_init_script(f"localStorage.setItem('poppy-token', '{TOKEN}')")
     page = context.new_page()
     page.set_default_timeout(WAIT_MS)
+    yield page
+    context.close()
+
+
+def _settings_page(tab: Any, served: Served) -> Any:
+    """The home page loaded afresh in the module's tab, its settings panel open."""
+    page = tab
     page.goto(served.url + "/")
     page.wait_for_function("() => window.poppy && window.poppy.ready")
     page.click("#settings-open")
     page.wait_for_selector("#settings-version")
-    return context, page
+    return page
 
 
 def test_renaming_from_the_page_runs_hostnamectl(
-    browser: Any, with_token: Served, fake: FakeTools
+    tab: Any, with_token: Served, fake: FakeTools
 ) -> None:
-    context, page = _settings_page(browser, with_token)
+    page = _settings_page(tab, with_token)
     try:
         assert page.inner_text("#settings-version").startswith("poppy ")
         assert page.is_hidden("#settings-reason")
@@ -63,25 +73,25 @@ def test_renaming_from_the_page_runs_hostnamectl(
             "() => document.getElementById('message').textContent.includes('ergo-7.local')"
         )
     finally:
-        context.close()
+        page.goto("about:blank")  # the page's stream and polls end with the test
 
 
 def test_without_networkmanager_the_panel_is_read_only_and_says_why(
-    browser: Any, with_token: Served, fake: FakeTools, monkeypatch: pytest.MonkeyPatch
+    tab: Any, with_token: Served, fake: FakeTools, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     fake.alone(monkeypatch)
     fake.remove("nmcli")
-    context, page = _settings_page(browser, with_token)
+    page = _settings_page(tab, with_token)
     try:
         assert "nmcli not found" in page.inner_text("#settings-reason")
         assert page.is_disabled("#settings-rename") and page.is_disabled("#settings-name")
     finally:
-        context.close()
+        page.goto("about:blank")  # the page's stream and polls end with the test
     assert fake.changes() == []
 
 
 def test_snap_and_the_token_from_the_page_write_the_files_and_restart_the_service(
-    browser: Any,
+    tab: Any,
     with_token: Served,
     fake: FakeTools,
     tmp_path: Path,
@@ -98,7 +108,7 @@ def test_snap_and_the_token_from_the_page_write_the_files_and_restart_the_servic
     monkeypatch.setattr(settings.served, "token_file", folder / "token")
     monkeypatch.setattr(settings, "system", SystemTools(cgroup="0::/system.slice/poppy.service"))
     restart = ["systemctl", "restart", "--no-block", "poppy.service"]
-    context, page = _settings_page(browser, with_token)
+    page = _settings_page(tab, with_token)
     try:
         # ZMQ has no token: a robot requiring one does not turn it on from its page, which says so
         assert page.is_disabled("#settings-zmq")
@@ -116,4 +126,4 @@ def test_snap_and_the_token_from_the_page_write_the_files_and_restart_the_servic
         # the page sends the new token once the service is back
         page.wait_for_function("() => localStorage.getItem('poppy-token') === 'a-new-token-42'")
     finally:
-        context.close()
+        page.goto("about:blank")  # the page's stream and polls end with the test

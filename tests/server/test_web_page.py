@@ -44,8 +44,10 @@ def browser() -> Iterator[Any]:
     yield from launched()
 
 
-@pytest.fixture
-def page(browser: Any, served: Served) -> Iterator[Any]:
+@pytest.fixture(scope="module")
+def tab(browser: Any) -> Iterator[tuple[Any, list[str]]]:
+    """The module's tab and the errors its page reports (a new context costs the browser about
+    three times what loading the page again in this one does)."""
     context, opened = new_tab(browser, WAIT_S * 1000)
     errors: list[str] = []
     opened.on("pageerror", lambda error: errors.append(str(error)))
@@ -55,10 +57,20 @@ def page(browser: Any, served: Served) -> Iterator[Any]:
             errors.append(message.text) if "Content Security Policy" in message.text else None
         ),
     )
+    yield opened, errors
+    context.close()
+
+
+@pytest.fixture
+def page(tab: tuple[Any, list[str]], served: Served) -> Iterator[Any]:
+    """The home page loaded afresh in the module's tab (a new document, desktop size)."""
+    opened, errors = tab
+    errors.clear()
+    opened.set_viewport_size({"width": 1280, "height": 900})
     opened.goto(served.url + "/")
     opened.wait_for_function(LIVE)
     yield opened
-    context.close()
+    opened.goto("about:blank")  # the page's stream and polls end with the test
     assert not errors, errors
 
 
@@ -84,6 +96,32 @@ def test_the_table_shows_every_motor_and_values_move_on_a_goto(page: Any, served
     eventually(lambda: abs(cell(page, "m1", 1) - start) > 5, "m1's position to move on the page")
     eventually(lambda: abs(cell(page, "m1", 1) - target) < 2, "m1 to arrive on the page")
     robot.compliant = True
+
+
+# counts the motor table's DOM writes from now on, and the stream frames meanwhile
+COUNT_WRITES = """() => {
+  window.__writes = 0;
+  window.__framesAtStart = window.poppy.stats.frames;
+  new MutationObserver((records) => { window.__writes += records.length; }).observe(
+    document.querySelector("#motor-table tbody"),
+    { subtree: true, childList: true, characterData: true },
+  );
+}"""
+
+
+def test_a_still_robot_is_not_written_into_the_table_again_each_frame(
+    page: Any, served: Served
+) -> None:
+    # The table wrote its four live cells of each motor at every frame (20 a second), values
+    # unchanged or not: the page laid itself out again 20 times a second for nothing.
+    served.robot.compliant = True
+    page.evaluate(COUNT_WRITES)
+    counted = "() => [window.__writes, window.poppy.stats.frames - window.__framesAtStart]"
+    eventually(lambda: page.evaluate(counted)[1] >= 20, "20 frames of the stream")
+    writes, frames = page.evaluate(counted)
+    cells = 4 * len(served.robot.motors)  # what each frame used to rewrite
+    # a value that does change (a temperature, a load) is still written: two cells a frame at most
+    assert writes < 2 * frames, f"{writes} writes in {frames} frames (each rewrote {cells})"
 
 
 def test_compliance_toggles_change_the_robot(page: Any, served: Served) -> None:
@@ -406,8 +444,9 @@ def creature(moves_folder: str) -> Iterator[Served]:
     yield from serve_robot(from_profile("ergo-jr", sim=True))
 
 
-def test_chain_jog(browser: Any, creature: Served) -> None:
-    context, tab = new_tab(browser, WAIT_S * 1000)
+def test_chain_jog(tab: tuple[Any, list[str]], creature: Served) -> None:
+    tab, _ = tab
+    tab.set_viewport_size({"width": 1280, "height": 900})
     tab.goto(creature.url + "/")
     tab.wait_for_function(READY)
     robot = creature.robot
@@ -425,7 +464,7 @@ def test_chain_jog(browser: Any, creature: Served) -> None:
     eventually(shown_in_mm, "the tip shown in millimetres")
     # the Ergo Jr's chain keeps pypot's name in the URLs, and is shown as what it is
     eventually(lambda: tab.inner_text("#chain-chain h3") == "arm", "the chain shown as arm")
-    context.close()
+    tab.goto("about:blank")
     robot.compliant = True
 
 

@@ -20,7 +20,7 @@ import pytest
 
 from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServeSpec, serve
-from tests.helpers.chromium import launched, needs_chromium, new_tab
+from tests.helpers.chromium import launched, needs_chromium
 from tests.helpers.server import Served
 from tests.helpers.server import serve as serve_ergo
 from tests.helpers.waiting import eventually, http_timeout
@@ -67,8 +67,33 @@ def closed_port() -> int:
         return int(probe.getsockname()[1])
 
 
-def open_page(browser: Any, url: str, viewport: dict[str, int] = DESKTOP, **options: Any) -> Any:
-    context = browser.new_context(viewport=viewport, **options)
+@pytest.fixture(scope="module")
+def tab(browser: Any) -> Iterator[Any]:
+    """The module's tab, where each test loads its page afresh at its size (a new context costs
+    the browser about three times as much; no test keeps a token in this one)."""
+    context = browser.new_context(viewport=DESKTOP)
+    page = context.new_page()
+    page.set_default_timeout(WAIT_MS)
+    yield page
+    context.close()
+
+
+def open_page(tab: Any, url: str, viewport: dict[str, int] = DESKTOP) -> Any:
+    """``url``'s home page loaded afresh in the module's ``tab`` (a new document), live."""
+    tab.set_viewport_size(viewport)
+    tab.goto(url + "/")
+    tab.wait_for_function(LIVE)
+    return tab
+
+
+def leave(page: Any) -> None:
+    """Ends the page's stream and polls with the test (the tab stays for the next)."""
+    page.goto("about:blank")
+
+
+def open_phone(browser: Any, url: str) -> Any:
+    """``url``'s home page in a context of its own, as a phone shows it (touch, mobile viewport)."""
+    context = browser.new_context(viewport=PHONE, is_mobile=True)
     page = context.new_page()
     page.set_default_timeout(WAIT_MS)
     page.goto(url + "/")
@@ -82,33 +107,33 @@ def box(page: Any, selector: str) -> dict[str, float]:
     return dict(found)
 
 
-def test_the_name_is_in_the_header_the_tab_and_about(browser: Any, jr1: Any) -> None:
+def test_the_name_is_in_the_header_the_tab_and_about(tab: Any, jr1: Any) -> None:
     about = httpx.get(jr1.http.url + "/api/v1/web/about", timeout=http_timeout()).json()
     assert (about["name"], about["creature"]) == ("jr1", "ergo-jr")
-    page = open_page(browser, jr1.http.url)
+    page = open_page(tab, jr1.http.url)
     try:
         assert page.inner_text("#robot-name") == "jr1"
         assert page.inner_text("#creature") == "ergo-jr"
         assert page.title() == "jr1 · ergo-jr"
     finally:
-        page.context.close()
+        leave(page)
 
 
-def test_a_robot_without_a_name_is_named_once(browser: Any, served: Served) -> None:
+def test_a_robot_without_a_name_is_named_once(tab: Any, served: Served) -> None:
     # it said "ergo-jr ergo-jr" (the profile as the name, and again as the creature)
-    page = open_page(browser, served.url)
+    page = open_page(tab, served.url)
     try:
         assert page.inner_text("#robot-name") == "ergo-jr"
         assert page.inner_text("#creature") == ""
         assert page.title() == "ergo-jr · poppy"
     finally:
-        page.context.close()
+        leave(page)
 
 
 def test_with_snap_the_header_is_one_line_and_links_snap_not_a_dead_jupyter(
-    browser: Any, jr1: Any
+    tab: Any, jr1: Any
 ) -> None:
-    page = open_page(browser, jr1.http.url)
+    page = open_page(tab, jr1.http.url)
     try:
         links = page.eval_on_selector_all("#links a", "as => as.map(a => a.textContent)")
         assert links == ["Snap! with the Poppy blocks"], links  # no Jupyter answers
@@ -118,16 +143,16 @@ def test_with_snap_the_header_is_one_line_and_links_snap_not_a_dead_jupyter(
         assert max(middles.values()) - min(middles.values()) < 12, f"the header wraps: {middles}"
         assert box(page, "header")["height"] < 80
     finally:
-        page.context.close()
+        leave(page)
 
 
-def test_a_robot_without_snap_links_no_snap(browser: Any, served: Served) -> None:
-    page = open_page(browser, served.url)
+def test_a_robot_without_snap_links_no_snap(tab: Any, served: Served) -> None:
+    page = open_page(tab, served.url)
     try:
         assert page.locator("#links a").count() == 0
         assert "API docs" in page.inner_text("#dev-links")  # the programmers' links stay
     finally:
-        page.context.close()
+        leave(page)
 
 
 class FakeJupyter(http.server.BaseHTTPRequestHandler):
@@ -165,7 +190,7 @@ def jupyter_link(page: Any) -> str | None:
     return found.get_attribute("href") if found else None
 
 
-def test_the_jupyter_link_shows_only_while_a_jupyter_answers(browser: Any, served: Served) -> None:
+def test_the_jupyter_link_shows_only_while_a_jupyter_answers(tab: Any, served: Served) -> None:
     state = served.app.state
     other = listening(NotJupyter)
     jupyter = listening(FakeJupyter)
@@ -179,7 +204,7 @@ def test_the_jupyter_link_shows_only_while_a_jupyter_answers(browser: Any, serve
             "port": port,
             "path": "/notebooks/discover-your-robot.ipynb",
         }
-        page = open_page(browser, served.url)
+        page = open_page(tab, served.url)
         try:
             want = f"http://127.0.0.1:{port}/notebooks/discover-your-robot.ipynb"
             assert jupyter_link(page) == want
@@ -189,7 +214,7 @@ def test_the_jupyter_link_shows_only_while_a_jupyter_answers(browser: Any, serve
             # the page reads about every 5 s; the server asks Jupyter again after 3 s
             assert eventually(lambda: jupyter_link(page) is None, 30.0), "a dead Jupyter linked"
         finally:
-            page.context.close()
+            leave(page)
     finally:
         other.shutdown()
         other.server_close()
@@ -232,8 +257,8 @@ def test_the_token_prompt_is_no_outage(browser: Any, with_token: Served) -> None
         context.close()
 
 
-def test_desktop_the_3d_view_sits_beside_the_table(browser: Any, served: Served) -> None:
-    page = open_page(browser, served.url)
+def test_desktop_the_3d_view_sits_beside_the_table(tab: Any, served: Served) -> None:
+    page = open_page(tab, served.url)
     try:
         view, motors = box(page, "#view3d"), box(page, "#motors")
         assert view["x"] + view["width"] <= motors["x"], (view, motors)
@@ -244,13 +269,13 @@ def test_desktop_the_3d_view_sits_beside_the_table(browser: Any, served: Served)
         used = max(box(page, s)["x"] + box(page, s)["width"] for s in ("#motors", "#primitives"))
         assert used > 1200, f"the page leaves {1280 - used:.0f} px empty on the right"
     finally:
-        page.context.close()
+        leave(page)
 
 
 def test_phone_the_view_is_under_the_table_and_nothing_is_wider(
     browser: Any, served: Served
 ) -> None:
-    page = open_page(browser, served.url, PHONE, is_mobile=True)
+    page = open_phone(browser, served.url)
     try:
         assert page.evaluate("document.documentElement.scrollWidth") <= PHONE["width"]
         view, motors = box(page, "#view3d"), box(page, "#motors")
@@ -271,9 +296,9 @@ ROWS = """rows => rows.map(row => ({
 
 @pytest.mark.parametrize("viewport", [DESKTOP, PHONE], ids=["desktop", "phone"])
 def test_behaviours_are_one_compact_row_each_with_one_toggle(
-    browser: Any, served: Served, viewport: dict[str, int]
+    tab: Any, served: Served, viewport: dict[str, int]
 ) -> None:
-    page = open_page(browser, served.url, viewport)
+    page = open_page(tab, served.url, viewport)
     try:
         page.wait_for_selector("#primitive-sinus")
         rows = page.eval_on_selector_all("#primitive-list > li", ROWS)
@@ -290,11 +315,11 @@ def test_behaviours_are_one_compact_row_each_with_one_toggle(
             )
             assert len(set(tops)) <= (len(tops) + 1) // 2
     finally:
-        page.context.close()
+        leave(page)
 
 
-def test_the_toggle_starts_and_stops_and_the_fold_pauses(browser: Any, served: Served) -> None:
-    page = open_page(browser, served.url)
+def test_the_toggle_starts_and_stops_and_the_fold_pauses(tab: Any, served: Served) -> None:
+    page = open_page(tab, served.url)
     robot = served.robot
     toggle = "#primitive-square button.run"
 
@@ -320,15 +345,15 @@ def test_the_toggle_starts_and_stops_and_the_fold_pauses(browser: Any, served: S
         assert eventually(lambda: not robot.square.is_alive())
         assert eventually(lambda: shown() == ("start square", "false", False, False)), shown()
     finally:
-        page.context.close()
+        leave(page)
         robot.compliant = True
 
 
 @pytest.mark.parametrize("viewport", [DESKTOP, PHONE], ids=["desktop", "phone"])
 def test_settings_are_one_click_from_the_header(
-    browser: Any, served: Served, viewport: dict[str, int]
+    tab: Any, served: Served, viewport: dict[str, int]
 ) -> None:
-    page = open_page(browser, served.url, viewport)
+    page = open_page(tab, served.url, viewport)
     try:
         page.evaluate("window.scrollTo(0, document.body.scrollHeight)")  # wherever one is
         page.click("#settings-open")
@@ -339,20 +364,20 @@ def test_settings_are_one_click_from_the_header(
         page.click("#settings-open")
         assert page.is_hidden("#settings")
     finally:
-        page.context.close()
+        leave(page)
 
 
-def test_an_ideal_sim_camera_panel_says_no_camera(browser: Any, served: Served) -> None:
+def test_an_ideal_sim_camera_panel_says_no_camera(tab: Any, served: Served) -> None:
     about = httpx.get(served.url + "/api/v1/web/about", timeout=http_timeout()).json()
     assert about["camera_views"] == [] and about["cameras"] == ["camera"]  # a DummyCamera
-    page = open_page(browser, served.url)
+    page = open_page(tab, served.url)
     try:
         assert page.inner_text("#camera-h") == "Camera"
         assert page.inner_text("#no-camera").startswith("No camera")
         assert "--sim mujoco" in page.inner_text("#no-camera")
         assert page.query_selector("#camera-views img") is None  # no black square
     finally:
-        page.context.close()
+        leave(page)
 
 
 MEAN_PIXEL = """img => {
@@ -383,12 +408,10 @@ def mujoco_robot(moves_folder: str) -> Iterator[Served]:
 
 
 def test_under_mujoco_the_camera_panel_shows_the_simulated_picture(
-    browser: Any, mujoco_robot: Served
+    tab: Any, mujoco_robot: Served
 ) -> None:
-    context, page = new_tab(browser, WAIT_MS)
+    page = open_page(tab, mujoco_robot.url)
     try:
-        page.goto(mujoco_robot.url + "/")
-        page.wait_for_function(LIVE)
         label = page.inner_text("#camera-camera .camera-label")
         assert label.startswith("camera: simulated by MuJoCo"), label
         page.click("#camera-camera button")
@@ -396,12 +419,12 @@ def test_under_mujoco_the_camera_panel_shows_the_simulated_picture(
         assert eventually(lambda: img.evaluate("i => i.naturalWidth") > 0, 30.0)
         assert eventually(lambda: img.evaluate(MEAN_PIXEL) > 20, 30.0), "a black picture"
     finally:
-        context.close()
+        leave(page)
 
 
-def test_the_speed_column_moves_while_a_goto_plays(browser: Any, served: Served) -> None:
+def test_the_speed_column_moves_while_a_goto_plays(tab: Any, served: Served) -> None:
     # it read 0.0 while the arm danced: the emulator's present speed was 0 during a goto
-    page = open_page(browser, served.url)
+    page = open_page(tab, served.url)
     robot = served.robot
     speeds: list[float] = []
 
@@ -419,6 +442,6 @@ def test_the_speed_column_moves_while_a_goto_plays(browser: Any, served: Served)
         robot.goto_position({"m1": 60.0}, 3.0, wait=False)
         assert eventually(at_goto_speed, 30.0), f"the speed column read {sorted(set(speeds))}"
     finally:
-        page.context.close()
+        leave(page)
         robot.goto_position({"m1": 0.0}, 0.5, wait=True)
         robot.compliant = True

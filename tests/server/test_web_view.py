@@ -27,7 +27,12 @@ Image = pytest.importorskip("PIL.Image", reason="needs pillow to read the screen
 pytestmark = needs_chromium
 
 WAIT_S = 60.0
-WEBGL_ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+WEBGL_ARGS = [
+    "--no-sandbox",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--disable-gpu-compositing",
+]
 DRAWN = "() => window.poppy && window.poppy.view && window.poppy.view.frames > 0"
 
 
@@ -50,16 +55,29 @@ def humanoid(moves_folder: str) -> Iterator[Served]:
     yield from serve_robot(from_profile("humanoid", sim=True))
 
 
-def open_view(browser: Any, url: str, errors: list[str]) -> Any:
-    _, page = new_tab(browser, WAIT_S * 1000)
+@pytest.fixture(scope="module")
+def tab(browser: Any) -> Iterator[tuple[Any, list[str]]]:
+    """The module's tab and the errors its page reports (a new context costs the browser about
+    three times what loading the page again in this one does)."""
+    context, page = new_tab(browser, WAIT_S * 1000)
+    errors: list[str] = []
     page.on("pageerror", lambda error: errors.append(str(error)))
     page.on(
         "console",
         lambda m: errors.append(m.text) if "Content Security Policy" in m.text else None,
     )
+    yield page, errors
+    context.close()
+
+
+def open_view(tab: tuple[Any, list[str]], url: str) -> tuple[Any, list[str]]:
+    """``url``'s home page loaded afresh in the module's tab, its view drawn; the page's errors
+    from then on."""
+    page, errors = tab
+    errors.clear()
     page.goto(url + "/")
     page.wait_for_function(DRAWN)
-    return page
+    return page, errors
 
 
 def wait(page: Any, condition: str, what: str) -> None:
@@ -124,38 +142,35 @@ def tips_match_the_chains(page: Any, served: Served) -> None:
 
 
 def test_the_ergo_jr_is_drawn_and_m1_turning_30_degrees_changes_it(
-    browser: Any, served: Served
+    tab: tuple[Any, list[str]], served: Served
 ) -> None:
-    errors: list[str] = []
-    page = open_view(browser, served.url, errors)
+    page, errors = open_view(tab, served.url)
     assert move_and_compare(page, served.robot, "m1", 30.0) > 300
     served.robot.compliant = False
     served.robot.goto_position({"m1": 20.0, "m2": -30.0, "m3": 40.0, "m5": 25.0}, 0.5, wait=True)
     tips_match_the_chains(page, served)
     served.robot.goto_position({m.name: 0.0 for m in served.robot.motors}, 0.5, wait=True)
     served.robot.compliant = True
-    page.context.close()
+    page.goto("about:blank")  # the page's stream and polls end with the test
     assert not errors, errors
 
 
 def test_the_humanoid_is_drawn_and_its_l_shoulder_y_moves_it(
-    browser: Any, humanoid: Served
+    tab: tuple[Any, list[str]], humanoid: Served
 ) -> None:
-    errors: list[str] = []
-    page = open_view(browser, humanoid.url, errors)
+    page, errors = open_view(tab, humanoid.url)
     assert move_and_compare(page, humanoid.robot, "l_shoulder_y", -60.0) > 150
     humanoid.robot.compliant = False
     humanoid.robot.goto_position({"l_shoulder_x": 40.0, "r_elbow_y": -50.0}, 0.5, wait=True)
     tips_match_the_chains(page, humanoid)
-    page.context.close()
+    page.goto("about:blank")  # the page's stream and polls end with the test
     assert not errors, errors
 
 
 def test_a_goto_shows_its_goal_as_a_ghost_and_a_cartesian_goto_its_target(
-    browser: Any, served: Served
+    tab: tuple[Any, list[str]], served: Served
 ) -> None:
-    errors: list[str] = []
-    page = open_view(browser, served.url, errors)
+    page, errors = open_view(tab, served.url)
     robot = served.robot
     robot.compliant = False
     handle = robot.goto_position({"m2": 40.0}, 6.0)
@@ -167,20 +182,19 @@ def test_a_goto_shows_its_goal_as_a_ghost_and_a_cartesian_goto_its_target(
     robot.chain.goto([tip[0], tip[1], tip[2] - 0.02], duration=6.0)
     wait(page, "() => window.poppy.view.targets === 1", "the target during the goto")
     robot.compliant = True
-    page.context.close()
+    page.goto("about:blank")  # the page's stream and polls end with the test
     assert not errors, errors
 
 
 def test_what_a_running_marker_detector_sees_is_said_under_the_view(
-    browser: Any, served: Served, client: httpx.Client
+    tab: tuple[Any, list[str]], served: Served, client: httpx.Client
 ) -> None:
-    errors: list[str] = []
-    page = open_view(browser, served.url, errors)
+    page, errors = open_view(tab, served.url)
     assert page.evaluate("() => window.poppy.view.seen") is None  # idle: not started by the view
     assert client.get("/api/v1/sensors/marker_detector").status_code == 200  # someone uses it
     wait(page, "() => window.poppy.view.seen === 'marker_detector sees no marker'", "the line")
     assert page.inner_text("#view3d .view-seen") == "marker_detector sees no marker"
-    page.context.close()
+    page.goto("about:blank")  # the page's stream and polls end with the test
     assert not errors, errors
 
 

@@ -184,6 +184,10 @@ export async function refresh() {
   } catch { /* the connection badge says */ }
 }
 
+function setText(cell, text) {
+  if (cell.textContent !== text) cell.textContent = text;
+}
+
 export function onFrame(frame) {
   if (!rows.size) { pending = frame; return; } // shown as soon as the table is built
   stats.frames += 1;
@@ -191,7 +195,11 @@ export function onFrame(frame) {
   for (const [name, state] of Object.entries(frame)) {
     const row = rows.get(name);
     if (!row) continue;
-    for (const key of FAST) row.cells[key].textContent = fmt(state[key]);
-    if (document.activeElement !== row.led && state.led !== undefined) row.led.value = JSON.stringify(state.led);
+    // written only when it changed: a write lays the page out again, 20 times a second
+    for (const key of FAST) setText(row.cells[key], fmt(state[key]));
+    if (document.activeElement !== row.led && state.led !== undefined) {
+      const led = JSON.stringify(state.led);
+      if (row.led.value !== led) row.led.value = led;
+    }
   }
 }
