@@ -22,7 +22,8 @@ from poppy_core import from_profile
 from poppy_core.assembly import Listen, ServerSet, ServeSpec, serve
 from poppy_core.motion import Move, save_move
 from tests.helpers.cli import command_env
-from tests.helpers.lerobot_venv import run_oracle
+from tests.helpers.json_lines import JsonChild
+from tests.helpers.lerobot_venv import oracle_child
 from tests.helpers.processes import reap, start
 from tests.helpers.server import serve_robot
 from tests.helpers.waiting import eventually, http_timeout
@@ -31,6 +32,16 @@ pytestmark = pytest.mark.slow
 WAVE = Move(10.0, ["m1", "m2"], [[20 * math.sin(k / 5), 10.0] for k in range(300)])  # 30 s
 POPPY = [sys.executable, "-m", "poppy_cli"]
 QUICK = {"fps": 10, "reset_s": 0, "cameras": []}
+
+
+@pytest.fixture(scope="module")
+def oracle(tmp_path_factory: pytest.TempPathFactory) -> Iterator[JsonChild]:
+    """One LeRobot process loads the module's datasets (a start costs seconds of CPU)."""
+    child = oracle_child(tmp_path_factory.mktemp("lerobot-oracle") / "hf-cache")
+    try:
+        yield child
+    finally:
+        child.close()
 
 
 @pytest.fixture
@@ -102,7 +113,9 @@ def rows(root: Path) -> dict[str, list[Any]]:
     return columns
 
 
-def test_by_hand_with_the_robots_camera_loads_in_lerobot(http: httpx.Client, home: Path) -> None:
+def test_by_hand_with_the_robots_camera_loads_in_lerobot(
+    http: httpx.Client, home: Path, oracle: JsonChild
+) -> None:
     assert state(http) == {"active": False, "phase": "idle"} | {
         k: None for k in state(http) if k not in ("active", "phase")
     }
@@ -129,7 +142,7 @@ def test_by_hand_with_the_robots_camera_loads_in_lerobot(http: httpx.Client, hom
     assert "dataset recording" not in str(http.get("/api/v1/motors").json())
     root = home / "class/by_hand"
     frames = sum(e["frames"] for e in ended["saved"])
-    seen = run_oracle("load", str(root), "class/by_hand", f"0,{frames - 1}")
+    seen = oracle.ask("load", str(root), "class/by_hand", f"0,{frames - 1}")
     assert (seen["len"], seen["num_episodes"], seen["fps"]) == (frames, 2, 10)
     assert seen["tasks"] == ["wave at the class"]
     assert seen["features"]["observation.images.camera"]["shape"] == [480, 640, 3]
@@ -138,7 +151,9 @@ def test_by_hand_with_the_robots_camera_loads_in_lerobot(http: httpx.Client, hom
     assert (first["episode_index"], last["episode_index"]) == (0, 1)
 
 
-def test_a_move_with_rerecord_end_episode_and_stop(http: httpx.Client, home: Path) -> None:
+def test_a_move_with_rerecord_end_episode_and_stop(
+    http: httpx.Client, home: Path, oracle: JsonChild
+) -> None:
     record(
         http,
         repo_id="class/wave",
@@ -188,7 +203,7 @@ def test_a_move_with_rerecord_end_episode_and_stop(http: httpx.Client, home: Pat
     assert data["frame_index"] == list(range(saved[0])) + list(range(saved[1]))
     actions = [a[0] for a in data["action"]]
     assert max(actions) - min(actions) > 1.0  # the move's goals for m1
-    seen = run_oracle("load", str(root), "class/wave", "0")
+    seen = oracle.ask("load", str(root), "class/wave", "0")
     assert (seen["len"], seen["num_episodes"]) == (sum(saved), 2)
     info = json.loads((root / "meta/info.json").read_text())
     assert info["total_episodes"] == 2 and info["total_frames"] == sum(saved)
@@ -239,7 +254,9 @@ def test_nan_and_a_dataset_that_exists_are_refused(http: httpx.Client, home: Pat
     assert list((home / "class/taken").iterdir()) == []  # nothing written in it
 
 
-def test_ctrl_c_of_poppy_serve_keeps_the_saved_episodes_loadable(tmp_path: Path) -> None:
+def test_ctrl_c_of_poppy_serve_keeps_the_saved_episodes_loadable(
+    tmp_path: Path, oracle: JsonChild
+) -> None:
     home = tmp_path / "lerobot"
     env = dict(os.environ, **command_env({"HF_LEROBOT_HOME": str(home)}))
     argv = [*POPPY, "serve", "--http", "--http-port", "0", "--sim", "--profile", "ergo-jr"]
@@ -270,7 +287,7 @@ def test_ctrl_c_of_poppy_serve_keeps_the_saved_episodes_loadable(tmp_path: Path)
     info = json.loads((root / "meta/info.json").read_text())
     assert info["total_episodes"] == 2  # the finished one, and the one under way saved (as Esc)
     assert not [p for p in root.rglob("*") if p.name.startswith(".")]  # no leftover
-    seen = run_oracle("load", str(root), "class/cut", "0")
+    seen = oracle.ask("load", str(root), "class/cut", "0")
     assert (seen["len"], seen["num_episodes"]) == (info["total_frames"], 2)
 
 
