@@ -70,6 +70,11 @@ HANG_LIMIT_S = 600
 # ignored, and so would every `poppy` the tests start (Python then installs no KeyboardInterrupt):
 # the Ctrl-C tests would see a command that cannot be interrupted. A handler here is reset to
 # the default in each child at exec, where Python installs its own again.
+# Bytecode caches are written even when PYTHONDONTWRITEBYTECODE is set (containers set it): without
+# them each test process compiles and assertion-rewrites all 600 test modules again (~10 s of CPU
+# a process at collection, 40% of it) and every `poppy` subprocess compiles poppy's modules
+# (subprocesses still read them; git ignores them).
+sys.dont_write_bytecode = False
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 # Each test process (each xdist worker too) has user folders of its own: no test reads or
