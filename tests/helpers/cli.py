@@ -112,15 +112,19 @@ def built_tree() -> Any:
     (``tests.helpers.cli_tree.root`` builds one of its own to change)."""
     import typer.main
 
-    from poppy_cli.main import app
+    import poppy_cli.main as cli_main
 
-    return typer.main.get_command(app)
+    app = cli_main.app
+    return typer.main.get_command(app.app if isinstance(app, _Prebuilt) else app)
 
 
 class _Prebuilt:
     """Stands for ``poppy_cli.main.app`` during ``run_poppy``: calls ``built_tree`` as ``app``
     calls the tree it builds (Typer's exception hook and notes only print uncaught exceptions
     prettily, which `poppy` turns off)."""
+
+    def __init__(self, app: Any) -> None:
+        self.app = app
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         return built_tree()(*args, **kwargs)
@@ -173,8 +177,7 @@ def _as_a_process(
     consoles = [(c, c._width, c._color_system, c.quiet) for c in (console, err_console)]
     saved_app = cli_main.app
     if isinstance(saved_app, typer.Typer):  # not a stand-in of the test's
-        built_tree()  # from the real ``app``
-        cli_main.app = _Prebuilt()  # type: ignore[assignment]
+        cli_main.app = _Prebuilt(saved_app)  # type: ignore[assignment]
     saved_tempdir = tempfile.tempdir
     tempfile.tempdir = None  # found again from TMPDIR, as a new process does
     sys.stdin = input if isinstance(input, io.TextIOBase) else io.StringIO(input or "")
