@@ -137,10 +137,15 @@ def _longest_groups_first(items: list[pytest.Item], groups: dict[pytest.Item, st
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     grouped = config.pluginmanager.hasplugin("xdist")
     groups: dict[pytest.Item, str] = {}
+    relatives: dict[str, Path | None] = {}  # a module's tests share its path: resolved once
     for item in items:
-        try:
-            relative = Path(str(item.path)).resolve().relative_to(TESTS)
-        except ValueError:
+        path = str(item.path)
+        if path not in relatives:
+            resolved = Path(path).resolve()
+            inside = resolved.is_relative_to(TESTS)
+            relatives[path] = resolved.relative_to(TESTS) if inside else None
+        relative = relatives[path]
+        if relative is None:
             continue
         if relative.parts[0] in SLOW_FOLDERS or relative.as_posix() in SLOW_MODULES:
             item.add_marker(pytest.mark.slow)
