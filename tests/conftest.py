@@ -70,6 +70,11 @@ HANG_LIMIT_S = 600
 # ignored, and so would every `poppy` the tests start (Python then installs no KeyboardInterrupt):
 # the Ctrl-C tests would see a command that cannot be interrupted. A handler here is reset to
 # the default in each child at exec, where Python installs its own again.
+# Bytecode caches are written even when PYTHONDONTWRITEBYTECODE is set (containers set it): without
+# them each test process compiles and assertion-rewrites all 600 test modules again (~10 s of CPU
+# a process at collection, 40% of it) and every `poppy` subprocess compiles poppy's modules
+# (subprocesses still read them; git ignores them).
+sys.dont_write_bytecode = False
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 # Each test process (each xdist worker too) has user folders of its own: no test reads or
@@ -132,10 +137,15 @@ def _longest_groups_first(items: list[pytest.Item], groups: dict[pytest.Item, st
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     grouped = config.pluginmanager.hasplugin("xdist")
     groups: dict[pytest.Item, str] = {}
+    relatives: dict[str, Path | None] = {}  # a module's tests share its path: resolved once
     for item in items:
-        try:
-            relative = Path(str(item.path)).resolve().relative_to(TESTS)
-        except ValueError:
+        path = str(item.path)
+        if path not in relatives:
+            resolved = Path(path).resolve()
+            inside = resolved.is_relative_to(TESTS)
+            relatives[path] = resolved.relative_to(TESTS) if inside else None
+        relative = relatives[path]
+        if relative is None:
             continue
         if relative.parts[0] in SLOW_FOLDERS or relative.as_posix() in SLOW_MODULES:
             item.add_marker(pytest.mark.slow)

@@ -10,7 +10,7 @@ import pytest
 import typer
 
 from poppy_cli.options import parse_ids
-from tests.helpers.cli import run_poppy_process
+from tests.helpers.cli import run_poppy
 
 HUGE = "99999999999999999999"
 ROBOT = ("--sim", "--profile", "ergo-jr")
@@ -61,10 +61,11 @@ TABLE: list[tuple[tuple[str, ...], str]] = [
 
 @pytest.mark.parametrize(("args", "words"), TABLE, ids=[" ".join(a)[:90] for a, _ in TABLE])
 def test_a_hostile_number_is_one_usage_line(args: tuple[str, ...], words: str) -> None:
-    # A process of its own: before the fix some of these served forever (emulate, serve) or
-    # crashed; the timeout turns a command that runs into a failure.
+    # Before the fix some of these served forever (emulate, serve) or crashed: pytest-timeout
+    # turns a command that runs into a failure, as a subprocess's timeout did (each started
+    # Python and the CLI for a refusal, 0.5-1 s of CPU), and a crash is "unexpected" or exit 1.
     url = "socket://127.0.0.1:9"  # never opened: every refusal comes first
-    result = run_poppy_process(*(url if a == "URL" else a for a in args), timeout=60)
+    result = run_poppy(*(url if a == "URL" else a for a in args), timeout=60)
     _one_usage_line(result, words)
 
 

@@ -5,6 +5,10 @@ environment a subprocess would get: starting a Python interpreter and importing 
 one to two seconds on a loaded machine, and the CLI tests run a few hundred commands. Tests
 whose subject is the process itself (Ctrl-C, signals, what an import pulls in, a program
 serving until stopped) start ``POPPY`` with ``subprocess`` (``run_poppy_process``).
+
+Typer builds Click's command tree from ``poppy_cli.main.app`` at each call of ``app`` (0.1 s of
+CPU: ~400 signatures read); a process calls it once. The tree depends on no argument, variable
+or stream, so ``run_poppy`` builds it once a test process (``built_tree``) and reuses it.
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ import traceback
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -101,6 +106,30 @@ def run_poppy(
     return Result(code, stdout.getvalue(), stderr.getvalue())
 
 
+@cache
+def built_tree() -> Any:
+    """`poppy`'s Click command tree as ``app`` builds it at each call; built once, never changed
+    (``tests.helpers.cli_tree.root`` builds one of its own to change)."""
+    import typer.main
+
+    import poppy_cli.main as cli_main
+
+    app = cli_main.app
+    return typer.main.get_command(app.app if isinstance(app, _Prebuilt) else app)
+
+
+class _Prebuilt:
+    """Stands for ``poppy_cli.main.app`` during ``run_poppy``: calls ``built_tree`` as ``app``
+    calls the tree it builds (Typer's exception hook and notes only print uncaught exceptions
+    prettily, which `poppy` turns off)."""
+
+    def __init__(self, app: Any) -> None:
+        self.app = app
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return built_tree()(*args, **kwargs)
+
+
 def _stream() -> io.TextIOWrapper:
     """A text stream like a pipe's (with a ``buffer``), readable after the command."""
     return _Captured(io.BytesIO(), encoding="utf-8", newline="", write_through=True)
@@ -133,6 +162,9 @@ def _as_a_process(
     env: Mapping[str, str],
 ) -> Iterator[None]:
     """Give the command what a fresh `poppy` process would have, and take it back after."""
+    import typer
+
+    import poppy_cli.main as cli_main
     from poppy_cli import state
     from poppy_cli.output import console, err_console
 
@@ -143,6 +175,9 @@ def _as_a_process(
     saved_logging = root.handlers[:], root.level
     handlers = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
     consoles = [(c, c._width, c._color_system, c.quiet) for c in (console, err_console)]
+    saved_app = cli_main.app
+    if isinstance(saved_app, typer.Typer):  # not a stand-in of the test's
+        cli_main.app = _Prebuilt(saved_app)  # type: ignore[assignment]
     saved_tempdir = tempfile.tempdir
     tempfile.tempdir = None  # found again from TMPDIR, as a new process does
     sys.stdin = input if isinstance(input, io.TextIOBase) else io.StringIO(input or "")
@@ -156,6 +191,7 @@ def _as_a_process(
     try:
         yield
     finally:
+        cli_main.app = saved_app
         tempfile.tempdir = saved_tempdir
         for c, width, colors, quiet in consoles:
             c._width, c._color_system, c.quiet = width, colors, quiet

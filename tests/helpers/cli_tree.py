@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
+from functools import cache
 from typing import Any
 
 import typer.main
@@ -11,6 +12,7 @@ from typer import _click as click
 from typer.core import TyperOption
 
 from poppy_cli.main import app
+from tests.helpers.cli import built_tree
 
 
 def root() -> Any:
@@ -19,8 +21,9 @@ def root() -> Any:
 
 
 def walk(command: Any | None = None, path: tuple[str, ...] = ()) -> Iterator[tuple[str, Any]]:
-    """Every command and group: (path after `poppy`, e.g. "motor get"; "" for the root)."""
-    command = root() if command is None else command
+    """Every command and group: (path after `poppy`, e.g. "motor get"; "" for the root); the
+    tree walked is ``command``'s, else `poppy`'s as built once (``built_tree``: read only)."""
+    command = built_tree() if command is None else command
     yield " ".join(path), command
     for name, sub in getattr(command, "commands", {}).items():
         yield from walk(sub, (*path, name))
@@ -47,13 +50,22 @@ def parse(args: Sequence[str]) -> Parsed:
     Raises:
         click.exceptions.UsageError: the line does not parse.
     """
-    parsed = Parsed()
+    tree, last = _recording_tree()
+    last[:] = [Parsed()]
+    tree.main(list(args), prog_name="poppy", standalone_mode=False)
+    return last[0]
+
+
+@cache
+def _recording_tree() -> tuple[Any, list[Parsed]]:
+    """A tree of `poppy` built once, each command's body replaced by one that records what it
+    was given in the list returned with it."""
+    last = [Parsed()]
     tree = root()
     for path, command in walk(tree):
 
         def record(__path: str = path, **params: Any) -> None:
-            parsed.path, parsed.params = __path, params
+            last[0] = Parsed(__path, params)
 
         command.callback = record
-    tree.main(list(args), prog_name="poppy", standalone_mode=False)
-    return parsed
+    return tree, last

@@ -8,6 +8,7 @@ the robot's state then shows what the cells did. The command itself is checked i
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import signal
@@ -27,8 +28,11 @@ from tests.helpers.processes import reap
 from tests.helpers.server import Served, serve
 from tests.helpers.waiting import eventually, scaled
 
-nbformat = pytest.importorskip("nbformat")
-nbclient = pytest.importorskip("nbclient")
+# found, not imported: nbformat's import (jsonschema's grammars) costs 2 s of CPU, which every
+# test process would pay at collection; the one test running the notebook imports them
+for _name in ("nbformat", "nbclient"):
+    if importlib.util.find_spec(_name) is None:
+        pytest.skip(f"could not import {_name!r}", allow_module_level=True)
 
 NOTEBOOK = Path(notebook_cmd.__file__).parents[1] / "notebooks" / "discover-your-robot.ipynb"
 
@@ -62,6 +66,9 @@ def _text(cell: Any) -> str:
 def test_discover_your_robot_runs_top_to_bottom_on_a_served_ergo_jr(
     served_robot: Served, jupyter_dirs: dict[str, str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    import nbclient
+    import nbformat
+
     robot = served_robot.robot
     monkeypatch.setenv("POPPY_ROBOT_URL", served_robot.url)  # as `poppy notebook` sets it
     notebook = nbformat.read(NOTEBOOK, as_version=4)
