@@ -52,7 +52,9 @@ def test_goto_ends_within_5_mm_with_physics(
     )
     # the chain's own reading (the motors' present positions, 0.29° steps read at 50 Hz)
     # agrees with the physics
-    assert np.linalg.norm(ergo.chain.position - _simulated_tip(ergo)) < 0.01
+    assert _wait_until(
+        lambda: np.linalg.norm(ergo.chain.position - _simulated_tip(ergo)) < 0.01, 8.0
+    ), f"chain at {ergo.chain.position}, tip at {_simulated_tip(ergo)}"
 
 
 def test_head_follow_is_attached_only_with_mujoco() -> None:

@@ -18,6 +18,8 @@ import pytest
 pytest.importorskip("zenoh")
 pytest.importorskip("rosbags")
 
+import itertools
+
 import zenoh
 
 from poppy_core import from_profile
@@ -119,9 +121,12 @@ def test_joint_states_decode_under_rmw_zenohs_key_with_the_attachment(node: Node
     assert abs(stamp / 1e9 - time.time()) < 600  # a wall-clock time in ns, not a counter
     assert message.header.stamp.sec > 0
     assert len(gid) == 16
-    # every cycle arrives, in order: consecutive sequence numbers from one writer
+    # the cycles arrive in order from one writer: increasing sequence numbers, each cycle
+    # numbered (/joint_states is keep-last, so its publisher drops under congestion as rmw_zenoh's
+    # does: a machine at load 16 lost two of 20 in a run)
     sequences = [s[2][0] for s in samples]
-    assert sequences == list(range(sequences[0], sequences[0] + len(sequences)))
+    assert all(b > a for a, b in itertools.pairwise(sequences)), sequences
+    assert len(sequences) >= 0.8 * (sequences[-1] - sequences[0] + 1), sequences
     assert {s[2][2] for s in samples} == {gid}
 
 
