@@ -8,7 +8,6 @@ tests/helpers/lerobot_venv.py).
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -19,19 +18,12 @@ from poppy_core.dataset.delete import delete_episode
 from poppy_core.dataset.writer import DatasetWriter
 from tests.dataset.test_writer import SPEC, frame, killed_recording, record
 from tests.helpers.json_lines import JsonChild
-from tests.helpers.lerobot_venv import oracle_child
+from tests.helpers.lerobot_venv import oracle_fixture
 
 pytestmark = pytest.mark.slow
 
 
-@pytest.fixture(scope="module")
-def oracle(tmp_path_factory: pytest.TempPathFactory) -> Iterator[JsonChild]:
-    """One LeRobot process answers the module's questions (a start costs seconds of CPU)."""
-    child = oracle_child(tmp_path_factory.mktemp("lerobot-oracle") / "hf-cache")
-    try:
-        yield child
-    finally:
-        child.close()
+oracle = oracle_fixture()
 
 
 def test_lerobot_loads_and_decodes_a_poppy_recording(oracle: JsonChild, tmp_path: Path) -> None:

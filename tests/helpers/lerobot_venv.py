@@ -9,8 +9,11 @@ from __future__ import annotations
 import json
 import os
 import subprocess
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
+
+import pytest
 
 from tests.helpers.json_lines import JsonChild
 from tests.helpers.pypot_files import needed
@@ -55,3 +58,18 @@ def oracle_child(cache: Path) -> JsonChild:
     """tests/dataset/lerobot_oracle.py started in LeRobot's venv for many commands (``ask``
     them as ``run_oracle``'s arguments; ``close`` it): one Python start for a test module."""
     return JsonChild(lerobot_python(), ORACLE, _oracle_env(cache))
+
+
+def oracle_fixture() -> Callable[..., Iterator[JsonChild]]:
+    """A module fixture (``oracle = oracle_fixture()`` in a test module): one LeRobot oracle
+    process answers the module's questions (a start costs seconds of CPU: torch's imports)."""
+
+    @pytest.fixture(scope="module")
+    def oracle(tmp_path_factory: pytest.TempPathFactory) -> Iterator[JsonChild]:
+        child = oracle_child(tmp_path_factory.mktemp("lerobot-oracle") / "hf-cache")
+        try:
+            yield child
+        finally:
+            child.close()
+
+    return oracle

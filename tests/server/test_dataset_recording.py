@@ -23,7 +23,7 @@ from poppy_core.assembly import Listen, ServerSet, ServeSpec, serve
 from poppy_core.motion import Move, save_move
 from tests.helpers.cli import command_env
 from tests.helpers.json_lines import JsonChild
-from tests.helpers.lerobot_venv import oracle_child
+from tests.helpers.lerobot_venv import oracle_fixture
 from tests.helpers.processes import reap, start
 from tests.helpers.server import serve_robot
 from tests.helpers.waiting import eventually, http_timeout
@@ -34,14 +34,7 @@ POPPY = [sys.executable, "-m", "poppy_cli"]
 QUICK = {"fps": 10, "reset_s": 0, "cameras": []}
 
 
-@pytest.fixture(scope="module")
-def oracle(tmp_path_factory: pytest.TempPathFactory) -> Iterator[JsonChild]:
-    """One LeRobot process loads the module's datasets (a start costs seconds of CPU)."""
-    child = oracle_child(tmp_path_factory.mktemp("lerobot-oracle") / "hf-cache")
-    try:
-        yield child
-    finally:
-        child.close()
+oracle = oracle_fixture()
 
 
 @pytest.fixture
