@@ -263,7 +263,11 @@ class Tour:
         """Start `poppy emulate ARGS`; its pty path (its first line)."""
         emulator = Running(["emulate", *args], self.env, self.home, stdin=False)
         self.emulators.append(emulator)
-        assert emulator.wait_for("\n"), f"poppy emulate {args} printed nothing: {emulator.stderr}"
+        # its first line on stdout (a warning on stderr may come first on a busy machine)
+        eventually(
+            lambda: "\n" in emulator.stdout or emulator.proc.poll() is not None, FIRST_LINE_S
+        )
+        assert "\n" in emulator.stdout, f"poppy emulate {args} printed no path: {emulator.stderr}"
         return emulator.stdout.splitlines()[0].strip()
 
     def argv(self, step: Step) -> list[str]:
