@@ -66,15 +66,15 @@ HANG_LIMIT_S = 600
 # runs ten times as many (before a release, or when a codec or parser changed). Neither has a
 # deadline per example. Tests whose
 # examples are costly (a whole HTTP API fuzzed) scale from ``settings.default.max_examples``.
-# A run started in the background by a non-interactive shell (`.ci/run &`, nohup) inherits SIGINT
-# ignored, and so would every `poppy` the tests start (Python then installs no KeyboardInterrupt):
-# the Ctrl-C tests would see a command that cannot be interrupted. A handler here is reset to
-# the default in each child at exec, where Python installs its own again.
 # Bytecode caches are written even when PYTHONDONTWRITEBYTECODE is set (containers set it): without
 # them each test process compiles and assertion-rewrites all 600 test modules again (~10 s of CPU
 # a process at collection, 40% of it) and every `poppy` subprocess compiles poppy's modules
 # (subprocesses still read them; git ignores them).
 sys.dont_write_bytecode = False
+# A run started in the background by a non-interactive shell (`.ci/run &`, nohup) inherits SIGINT
+# ignored, and so would every `poppy` the tests start (Python then installs no KeyboardInterrupt):
+# the Ctrl-C tests would see a command that cannot be interrupted. A handler here is reset to
+# the default in each child at exec, where Python installs its own again.
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 # Each test process (each xdist worker too) has user folders of its own: no test reads or
