@@ -81,6 +81,28 @@ def test_together_fails_when_a_command_beside_the_main_one_fails() -> None:
         "",
         "==== echo fine (exit 0) ====",
         "fine",
+        "",
+        "==== recap ====",
+        "echo main (exit 0)",
+        'sh -c "echo broken; exit 3" (exit 3)',
+        "echo fine (exit 0)",
+    ]
+
+
+def test_together_recaps_the_failed_tests_last() -> None:
+    # a CI summary shows only the log's tail: the failures of the main command must be in it
+    main = (
+        'sh -c "echo FAILED tests/a.py::t - boom; echo; echo \\"== 1 failed in 2.5s ==\\"; exit 1"'
+    )
+    done = together(main, 'sh -c "echo ERROR tests/b.py; echo; exit 2"')
+    assert done.returncode == 1, done
+    recap = done.stdout.splitlines()
+    assert recap[recap.index("==== recap ====") + 1 :] == [
+        f"{main} (exit 1)",
+        "    FAILED tests/a.py::t - boom",
+        "    == 1 failed in 2.5s ==",
+        'sh -c "echo ERROR tests/b.py; echo; exit 2" (exit 2)',
+        "    ERROR tests/b.py",
     ]
 
 

@@ -56,6 +56,8 @@ class FrameDetector(Sensor, Generic[T]):
         self.cameras = list(cameras)
         self._found: list[T] = []
         self._seen: dict[str, tuple[int, list[T]]] = {}
+        self._waited = False
+        self._said_slow = False
 
     def find(self, image: np.ndarray, camera: Camera) -> list[T]:
         """What is in one frame of ``camera`` (called in the detector's thread or by ``detect``)."""
@@ -97,10 +99,28 @@ class FrameDetector(Sensor, Generic[T]):
     def found(self) -> list[T]:
         """What the latest frames hold (the first call starts the detector and waits).
 
+        A camera that is up but slow to give its first frame (a simulated camera starting its
+        renderer on a busy machine) is not a failure: after one wait, nothing seen yet is what
+        is found (pypot's detectors read an empty list until their first detection), with one
+        WARNING; the following calls do not wait again.
+
         Raises:
-            SensorError: no detection ran in time (a camera gives no frame).
+            SensorError: the detector failed for good, or one of its cameras is lost.
         """
-        self.wait_first(FIRST_VALUE_TIMEOUT_S * 2)
+        try:
+            self.wait_first(0.0 if self._waited else FIRST_VALUE_TIMEOUT_S * 2)
+        except SensorError:
+            self._waited = True
+            if self._fatal or not all(camera.health().connected for camera in self.cameras):
+                raise
+            if not self._said_slow:
+                self._said_slow = True
+                logger.warning(
+                    "%s %s: no frame yet from its cameras; nothing seen so far",
+                    self.kind,
+                    self.name,
+                )
+            return []
         return list(self._found)
 
     def detect(self, camera: Camera | None = None) -> list[T]:

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import logging
+import threading
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -9,7 +12,11 @@ from hypothesis import strategies as st
 
 from poppy_core.errors import SensorError
 from poppy_core.sensors import CameraCalibration, DummyCamera, MarkerDetector, hamming
+from poppy_core.sensors import camera as camera_module
+from poppy_core.sensors import detector as detector_module
+from poppy_core.sensors.base import SensorLost
 from poppy_core.sensors.markers import MarkerFinder, marker_image
+from tests.helpers.waiting import eventually
 
 cv2 = pytest.importorskip("cv2")
 
@@ -114,3 +121,56 @@ def test_the_detector_names_cards() -> None:
             with pytest.raises(SensorError, match="no card '³'"):
                 detector.sees("³")  # a digit to str.isdigit, not to int()
             assert detector.health().ok and detector.health().target_hz == 20.0
+
+
+class SlowToStart(DummyCamera):
+    """A camera that is up but gives its first frame only when let (a renderer starting)."""
+
+    def __init__(self, name: str) -> None:
+        super().__init__(name, (64, 48))
+        self.let = threading.Event()
+
+    def grab(self) -> np.ndarray:
+        if not self.let.wait(10.0):
+            raise SensorError("test camera never let")
+        return super().grab()
+
+
+def test_a_camera_slow_to_give_its_first_frame_shows_nothing_instead_of_failing(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    # pypot's detectors read [] until their first detection; a primitive reading them in its
+    # loop (poppy-ergo-jr's TrackingFeedback on a loaded MuJoCo) must not die of a slow start
+    monkeypatch.setattr(detector_module, "FIRST_VALUE_TIMEOUT_S", 0.1)
+    monkeypatch.setattr(camera_module, "FIRST_VALUE_TIMEOUT_S", 0.1)
+    with SlowToStart("camera") as camera, caplog.at_level(logging.WARNING):
+        detector = MarkerDetector("marker_detector", [camera], 20.0)
+        with detector:
+            assert detector.markers == []
+            assert detector.markers == [] and detector.cards == []  # no second wait
+            said = [r.getMessage() for r in caplog.records if "no frame yet" in r.getMessage()]
+            assert said == [
+                "MarkerDetector marker_detector: no frame yet from its cameras; nothing seen so far"
+            ]
+            camera.let.set()
+            assert eventually(lambda: detector.health().ok, timeout_s=10)
+            assert detector.markers == []  # looked at a black frame
+
+
+class Unplugged(DummyCamera):
+    """A camera whose cable is out: every grab finds it gone."""
+
+    def grab(self) -> np.ndarray:
+        raise SensorLost("unplugged")
+
+
+def test_a_detector_whose_camera_is_lost_still_says_so(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(detector_module, "FIRST_VALUE_TIMEOUT_S", 0.1)
+    with Unplugged("camera", (64, 48)) as camera:
+        camera.start()
+        assert eventually(lambda: not camera.health().connected, timeout_s=10)
+        with (
+            MarkerDetector("marker_detector", [camera], 20.0) as detector,
+            pytest.raises(SensorError, match="marker_detector"),
+        ):
+            detector.markers  # noqa: B018
