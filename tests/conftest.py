@@ -22,6 +22,7 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+from poppy_core.dataset.realtime import calling_thread_realtime, undo_realtime
 from tests.helpers import timing
 from tests.helpers.waiting import load_factor, runnable_now
 
@@ -182,3 +183,14 @@ def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
         yield
     finally:
         faulthandler.cancel_dump_traceback_later()
+        _not_real_time(item)
+
+
+def _not_real_time(item: pytest.Item) -> None:
+    """A library that made this worker real-time (SVT-AV1 does, as root) is undone at once: every
+    thread and process the worker starts later would inherit SCHED_FIFO 99, and a busy one would
+    hold a core the worker's own threads then never get (stop 37's CI run hung that way)."""
+    if calling_thread_realtime():
+        undone = undo_realtime()
+        said = f"conftest: {item.nodeid} left {undone} thread(s) real-time: undone"
+        print(said, file=sys.__stderr__)

@@ -2,7 +2,9 @@
 
 Facts from LeRobot 0.4.4's ``video_utils.py``: libsvtav1 with g=2, crf=30, preset 12, yuv420p,
 and what ``get_video_info`` puts in info.json. Frame k is stamped k/fps exactly (time base
-1/fps, pts k). ``Mp4File`` encodes where it is called: ``encoder`` runs it in a process of its own.
+1/fps, pts k). ``Mp4File`` encodes where it is called: ``encoder`` runs it in a process of its own;
+the threads SVT-AV1 makes real-time (as root) are put back to the normal policy
+(``poppy_core.dataset.realtime``).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import av
 import numpy as np
 from numpy.typing import NDArray
 
+from poppy_core.dataset.realtime import calling_thread_realtime, realtime_threads, undo_realtime
 from poppy_core.errors import PoppyError
 
 AV1 = "libsvtav1"
@@ -57,6 +60,13 @@ class Mp4File:
         stream.height = height
         self._stream: Any = stream
         self._time_base = Fraction(1, fps)
+        self._realtime_before = frozenset(realtime_threads())
+
+    def _normal_policy(self, always: bool = False) -> None:
+        """After the codec opened (the first frame), at the end, or whenever the caller became
+        real-time."""
+        if always or self.frames <= 1 or calling_thread_realtime():
+            undo_realtime(self._realtime_before)
 
     def encode(self, frame: NDArray[np.uint8]) -> None:
         """The next frame."""
@@ -66,6 +76,7 @@ class Mp4File:
         for packet in self._stream.encode(picture):
             self._container.mux(packet)
         self.frames += 1
+        self._normal_policy()
 
     def finish(self) -> None:
         """Flush the encoder and close the file."""
@@ -74,6 +85,7 @@ class Mp4File:
                 self._container.mux(packet)
         finally:
             self.close()
+            self._normal_policy(always=True)
 
     def close(self) -> None:
         with contextlib.suppress(av.error.FFmpegError, OSError):

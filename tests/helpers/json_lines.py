@@ -20,6 +20,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from tests.helpers.no_real_time import without_real_time
+
 READY = {"ready": True}
 
 
@@ -69,6 +71,7 @@ class JsonChild:
             stderr=self._stderr,
             text=True,
             env=env,
+            preexec_fn=without_real_time,  # a peer's AV1 encoder must not go SCHED_FIFO
         )
         self._lines: queue.Queue[str] = queue.Queue()
         threading.Thread(target=self._read, daemon=True).start()

@@ -16,6 +16,7 @@ from typing import Any
 import pytest
 
 from tests.helpers.json_lines import JsonChild
+from tests.helpers.no_real_time import without_real_time
 from tests.helpers.pypot_files import needed
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -48,6 +49,7 @@ def run_oracle(*args: str, timeout: float = 600) -> dict[str, Any]:
         timeout=timeout,
         check=False,
         env=env,
+        preexec_fn=without_real_time,  # LeRobot's AV1 encoder must not go SCHED_FIFO
     )
     assert done.returncode == 0, done.stderr[-3000:]
     result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])

@@ -20,6 +20,7 @@ import pytest
 from tests.helpers.cli import command_env
 from tests.helpers.json_lines import JsonChild
 from tests.helpers.lerobot_venv import ROOT, lerobot_python
+from tests.helpers.no_real_time import without_real_time
 from tests.helpers.pypot_files import needed
 
 PLUGIN = ROOT / "plugins" / "lerobot_robot_poppy"
@@ -37,7 +38,12 @@ class Running:
     def __init__(self, command: list[str], env: dict[str, str], timeout: float) -> None:
         self.output = tempfile.TemporaryFile("w+")  # noqa: SIM115 (closed by __exit__)
         self.process = subprocess.Popen(
-            command, stdout=self.output, stderr=subprocess.STDOUT, text=True, env=env
+            command,
+            stdout=self.output,
+            stderr=subprocess.STDOUT,
+            text=True,
+            env=env,
+            preexec_fn=without_real_time,  # LeRobot's AV1 encoder must not go SCHED_FIFO
         )
         self.timeout = timeout
 
