@@ -20,8 +20,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from tests.helpers.no_real_time import without_real_time
-
 READY = {"ready": True}
 
 
@@ -63,6 +61,9 @@ class JsonChild:
     question): ``ask(...)`` sends a question, returns its JSON answer."""
 
     def __init__(self, python: Path, script: Path, env: dict[str, str]) -> None:
+        # here, not at the top: the serving side loads this file by path, without `tests`
+        from tests.helpers.no_real_time import without_real_time
+
         self._stderr = tempfile.TemporaryFile()  # noqa: SIM115 (closed by close())
         self.process = subprocess.Popen(
             [str(python), str(script), "serve"],
