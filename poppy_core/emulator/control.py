@@ -300,9 +300,15 @@ class EmulatorControl:
                 self.at(back, f"plug {motor_id}", partial(bus.plug, motor_id))
 
     def at(self, when: float, what: str, action: Callable[[], None]) -> None:
-        """Run ``action`` at ``when`` (the control's clock) in the control's thread."""
+        """Run ``action`` at ``when`` (the control's clock) in the control's thread; one already
+        due, with nothing due before it, runs now, before this returns (``--unplug 2@0``: motor 2
+        is away before the emulator says where it serves, however late its thread would run)."""
         with self._cond:
             if self._closed:
+                return
+            due_before = bool(self._events) and self._events[0][0] <= when
+            if when <= self._clock() and not due_before:
+                self._act(what, action)
                 return
             heapq.heappush(self._events, (when, next(self._order), what, action))
             if self._worker is None:
@@ -320,11 +326,15 @@ class EmulatorControl:
                 if self._closed:
                     return
                 _, _, what, action = heapq.heappop(self._events)
-            try:
-                action()
-                logger.info("emulator control: %s", what)
-            except Exception:
-                logger.exception("emulator control: %s failed", what)
+            self._act(what, action)
+
+    @staticmethod
+    def _act(what: str, action: Callable[[], None]) -> None:
+        try:
+            action()
+            logger.info("emulator control: %s", what)
+        except Exception:
+            logger.exception("emulator control: %s failed", what)
 
     def close(self) -> None:
         """Forget pending timed actions and stop the thread."""
