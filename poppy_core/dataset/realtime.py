@@ -2,7 +2,7 @@
 
 SVT-AV1 (the AV1 encoder of PyAV's wheels) asks for ``SCHED_FIFO`` priority 99 when it opens:
 as root it gets it, for the calling thread and the ~50 threads it starts (measured with
-PyAV 16's libSvtAv1Enc 4.1). A real-time encoder on a 2-core robot starves its sync loop and its
+PyAV 18.1's libSvtAv1Enc 4.1). A real-time encoder on a 2-core robot starves its sync loop and its
 servers, and every thread or process the caller starts afterwards inherits the policy (a busy
 one never yields a core). Without root the request fails and nothing changes.
 """
