@@ -60,7 +60,14 @@ from poppy_core.bus.find import (
 )
 from poppy_core.bus.results import FoundMotor, PingResult, ScanProgress
 from poppy_core.bus.scan_state import ScanState, found_motor
-from poppy_core.bus.settle import answers, doubt_learned, heard_in_silence, ping_found, settle
+from poppy_core.bus.settle import (
+    answers,
+    ask_patiently,
+    doubt_learned,
+    heard_in_silence,
+    ping_found,
+    settle,
+)
 from poppy_core.bus.timing import DEFAULT_RETURN_DELAY_S, LinkTiming
 from poppy_core.bus.transport import Transport, open_each
 from poppy_core.models import standard_baudrates
@@ -157,7 +164,11 @@ def _scan_rate(
         late |= settle(bus) & wanted
     for motor_id in sorted(late - set(candidates)):
         # A late broadcast reply, if asking again goes unanswered (the other end still late).
-        result = ping_found(bus, motor_id, retries=1) or heard.get(motor_id)
+        result = (
+            ping_found(bus, motor_id, retries=1)
+            or heard.get(motor_id)
+            or ask_patiently(bus, motor_id)
+        )
         if result is not None:
             candidates[motor_id] = result
     if first:
@@ -248,6 +259,7 @@ def _confirm(
     if by_broadcast:
         again = {pinged.id for pinged in bus.broadcast_ping()}
     again |= {i for i in candidates if i not in again and answers(bus, i)}
+    again |= {i for i in candidates if i not in again and ask_patiently(bus, i, identify=False)}
     for motor_id, result in candidates.items():
         if motor_id in again:
             state.add(found_motor(port, bus, result))

@@ -14,6 +14,9 @@ logger = logging.getLogger(__name__)
 
 # Pings, at most, to tell a slow adapter from a busy moment (see doubt_learned).
 DOUBT_PINGS = 3
+# The wait for each reply when a motor heard at a rate is asked a last time (``ask_patiently``):
+# as ``find.PATIENT_LATENCY_S``, longer than a busy machine runs an emulator late.
+PATIENT_REPLY_S = 0.15
 
 
 def ping_found(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
@@ -63,6 +66,32 @@ def heard_in_silence(bus: DxlBus, wanted: set[int]) -> dict[int, PingResult]:
             ", ".join(map(str, sorted(heard))),
         )
     return heard
+
+
+def ask_patiently(bus: DxlBus, motor_id: int, *, identify: bool = True) -> PingResult | None:
+    """Ask ``motor_id``, heard at this rate but silent when asked again, a last time, patiently.
+
+    Its reply may have been a late one from the rate before (a slow adapter), or the other end
+    was run late twice in a row (an emulator on a busy machine: a factory-new MX-28 went
+    unfound by ``poppy scan --all-bauds`` when the ping confirming it came 20 ms late). The
+    line is left quiet first, so that a late reply from elsewhere is not taken for an answer;
+    then a motor really at this rate answers, however late the OS runs it (``PATIENT_REPLY_S``
+    a reply, one retry), and an echo from another rate does not. Costs 0.3 s for an echo.
+    """
+    settle(bus)
+    with bus.patient(1, PATIENT_REPLY_S):
+        try:
+            result = bus.ping(motor_id, retries=1, identify=identify)
+        except CorruptPacketError:
+            return None
+    if result is not None:
+        logger.info(
+            "%s: motor %d answered at %d bps only when asked patiently (a busy machine?)",
+            bus.port,
+            motor_id,
+            bus.baudrate,
+        )
+    return result
 
 
 def answers(bus: DxlBus, motor_id: int) -> bool:

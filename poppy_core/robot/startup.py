@@ -20,6 +20,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from poppy_core.bus import DxlBus
+from poppy_core.bus.results import PingResult
 from poppy_core.bus.setup import eeprom_unlocked
 from poppy_core.errors import BusError, MotorError, RegisterError
 from poppy_core.robot import registers as regs
@@ -55,6 +56,9 @@ def where(bus: DxlBus) -> str:
 
 
 STARTUP_PING_RETRIES = 3
+# A motor silent through its start-up pings is asked this many times more, patiently
+# (``check_presence``), before it counts as missing.
+PRESENCE_RETRIES = 1
 # Start-up reads and writes go to motors that answered their ping: a reply the OS delivered
 # late (an emulator starved on a loaded machine, seen stalling past 20 ms beside four busy
 # loops) must not fail the first state or a write the user agreed to. A motor that answers in
@@ -72,21 +76,20 @@ def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> lis
 
     Motors that do not answer are marked offline (``motor.online`` is False).
     """
+    found = {
+        motor.id: _ping(bus, motor.id, max(STARTUP_PING_RETRIES, bus.retries)) for motor in motors
+    }
+    _ask_the_silent_again(bus, found)
     missing: list[str] = []
     wrong: list[str] = []
     for motor in motors:
-        try:
-            # A robot is refused when one motor is missing: a reply late once (a busy machine
-            # serving an emulator) must not decide it; a motor really absent costs a few ms more.
-            found = bus.ping(motor.id, retries=max(STARTUP_PING_RETRIES, bus.retries))
-        except BusError:
-            found = None
-        if found is None:
+        pinged = found[motor.id]
+        if pinged is None:
             link_of(motor).mark_offline()
             missing.append(f"{motor.name} (id {motor.id})")
             continue
-        if found.model is None or found.model.name != motor.model.name:
-            seen = found.model_name or f"model number {found.model_number}"
+        if pinged.model is None or pinged.model.name != motor.model.name:
+            seen = pinged.model_name or f"model number {pinged.model_number}"
             wrong.append(f"{motor.name} (id {motor.id}) is {seen}, config says {motor.model.name}")
     problems = []
     if missing:
@@ -97,6 +100,39 @@ def check_presence(bus: DxlBus, controller: str, motors: Sequence[Motor]) -> lis
     if wrong:
         problems.append(f"controller {controller!r}: wrong model: {', '.join(wrong)}")
     return problems
+
+
+def _ping(bus: DxlBus, motor_id: int, retries: int) -> PingResult | None:
+    try:
+        return bus.ping(motor_id, retries=retries)
+    except BusError:
+        return None
+
+
+def _ask_the_silent_again(bus: DxlBus, found: dict[int, PingResult | None]) -> None:
+    """Ping the motors that did not answer once more, patiently, before they count as missing.
+
+    A robot is refused when one motor is missing, and a reply the OS delivered late (an
+    emulator starved on a busy machine: a first ping went unanswered 4 times in a row, 45 ms)
+    must not decide it. Each silent motor is asked ``PRESENCE_RETRIES`` more times, waiting
+    ``STARTUP_REPLY_TIMEOUT_S`` for each reply. When no motor answered at all (most likely an
+    empty bus, or one at another rate), the first is asked, and the others only if it answers:
+    a whole robot absent costs 0.2 s more, not 0.2 s a motor.
+    """
+    silent = [motor_id for motor_id, pinged in found.items() if pinged is None]
+    if not silent:
+        return
+    with bus.patient(PRESENCE_RETRIES, STARTUP_REPLY_TIMEOUT_S):
+        if len(silent) == len(found):
+            first = silent.pop(0)
+            found[first] = _ping(bus, first, PRESENCE_RETRIES)
+            if found[first] is None:
+                return
+        for motor_id in silent:
+            found[motor_id] = _ping(bus, motor_id, PRESENCE_RETRIES)
+    answered_late = [motor_id for motor_id in silent if found[motor_id] is not None]
+    if answered_late:
+        logger.info("%s: motors %s answered only when asked patiently", bus.port, answered_late)
 
 
 def load_state(bus: DxlBus, motors: Sequence[Motor]) -> None:

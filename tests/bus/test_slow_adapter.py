@@ -13,6 +13,7 @@ from poppy_core.models import model_by_name
 from poppy_core.robot import Motor
 from poppy_core.robot.startup import check_presence
 from tests.helpers.bus import loaded_reply_floor_s
+from tests.helpers.late_replies import DropFirst, LateAfter, LateFirst
 
 if TYPE_CHECKING:
     from tests.helpers.bus import Emulate
@@ -83,18 +84,6 @@ def test_find_port_on_a_port_that_cannot_open_is_a_port_error(tmp_path: object) 
         find_port([3], ["/dev/ttyUSB_poppy_missing_4", "/dev/ttyUSB_poppy_missing_5"])
 
 
-class DropFirst(FaultInjector):
-    """Loses the first ``count`` replies, as replies late on a busy machine."""
-
-    def __init__(self, count: int) -> None:
-        super().__init__()
-        self.left = count
-
-    def filter_reply(self, data: bytes) -> bytes | None:
-        self.left -= 1
-        return None if self.left >= 0 else data
-
-
 def test_a_robot_is_not_refused_for_a_motor_late_twice_at_startup() -> None:
     # Two lost replies in a row exceed the bus's single retry; the startup check retries more.
     motor = VirtualMotor(model_by_name("MX-28"), 7, 1_000_000)
@@ -109,20 +98,6 @@ def test_a_robot_is_not_refused_for_a_motor_late_twice_at_startup() -> None:
         assert robot_motor.online
 
 
-class LateFirst(FaultInjector):
-    """Holds the first ``count`` replies back ``delay_s``, as an emulator the OS ran late."""
-
-    def __init__(self, count: int, delay_s: float) -> None:
-        super().__init__()
-        self.left = count
-        self.delay_s = delay_s
-
-    def filter_reply(self, data: bytes) -> bytes | None:
-        self.left -= 1
-        self._extra_delay_s = self.delay_s if self.left >= 0 else 0.0
-        return data
-
-
 @pytest.mark.parametrize(
     "rates",
     [[1_000_000], [2_000_000, 1_000_000], [1_000_000, 2_000_000], [57_600, 1_000_000, 2_000_000]],
@@ -135,3 +110,15 @@ def test_two_late_empty_broadcasts_do_not_hide_the_motors(rates: list[int]) -> N
         found = scan(server.url, rates, [2])
     assert _found(found) == [(1, 1_000_000), (2, 1_000_000), (3, 1_000_000)]
     assert all(f.model == "XL-320" for f in found)
+
+
+@pytest.mark.parametrize(("model", "protocol"), [("MX-28", 1), ("XL-320", 2)])
+def test_a_motor_late_when_asked_again_is_not_dropped(model: str, protocol: int) -> None:
+    # A factory-new motor (57,600 bps) found at the second rate tried is asked again before it
+    # is reported; the OS runs its emulator 50 ms late right then (the replies after the ping
+    # and the model read, or the two broadcast pings). It is not taken for a late echo from the
+    # rate before and dropped (`poppy scan --all-bauds` in CI): asked patiently, it answers.
+    motor = VirtualMotor(model_by_name(model), 1, 57_600)
+    with serve_link(VirtualBus([motor], protocol, faults=LateAfter(2, 2, 0.05))) as server:
+        found = scan(server.url, [1_000_000, 57_600, 19_200], [protocol], patient=False)
+    assert _found(found) == [(1, 57_600)]
