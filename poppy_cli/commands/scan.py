@@ -134,11 +134,14 @@ def scan(
     _show(found, json_output)
     if not found:
         where = ", ".join(ports)
-        rates = "all standard rates" if baudrates is None else ", ".join(map(str, baudrates))
-        error_line(
-            f"no motor answered on {where} at {rates} (protocol {protocol}): "
-            "check power and wiring, or try --all-bauds"
-        )
+        if baudrates is None:  # every rate tried: the rate is not what is wrong
+            rates, advice = "all standard rates", "check power, wiring and the adapter's cable"
+        else:
+            rates, advice = (
+                ", ".join(map(str, baudrates)),
+                "check power and wiring, or try --all-bauds",
+            )
+        error_line(f"no motor answered on {where} at {rates} (protocol {protocol}): {advice}")
         raise typer.Exit(EXIT_FAILURE)
 
 

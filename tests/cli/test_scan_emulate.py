@@ -41,7 +41,19 @@ def test_scan_with_nothing_answering_is_one_line_and_exit_1(poppy: Any, ergo_jr:
     result = poppy("scan", "--port", ergo_jr.url, "--baud", "57600", "--protocol", "2")
     assert result.code == 1
     assert "no motor answered" in result.stderr
+    assert "or try --all-bauds" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_scan_of_every_rate_with_nothing_answering_does_not_advise_every_rate(
+    poppy: Any, ergo_jr: Any
+) -> None:
+    result = poppy("scan", "--port", ergo_jr.url, "--all-bauds", "--protocol", "1", "--ids", "1")
+    assert result.code == 1
+    assert result.stderr.count("\n") == 1, result.stderr
+    assert "no motor answered" in result.stderr
+    assert "all standard rates" in result.stderr
+    assert "--all-bauds" not in result.stderr
 
 
 def test_scan_all_bauds_finds_a_motor_at_another_rate(poppy: Any, emulator_factory: Any) -> None:
