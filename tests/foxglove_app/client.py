@@ -18,6 +18,8 @@ import websockets
 from mcap.records import Schema
 from mcap_protobuf.decoder import DecoderFactory
 
+from tests.helpers.waiting import scaled
+
 SUBPROTOCOL = "foxglove.sdk.v1"
 MESSAGE_DATA = 1
 FETCH_ASSET_RESPONSE = 4
@@ -60,7 +62,10 @@ class FoxgloveClient:
         self._ready = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
         self._thread.start()
-        assert self._ready.wait(30), "no connection"
+        # Ready once the server said who it is (its first message), not when the socket opened:
+        # a loaded machine delivered serverInfo after a test had read an empty server_info.
+        assert self._ready.wait(scaled(30)), "no serverInfo"
+        assert self.server_info or not self.errors, self.errors
 
     def _run(self) -> None:
         self._loop.run_until_complete(self._main())
@@ -72,7 +77,6 @@ class FoxgloveClient:
             ) as ws:
                 assert ws.subprotocol == SUBPROTOCOL
                 self._ws = ws
-                self._ready.set()
                 async for frame in ws:
                     self._on(frame)
         except websockets.ConnectionClosed:
@@ -87,6 +91,7 @@ class FoxgloveClient:
             message = json.loads(frame)
             if message["op"] == "serverInfo":
                 self.server_info = message
+                self._ready.set()
             elif message["op"] == "advertise":
                 fresh = []
                 for channel in message["channels"]:

@@ -87,7 +87,7 @@ def test_every_channel_decodes_and_joint_states_are_the_motors_radians(served: S
         "/camera/image",
         "/camera/detections",
     }
-    assert client.topics() == topics
+    assert eventually(lambda: client.topics() == topics, 30.0), client.topics()
     assert eventually(lambda: all(client.of(t) for t in topics), 30.0), {
         t: len(client.of(t)) for t in topics
     }
