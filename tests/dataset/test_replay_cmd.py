@@ -96,12 +96,15 @@ def test_the_motors_go_through_the_recorded_positions_in_order(dataset: Path) ->
         last = [m1_path(29), 0.0, 0.0, -29.0, 0.0, 0.0]
         for motor, where in zip(bus.motors, last, strict=True):
             assert motor.goal_position_deg == pytest.approx(where, abs=0.5)
-    # shape: a ramp from 0° to the first frame (15°), up to 30°, then down to -17.5°, in order
+    # shape: a ramp from 0° to the first frame (15°), up to 30°, then down to -17.5°, in order.
+    # The bus writes the newest goal each cycle: a cycle the OS ran 50 ms late (a busy machine)
+    # skips the frame it outlived, the peak's included, so the peak is any frame within 3° of it
+    # (frames 8-11: 27°, 28.5°, 30°, 27.5°).
     first = next(i for i, g in enumerate(goals) if g >= 14.5)
-    peak = next(i for i, g in enumerate(goals) if g >= 29.5)
+    peak = next(i for i, g in enumerate(goals) if g >= 26.9)
     low = next(i for i, g in enumerate(goals) if g <= -17.0)
     assert first < peak < low
-    assert max(goals) == pytest.approx(30.0, abs=0.5)
+    assert 26.9 <= max(goals) <= 30.5
     assert min(goals) == pytest.approx(-17.5, abs=0.5)
     assert all(g >= -0.5 for g in goals[:peak])  # nothing below the ramp's start before the peak
 
