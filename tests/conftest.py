@@ -19,14 +19,17 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+import _pytest.unraisableexception as _pytest_unraisable
 import pytest
 from hypothesis import settings
 
 from poppy_core.dataset.realtime import calling_thread_realtime, undo_realtime
 from tests.helpers import timing
+from tests.helpers.tls import share_one_context
 from tests.helpers.waiting import load_factor, runnable_now
 
 TESTS = Path(__file__).resolve().parent
+share_one_context()  # ~30 ms of CPU per httpx client otherwise (tests/helpers/tls.py)
 SLOW_FOLDERS = {"cli", "creatures", "gym", "server", "sim", "teleop", "tui"}
 SLOW_MODULES = {
     "emulator/test_emulator_threads.py",
@@ -121,6 +124,13 @@ def pytest_configure(config: pytest.Config) -> None:
         # The workers' collection order (longest groups first, pytest_collection_modifyitems)
         # is the order groups are handed out in: xdist must not sort them by test count.
         config.option.loadscopereorder = False
+    # pytest collects garbage 5 times at the end of each process, to report the unraisable
+    # exceptions of objects freed last; with the heap a worker has then, each pass took 0.2-0.5 s
+    # of CPU, in every process at once. One pass frees what the tests left; the four others
+    # mostly walked the heap again.
+    iterations = getattr(_pytest_unraisable, "gc_collect_iterations_key", None)
+    if iterations is not None:
+        config.stash[iterations] = 1
 
 
 def _longest_groups_first(items: list[pytest.Item], groups: dict[pytest.Item, str]) -> None:
