@@ -162,15 +162,7 @@ def _scan_rate(
     # Replies still coming are late answers of this rate: wait for them before the next rate.
     if not (trusted and last):
         late |= settle(bus) & wanted
-    for motor_id in sorted(late - set(candidates)):
-        # A late broadcast reply, if asking again goes unanswered (the other end still late).
-        result = (
-            ping_found(bus, motor_id, retries=1)
-            or heard.get(motor_id)
-            or ask_patiently(bus, motor_id)
-        )
-        if result is not None:
-            candidates[motor_id] = result
+    _ask_the_late(bus, late, candidates, heard, wanted)
     if first:
         for result in candidates.values():
             state.add(found_motor(port, bus, result))
@@ -182,6 +174,39 @@ def _scan_rate(
     if bus.latency_s > began_s and here:
         doubt_learned(bus, began_s, max(here))
     return (unconfirmed | late) - set(here)
+
+
+def _ask_the_late(
+    bus: DxlBus,
+    late: set[int],
+    candidates: dict[int, PingResult],
+    heard: dict[int, PingResult],
+    wanted: set[int],
+) -> None:
+    """Ask each ID whose reply came late (``late``) again; those found join ``candidates``.
+
+    A late broadcast reply stands for its motor if asking again goes unanswered (the other end
+    still late); a motor still silent is asked patiently (``ask_patiently``). Replies that come
+    late while these are asked (kept aside, or heard in a quiet time) are asked in turn, and
+    added to ``late``: a reply held back behind another was lost so once.
+    """
+    pending = sorted(late - set(candidates))
+    asked: set[int] = set()
+    while pending:
+        motor_id = pending.pop(0)
+        asked.add(motor_id)
+        came: set[int] = set()
+        result = (
+            ping_found(bus, motor_id, retries=1)
+            or heard.get(motor_id)
+            or ask_patiently(bus, motor_id, heard=came)
+        )
+        if result is not None:
+            candidates[motor_id] = result
+        came |= {status.id for status in bus.take_strays()}
+        for other in sorted((came & wanted) - set(candidates) - asked - set(pending)):
+            pending.append(other)
+            late.add(other)
 
 
 def _ping_deadline_s(bus: DxlBus, latency_s: float) -> float:
@@ -234,7 +259,7 @@ def _revisit(state: ScanState, port: str, bus: DxlBus, ids: set[int]) -> None:
     settle(bus)
     candidates = {}
     for motor_id in sorted(ids):
-        result = ping_found(bus, motor_id, retries=1)
+        result = ping_found(bus, motor_id, retries=1) or ask_patiently(bus, motor_id)
         if result is not None:
             candidates[motor_id] = result
     _confirm(state, port, bus, candidates, by_broadcast=False)

@@ -68,7 +68,9 @@ def heard_in_silence(bus: DxlBus, wanted: set[int]) -> dict[int, PingResult]:
     return heard
 
 
-def ask_patiently(bus: DxlBus, motor_id: int, *, identify: bool = True) -> PingResult | None:
+def ask_patiently(
+    bus: DxlBus, motor_id: int, *, identify: bool = True, heard: set[int] | None = None
+) -> PingResult | None:
     """Ask ``motor_id``, heard at this rate but silent when asked again, a last time, patiently.
 
     Its reply may have been a late one from the rate before (a slow adapter), or the other end
@@ -77,8 +79,12 @@ def ask_patiently(bus: DxlBus, motor_id: int, *, identify: bool = True) -> PingR
     line is left quiet first, so that a late reply from elsewhere is not taken for an answer;
     then a motor really at this rate answers, however late the OS runs it (``PATIENT_REPLY_S``
     a reply, one retry), and an echo from another rate does not. Costs 0.3 s for an echo.
+    The IDs whose replies came in the quiet time (or were kept aside before) are added to
+    ``heard``: they are late too, and the caller asks them in turn.
     """
-    settle(bus)
+    quiet = settle(bus)
+    if heard is not None:
+        heard.update(quiet)
     with bus.patient(1, PATIENT_REPLY_S):
         try:
             result = bus.ping(motor_id, retries=1, identify=identify)
