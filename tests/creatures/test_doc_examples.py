@@ -92,12 +92,12 @@ def test_moving_speed_then_goal(poppy: Robot) -> None:
 
 
 def test_goto_with_and_without_wait(poppy: Robot) -> None:
-    seen: list[float] = []
+    seen: list[tuple[float, float]] = []  # (goal, present) as each call returned
     original = poppy.head_y.goto_position
 
     def spy(*args: object, **kwargs: object) -> object:
         handle = original(*args, **kwargs)  # type: ignore[arg-type]
-        seen.append(poppy.head_y.present_position)
+        seen.append((poppy.head_y.goal_position, poppy.head_y.present_position))
         return handle
 
     poppy.head_y.goto_position = spy  # type: ignore[method-assign]
@@ -105,8 +105,12 @@ def test_goto_with_and_without_wait(poppy: Robot) -> None:
         doc.run(doc.GOTO, poppy=poppy)
     finally:
         del poppy.head_y.goto_position
-    assert abs(seen[0] - 10.0) <= TOLERANCE_DEG[poppy.extensions["doc_simulator"]]  # type: ignore[index]
-    assert abs(seen[1] - 10.0) <= 5.0  # wait=False returned before the 2 s motion went far
+    # wait=True returned once its trajectory had ended: the goal is the target; the position read
+    # then may be a sync cycle or two behind it (a busy machine ran one 1.9° behind)
+    (goal, present), (_, present_after) = seen
+    assert goal == pytest.approx(10.0, abs=0.01)
+    assert abs(present - 10.0) <= 5.0
+    assert abs(present_after - 10.0) <= 5.0  # wait=False returned before the 2 s motion went far
     assert wait_until(lambda: _near(poppy, "head_y", -10.0), 10.0)
 
 
