@@ -158,7 +158,7 @@ def _scan_rate(
         finally:
             bus.timeout_s = None
     if bus.latency_s > began_s and candidates:  # before the waits that follow use it
-        doubt_learned(bus, began_s, max(candidates))
+        late |= doubt_learned(bus, began_s, max(candidates)) & wanted
     # Replies still coming are late answers of this rate: wait for them before the next rate.
     if not (trusted and last):
         late |= settle(bus) & wanted
@@ -172,7 +172,21 @@ def _scan_rate(
         unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
     here = [f.id for f in state.found if (f.baudrate, f.protocol) == (bus.baudrate, bus.protocol)]
     if bus.latency_s > began_s and here:
-        doubt_learned(bus, began_s, max(here))
+        came = (doubt_learned(bus, began_s, max(here)) & wanted) - set(here)
+        if came:  # late replies heard while doubting: asked too (one came behind another so)
+            more: dict[int, PingResult] = {}
+            _ask_the_late(bus, came, more, {}, wanted)
+            late |= came
+            if first:
+                for result in more.values():
+                    state.add(found_motor(port, bus, result))
+            else:
+                unconfirmed |= _confirm(state, port, bus, more, by_broadcast=False)
+            here = [
+                f.id
+                for f in state.found
+                if (f.baudrate, f.protocol) == (bus.baudrate, bus.protocol)
+            ]
     return (unconfirmed | late) - set(here)
 
 

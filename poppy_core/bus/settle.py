@@ -108,7 +108,7 @@ def answers(bus: DxlBus, motor_id: int) -> bool:
         return False
 
 
-def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> None:
+def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> set[int]:
     """Keep the latency learned at this rate only if a motor found at it still needs it.
 
     A late reply may come from a slow adapter, or from a moment the OS ran the other end late
@@ -118,11 +118,15 @@ def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> None:
     ``DOUBT_PINGS`` times: one answer on time shows that the adapter keeps up, and the latency
     of before is restored. A slow adapter is late every time (the line is left quiet between
     the pings, so that a late answer is not taken for the next one's); the latency learned stays.
+
+    Returns:
+        The other IDs whose replies came meanwhile (late ones: the caller asks them again).
     """
     learned = bus.latency_s
+    others: set[int] = set()
     for attempt in range(DOUBT_PINGS):
-        if attempt:
-            bus.listen(settle_s(learned))  # the last ping's late answer, if it is coming
+        if attempt:  # the last ping's late answer, if it is coming
+            others.update(status.id for status in bus.listen(settle_s(learned)))
         bus.latency_s = before_s
         try:
             on_time = bus.ping(motor_id, retries=0, identify=False) is not None
@@ -137,7 +141,9 @@ def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> None:
                 before_s * 1000,
                 learned * 1000,
             )
-            return
+            others.update(status.id for status in bus.take_strays())
+            return others - {motor_id}
         learned = max(learned, bus.latency_s)
     bus.latency_s = learned
-    settle(bus)  # the last ping's late answer must not land at the next rate
+    others |= settle(bus)  # the last ping's late answer must not land at the next rate
+    return others - {motor_id}

@@ -115,9 +115,9 @@ def _ask_the_silent_again(bus: DxlBus, found: dict[int, PingResult | None]) -> N
     A robot is refused when one motor is missing, and a reply the OS delivered late (an
     emulator starved on a busy machine: a first ping went unanswered 4 times in a row, 45 ms)
     must not decide it. Each silent motor is pinged again (``PRESENCE_RETRIES`` retries),
-    waiting ``STARTUP_REPLY_TIMEOUT_S`` for each reply. When no motor answered at all (most likely an
-    empty bus, or one at another rate), the first is asked, and the others only if it answers:
-    a whole robot absent costs 0.2 s more, not 0.2 s a motor.
+    waiting ``STARTUP_REPLY_TIMEOUT_S`` for each reply. When no motor answered at all (most
+    likely an empty bus, or one at another rate), the first is asked, and the others only if
+    it answers: a whole robot absent costs 0.2 s more, not 0.2 s a motor.
     """
     silent = [motor_id for motor_id, pinged in found.items() if pinged is None]
     if not silent:

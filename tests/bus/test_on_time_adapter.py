@@ -188,10 +188,11 @@ def test_a_reply_late_once_does_not_lengthen_the_quiet_time(
         listened.append((duration_s, self.latency_s))
         return real_listen(self, duration_s)
 
-    def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> None:
+    def doubt_learned(bus: DxlBus, before_s: float, motor_id: int) -> set[int]:
         learned = bus.latency_s
-        real_doubt(bus, before_s, motor_id)
+        others = real_doubt(bus, before_s, motor_id)
         doubted.append((learned, bus.latency_s))
+        return others
 
     monkeypatch.setattr(bus_core.BusCore, "listen", listen)
     monkeypatch.setattr(scan_module, "doubt_learned", doubt_learned)
