@@ -163,31 +163,44 @@ def _scan_rate(
     if not (trusted and last):
         late |= settle(bus) & wanted
     _ask_the_late(bus, late, candidates, heard, wanted)
-    if first:
-        for result in candidates.values():
-            state.add(found_motor(port, bus, result))
-        state.unconfirmed = 0
-        unconfirmed: set[int] = set()
-    else:
-        unconfirmed = _confirm(state, port, bus, candidates, by_broadcast=trusted)
-    here = [f.id for f in state.found if (f.baudrate, f.protocol) == (bus.baudrate, bus.protocol)]
+    unconfirmed = _report(state, port, bus, candidates, first=first, by_broadcast=trusted)
+    here = _found_here(state, bus)
     if bus.latency_s > began_s and here:
-        came = (doubt_learned(bus, began_s, max(here)) & wanted) - set(here)
+        came = (doubt_learned(bus, began_s, max(here)) & wanted) - here
         if came:  # late replies heard while doubting: asked too (one came behind another so)
             more: dict[int, PingResult] = {}
             _ask_the_late(bus, came, more, {}, wanted)
             late |= came
-            if first:
-                for result in more.values():
-                    state.add(found_motor(port, bus, result))
-            else:
-                unconfirmed |= _confirm(state, port, bus, more, by_broadcast=False)
-            here = [
-                f.id
-                for f in state.found
-                if (f.baudrate, f.protocol) == (bus.baudrate, bus.protocol)
-            ]
-    return (unconfirmed | late) - set(here)
+            unconfirmed |= _report(state, port, bus, more, first=first, by_broadcast=False)
+            here = _found_here(state, bus)
+    return (unconfirmed | late) - here
+
+
+def _report(
+    state: ScanState,
+    port: str,
+    bus: DxlBus,
+    candidates: dict[int, PingResult],
+    *,
+    first: bool,
+    by_broadcast: bool,
+) -> set[int]:
+    """Report ``candidates``: at once at the port's first rate, else once confirmed.
+
+    Returns:
+        The candidates that did not confirm.
+    """
+    if not first:
+        return _confirm(state, port, bus, candidates, by_broadcast=by_broadcast)
+    for result in candidates.values():
+        state.add(found_motor(port, bus, result))
+    state.unconfirmed = 0
+    return set()
+
+
+def _found_here(state: ScanState, bus: DxlBus) -> set[int]:
+    """The IDs found so far at ``bus``'s rate and protocol."""
+    return {f.id for f in state.found if (f.baudrate, f.protocol) == (bus.baudrate, bus.protocol)}
 
 
 def _ask_the_late(
