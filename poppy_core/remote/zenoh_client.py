@@ -217,8 +217,10 @@ def reply_of(
             "the robots seen; check the endpoints: --zenoh-connect or POPPY_ZENOH_CONNECT)",
             port=where,
         )
-    errors = [r.err.payload.to_bytes().decode(errors="replace") for r in replies]
-    if not replies or errors == ["Timeout"]:  # Zenoh's own reply when the time ran out
+    errors = list(dict.fromkeys(r.err.payload.to_bytes().decode(errors="replace") for r in replies))
+    # Zenoh's own reply when the time ran out; a router or the robot's session, timing the
+    # query out too, may send one of their own before the client's (a loaded machine)
+    if not replies or errors == ["Timeout"]:
         raise BusTimeout(
             f"{where}: no answer within {timeout_s:g} s (is the robot served with "
             "`poppy serve --zenoh` and reachable? `poppy fleet list` shows the robots seen)",
