@@ -18,6 +18,12 @@ uvicorn's HTTP protocol class:
   request's headers have arrived (``on_headers_complete``), so sockets that send nothing are all
   accepted and each holds a file descriptor until the header deadline.
 
+A refused request's answer is followed by a **lingering close** (RFC 9112, 9.6): the server
+half-closes, reads and drops what the client still sends, and closes once the client is quiet
+(``LINGER_QUIET_S``), at its end, or after ``LINGER_MAX_S``. Closing at once with the rest of a
+too-large head unread makes the kernel reset the connection: the client reads the answer and then
+an error (a browser may show only the reset), or loses the answer not yet sent.
+
 It relies on the attributes uvicorn's protocols share (``connections``, ``cycle``, ``transport``,
 ``loop``, ``on_response_complete``): pyproject bounds uvicorn to the minor versions tested,
 ``tests/server/test_uvicorn_contract.py`` checks those attributes and
@@ -43,8 +49,10 @@ MAX_HEADER_BYTES = 64 * 1024
 MAX_HEADER_LINES = 100
 """Most lines in a request's head (the request line and its headers)."""
 HEAD_END = b"\r\n\r\n"
-REFUSED_LINGER_S = 1.0
-"""How long a refused connection stays open so that the client reads the 503 (not a reset)."""
+LINGER_QUIET_S = 0.5
+"""After a refusal, how long the client may send nothing before the connection is closed."""
+LINGER_MAX_S = 5.0
+"""After a refusal, the longest the connection stays open (a client that never stops sending)."""
 
 
 def _answer(status: int, reason: str, message: str, tip: str) -> bytes:
@@ -88,28 +96,29 @@ def guarded_protocol(base: Any, header_timeout_s: float, max_connections: int) -
             self._head_bytes = 0
             self._head_lines = 0
             self._head_tail = b""
-            self._too_large = False
+            self._lingering: Any = None  # the transport closed once the client is quiet
+            self._linger_end = 0.0
+            self._linger_timer: asyncio.TimerHandle | None = None
 
         def connection_made(self, transport: Any) -> None:
             if len(self.connections) >= max_connections:
                 self._refused = True
                 logger.warning("refused a connection: %d already open", len(self.connections))
                 transport.write(busy)
-                if transport.can_write_eof():
-                    transport.write_eof()
-                self.loop.call_later(REFUSED_LINGER_S, transport.close)
+                self._linger(transport)
                 return
             super().connection_made(transport)
             self._arm()
 
         def data_received(self, data: bytes) -> None:
-            if self._refused or self._too_large:
+            if self._lingering is not None:
+                self._linger_on()  # dropped: the client is still sending what was refused
                 return
             if self._deadline is not None and self._head_too_large(data):
-                self._too_large = True
+                self._disarm()
                 logger.info("refused a request whose headers passed the size limits")
                 self.transport.write(too_large)
-                self.transport.close()
+                self._linger(self.transport)
                 return
             self._partial = True
             super().data_received(data)
@@ -125,13 +134,32 @@ def guarded_protocol(base: Any, header_timeout_s: float, max_connections: int) -
 
         def connection_lost(self, exc: Exception | None) -> None:
             self._disarm()
+            if self._linger_timer is not None:
+                self._linger_timer.cancel()
             if not self._refused:
                 super().connection_lost(exc)
 
         def eof_received(self) -> Any:
-            if self._refused:
-                return None
+            if self._lingering is not None:
+                return None  # the client is done: the transport closes
             return super().eof_received()
+
+        def _linger(self, transport: Any) -> None:
+            """Half-close after a refusal's answer; close once the client is quiet (a lingering
+            close: see the module's docstring)."""
+            if transport.can_write_eof():
+                transport.write_eof()
+            self._lingering = transport
+            self._linger_end = self.loop.time() + LINGER_MAX_S
+            self._linger_on()
+
+        def _linger_on(self) -> None:
+            if self._linger_timer is not None:
+                self._linger_timer.cancel()
+            left = max(0.0, self._linger_end - self.loop.time())
+            self._linger_timer = self.loop.call_later(
+                min(LINGER_QUIET_S, left), self._lingering.close
+            )
 
         def _head_too_large(self, data: bytes) -> bool:
             """Count the bytes and lines of ``data`` that belong to the head being received."""
@@ -166,7 +194,9 @@ def guarded_protocol(base: Any, header_timeout_s: float, max_connections: int) -
                 return
             if self._partial:
                 transport.write(slow)
-            transport.close()
+                self._linger(transport)
+            else:
+                transport.close()
 
     GuardedProtocol.__name__ = f"Guarded{base.__name__}"
     GuardedProtocol.__qualname__ = GuardedProtocol.__name__

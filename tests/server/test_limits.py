@@ -16,7 +16,7 @@ import pytest
 from websockets.sync.client import connect
 
 from poppy_core import from_profile
-from poppy_core.server import ServerThread, create_app
+from poppy_core.server import ServerThread, create_app, limits
 from tests.helpers.waiting import eventually, scaled
 
 WAIT_S = 15.0  # upper bound for what should take well under a second
@@ -169,3 +169,47 @@ def test_request_headers_have_a_size_and_a_count_limit(strict: ServerThread) -> 
         headers = {f"X-{i}": "b" * 600 for i in range(90)}  # and httpx's 5
         for _ in range(2):
             assert http.get("/robot.json", headers=headers).status_code == 200
+
+
+def test_a_client_that_sends_its_whole_refused_head_first_reads_the_431_then_an_end(
+    strict: ServerThread,
+) -> None:
+    # A client that writes its whole request before reading (the kernel takes 1 MiB at once):
+    # closing with the rest of the head unread reset the connection after the answer (10 of 10
+    # before the lingering close), and could lose the answer itself.
+    head = (
+        b"GET /robot.json HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Big: " + b"a" * (1 << 20) + b"\r\n\r\n"
+    )
+    for _ in range(3):
+        with socket.create_connection(("127.0.0.1", strict.port)) as sock:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 8 << 20)
+            sock.sendall(head)
+            time.sleep(0.3)  # the server has read its 64 KiB and answered meanwhile
+            try:
+                answer = _closed_within(sock, scaled(WAIT_S))
+            except ConnectionResetError:
+                raise AssertionError("the answer was followed by a reset, not an end") from None
+        assert answer.startswith(b"HTTP/1.1 431"), answer[:80]
+
+
+def test_a_refused_client_that_never_stops_sending_is_closed(
+    moves_folder: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(limits, "LINGER_MAX_S", 1.0)
+    robot = from_profile("ergo-jr", sim=True)
+    server = ServerThread(create_app(robot), header_timeout_s=0.5).start()
+    try:
+        with socket.create_connection(("127.0.0.1", server.port)) as sock:
+            sock.sendall(b"GET /robot.json HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Big: " + b"a" * 70000)
+            closed = False
+            deadline = time.monotonic() + scaled(WAIT_S)
+            while not closed and time.monotonic() < deadline:  # a byte every 0.1 s, for ever
+                try:
+                    sock.sendall(b"a")
+                except (BrokenPipeError, ConnectionResetError):
+                    closed = True
+                time.sleep(0.1)
+            assert closed, "the server kept a refused connection open while the client sent"
+    finally:
+        server.stop()
+        robot.close()
