@@ -217,7 +217,8 @@ class Sensor:
         return self._closed
 
     def start(self) -> None:
-        """Start the background update (idempotent; reading a register does it too).
+        """Start the background update (idempotent; reading a register does it too). A sensor
+        that failed for good (``fail``) stays stopped: its reads raise or stay empty.
 
         Raises:
             SensorError: the sensor was closed.
@@ -226,8 +227,8 @@ class Sensor:
             if self._closed:
                 raise SensorError(f"sensor {self._name!r} is closed", sensor=self._name)
             self._watching = False
-            if self._thread is not None:
-                return
+            if self._thread is not None or self._fatal:
+                return  # running, or failed for good: a read must not revive it (``fail``)
             self._start_thread()
 
     def _start_thread(self) -> None:

@@ -10,9 +10,10 @@ import pytest
 from poppy_core import from_config
 from poppy_core.errors import ConfigError
 from poppy_core.robot import RobotConfig, load_profile
-from poppy_core.sensors import PoseSkeleton
+from poppy_core.sensors import DummyCamera, PoseSkeleton
 from poppy_core.sensors.kinect import JOINTS
 from poppy_core.sensors.pose import JOINT_LANDMARKS, skeleton_from_landmarks
+from tests.helpers.waiting import within
 
 
 def landmarks() -> tuple[np.ndarray, np.ndarray]:
@@ -75,6 +76,23 @@ def test_without_mediapipe_the_robot_builds_and_health_says_why(tmp_path: Any) -
         health = robot.sensor_health()["pose"]
         assert not health.ok and "no interpreter" in health.last_error
         assert "mimic" in robot.primitive_names  # a Torso with a skeleton sensor
+
+
+def test_reading_a_sensor_that_failed_for_good_does_not_revive_it(
+    tmp_path: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    # Reading started the sensor's thread again, which tried the missing interpreter: health
+    # then said "cannot run ...: No such file" in place of why, once the thread was quick enough
+    # (a mimic on a busy machine reported either).
+    camera = DummyCamera("camera", (64, 48), 10.0)
+    sensor = PoseSkeleton("pose", camera, python=str(tmp_path / "no" / "python"))
+    with camera, sensor:
+        assert sensor.tracked_skeleton == {}
+        assert not within(lambda: "cannot run" in sensor.health().last_error, 1.0)
+        assert sensor.tracked_skeleton == {}
+        health = sensor.health()
+        assert not health.ok and "no interpreter" in health.last_error
+    assert not [r for r in caplog.records if "cannot run" in r.getMessage()]
 
 
 @pytest.mark.parametrize(
