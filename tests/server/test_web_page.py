@@ -241,9 +241,6 @@ def test_a_move_recorded_from_the_page_replays(page: Any, served: Served) -> Non
     page.click("button[aria-label='plot wave']")
     eventually(lambda: page.is_visible("#plot polyline"), "the plot")
     assert "m1" in page.inner_text("#plot-title")
-    # the row is drawn again when the replay ends (its ▶ goes): a click at that moment fell on
-    # the row being replaced and was lost (a loaded run), so delete once it has ended
-    eventually(lambda: "▶" not in page.inner_text("#move-wave th"), "the replay to end")
     page.once("dialog", lambda dialog: dialog.accept())
     page.click("button[aria-label='delete wave']")
     eventually(lambda: page.query_selector("#move-wave") is None, "the move deleted")
@@ -324,6 +321,21 @@ def test_the_move_list_gives_durations(page: Any, timed: str) -> None:
     assert "duration" in row, f"no duration column: {sorted(row)}"
     assert row["duration"].replace("\xa0", " ") == "2.98 s"  # as `poppy moves list` says it
     assert re.fullmatch(r"\d+\.\d kB", row["size"].replace("\xa0", " ")), row["size"]
+
+
+def test_a_replay_starting_and_ending_keeps_the_row_as_it_was(
+    page: Any, served: Served, timed: str
+) -> None:
+    served.robot.compliant = False
+    page.fill("[aria-label='timed speed']", "1.0")  # drawn again, the row would say "1"
+    delete = page.query_selector("button[aria-label='delete timed']")
+    page.click("button[aria-label='play timed']")
+    eventually(lambda: "▶" in page.inner_text("#move-timed th"), "the row to say it plays")
+    eventually(lambda: "▶" not in page.inner_text("#move-timed th"), "the replay to end")
+    # marked in place: the typed speed is kept, and the buttons are the ones a click aimed at
+    assert page.input_value("[aria-label='timed speed']") == "1.0"
+    assert delete is not None and delete.evaluate("button => button.isConnected")
+    served.robot.compliant = True
 
 
 def test_no_value_of_the_move_list_wraps(page: Any, timed: str) -> None:

@@ -40,6 +40,7 @@ async function play(name, speed, backwards) {
     await post(`/api/v1/moves/${name}/play`, { speed, backwards });
     say(`playing ${name}${backwards ? " backwards" : ""} at ×${speed}`);
   } catch (error) { say(`${name}: ${error.message}`, true); }
+  refreshMoves();
 }
 
 async function remove(name) {
@@ -130,6 +131,7 @@ function row(entry, playing) {
 }
 
 let shown = "";
+let shownEntries = "";
 export async function refreshMoves() {
   let entries, status;
   try {
@@ -141,7 +143,17 @@ export async function refreshMoves() {
   const key = JSON.stringify([entries, status.playing]);
   if (key === shown) return; // keep focus and typed speeds while nothing changed
   shown = key;
-  const names = [...new Set(entries.map((e) => e.name))];
   const body = document.querySelector("#move-table tbody");
+  const entriesKey = JSON.stringify(entries);
+  if (entriesKey === shownEntries) {
+    // only what plays changed: mark the rows in place, keeping typed speeds, the focus and a
+    // click under way (a row drawn again as a replay ended took the click meant for it)
+    for (const tr of body.rows) {
+      tr.querySelector("th").textContent = tr.dataset.move + (status.playing.includes(tr.dataset.move) ? " ▶" : "");
+    }
+    return;
+  }
+  shownEntries = entriesKey;
+  const names = [...new Set(entries.map((e) => e.name))];
   body.replaceChildren(...names.map((n) => row(entries.find((e) => e.name === n), status.playing.includes(n))));
 }
