@@ -67,13 +67,17 @@ def _open(
 ) -> tuple[ZenohClient, _StateWatch, list[str]]:
     client = ZenohClient(name, token, timeout_s, settings=settings or client_settings())
     try:
-        motors = [str(m["name"]) for m in client.get(path_of("motors"))]
+        # subscribed first: the subscription reaches the robot while its motors are asked
         watch = _StateWatch(client.session, name)
-        if not watch.arrived.wait(timeout_s):
+        try:
+            motors = [str(m["name"]) for m in client.get(path_of("motors"))]
+            if not watch.arrived.wait(timeout_s):
+                raise CommunicationError(
+                    f"zenoh:{name}: no state message within {timeout_s:g} s", port=f"zenoh:{name}"
+                )
+        except BaseException:
             watch.close()
-            raise CommunicationError(
-                f"zenoh:{name}: no state message within {timeout_s:g} s", port=f"zenoh:{name}"
-            )
+            raise
     except BaseException:
         client.close()
         raise

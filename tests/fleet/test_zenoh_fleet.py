@@ -26,7 +26,7 @@ from poppy_core.zenoh_wire import ZenohSettings as Settings
 from poppy_core.zenoh_wire import check_name, pack_state, session_config, unpack_state
 from tests.helpers.cli import POPPY, command_env, run_poppy
 from tests.helpers.processes import reap
-from tests.helpers.waiting import eventually, http_timeout
+from tests.helpers.waiting import eventually, http_timeout, scaled
 from tests.helpers.zenoh_served import TOKEN, Served, connect_to, fleet_timeout_s, free_endpoint
 
 pytest.importorskip("zenoh")
@@ -297,8 +297,9 @@ def test_teleop_across_two_served_robots(two: tuple[Served, Served]) -> None:
 
     a, b = two
     settings = Settings(connect=connect_to(a, b))
-    leader = ZenohLeader("jr-a", TOKEN, settings=settings)
-    follower = ZenohFollower("jr-b", TOKEN, settings=settings, ramp_s=0.2)
+    # the first state within the product's 3 s times the load (a loaded run waited longer)
+    leader = ZenohLeader("jr-a", TOKEN, settings=settings, timeout_s=scaled(3.0))
+    follower = ZenohFollower("jr-b", TOKEN, settings=settings, ramp_s=0.2, timeout_s=scaled(3.0))
     changes: list[str] = []
     run = Teleoperation(leader, follower, rate_hz=100, on_change=lambda s, r: changes.append(s))
     try:
@@ -319,6 +320,19 @@ def test_teleop_across_two_served_robots(two: tuple[Served, Served]) -> None:
         run.stop()
         leader.close()
         follower.close()
+
+
+def test_a_leader_whose_state_never_comes_is_refused_in_one_line(
+    two: tuple[Served, Served],
+) -> None:
+    from poppy_core.remote.zenoh_teleop import ZenohLeader
+
+    a, _ = two
+    node = a.servers.zenoh
+    assert node is not None
+    node._worker.close()  # it answers its api, but publishes no state
+    with pytest.raises(CommunicationError, match=r"^zenoh:jr-a: no state message within 1 s$"):
+        ZenohLeader("jr-a", TOKEN, settings=Settings(connect=(a.endpoint,)), timeout_s=1.0)
 
 
 def test_poppy_teleop_takes_zenoh_robots(two: tuple[Served, Served]) -> None:
