@@ -170,11 +170,15 @@ def read_table(bus: DxlBus, motor_id: int, model: ServoModel) -> list[RegisterRo
     return rows
 
 
-def _read_one(bus: DxlBus, motor_id: int, reg: Register) -> SIValue | None:
-    try:
-        return reg.decode_si(bus.read(motor_id, reg.address, reg.size))
-    except PoppyError:
-        return None
+def _read_one(bus: DxlBus, motor_id: int, reg: Register, attempts: int = 2) -> SIValue | None:
+    """One register, asked twice before it shows as unknown: the block read failed already, so
+    the line is unreliable now (a busy machine's adapter, a noisy bus)."""
+    for _ in range(attempts):
+        try:
+            return reg.decode_si(bus.read(motor_id, reg.address, reg.size))
+        except PoppyError:
+            continue
+    return None
 
 
 def read_live(bus: DxlBus, motor_id: int, model: ServoModel) -> LiveValues:
