@@ -253,7 +253,10 @@ def serve(
             servers: ServerSet | None = None
             try:
                 servers = serve(robot, spec)
-                _announce(servers, host, open_browser)
+                try:
+                    _announce(servers, host, open_browser)
+                except KeyboardInterrupt:  # serving already (its URL printed): a stop, as below
+                    stop.set()
                 _wait_for_signal(list(servers.servers.values()), stop)
             except RuntimeError as exc:
                 error_line(f"{exc} (the server's log above says why)")

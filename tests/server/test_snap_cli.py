@@ -140,3 +140,25 @@ def test_snap_blocks_writes_the_library_and_refuses_to_overwrite(tmp_path: Path)
     assert ET.parse(tmp_path / "record-replay.xml").getroot().get("name") == "record-replay"
     unknown = _run("snap", "project", "nope", "-o", str(tmp_path), cwd=tmp_path)
     assert unknown.returncode == 2 and "first-steps" in unknown.stderr
+
+
+def test_ctrl_c_while_the_browser_opens_is_a_clean_stop(tmp_path: Path) -> None:
+    # The README tour's Ctrl-C came while `--open` was starting the browser (the URLs printed):
+    # the interrupt escaped as "interrupted", 130, with no `stopped`.
+    started = tmp_path / "browser-started"
+    browser = tmp_path / "browser.sh"  # a browser slow to start: webbrowser waits for it
+    browser.write_text(f"#!/bin/sh\ntouch {started}\nsleep 5\n")
+    browser.chmod(0o755)
+    args = ["serve", "--snap", "--snap-port", "0", "--sim", "--profile", "ergo-jr", "--open"]
+    env = {**_env(tmp_path / "moves"), "BROWSER": f"{browser} %s"}
+    proc = start([*POPPY, *args], env)
+    try:
+        deadline = time.monotonic() + TIMEOUT_S
+        while not started.exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert started.exists(), "the browser was never started"
+    finally:
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=TIMEOUT_S)
+    assert proc.returncode == 0, err
+    assert "stopped" in err and "Traceback" not in err
