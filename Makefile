@@ -29,16 +29,22 @@ run: $(VENV)/.installed
 # the load needs (POPPY_REPLY_FLOOR_S, see docs/testing.md); TEST_WORKERS=4 for four,
 # TEST_WORKERS=0 runs in one process.
 TEST_WORKERS ?= auto
+# The modules that mostly wait (documentation examples sleeping as written, the README tour,
+# scans waiting out absent motors: tests/helpers/parts.py) run in workers of their own.
+WAITING_WORKERS ?= 3
 
-# The whole suite in parallel workers, a test module per worker (see tests/conftest.py); the
-# OpenGL tests run in a pytest process of their own. mypy and that process run beside the
-# parallel suite, which mostly waits (tests/together.sh: their output follows the suite's, and
+# The whole suite in parallel workers, a test module per worker (see tests/conftest.py): the
+# modules that mostly wait in WAITING_WORKERS of their own beside the others, so that the cores
+# stay busy while they wait; the OpenGL tests in a pytest process of their own; and mypy. All
+# four at once (tests/together.sh: the others' output follows the first's, then a recap, and
 # any failure fails `make test`).
 test: $(VENV)/.installed-test
 	$(BIN)/ruff check poppy_core poppy_cli tests bench
 	$(BIN)/ruff format --check poppy_core poppy_cli tests bench
-	sh tests/together.sh '$(BIN)/pytest -m "not gl" -n $(TEST_WORKERS) --dist loadgroup' \
-		'$(BIN)/mypy' '$(BIN)/pytest -m gl'
+	sh tests/together.sh \
+		'env POPPY_TEST_PART=rest $(BIN)/pytest -m "not gl" -n $(TEST_WORKERS) --dist loadgroup' \
+		'env POPPY_TEST_PART=waiting $(BIN)/pytest -m "not gl" -n $(WAITING_WORKERS) --dist loadgroup' \
+		'$(BIN)/mypy' 'env POPPY_TEST_PART=gl $(BIN)/pytest -m gl'
 
 # The inner loop (under 90 s on a quiet machine): lint, then every test not marked `slow`.
 test-fast: $(VENV)/.installed-test

@@ -25,6 +25,7 @@ from hypothesis import settings
 
 from poppy_core.dataset.realtime import calling_thread_realtime, undo_realtime
 from tests.helpers import timing
+from tests.helpers.parts import GL_MODULES, UnknownPart, current_part, outside_part
 from tests.helpers.tls import share_one_context
 from tests.helpers.waiting import load_factor, runnable_now
 
@@ -36,16 +37,6 @@ SLOW_MODULES = {
     "kinematics/test_sim_chain.py",
     "robot/test_bus_loss.py",
     "robot/test_config_hypothesis.py",
-}
-# Tests that render with OpenGL in the test process. `make test` runs them in a pytest process
-# of their own (`-m gl`): a render stuck in the driver would otherwise take the whole run with it
-# (it happened when mujoco was imported before MUJOCO_GL was set; see docs/simulation.md).
-GL_MODULES = {
-    "gym/test_gym_pixels.py",
-    "sim/test_sim_camera.py",
-    "sim/test_sim_meshes.py",
-    "sim/test_sim_plant.py",
-    "sim/test_sim_tracking.py",
 }
 # `make test` runs the suite in parallel worker processes (pytest-xdist, `--dist loadgroup`).
 # A module's tests stay in one worker: they share module-scoped servers, robots and MuJoCo
@@ -119,6 +110,10 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    try:
+        current_part()
+    except UnknownPart as error:
+        raise pytest.UsageError(str(error)) from None
     timing.pytest_configure(config)
     if getattr(config.option, "dist", "no") == "loadgroup":
         # The workers' collection order (longest groups first, pytest_collection_modifyitems)
@@ -142,6 +137,25 @@ def _longest_groups_first(items: list[pytest.Item], groups: dict[pytest.Item, st
         counts[groups[item]] = counts.get(groups[item], 0) + 1
     rank = {group: index for index, group in enumerate(timing.handout_order(counts))}
     items.sort(key=lambda item: rank[groups[item]])
+
+
+def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
+    """Leaves out the test modules of the other part when ``POPPY_TEST_PART`` names one
+    (tests/helpers/parts.py: `make test` runs the modules that mostly wait beside the rest)."""
+    del config
+    part = current_part()
+    if (
+        part is None
+        or collection_path.suffix != ".py"
+        or not collection_path.name.startswith("test_")
+    ):
+        return None
+    resolved = collection_path.resolve()
+    if not resolved.is_relative_to(TESTS):
+        return None
+    module = resolved.relative_to(TESTS).as_posix()
+    source = lambda: resolved.read_text(encoding="utf-8")  # noqa: E731 (read only if needed)
+    return True if outside_part(module, part, source) else None
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the groups

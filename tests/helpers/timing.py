@@ -1,7 +1,8 @@
 """Where the suite's time goes: each test's wall and CPU time, per worker, and a summary of them.
 
 `POPPY_TEST_TIMES=DIR pytest ...` makes each test process (each xdist worker) write
-``DIR/times-<worker>.json``: for every test its node id, xdist group, start and end (epoch
+``DIR/times-<worker>.json`` (``times-<part>-<worker>.json`` in a part of the suite,
+tests/helpers/parts.py): for every test its node id, xdist group, start and end (epoch
 seconds, setup and teardown included, so a module fixture counts in its first test), and the
 CPU time the process spent meanwhile (its own threads, plus children it waited for).
 ``python -m tests.helpers.timing DIR`` sums them per module and group, says how much of the
@@ -21,6 +22,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
+from tests.helpers.parts import PART_ENV
 
 TIMES_ENV = "POPPY_TEST_TIMES"
 
@@ -90,7 +93,9 @@ class TimesRecorder:
 
     def __init__(self, folder: Path) -> None:
         self.folder = folder
-        self.worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
+        worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
+        part = os.environ.get(PART_ENV, "").strip()  # two parts' workers share their names
+        self.worker = f"{part}-{worker}" if part else worker
         self.rows: list[dict[str, Any]] = []
         self.started = time.time()
 
