@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from poppy_core import zenoh_wire
 from poppy_core.errors import CommunicationError, ConfigError
-from poppy_core.remote.client import path_of
+from poppy_core.remote.client import DEFAULT_TIMEOUT_S, path_of
 from poppy_core.remote.zenoh_client import ZenohClient, client_settings
 
 if TYPE_CHECKING:
@@ -128,7 +128,7 @@ class ZenohLeader:
         token: str | None = None,
         *,
         settings: zenoh_wire.ZenohSettings | None = None,
-        timeout_s: float = 3.0,
+        timeout_s: float = DEFAULT_TIMEOUT_S,
     ) -> None:
         self.client, self.watch, names = _open(name, token, settings, timeout_s)
         self.url = f"zenoh:{name}"
@@ -172,7 +172,7 @@ class ZenohFollower:
         token: str | None = None,
         *,
         settings: zenoh_wire.ZenohSettings | None = None,
-        timeout_s: float = 3.0,
+        timeout_s: float = DEFAULT_TIMEOUT_S,
         ramp_s: float = RAMP_S,
     ) -> None:
         import zenoh

@@ -6,6 +6,7 @@ the fleet's client connects to them.
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import socket
@@ -297,7 +298,7 @@ def test_teleop_across_two_served_robots(two: tuple[Served, Served]) -> None:
 
     a, b = two
     settings = Settings(connect=connect_to(a, b))
-    # the first state within the product's 3 s times the load (a loaded run waited longer)
+    # the first state within 3 s times the load (a loaded run waited longer)
     leader = ZenohLeader("jr-a", TOKEN, settings=settings, timeout_s=scaled(3.0))
     follower = ZenohFollower("jr-b", TOKEN, settings=settings, ramp_s=0.2, timeout_s=scaled(3.0))
     changes: list[str] = []
@@ -356,6 +357,44 @@ def test_poppy_teleop_takes_zenoh_robots(two: tuple[Served, Served]) -> None:
     summary = result.json()
     assert summary["follower"] == "zenoh:jr-b"
     assert not b.robot.m1.compliant
+
+
+def test_poppy_teleop_waits_for_a_robot_slow_to_answer_as_long_as_remote_clients_do(
+    two: tuple[Served, Served], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A follower that answers its first request after 4 s (a robot busy starting, a loaded
+    machine) is taken: teleop waits as long as every other remote client (10 s), not 3 s."""
+    a, b = two
+    node = b.servers.zenoh
+    assert node is not None
+    answer = node._call
+    delayed: list[str] = []
+
+    async def slow_first_answer(caller: Any, request: Any) -> dict[str, Any]:
+        if not delayed:
+            delayed.append(request.path)
+            await asyncio.sleep(4.0)
+        return await answer(caller, request)
+
+    monkeypatch.setattr(node, "_call", slow_first_answer)
+    result = run_poppy(
+        "teleop",
+        "--leader",
+        "zenoh:jr-a",
+        "--follower",
+        "zenoh:jr-b",
+        "--duration",
+        "0.5",
+        "--connect",
+        a.endpoint,
+        "--connect",
+        b.endpoint,
+        "--json",
+        env={"POPPY_TOKEN": TOKEN},
+    )
+    assert delayed == ["/api/v1/motors"]
+    assert result.code == 0, result.stderr
+    assert result.json()["follower"] == "zenoh:jr-b"
 
 
 def test_remote_zenoh_works_where_remote_url_does(two: tuple[Served, Served]) -> None:
