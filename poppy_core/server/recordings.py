@@ -87,6 +87,9 @@ class Recording:
         }
         if self.session is not None:
             base.update(self.session.status())
+        if base.get("phase") == "done" and base["active"]:
+            # the takes are in, the dataset is still being written: "done" once it is
+            base["phase"] = "finishing"
         base["total_episodes"] = len(self.writer.episodes) if self.writer is not None else 0
         return base
 

@@ -10,6 +10,7 @@ import math
 import os
 import signal
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -343,3 +344,31 @@ def test_a_primitive_runs_each_episode_and_a_running_one_is_refused(
     assert http.get("/api/v1/primitives/dance").json()["state"] != "running"
     data = rows(home / "class/dance")
     assert data["episode_index"].count(1) == ended["saved"][1]["frames"]
+
+
+def test_done_means_the_dataset_is_written_finishing_until_then(
+    http: httpx.Client, home: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The takes are in but the dataset is still being written (a loaded machine, long videos):
+    the state says `finishing`, still active; `done` only once the recording is over, so a page
+    that reads "done" can record again at once."""
+    from poppy_core.dataset.writer import DatasetWriter
+
+    close = DatasetWriter.close
+
+    def slow_close(self: DatasetWriter) -> None:
+        time.sleep(1.0)
+        close(self)
+
+    monkeypatch.setattr(DatasetWriter, "close", slow_close)
+    record(
+        http, repo_id="class/slow", task="wave", source="by_hand", episodes=1, episode_s=60, **QUICK
+    )
+    until(http, "frames", lambda s: s["frames"] >= 3)
+    press(http, "stop")
+    seen = [state(http)]
+    while seen[-1]["active"]:
+        seen.append(state(http))
+    assert all(s["phase"] != "done" for s in seen if s["active"]), seen
+    assert "finishing" in [s["phase"] for s in seen], [s["phase"] for s in seen]
+    assert seen[-1]["phase"] == "done" and [e["episode"] for e in seen[-1]["saved"]] == [0]

@@ -209,9 +209,24 @@ def test_a_compliant_motor_says_so_where_its_goal_is_set(page: Any, served: Serv
     robot.compliant = True
 
 
+def unfold(page: Any, primitive: str) -> None:
+    """Shows ``primitive``'s properties: its ⋯ button clicked until it says it is expanded. The
+    panels above it still fill after the page is live (the camera's first frame, the 3D view,
+    the sensors and chains shown): on a loaded machine the row can move between Playwright's
+    check of the click's target and the click, which then lands elsewhere (a loaded run)."""
+    fold = f"button[aria-label^='more of {primitive}']"
+
+    def expanded() -> bool:
+        if page.get_attribute(fold, "aria-expanded") != "true":
+            page.click(fold)
+        return page.get_attribute(fold, "aria-expanded") == "true"
+
+    eventually(expanded, f"{primitive}'s properties shown")
+
+
 def test_a_primitive_starts_and_stops_from_its_buttons(page: Any, served: Served) -> None:
     robot = served.robot
-    page.click("button[aria-label^='more of sinus']")
+    unfold(page, "sinus")
     page.fill("#primitive-sinus input[data-prop=amplitude]", "5")
     page.press("#primitive-sinus input[data-prop=amplitude]", "Enter")
     eventually(lambda: robot.sinus.amplitude == 5, "the amplitude set from the page")

@@ -46,7 +46,10 @@ class RecordingState(BaseModel):
     """The recording under way, or the last one (``phase`` idle when there was none)."""
 
     active: bool
-    phase: str = Field(description="idle, starting, recording, resetting or done.")
+    phase: str = Field(
+        description="idle, starting, recording, resetting, finishing (the dataset being written)"
+        " or done."
+    )
     repo_id: str | None = None
     folder: str | None = Field(None, description="The dataset's folder on the robot.")
     task: str | None = None

@@ -28,6 +28,7 @@ function liveText(state) {
     const failed = state.error ? ` ${state.error}` : "";
     return `done: ${saved} episode(s) saved, the dataset holds ${state.total_episodes} (${where}).${failed}`;
   }
+  if (state.phase === "finishing") return `finishing: ${saved} episode(s) saved, writing the dataset… (${where})`;
   const what = state.phase === "resetting" ? "reset before episode" : "episode";
   return `${what} ${state.episode}/${state.episodes}  ${state.elapsed_s.toFixed(1)}/${state.duration_s} s  `
     + `${state.frames} frames  ${state.dropped} dropped  (${saved} saved; ${where})`;
