@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -26,6 +27,32 @@ if TYPE_CHECKING:
 T = TypeVar("T")
 
 DEFAULT_TIMEOUT_S = 2.0
+TIMEOUT_ENV = "POPPY_FLEET_TIMEOUT_S"
+MAX_TIMEOUT_S = 60.0
+
+
+def fleet_timeout_s() -> float:
+    """How long a robot has to answer a fleet's command: ``$POPPY_FLEET_TIMEOUT_S`` when set (a
+    slow network, busy robots), else ``DEFAULT_TIMEOUT_S`` (read at each call).
+
+    Raises:
+        ConfigError: the variable is not a number of seconds above 0, at most ``MAX_TIMEOUT_S``.
+    """
+    text = os.environ.get(TIMEOUT_ENV, "").strip()
+    if not text:
+        return DEFAULT_TIMEOUT_S
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0.0 < value <= MAX_TIMEOUT_S:  # also refuses nan
+        raise ConfigError(
+            f"{TIMEOUT_ENV}={text!r} is not a time-out: give seconds above 0, at most "
+            f"{MAX_TIMEOUT_S:g} (e.g. 5), or unset it for {DEFAULT_TIMEOUT_S:g} s"
+        )
+    return value
+
+
 START_LEAD_S = 0.3
 """The least lead of a shared start (how far ahead of now it is set) when it is measured."""
 LEAD_MARGIN = 3.0
@@ -63,7 +90,7 @@ class Fleet:
     Args:
         settings: how to join it (``client_settings()`` when None).
         token: signs every command (``zenoh_auth``: the token itself is never sent).
-        timeout_s: how long a robot has to answer.
+        timeout_s: how long a robot has to answer (None: ``fleet_timeout_s()``).
         session: an open session to use (kept open on ``close``).
     """
 
@@ -72,11 +99,11 @@ class Fleet:
         settings: zenoh_wire.ZenohSettings | None = None,
         *,
         token: str | None = None,
-        timeout_s: float = DEFAULT_TIMEOUT_S,
+        timeout_s: float | None = None,
         session: zenoh.Session | None = None,
     ) -> None:
         self.token = token
-        self.timeout_s = timeout_s
+        self.timeout_s = fleet_timeout_s() if timeout_s is None else timeout_s
         self._owned = session is None
         settings = settings or client_settings()
         self.session = session or zenoh_wire.open_session(settings)
@@ -87,7 +114,7 @@ class Fleet:
         self.last_lead_s: float | None = None
         """How far ahead of the command that start was set (measured, or given)."""
         if self._owned:  # a new session: let its links come up before the first query
-            zenoh_wire.await_peers(self.session, settings, timeout_s)
+            zenoh_wire.await_peers(self.session, settings, self.timeout_s)
 
     def names(self) -> list[str]:
         """The robots alive now (by their liveliness tokens), sorted."""

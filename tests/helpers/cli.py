@@ -31,6 +31,8 @@ from typing import Any
 
 import pytest
 
+from poppy_core.remote.zenoh_fleet import DEFAULT_TIMEOUT_S as FLEET_TIMEOUT_S
+from poppy_core.remote.zenoh_fleet import TIMEOUT_ENV as FLEET_TIMEOUT_ENV
 from tests.helpers.waiting import reply_floor_env, scaled
 
 POPPY = [sys.executable, "-m", "poppy_cli"]
@@ -42,8 +44,11 @@ ENV = {"COLUMNS": str(WIDTH), "NO_COLOR": "1", **reply_floor_env()}
 
 
 def command_env(env: Mapping[str, str] | None = None) -> dict[str, str]:
-    """``ENV`` with the reply floor scaled by the load measured now, then ``env``."""
-    return {**ENV, **reply_floor_env(), **(env or {})}
+    """``ENV`` with the reply floor and the fleet's time-out (its robots are threads or
+    processes of the test, late on a busy machine) scaled by the load measured now, then
+    ``env``."""
+    fleet = {FLEET_TIMEOUT_ENV: f"{scaled(FLEET_TIMEOUT_S):.3f}"}
+    return {**ENV, **reply_floor_env(), **fleet, **(env or {})}
 
 
 @dataclass
