@@ -25,7 +25,7 @@ from poppy_core.remote.zenoh_fleet import Fleet
 from poppy_core.robot import from_remote
 from poppy_core.zenoh_wire import ZenohSettings as Settings
 from poppy_core.zenoh_wire import check_name, pack_state, session_config, unpack_state
-from tests.helpers.cli import POPPY, command_env, run_poppy
+from tests.helpers.cli import POPPY, Result, command_env, run_poppy
 from tests.helpers.processes import reap
 from tests.helpers.waiting import eventually, http_timeout, scaled
 from tests.helpers.zenoh_served import TOKEN, Served, connect_to, fleet_timeout_s, free_endpoint
@@ -336,23 +336,16 @@ def test_a_leader_whose_state_never_comes_is_refused_in_one_line(
         ZenohLeader("jr-a", TOKEN, settings=Settings(connect=(a.endpoint,)), timeout_s=1.0)
 
 
+def teleop_a_to_b(a: Served, b: Served) -> Result:
+    """`poppy teleop` of half a second, A leading and B following, both on Zenoh."""
+    args = ["--leader", "zenoh:jr-a", "--follower", "zenoh:jr-b", "--duration", "0.5"]
+    connect = ["--connect", a.endpoint, "--connect", b.endpoint]
+    return run_poppy("teleop", *args, *connect, "--json", env={"POPPY_TOKEN": TOKEN})
+
+
 def test_poppy_teleop_takes_zenoh_robots(two: tuple[Served, Served]) -> None:
     a, b = two
-    result = run_poppy(
-        "teleop",
-        "--leader",
-        "zenoh:jr-a",
-        "--follower",
-        "zenoh:jr-b",
-        "--duration",
-        "0.5",
-        "--connect",
-        a.endpoint,
-        "--connect",
-        b.endpoint,
-        "--json",
-        env={"POPPY_TOKEN": TOKEN},
-    )
+    result = teleop_a_to_b(a, b)
     assert result.code == 0, result.stderr
     summary = result.json()
     assert summary["follower"] == "zenoh:jr-b"
@@ -377,21 +370,7 @@ def test_poppy_teleop_waits_for_a_robot_slow_to_answer_as_long_as_remote_clients
         return await answer(caller, request)
 
     monkeypatch.setattr(node, "_call", slow_first_answer)
-    result = run_poppy(
-        "teleop",
-        "--leader",
-        "zenoh:jr-a",
-        "--follower",
-        "zenoh:jr-b",
-        "--duration",
-        "0.5",
-        "--connect",
-        a.endpoint,
-        "--connect",
-        b.endpoint,
-        "--json",
-        env={"POPPY_TOKEN": TOKEN},
-    )
+    result = teleop_a_to_b(a, b)
     assert delayed == ["/api/v1/motors"]
     assert result.code == 0, result.stderr
     assert result.json()["follower"] == "zenoh:jr-b"
