@@ -282,7 +282,12 @@ def test_the_page_plays_a_move_on_both_robots_together_and_stop_stops_both(
             ),
             timeout_s=WAIT_S,
         ), "the cards say what the robots do (live over Zenoh)"
-        assert page.inner_text("#message") == f"play {MOVE}: jr1, jr2, started together"
+        # the page says so when the fleet's answer arrives, which may come after the cards (the
+        # robots start at the shared time; their answers are gathered, then sent back)
+        said = f"play {MOVE}: jr1, jr2, started together"
+        assert eventually(lambda: page.inner_text("#message") == said, timeout_s=WAIT_S), (
+            page.inner_text("#message")
+        )
         assert page.inner_text("#robot-jr1 .outcome") == f"play {MOVE}: done"
         page.click("#stop-all")
         assert eventually(lambda: not _playing(jr1) and not _playing(jr2), timeout_s=WAIT_S), (
