@@ -210,10 +210,10 @@ def test_a_compliant_motor_says_so_where_its_goal_is_set(page: Any, served: Serv
 
 
 def unfold(page: Any, primitive: str) -> None:
-    """Shows ``primitive``'s properties: its ⋯ button clicked until it says it is expanded. The
-    panels above it still fill after the page is live (the camera's first frame, the 3D view,
-    the sensors and chains shown): on a loaded machine the row can move between Playwright's
-    check of the click's target and the click, which then lands elsewhere (a loaded run)."""
+    """Shows ``primitive``'s properties: its ⋯ button clicked until it says it is expanded, as a
+    person clicks again. One click was lost on a loaded machine (a loaded run: the properties
+    stayed hidden for 30 s); at this width nothing above the row moves once the page is live
+    (test_web_page_layout), so where it went is not known."""
     fold = f"button[aria-label^='more of {primitive}']"
 
     def expanded() -> bool:

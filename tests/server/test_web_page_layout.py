@@ -318,6 +318,36 @@ def test_behaviours_are_one_compact_row_each_with_one_toggle(
         leave(page)
 
 
+TABLET = {"width": 820, "height": 1180}
+TOP = "sel => document.querySelector(sel).getBoundingClientRect().top + window.scrollY"
+FILLED = (
+    "() => window.poppy.view && window.poppy.view.frames > 0"
+    " && window.poppy.datasets && window.poppy.datasets.ready"
+)
+
+
+@pytest.mark.parametrize("viewport", [DESKTOP, TABLET, PHONE], ids=["desktop", "tablet", "phone"])
+def test_the_behaviours_stay_where_they_were_when_the_page_went_live(
+    tab: Any, served: Served, viewport: dict[str, int]
+) -> None:
+    """What fills in after the page is live (the 3D view once drawn, the datasets once read)
+    keeps its room or sits under the behaviours: a row a student aims at is still there when
+    the click lands (on one column the view grew by 240-480 px above them, a loaded run's
+    lost click)."""
+    page = open_page(tab, served.url, viewport)
+    try:
+        live = page.evaluate(TOP, "#primitives")
+        page.locator("#view3d").scroll_into_view_if_needed()  # the view loads once shown
+        page.wait_for_function(FILLED)
+        page.wait_for_selector("#primitive-sinus")
+        moved = page.evaluate(TOP, "#primitives") - live
+        assert abs(moved) < 1, f"the behaviours moved by {moved} px"  # < 1: the canvas's rounding
+        if viewport is not DESKTOP:  # one column: the datasets under the lists they would push
+            assert page.evaluate(TOP, "#datasets") > page.evaluate(TOP, "#moves")
+    finally:
+        leave(page)
+
+
 def test_the_toggle_starts_and_stops_and_the_fold_pauses(tab: Any, served: Served) -> None:
     page = open_page(tab, served.url)
     robot = served.robot

@@ -31,7 +31,9 @@ function line(panel, text) {
 async function start(panel, about) {
   if (started) return;
   started = true;
+  const room = panel.querySelector(".view-canvas");
   if (!hasWebGL()) {
+    room.classList.remove("loading");
     line(panel, "No 3D view: this browser has no WebGL (the table below shows every motor).");
     window.poppy.view = { ready: false, fallback: true };
     sceneReady(null);
@@ -43,11 +45,13 @@ async function start(panel, about) {
   await new Promise((resolve) => setTimeout(resolve, 50));
   try {
     const { startView } = await import("./view/scene.js");
-    scene = await startView(panel.querySelector(".view-canvas"), about);
+    scene = await startView(room, about);
+    room.classList.remove("loading");
     line(panel, "Drag to turn, wheel or pinch to zoom, right-drag or two fingers to pan.");
     if (lastFrame) scene.frame(lastFrame);
     sceneReady(scene);
   } catch (error) {
+    room.classList.remove("loading");
     line(panel, `No 3D view: ${error.message}`);
     window.poppy.view = { ready: false, error: error.message };
     sceneReady(null);
@@ -63,9 +67,10 @@ export function setupView(about) {
   const toggle = el("button", { type: "button", textContent: "hide" });
   toggle.setAttribute("aria-controls", "view3d-canvas");
   toggle.setAttribute("aria-expanded", "true");
-  const canvas = el("div", { className: "view-canvas", id: "view3d-canvas" });
+  // the view's room is kept until it is drawn (style.css): nothing under it moves then
+  const canvas = el("div", { className: "view-canvas loading", id: "view3d-canvas" });
   panel.querySelector("h2").append(" ", toggle);
-  panel.append(el("p", { className: "view-note muted" }), canvas);
+  panel.append(el("p", { className: "view-note muted", textContent: "Loading the 3D model…" }), canvas);
   toggle.addEventListener("click", () => {
     const open = canvas.hidden;
     canvas.hidden = !open;
