@@ -1,9 +1,11 @@
 """Checks of call arguments (finite, positive, a duration, a rate, a robot's name, one line of
-text, a Wi-Fi network and password; a peer's page link): one rule each, ArgumentError."""
+text, a Wi-Fi network and password; a peer's page link): one rule each, ArgumentError; and
+seconds read from an environment variable (ConfigError)."""
 
 from __future__ import annotations
 
 import math
+import os
 import re
 import unicodedata
 from collections.abc import Callable, Iterable
@@ -11,7 +13,7 @@ from numbers import Real
 from typing import Any, Generic, TypeVar, cast, overload
 from urllib.parse import urlsplit
 
-from poppy_core.errors import ArgumentError
+from poppy_core.errors import ArgumentError, ConfigError
 
 # A loop never runs faster than this, whatever it is asked: a period under a millisecond would
 # spin a core (the sync loops of a real bus run at 50-100 Hz, a servo cannot follow faster).
@@ -114,6 +116,33 @@ def in_range(value: object, low: float, high: float, field: str = "", unit: str 
             value=value,
         )
     return result
+
+
+def seconds_from_env(
+    name: str, default: float, *, high: float, zero: bool, what: str, example: str, unset: str
+) -> float:
+    """Seconds from the environment variable ``name`` (read at each call): ``default`` when it is
+    unset or blank, else a number from 0 (``zero``) or above 0, at most ``high``.
+
+    Raises:
+        ConfigError: in one line, ``NAME='TEXT' is not WHAT: give seconds ... (e.g. EXAMPLE), or
+            unset it for UNSET`` (text, nan, infinities and numbers out of range alike).
+    """
+    text = os.environ.get(name, "").strip()
+    if not text:
+        return default
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan  # refused below, as nan is
+    low_ok = value >= 0.0 if zero else value > 0.0
+    if not (low_ok and value <= high):
+        span = f"from 0 to {high:g}" if zero else f"above 0, at most {high:g}"
+        raise ConfigError(
+            f"{name}={text!r} is not {what}: give seconds {span} (e.g. {example}), "
+            f"or unset it for {unset}"
+        )
+    return value
 
 
 def duration(value: object, field: str = "duration", *, allow_zero: bool = True) -> float:

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from poppy_core import checks
-from poppy_core.errors import ArgumentError
+from poppy_core.errors import ArgumentError, ConfigError
 
 BAD_NUMBERS = [math.nan, math.inf, -math.inf, 10**400, 1e300, "12", None, True, [1]]
 
@@ -165,3 +165,57 @@ def test_one_line_refuses_control_characters(text: object) -> None:
     with pytest.raises(ArgumentError) as caught:
         checks.one_line(text, "--port")
     assert str(caught.value).startswith("--port ") and "\n" not in str(caught.value)
+
+
+ENV_NAME = "POPPY_TEST_SECONDS"
+# what an environment variable can hold (no NUL, no lone surrogate)
+ENV_CHARACTERS = st.characters(blacklist_categories=("Cs",), blacklist_characters="\x00")
+
+
+def env_seconds(zero: bool) -> float:
+    return checks.seconds_from_env(
+        ENV_NAME, 2.0, high=60.0, zero=zero, what="a wait", example="5", unset="2 s"
+    )
+
+
+@given(st.floats(min_value=0.0, max_value=60.0), st.booleans())
+def test_seconds_from_env_in_range_are_read_back(seconds: float, zero: bool) -> None:
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv(ENV_NAME, f" {seconds!r} ")
+        if seconds == 0.0 and not zero:
+            with pytest.raises(ConfigError, match="give seconds above 0, at most 60 "):
+                env_seconds(zero)
+        else:
+            assert env_seconds(zero) == seconds
+
+
+@given(
+    st.one_of(
+        st.floats(allow_nan=True).filter(lambda v: not 0.0 <= v <= 60.0).map(repr),
+        st.text(alphabet=ENV_CHARACTERS).filter(lambda t: t.strip() and not _is_number(t)),
+    ),
+    st.booleans(),
+)
+def test_seconds_from_env_refuses_the_rest_in_one_line(text: str, zero: bool) -> None:
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv(ENV_NAME, text)
+        with pytest.raises(ConfigError) as refused:
+            env_seconds(zero)
+    message = str(refused.value)
+    assert message.startswith(f"{ENV_NAME}=") and "or unset it for 2 s" in message
+    assert "\n" not in message
+
+
+def test_seconds_from_env_unset_or_blank_is_the_default(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(ENV_NAME, raising=False)
+    assert env_seconds(True) == 2.0
+    monkeypatch.setenv(ENV_NAME, "   ")
+    assert env_seconds(False) == 2.0
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True

@@ -29,8 +29,8 @@ import os
 import time
 from dataclasses import dataclass
 
+from poppy_core import checks
 from poppy_core.bus.ports import read_ftdi_latency_ms
-from poppy_core.errors import ConfigError
 from poppy_core.protocol import DxlProtocol, protocol_for
 
 # A UART frame is 1 start bit, 8 data bits, 1 stop bit (e-manual "Protocol 1.0"/"Protocol 2.0":
@@ -81,20 +81,15 @@ def reply_floor_s() -> float:
     Raises:
         ConfigError: the variable is not a number of seconds from 0 to ``MAX_REPLY_FLOOR_S``.
     """
-    text = os.environ.get(REPLY_FLOOR_ENV, "").strip()
-    if not text:
-        return MIN_REPLY_TIMEOUT_S
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not 0.0 <= value <= MAX_REPLY_FLOOR_S:  # also refuses nan
-        raise ConfigError(
-            f"{REPLY_FLOOR_ENV}={text!r} is not a reply floor: give seconds from 0 to "
-            f"{MAX_REPLY_FLOOR_S:g} (e.g. 0.5), or unset it for the adapter's "
-            f"{MIN_REPLY_TIMEOUT_S * 1000:g} ms"
-        )
-    return value
+    return checks.seconds_from_env(
+        REPLY_FLOOR_ENV,
+        MIN_REPLY_TIMEOUT_S,
+        high=MAX_REPLY_FLOOR_S,
+        zero=True,
+        what="a reply floor",
+        example="0.5",
+        unset=f"the adapter's {MIN_REPLY_TIMEOUT_S * 1000:g} ms",
+    )
 
 
 def byte_time_s(baudrate: int) -> float:

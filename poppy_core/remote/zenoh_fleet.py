@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import contextlib
 import json
-import os
 import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from poppy_core import zenoh_auth, zenoh_wire
+from poppy_core import checks, zenoh_auth, zenoh_wire
 from poppy_core.errors import BusTimeout, CommunicationError, ConfigError
 from poppy_core.remote.zenoh_client import client_settings, reply_of
 
@@ -38,19 +37,15 @@ def fleet_timeout_s() -> float:
     Raises:
         ConfigError: the variable is not a number of seconds above 0, at most ``MAX_TIMEOUT_S``.
     """
-    text = os.environ.get(TIMEOUT_ENV, "").strip()
-    if not text:
-        return DEFAULT_TIMEOUT_S
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not 0.0 < value <= MAX_TIMEOUT_S:  # also refuses nan
-        raise ConfigError(
-            f"{TIMEOUT_ENV}={text!r} is not a time-out: give seconds above 0, at most "
-            f"{MAX_TIMEOUT_S:g} (e.g. 5), or unset it for {DEFAULT_TIMEOUT_S:g} s"
-        )
-    return value
+    return checks.seconds_from_env(
+        TIMEOUT_ENV,
+        DEFAULT_TIMEOUT_S,
+        high=MAX_TIMEOUT_S,
+        zero=False,
+        what="a time-out",
+        example="5",
+        unset=f"{DEFAULT_TIMEOUT_S:g} s",
+    )
 
 
 START_LEAD_S = 0.3
